@@ -1,0 +1,60 @@
+#include "test_util.h"
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <unistd.h>
+
+namespace lrcal::testing {
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(LRCAL_SOURCE_DIR) + "/" + relative;
+}
+
+std::string LrcalBinary() { return std::string(LRCAL_BINARY_DIR) + "/lrcal"; }
+
+const RobotModel& PaperRobot() {
+  static const RobotModel robot = LoadRobotModel(SourcePath("studies/robots/paper.yaml"));
+  return robot;
+}
+
+ConfigurationSet PaperHittingConfigurations(int count, unsigned seed) {
+  const RobotModel& robot = PaperRobot();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-M_PI, M_PI);
+  ConfigurationSet out(robot.num_links());
+  ModelPoint point;
+  PrepareModelPoint(robot, robot.nominal_values().data(), *robot.default_plane, &point);
+  while (out.size() < count) {
+    double q[6];
+    for (double& v : q) v = u(rng);
+    ConfigurationSet one(6);
+    one.Add(q);
+    Pose<double> pose = ToolPose(point, one, 0);
+    const Plane& pl = point.plane;
+    double nb = pl.normal.dot(pose.R_BT.col(2));
+    double h = -(pl.normal.dot(pose.p_BT) + pl.offset) / nb;
+    if (ClassifyReading(h, nb, robot.ranger) == BeamMiss::kNone) out.Add(q);
+  }
+  return out;
+}
+
+int RunCommand(const std::string& command, std::string* output) {
+  output->clear();
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buffer;
+  while (fgets(buffer.data(), buffer.size(), pipe)) *output += buffer.data();
+  int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string TempDir(const std::string& name) {
+  namespace fs = std::filesystem;
+  fs::path p = fs::temp_directory_path() / ("lrcal_test_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+}  // namespace lrcal::testing

@@ -1,0 +1,26 @@
+// Shared helpers for lrcal's tests.
+#pragma once
+
+#include <random>
+#include <string>
+
+#include "lrcal/measurement_model.h"
+#include "lrcal/robot_model.h"
+
+namespace lrcal::testing {
+
+/// Path of a file in the source tree (e.g. "studies/robots/paper.yaml").
+std::string SourcePath(const std::string& relative);
+/// Path of the built lrcal program.
+std::string LrcalBinary();
+/// The paper's robot (studies/robots/paper.yaml).
+const RobotModel& PaperRobot();
+/// `count` configurations of the paper's arm whose nominal beam hits the paper's plane, drawn
+/// from a fixed std::mt19937 seed (test data only; the library uses counter-based streams).
+ConfigurationSet PaperHittingConfigurations(int count, unsigned seed = 1);
+/// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
+int RunCommand(const std::string& command, std::string* output);
+/// A fresh empty temporary directory for one test.
+std::string TempDir(const std::string& name);
+
+}  // namespace lrcal::testing
