@@ -1,1 +1,394 @@
-// placeholder during bring-up
+#include "lrcal/identification.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+namespace lrcal {
+
+const char* TerminationName(Termination t) {
+  switch (t) {
+    case Termination::kConverged: return "converged";
+    case Termination::kMaxIterations: return "max_iterations";
+    case Termination::kRankDeficient: return "rank_deficient";
+    case Termination::kBeamMissed: return "beam_missed";
+    case Termination::kNumericalFailure: return "numerical_failure";
+    case Termination::kInvalidInput: return "invalid_input";
+  }
+  return "unknown";
+}
+
+std::string IdentificationOptions::Validate() const {
+  if (max_iterations < 1) return "max_iterations must be at least 1";
+  if (!(parameter_tolerance >= 0)) return "parameter_tolerance must be >= 0";
+  if (!(function_tolerance >= 0)) return "function_tolerance must be >= 0";
+  if (!(sigma >= 0) || !std::isfinite(sigma)) return "sigma must be a finite value >= 0 (m)";
+  if (loss != RobustLoss::kNone && !(loss_scale > 0)) return "loss_scale must be > 0 (m)";
+  if (loss != RobustLoss::kNone && solver != Solver::kCeres)
+    return "robust losses need the Ceres solver (solver: ceres)";
+  return "";
+}
+
+bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::MatrixXd* L,
+                   Eigen::VectorXd* x, double min_pivot) {
+  const int n = static_cast<int>(A.rows());
+  L->resize(n, n);
+  double max_diag = 0;
+  for (int i = 0; i < n; ++i) max_diag = std::max(max_diag, A(i, i));
+  const double threshold = min_pivot * max_diag;
+  for (int j = 0; j < n; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= (*L)(j, k) * (*L)(j, k);
+    if (!(d > threshold) || !(d > 0)) return false;
+    const double ljj = std::sqrt(d);
+    (*L)(j, j) = ljj;
+    const double inv = 1.0 / ljj;
+    for (int i = j + 1; i < n; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= (*L)(i, k) * (*L)(j, k);
+      (*L)(i, j) = s * inv;
+    }
+  }
+  x->resize(n);
+  for (int i = 0; i < n; ++i) {  // L·y = b
+    double s = b[i];
+    for (int k = 0; k < i; ++k) s -= (*L)(i, k) * (*x)[k];
+    (*x)[i] = s / (*L)(i, i);
+  }
+  for (int i = n - 1; i >= 0; --i) {  // Lᵀ·x = y
+    double s = (*x)[i];
+    for (int k = i + 1; k < n; ++k) s -= (*L)(k, i) * (*x)[k];
+    (*x)[i] = s / (*L)(i, i);
+  }
+  return true;
+}
+
+double LevenbergMarquardt::Linearize(const MeasurementModel& model,
+                                     const ConfigurationSet& configs, const double* mean_h,
+                                     const double* weights, const Eigen::VectorXd& e) {
+  const int n = model.num_parameters();
+  model.Prepare(e.data(), &point_);
+  A_trial_.setZero(n, n);
+  g_trial_.setZero(n);
+  row_.resize(n);
+  double cost = 0;
+  for (int i = 0; i < configs.size(); ++i) {
+    double h;
+    const double nb = model.Evaluate(point_, configs, i, &h, row_.data());
+    if (!(std::fabs(nb) > 1e-12)) return std::numeric_limits<double>::quiet_NaN();
+    const double r = mean_h[i] - h;
+    const double w = weights[i];
+    cost += 0.5 * w * r * r;
+    g_trial_.noalias() += (w * r) * row_;
+    A_trial_.selfadjointView<Eigen::Lower>().rankUpdate(row_, w);
+  }
+  A_trial_.triangularView<Eigen::StrictlyUpper>() = A_trial_.transpose();
+  return cost;
+}
+
+LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& model,
+                                                     const ConfigurationSet& configs,
+                                                     const double* mean_h, const double* weights,
+                                                     const IdentificationOptions& options,
+                                                     Eigen::VectorXd* e) {
+  Result result;
+  const int n = model.num_parameters();
+  e->setZero(n);
+  if (configs.size() < n || n == 0) return result;  // kInvalidInput
+  double cost = Linearize(model, configs, mean_h, weights, *e);
+  result.initial_cost = result.final_cost = cost;
+  if (!std::isfinite(cost)) {
+    result.termination = Termination::kBeamMissed;
+    return result;
+  }
+  A_.swap(A_trial_);
+  g_.swap(g_trial_);
+
+  // Rank test on the column-scaled normal matrix (unit diagonal): a pivot below 1e-13 means a
+  // direction with relative singular value below ~3e-7.
+  constexpr double kMinScaledPivot = 1e-13;
+  scale_.resize(n);
+  const double max_diag = A_.diagonal().maxCoeff();
+  for (int k = 0; k < n; ++k) {
+    if (!(A_(k, k) > 1e-20 * max_diag)) {
+      result.termination = Termination::kRankDeficient;
+      return result;
+    }
+    scale_[k] = 1.0 / std::sqrt(A_(k, k));
+  }
+
+  constexpr double kCostResolution = 1e-10;
+  double lambda = 0;
+  for (int iter = 1; iter <= options.max_iterations; ++iter) {
+    result.iterations = iter;
+    // Solve (S·A·S + λ·I)·y = S·g, step = S·y: LM with Marquardt's diagonal scaling.
+    Eigen::MatrixXd& As = A_trial_;
+    As = scale_.asDiagonal() * A_ * scale_.asDiagonal();
+    As.diagonal().array() += lambda;
+    Eigen::VectorXd rhs = scale_.cwiseProduct(g_);
+    if (!CholeskySolve(As, rhs, &L_, &step_, lambda == 0 ? kMinScaledPivot : 0)) {
+      result.termination =
+          lambda == 0 && iter == 1 ? Termination::kRankDeficient : Termination::kNumericalFailure;
+      return result;
+    }
+    step_ = scale_.cwiseProduct(step_);
+    e_trial_ = *e + step_;
+    const bool small_step =
+        step_.norm() <= options.parameter_tolerance * (e->norm() + options.parameter_tolerance);
+    const double trial_cost = Linearize(model, configs, mean_h, weights, e_trial_);
+    // Near the minimum the cost is resolvable only to ~1e-12 relative (residuals of 0.1 mm on
+    // readings of 1 m): a step whose predicted decrease is below that is taken on the model's
+    // word, not rejected on rounding noise.
+    const double predicted_decrease = 0.5 * step_.dot(g_);
+    const bool below_noise = predicted_decrease <= kCostResolution * cost;
+    if (std::isfinite(trial_cost) && (trial_cost <= cost || below_noise)) {
+      const bool small_decrease = cost - trial_cost <= options.function_tolerance * cost;
+      e->swap(e_trial_);
+      A_.swap(A_trial_);
+      g_.swap(g_trial_);
+      cost = trial_cost;
+      lambda = lambda < 1e-10 ? 0 : lambda / 10;
+      if (small_step || small_decrease) {
+        result.termination = Termination::kConverged;
+        result.final_cost = cost;
+        return result;
+      }
+    } else {
+      if (small_step) {  // at the minimum to rounding: the step cannot lower the cost
+        result.termination = Termination::kConverged;
+        result.final_cost = cost;
+        // A_ still holds the normal matrix at *e.
+        return result;
+      }
+      lambda = lambda == 0 ? 1e-6 : lambda * 10;
+      if (lambda > 1e12) {
+        result.termination = Termination::kNumericalFailure;
+        result.final_cost = cost;
+        return result;
+      }
+    }
+  }
+  result.termination = Termination::kMaxIterations;
+  result.final_cost = cost;
+  return result;
+}
+
+namespace {
+
+// All configurations in one residual block: Ceres' per-block overhead and the link trig are
+// paid once per evaluation (DESIGN.md).
+class LaserPlaneCost : public ceres::CostFunction {
+ public:
+  LaserPlaneCost(const MeasurementModel& model, const MeasurementSet& data)
+      : model_(model), data_(data) {
+    set_num_residuals(data.size());
+    mutable_parameter_block_sizes()->push_back(model.num_parameters());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int n = model_.num_parameters();
+    ModelPoint point;
+    model_.Prepare(parameters[0], &point);
+    for (int i = 0; i < data_.size(); ++i) {
+      double* row = (jacobians && jacobians[0]) ? jacobians[0] + i * n : nullptr;
+      double h;
+      const double nb = model_.Evaluate(point, data_.configs, i, &h, row);
+      if (!(std::fabs(nb) > 1e-12)) return false;
+      const double w = std::sqrt(static_cast<double>(data_.repetitions[i]));
+      residuals[i] = w * (data_.mean_h[i] - h);
+      if (row)
+        for (int k = 0; k < n; ++k) row[k] *= -w;
+    }
+    return true;
+  }
+
+ private:
+  const MeasurementModel& model_;
+  const MeasurementSet& data_;
+};
+
+Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           int* iterations, std::string* message) {
+  e->setZero(model.num_parameters());
+  ceres::Problem::Options problem_options;
+  ceres::Problem problem(problem_options);
+  ceres::LossFunction* loss = nullptr;
+  // The loss acts on the squared residual of a mean reading weighted by √R.
+  if (options.loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(options.loss_scale);
+  if (options.loss == RobustLoss::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale);
+  problem.AddResidualBlock(new LaserPlaneCost(model, data), loss, e->data());
+  ceres::Solver::Options so;
+  so.minimizer_type = ceres::TRUST_REGION;
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = options.function_tolerance;
+  so.parameter_tolerance = options.parameter_tolerance;
+  so.gradient_tolerance = 1e-20;
+  // Near the minimum the cost is noisy at ~1e-12 relative; non-monotonic steps keep Ceres from
+  // shrinking its trust region on that noise and stopping short (DESIGN.md).
+  so.use_nonmonotonic_steps = true;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  *iterations = static_cast<int>(summary.iterations.size()) - 1;
+  *message = summary.message;
+  switch (summary.termination_type) {
+    case ceres::CONVERGENCE: return Termination::kConverged;
+    case ceres::NO_CONVERGENCE: return Termination::kMaxIterations;
+    default: return Termination::kNumericalFailure;
+  }
+}
+
+}  // namespace
+
+IdentificationSummary Identify(const MeasurementModel& model_in, const MeasurementSet& data,
+                               const IdentificationOptions& options) {
+  IdentificationSummary s;
+  s.solver = options.solver == IdentificationOptions::Solver::kCeres ? "ceres" : "lrcal-lm";
+  s.num_configurations = data.size();
+  if (std::string problem = options.Validate(); !problem.empty()) {
+    s.message = "invalid options: " + problem;
+    return s;
+  }
+  if (static_cast<int>(data.mean_h.size()) != data.size() ||
+      static_cast<int>(data.repetitions.size()) != data.size()) {
+    s.message = "measurement set is inconsistent (configurations, readings, repetitions)";
+    return s;
+  }
+
+  // Identifiability first: a rank-deficient set never gets a "converged" answer.
+  std::unique_ptr<MeasurementModel> reduced;
+  const MeasurementModel* model = &model_in;
+  s.identifiability = AnalyzeIdentifiability(*model, data.configs, nullptr, options.identifiability);
+  if (!s.identifiability.full_rank()) {
+    std::ostringstream msg;
+    msg << "the parameter set is rank-deficient on these configurations (rank "
+        << s.identifiability.rank << " of " << s.identifiability.num_params() << ")";
+    if (!options.fix_dependent_parameters) {
+      s.names = model->parameters().names;
+      s.termination = Termination::kRankDeficient;
+      msg << "; fix: ";
+      for (const auto& f : s.identifiability.suggested_fixed) msg << f << " ";
+      s.message = msg.str();
+      return s;
+    }
+    s.fixed = s.identifiability.suggested_fixed;
+    // The same set without the suggested parameters (and without those fixed already).
+    const ParameterSet& in = model_in.parameters();
+    std::vector<std::string> fixed = s.fixed;
+    for (int k : model_in.robot().parameter_indices())
+      if (std::find(in.robot_values.begin(), in.robot_values.end(), k) == in.robot_values.end())
+        fixed.push_back(model_in.robot().ValueName(k));
+    if (in.plane.normal && in.u_index[0] < 0) fixed.push_back("plane_u1");
+    if (in.plane.normal && in.u_index[1] < 0) fixed.push_back("plane_u2");
+    if (in.plane.offset && in.f_index < 0) fixed.push_back("plane_f");
+    ParameterSet rebuilt = MakeParameterSet(model_in.robot(), in.plane, fixed);
+    reduced = std::make_unique<MeasurementModel>(model_in.robot(), model_in.nominal_plane(),
+                                                 rebuilt);
+    model = reduced.get();
+    s.identifiability =
+        AnalyzeIdentifiability(*model, data.configs, nullptr, options.identifiability);
+    if (!s.identifiability.full_rank()) {
+      s.names = model->parameters().names;
+      s.termination = Termination::kRankDeficient;
+      s.message = msg.str() + "; still rank-deficient after fixing the suggested parameters";
+      return s;
+    }
+  }
+
+  const int n = model->num_parameters();
+  const int m = data.size();
+  s.names = model->parameters().names;
+  if (m < n) {
+    s.message = "fewer configurations (" + std::to_string(m) + ") than parameters (" +
+                std::to_string(n) + ")";
+    return s;
+  }
+  std::vector<double> weights(data.repetitions.begin(), data.repetitions.end());
+  Eigen::VectorXd e;
+  LevenbergMarquardt lm;
+  if (options.solver == IdentificationOptions::Solver::kCeres) {
+    s.termination = SolveWithCeres(*model, data, options, &e, &s.iterations, &s.message);
+  } else {
+    LevenbergMarquardt::Result r =
+        lm.Solve(*model, data.configs, data.mean_h.data(), weights.data(), options, &e);
+    s.termination = r.termination;
+    s.iterations = r.iterations;
+    s.message = std::string("lrcal Levenberg-Marquardt: ") + TerminationName(r.termination);
+  }
+
+  // Costs, residuals and covariance at the estimate (same formulas for both solvers).
+  ModelPoint point;
+  std::vector<double> zero(n, 0.0);
+  auto cost_at = [&](const double* x, double* rms) {
+    model->Prepare(x, &point);
+    double c = 0, ss = 0;
+    for (int i = 0; i < m; ++i) {
+      double h;
+      model->Evaluate(point, data.configs, i, &h, nullptr);
+      const double r = data.mean_h[i] - h;
+      c += 0.5 * data.repetitions[i] * r * r;
+      ss += r * r;
+    }
+    if (rms) *rms = std::sqrt(ss / m);
+    return c;
+  };
+  s.initial_cost = cost_at(zero.data(), nullptr);
+  s.final_cost = cost_at(e.data(), &s.residual_rms);
+  s.delta = e;
+  s.nominal.resize(n);
+  const ParameterSet& ps = model->parameters();
+  for (int k = 0; k < ps.num_robot(); ++k)
+    s.nominal[k] = model->robot().nominal_values()[ps.robot_values[k]];
+  for (int c = 0; c < 2; ++c)
+    if (ps.u_index[c] >= 0) s.nominal[ps.u_index[c]] = 0;
+  if (ps.f_index >= 0) s.nominal[ps.f_index] = model->nominal_plane().offset;
+  s.estimate = s.nominal + s.delta;
+
+  Eigen::MatrixXd G = IdentificationJacobian(*model, data.configs, e.data());
+  Eigen::MatrixXd A = G.transpose() * Eigen::VectorXd(Eigen::Map<Eigen::VectorXd>(
+                                          weights.data(), m)).asDiagonal() * G;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+  Eigen::MatrixXd Ainv = ldlt.solve(Eigen::MatrixXd::Identity(n, n));
+  s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : 0.0;
+  s.covariance_residual = s.sigma_hat * s.sigma_hat * Ainv;
+  s.std_residual = s.covariance_residual.diagonal().cwiseSqrt();
+  if (options.sigma > 0) {
+    s.covariance_given = options.sigma * options.sigma * Ainv;
+    s.std_given = s.covariance_given.diagonal().cwiseSqrt();
+  }
+  Eigen::VectorXd d = Ainv.diagonal().cwiseSqrt().cwiseInverse();
+  s.correlation = d.asDiagonal() * Ainv * d.asDiagonal();
+  return s;
+}
+
+std::string IdentificationSummary::BriefReport() const {
+  std::ostringstream out;
+  out << "lrcal identification (" << solver << "): " << TerminationName(termination) << ", "
+      << iterations << " iterations, " << names.size() << " parameters, " << num_configurations
+      << " configurations, cost " << initial_cost << " -> " << final_cost
+      << " m^2, residual RMS " << residual_rms * 1e3 << " mm";
+  return out.str();
+}
+
+std::string IdentificationSummary::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n" << message << "\n";
+  if (!fixed.empty()) {
+    out << "fixed at nominal (rank deficiency):";
+    for (const auto& f : fixed) out << " " << f;
+    out << "\n";
+  }
+  if (IsSolutionUsable()) {
+    out << "sigma_hat per reading: " << sigma_hat * 1e3 << " mm\n";
+  }
+  return out.str();
+}
+
+}  // namespace lrcal

@@ -36,7 +36,8 @@ inline constexpr int kMaxLinks = 16;
 /// are q(i)[0..N-1] (rad, or m for prismatic joints).
 class ConfigurationSet {
  public:
-  explicit ConfigurationSet(int num_joints = 0) : num_joints_(num_joints) {}
+  ConfigurationSet() = default;
+  explicit ConfigurationSet(int num_joints) : num_joints_(num_joints) {}
   int num_joints() const { return num_joints_; }
   int size() const { return num_joints_ == 0 ? 0 : static_cast<int>(q_.size()) / num_joints_; }
   void Add(const double* q);
@@ -49,7 +50,7 @@ class ConfigurationSet {
   ConfigurationSet Subset(const std::vector<int>& indices) const;
 
  private:
-  int num_joints_;
+  int num_joints_ = 0;
   std::vector<double> q_, cos_q_, sin_q_;
 };
 

@@ -1,0 +1,53 @@
+// Counter-based random numbers (Random123's Philox4x64-10): every draw is *addressed*, never
+// taken from a running sequence, so a trial's numbers do not depend on which thread, shard, rank
+// or restart computes it.
+//
+// Address of a draw: key = (study seed, stream), counter = (trial, purpose, block, 0), where one
+// counter block yields four 64-bit words. Standard normals come from Random123's Box–Muller
+// transform (pairs of words → pairs of normals), uniforms from its u01 (in (0, 1]). Neither
+// std::normal_distribution nor std::seed_seq is used: their results are implementation-defined.
+// random_test.cc pins Philox against Random123's published known-answer vectors and the normal
+// transform against fixed values.
+//
+// Common random numbers: the stream is chosen by the *purpose* of the draw, not by the study cell,
+// so two cells that differ only in σ (or in the number of configurations) see the same standard
+// normals for the same trial index. Comparisons between cells then carry less Monte-Carlo noise.
+#pragma once
+
+#include <cstdint>
+
+namespace lrcal {
+
+/// What a stream of draws is for (part of its address).
+enum class RandomPurpose : std::uint32_t {
+  kNoise = 1,       ///< reading noise: index = configuration·R + repetition
+  kPool = 2,        ///< candidate configurations: index = attempt·joints + joint
+  kValidation = 3,  ///< validation configurations
+  kTruth = 4,       ///< per-trial parameter errors
+  kSelection = 5,   ///< random selection / exchange restarts
+};
+
+class RandomStream {
+ public:
+  /// `stream` separates independent families (e.g. a cell-specific pool); 0 for common numbers.
+  RandomStream(std::uint64_t seed, std::uint64_t stream, std::uint64_t trial,
+               RandomPurpose purpose)
+      : seed_(seed), stream_(stream), trial_(trial), purpose_(static_cast<std::uint64_t>(purpose)) {}
+
+  /// The four raw words of counter block `block`.
+  void Block(std::uint64_t block, std::uint64_t out[4]) const;
+  /// Uniform in (0, 1] at draw `index`.
+  double Uniform(std::uint64_t index) const;
+  /// Standard normal at draw `index`.
+  double Normal(std::uint64_t index) const;
+  /// Fills out[0..count) with the standard normals at indices first .. first+count-1.
+  void Normals(std::uint64_t first, int count, double* out) const;
+
+ private:
+  std::uint64_t seed_, stream_, trial_, purpose_;
+};
+
+/// Philox4x64-10 of (counter, key), exposed for the known-answer test.
+void Philox4x64(const std::uint64_t counter[4], const std::uint64_t key[2], std::uint64_t out[4]);
+
+}  // namespace lrcal

@@ -1,0 +1,37 @@
+// Simulated laser readings from a "true" robot and plane.
+//
+// A reading at configuration i, repetition r is h_true(q_i) + σ·z, z the standard normal at
+// index i·R + r of the noise stream (random.h); the measurand of a configuration is the mean of
+// its R readings (slide 'Measurement Noise'). A configuration whose true beam misses the plane
+// (laser_plane.h) has no reading: it is reported, never filled with a NaN.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "lrcal/identification.h"
+#include "lrcal/measurement_model.h"
+#include "lrcal/random.h"
+
+namespace lrcal {
+
+/// The model readings of (link values, plane) at every configuration, and each one's BeamMiss.
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                   const Plane& plane, const ConfigurationSet& configs, std::vector<double>* h,
+                   std::vector<BeamMiss>* misses);
+
+struct NoiseModel {
+  double sigma = 0.2e-3;  ///< m, standard deviation of one reading
+  int repetitions = 10;   ///< readings averaged per configuration
+};
+
+/// Noisy readings of the true model. Fills `data` with the configurations that have a reading
+/// (mean of R) and returns the number of configurations whose true beam missed; `misses` (if
+/// given) gets every configuration's reason. `raw` (if given) gets every single reading,
+/// configuration-major.
+int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
+                     const Plane& true_plane, const ConfigurationSet& configs,
+                     const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
+                     std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr);
+
+}  // namespace lrcal

@@ -1,0 +1,56 @@
+#include "lrcal/simulation.h"
+
+namespace lrcal {
+
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                   const Plane& plane, const ConfigurationSet& configs, std::vector<double>* h,
+                   std::vector<BeamMiss>* misses) {
+  ModelPoint point;
+  PrepareModelPoint(robot, link_values.data(), plane, &point);
+  h->resize(configs.size());
+  if (misses) misses->resize(configs.size());
+  for (int i = 0; i < configs.size(); ++i) {
+    const Pose<double> pose = ToolPose(point, configs, i);
+    const double nb = plane.normal.dot(pose.R_BT.col(2));
+    (*h)[i] = -plane.SignedDistance(pose.p_BT) / nb;
+    if (misses) (*misses)[i] = ClassifyReading((*h)[i], nb, robot.ranger);
+  }
+}
+
+int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
+                     const Plane& true_plane, const ConfigurationSet& configs,
+                     const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
+                     std::vector<BeamMiss>* misses, std::vector<double>* raw) {
+  std::vector<double> h;
+  std::vector<BeamMiss> local;
+  std::vector<BeamMiss>* m = misses ? misses : &local;
+  ExactReadings(robot, true_link_values, true_plane, configs, &h, m);
+  *data = MeasurementSet{};
+  data->configs = ConfigurationSet(configs.num_joints());
+  data->configs.Reserve(configs.size());
+  data->mean_h.reserve(configs.size());
+  data->repetitions.reserve(configs.size());
+  const int R = noise.repetitions;
+  std::vector<double> z(R);
+  if (raw) raw->clear();
+  int missed = 0;
+  for (int i = 0; i < configs.size(); ++i) {
+    stream.Normals(static_cast<std::uint64_t>(i) * R, R, z.data());
+    if ((*m)[i] != BeamMiss::kNone) {
+      ++missed;
+      continue;
+    }
+    double sum = 0;
+    for (int r = 0; r < R; ++r) {
+      const double reading = h[i] + noise.sigma * z[r];
+      sum += reading;
+      if (raw) raw->push_back(reading);
+    }
+    data->configs.Add(configs.q(i));
+    data->mean_h.push_back(sum / R);
+    data->repetitions.push_back(R);
+  }
+  return missed;
+}
+
+}  // namespace lrcal
