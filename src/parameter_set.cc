@@ -45,11 +45,13 @@ std::string PlaneTerms::ToString() const {
   return "none";
 }
 
-bool ParameterSet::IsAngular(int k) const {
-  if (k >= num_robot()) return k != f_index;
-  return names[k].rfind("theta", 0) == 0 || names[k].rfind("alpha", 0) == 0 ||
-         names[k].rfind("beta", 0) == 0;
+bool IsAngularName(const std::string& name) {
+  for (const char* prefix : {"theta", "alpha", "beta", "plane_u"})
+    if (name.rfind(prefix, 0) == 0) return true;
+  return false;
 }
+
+bool ParameterSet::IsAngular(int k) const { return IsAngularName(names[k]); }
 
 int ParameterSet::Find(const std::string& name) const {
   auto it = std::find(names.begin(), names.end(), name);

@@ -20,7 +20,8 @@ void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const Plane& true_plane, const ConfigurationSet& configs,
                      const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
-                     std::vector<BeamMiss>* misses, std::vector<double>* raw) {
+                     std::vector<BeamMiss>* misses, std::vector<double>* raw,
+                     const std::vector<int>* noise_slots) {
   std::vector<double> h;
   std::vector<BeamMiss> local;
   std::vector<BeamMiss>* m = misses ? misses : &local;
@@ -35,7 +36,8 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   if (raw) raw->clear();
   int missed = 0;
   for (int i = 0; i < configs.size(); ++i) {
-    stream.Normals(static_cast<std::uint64_t>(i) * R, R, z.data());
+    const std::uint64_t slot = noise_slots ? (*noise_slots)[i] : i;
+    stream.Normals(slot * R, R, z.data());
     if ((*m)[i] != BeamMiss::kNone) {
       ++missed;
       continue;

@@ -48,6 +48,9 @@ ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed = {},
                               const std::string& source = "--fix");
 
+/// True for names of quantities in rad (theta*, alpha*, beta*, plane_u*); false for metres.
+bool IsAngularName(const std::string& name);
+
 /// Splits "a,b,c" into names (empty string → empty list).
 std::vector<std::string> SplitList(const std::string& text, char separator = ',');
 

@@ -28,10 +28,13 @@ struct NoiseModel {
 /// Noisy readings of the true model. Fills `data` with the configurations that have a reading
 /// (mean of R) and returns the number of configurations whose true beam missed; `misses` (if
 /// given) gets every configuration's reason. `raw` (if given) gets every single reading,
-/// configuration-major.
+/// configuration-major. `noise_slots` (if given) addresses each configuration's noise by a slot
+/// (e.g. its index in the candidate pool: draws slot·R + r) instead of its position i, so that
+/// two designs drawn from one pool see the same noise on the configurations they share.
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const Plane& true_plane, const ConfigurationSet& configs,
                      const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
-                     std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr);
+                     std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr,
+                     const std::vector<int>* noise_slots = nullptr);
 
 }  // namespace lrcal

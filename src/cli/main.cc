@@ -1,1 +1,70 @@
-int main(){return 0;}
+// lrcal: kinematic calibration of robot arms with a laser ranger, and Monte-Carlo studies of it.
+// A thin layer over the library: each subcommand parses its options and calls lrcal/.
+#include <cstring>
+#include <iostream>
+
+#include "cli_common.h"
+#include "lrcal/build_info.h"
+
+namespace lrcal::cli {
+
+const std::vector<Command>& Commands() {
+  static const std::vector<Command> commands = {
+      {"paper", "the paper's case 1 and case 2, one realisation, beside its published tables",
+       PaperCommand},
+      {"kinematics", "tool pose, beam, laser distance (and Jacobian row) per configuration",
+       KinematicsCommand},
+      {"sample", "draw measurement or validation configurations for a robot and plane",
+       SampleCommand},
+      {"simulate", "noisy laser readings of the true robot at given configurations",
+       SimulateCommand},
+      {"identify", "identify the parameters from measured (or simulated) readings",
+       IdentifyCommand},
+      {"identifiability", "rank, singular values and dependencies of a parameter set",
+       IdentifiabilityCommand},
+  };
+  return commands;
+}
+
+}  // namespace lrcal::cli
+
+namespace {
+
+void PrintUsage(std::ostream& out) {
+  out << "lrcal " << LRCAL_VERSION << " — laser-ranger calibration of robot arms\n\n"
+      << "usage: lrcal COMMAND [options]   (lrcal COMMAND --help for its options)\n\ncommands:\n";
+  for (const auto& c : lrcal::cli::Commands())
+    out << "  " << c.name << std::string(18 - c.name.size(), ' ') << c.summary << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    PrintUsage(std::cout);
+    return argc < 2 ? 2 : 0;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::cout << "lrcal " << LRCAL_VERSION << " (" << LRCAL_GIT_COMMIT << ", " << LRCAL_COMPILER
+              << ")\n";
+    return 0;
+  }
+  const std::string name = argv[1];
+  std::vector<std::string> args(argv + 2, argv + argc);
+  for (const auto& c : lrcal::cli::Commands()) {
+    if (c.name != name) continue;
+    try {
+      return c.run(args);
+    } catch (const lrcal::InputError& e) {
+      std::cerr << "lrcal " << name << ": error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "lrcal " << name << ": failed: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  std::cerr << "lrcal: unknown command '" << name << "'\n\n";
+  PrintUsage(std::cerr);
+  return 2;
+}

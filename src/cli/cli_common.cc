@@ -1,0 +1,77 @@
+#include "cli_common.h"
+
+namespace lrcal::cli {
+
+bool Parse(const std::string& command, const std::string& usage, po::options_description& options,
+           const std::vector<std::string>& args, po::variables_map* vm,
+           const po::positional_options_description* positional) {
+  options.add_options()("help,h", "show this help");
+  try {
+    po::command_line_parser parser(args);
+    parser.options(options);
+    if (positional) parser.positional(*positional);
+    po::store(parser.run(), *vm);
+    if (vm->count("help")) {
+      std::cout << "usage: lrcal " << command << " " << usage << "\n\n" << options << "\n";
+      return false;
+    }
+    po::notify(*vm);
+  } catch (const po::error& e) {
+    throw InputError("command line", std::string(e.what()) + " (see lrcal " + command + " --help)");
+  }
+  return true;
+}
+
+void AddCommonOptions(po::options_description& options) {
+  options.add_options()
+      ("robot", po::value<std::string>()->default_value("paper"),
+       "robot file (YAML) or shipped robot name")
+      ("plane", po::value<std::string>(),
+       "plane nx,ny,nz,f in the base frame (normalised); default: the robot file's plane")
+      ("format", po::value<std::string>()->default_value("text"), "output: text or json");
+}
+
+RobotModel LoadRobot(const std::string& name_or_path) {
+  return LoadRobotModel(ResolveRobotPath(name_or_path));
+}
+
+Plane ResolvePlane(const RobotModel& robot, const po::variables_map& vm) {
+  if (vm.count("plane")) return Plane::Parse(vm["plane"].as<std::string>(), "--plane");
+  if (robot.default_plane) return *robot.default_plane;
+  throw InputError("--plane", "the robot file '" + robot.source +
+                                  "' has no plane: give --plane nx,ny,nz,f");
+}
+
+ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm) {
+  PlaneTerms terms;
+  if (vm.count("estimate-plane"))
+    terms = PlaneTerms::Parse(vm["estimate-plane"].as<std::string>(), "--estimate-plane");
+  std::vector<std::string> fixed;
+  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  return MakeParameterSet(robot, terms, fixed, "--fix");
+}
+
+Format ResolveFormat(const po::variables_map& vm) {
+  const std::string f = vm["format"].as<std::string>();
+  if (f == "text") return Format::kText;
+  if (f == "json") return Format::kJson;
+  throw InputError("--format", "expected text or json, got '" + f + "'");
+}
+
+Json ToJson(const Eigen::VectorXd& v) {
+  Json j = Json::array();
+  for (int i = 0; i < v.size(); ++i) j.push_back(v[i]);
+  return j;
+}
+
+Json ToJson(const Eigen::MatrixXd& m) {
+  Json j = Json::array();
+  for (int r = 0; r < m.rows(); ++r) {
+    Json row = Json::array();
+    for (int c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    j.push_back(row);
+  }
+  return j;
+}
+
+}  // namespace lrcal::cli

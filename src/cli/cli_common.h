@@ -1,0 +1,58 @@
+// Shared pieces of the lrcal command-line program (private to src/cli).
+#pragma once
+
+#include <boost/program_options.hpp>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "lrcal/error.h"
+#include "lrcal/parameter_set.h"
+#include "lrcal/robot_model.h"
+
+namespace lrcal::cli {
+
+namespace po = boost::program_options;
+using Json = nlohmann::ordered_json;
+
+/// A subcommand: name, one-line summary, and its entry point (args exclude the subcommand).
+struct Command {
+  std::string name;
+  std::string summary;
+  std::function<int(const std::vector<std::string>&)> run;
+};
+const std::vector<Command>& Commands();
+
+/// Parses `args` against `options`; prints help and returns false for --help. Unknown options and
+/// bad values become InputErrors naming the option.
+bool Parse(const std::string& command, const std::string& usage, po::options_description& options,
+           const std::vector<std::string>& args, po::variables_map* vm,
+           const po::positional_options_description* positional = nullptr);
+
+/// --robot: a path or a shipped name ("paper").
+RobotModel LoadRobot(const std::string& name_or_path);
+/// --plane if given, else the robot file's plane; InputError if neither.
+Plane ResolvePlane(const RobotModel& robot, const po::variables_map& vm);
+/// --estimate-plane and --fix.
+ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm);
+
+enum class Format { kText, kJson };
+Format ResolveFormat(const po::variables_map& vm);
+
+/// Adds --robot, --plane, --format to `options` (the options every science command takes).
+void AddCommonOptions(po::options_description& options);
+
+Json ToJson(const Eigen::VectorXd& v);
+Json ToJson(const Eigen::MatrixXd& m);
+
+int KinematicsCommand(const std::vector<std::string>& args);
+int SampleCommand(const std::vector<std::string>& args);
+int SimulateCommand(const std::vector<std::string>& args);
+int IdentifyCommand(const std::vector<std::string>& args);
+int IdentifiabilityCommand(const std::vector<std::string>& args);
+int PaperCommand(const std::vector<std::string>& args);
+
+}  // namespace lrcal::cli
