@@ -360,6 +360,10 @@ int PaperCommand(const std::vector<std::string>& args) {
       for (std::size_t k = 0; k < c.summary.names.size() && c.summary.IsSolutionUsable(); ++k)
         p[c.summary.names[k]] = c.summary.delta[k];
       cj["delta"] = p;
+      Json sd = Json::object();
+      for (std::size_t k = 0; k < c.summary.names.size() && c.summary.IsSolutionUsable(); ++k)
+        sd[c.summary.names[k]] = c.summary.std_given[k];
+      cj["std_given_sigma"] = sd;
       cj["validation_rms_position"] = ToJson(Eigen::VectorXd(c.validation.stats.rms_position));
       cj["validation_rms_orientation"] = ToJson(Eigen::VectorXd(c.validation.stats.rms_orientation));
       cj["validation_max_position"] = ToJson(Eigen::VectorXd(c.validation.stats.max_position));
