@@ -54,5 +54,10 @@ int SimulateCommand(const std::vector<std::string>& args);
 int IdentifyCommand(const std::vector<std::string>& args);
 int IdentifiabilityCommand(const std::vector<std::string>& args);
 int PaperCommand(const std::vector<std::string>& args);
+int RunCommand(const std::vector<std::string>& args);
+int PlanCommand(const std::vector<std::string>& args);
+int StatusCommand(const std::vector<std::string>& args);
+int MergeCommand(const std::vector<std::string>& args);
+int AggregateCommand(const std::vector<std::string>& args);
 
 }  // namespace lrcal::cli

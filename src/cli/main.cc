@@ -10,6 +10,11 @@ namespace lrcal::cli {
 
 const std::vector<Command>& Commands() {
   static const std::vector<Command> commands = {
+      {"run", "run (or resume) a Monte-Carlo study: lrcal run [STUDY.yaml] [--out DIR]", RunCommand},
+      {"plan", "dry run: cells, trials and an estimated run time of a study", PlanCommand},
+      {"status", "done / remaining trials per cell of a run directory", StatusCommand},
+      {"merge", "combine shard run directories into one run", MergeCommand},
+      {"aggregate", "rewrite the tables of a run directory from its trial store", AggregateCommand},
       {"paper", "the paper's case 1 and case 2, one realisation, beside its published tables",
        PaperCommand},
       {"kinematics", "tool pose, beam, laser distance (and Jacobian row) per configuration",

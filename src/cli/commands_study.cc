@@ -1,0 +1,155 @@
+// The study subcommands: run, plan, status, merge, aggregate.
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "cli_common.h"
+#include "lrcal/monte_carlo.h"
+#include "lrcal/study.h"
+#include "lrcal/table.h"
+#include "lrcal/trial.h"
+
+namespace lrcal::cli {
+
+namespace {
+
+constexpr const char* kDefaultStudy = "paper";
+
+Study LoadStudyArg(const po::variables_map& vm) {
+  const std::string arg = vm.count("study") ? vm["study"].as<std::string>() : kDefaultStudy;
+  return LoadStudy(ResolveStudyPath(arg));
+}
+
+std::string DefaultOut(const Study& study) { return "output/" + study.name; }
+
+}  // namespace
+
+int RunCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal run options");
+  o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")
+      ("out", po::value<std::string>(), "run directory (default: output/<study name>)")
+      ("threads", po::value<int>()->default_value(0), "worker threads (0: all cores)")
+      ("shard", po::value<std::string>(), "run only shard i/N of the trials (batch schedulers)")
+      ("max-trials", po::value<long long>()->default_value(0),
+       "stop after this many new trials (0: no limit); rerun to continue")
+      ("quiet", po::bool_switch(), "no progress output");
+  po::positional_options_description pos;
+  pos.add("study", 1);
+  po::variables_map vm;
+  if (!Parse("run", "[STUDY.yaml] [--out DIR] [--threads N] [--shard i/N]", o, args, &vm, &pos))
+    return 0;
+  const Study study = LoadStudyArg(vm);
+  RunOptions options;
+  options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : DefaultOut(study);
+  options.threads = vm["threads"].as<int>();
+  if (options.threads < 0) throw InputError("--threads", "expected 0 (all cores) or more");
+  if (vm.count("shard")) ParseShard(vm["shard"].as<std::string>(), &options.shard_index, &options.shard_count);
+  options.max_new_trials = vm["max-trials"].as<long long>();
+  options.progress = !vm["quiet"].as<bool>();
+  InstallStopHandlers();
+  std::cerr << "lrcal run: study '" << study.name << "', " << study.cells.size() << " cells × "
+            << study.trials << " trials → " << options.out_dir << "\n";
+  const RunResult r = RunStudy(study, options);
+  std::cerr << "lrcal run: " << r.computed << " trials computed in " << Fixed(r.seconds, 1)
+            << " s (" << r.done_before << " already done, " << r.total << " in this run";
+  if (r.computed > 0)
+    std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial";
+  std::cerr << ")\n";
+  if (r.tables_written) {
+    std::cout << "tables: " << options.out_dir << "/tables/summary.md (also .csv, .json, .tex)\n";
+  } else if (r.interrupted) {
+    std::cout << "interrupted: " << r.done_before + r.computed << "/" << r.total
+              << " trials recorded; run the same command again to continue\n";
+    return 130;
+  } else {
+    std::cout << "shard done; combine the shards with: lrcal merge DIR... --out DIR\n";
+  }
+  return 0;
+}
+
+int PlanCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal plan options");
+  o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")
+      ("threads", po::value<int>()->default_value(0), "threads the run would use (0: all cores)")
+      ("format", po::value<std::string>()->default_value("text"), "text or json");
+  po::positional_options_description pos;
+  pos.add("study", 1);
+  po::variables_map vm;
+  if (!Parse("plan", "[STUDY.yaml]", o, args, &vm, &pos)) return 0;
+  const Study study = LoadStudyArg(vm);
+  const int threads = vm["threads"].as<int>() > 0 ? vm["threads"].as<int>()
+                                                  : std::max(1u, std::thread::hardware_concurrency());
+  Table t({"cell", "id", "trials", "prepare (s)", "µs/trial (measured)", "estimate (s)"},
+          "Plan of study '" + study.name + "' (dry run: each cell prepared, a few trials timed)");
+  Json j = Json::array();
+  double total_seconds = 0;
+  for (const Cell& cell : study.cells) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto ctx = PrepareCell(study, cell);
+    const auto t1 = std::chrono::steady_clock::now();
+    TrialWorkspace ws;
+    const int probe = static_cast<int>(std::min<long long>(study.trials, 20));
+    for (int k = 0; k < probe; ++k) RunTrial(*ctx, k, &ws);
+    const auto t2 = std::chrono::steady_clock::now();
+    const double prep = std::chrono::duration<double>(t1 - t0).count();
+    const double per = std::chrono::duration<double>(t2 - t1).count() / probe;
+    const double est = prep + per * study.trials / threads;
+    total_seconds += est;
+    t.AddRow({cell.label, cell.id, std::to_string(study.trials), Fixed(prep, 3), Fixed(per * 1e6, 1),
+              Fixed(est, 1)});
+    j.push_back({{"label", cell.label}, {"id", cell.id}, {"trials", study.trials},
+                 {"prepare_seconds", prep}, {"seconds_per_trial", per}, {"estimate_seconds", est},
+                 {"settings", cell.settings}});
+  }
+  if (vm["format"].as<std::string>() == "json") {
+    std::cout << Json{{"study", study.name}, {"cells", j}, {"threads", threads},
+                      {"total_trials", study.total_trials()}, {"estimate_seconds", total_seconds}}
+                     .dump(2)
+              << "\n";
+  } else {
+    std::cout << t.ToText() << "total: " << study.cells.size() << " cells, "
+              << study.total_trials() << " trials, about " << Fixed(total_seconds, 0) << " s on "
+              << threads << " threads\n";
+  }
+  return 0;
+}
+
+int StatusCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal status options");
+  o.add_options()("dir", po::value<std::string>()->required(), "run directory");
+  po::positional_options_description pos;
+  pos.add("dir", 1);
+  po::variables_map vm;
+  if (!Parse("status", "RUN_DIR", o, args, &vm, &pos)) return 0;
+  std::cout << RunStatus(vm["dir"].as<std::string>());
+  return 0;
+}
+
+int MergeCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal merge options");
+  o.add_options()("dirs", po::value<std::vector<std::string>>()->multitoken()->required(),
+                  "shard run directories")
+      ("out", po::value<std::string>()->required(), "merged run directory");
+  po::positional_options_description pos;
+  pos.add("dirs", -1);
+  po::variables_map vm;
+  if (!Parse("merge", "DIR... --out DIR", o, args, &vm, &pos)) return 0;
+  MergeRuns(vm["dirs"].as<std::vector<std::string>>(), vm["out"].as<std::string>());
+  std::cout << RunStatus(vm["out"].as<std::string>());
+  std::cout << "tables: " << vm["out"].as<std::string>() << "/tables/summary.md\n";
+  return 0;
+}
+
+int AggregateCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal aggregate options");
+  o.add_options()("dir", po::value<std::string>()->required(), "run directory");
+  po::positional_options_description pos;
+  pos.add("dir", 1);
+  po::variables_map vm;
+  if (!Parse("aggregate", "RUN_DIR", o, args, &vm, &pos)) return 0;
+  AggregateRun(vm["dir"].as<std::string>());
+  std::cout << "tables: " << vm["dir"].as<std::string>() << "/tables/summary.md\n";
+  return 0;
+}
+
+}  // namespace lrcal::cli

@@ -1,0 +1,110 @@
+#include "lrcal/statistics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lrcal {
+
+double Percentile(const std::vector<double>& s, double p) {
+  if (s.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const double h = (s.size() - 1) * p / 100.0;
+  const std::size_t lo = static_cast<std::size_t>(std::floor(h));
+  const std::size_t hi = std::min(lo + 1, s.size() - 1);
+  return s[lo] + (h - lo) * (s[hi] - s[lo]);
+}
+
+double PercentileRank(const std::vector<double>& s, double x) {
+  if (s.empty() || std::isnan(x)) return std::numeric_limits<double>::quiet_NaN();
+  const auto lo = std::lower_bound(s.begin(), s.end(), x);
+  const auto hi = std::upper_bound(s.begin(), s.end(), x);
+  return 100.0 * ((lo - s.begin()) + 0.5 * (hi - lo)) / s.size();
+}
+
+Distribution Describe(std::vector<double> v) {
+  Distribution d;
+  d.n = static_cast<long long>(v.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (v.empty()) {
+    d.mean = d.std = d.p5 = d.p50 = d.p95 = d.min = d.max = nan;
+    return d;
+  }
+  double sum = 0;
+  for (double x : v) sum += x;  // in the given (canonical) order
+  d.mean = sum / d.n;
+  double ss = 0;
+  for (double x : v) ss += (x - d.mean) * (x - d.mean);
+  d.std = d.n > 1 ? std::sqrt(ss / (d.n - 1)) : nan;
+  std::sort(v.begin(), v.end());
+  d.p5 = Percentile(v, 5);
+  d.p50 = Percentile(v, 50);
+  d.p95 = Percentile(v, 95);
+  d.min = v.front();
+  d.max = v.back();
+  return d;
+}
+
+CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
+  CellSummary s;
+  s.cell = cell;
+  const int n = static_cast<int>(cell.parameter_names.size());
+  std::vector<std::vector<double>> errors(n);
+  std::array<std::vector<double>, 12> val, nom;
+  std::vector<double> iterations, sigma_hat;
+  store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
+    ++s.trials;
+    for (int k = 0; k < 12; ++k) nom[k].push_back(r.nominal[k]);
+    if (r.status != TrialStatus::kOk) {
+      ++s.failed[TrialStatusName(r.status)];
+      return;
+    }
+    ++s.ok;
+    for (int k = 0; k < n && k < static_cast<int>(r.errors.size()); ++k)
+      errors[k].push_back(r.errors[k]);
+    for (int k = 0; k < 12; ++k) val[k].push_back(r.validation[k]);
+    iterations.push_back(r.iterations);
+    sigma_hat.push_back(r.sigma_hat);
+  });
+  for (int k = 0; k < 12; ++k) {
+    s.validation[k] = Describe(val[k]);
+    s.nominal[k] = Describe(nom[k]);
+    s.validation_sorted[k] = val[k];
+    std::sort(s.validation_sorted[k].begin(), s.validation_sorted[k].end());
+  }
+  s.iterations = Describe(iterations);
+  s.sigma_hat = Describe(sigma_hat);
+  // Parameters: bias, spread, and the empirical covariance (two passes, canonical order).
+  const long long m = s.ok;
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    for (double x : errors[k]) mean[k] += x;
+    if (m) mean[k] /= m;
+  }
+  s.covariance = Eigen::MatrixXd::Zero(n, n);
+  for (long long t = 0; t < m; ++t)
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b <= a; ++b)
+        s.covariance(a, b) += (errors[a][t] - mean[a]) * (errors[b][t] - mean[b]);
+  if (m > 1) s.covariance /= static_cast<double>(m - 1);
+  s.covariance.triangularView<Eigen::StrictlyUpper>() = s.covariance.transpose();
+  Eigen::VectorXd sd = s.covariance.diagonal().cwiseSqrt();
+  s.correlation = s.covariance;
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) s.correlation(a, b) /= sd[a] * sd[b];
+  s.errors_sorted = errors;
+  for (auto& e : s.errors_sorted) std::sort(e.begin(), e.end());
+  for (int k = 0; k < n; ++k) {
+    ParameterStats p;
+    p.name = cell.parameter_names[k];
+    p.bias = m ? mean[k] : std::nan("");
+    p.std = m > 1 ? sd[k] : std::nan("");
+    p.bias_se = m > 1 ? p.std / std::sqrt(static_cast<double>(m)) : std::nan("");
+    p.predicted_std = k < static_cast<int>(cell.predicted_std.size()) ? cell.predicted_std[k]
+                                                                       : std::nan("");
+    p.ratio = p.std / p.predicted_std;
+    s.parameters.push_back(p);
+  }
+  return s;
+}
+
+}  // namespace lrcal
