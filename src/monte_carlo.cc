@@ -145,6 +145,11 @@ void ParseShard(const std::string& text, int* index, int* count) {
 
 RunResult RunStudy(const Study& study, const RunOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
+  // Prepare the cells (configurations, designs, predicted covariance) first: a study that cannot
+  // run fails here, before anything is written.
+  std::vector<std::unique_ptr<CellContext>> contexts;
+  for (const Cell& cell : study.cells) contexts.push_back(PrepareCell(study, cell));
+
   const fs::path dir = options.out_dir;
   fs::create_directories(dir);
   DirectoryLock lock(dir);
@@ -193,12 +198,7 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
   TrialStore store((dir / "trials.sqlite").string());
   store.SetMeta("study", study_json.dump());
 
-  // Prepare the cells (configurations, designs, predicted covariance) before any trial runs.
-  std::vector<std::unique_ptr<CellContext>> contexts;
-  for (const Cell& cell : study.cells) {
-    contexts.push_back(PrepareCell(study, cell));
-    store.PutCell(ToStoredCell(*contexts.back()));
-  }
+  for (const auto& context : contexts) store.PutCell(ToStoredCell(*context));
 
   // The work: every (cell, trial) of this shard that the store does not have.
   struct Work {
