@@ -26,7 +26,7 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
 
 case "$action" in
-  run) ./build/lrcal paper ;;
+  run) ./build/lrcal run studies/paper.yaml ;;
   test) ctest --test-dir build -j2 --output-on-failure ;;
   build) ;;
 esac

@@ -59,7 +59,10 @@ double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion
   const int n = static_cast<int>(lambda.size());
   const double minus_inf = -std::numeric_limits<double>::infinity();
   const double lmin = lambda[0], lmax = lambda[n - 1];
-  if (!(lmin > 1e-300)) return minus_inf;
+  if (!(lmin > 1e-300)) {
+    // Singular: the σ-based indices are 0 (their worst value); log det and −trace(A⁻¹) are −∞.
+    return criterion == DesignCriterion::kD || criterion == DesignCriterion::kA ? minus_inf : 0.0;
+  }
   switch (criterion) {
     case DesignCriterion::kE: return std::sqrt(lmin);
     case DesignCriterion::kD: return lambda.array().log().sum();

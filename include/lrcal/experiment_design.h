@@ -44,7 +44,8 @@ struct SelectionResult {
   long long evaluations = 0; ///< criterion evaluations spent
 };
 
-/// Score of the normal matrix A = GᵀG of m configurations (−∞ when singular for E/D/A/O*).
+/// Score of the normal matrix A = GᵀG of m configurations. When A is singular the σ-based
+/// indices (E, O1, O2, O4, O5) are 0 and D, A are −∞.
 double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion);
 
 /// Chooses k rows of G (N×n). Throws InputError for k > N, k < n, or an exhaustive search too
