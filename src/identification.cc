@@ -32,84 +32,108 @@ std::string IdentificationOptions::Validate() const {
   return "";
 }
 
-bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::MatrixXd* L,
+bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>* L_out,
                    Eigen::VectorXd* x, double min_pivot) {
   const int n = static_cast<int>(A.rows());
-  L->resize(n, n);
+  L_out->resize(n, n);
+  double* L = L_out->data();  // row-major: L[i*n + k]
   double max_diag = 0;
   for (int i = 0; i < n; ++i) max_diag = std::max(max_diag, A(i, i));
   const double threshold = min_pivot * max_diag;
   for (int j = 0; j < n; ++j) {
+    const double* lj = L + j * n;
     double d = A(j, j);
-    for (int k = 0; k < j; ++k) d -= (*L)(j, k) * (*L)(j, k);
+    for (int k = 0; k < j; ++k) d -= lj[k] * lj[k];
     if (!(d > threshold) || !(d > 0)) return false;
     const double ljj = std::sqrt(d);
-    (*L)(j, j) = ljj;
+    L[j * n + j] = ljj;
     const double inv = 1.0 / ljj;
     for (int i = j + 1; i < n; ++i) {
+      const double* li = L + i * n;
       double s = A(i, j);
-      for (int k = 0; k < j; ++k) s -= (*L)(i, k) * (*L)(j, k);
-      (*L)(i, j) = s * inv;
+      for (int k = 0; k < j; ++k) s -= li[k] * lj[k];  // contiguous in both rows
+      L[i * n + j] = s * inv;
     }
   }
   x->resize(n);
+  double* y = x->data();
   for (int i = 0; i < n; ++i) {  // L·y = b
+    const double* li = L + i * n;
     double s = b[i];
-    for (int k = 0; k < i; ++k) s -= (*L)(i, k) * (*x)[k];
-    (*x)[i] = s / (*L)(i, i);
+    for (int k = 0; k < i; ++k) s -= li[k] * y[k];
+    y[i] = s / li[i];
   }
   for (int i = n - 1; i >= 0; --i) {  // Lᵀ·x = y
-    double s = (*x)[i];
-    for (int k = i + 1; k < n; ++k) s -= (*L)(k, i) * (*x)[k];
-    (*x)[i] = s / (*L)(i, i);
+    double s = y[i];
+    for (int k = i + 1; k < n; ++k) s -= L[k * n + i] * y[k];
+    y[i] = s / L[i * n + i];
   }
   return true;
 }
 
-double LevenbergMarquardt::Linearize(const MeasurementModel& model,
-                                     const ConfigurationSet& configs, const double* mean_h,
-                                     const double* weights, const Eigen::VectorXd& e) {
-  const int n = model.num_parameters();
+double LevenbergMarquardt::Linearize(const MeasurementModel& model, const double* mean_h,
+                                     const Eigen::VectorXd& e, Eigen::VectorXd* r,
+                                     Eigen::MatrixXd* J) {
+  const int n = model.num_parameters(), m = batch_.size();
   model.Prepare(e.data(), &point_);
-  A_trial_.setZero(n, n);
-  g_trial_.setZero(n);
-  row_.resize(n);
-  double cost = 0;
-  for (int i = 0; i < configs.size(); ++i) {
-    double h;
-    const double nb = model.Evaluate(point_, configs, i, &h, row_.data());
-    if (!(std::fabs(nb) > 1e-12)) return std::numeric_limits<double>::quiet_NaN();
-    const double r = mean_h[i] - h;
-    const double w = weights[i];
-    cost += 0.5 * w * r * r;
-    g_trial_.noalias() += (w * r) * row_;
-    A_trial_.selfadjointView<Eigen::Lower>().rankUpdate(row_, w);
-  }
-  A_trial_.triangularView<Eigen::StrictlyUpper>() = A_trial_.transpose();
-  return cost;
+  J->resize(m, n);
+  r->resize(m);
+  h_.resize(m);
+  if (!batch_.Evaluate(model, point_, h_.data(), J->data()))
+    return std::numeric_limits<double>::quiet_NaN();
+  J->array().colwise() *= sqrt_w_.array();
+  *r = sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_);
+  return 0.5 * r->squaredNorm();
+}
+
+double LevenbergMarquardt::Cost(const MeasurementModel& model, const double* mean_h,
+                                const Eigen::VectorXd& e) {
+  const int m = batch_.size();
+  model.Prepare(e.data(), &point_);
+  h_.resize(m);
+  if (!batch_.Evaluate(model, point_, h_.data(), nullptr))
+    return std::numeric_limits<double>::quiet_NaN();
+  return 0.5 * sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_).squaredNorm();
+}
+
+void LevenbergMarquardt::FormNormalEquations() {
+  const Eigen::Index n = J_.cols();
+  A_.setZero(n, n);
+  A_.selfadjointView<Eigen::Lower>().rankUpdate(J_.transpose());
+  A_.triangularView<Eigen::StrictlyUpper>() = A_.transpose();
+  g_.noalias() = J_.transpose() * r_;
 }
 
 LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& model,
                                                      const ConfigurationSet& configs,
                                                      const double* mean_h, const double* weights,
                                                      const IdentificationOptions& options,
-                                                     Eigen::VectorXd* e) {
+                                                     Eigen::VectorXd* e, const Nominal* nominal) {
   Result result;
-  const int n = model.num_parameters();
+  const int n = model.num_parameters(), m = configs.size();
   e->setZero(n);
-  if (configs.size() < n || n == 0) return result;  // kInvalidInput
-  double cost = Linearize(model, configs, mean_h, weights, *e);
+  if (m < n || n == 0) return result;  // kInvalidInput
+  batch_.SetConfigurations(configs);
+  sqrt_w_ = Eigen::Map<const Eigen::VectorXd>(weights, m).cwiseSqrt();
+  double cost;
+  if (nominal) {
+    J_ = nominal->G;
+    J_.array().colwise() *= sqrt_w_.array();
+    r_ = sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) -
+                              Eigen::Map<const Eigen::VectorXd>(nominal->h.data(), m));
+    cost = 0.5 * r_.squaredNorm();
+  } else {
+    cost = Linearize(model, mean_h, *e, &r_, &J_);
+  }
   result.initial_cost = result.final_cost = cost;
   if (!std::isfinite(cost)) {
     result.termination = Termination::kBeamMissed;
     return result;
   }
-  A_.swap(A_trial_);
-  g_.swap(g_trial_);
+  FormNormalEquations();
 
-  // Rank test on the column-scaled normal matrix (unit diagonal): a pivot below 1e-13 means a
-  // direction with relative singular value below ~3e-7.
-  constexpr double kMinScaledPivot = 1e-13;
+  // Column scaling (Marquardt): unit diagonal. A zero column is rank deficiency outright.
   scale_.resize(n);
   const double max_diag = A_.diagonal().maxCoeff();
   for (int k = 0; k < n; ++k) {
@@ -119,50 +143,69 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
     }
     scale_[k] = 1.0 / std::sqrt(A_(k, k));
   }
-
+  // A pivot below 1e-13 of the scaled matrix: relative singular value below ~3e-7.
+  constexpr double kMinScaledPivot = 1e-13;
+  // Near the minimum the cost is resolvable only to ~1e-12 relative (residuals of 0.1 mm on
+  // readings of 1 m): a step whose predicted decrease is below that is taken on the model's
+  // word, not rejected on rounding noise.
   constexpr double kCostResolution = 1e-10;
   double lambda = 0;
+  double previous_step = std::numeric_limits<double>::infinity();
   for (int iter = 1; iter <= options.max_iterations; ++iter) {
     result.iterations = iter;
-    // Solve (S·A·S + λ·I)·y = S·g, step = S·y: LM with Marquardt's diagonal scaling.
-    Eigen::MatrixXd& As = A_trial_;
-    As = scale_.asDiagonal() * A_ * scale_.asDiagonal();
-    As.diagonal().array() += lambda;
-    Eigen::VectorXd rhs = scale_.cwiseProduct(g_);
-    if (!CholeskySolve(As, rhs, &L_, &step_, lambda == 0 ? kMinScaledPivot : 0)) {
+    // Solve (S·A·S + λ·I)·y = S·g, step = S·y.
+    As_.noalias() = scale_.asDiagonal() * A_ * scale_.asDiagonal();
+    As_.diagonal().array() += lambda;
+    rhs_ = scale_.cwiseProduct(g_);
+    if (!CholeskySolve(As_, rhs_, &L_, &step_, lambda == 0 ? kMinScaledPivot : 0)) {
       result.termination =
           lambda == 0 && iter == 1 ? Termination::kRankDeficient : Termination::kNumericalFailure;
       return result;
     }
     step_ = scale_.cwiseProduct(step_);
     e_trial_ = *e + step_;
-    const bool small_step =
-        step_.norm() <= options.parameter_tolerance * (e->norm() + options.parameter_tolerance);
-    const double trial_cost = Linearize(model, configs, mean_h, weights, e_trial_);
-    // Near the minimum the cost is resolvable only to ~1e-12 relative (residuals of 0.1 mm on
-    // readings of 1 m): a step whose predicted decrease is below that is taken on the model's
-    // word, not rejected on rounding noise.
+    const double step_norm = step_.norm();
+    const double tolerance = options.parameter_tolerance * (e->norm() + options.parameter_tolerance);
+    const bool small_step = step_norm <= tolerance;
+    // Predicted error left after this step: the step times the observed contraction.
+    const double contraction = step_norm / previous_step;
+    const bool last_step = std::isfinite(previous_step) && contraction < 0.5 &&
+                           contraction * step_norm <= tolerance;
     const double predicted_decrease = 0.5 * step_.dot(g_);
-    const bool below_noise = predicted_decrease <= kCostResolution * cost;
-    if (std::isfinite(trial_cost) && (trial_cost <= cost || below_noise)) {
+    if (small_step || last_step) {
+      // The final step: check it on residuals alone.
+      const double trial_cost = Cost(model, mean_h, e_trial_);
+      if (std::isfinite(trial_cost) &&
+          (trial_cost <= cost || predicted_decrease <= kCostResolution * cost)) {
+        e->swap(e_trial_);
+        cost = trial_cost;
+        result.termination = Termination::kConverged;
+        result.final_cost = cost;
+        return result;
+      }
+      if (small_step) {  // at the minimum to rounding: the step cannot lower the cost
+        result.termination = Termination::kConverged;
+        result.final_cost = cost;
+        return result;
+      }
+    }
+    const double trial_cost = Linearize(model, mean_h, e_trial_, &r_trial_, &J_trial_);
+    if (std::isfinite(trial_cost) &&
+        (trial_cost <= cost || predicted_decrease <= kCostResolution * cost)) {
       const bool small_decrease = cost - trial_cost <= options.function_tolerance * cost;
       e->swap(e_trial_);
-      A_.swap(A_trial_);
-      g_.swap(g_trial_);
+      J_.swap(J_trial_);
+      r_.swap(r_trial_);
+      FormNormalEquations();
       cost = trial_cost;
+      previous_step = step_norm;
       lambda = lambda < 1e-10 ? 0 : lambda / 10;
-      if (small_step || small_decrease) {
+      if (small_decrease) {
         result.termination = Termination::kConverged;
         result.final_cost = cost;
         return result;
       }
     } else {
-      if (small_step) {  // at the minimum to rounding: the step cannot lower the cost
-        result.termination = Termination::kConverged;
-        result.final_cost = cost;
-        // A_ still holds the normal matrix at *e.
-        return result;
-      }
       lambda = lambda == 0 ? 1e-6 : lambda * 10;
       if (lambda > 1e12) {
         result.termination = Termination::kNumericalFailure;

@@ -14,6 +14,12 @@ void ConfigurationSet::Add(const double* q) {
   }
 }
 
+void ConfigurationSet::AddFrom(const ConfigurationSet& other, int i) {
+  q_.insert(q_.end(), other.q(i), other.q(i) + num_joints_);
+  cos_q_.insert(cos_q_.end(), other.cos_q(i), other.cos_q(i) + num_joints_);
+  sin_q_.insert(sin_q_.end(), other.sin_q(i), other.sin_q(i) + num_joints_);
+}
+
 void ConfigurationSet::Reserve(int n) {
   q_.reserve(n * num_joints_);
   cos_q_.reserve(n * num_joints_);
@@ -23,7 +29,7 @@ void ConfigurationSet::Reserve(int n) {
 ConfigurationSet ConfigurationSet::Subset(const std::vector<int>& indices) const {
   ConfigurationSet out(num_joints_);
   out.Reserve(static_cast<int>(indices.size()));
-  for (int i : indices) out.Add(q(i));
+  for (int i : indices) out.AddFrom(*this, i);
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include "lrcal/simulation.h"
 
+#include <cmath>
+
 namespace lrcal {
 
 void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
@@ -26,30 +28,38 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   std::vector<BeamMiss> local;
   std::vector<BeamMiss>* m = misses ? misses : &local;
   ExactReadings(robot, true_link_values, true_plane, configs, &h, m);
-  *data = MeasurementSet{};
-  data->configs = ConfigurationSet(configs.num_joints());
+  // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial).
+  if (data->configs.num_joints() != configs.num_joints()) data->configs = ConfigurationSet(configs.num_joints());
+  data->configs.Clear();
   data->configs.Reserve(configs.size());
-  data->mean_h.reserve(configs.size());
-  data->repetitions.reserve(configs.size());
+  data->mean_h.clear();
+  data->repetitions.clear();
   const int R = noise.repetitions;
-  std::vector<double> z(R);
+  const double sigma_mean = noise.sigma / std::sqrt(static_cast<double>(R));
+  std::vector<double> z(noise.draw_mean ? 1 : R);
   if (raw) raw->clear();
   int missed = 0;
   for (int i = 0; i < configs.size(); ++i) {
     const std::uint64_t slot = noise_slots ? (*noise_slots)[i] : i;
-    stream.Normals(slot * R, R, z.data());
     if ((*m)[i] != BeamMiss::kNone) {
       ++missed;
       continue;
     }
-    double sum = 0;
-    for (int r = 0; r < R; ++r) {
-      const double reading = h[i] + noise.sigma * z[r];
-      sum += reading;
-      if (raw) raw->push_back(reading);
+    double mean;
+    if (noise.draw_mean) {
+      mean = h[i] + sigma_mean * stream.Normal(slot);
+    } else {
+      stream.Normals(slot * R, R, z.data());
+      double sum = 0;
+      for (int r = 0; r < R; ++r) {
+        const double reading = h[i] + noise.sigma * z[r];
+        sum += reading;
+        if (raw) raw->push_back(reading);
+      }
+      mean = sum / R;
     }
-    data->configs.Add(configs.q(i));
-    data->mean_h.push_back(sum / R);
+    data->configs.AddFrom(configs, i);
+    data->mean_h.push_back(mean);
     data->repetitions.push_back(R);
   }
   return missed;

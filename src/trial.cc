@@ -161,6 +161,13 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
         c->rank_message = AnalyzeIdentifiability(*c->model, c->design).ToString();
       c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
     }
+    // The first linearisation of every trial (the nominal model on the design), once.
+    {
+      std::vector<BeamMiss> unused;
+      ExactReadings(*c->robot, c->robot->nominal_values(), c->plane, c->design,
+                    &c->design_nominal.h, &unused);
+      c->design_nominal.G = IdentificationJacobian(*c->model, c->design);
+    }
     if (!s.truth_random)
       c->nominal_validation =
           ComparePoses(*c->robot, c->true_values_fixed, c->robot->nominal_values(), c->validation)
@@ -223,7 +230,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
     rec.sigma_min = CriterionScore(Gd.transpose() * Gd, redrawn_design.size(), DesignCriterion::kE);
   }
 
-  NoiseModel noise{s.sigma, s.repetitions};
+  NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
   const int missed = SimulateReadings(*c.robot, truth_values, c.plane, *design, noise,
                                       RandomStream(c.seed, 0, static_cast<std::uint64_t>(trial),
                                                    RandomPurpose::kNoise),
@@ -231,8 +238,9 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
   if (missed > 0) return finish(TrialStatus::kBeamMissed);
   ws->weights.assign(ws->data.repetitions.begin(), ws->data.repetitions.end());
   IdentificationOptions options = s.identification;
-  const LevenbergMarquardt::Result r = ws->solver.Solve(
-      *c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(), options, &ws->e);
+  const LevenbergMarquardt::Result r =
+      ws->solver.Solve(*c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(),
+                       options, &ws->e, s.pool_redraw ? nullptr : &c.design_nominal);
   rec.iterations = r.iterations;
   const int m = ws->data.size(), n = c.model->num_parameters();
   rec.residual_rms = std::sqrt(2 * r.final_cost / (m * s.repetitions));  // per-config mean residual

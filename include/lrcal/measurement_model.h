@@ -42,6 +42,9 @@ class ConfigurationSet {
   int size() const { return num_joints_ == 0 ? 0 : static_cast<int>(q_.size()) / num_joints_; }
   void Add(const double* q);
   void Add(const std::vector<double>& q) { Add(q.data()); }
+  /// Appends configuration i of `other` with its precomputed cos/sin (no trig).
+  void AddFrom(const ConfigurationSet& other, int i);
+  void Clear() { q_.clear(); cos_q_.clear(); sin_q_.clear(); }
   void Reserve(int n);
   const double* q(int i) const { return q_.data() + i * num_joints_; }
   const double* cos_q(int i) const { return cos_q_.data() + i * num_joints_; }

@@ -43,6 +43,7 @@ struct CellContext {
   std::vector<int> selected;         ///< pool indices, when the pool is fixed and selection fixed
   double design_sigma_min = 0;       ///< σ_min of G (SI) of the selected design
   ConfigurationSet design;           ///< the selected configurations
+  LevenbergMarquardt::Nominal design_nominal;  ///< h and G of the nominal model on the design
   ConfigurationSet validation;       ///< when not redrawn (validation is always shared per cell)
   Eigen::VectorXd predicted_std;     ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
   Eigen::VectorXd true_delta_fixed;  ///< truth (estimate-vector layout) when the truth is fixed

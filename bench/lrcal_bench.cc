@@ -1,0 +1,224 @@
+// lrcal's benchmarks (Google Benchmark). docs/PERFORMANCE.md says how to run them and what they
+// showed. Build type Release; run with --benchmark_repetitions=5 --benchmark_report_aggregates_only
+// and quote medians.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "lrcal/batch_evaluation.h"
+#include "lrcal/identification.h"
+#include "lrcal/monte_carlo.h"
+#include "lrcal/statistics.h"
+#include "lrcal/study.h"
+#include "lrcal/trial.h"
+#include "lrcal/trial_store.h"
+
+namespace lrcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string PaperRobotPath() { return std::string(LRCAL_SOURCE_DIR) + "/studies/robots/paper.yaml"; }
+
+// A one-cell study of the paper's arm: `count` of 101 (exhaustive leave-one-out for 100, greedy
+// otherwise), `repetitions` readings.
+std::string WriteStudy(int count, int repetitions, int trials = 1000, int pool = 101) {
+  const fs::path dir = fs::temp_directory_path() / "lrcal_bench";
+  fs::create_directories(dir);
+  const std::string path = (dir / ("s_" + std::to_string(count) + "_" + std::to_string(repetitions) +
+                                   "_" + std::to_string(trials) + "_" + std::to_string(pool) + ".yaml"))
+                               .string();
+  std::ofstream(path) << "name: bench\nseed: 1\ntrials: " << trials << "\nrobot: " << PaperRobotPath()
+                      << "\nnoise: {sigma_mm: 0.2, repetitions: " << repetitions << "}\npool: {size: "
+                      << pool << "}\nselection: {count: " << count << ", method: "
+                      << (count == pool - 1 ? "exhaustive" : "greedy") << "}\n";
+  return path;
+}
+
+struct Fixture {
+  Study study;
+  std::unique_ptr<CellContext> context;
+  explicit Fixture(const std::string& path) : study(LoadStudy(path)) {
+    context = PrepareCell(study, study.cells[0]);
+  }
+};
+
+Fixture& Case(int count, int repetitions = 10, int pool = 101) {
+  static std::map<std::tuple<int, int, int>, std::unique_ptr<Fixture>> cache;
+  auto& f = cache[{count, repetitions, pool}];
+  if (!f) f = std::make_unique<Fixture>(WriteStudy(count, repetitions, 1000, pool));
+  return *f;
+}
+
+void BM_ForwardKinematics(benchmark::State& state) {
+  const CellContext& c = *Case(100).context;
+  ModelPoint point;
+  c.model->Prepare(std::vector<double>(c.model->num_parameters(), 0.0).data(), &point);
+  int i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ToolPose(point, c.design, i));
+    i = (i + 1) % c.design.size();
+  }
+}
+BENCHMARK(BM_ForwardKinematics);
+
+void BM_DistanceAndJacobian100(benchmark::State& state) {
+  const CellContext& c = *Case(100).context;
+  const int n = c.model->num_parameters();
+  ModelPoint point;
+  std::vector<double> e(n, 0.0), row(n);
+  c.model->Prepare(e.data(), &point);
+  for (auto _ : state) {
+    for (int i = 0; i < c.design.size(); ++i) {
+      double h;
+      c.model->Evaluate(point, c.design, i, &h, row.data());
+      benchmark::DoNotOptimize(row.data());
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * c.design.size());
+}
+BENCHMARK(BM_DistanceAndJacobian100);
+
+void BM_BatchDistanceAndJacobian100(benchmark::State& state) {
+  const CellContext& c = *Case(100).context;
+  const int n = c.model->num_parameters(), m = c.design.size();
+  ModelPoint point;
+  std::vector<double> e(n, 0.0), h(m), J(static_cast<std::size_t>(m) * n);
+  c.model->Prepare(e.data(), &point);
+  BatchEvaluator batch;
+  batch.SetConfigurations(c.design);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(batch.Evaluate(*c.model, point, h.data(), state.range(0) ? J.data() : nullptr));
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * m);
+}
+BENCHMARK(BM_BatchDistanceAndJacobian100)->Arg(0)->Arg(1);
+
+void BM_NormalEquations100x25(benchmark::State& state) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Random(100, 25), A(25, 25);
+  for (auto _ : state) {
+    A.setZero();
+    A.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+    benchmark::DoNotOptimize(A.data());
+  }
+}
+BENCHMARK(BM_NormalEquations100x25);
+
+void BM_Cholesky25(benchmark::State& state) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Random(100, 25);
+  Eigen::MatrixXd A = J.transpose() * J;
+  Eigen::VectorXd b = Eigen::VectorXd::Random(25), x;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> L;
+  for (auto _ : state) benchmark::DoNotOptimize(CholeskySolve(A, b, &L, &x));
+}
+BENCHMARK(BM_Cholesky25);
+
+void Identify(benchmark::State& state, int count, IdentificationOptions::Solver solver) {
+  const CellContext& c = *Case(count).context;
+  TrialWorkspace ws;
+  RunTrial(c, 0, &ws);  // fills ws.data with trial 0's readings
+  MeasurementSet data = ws.data;
+  IdentificationOptions options;
+  options.solver = solver;
+  std::vector<double> w(data.repetitions.begin(), data.repetitions.end());
+  LevenbergMarquardt lm;
+  Eigen::VectorXd e;
+  for (auto _ : state) {
+    if (solver == IdentificationOptions::Solver::kCeres) {
+      benchmark::DoNotOptimize(lrcal::Identify(*c.model, data, options));
+    } else {
+      benchmark::DoNotOptimize(lm.Solve(*c.model, data.configs, data.mean_h.data(), w.data(), options, &e));
+    }
+  }
+}
+void BM_IdentifyCase1_LM(benchmark::State& s) { Identify(s, 50, IdentificationOptions::Solver::kLevenbergMarquardt); }
+void BM_IdentifyCase2_LM(benchmark::State& s) { Identify(s, 100, IdentificationOptions::Solver::kLevenbergMarquardt); }
+void BM_IdentifyCase1_Ceres(benchmark::State& s) { Identify(s, 50, IdentificationOptions::Solver::kCeres); }
+void BM_IdentifyCase2_Ceres(benchmark::State& s) { Identify(s, 100, IdentificationOptions::Solver::kCeres); }
+BENCHMARK(BM_IdentifyCase1_LM)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_IdentifyCase2_LM)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_IdentifyCase1_Ceres)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_IdentifyCase2_Ceres)->Unit(benchmark::kMicrosecond);
+
+// The full case-2 trial: simulate 100 × 10 readings, identify 25 parameters, validate on 20.
+void BM_Case2Trial(benchmark::State& state) {
+  const CellContext& c = *Case(100).context;
+  TrialWorkspace ws;
+  long long t = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(RunTrial(c, t++, &ws));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Case2Trial)->Unit(benchmark::kMicrosecond);
+
+// Cost against the number of configurations (pool of N+1, leave-one-out design of N).
+void BM_TrialVsConfigurations(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const CellContext& c = *Case(n, 10, n + 1).context;
+  TrialWorkspace ws;
+  long long t = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(RunTrial(c, t++, &ws));
+  state.counters["configurations"] = n;
+}
+BENCHMARK(BM_TrialVsConfigurations)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMicrosecond);
+
+// Cost against the number of readings per configuration (case 2 design).
+void BM_TrialVsRepetitions(benchmark::State& state) {
+  const int r = static_cast<int>(state.range(0));
+  const CellContext& c = *Case(100, r).context;
+  TrialWorkspace ws;
+  long long t = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(RunTrial(c, t++, &ws));
+  state.counters["repetitions"] = r;
+}
+BENCHMARK(BM_TrialVsRepetitions)->Arg(1)->Arg(10)->Arg(100)->Unit(benchmark::kMicrosecond);
+
+// The whole runner (records, aggregation, tables) on a one-cell case-2 study of 4000 trials.
+void BM_StudyThroughput(benchmark::State& state) {
+  const std::string path = WriteStudy(100, 10, 4000);
+  const Study study = LoadStudy(path);
+  int run = 0;
+  for (auto _ : state) {
+    RunOptions o;
+    o.out_dir = (fs::temp_directory_path() / "lrcal_bench" / ("run" + std::to_string(run++))).string();
+    fs::remove_all(o.out_dir);
+    o.threads = static_cast<int>(state.range(0));
+    o.progress = false;
+    RunResult r = RunStudy(study, o);
+    state.counters["trials_per_s"] = r.computed / r.seconds;
+    state.counters["compute_us_per_trial"] = 1e6 * r.trial_seconds / r.computed;
+    fs::remove_all(o.out_dir);
+  }
+}
+BENCHMARK(BM_StudyThroughput)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+// Aggregation of 10^5 records (one cell).
+void BM_Aggregate1e5(benchmark::State& state) {
+  const fs::path dir = fs::temp_directory_path() / "lrcal_bench" / "agg";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const CellContext& c = *Case(100).context;
+  TrialStore store((dir / "trials.sqlite").string());
+  store.PutCell(ToStoredCell(c));
+  TrialWorkspace ws;
+  TrialRecord proto = RunTrial(c, 0, &ws);
+  std::vector<TrialRecord> batch;
+  for (long long t = 0; t < 100000; ++t) {
+    proto.trial = t;
+    proto.errors[0] = 1e-6 * (t % 97);
+    batch.push_back(proto);
+    if (batch.size() == 10000) {
+      store.Insert(batch);
+      batch.clear();
+    }
+  }
+  const StoredCell cell = store.Cells()[0];
+  for (auto _ : state) benchmark::DoNotOptimize(SummarizeCell(store, cell));
+}
+BENCHMARK(BM_Aggregate1e5)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+}  // namespace lrcal
+
+BENCHMARK_MAIN();
