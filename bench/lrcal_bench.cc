@@ -96,6 +96,7 @@ void BM_BatchDistanceAndJacobian100(benchmark::State& state) {
 }
 BENCHMARK(BM_BatchDistanceAndJacobian100)->Arg(0)->Arg(1);
 
+// Eigen's SYRK, for comparison with NormalMatrix (which lrcal uses).
 void BM_NormalEquations100x25(benchmark::State& state) {
   Eigen::MatrixXd J = Eigen::MatrixXd::Random(100, 25), A(25, 25);
   for (auto _ : state) {
@@ -105,6 +106,15 @@ void BM_NormalEquations100x25(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_NormalEquations100x25);
+
+void BM_NormalMatrixFixedLanes100x25(benchmark::State& state) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Random(100, 25), A;
+  for (auto _ : state) {
+    NormalMatrix(J, &A);
+    benchmark::DoNotOptimize(A.data());
+  }
+}
+BENCHMARK(BM_NormalMatrixFixedLanes100x25);
 
 void BM_Cholesky25(benchmark::State& state) {
   Eigen::MatrixXd J = Eigen::MatrixXd::Random(100, 25);

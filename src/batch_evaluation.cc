@@ -1,5 +1,7 @@
 #include "lrcal/batch_evaluation.h"
 
+#include "lrcal/cpu_dispatch.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -30,16 +32,29 @@ void BatchEvaluator::SetConfigurations(const ConfigurationSet& configs) {
   scratch_.resize(8 * static_cast<std::size_t>(m_));
 }
 
-bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point,
-                              double* __restrict h, double* __restrict J) {
-  return J ? EvaluateImpl<true>(model, point, h, J) : EvaluateImpl<false>(model, point, h, nullptr);
-}
+namespace {
+
+struct KernelArgs {
+  int m;
+  const ModelPoint* point;
+  const ParameterSet* parameters;
+  const double* q;
+  const double* cq;
+  const double* sq;
+  double* state;
+  double* frames;
+  double* scratch;
+  double* h;
+  double* J;
+};
 
 template <bool kJacobian>
-bool BatchEvaluator::EvaluateImpl(const MeasurementModel& model, const ModelPoint& point,
-                                  double* __restrict h, double* __restrict J) {
-  const int m = m_;
-  double* __restrict x0 = state_.data();
+[[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
+  const int m = args.m;
+  const ModelPoint& point = *args.point;
+  double* __restrict h = args.h;
+  double* __restrict J = args.J;
+  double* __restrict x0 = args.state;
   double* __restrict x1 = x0 + m;
   double* __restrict x2 = x1 + m;
   double* __restrict y0 = x2 + m;
@@ -51,17 +66,17 @@ bool BatchEvaluator::EvaluateImpl(const MeasurementModel& model, const ModelPoin
   double* __restrict o0 = z2 + m;
   double* __restrict o1 = o0 + m;
   double* __restrict o2 = o1 + m;
-  std::fill(state_.begin(), state_.end(), 0.0);
+  std::fill(args.state, args.state + 12 * m, 0.0);
   std::fill(x0, x0 + m, 1.0);
   std::fill(y1, y1 + m, 1.0);
   std::fill(z2, z2 + m, 1.0);
 
   for (int l = 0; l < point.num_links; ++l) {
     const ModelPoint::LinkTrig& t = point.links[l];
-    const double* __restrict cq = cq_.data() + l * m;
-    const double* __restrict sq = sq_.data() + l * m;
-    const double* __restrict q = q_.data() + l * m;
-    double* f = frames_.data() + static_cast<std::size_t>(l) * kFrameArrays * m;
+    const double* __restrict cq = args.cq + l * m;
+    const double* __restrict sq = args.sq + l * m;
+    const double* __restrict q = args.q + l * m;
+    double* f = args.frames + static_cast<std::size_t>(l) * kFrameArrays * m;
     double* __restrict fz0 = f + (kZPrev + 0) * m;
     double* __restrict fz1 = f + (kZPrev + 1) * m;
     double* __restrict fz2 = f + (kZPrev + 2) * m;
@@ -123,7 +138,7 @@ bool BatchEvaluator::EvaluateImpl(const MeasurementModel& model, const ModelPoin
   // Readings: h = -(n·p + f)/(n·b); keep -1/(n·b) and the hit point for the Jacobian.
   const double n0 = point.plane.normal.x(), n1 = point.plane.normal.y(),
                n2 = point.plane.normal.z(), fo = point.plane.offset;
-  double* __restrict inv = scratch_.data();
+  double* __restrict inv = args.scratch;
   double* __restrict ph0 = inv + m;
   double* __restrict ph1 = ph0 + m;
   double* __restrict ph2 = ph1 + m;
@@ -143,11 +158,11 @@ bool BatchEvaluator::EvaluateImpl(const MeasurementModel& model, const ModelPoin
   for (int i = 0; i < m; ++i) parallel += std::fabs(nbs[i]) <= 1e-12;
   if constexpr (!kJacobian) return parallel == 0;
 
-  const ParameterSet& ps = model.parameters();
+  const ParameterSet& ps = *args.parameters;
   for (int k = 0; k < ps.num_robot(); ++k) {
     const int index = ps.robot_values[k];
     const int l = index / kValuesPerLink;
-    const double* f = frames_.data() + static_cast<std::size_t>(l) * kFrameArrays * m;
+    const double* f = args.frames + static_cast<std::size_t>(l) * kFrameArrays * m;
     double* __restrict col = J + static_cast<std::size_t>(k) * m;
     const int v = index % kValuesPerLink;
     if (v == kD || v == kA) {
@@ -187,6 +202,37 @@ bool BatchEvaluator::EvaluateImpl(const MeasurementModel& model, const ModelPoin
     for (int i = 0; i < m; ++i) col[i] = inv[i];
   }
   return parallel == 0;
+}
+
+bool KernelDefault(const KernelArgs& a) { return a.J ? KernelBody<true>(a) : KernelBody<false>(a); }
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) bool KernelAvx2(const KernelArgs& a) {
+  return a.J ? KernelBody<true>(a) : KernelBody<false>(a);
+}
+__attribute__((target("avx512f"))) bool KernelAvx512(const KernelArgs& a) {
+  return a.J ? KernelBody<true>(a) : KernelBody<false>(a);
+}
+#endif
+
+}  // namespace
+
+bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
+                              double* J) {
+  return Evaluate(model, point, h, J, ActiveIsa());
+}
+
+bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
+                              double* J, Isa isa) {
+  const KernelArgs args{m_,          &point,        &model.parameters(), q_.data(),
+                        cq_.data(),  sq_.data(),    state_.data(),       frames_.data(),
+                        scratch_.data(), h,         J};
+  switch (isa) {
+#if defined(__x86_64__)
+    case Isa::kAvx512: return KernelAvx512(args);
+    case Isa::kAvx2: return KernelAvx2(args);
+#endif
+    default: return KernelDefault(args);
+  }
 }
 
 }  // namespace lrcal

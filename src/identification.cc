@@ -1,5 +1,7 @@
 #include "lrcal/identification.h"
 
+#include "lrcal/cpu_dispatch.h"
+
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
@@ -97,11 +99,58 @@ double LevenbergMarquardt::Cost(const MeasurementModel& model, const double* mea
   return 0.5 * sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_).squaredNorm();
 }
 
+namespace {
+
+[[gnu::always_inline]] inline void NormalMatrixBody(const double* __restrict J, int m, int n,
+                                                    double* __restrict A) {
+  constexpr int kLanes = 8;
+  const int full = m - m % kLanes;
+  for (int a = 0; a < n; ++a) {
+    const double* __restrict ca = J + static_cast<std::size_t>(a) * m;
+    for (int b = 0; b <= a; ++b) {
+      const double* __restrict cb = J + static_cast<std::size_t>(b) * m;
+      double acc[kLanes] = {0, 0, 0, 0, 0, 0, 0, 0};
+      for (int i = 0; i < full; i += kLanes)
+        for (int l = 0; l < kLanes; ++l) acc[l] += ca[i + l] * cb[i + l];
+      double tail = 0;
+      for (int i = full; i < m; ++i) tail += ca[i] * cb[i];
+      const double sum =
+          ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail;
+      A[a + static_cast<std::size_t>(b) * n] = sum;
+      A[b + static_cast<std::size_t>(a) * n] = sum;
+    }
+  }
+}
+
+void NormalMatrixDefault(const double* J, int m, int n, double* A) { NormalMatrixBody(J, m, n, A); }
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void NormalMatrixAvx2(const double* J, int m, int n, double* A) {
+  NormalMatrixBody(J, m, n, A);
+}
+__attribute__((target("avx512f"))) void NormalMatrixAvx512(const double* J, int m, int n,
+                                                            double* A) {
+  NormalMatrixBody(J, m, n, A);
+}
+#endif
+
+}  // namespace
+
+void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa) {
+  const int m = static_cast<int>(J.rows()), n = static_cast<int>(J.cols());
+  A->resize(n, n);
+  switch (isa) {
+#if defined(__x86_64__)
+    case Isa::kAvx512: NormalMatrixAvx512(J.data(), m, n, A->data()); return;
+    case Isa::kAvx2: NormalMatrixAvx2(J.data(), m, n, A->data()); return;
+#endif
+    default: NormalMatrixDefault(J.data(), m, n, A->data()); return;
+  }
+}
+
+void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A) { NormalMatrix(J, A, ActiveIsa()); }
+
 void LevenbergMarquardt::FormNormalEquations() {
-  const Eigen::Index n = J_.cols();
-  A_.setZero(n, n);
-  A_.selfadjointView<Eigen::Lower>().rankUpdate(J_.transpose());
-  A_.triangularView<Eigen::StrictlyUpper>() = A_.transpose();
+  NormalMatrix(J_, &A_);
   g_.noalias() = J_.transpose() * r_;
 }
 
@@ -131,7 +180,13 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
     result.termination = Termination::kBeamMissed;
     return result;
   }
-  FormNormalEquations();
+  const bool equal_weights = (sqrt_w_.array() == sqrt_w_[0]).all();
+  if (nominal && equal_weights && nominal->GtG.rows() == n) {
+    A_ = weights[0] * nominal->GtG;  // the first normal matrix is the same for every trial
+    g_.noalias() = J_.transpose() * r_;
+  } else {
+    FormNormalEquations();
+  }
 
   // Column scaling (Marquardt): unit diagonal. A zero column is rank deficiency outright.
   scale_.resize(n);

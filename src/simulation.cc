@@ -28,6 +28,12 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   std::vector<BeamMiss> local;
   std::vector<BeamMiss>* m = misses ? misses : &local;
   ExactReadings(robot, true_link_values, true_plane, configs, &h, m);
+  return AddNoise(h, *m, configs, noise, stream, data, raw, noise_slots);
+}
+
+int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
+             const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
+             MeasurementSet* data, std::vector<double>* raw, const std::vector<int>* noise_slots) {
   // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial).
   if (data->configs.num_joints() != configs.num_joints()) data->configs = ConfigurationSet(configs.num_joints());
   data->configs.Clear();
@@ -41,7 +47,7 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   int missed = 0;
   for (int i = 0; i < configs.size(); ++i) {
     const std::uint64_t slot = noise_slots ? (*noise_slots)[i] : i;
-    if ((*m)[i] != BeamMiss::kNone) {
+    if (misses[i] != BeamMiss::kNone) {
       ++missed;
       continue;
     }

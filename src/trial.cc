@@ -167,6 +167,12 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
       ExactReadings(*c->robot, c->robot->nominal_values(), c->plane, c->design,
                     &c->design_nominal.h, &unused);
       c->design_nominal.G = IdentificationJacobian(*c->model, c->design);
+      c->design_nominal.GtG = c->design_nominal.G.transpose() * c->design_nominal.G;
+    }
+    if (!s.truth_random) {
+      ExactReadings(*c->robot, c->true_values_fixed, c->plane, c->design, &c->design_true_h,
+                    &c->design_true_miss);
+      c->validation_true_poses = ToolPoses(*c->robot, c->true_values_fixed, c->validation);
     }
     if (!s.truth_random)
       c->nominal_validation =
@@ -231,10 +237,13 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
   }
 
   NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
-  const int missed = SimulateReadings(*c.robot, truth_values, c.plane, *design, noise,
-                                      RandomStream(c.seed, 0, static_cast<std::uint64_t>(trial),
-                                                   RandomPurpose::kNoise),
-                                      &ws->data, nullptr, nullptr, slots);
+  const RandomStream noise_stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
+  const bool cached = !s.truth_random && !s.pool_redraw;
+  const int missed =
+      cached ? AddNoise(c.design_true_h, c.design_true_miss, *design, noise, noise_stream, &ws->data,
+                        nullptr, slots)
+             : SimulateReadings(*c.robot, truth_values, c.plane, *design, noise, noise_stream,
+                                &ws->data, nullptr, nullptr, slots);
   if (missed > 0) return finish(TrialStatus::kBeamMissed);
   ws->weights.assign(ws->data.repetitions.begin(), ws->data.repetitions.end());
   IdentificationOptions options = s.identification;
@@ -255,7 +264,10 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
   rec.errors.resize(n);
   for (int k = 0; k < n; ++k) rec.errors[k] = ws->e[k] - truth_delta[k];
   const Eigen::VectorXd identified = c.model->LinkValues(ws->e.data());
-  rec.validation = Flatten(ComparePoses(*c.robot, truth_values, identified, c.validation).stats);
+  rec.validation = Flatten(
+      (s.truth_random ? ComparePoses(*c.robot, truth_values, identified, c.validation)
+                      : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation))
+          .stats);
   return finish(TrialStatus::kOk);
 }
 

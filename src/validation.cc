@@ -10,17 +10,30 @@ Eigen::Vector3d RotationVector(const Eigen::Matrix3d& R) {
   return aa.angle() * aa.axis();
 }
 
+std::vector<Pose<double>> ToolPoses(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                                    const ConfigurationSet& configs) {
+  ModelPoint point;
+  PrepareModelPoint(robot, link_values.data(), Plane{}, &point);
+  std::vector<Pose<double>> poses(configs.size());
+  for (int i = 0; i < configs.size(); ++i) poses[i] = ToolPose(point, configs, i);
+  return poses;
+}
+
 PoseErrors ComparePoses(const RobotModel& robot, const Eigen::VectorXd& true_values,
                         const Eigen::VectorXd& model_values, const ConfigurationSet& configs) {
-  ModelPoint truth, model;
-  PrepareModelPoint(robot, true_values.data(), Plane{}, &truth);
+  return ComparePoses(robot, ToolPoses(robot, true_values, configs), model_values, configs);
+}
+
+PoseErrors ComparePoses(const RobotModel& robot, const std::vector<Pose<double>>& true_poses,
+                        const Eigen::VectorXd& model_values, const ConfigurationSet& configs) {
+  ModelPoint model;
   PrepareModelPoint(robot, model_values.data(), Plane{}, &model);
   const int m = configs.size();
   PoseErrors out;
   out.position.resize(3, m);
   out.orientation.resize(3, m);
   for (int i = 0; i < m; ++i) {
-    const Pose<double> pt = ToolPose(truth, configs, i);
+    const Pose<double>& pt = true_poses[i];
     const Pose<double> pm = ToolPose(model, configs, i);
     out.position.col(i) = pt.p_BT - pm.p_BT;
     out.orientation.col(i) = RotationVector(pt.R_BT * pm.R_BT.transpose());

@@ -78,6 +78,23 @@ TEST(MonteCarlo, TablesAreBitIdenticalForOneTwoAndFourThreads) {
   EXPECT_EQ(t1, Tables(dir + "/t4"));
 }
 
+TEST(MonteCarlo, TablesAreBitIdenticalWhicheverInstructionSetRuns) {
+  // A machine without AVX-512 (or a shard on another node) runs the default variant of the hot
+  // kernels: the tables must not change.
+  const std::string dir = testing::TempDir("mc_isa");
+  const std::string study = SmallStudy(dir, 30);
+  std::string out;
+  for (const char* isa : {"default", "avx2", "avx512"}) {
+    ASSERT_EQ(testing::RunCommand(std::string("LRCAL_ISA=") + isa + " " + testing::LrcalBinary() +
+                                      " run " + study + " --out " + dir + "/" + isa + " --quiet",
+                                  &out),
+              0)
+        << out;
+  }
+  EXPECT_EQ(Tables(dir + "/default"), Tables(dir + "/avx2"));
+  EXPECT_EQ(Tables(dir + "/default"), Tables(dir + "/avx512"));
+}
+
 TEST(MonteCarlo, ShardsMergedEqualOneRun) {
   const std::string dir = testing::TempDir("mc_shards");
   const std::string study = SmallStudy(dir, 30);

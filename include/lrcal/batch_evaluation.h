@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "lrcal/cpu_dispatch.h"
 #include "lrcal/measurement_model.h"
 
 namespace lrcal {
@@ -24,10 +25,11 @@ class BatchEvaluator {
   /// matrix J (leading dimension m). Returns false if some beam runs parallel to the plane
   /// (|n·b| ≤ 1e-12), whose h is then not finite.
   bool Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h, double* J);
+  /// The same with a chosen instruction-set variant (cpu_dispatch.h): identical bits.
+  bool Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h, double* J,
+                Isa isa);
 
  private:
-  template <bool kJacobian>
-  bool EvaluateImpl(const MeasurementModel& model, const ModelPoint& point, double* h, double* J);
   int m_ = 0, joints_ = 0;
   std::vector<double> q_, cq_, sq_;  // [joint·m + i]
   // Chain state and per-link frames: [(link·kFrameArrays + k)·m + i].

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "lrcal/batch_evaluation.h"
+#include "lrcal/cpu_dispatch.h"
 #include "lrcal/identifiability.h"
 #include "lrcal/measurement_model.h"
 
@@ -118,7 +119,8 @@ class LevenbergMarquardt {
   /// every trial of a Monte-Carlo cell, so it is computed once per cell.
   struct Nominal {
     std::vector<double> h;
-    Eigen::MatrixXd G;  ///< m×n
+    Eigen::MatrixXd G;    ///< m×n
+    Eigen::MatrixXd GtG;  ///< GᵀG (unweighted), used when every weight is the same
   };
   /// Solves for e (resized to model.num_parameters(), started at 0). `mean_h` and `weights`
   /// have configs.size() entries (weights = repetitions). `nominal`, if given, must be the model
@@ -147,6 +149,14 @@ class LevenbergMarquardt {
   Eigen::VectorXd g_, step_, rhs_, e_trial_, scale_;
   ModelPoint point_;
 };
+
+/// A = JᵀJ (n×n, both triangles) for a column-major m×n J. Each entry is summed in 8 fixed
+/// partial sums (index mod 8) added in a fixed order, so the result has the same bits whatever
+/// vector width the compiler uses (SSE2, AVX2, AVX-512) — and it vectorises without
+/// -ffast-math.
+void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A);
+/// The same with a chosen instruction-set variant (cpu_dispatch.h), for tests and benchmarks.
+void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa);
 
 /// Solves the symmetric positive definite system A·x = b in place by a plain Cholesky
 /// factorisation (faster than Eigen's LLT at these sizes). Returns false if a pivot is not

@@ -42,4 +42,11 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
                      std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr,
                      const std::vector<int>* noise_slots = nullptr);
 
+/// The noisy part of SimulateReadings, from exact readings already computed (e.g. once per
+/// Monte-Carlo cell when the truth and the design are fixed). Same results as SimulateReadings.
+int AddNoise(const std::vector<double>& exact_h, const std::vector<BeamMiss>& misses,
+             const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
+             MeasurementSet* data, std::vector<double>* raw = nullptr,
+             const std::vector<int>* noise_slots = nullptr);
+
 }  // namespace lrcal

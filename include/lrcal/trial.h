@@ -44,6 +44,9 @@ struct CellContext {
   double design_sigma_min = 0;       ///< σ_min of G (SI) of the selected design
   ConfigurationSet design;           ///< the selected configurations
   LevenbergMarquardt::Nominal design_nominal;  ///< h and G of the nominal model on the design
+  std::vector<double> design_true_h;           ///< exact true readings on the design (fixed truth)
+  std::vector<BeamMiss> design_true_miss;
+  std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
   ConfigurationSet validation;       ///< when not redrawn (validation is always shared per cell)
   Eigen::VectorXd predicted_std;     ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
   Eigen::VectorXd true_delta_fixed;  ///< truth (estimate-vector layout) when the truth is fixed

@@ -31,6 +31,13 @@ struct PoseErrors {
 PoseErrors ComparePoses(const RobotModel& robot, const Eigen::VectorXd& true_values,
                         const Eigen::VectorXd& model_values, const ConfigurationSet& configs);
 
+/// The true robot's tool poses at every configuration (for ComparePoses below).
+std::vector<Pose<double>> ToolPoses(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                                    const ConfigurationSet& configs);
+/// The same as ComparePoses with the true poses computed beforehand.
+PoseErrors ComparePoses(const RobotModel& robot, const std::vector<Pose<double>>& true_poses,
+                        const Eigen::VectorXd& model_values, const ConfigurationSet& configs);
+
 /// Rotation vector (axis·angle, rad) of a rotation matrix; exact near 0 and π.
 Eigen::Vector3d RotationVector(const Eigen::Matrix3d& R);
 
