@@ -200,48 +200,57 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
 
   for (const auto& context : contexts) store.PutCell(ToStoredCell(*context));
 
-  // The work: every (cell, trial) of this shard that the store does not have.
-  struct Work {
-    int cell;
-    long long trial;
-  };
-  std::vector<Work> work;
+  // The work: every (cell, trial) of this shard that the store does not have. Claimed lazily
+  // from a cursor over (cell, trial) with a done-bitmap per cell, so memory does not grow with
+  // the number of trials.
   RunResult result;
+  const long long trials = study.trials;
+  std::vector<std::vector<bool>> done(study.cells.size());
   for (std::size_t c = 0; c < study.cells.size(); ++c) {
-    const std::vector<long long> done = store.DoneTrials(study.cells[c].id);
-    std::size_t d = 0;
-    for (long long t = 0; t < study.trials; ++t) {
-      if (t % options.shard_count != options.shard_index) continue;
+    done[c].assign(trials, false);
+    for (long long t : store.DoneTrials(study.cells[c].id))
+      if (t >= 0 && t < trials) done[c][t] = true;
+    for (long long t = options.shard_index; t < trials; t += options.shard_count) {
       ++result.total;
-      while (d < done.size() && done[d] < t) ++d;
-      if (d < done.size() && done[d] == t) {
-        ++result.done_before;
-        continue;
-      }
-      work.push_back({static_cast<int>(c), t});
+      if (done[c][t]) ++result.done_before;
     }
   }
-  if (options.max_new_trials > 0 && static_cast<long long>(work.size()) > options.max_new_trials)
-    work.resize(options.max_new_trials);
+  long long budget = result.total - result.done_before;
+  if (options.max_new_trials > 0) budget = std::min(budget, options.max_new_trials);
+  const long long space = static_cast<long long>(study.cells.size()) * trials;
+  std::mutex claim_mutex;
+  long long cursor = 0;   // next (cell·trials + trial) to look at
+  long long claimed = 0;  // trials handed out
+  // Hands out up to `max` (cell, trial) pairs of this shard not done yet, in canonical order.
+  auto claim = [&](std::vector<std::pair<int, long long>>* out, int max) {
+    out->clear();
+    std::lock_guard<std::mutex> g(claim_mutex);
+    while (static_cast<int>(out->size()) < max && claimed < budget && cursor < space) {
+      const int c = static_cast<int>(cursor / trials);
+      const long long t = cursor % trials;
+      ++cursor;
+      if (t % options.shard_count != options.shard_index || done[c][t]) continue;
+      out->emplace_back(c, t);
+      ++claimed;
+    }
+  };
 
   // Workers compute; this thread writes batches and reports progress.
-  std::atomic<std::size_t> next{0};
   std::atomic<int> running{threads};
   std::mutex mutex;
   std::condition_variable cv;
   std::vector<TrialRecord> pending;
   std::exception_ptr failure;
-  constexpr std::size_t kChunk = 8;
+  constexpr int kChunk = 8;
   auto worker = [&] {
     TrialWorkspace ws;
     std::vector<TrialRecord> local;
+    std::vector<std::pair<int, long long>> chunk;
     try {
       while (g_stop_signals.load() == 0) {
-        const std::size_t begin = next.fetch_add(kChunk);
-        if (begin >= work.size()) break;
-        const std::size_t end = std::min(work.size(), begin + kChunk);
-        for (std::size_t i = begin; i < end; ++i)
-          local.push_back(RunTrial(*contexts[work[i].cell], work[i].trial, &ws));
+        claim(&chunk, kChunk);
+        if (chunk.empty()) break;
+        for (const auto& [cell, trial] : chunk) local.push_back(RunTrial(*contexts[cell], trial, &ws));
         std::lock_guard<std::mutex> g(mutex);
         for (auto& r : local) pending.push_back(std::move(r));
         local.clear();

@@ -21,7 +21,10 @@ double PercentileRank(const std::vector<double>& s, double x) {
   return 100.0 * ((lo - s.begin()) + 0.5 * (hi - lo)) / s.size();
 }
 
-Distribution Describe(std::vector<double> v) {
+Distribution Describe(std::vector<double> v) { return DescribeInPlace(&v); }
+
+Distribution DescribeInPlace(std::vector<double>* values) {
+  std::vector<double>& v = *values;
   Distribution d;
   d.n = static_cast<long long>(v.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -66,13 +69,13 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
     sigma_hat.push_back(r.sigma_hat);
   });
   for (int k = 0; k < 12; ++k) {
-    s.validation[k] = Describe(val[k]);
-    s.nominal[k] = Describe(nom[k]);
-    s.validation_sorted[k] = val[k];
-    std::sort(s.validation_sorted[k].begin(), s.validation_sorted[k].end());
+    s.validation[k] = DescribeInPlace(&val[k]);  // leaves val[k] sorted
+    s.nominal[k] = DescribeInPlace(&nom[k]);
+    s.validation_sorted[k] = std::move(val[k]);
+    std::vector<double>().swap(nom[k]);
   }
-  s.iterations = Describe(iterations);
-  s.sigma_hat = Describe(sigma_hat);
+  s.iterations = DescribeInPlace(&iterations);
+  s.sigma_hat = DescribeInPlace(&sigma_hat);
   // Parameters: bias, spread, and the empirical covariance (two passes, canonical order).
   const long long m = s.ok;
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(n);
@@ -91,7 +94,7 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
   s.correlation = s.covariance;
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) s.correlation(a, b) /= sd[a] * sd[b];
-  s.errors_sorted = errors;
+  s.errors_sorted = std::move(errors);  // sorted in place below, after the last use in order
   for (auto& e : s.errors_sorted) std::sort(e.begin(), e.end());
   for (int k = 0; k < n; ++k) {
     ParameterStats p;

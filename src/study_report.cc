@@ -58,6 +58,51 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   fs::create_directories(dir);
   StudyTablesResult result;
   const long long trials = study.value("trials", 0LL);
+  // The paper's published numbers in our distributions.
+  Table place({"case", "quantity", "axis/parameter", "unit", "paper", "lrcal p5", "lrcal p50",
+               "lrcal p95", "percentile of paper"});
+  bool any_paper = false;
+  // Placement needs a cell's sorted values; it runs as each cell is summarised, after which the
+  // values are released (memory: one cell's worth).
+  auto place_cell = [&](const CellSummary& s) {
+    const Json settings = Json::parse(s.cell.settings);
+    const int pc = settings.value("paper_case", 0);
+    if (pc < 1 || pc > 2) return;
+    any_paper = true;
+    const std::string label = "case " + std::to_string(pc);
+    for (int m = 0; m < 4; ++m) {
+      for (int a = 0; a < 3; ++a) {
+        const int k = 3 * m + a;
+        const double paper = kPaperValidation[pc][a][m];
+        const auto& sorted = s.validation_sorted[k];
+        place.AddRow({label, std::string("validation ") + kMetricNames[m], kAxes[a],
+                      m % 2 == 0 ? "mm" : "mrad", Fixed(paper), Fixed(s.validation[k].p5 * 1e3),
+                      Fixed(s.validation[k].p50 * 1e3), Fixed(s.validation[k].p95 * 1e3),
+                      Fixed(PercentileRank(sorted, paper * 1e-3), 2)});
+      }
+    }
+    // Identified parameters: published error = published Δ − the robot file's true Δ.
+    try {
+      const RobotModel robot = LoadRobotModel(ResolveRobotPath(settings["robot"].get<std::string>()));
+      const double scale = settings["truth"].value("scale", 1.0);
+      if (robot.num_links() == 6 && settings["truth"].value("mode", std::string()) == "robot_file") {
+        for (std::size_t k = 0; k < s.parameters.size(); ++k) {
+          const int index = robot.FindValue(s.parameters[k].name);
+          if (index < 0) continue;
+          const double published = kPaperIdentified[pc - 1][index / kValuesPerLink][index % kValuesPerLink];
+          if (std::isnan(published)) continue;
+          const double err = published * 1e-3 - robot.true_errors()[index] * scale;
+          const auto& sorted = s.errors_sorted[k];
+          place.AddRow({label, "identified error", s.parameters[k].name,
+                        IsAngularName(s.parameters[k].name) ? "mrad" : "mm", Fixed(err * 1e3),
+                        Fixed(Percentile(sorted, 5) * 1e3), Fixed(Percentile(sorted, 50) * 1e3),
+                        Fixed(Percentile(sorted, 95) * 1e3), Fixed(PercentileRank(sorted, err), 2)});
+        }
+      }
+    } catch (const InputError&) {
+      // The robot file is gone: the placement of parameters is left out, the rest stands.
+    }
+  };
   // The study's cells in its canonical order (the store may also hold cells of an earlier sweep).
   std::vector<StoredCell> stored = store.Cells();
   std::vector<StoredCell> cells_in_order;
@@ -70,6 +115,9 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   }
   for (const StoredCell& c : cells_in_order) {
     result.cells.push_back(SummarizeCell(store, c));
+    place_cell(result.cells.back());
+    for (auto& v : result.cells.back().validation_sorted) std::vector<double>().swap(v);
+    std::vector<std::vector<double>>().swap(result.cells.back().errors_sorted);
     if (result.cells.back().trials < trials) result.complete = false;
   }
 
@@ -190,49 +238,6 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
     md << "\n" << t.ToMarkdown();
   }
 
-  // The paper's published numbers in our distributions.
-  Table place({"case", "quantity", "axis/parameter", "unit", "paper", "lrcal p5", "lrcal p50",
-               "lrcal p95", "percentile of paper"});
-  bool any_paper = false;
-  for (const auto& s : result.cells) {
-    const Json settings = Json::parse(s.cell.settings);
-    const int pc = settings.value("paper_case", 0);
-    if (pc < 1 || pc > 2) continue;
-    any_paper = true;
-    const std::string label = "case " + std::to_string(pc);
-    for (int m = 0; m < 4; ++m) {
-      for (int a = 0; a < 3; ++a) {
-        const int k = 3 * m + a;
-        const double paper = kPaperValidation[pc][a][m];
-        const auto& sorted = s.validation_sorted[k];
-        place.AddRow({label, std::string("validation ") + kMetricNames[m], kAxes[a],
-                      m % 2 == 0 ? "mm" : "mrad", Fixed(paper), Fixed(s.validation[k].p5 * 1e3),
-                      Fixed(s.validation[k].p50 * 1e3), Fixed(s.validation[k].p95 * 1e3),
-                      Fixed(PercentileRank(sorted, paper * 1e-3), 2)});
-      }
-    }
-    // Identified parameters: published error = published Δ − the robot file's true Δ.
-    try {
-      const RobotModel robot = LoadRobotModel(ResolveRobotPath(settings["robot"].get<std::string>()));
-      const double scale = settings["truth"].value("scale", 1.0);
-      if (robot.num_links() == 6 && settings["truth"].value("mode", std::string()) == "robot_file") {
-        for (std::size_t k = 0; k < s.parameters.size(); ++k) {
-          const int index = robot.FindValue(s.parameters[k].name);
-          if (index < 0) continue;
-          const double published = kPaperIdentified[pc - 1][index / kValuesPerLink][index % kValuesPerLink];
-          if (std::isnan(published)) continue;
-          const double err = published * 1e-3 - robot.true_errors()[index] * scale;
-          const auto& sorted = s.errors_sorted[k];
-          place.AddRow({label, "identified error", s.parameters[k].name,
-                        IsAngularName(s.parameters[k].name) ? "mrad" : "mm", Fixed(err * 1e3),
-                        Fixed(Percentile(sorted, 5) * 1e3), Fixed(Percentile(sorted, 50) * 1e3),
-                        Fixed(Percentile(sorted, 95) * 1e3), Fixed(PercentileRank(sorted, err), 2)});
-        }
-      }
-    } catch (const InputError&) {
-      // The robot file is gone: the placement of parameters is left out, the rest stands.
-    }
-  }
   if (any_paper) {
     md << "\n## The paper's published numbers in lrcal's distributions\n\nPercentile of the "
           "published value among lrcal's trials (0 or 100: outside every trial). Identified "

@@ -23,8 +23,11 @@ struct Distribution {
   double mean = 0, std = 0, p5 = 0, p50 = 0, p95 = 0, min = 0, max = 0;
 };
 
-/// Sample statistics of `values` (std with n−1; NaN fields when n = 0).
+/// Sample statistics of `values` (std with n−1; NaN fields when n = 0). Mean and std are summed
+/// in the given (canonical) order.
 Distribution Describe(std::vector<double> values);
+/// The same without a copy: sorts `values` in place.
+Distribution DescribeInPlace(std::vector<double>* values);
 /// Percentile p in [0, 100] of ascending `sorted` values (type 7).
 double Percentile(const std::vector<double>& sorted, double p);
 /// Where x falls in ascending `sorted` values, in percent: 100·(#below + ½#equal)/n.
@@ -43,8 +46,8 @@ struct CellSummary {
   Eigen::MatrixXd covariance, correlation;  ///< empirical, SI
   std::array<Distribution, 12> validation;  ///< identified model, SI (layout: trial.h)
   std::array<Distribution, 12> nominal;     ///< nominal model, SI
-  /// Sorted values, kept for percentile ranks (paper placement): validation metrics, and the
-  /// identified Δ = truth + error per parameter.
+  /// Sorted values, kept for percentile ranks (paper placement): validation metrics and the
+  /// parameter errors. The caller may release them once used (memory is then one cell's worth).
   std::array<std::vector<double>, 12> validation_sorted;
   std::vector<std::vector<double>> errors_sorted;
   Distribution iterations, sigma_hat;
