@@ -149,6 +149,7 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
   // run fails here, before anything is written.
   std::vector<std::unique_ptr<CellContext>> contexts;
   for (const Cell& cell : study.cells) contexts.push_back(PrepareCell(study, cell));
+  const auto t_prepared = std::chrono::steady_clock::now();
 
   const fs::path dir = options.out_dir;
   fs::create_directories(dir);
@@ -251,19 +252,28 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
         claim(&chunk, kChunk);
         if (chunk.empty()) break;
         for (const auto& [cell, trial] : chunk) local.push_back(RunTrial(*contexts[cell], trial, &ws));
-        std::lock_guard<std::mutex> g(mutex);
-        for (auto& r : local) pending.push_back(std::move(r));
+        bool full;
+        {
+          std::lock_guard<std::mutex> g(mutex);
+          for (auto& r : local) pending.push_back(std::move(r));
+          full = pending.size() >= static_cast<std::size_t>(options.batch_size);
+        }
         local.clear();
-        cv.notify_one();
+        if (full) cv.notify_one();  // else the writer wakes on its own every 100 ms
       }
     } catch (...) {
       std::lock_guard<std::mutex> g(mutex);
       if (!failure) failure = std::current_exception();
       g_stop_signals.fetch_add(1);
     }
-    running.fetch_sub(1);
+    {
+      // Under the mutex: the writer checks `running` under it, so this wake-up cannot be lost.
+      std::lock_guard<std::mutex> g(mutex);
+      running.fetch_sub(1);
+    }
     cv.notify_one();
   };
+  const auto t_run = std::chrono::steady_clock::now();
   std::vector<std::thread> pool;
   for (int i = 0; i < threads; ++i) pool.emplace_back(worker);
 
@@ -297,7 +307,9 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
     bool finished;
     {
       std::unique_lock<std::mutex> g(mutex);
-      cv.wait_for(g, std::chrono::milliseconds(100));
+      cv.wait_for(g, std::chrono::milliseconds(100), [&] {
+        return running.load() == 0 || pending.size() >= static_cast<std::size_t>(options.batch_size);
+      });
       for (auto& r : pending) batch.push_back(std::move(r));
       pending.clear();
       finished = running.load() == 0;
@@ -319,20 +331,29 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
     if (finished) break;
   }
   for (auto& t : pool) t.join();
+  const auto t_ran = std::chrono::steady_clock::now();
   report(true);
   if (failure) std::rethrow_exception(failure);
+  result.prepare_seconds = std::chrono::duration<double>(t_prepared - t0).count();
+  result.run_seconds = std::chrono::duration<double>(t_ran - t_run).count();
 
   result.interrupted = g_stop_signals.load() > 0 ||
                        result.done_before + result.computed < result.total;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   manifest["sessions"][session_index]["end"] = Now();
   manifest["sessions"][session_index]["trials_computed"] = result.computed;
   manifest["sessions"][session_index]["ended"] = result.interrupted ? "interrupted" : "completed";
   if (!result.interrupted && options.shard_count == 1) {
+    const auto t_tables = std::chrono::steady_clock::now();
     WriteStudyTables(store, study_json, dir.string());
     result.tables_written = true;
+    result.tables_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_tables).count();
     manifest["finished"] = Now();
   }
+  manifest["sessions"][session_index]["seconds"] = {
+      {"prepare", result.prepare_seconds}, {"trials", result.run_seconds},
+      {"tables", result.tables_seconds}, {"sum_of_trial_times", result.trial_seconds}};
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   WriteJsonAtomically(manifest_path, manifest);
   return result;
 }

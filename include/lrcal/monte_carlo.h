@@ -40,8 +40,11 @@ struct RunResult {
   long long computed = 0;       ///< computed by this session
   bool interrupted = false;
   bool tables_written = false;
-  double seconds = 0;
+  double seconds = 0;           ///< wall time of the whole call
   double trial_seconds = 0;     ///< sum of the computed trials' own wall time
+  double prepare_seconds = 0;   ///< wall time preparing the cells (pools, designs, covariance)
+  double run_seconds = 0;       ///< wall time from the first trial to the last record written
+  double tables_seconds = 0;    ///< wall time aggregating and writing the tables
 };
 
 /// Parses "i/N" (1-based i) into index i−1 and count N. Throws InputError.

@@ -55,6 +55,14 @@ int RunCommand(const std::vector<std::string>& args) {
   if (r.computed > 0)
     std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial";
   std::cerr << ")\n";
+  if (r.computed > 0) {
+    const int threads = options.threads > 0 ? options.threads
+                                            : std::max(1u, std::thread::hardware_concurrency());
+    std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
+              << Fixed(r.run_seconds, 3) << " s (" << threads << " threads; runner overhead "
+              << Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1)
+              << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3) << " s\n";
+  }
   if (r.tables_written) {
     std::cout << "tables: " << options.out_dir << "/tables/summary.md (also .csv, .json, .tex)\n";
   } else if (r.interrupted) {
