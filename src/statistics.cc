@@ -14,11 +14,26 @@ double Percentile(const std::vector<double>& s, double p) {
   return s[lo] + (h - lo) * (s[hi] - s[lo]);
 }
 
-double PercentileRank(const std::vector<double>& s, double x) {
-  if (s.empty() || std::isnan(x)) return std::numeric_limits<double>::quiet_NaN();
-  const auto lo = std::lower_bound(s.begin(), s.end(), x);
-  const auto hi = std::upper_bound(s.begin(), s.end(), x);
-  return 100.0 * ((lo - s.begin()) + 0.5 * (hi - lo)) / s.size();
+double Quantile(std::vector<double>* values, double p) {
+  std::vector<double>& v = *values;
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const double h = (v.size() - 1) * p / 100.0;
+  const std::size_t lo = static_cast<std::size_t>(std::floor(h));
+  std::nth_element(v.begin(), v.begin() + lo, v.end());
+  const double below = v[lo];
+  if (lo + 1 >= v.size()) return below;
+  const double above = *std::min_element(v.begin() + lo + 1, v.end());
+  return below + (h - lo) * (above - below);
+}
+
+double PercentileRank(const std::vector<double>& v, double x) {
+  if (v.empty() || std::isnan(x)) return std::numeric_limits<double>::quiet_NaN();
+  std::size_t below = 0, equal = 0;
+  for (double y : v) {
+    below += y < x;
+    equal += y == x;
+  }
+  return 100.0 * (below + 0.5 * equal) / v.size();
 }
 
 Distribution Describe(std::vector<double> v) { return DescribeInPlace(&v); }
@@ -38,12 +53,12 @@ Distribution DescribeInPlace(std::vector<double>* values) {
   double ss = 0;
   for (double x : v) ss += (x - d.mean) * (x - d.mean);
   d.std = d.n > 1 ? std::sqrt(ss / (d.n - 1)) : nan;
-  std::sort(v.begin(), v.end());
-  d.p5 = Percentile(v, 5);
-  d.p50 = Percentile(v, 50);
-  d.p95 = Percentile(v, 95);
-  d.min = v.front();
-  d.max = v.back();
+  // Order statistics by selection (O(n)), not a full sort: the same values.
+  d.min = *std::min_element(v.begin(), v.end());
+  d.max = *std::max_element(v.begin(), v.end());
+  d.p5 = Quantile(&v, 5);
+  d.p50 = Quantile(&v, 50);
+  d.p95 = Quantile(&v, 95);
   return d;
 }
 
@@ -69,9 +84,9 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
     sigma_hat.push_back(r.sigma_hat);
   });
   for (int k = 0; k < 12; ++k) {
-    s.validation[k] = DescribeInPlace(&val[k]);  // leaves val[k] sorted
+    s.validation[k] = DescribeInPlace(&val[k]);
     s.nominal[k] = DescribeInPlace(&nom[k]);
-    s.validation_sorted[k] = std::move(val[k]);
+    s.validation_values[k] = std::move(val[k]);
     std::vector<double>().swap(nom[k]);
   }
   s.iterations = DescribeInPlace(&iterations);
@@ -94,8 +109,7 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
   s.correlation = s.covariance;
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) s.correlation(a, b) /= sd[a] * sd[b];
-  s.errors_sorted = std::move(errors);  // sorted in place below, after the last use in order
-  for (auto& e : s.errors_sorted) std::sort(e.begin(), e.end());
+  s.error_values = std::move(errors);  // after their last use in canonical order
   for (int k = 0; k < n; ++k) {
     ParameterStats p;
     p.name = cell.parameter_names[k];

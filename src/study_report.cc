@@ -3,7 +3,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <atomic>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "lrcal/error.h"
 #include "lrcal/paper_case.h"
@@ -64,18 +67,19 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   bool any_paper = false;
   // Placement needs a cell's sorted values; it runs as each cell is summarised, after which the
   // values are released (memory: one cell's worth).
-  auto place_cell = [&](const CellSummary& s) {
+  // Returns the cell's placement rows (none unless it is a paper cell).
+  auto place_cell = [](const CellSummary& s) {
+    std::vector<std::vector<std::string>> rows;
     const Json settings = Json::parse(s.cell.settings);
     const int pc = settings.value("paper_case", 0);
-    if (pc < 1 || pc > 2) return;
-    any_paper = true;
+    if (pc < 1 || pc > 2) return rows;
     const std::string label = "case " + std::to_string(pc);
     for (int m = 0; m < 4; ++m) {
       for (int a = 0; a < 3; ++a) {
         const int k = 3 * m + a;
         const double paper = kPaperValidation[pc][a][m];
-        const auto& sorted = s.validation_sorted[k];
-        place.AddRow({label, std::string("validation ") + kMetricNames[m], kAxes[a],
+        const auto& sorted = s.validation_values[k];
+        rows.push_back({label, std::string("validation ") + kMetricNames[m], kAxes[a],
                       m % 2 == 0 ? "mm" : "mrad", Fixed(paper), Fixed(s.validation[k].p5 * 1e3),
                       Fixed(s.validation[k].p50 * 1e3), Fixed(s.validation[k].p95 * 1e3),
                       Fixed(PercentileRank(sorted, paper * 1e-3), 2)});
@@ -92,16 +96,17 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
           const double published = kPaperIdentified[pc - 1][index / kValuesPerLink][index % kValuesPerLink];
           if (std::isnan(published)) continue;
           const double err = published * 1e-3 - robot.true_errors()[index] * scale;
-          const auto& sorted = s.errors_sorted[k];
-          place.AddRow({label, "identified error", s.parameters[k].name,
+          std::vector<double> values = s.error_values[k];
+          rows.push_back({label, "identified error", s.parameters[k].name,
                         IsAngularName(s.parameters[k].name) ? "mrad" : "mm", Fixed(err * 1e3),
-                        Fixed(Percentile(sorted, 5) * 1e3), Fixed(Percentile(sorted, 50) * 1e3),
-                        Fixed(Percentile(sorted, 95) * 1e3), Fixed(PercentileRank(sorted, err), 2)});
+                        Fixed(Quantile(&values, 5) * 1e3), Fixed(Quantile(&values, 50) * 1e3),
+                        Fixed(Quantile(&values, 95) * 1e3), Fixed(PercentileRank(values, err), 2)});
         }
       }
     } catch (const InputError&) {
       // The robot file is gone: the placement of parameters is left out, the rest stands.
     }
+    return rows;
   };
   // The study's cells in its canonical order (the store may also hold cells of an earlier sweep).
   std::vector<StoredCell> stored = store.Cells();
@@ -113,12 +118,41 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   } else {
     cells_in_order = stored;
   }
-  for (const StoredCell& c : cells_in_order) {
-    result.cells.push_back(SummarizeCell(store, c));
-    place_cell(result.cells.back());
-    for (auto& v : result.cells.back().validation_sorted) std::vector<double>().swap(v);
-    std::vector<std::vector<double>>().swap(result.cells.back().errors_sorted);
-    if (result.cells.back().trials < trials) result.complete = false;
+  // Cells are summarised in parallel (each thread with its own read-only connection) and kept in
+  // canonical order; each cell's values are released once its placement rows are made, so
+  // memory is a few cells' worth.
+  const std::size_t num_cells = cells_in_order.size();
+  result.cells.resize(num_cells);
+  std::vector<std::vector<std::vector<std::string>>> place_rows(num_cells);
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto summarize = [&] {
+    try {
+      TrialStore local(store.path());
+      for (std::size_t i; (i = next.fetch_add(1)) < num_cells;) {
+        CellSummary& s = result.cells[i];
+        s = SummarizeCell(local, cells_in_order[i]);
+        place_rows[i] = place_cell(s);
+        for (auto& v : s.validation_values) std::vector<double>().swap(v);
+        std::vector<std::vector<double>>().swap(s.error_values);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> g(failure_mutex);
+      if (!failure) failure = std::current_exception();
+    }
+  };
+  const std::size_t workers =
+      std::max<std::size_t>(1, std::min<std::size_t>(num_cells, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (std::size_t w = 0; w < workers; ++w) pool.emplace_back(summarize);
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+  for (const auto& s : result.cells)
+    if (s.trials < trials) result.complete = false;
+  for (const auto& rows : place_rows) {
+    for (const auto& row : rows) place.AddRow(row);
+    any_paper |= !rows.empty();
   }
 
   std::ostringstream md;

@@ -26,12 +26,14 @@ struct Distribution {
 /// Sample statistics of `values` (std with n−1; NaN fields when n = 0). Mean and std are summed
 /// in the given (canonical) order.
 Distribution Describe(std::vector<double> values);
-/// The same without a copy: sorts `values` in place.
+/// The same without a copy: reorders `values`.
 Distribution DescribeInPlace(std::vector<double>* values);
 /// Percentile p in [0, 100] of ascending `sorted` values (type 7).
 double Percentile(const std::vector<double>& sorted, double p);
-/// Where x falls in ascending `sorted` values, in percent: 100·(#below + ½#equal)/n.
-double PercentileRank(const std::vector<double>& sorted, double x);
+/// The same percentile of values in any order, by selection in O(n) (reorders `values`).
+double Quantile(std::vector<double>* values, double p);
+/// Where x falls among `values` (any order), in percent: 100·(#below + ½#equal)/n.
+double PercentileRank(const std::vector<double>& values, double x);
 
 struct ParameterStats {
   std::string name;
@@ -48,8 +50,8 @@ struct CellSummary {
   std::array<Distribution, 12> nominal;     ///< nominal model, SI
   /// Sorted values, kept for percentile ranks (paper placement): validation metrics and the
   /// parameter errors. The caller may release them once used (memory is then one cell's worth).
-  std::array<std::vector<double>, 12> validation_sorted;
-  std::vector<std::vector<double>> errors_sorted;
+  std::array<std::vector<double>, 12> validation_values;
+  std::vector<std::vector<double>> error_values;
   Distribution iterations, sigma_hat;
 };
 

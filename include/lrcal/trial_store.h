@@ -60,6 +60,8 @@ class TrialStore {
   void SetMeta(const std::string& key, const std::string& value);
   std::optional<std::string> GetMeta(const std::string& key) const;
 
+  const std::string& path() const { return path_; }
+
   static const char* const kMetricColumns[12];  ///< rms_pos_x ... max_ori_z
 
  private:
