@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <Eigen/Core>
@@ -111,6 +112,12 @@ class DirectoryLock {
  private:
   int fd_ = -1;
 };
+
+// Peak resident set size of this process so far (kB).
+long PeakRssKb() {
+  struct rusage usage;
+  return getrusage(RUSAGE_SELF, &usage) == 0 ? usage.ru_maxrss : -1;
+}
 
 std::string Duration(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
@@ -334,6 +341,7 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
   const auto t_ran = std::chrono::steady_clock::now();
   report(true);
   if (failure) std::rethrow_exception(failure);
+  result.peak_rss_kb_trials = PeakRssKb();
   result.prepare_seconds = std::chrono::duration<double>(t_prepared - t0).count();
   result.run_seconds = std::chrono::duration<double>(t_ran - t_run).count();
 
@@ -353,6 +361,9 @@ RunResult RunStudy(const Study& study, const RunOptions& options) {
   manifest["sessions"][session_index]["seconds"] = {
       {"prepare", result.prepare_seconds}, {"trials", result.run_seconds},
       {"tables", result.tables_seconds}, {"sum_of_trial_times", result.trial_seconds}};
+  result.peak_rss_kb = PeakRssKb();
+  manifest["sessions"][session_index]["peak_rss_kb"] = {{"after_trials", result.peak_rss_kb_trials},
+                                                        {"after_tables", result.peak_rss_kb}};
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   WriteJsonAtomically(manifest_path, manifest);
   return result;

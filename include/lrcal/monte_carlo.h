@@ -45,6 +45,8 @@ struct RunResult {
   double prepare_seconds = 0;   ///< wall time preparing the cells (pools, designs, covariance)
   double run_seconds = 0;       ///< wall time from the first trial to the last record written
   double tables_seconds = 0;    ///< wall time aggregating and writing the tables
+  long peak_rss_kb_trials = 0;  ///< peak resident memory when the trials were done (kB)
+  long peak_rss_kb = 0;         ///< peak resident memory at the end, tables included (kB)
 };
 
 /// Parses "i/N" (1-based i) into index i−1 and count N. Throws InputError.

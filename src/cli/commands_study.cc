@@ -61,7 +61,9 @@ int RunCommand(const std::vector<std::string>& args) {
     std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
               << Fixed(r.run_seconds, 3) << " s (" << threads << " threads; runner overhead "
               << Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1)
-              << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3) << " s\n";
+              << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3)
+              << " s; peak memory " << r.peak_rss_kb_trials / 1024 << " MiB after the trials, "
+              << r.peak_rss_kb / 1024 << " MiB with the tables\n";
   }
   if (r.tables_written) {
     std::cout << "tables: " << options.out_dir << "/tables/summary.md (also .csv, .json, .tex)\n";
