@@ -1,10 +1,16 @@
 #include "lrcal/statistics.h"
 
+#include <nlohmann/json.hpp>
+
+#include "lrcal/identification.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace lrcal {
+
+using Json = nlohmann::json;
 
 double Percentile(const std::vector<double>& s, double p) {
   if (s.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -66,9 +72,19 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
   CellSummary s;
   s.cell = cell;
   const int n = static_cast<int>(cell.parameter_names.size());
-  std::vector<std::vector<double>> errors(n);
+  // Errors in one column-major matrix (row = ok trial in canonical order): each parameter's
+  // values are contiguous, and the covariance is one fixed-lane normal-matrix product.
+  Eigen::MatrixXd errors;
   std::array<std::vector<double>, 12> val, nom;
   std::vector<double> iterations, sigma_hat;
+  const std::size_t expected = static_cast<std::size_t>(store.CountTrials(cell.id));
+  errors.resize(static_cast<Eigen::Index>(expected), n);
+  for (int k = 0; k < 12; ++k) {
+    val[k].reserve(expected);
+    nom[k].reserve(expected);
+  }
+  iterations.reserve(expected);
+  sigma_hat.reserve(expected);
   store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
     ++s.trials;
     for (int k = 0; k < 12; ++k) nom[k].push_back(r.nominal[k]);
@@ -78,7 +94,7 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
     }
     ++s.ok;
     for (int k = 0; k < n && k < static_cast<int>(r.errors.size()); ++k)
-      errors[k].push_back(r.errors[k]);
+      errors(s.ok - 1, k) = r.errors[k];
     for (int k = 0; k < 12; ++k) val[k].push_back(r.validation[k]);
     iterations.push_back(r.iterations);
     sigma_hat.push_back(r.sigma_hat);
@@ -93,23 +109,25 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
   s.sigma_hat = DescribeInPlace(&sigma_hat);
   // Parameters: bias, spread, and the empirical covariance (two passes, canonical order).
   const long long m = s.ok;
+  errors.conservativeResize(m, n);
+  // The paper's placement needs the raw values of paper cells; keep only those.
+  const bool keep_values = Json::parse(cell.settings).value("paper_case", 0) > 0;
+  if (keep_values)
+    for (int k = 0; k < n; ++k)
+      s.error_values.emplace_back(errors.col(k).data(), errors.col(k).data() + m);
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(n);
   for (int k = 0; k < n; ++k) {
-    for (double x : errors[k]) mean[k] += x;
+    const double* x = errors.col(k).data();
+    for (long long t = 0; t < m; ++t) mean[k] += x[t];
     if (m) mean[k] /= m;
   }
-  s.covariance = Eigen::MatrixXd::Zero(n, n);
-  for (long long t = 0; t < m; ++t)
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; b <= a; ++b)
-        s.covariance(a, b) += (errors[a][t] - mean[a]) * (errors[b][t] - mean[b]);
+  for (int k = 0; k < n; ++k) errors.col(k).array() -= mean[k];
+  NormalMatrix(errors, &s.covariance);
   if (m > 1) s.covariance /= static_cast<double>(m - 1);
-  s.covariance.triangularView<Eigen::StrictlyUpper>() = s.covariance.transpose();
   Eigen::VectorXd sd = s.covariance.diagonal().cwiseSqrt();
   s.correlation = s.covariance;
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) s.correlation(a, b) /= sd[a] * sd[b];
-  s.error_values = std::move(errors);  // after their last use in canonical order
   for (int k = 0; k < n; ++k) {
     ParameterStats p;
     p.name = cell.parameter_names[k];

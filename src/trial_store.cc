@@ -211,8 +211,8 @@ void TrialStore::ForEachTrial(const std::string& cell_id,
   Statement st(db_, "SELECT " + TrialColumns() + " FROM trials WHERE cell_id = ? ORDER BY trial");
   st.Text(1, cell_id);
   TrialRecord r;
+  r.cell_id = cell_id;  // every row has it: no per-row string
   while (st.Step()) {
-    r.cell_id = st.ColumnText(0);
     r.trial = sqlite3_column_int64(st.get(), 1);
     r.status = StatusFromName(st.ColumnText(2));
     r.iterations = sqlite3_column_int(st.get(), 3);
