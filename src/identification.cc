@@ -58,6 +58,14 @@ bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
       L[i * n + j] = s * inv;
     }
   }
+  CholeskySubstitute(*L_out, b, x);
+  return true;
+}
+
+void CholeskySubstitute(const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& L_in,
+                        const Eigen::VectorXd& b, Eigen::VectorXd* x) {
+  const int n = static_cast<int>(L_in.rows());
+  const double* L = L_in.data();
   x->resize(n);
   double* y = x->data();
   for (int i = 0; i < n; ++i) {  // L·y = b
@@ -71,7 +79,16 @@ bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
     for (int k = i + 1; k < n; ++k) s -= L[k * n + i] * y[k];
     y[i] = s / L[i * n + i];
   }
-  return true;
+}
+
+void LevenbergMarquardt::Nominal::Factorize() {
+  NormalMatrix(G, &GtG);
+  const int n = static_cast<int>(GtG.rows());
+  D = GtG.diagonal().cwiseSqrt().cwiseInverse();
+  Eigen::MatrixXd scaled = D.asDiagonal() * GtG * D.asDiagonal();
+  Eigen::VectorXd unused;
+  if (!D.allFinite() || !CholeskySolve(scaled, Eigen::VectorXd::Zero(n), &L0, &unused, 1e-13))
+    L0.resize(0, 0);
 }
 
 double LevenbergMarquardt::Linearize(const MeasurementModel& model, const double* mean_h,
@@ -181,12 +198,16 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
     return result;
   }
   const bool equal_weights = (sqrt_w_.array() == sqrt_w_[0]).all();
-  if (nominal && equal_weights && nominal->GtG.rows() == n) {
-    A_ = weights[0] * nominal->GtG;  // the first normal matrix is the same for every trial
+  // With equal weights the first normal matrix, and its scaled factorisation, are the same for
+  // every trial of a cell (computed once: Nominal::Factorize).
+  const bool first_from_cache = nominal && equal_weights && nominal->GtG.rows() == n;
+  if (first_from_cache) {
+    A_ = weights[0] * nominal->GtG;
     g_.noalias() = J_.transpose() * r_;
   } else {
     FormNormalEquations();
   }
+  const bool first_factor_cached = first_from_cache && nominal->L0.rows() == n;
 
   // Column scaling (Marquardt): unit diagonal. A zero column is rank deficiency outright.
   scale_.resize(n);
@@ -196,7 +217,7 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
       result.termination = Termination::kRankDeficient;
       return result;
     }
-    scale_[k] = 1.0 / std::sqrt(A_(k, k));
+    scale_[k] = first_factor_cached ? nominal->D[k] / sqrt_w_[0] : 1.0 / std::sqrt(A_(k, k));
   }
   // A pivot below 1e-13 of the scaled matrix: relative singular value below ~3e-7.
   constexpr double kMinScaledPivot = 1e-13;
@@ -209,13 +230,17 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
   for (int iter = 1; iter <= options.max_iterations; ++iter) {
     result.iterations = iter;
     // Solve (S·A·S + λ·I)·y = S·g, step = S·y.
-    As_.noalias() = scale_.asDiagonal() * A_ * scale_.asDiagonal();
-    As_.diagonal().array() += lambda;
     rhs_ = scale_.cwiseProduct(g_);
-    if (!CholeskySolve(As_, rhs_, &L_, &step_, lambda == 0 ? kMinScaledPivot : 0)) {
-      result.termination =
-          lambda == 0 && iter == 1 ? Termination::kRankDeficient : Termination::kNumericalFailure;
-      return result;
+    if (iter == 1 && first_factor_cached) {
+      CholeskySubstitute(nominal->L0, rhs_, &step_);
+    } else {
+      As_.noalias() = scale_.asDiagonal() * A_ * scale_.asDiagonal();
+      As_.diagonal().array() += lambda;
+      if (!CholeskySolve(As_, rhs_, &L_, &step_, lambda == 0 ? kMinScaledPivot : 0)) {
+        result.termination =
+            lambda == 0 && iter == 1 ? Termination::kRankDeficient : Termination::kNumericalFailure;
+        return result;
+      }
     }
     step_ = scale_.cwiseProduct(step_);
     e_trial_ = *e + step_;

@@ -167,7 +167,7 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
       ExactReadings(*c->robot, c->robot->nominal_values(), c->plane, c->design,
                     &c->design_nominal.h, &unused);
       c->design_nominal.G = IdentificationJacobian(*c->model, c->design);
-      c->design_nominal.GtG = c->design_nominal.G.transpose() * c->design_nominal.G;
+      c->design_nominal.Factorize();
     }
     if (!s.truth_random) {
       ExactReadings(*c->robot, c->true_values_fixed, c->plane, c->design, &c->design_true_h,

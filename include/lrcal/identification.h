@@ -121,6 +121,12 @@ class LevenbergMarquardt {
     std::vector<double> h;
     Eigen::MatrixXd G;    ///< m×n
     Eigen::MatrixXd GtG;  ///< GᵀG (unweighted), used when every weight is the same
+    /// Cholesky factor of D·GᵀG·D, D = diag(GᵀG)^(-1/2): the first (scaled, undamped) system of
+    /// every trial, whatever the common weight. Empty if not set, or if GᵀG is (near) singular.
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> L0;
+    Eigen::VectorXd D;
+    /// Fills GtG, D and L0 from G.
+    void Factorize();
   };
   /// Solves for e (resized to model.num_parameters(), started at 0). `mean_h` and `weights`
   /// have configs.size() entries (weights = repetitions). `nominal`, if given, must be the model
@@ -149,6 +155,10 @@ class LevenbergMarquardt {
   Eigen::VectorXd g_, step_, rhs_, e_trial_, scale_;
   ModelPoint point_;
 };
+
+/// Solves L·Lᵀ·x = b for a row-major Cholesky factor L (from CholeskySolve).
+void CholeskySubstitute(const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& L,
+                        const Eigen::VectorXd& b, Eigen::VectorXd* x);
 
 /// A = JᵀJ (n×n, both triangles) for a column-major m×n J. Each entry is summed in 8 fixed
 /// partial sums (index mod 8) added in a fixed order, so the result has the same bits whatever
