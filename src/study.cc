@@ -85,7 +85,8 @@ const Json& Defaults() {
     "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0},
     "noise": {"sigma_mm": 0.2, "repetitions": 10},
     "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
-    "selection": {"count": 50, "method": "greedy", "criterion": "E", "samples": 1000},
+    "selection": {"count": 50, "method": "backward", "criterion": "E", "samples": 1000,
+                  "scaling": "si", "restarts": 4, "redraw": false},
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
                        "max_iterations": 100, "on_rank_deficient": "fail"},
@@ -243,6 +244,10 @@ CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   c.selection.criterion = ParseDesignCriterion(
       Str(s["selection"]["criterion"], "selection.criterion", where), where("selection.criterion"));
   c.selection.samples = Int(s, "selection.samples", where, 1);
+  c.selection.restarts = Int(s, "selection.restarts", where, 1);
+  c.selection_redraw = Bool(s["selection"]["redraw"], "selection.redraw", where);
+  c.scaling = ParseDesignScaling(Str(s["selection"]["scaling"], "selection.scaling", where),
+                                 where("selection.scaling"));
 
   c.validation_size = Int(s, "validation.size", where, 1);
 

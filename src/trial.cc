@@ -63,6 +63,18 @@ void DrawTruth(const CellContext& c, long long trial, Eigen::VectorXd* values,
   for (int k = 0; k < ps.num_robot(); ++k) (*delta)[k] = errors[ps.robot_values[k]];
 }
 
+// G of a candidate pool at the nominal model, scaled as the cell's selection says (the paper:
+// SI). Expected-error scaling uses the truth's prior σ (truth.angle_sigma_mrad,
+// truth.length_sigma_mm) for robot parameters and plane terms alike.
+Eigen::MatrixXd DesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
+  const CellSettings& s = c.cell->typed;
+  const ParameterSet& ps = c.model->parameters();
+  Eigen::VectorXd expected(ps.size());
+  for (int k = 0; k < ps.size(); ++k)
+    expected[k] = ps.IsAngular(k) ? s.truth_angle_sigma : s.truth_length_sigma;
+  return ScaleColumns(IdentificationJacobian(*c.model, pool), s.scaling, expected);
+}
+
 ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::VectorXd& truth,
                             SamplingReport* report) {
   const CellSettings& s = c.cell->typed;
@@ -137,7 +149,8 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
     }
     c->parameter_names = c->model->parameters().names;
 
-    const Eigen::MatrixXd G = IdentificationJacobian(*c->model, c->pool);
+    const Eigen::MatrixXd G = DesignJacobian(*c, c->pool);
+    if (s.selection_redraw) c->pool_design_G = G;
     SelectionResult sel = SelectConfigurations(
         G, s.select_count, s.selection,
         RandomStream(study.seed, c->pool_stream, 0, RandomPurpose::kSelection));
@@ -172,6 +185,9 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
     if (!s.truth_random) {
       ExactReadings(*c->robot, c->true_values_fixed, c->plane, c->design, &c->design_true_h,
                     &c->design_true_miss);
+      if (s.selection_redraw)
+        ExactReadings(*c->robot, c->true_values_fixed, c->plane, c->pool, &c->pool_true_h,
+                      &c->pool_true_miss);
       c->validation_true_poses = ToolPoses(*c->robot, c->true_values_fixed, c->validation);
     }
     if (!s.truth_random)
@@ -223,7 +239,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
     } catch (const InputError&) {
       return finish(TrialStatus::kBeamMissed);
     }
-    const Eigen::MatrixXd G = IdentificationJacobian(*c.model, pool);
+    const Eigen::MatrixXd G = DesignJacobian(c, pool);
     SelectionResult sel = SelectConfigurations(
         G, s.select_count, s.selection,
         RandomStream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
@@ -236,20 +252,45 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
     rec.sigma_min = CriterionScore(Gd.transpose() * Gd, redrawn_design.size(), DesignCriterion::kE);
   }
 
+  // A new selection from the cell's pool in every trial (e.g. the random baseline).
+  if (s.selection_redraw && !s.pool_redraw) {
+    SelectionResult sel = SelectConfigurations(
+        c.pool_design_G, s.select_count, s.selection,
+        RandomStream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
+                     RandomPurpose::kSelection));
+    redrawn_selected = sel.indices;
+    redrawn_design = c.pool.Subset(sel.indices);
+    design = &redrawn_design;
+    slots = &redrawn_selected;
+    Eigen::MatrixXd Gd = IdentificationJacobian(*c.model, redrawn_design);
+    rec.sigma_min = CriterionScore(Gd.transpose() * Gd, redrawn_design.size(), DesignCriterion::kE);
+  }
+  const bool redrawn = s.pool_redraw || s.selection_redraw;
   NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
   const RandomStream noise_stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
-  const bool cached = !s.truth_random && !s.pool_redraw;
-  const int missed =
-      cached ? AddNoise(c.design_true_h, c.design_true_miss, *design, noise, noise_stream, &ws->data,
-                        nullptr, slots)
-             : SimulateReadings(*c.robot, truth_values, c.plane, *design, noise, noise_stream,
-                                &ws->data, nullptr, nullptr, slots);
+  int missed;
+  if (!s.truth_random && !redrawn) {
+    missed = AddNoise(c.design_true_h, c.design_true_miss, *design, noise, noise_stream, &ws->data,
+                      nullptr, slots);
+  } else if (!s.truth_random && !s.pool_redraw) {  // selection redrawn: the pool's readings
+    ws->exact_h.clear();
+    ws->exact_miss.clear();
+    for (int i : *slots) {
+      ws->exact_h.push_back(c.pool_true_h[i]);
+      ws->exact_miss.push_back(c.pool_true_miss[i]);
+    }
+    missed = AddNoise(ws->exact_h, ws->exact_miss, *design, noise, noise_stream, &ws->data, nullptr,
+                      slots);
+  } else {
+    missed = SimulateReadings(*c.robot, truth_values, c.plane, *design, noise, noise_stream,
+                              &ws->data, nullptr, nullptr, slots);
+  }
   if (missed > 0) return finish(TrialStatus::kBeamMissed);
   ws->weights.assign(ws->data.repetitions.begin(), ws->data.repetitions.end());
   IdentificationOptions options = s.identification;
   const LevenbergMarquardt::Result r =
       ws->solver.Solve(*c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(),
-                       options, &ws->e, s.pool_redraw ? nullptr : &c.design_nominal);
+                       options, &ws->e, redrawn ? nullptr : &c.design_nominal);
   rec.iterations = r.iterations;
   const int m = ws->data.size(), n = c.model->num_parameters();
   rec.residual_rms = std::sqrt(2 * r.final_cost / (m * s.repetitions));  // per-config mean residual

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -267,6 +268,37 @@ TEST(MonteCarlo, AddingASweepValueKeepsExistingCells) {
   }
 }
 
+TEST(MonteCarlo, SelectionRedrawnPerTrialVariesTheDesign) {
+  // selection.redraw: a random design per trial (the baseline of studies/design.yaml); a fixed
+  // selection gives one design (one σ_min) for the whole cell.
+  const std::string dir = testing::TempDir("mc_redraw");
+  const std::string path = dir + "/redraw.yaml";
+  std::ofstream(path) << "name: redraw\nseed: 4\ntrials: 12\nrobot: "
+                      << testing::SourcePath("studies/robots/paper.yaml")
+                      << "\npool: {size: 60}\nvalidation: {size: 5}\n"
+                         "sweep:\n  axes:\n    - key: selection\n      values:\n"
+                         "        - {count: 30, method: random, redraw: true}\n"
+                         "        - {count: 30, method: exchange, scaling: unit, criterion: A}\n";
+  RunSmall(path, dir + "/run", 2);
+  TrialStore store(dir + "/run/trials.sqlite");
+  const auto cells = store.Cells();
+  ASSERT_EQ(cells.size(), 2u);
+  for (const auto& cell : cells) {
+    std::set<double> sigma_min;
+    long long ok = 0;
+    store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
+      sigma_min.insert(r.sigma_min);
+      ok += r.status == TrialStatus::kOk;
+    });
+    EXPECT_EQ(ok, 12) << cell.label;
+    if (cell.label.find("random") != std::string::npos) {
+      EXPECT_GT(sigma_min.size(), 6u) << "random designs should differ from trial to trial";
+    } else {
+      EXPECT_EQ(sigma_min.size(), 1u);
+    }
+  }
+}
+
 struct BadStudy {
   std::string name, text, expected;
 };
@@ -306,6 +338,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadStudy{"UnknownSweepKey", "sweep:\n  axes:\n    - key: noise.sigma\n      values: [1]\n",
                  "'noise.sigma' is not a study setting"},
         BadStudy{"UnknownMethod", "selection: {method: best}\n", "unknown selection method 'best'"},
+        BadStudy{"UnknownScaling", "selection: {scaling: log}\n", "unknown scaling 'log'"},
         BadStudy{"ZipOfUnequalAxes",
                  "sweep:\n  combine: zip\n  axes:\n    - {key: noise.sigma_mm, values: [0.1, 0.2]}\n"
                  "    - {key: noise.repetitions, values: [1]}\n",

@@ -1,13 +1,25 @@
 // Experimental design: choosing k measurement configurations out of N candidates.
 //
 // The criteria are functions of the singular values σ_i of the identification Jacobian G (m×n)
-// of the chosen configurations, computed from the eigenvalues λ_i = σ_i² of GᵀG; every score
+// of the chosen configurations, computed from the eigenvalues λ_i = σ_i² of A = GᵀG; every score
 // is "larger is better":
 //   E  = O3 = σ_min                (the paper's E-optimality, slide 'Optimal Experimental Design')
 //   O1 = (Π σ_i)^(1/n) / √m        O2 = σ_min/σ_max        O4 = σ_min²/σ_max
 //   O5 = 1 / Σ 1/σ_i               D  = log det GᵀG        A  = −trace (GᵀG)⁻¹
-// G's columns are in SI (m/rad, m/m) unless a scaling is applied first (column weights): the
-// E-optimal set depends on units, and the paper's criterion is σ_min of G as it stands (SI).
+// When A is singular the σ-based indices are 0 and D, A are −∞.
+//
+// Column scaling is a stated choice, because E-optimality depends on units (m/rad against m/m):
+//  - kSI: G as it stands. **This is the paper's method** (σ_min of the identification Jacobian,
+//    no scaling mentioned); for the paper's arm, link lengths of ~1 m make rad and m columns of
+//    similar size.
+//  - kUnitColumns: every column of the candidate pool's G scaled to unit norm.
+//  - kExpectedErrors: column j multiplied by the expected magnitude of parameter j's error
+//    (prior σ in rad or m), so the criterion weighs the readings' sensitivity to plausible errors.
+//
+// Candidate evaluations use rank-one spectral updates: with A = QΛQᵀ and z = Qᵀg, the spectrum of
+// A ± ggᵀ follows from the secular equation 1 ± Σ z_i²/(λ_i − μ) = 0 (each root bracketed between
+// consecutive λ), log det from the determinant lemma and trace A⁻¹ from Sherman–Morrison: O(n²)
+// per candidate instead of an O(n³) eigendecomposition.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,33 +36,50 @@ const char* DesignCriterionName(DesignCriterion c);
 
 enum class SelectionMethod {
   kExhaustive,  ///< every subset (k = N−1 is the paper's case 2: N evaluations)
-  kGreedy,      ///< backward elimination: drop the candidate whose removal hurts least
+  kGreedy,      ///< greedy forward: add the candidate that helps most (D-optimal until rank n)
+  kBackward,    ///< greedy backward elimination: drop the candidate whose removal hurts least
+  kExchange,    ///< Fedorov / DETMAX exchange: best single swaps until none improves, restarts
   kSampled,     ///< the paper's case 1: best of `samples` random subsets
   kRandom,      ///< one random subset: the baseline
 };
 SelectionMethod ParseSelectionMethod(const std::string& text, const std::string& source);
 const char* SelectionMethodName(SelectionMethod m);
 
+enum class DesignScaling { kSI, kUnitColumns, kExpectedErrors };
+DesignScaling ParseDesignScaling(const std::string& text, const std::string& source);
+const char* DesignScalingName(DesignScaling s);
+
 struct SelectionOptions {
   DesignCriterion criterion = DesignCriterion::kE;
-  SelectionMethod method = SelectionMethod::kGreedy;
-  int samples = 1000;                   ///< subsets tried by kSampled
-  double exhaustive_limit = 5e6;        ///< most subsets kExhaustive will enumerate
+  SelectionMethod method = SelectionMethod::kBackward;
+  int samples = 1000;             ///< subsets tried by kSampled
+  int restarts = 4;               ///< kExchange: starts = backward-greedy design + (restarts−1) random
+  double exhaustive_limit = 5e6;  ///< most subsets kExhaustive will enumerate
 };
 
 struct SelectionResult {
-  std::vector<int> indices;  ///< chosen candidates, ascending
-  double score = 0;          ///< criterion value of the chosen set
-  long long evaluations = 0; ///< criterion evaluations spent
+  std::vector<int> indices;   ///< chosen candidates, ascending
+  double score = 0;           ///< criterion value of the chosen set (exact eigendecomposition)
+  long long evaluations = 0;  ///< candidate evaluations spent
+  double start_score = 0;     ///< kExchange: score of the best start before exchanging
 };
 
-/// Score of the normal matrix A = GᵀG of m configurations. When A is singular the σ-based
-/// indices (E, O1, O2, O4, O5) are 0 and D, A are −∞.
+/// Score of the normal matrix A = GᵀG of m configurations.
 double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion);
 
-/// Chooses k rows of G (N×n). Throws InputError for k > N, k < n, or an exhaustive search too
-/// large for exhaustive_limit.
+/// Scales the columns of G (N×n) as `scaling` says; `expected` holds each parameter's expected
+/// error magnitude (rad or m) for kExpectedErrors. Column norms are those of G itself.
+Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
+                             const Eigen::VectorXd& expected = Eigen::VectorXd());
+
+/// Chooses k rows of G (N×n). Throws InputError for an empty pool, k > N, k < n, or an
+/// exhaustive search beyond exhaustive_limit.
 SelectionResult SelectConfigurations(const Eigen::MatrixXd& G, int k,
                                      const SelectionOptions& options, const RandomStream& stream);
+
+/// Eigenvalues (ascending) of diag(lambda) + rho·z·zᵀ, rho = ±1, by the secular equation
+/// (exposed for tests).
+Eigen::VectorXd RankOneUpdatedEigenvalues(const Eigen::VectorXd& lambda, const Eigen::VectorXd& z,
+                                          double rho);
 
 }  // namespace lrcal

@@ -28,7 +28,7 @@ struct PaperCaseOptions {
   int case2_count = 100;
   NoiseModel noise;  ///< 0.2 mm, 10 readings
   std::uint64_t seed = 1;
-  SelectionOptions case1_selection{DesignCriterion::kE, SelectionMethod::kGreedy};
+  SelectionOptions case1_selection{DesignCriterion::kE, SelectionMethod::kBackward};
   SelectionOptions case2_selection{DesignCriterion::kE, SelectionMethod::kExhaustive};
   PlaneTerms plane_terms;
   IdentificationOptions identification;

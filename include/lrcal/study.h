@@ -47,6 +47,10 @@ struct CellSettings {
   // Selection.
   int select_count = 50;
   SelectionOptions selection;
+  DesignScaling scaling = DesignScaling::kSI;  ///< column scaling of G before selection
+  /// Select anew in every trial (from the cell's pool): a random or sampled design then varies
+  /// from trial to trial, which is the honest baseline for "how much does the design buy".
+  bool selection_redraw = false;
   // Validation.
   int validation_size = 20;
   // Identification.

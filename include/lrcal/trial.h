@@ -44,6 +44,9 @@ struct CellContext {
   double design_sigma_min = 0;       ///< σ_min of G (SI) of the selected design
   ConfigurationSet design;           ///< the selected configurations
   LevenbergMarquardt::Nominal design_nominal;  ///< h and G of the nominal model on the design
+  Eigen::MatrixXd pool_design_G;               ///< scaled G of the pool (selection redrawn per trial)
+  std::vector<double> pool_true_h;             ///< exact true readings on the pool (fixed truth)
+  std::vector<BeamMiss> pool_true_miss;
   std::vector<double> design_true_h;           ///< exact true readings on the design (fixed truth)
   std::vector<BeamMiss> design_true_miss;
   std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
@@ -85,6 +88,8 @@ struct TrialWorkspace {
   MeasurementSet data;
   Eigen::VectorXd e;
   std::vector<double> weights;
+  std::vector<double> exact_h;
+  std::vector<BeamMiss> exact_miss;
 };
 
 TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace);

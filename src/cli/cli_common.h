@@ -55,6 +55,7 @@ int IdentifyCommand(const std::vector<std::string>& args);
 int IdentifiabilityCommand(const std::vector<std::string>& args);
 int PaperCommand(const std::vector<std::string>& args);
 int RunCommand(const std::vector<std::string>& args);
+int DesignCommand(const std::vector<std::string>& args);
 int PlanCommand(const std::vector<std::string>& args);
 int StatusCommand(const std::vector<std::string>& args);
 int MergeCommand(const std::vector<std::string>& args);

@@ -326,8 +326,8 @@ int PaperCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal paper options");
   o.add_options()("robot", po::value<std::string>()->default_value("paper"), "robot file or name")
       ("seed", po::value<long long>()->default_value(1), "random seed of the realisation")
-      ("case1-selection", po::value<std::string>()->default_value("greedy"),
-       "how case 1 picks 50 of 101: greedy, sampled (the paper's), exhaustive, random")
+      ("case1-selection", po::value<std::string>()->default_value("backward"),
+       "how case 1 picks 50 of 101: backward, exchange, greedy, sampled (the paper's), random")
       ("samples", po::value<int>()->default_value(1000), "subsets tried by 'sampled'")
       ("format", po::value<std::string>()->default_value("text"), "text or json");
   po::variables_map vm;

@@ -1,0 +1,169 @@
+// lrcal design: choose measurement configurations from a candidate pool by an observability
+// criterion, and compare the choice with random designs of the same size.
+#include <chrono>
+#include <cmath>
+
+#include "cli_common.h"
+#include "lrcal/configuration_sampling.h"
+#include "lrcal/csv.h"
+#include "lrcal/experiment_design.h"
+#include "lrcal/identifiability.h"
+#include "lrcal/statistics.h"
+#include "lrcal/table.h"
+
+namespace lrcal::cli {
+
+int DesignCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal design options");
+  AddCommonOptions(o);
+  o.add_options()("pool", po::value<std::string>(), "candidate configurations CSV (q1..qN)")
+      ("generate", po::value<int>(), "or: generate this many candidates (beam hits, non-singular)")
+      ("seed", po::value<long long>()->default_value(1), "seed for --generate, random starts, baseline")
+      ("select", po::value<int>()->required(), "configurations to choose (k)")
+      ("criterion", po::value<std::string>()->default_value("E"), "E (=O3), D, A, O1, O2, O4, O5")
+      ("method", po::value<std::string>()->default_value("exchange"),
+       "exhaustive, greedy (forward), backward, exchange, sampled, random")
+      ("scaling", po::value<std::string>()->default_value("si"),
+       "columns of G: si (the paper), unit (unit-norm), expected (× expected error)")
+      ("expected-angle-mrad", po::value<double>()->default_value(1.0), "expected angle error (mrad)")
+      ("expected-length-mm", po::value<double>()->default_value(1.0), "expected length error (mm)")
+      ("restarts", po::value<int>()->default_value(4), "exchange: starts (backward design + random)")
+      ("samples", po::value<int>()->default_value(1000), "sampled: random subsets tried")
+      ("baseline", po::value<int>()->default_value(1000), "random designs for the baseline")
+      ("estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")
+      ("fix", po::value<std::string>(), "parameters left out, comma-separated")
+      ("out", po::value<std::string>(), "write the chosen configurations (CSV)");
+  po::variables_map vm;
+  if (!Parse("design", "--pool C.csv|--generate N --select K [options] --out chosen.csv", o, args,
+             &vm))
+    return 0;
+  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
+  const Plane plane = ResolvePlane(robot, vm);
+  const long long seed_value = vm["seed"].as<long long>();
+  if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
+  const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);
+  if (vm.count("pool") == vm.count("generate"))
+    throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
+
+  // The candidate pool, with what was rejected and why.
+  ConfigurationSet pool(robot.num_links());
+  SamplingReport report;
+  std::string pool_source;
+  if (vm.count("generate")) {
+    const int n = vm["generate"].as<int>();
+    if (n < 1) throw InputError("--generate", "expected a positive number of candidates");
+    pool = SampleConfigurations(robot, plane, n, RandomStream(seed, 0, 0, RandomPurpose::kPool),
+                                SamplingOptions{}, &report);
+    pool_source = "generated: " + report.ToString();
+  } else {
+    const std::string path = vm["pool"].as<std::string>();
+    const ConfigurationSet read = ReadConfigurations(path, robot.num_links());
+    std::vector<double> h;
+    std::vector<BeamMiss> misses;
+    ModelPoint point;
+    PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
+    report.requested = report.attempts = read.size();
+    for (int i = 0; i < read.size(); ++i) {
+      const Pose<double> pose = ToolPose(point, read, i);
+      const double nb = plane.normal.dot(pose.R_BT.col(2));
+      const BeamMiss miss = ClassifyReading(-plane.SignedDistance(pose.p_BT) / nb, nb, robot.ranger);
+      if (miss != BeamMiss::kNone) {
+        ++report.rejected[BeamMissName(miss)];
+        std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
+                  << ") rejected: " << BeamMissName(miss) << "\n";
+        continue;
+      }
+      pool.AddFrom(read, i);
+    }
+    report.accepted = pool.size();
+    pool_source = path + ": " + report.ToString();
+  }
+  if (pool.size() == 0) throw InputError("--pool", "no usable candidate configurations");
+
+  const ParameterSet ps = ResolveParameterSet(robot, vm);
+  MeasurementModel model(robot, plane, ps);
+  SelectionOptions options;
+  options.criterion = ParseDesignCriterion(vm["criterion"].as<std::string>(), "--criterion");
+  options.method = ParseSelectionMethod(vm["method"].as<std::string>(), "--method");
+  options.restarts = vm["restarts"].as<int>();
+  options.samples = vm["samples"].as<int>();
+  if (options.restarts < 1) throw InputError("--restarts", "expected at least 1");
+  if (options.samples < 1) throw InputError("--samples", "expected at least 1");
+  const DesignScaling scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
+  Eigen::VectorXd expected(ps.size());
+  for (int k = 0; k < ps.size(); ++k)
+    expected[k] = ps.IsAngular(k) ? vm["expected-angle-mrad"].as<double>() * 1e-3
+                                  : vm["expected-length-mm"].as<double>() * 1e-3;
+  const Eigen::MatrixXd G_si = IdentificationJacobian(model, pool);
+  const Eigen::MatrixXd G = ScaleColumns(G_si, scaling, expected);
+  const int k = vm["select"].as<int>();
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const SelectionResult chosen =
+      SelectConfigurations(G, k, options, RandomStream(seed, 1, 0, RandomPurpose::kSelection));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // Every index of the chosen set and of random designs of the same size.
+  const DesignCriterion all[] = {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA,
+                                 DesignCriterion::kO1, DesignCriterion::kO2, DesignCriterion::kO4,
+                                 DesignCriterion::kO5};
+  auto normal = [&](const std::vector<int>& rows) {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+    for (int r : rows) A += G.row(r).transpose() * G.row(r);
+    return A;
+  };
+  const Eigen::MatrixXd A_chosen = normal(chosen.indices);
+  const int baseline = vm["baseline"].as<int>();
+  std::vector<std::vector<double>> random_scores(std::size(all));
+  SelectionOptions random_options;
+  random_options.method = SelectionMethod::kRandom;
+  for (int b = 0; b < baseline; ++b) {
+    const SelectionResult r = SelectConfigurations(
+        G, k, random_options, RandomStream(seed, 2, static_cast<std::uint64_t>(b), RandomPurpose::kSelection));
+    const Eigen::MatrixXd A = normal(r.indices);
+    for (std::size_t c = 0; c < std::size(all); ++c) random_scores[c].push_back(CriterionScore(A, k, all[c]));
+  }
+  Table t({"index", "chosen", "random mean", "random p5", "random p95", "percentile of chosen"},
+          "Observability of the chosen " + std::to_string(k) + " of " + std::to_string(pool.size()) +
+              " against " + std::to_string(baseline) + " random designs (G scaled: " +
+              DesignScalingName(scaling) + "; E = sigma_min, D = log det, A = -trace inv)");
+  Json indices = Json::object();
+  for (std::size_t c = 0; c < std::size(all); ++c) {
+    const double value = CriterionScore(A_chosen, k, all[c]);
+    const Distribution d = Describe(random_scores[c]);
+    const double rank = PercentileRank(random_scores[c], value);
+    t.AddRow({DesignCriterionName(all[c]), Fixed(value, 6), Fixed(d.mean, 6), Fixed(d.p5, 6),
+              Fixed(d.p95, 6), Fixed(rank, 1)});
+    indices[DesignCriterionName(all[c])] = {{"chosen", value}, {"random_mean", d.mean},
+                                            {"random_p5", d.p5}, {"random_p95", d.p95},
+                                            {"percentile", rank}};
+  }
+  if (vm.count("out")) WriteConfigurations(vm["out"].as<std::string>(), pool.Subset(chosen.indices));
+
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j;
+    j["pool"] = {{"size", pool.size()}, {"source", pool_source}, {"rejected", report.rejected},
+                 {"tried", report.attempts}};
+    j["method"] = SelectionMethodName(options.method);
+    j["criterion"] = DesignCriterionName(options.criterion);
+    j["scaling"] = DesignScalingName(scaling);
+    j["selected"] = chosen.indices;
+    j["score"] = chosen.score;
+    j["evaluations"] = chosen.evaluations;
+    j["seconds"] = seconds;
+    j["indices"] = indices;
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "candidate pool: " << pool_source << "\n"
+            << "chose " << k << " of " << pool.size() << " by " << SelectionMethodName(options.method)
+            << ", criterion " << DesignCriterionName(options.criterion) << " = " << chosen.score
+            << " (" << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
+            << "chosen (0-based pool indices):";
+  for (int i : chosen.indices) std::cout << " " << i;
+  std::cout << "\n\n" << t.ToText();
+  if (vm.count("out")) std::cout << "wrote " << vm["out"].as<std::string>() << "\n";
+  return 0;
+}
+
+}  // namespace lrcal::cli
