@@ -132,6 +132,29 @@ TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   EXPECT_EQ(Json::parse(out)["fixed_for_rank"].size(), 1u);
 }
 
+TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
+  std::string out;
+  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E --baseline 200 "
+                "--format json --out " + Path("chosen.csv"),
+                &out),
+            0)
+      << out;
+  Json j = Json::parse(out);
+  EXPECT_EQ(j["selected"].size(), 30u);
+  EXPECT_EQ(j["pool"]["size"], 60);
+  EXPECT_GT(j["pool"]["tried"].get<int>(), 60);  // some candidates were rejected
+  EXPECT_GE(j["score"].get<double>(), j["indices"]["E"]["random_p95"].get<double>());
+  EXPECT_NEAR(j["indices"]["E"]["chosen"].get<double>(), j["score"].get<double>(), 1e-12);
+  // The chosen configurations were written, and the same call chooses the same set.
+  std::string again;
+  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --baseline 200 --format json",
+                &again),
+            0);
+  EXPECT_EQ(Json::parse(again)["selected"], j["selected"]);
+  ASSERT_EQ(Run("identifiability --configs " + Path("chosen.csv") + " --format json", &out), 0) << out;
+  EXPECT_EQ(Json::parse(out)["rank"], 25);
+}
+
 TEST_F(CliTest, PaperIsDeterministicForASeed) {
   std::string a, b, c;
   ASSERT_EQ(Run("paper --seed 5 --format json", &a), 0) << a;
@@ -193,7 +216,17 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"UnknownRobot", "", "kinematics --robot nosuchrobot --configs {}",
                  "neither a robot file nor a shipped robot name"},
         BadInput{"UnknownOption", "", "kinematics --colour red", "unrecognised option"},
-        BadInput{"UnknownCommand", "", "calibrate", "unknown command 'calibrate'"}),
+        BadInput{"UnknownCommand", "", "calibrate", "unknown command 'calibrate'"},
+        BadInput{"DesignMoreThanThePool", "", "design --generate 30 --select 40",
+                 "cannot select 40 of 30 candidates"},
+        BadInput{"DesignFewerThanParameters", "", "design --generate 30 --select 10",
+                 "need at least as many configurations as parameters"},
+        BadInput{"DesignEmptyPool", "q1,q2,q3,q4,q5,q6\n", "design --pool {} --select 30",
+                 "no configurations (only a header)"},
+        BadInput{"DesignUnknownCriterion", "", "design --generate 30 --select 26 --criterion F",
+                 "unknown criterion 'F'"},
+        BadInput{"DesignPoolAndGenerate", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "design --pool {} --generate 5 --select 26", "give exactly one"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return info.param.name; });
 
 }  // namespace
