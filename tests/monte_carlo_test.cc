@@ -111,6 +111,22 @@ TEST(MonteCarlo, ShardsMergedEqualOneRun) {
   EXPECT_EQ(Tables(dir + "/single"), Tables(dir + "/merged"));
 }
 
+TEST(MonteCarlo, StatusOfShardsNamesTheTasksToResubmit) {
+  const std::string dir = testing::TempDir("mc_status");
+  const std::string study = SmallStudy(dir, 20);
+  RunSmall(study, dir + "/s1", 1, 0, 4);
+  RunSmall(study, dir + "/s2", 1, 1, 4, 7);  // interrupted
+  RunSmall(study, dir + "/s3", 1, 2, 4);     // shard 4 never ran
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + dir + "/s1 " + dir + "/s2 " +
+                                    dir + "/s3",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("unfinished or missing shards: 2,4"), std::string::npos) << out;
+  EXPECT_NE(out.find("sbatch --array=2,4"), std::string::npos) << out;
+}
+
 TEST(MonteCarlo, ResumedInSlicesEqualsUninterrupted) {
   const std::string dir = testing::TempDir("mc_slices");
   const std::string study = SmallStudy(dir, 30);

@@ -18,6 +18,7 @@
 #include <functional>
 #include <string>
 
+#include "lrcal/collective.h"
 #include "lrcal/study.h"
 
 namespace lrcal {
@@ -32,6 +33,9 @@ struct RunOptions {
   /// Stop (as if interrupted) after this many new trials; 0 = no limit. For tests and for
   /// running a study in slices.
   long long max_new_trials = 0;
+  /// MPI only: rank 0 hands out chunks of missing trials on request, instead of dealing every
+  /// P-th trial to each rank. For sweeps whose cells differ a lot in cost. Same results.
+  bool dynamic_schedule = false;
 };
 
 struct RunResult {
@@ -47,14 +51,19 @@ struct RunResult {
   double tables_seconds = 0;    ///< wall time aggregating and writing the tables
   long peak_rss_kb_trials = 0;  ///< peak resident memory when the trials were done (kB)
   long peak_rss_kb = 0;         ///< peak resident memory at the end, tables included (kB)
+  long long ranks_computed = 0; ///< trials computed by all ranks of this job
 };
 
 /// Parses "i/N" (1-based i) into index i−1 and count N. Throws InputError.
 void ParseShard(const std::string& text, int* index, int* count);
 
 /// Runs (or resumes) a study. Throws InputError for a bad study, a busy or incompatible run
-/// directory.
-RunResult RunStudy(const Study& study, const RunOptions& options);
+/// directory. With a `collective` of P > 1 ranks (an MPI job) every rank calls this: the missing
+/// trials are dealt to the ranks in turn (static schedule), each rank writes its own
+/// trials.rank<r>.sqlite, and rank 0 merges them and writes the tables. A rank store left by a
+/// killed job counts as done in any later run (with any P, or none) and is merged then.
+RunResult RunStudy(const Study& study, const RunOptions& options,
+                   Collective* collective = nullptr);
 
 /// Writes the tables of a run directory from its store (also for partial runs).
 void AggregateRun(const std::string& run_dir);
@@ -65,6 +74,13 @@ void MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& ou
 
 /// Done / total per cell of a run directory, as text lines (and, for a shard, the command that
 /// finishes it).
+struct RunStatusInfo {
+  std::string text;
+  bool complete = false;
+  int shard_index = 1, shard_count = 1;  ///< 1-based
+  std::string study_file;
+};
+RunStatusInfo GetRunStatus(const std::string& run_dir);
 std::string RunStatus(const std::string& run_dir);
 
 /// Installs the SIGINT/SIGTERM handlers that ask a running study to stop.

@@ -1,9 +1,11 @@
 // The study subcommands: run, plan, status, merge, aggregate.
 #include <chrono>
 #include <filesystem>
+#include <set>
 #include <thread>
 
 #include "cli_common.h"
+#include "lrcal/collective.h"
 #include "lrcal/monte_carlo.h"
 #include "lrcal/study.h"
 #include "lrcal/table.h"
@@ -32,6 +34,8 @@ int RunCommand(const std::vector<std::string>& args) {
       ("shard", po::value<std::string>(), "run only shard i/N of the trials (batch schedulers)")
       ("max-trials", po::value<long long>()->default_value(0),
        "stop after this many new trials (0: no limit); rerun to continue")
+      ("schedule", po::value<std::string>()->default_value("static"),
+       "MPI only: static (every P-th trial per rank) or dynamic (chunks from rank 0)")
       ("quiet", po::bool_switch(), "no progress output");
   po::positional_options_description pos;
   pos.add("study", 1);
@@ -46,20 +50,42 @@ int RunCommand(const std::vector<std::string>& args) {
   if (vm.count("shard")) ParseShard(vm["shard"].as<std::string>(), &options.shard_index, &options.shard_count);
   options.max_new_trials = vm["max-trials"].as<long long>();
   options.progress = !vm["quiet"].as<bool>();
+  const std::string schedule = vm["schedule"].as<std::string>();
+  if (schedule != "static" && schedule != "dynamic")
+    throw InputError("--schedule", "expected static or dynamic, got '" + schedule + "'");
+  options.dynamic_schedule = schedule == "dynamic";
+  // Under mpirun: every rank runs this command; trials are dealt to the ranks.
+  std::unique_ptr<Collective> world;
+  if (LaunchedUnderMpi()) {
+    if (!BuiltWithMpi())
+      throw InputError("mpirun", "this lrcal was built without MPI (CMake found no MPI when it "
+                                 "was configured): install OpenMPI (libopenmpi-dev) and rebuild, "
+                                 "or run without mpirun (threads: --threads N; several machines: "
+                                 "--shard i/N and lrcal merge)");
+    world = MpiWorld(nullptr, nullptr);
+  }
+  const int rank = world ? world->rank() : 0;
+  const int ranks = world ? world->size() : 1;
   InstallStopHandlers();
-  std::cerr << "lrcal run: study '" << study.name << "', " << study.cells.size() << " cells × "
-            << study.trials << " trials → " << options.out_dir << "\n";
-  const RunResult r = RunStudy(study, options);
-  std::cerr << "lrcal run: " << r.computed << " trials computed in " << Fixed(r.seconds, 1)
+  if (rank == 0)
+    std::cerr << "lrcal run: study '" << study.name << "', " << study.cells.size() << " cells × "
+              << study.trials << " trials → " << options.out_dir
+              << (ranks > 1 ? " (" + std::to_string(ranks) + " MPI ranks)" : std::string()) << "\n";
+  const RunResult r = RunStudy(study, options, world.get());
+  if (rank != 0) return r.interrupted ? 130 : 0;
+  std::cerr << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)
             << " s (" << r.done_before << " already done, " << r.total << " in this run";
   if (r.computed > 0)
-    std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial";
+    std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial"
+              << (ranks > 1 ? " on rank 0" : "");
   std::cerr << ")\n";
   if (r.computed > 0) {
     const int threads = options.threads > 0 ? options.threads
                                             : std::max(1u, std::thread::hardware_concurrency());
     std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
-              << Fixed(r.run_seconds, 3) << " s (" << threads << " threads; runner overhead "
+              << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
+              << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string())
+              << "; runner overhead "
               << Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1)
               << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3)
               << " s; peak memory " << r.peak_rss_kb_trials / 1024 << " MiB after the trials, "
@@ -126,12 +152,42 @@ int PlanCommand(const std::vector<std::string>& args) {
 
 int StatusCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal status options");
-  o.add_options()("dir", po::value<std::string>()->required(), "run directory");
+  o.add_options()("dirs", po::value<std::vector<std::string>>()->multitoken()->required(),
+                  "run directories (several: the shards of one study)");
   po::positional_options_description pos;
-  pos.add("dir", 1);
+  pos.add("dirs", -1);
   po::variables_map vm;
-  if (!Parse("status", "RUN_DIR", o, args, &vm, &pos)) return 0;
-  std::cout << RunStatus(vm["dir"].as<std::string>());
+  if (!Parse("status", "RUN_DIR...", o, args, &vm, &pos)) return 0;
+  const auto dirs = vm["dirs"].as<std::vector<std::string>>();
+  std::vector<RunStatusInfo> infos;
+  for (const std::string& d : dirs) {
+    infos.push_back(GetRunStatus(d));
+    std::cout << infos.back().text;
+  }
+  // Shards of one study: which array tasks to resubmit.
+  if (infos.size() > 1 && infos.front().shard_count > 1) {
+    std::string unfinished;
+    std::set<int> present;
+    for (const auto& i : infos) {
+      present.insert(i.shard_index);
+      if (!i.complete) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i.shard_index);
+    }
+    const int n = infos.front().shard_count;
+    for (int i = 1; i <= n; ++i)
+      if (!present.count(i)) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i);
+    if (unfinished.empty()) {
+      std::cout << "all " << n << " shards complete: lrcal merge " << [&] {
+        std::string l;
+        for (const auto& d : dirs) l += d + " ";
+        return l;
+      }() << "--out DIR\n";
+    } else {
+      std::cout << "unfinished or missing shards: " << unfinished << "\n"
+                << "resubmit: sbatch --array=" << unfinished
+                << " studies/slurm/lrcal_array.sbatch " << infos.front().study_file << " " << n
+                << "\n";
+    }
+  }
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // lrcal: kinematic calibration of robot arms with a laser ranger, and Monte-Carlo studies of it.
 // A thin layer over the library: each subcommand parses its options and calls lrcal/.
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 
@@ -37,6 +38,13 @@ const std::vector<Command>& Commands() {
 
 namespace {
 
+// Under mpirun every rank meets the same input errors: rank 0 alone reports them.
+bool OtherMpiRank() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+    if (const char* v = std::getenv(name)) return std::atoi(v) != 0;
+  return false;
+}
+
 void PrintUsage(std::ostream& out) {
   out << "lrcal " << LRCAL_VERSION << " — laser-ranger calibration of robot arms\n\n"
       << "usage: lrcal COMMAND [options]   (lrcal COMMAND --help for its options)\n\ncommands:\n";
@@ -64,7 +72,7 @@ int main(int argc, char** argv) {
     try {
       return c.run(args);
     } catch (const lrcal::InputError& e) {
-      std::cerr << "lrcal " << name << ": error: " << e.what() << "\n";
+      if (!OtherMpiRank()) std::cerr << "lrcal " << name << ": error: " << e.what() << "\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "lrcal " << name << ": failed: " << e.what() << "\n";
