@@ -10,7 +10,8 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make git pkg-config
   libeigen3-dev libceres-dev libyaml-cpp-dev libsqlite3-dev librandom123-dev nlohmann-json3-dev
-  libboost-program-options-dev libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin)
+  libboost-program-options-dev libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
+  python3 python3-pandas python3-numpy python3-matplotlib chromium)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

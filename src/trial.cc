@@ -200,7 +200,8 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
   return c;
 }
 
-TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) {
+TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
+                     TrialDetails* details) {
   const auto start = std::chrono::steady_clock::now();
   const CellSettings& s = c.cell->typed;
   TrialRecord rec;
@@ -309,6 +310,24 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws) 
       (s.truth_random ? ComparePoses(*c.robot, truth_values, identified, c.validation)
                       : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation))
           .stats);
+  if (details) {
+    const Eigen::VectorXd& nominal_values = c.robot->nominal_values();
+    std::vector<double> h_nominal, h_identified;
+    std::vector<BeamMiss> unused;
+    ExactReadings(*c.robot, nominal_values, c.plane, ws->data.configs, &h_nominal, &unused);
+    ExactReadings(*c.robot, identified, c.model->PlaneAt(ws->e.data()), ws->data.configs,
+                  &h_identified, &unused);
+    details->distance_error_nominal.clear();
+    details->distance_error_identified.clear();
+    for (int i = 0; i < ws->data.size(); ++i) {
+      details->distance_error_nominal.push_back(ws->data.mean_h[i] - h_nominal[i]);
+      details->distance_error_identified.push_back(ws->data.mean_h[i] - h_identified[i]);
+    }
+    details->measurement_nominal = ComparePoses(*c.robot, truth_values, nominal_values, ws->data.configs);
+    details->measurement_identified = ComparePoses(*c.robot, truth_values, identified, ws->data.configs);
+    details->validation_nominal = ComparePoses(*c.robot, truth_values, nominal_values, c.validation);
+    details->validation_identified = ComparePoses(*c.robot, truth_values, identified, c.validation);
+  }
   return finish(TrialStatus::kOk);
 }
 

@@ -92,7 +92,18 @@ struct TrialWorkspace {
   std::vector<BeamMiss> exact_miss;
 };
 
-TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace);
+/// One realisation in detail (the paper's figures): per measurement configuration the distance
+/// errors, and per measurement and validation configuration the pose errors, of the nominal and
+/// the identified model (SI).
+struct TrialDetails {
+  std::vector<double> distance_error_nominal;     ///< m, h̄ − h_nominal(q)
+  std::vector<double> distance_error_identified;  ///< m, h̄ − h_identified(q)
+  PoseErrors measurement_nominal, measurement_identified;
+  PoseErrors validation_nominal, validation_identified;
+};
+
+TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace,
+                     TrialDetails* details = nullptr);
 
 /// Flattens PoseErrorStats into the record's 12-number layout.
 std::array<double, 12> Flatten(const PoseErrorStats& s);

@@ -56,6 +56,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args);
 int PaperCommand(const std::vector<std::string>& args);
 int RunCommand(const std::vector<std::string>& args);
 int DesignCommand(const std::vector<std::string>& args);
+int ReportCommand(const std::vector<std::string>& args);
 int PlanCommand(const std::vector<std::string>& args);
 int StatusCommand(const std::vector<std::string>& args);
 int MergeCommand(const std::vector<std::string>& args);

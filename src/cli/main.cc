@@ -16,6 +16,8 @@ const std::vector<Command>& Commands() {
       {"status", "done / remaining trials per cell of a run directory", StatusCommand},
       {"merge", "combine shard run directories into one run", MergeCommand},
       {"aggregate", "rewrite the tables of a run directory from its trial store", AggregateCommand},
+      {"report", "figures (PNG, SVG) and a self-contained report.html of a run, partial or not",
+       ReportCommand},
       {"design", "choose k of N configurations by an observability criterion, against random",
        DesignCommand},
       {"paper", "the paper's case 1 and case 2, one realisation, beside its published tables",

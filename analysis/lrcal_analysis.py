@@ -1,0 +1,327 @@
+"""Figures of an lrcal run, from what `lrcal run` and `lrcal report` wrote (never recomputing the
+science): RUN_DIR/manifest.json and RUN_DIR/report/{tables/*, trials.snapshot.sqlite,
+realisation.json, status.json}. Units as in the tables: mm and mrad.
+
+Uses Debian's python3-pandas, python3-numpy and python3-matplotlib.
+"""
+import json
+import os
+import sqlite3
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+AXES = ("x", "y", "z")
+METRICS = (("rms_pos", "RMS position error (mm)"), ("rms_ori", "RMS orientation error (mrad)"),
+           ("max_pos", "max position error (mm)"), ("max_ori", "max orientation error (mrad)"))
+MAX_CELLS_PER_FIGURE = 12
+
+
+class RunDataError(Exception):
+    """A run directory that is missing or malformed: the message says what was expected."""
+
+
+class Run:
+    """Everything a report needs, loaded from a run directory prepared by `lrcal report`."""
+
+    def __init__(self, run_dir):
+        self.dir = run_dir
+        self.report_dir = os.path.join(run_dir, "report")
+        if not os.path.isdir(run_dir):
+            raise RunDataError(f"{run_dir}: no such run directory")
+        self.manifest = self._json(os.path.join(run_dir, "manifest.json"))
+        tables = os.path.join(self.report_dir, "tables")
+        self.summary = self._json(os.path.join(tables, "summary.json"))
+        self.status = self._json(os.path.join(self.report_dir, "status.json"))
+        self.validation = self._csv(os.path.join(tables, "validation.csv"))
+        self.parameters = self._csv(os.path.join(tables, "parameters.csv"))
+        self.cells_table = self._csv(os.path.join(tables, "cells.csv"))
+        placement = os.path.join(tables, "paper_placement.csv")
+        self.placement = pd.read_csv(placement) if os.path.exists(placement) else None
+        realisation = os.path.join(self.report_dir, "realisation.json")
+        self.realisation = self._json(realisation) if os.path.exists(realisation) else None
+        self.snapshot = os.path.join(self.report_dir, "trials.snapshot.sqlite")
+        with open(os.path.join(tables, "summary.md"), encoding="utf-8") as f:
+            self.summary_md = f.read()
+        self.cells = self.summary.get("cells", [])
+        if not isinstance(self.cells, list):
+            raise RunDataError(f"{tables}/summary.json: 'cells' should be a list")
+
+    @staticmethod
+    def _json(path):
+        if not os.path.exists(path):
+            raise RunDataError(f"{path}: missing (run `lrcal report RUN_DIR`, which prepares it)")
+        try:
+            with open(path, encoding="utf-8") as f:
+                return json.load(f)
+        except json.JSONDecodeError as e:
+            raise RunDataError(f"{path}: not valid JSON ({e})") from e
+
+    @staticmethod
+    def _csv(path):
+        if not os.path.exists(path):
+            raise RunDataError(f"{path}: missing (run `lrcal report RUN_DIR`, which prepares it)")
+        try:
+            return pd.read_csv(path)
+        except Exception as e:  # pandas raises several kinds
+            raise RunDataError(f"{path}: not a readable CSV ({e})") from e
+
+    def trial_metrics(self):
+        """One row per ok trial: cell_id, trial and the identified model's validation metrics."""
+        columns = ", ".join(f"val_{m}_{a}" for m, _ in METRICS for a in AXES)
+        with sqlite3.connect(f"file:{self.snapshot}?mode=ro", uri=True) as db:
+            return pd.read_sql_query(
+                f"SELECT cell_id, trial, {columns} FROM trials WHERE status = 'ok' "
+                "ORDER BY cell_id, trial", db)
+
+    def shown_cells(self, limit=MAX_CELLS_PER_FIGURE):
+        """Paper cells first, then the others, at most `limit`."""
+        paper = [c for c in self.cells if c["settings"].get("paper_case", 0)]
+        rest = [c for c in self.cells if not c["settings"].get("paper_case", 0)]
+        return (paper + rest)[:limit]
+
+    def paper_value(self, cell, metric, axis):
+        """The paper's published value for a paper cell, from paper_placement.csv (or None)."""
+        case = cell["settings"].get("paper_case", 0)
+        if not case or self.placement is None:
+            return None
+        rows = self.placement[(self.placement["case"] == f"case {case}") &
+                              (self.placement["quantity"] == f"validation {metric}") &
+                              (self.placement["axis/parameter"] == axis)]
+        return float(rows["paper"].iloc[0]) if len(rows) else None
+
+
+def _save(fig, out_dir, name):
+    os.makedirs(out_dir, exist_ok=True)
+    png = os.path.join(out_dir, name + ".png")
+    fig.savefig(png, dpi=110, bbox_inches="tight")
+    fig.savefig(os.path.join(out_dir, name + ".svg"), bbox_inches="tight")
+    plt.close(fig)
+    return png
+
+
+def realisation_figures(run, out_dir):
+    """The paper's figures from one realisation (trial 0 of each cell)."""
+    if not run.realisation:
+        return []
+    cells = [c for c in run.realisation["cells"] if "distance_error_nominal" in c]
+    cells = sorted(cells, key=lambda c: (not c.get("paper_case"), 0))[:4]
+    if not cells:
+        return []
+    out = []
+    fig, axes = plt.subplots(len(cells), 1, figsize=(9, 2.6 * len(cells)), squeeze=False)
+    for ax, c in zip(axes[:, 0], cells):
+        n = np.arange(1, len(c["distance_error_nominal"]) + 1)
+        ax.bar(n - 0.2, c["distance_error_nominal"], width=0.4, color="0.6", label="nominal model")
+        ax.bar(n + 0.2, c["distance_error_identified"], width=0.4, color="C0", label="identified")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_title(f"{c['label']}: distance error per measurement configuration (trial 0)")
+        ax.set_xlabel("measurement configuration")
+        ax.set_ylabel("h measured − h model (mm)")
+        ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    out.append((_save(fig, out_dir, "realisation_distance_errors"),
+                "Distance errors in the measurement configurations, nominal and identified model "
+                "(one realisation, as the paper's first figure)."))
+
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7))
+    for row, (key, title) in enumerate((("measurement", "measurement"), ("validation", "validation"))):
+        for col, (what, unit) in enumerate((("position", "mm"), ("orientation", "mrad"))):
+            ax = axes[row, col]
+            nominal = np.linalg.norm(np.array(cells[0][key][f"{what}_nominal"]), axis=1)
+            if key == "validation":
+                ax.plot(np.arange(1, len(nominal) + 1), nominal, "o-", color="0.5", label="nominal")
+            for i, c in enumerate(cells):
+                err = np.linalg.norm(np.array(c[key][f"{what}_identified"]), axis=1)
+                if key == "measurement":
+                    nom = np.linalg.norm(np.array(c[key][f"{what}_nominal"]), axis=1)
+                    ax.plot(np.arange(1, len(nom) + 1), nom, ".", color="0.6", ms=3,
+                            label="nominal" if i == 0 else None)
+                ax.plot(np.arange(1, len(err) + 1), err, "o-" if key == "validation" else ".-",
+                        color=f"C{i}", ms=3, label=c["label"])
+            ax.set_yscale("log")
+            ax.set_title(f"{what} error, {title} configurations")
+            ax.set_xlabel(f"{title} configuration")
+            ax.set_ylabel(f"|error| ({unit})")
+            ax.legend(fontsize=7)
+    fig.tight_layout()
+    out.append((_save(fig, out_dir, "realisation_pose_errors"),
+                "Position and orientation errors (norm over x, y, z) per configuration, in the "
+                "measurement and the validation configurations (one realisation; log scale)."))
+    return out
+
+
+def distribution_figure(run, out_dir):
+    """Box plots of the validation RMS and max errors per axis for each cell; the paper's
+    published values marked for paper cells."""
+    data = run.trial_metrics()
+    if data.empty:
+        return []
+    cells = run.shown_cells()
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7.5))
+    for ax, (metric, title) in zip(axes.flat, METRICS):
+        boxes, positions, colors = [], [], []
+        ticks, ticklabels = [], []
+        for i, cell in enumerate(cells):
+            rows = data[data["cell_id"] == cell["id"]]
+            for j, axis in enumerate(AXES):
+                boxes.append(rows[f"val_{metric}_{axis}"].to_numpy() * 1e3)
+                positions.append(i * 4 + j)
+                colors.append(f"C{j}")
+                paper = run.paper_value(cell, metric, axis)
+                if paper is not None:
+                    ax.plot(i * 4 + j, paper, "D", color="red", ms=5,
+                            label="paper" if (i == 0 and j == 0) or not ax.get_legend_handles_labels()[1] else None)
+            ticks.append(i * 4 + 1)
+            ticklabels.append(cell["label"])
+        bp = ax.boxplot(boxes, positions=positions, widths=0.8, showfliers=False, patch_artist=True)
+        for patch, color in zip(bp["boxes"], colors):
+            patch.set_facecolor(color)
+            patch.set_alpha(0.5)
+        ax.set_xticks(ticks)
+        ax.set_xticklabels(ticklabels, rotation=30, ha="right", fontsize=8)
+        ax.set_yscale("log")
+        ax.set_ylabel(title)
+        handles = [plt.Rectangle((0, 0), 1, 1, color=f"C{j}", alpha=0.5) for j in range(3)]
+        labels = list(AXES)
+        h, l = ax.get_legend_handles_labels()
+        ax.legend(handles + h, labels + l, fontsize=7, loc="upper right")
+    fig.suptitle("Validation errors over the Monte-Carlo trials (boxes: p25–p75, whiskers 1.5 IQR; "
+                 "red: the paper's published value)", fontsize=10)
+    fig.tight_layout()
+    return [(_save(fig, out_dir, "distributions_validation"),
+             "Distributions of the validation RMS and max errors per base axis over the trials of "
+             "each cell" + (" (first %d cells)" % len(cells) if len(run.cells) > len(cells) else "")
+             + ". Red diamonds: the paper's published values.")]
+
+
+def _axis_values(run, cell, axis_index, key, n_axes):
+    """The value of sweep axis `key` for a cell: the setting when it is a number, else the
+    cell's label part for that axis."""
+    value = cell["settings"]
+    if key != ".":
+        for part in key.split("."):
+            value = value.get(part) if isinstance(value, dict) else None
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return value, True
+    parts = cell["label"].split(", ")
+    return (parts[axis_index] if len(parts) == n_axes else cell["label"]), False
+
+
+def sensitivity_figures(run, out_dir):
+    """One figure per sweep axis: validation RMS position and orientation (mean over the x, y, z
+    axes of each axis' mean, p5 and p95) against the axis, one line per value of the others."""
+    axes_spec = (run.summary.get("study", {}).get("sweep") or {}).get("axes", [])
+    if not axes_spec:
+        return []
+    val = run.validation[run.validation["model"] == "identified"]
+    n_axes = len(axes_spec)
+    out = []
+    for a, spec in enumerate(axes_spec):
+        key = spec.get("key", "?")
+        rows = []
+        for cell in run.cells:
+            x, numeric = _axis_values(run, cell, a, key, n_axes)
+            others = ", ".join(str(_axis_values(run, cell, b, axes_spec[b].get("key", "?"), n_axes)[0])
+                               for b in range(n_axes) if b != a)
+            for metric in ("rms_pos", "rms_ori"):
+                r = val[(val["cell_id"] == cell["id"]) & (val["metric"] == metric)]
+                if r.empty:
+                    continue
+                rows.append(dict(x=x, numeric=numeric, group=others, metric=metric,
+                                 mean=r["mean"].mean(), p5=r["p5"].mean(), p95=r["p95"].mean()))
+        if not rows:
+            continue
+        df = pd.DataFrame(rows)
+        numeric = bool(df["numeric"].all())
+        categories = list(dict.fromkeys(df["x"]))
+        fig, axs = plt.subplots(1, 2, figsize=(12, 4.2))
+        for ax, (metric, title) in zip(axs, (("rms_pos", "RMS position error (mm)"),
+                                             ("rms_ori", "RMS orientation error (mrad)"))):
+            for g, (group, sub) in enumerate(df[df["metric"] == metric].groupby("group", sort=False)):
+                xs = sub["x"].to_numpy(dtype=float) if numeric else \
+                    np.array([categories.index(v) for v in sub["x"]], dtype=float)
+                order = np.argsort(xs)
+                ax.plot(xs[order], sub["mean"].to_numpy()[order], "o-", color=f"C{g % 10}",
+                        label=group or "mean")
+                ax.fill_between(xs[order], sub["p5"].to_numpy()[order], sub["p95"].to_numpy()[order],
+                                color=f"C{g % 10}", alpha=0.15)
+            if numeric:
+                values = df["x"].astype(float)
+                if values.min() > 0 and values.max() / values.min() > 20:
+                    ax.set_xscale("log")
+            else:
+                ax.set_xticks(range(len(categories)))
+                ax.set_xticklabels(categories, rotation=30, ha="right", fontsize=8)
+            ax.set_yscale("log")
+            ax.set_xlabel(key)
+            ax.set_ylabel(title)
+            ax.grid(alpha=0.3)
+            if df["group"].nunique() > 1:
+                ax.legend(fontsize=7)
+        fig.suptitle(f"Sensitivity to {key}: mean over trials with the p5–p95 band "
+                     "(averaged over the x, y, z axes)", fontsize=10)
+        fig.tight_layout()
+        safe = "".join(ch if ch.isalnum() else "_" for ch in key).strip("_") or "settings"
+        out.append((_save(fig, out_dir, f"sensitivity_{safe}"),
+                    f"Validation accuracy against the swept setting '{key}'."))
+    return out
+
+
+def parameter_figures(run, out_dir, limit=4):
+    """Empirical against predicted std per parameter, the bias with its Monte-Carlo error bar, and
+    the correlation matrix, for the first cells."""
+    out = []
+    for k, cell in enumerate(run.shown_cells(limit)):
+        params = pd.DataFrame(cell["parameters"])
+        if params.empty or params["std"].isna().all():
+            continue
+        names = params["name"].tolist()
+        x = np.arange(len(names))
+        fig, axs = plt.subplots(2, 1, figsize=(12, 6.5), sharex=True)
+        axs[0].bar(x - 0.2, params["std"] * 1e3, width=0.4, label="empirical std")
+        axs[0].bar(x + 0.2, params["predicted_std"].astype(float) * 1e3, width=0.4,
+                   label="predicted σ·√diag(GᵀWG)⁻¹")
+        axs[0].set_ylabel("std (mm or mrad)")
+        axs[0].legend(fontsize=8)
+        axs[1].errorbar(x, params["bias"] * 1e3, yerr=2 * params["bias_se"] * 1e3, fmt="o", ms=3,
+                        capsize=2, label="bias ± 2 SE")
+        axs[1].axhline(0, color="k", lw=0.5)
+        axs[1].set_ylabel("bias (mm or mrad)")
+        axs[1].legend(fontsize=8)
+        axs[1].set_xticks(x)
+        axs[1].set_xticklabels(names, rotation=60, fontsize=8)
+        fig.suptitle(f"Parameter errors, cell {cell['label']} ({cell['ok']} trials)", fontsize=10)
+        fig.tight_layout()
+        out.append((_save(fig, out_dir, f"parameters_{k}"),
+                    f"Cell {cell['label']}: empirical against predicted standard deviation of each "
+                    "parameter's error, and its bias with ±2 Monte-Carlo standard errors."))
+        corr = np.array([[np.nan if v is None else v for v in row] for row in cell["correlation"]],
+                        dtype=float)
+        fig, ax = plt.subplots(figsize=(7.5, 6.5))
+        im = ax.imshow(corr, cmap="RdBu_r", vmin=-1, vmax=1)
+        ax.set_xticks(x)
+        ax.set_yticks(x)
+        ax.set_xticklabels(names, rotation=90, fontsize=7)
+        ax.set_yticklabels(names, fontsize=7)
+        fig.colorbar(im, ax=ax, shrink=0.8, label="correlation")
+        ax.set_title(f"Empirical correlation of the parameter errors, {cell['label']}", fontsize=10)
+        fig.tight_layout()
+        out.append((_save(fig, out_dir, f"correlation_{k}"),
+                    f"Cell {cell['label']}: correlation matrix of the parameter errors over the "
+                    "trials."))
+    return out
+
+
+def all_figures(run, out_dir):
+    """Every figure, as (png path, caption) pairs."""
+    figures = []
+    figures += realisation_figures(run, out_dir)
+    figures += distribution_figure(run, out_dir)
+    figures += sensitivity_figures(run, out_dir)
+    figures += parameter_figures(run, out_dir)
+    return figures

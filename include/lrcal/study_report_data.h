@@ -1,0 +1,25 @@
+// What `lrcal report` prepares for the analysis scripts (analysis/report.py), in RUN_DIR/report/:
+//   trials.snapshot.sqlite  a consistent copy of every store of the run (main and rank stores),
+//                           so a run still going, or interrupted, can be reported
+//   tables/                 the tables of study_report.h, from the snapshot
+//   realisation.json        trial 0 of every cell in detail (TrialDetails): the paper's figures
+//   status.json             trials done / expected, and whether the run is complete
+#pragma once
+
+#include <string>
+
+namespace lrcal {
+
+struct ReportData {
+  std::string dir;        ///< RUN_DIR/report
+  long long done = 0;     ///< trials in the snapshot
+  long long expected = 0; ///< trials of the whole study
+  bool complete = false;
+  bool realisation = false;  ///< realisation.json written (needs the study file)
+  std::string note;          ///< why the realisation is missing, if it is
+};
+
+/// Prepares RUN_DIR/report. Throws InputError for a missing or malformed run directory.
+ReportData PrepareReportData(const std::string& run_dir);
+
+}  // namespace lrcal

@@ -1,0 +1,65 @@
+// lrcal report RUN_DIR: tables and a one-realisation file from the run's records (C++), then the
+// figures and report.html (analysis/report.py, which only reads what lrcal wrote).
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+
+#include "cli_common.h"
+#include "lrcal/study_report_data.h"
+#include "lrcal/table.h"
+
+namespace lrcal::cli {
+
+namespace {
+
+std::string Quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string FindReportScript() {
+  namespace fs = std::filesystem;
+  for (const fs::path& base : {fs::path("."), fs::path(LRCAL_SOURCE_DIR)}) {
+    const fs::path p = base / "analysis" / "report.py";
+    if (fs::exists(p)) return p.string();
+  }
+  throw InputError("analysis/report.py", "not found next to the working directory or in the "
+                                         "source tree " LRCAL_SOURCE_DIR);
+}
+
+}  // namespace
+
+int ReportCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal report options");
+  o.add_options()("dir", po::value<std::string>()->required(), "run directory");
+  po::positional_options_description pos;
+  pos.add("dir", 1);
+  po::variables_map vm;
+  if (!Parse("report", "RUN_DIR", o, args, &vm, &pos)) return 0;
+  const std::string dir = vm["dir"].as<std::string>();
+  const auto t0 = std::chrono::steady_clock::now();
+  const ReportData data = PrepareReportData(dir);
+  const std::string script = FindReportScript();
+  // Debian's interpreter, where python3-pandas and python3-matplotlib are installed (a python3
+  // earlier on PATH, e.g. from pyenv, may not have them); LRCAL_PYTHON overrides.
+  std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  if (const char* p = std::getenv("LRCAL_PYTHON")) python = p;
+  const int status = std::system((Quote(python) + " " + Quote(script) + " " + Quote(dir)).c_str());
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (code != 0) {
+    std::cerr << "lrcal report: analysis/report.py failed (exit " << code << ")\n";
+    return code == 2 ? 2 : 1;
+  }
+  std::cout << "report: " << data.dir << "/report.html (" << data.done << "/" << data.expected
+            << " trials" << (data.complete ? "" : ", PARTIAL run") << "; built in "
+            << Fixed(seconds, 1) << " s)\n";
+  if (!data.note.empty()) std::cout << data.note << "\n";
+  return 0;
+}
+
+}  // namespace lrcal::cli
