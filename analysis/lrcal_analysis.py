@@ -41,7 +41,7 @@ class Run:
         self.parameters = self._csv(os.path.join(tables, "parameters.csv"))
         self.cells_table = self._csv(os.path.join(tables, "cells.csv"))
         placement = os.path.join(tables, "paper_placement.csv")
-        self.placement = pd.read_csv(placement) if os.path.exists(placement) else None
+        self.placement = pd.read_csv(placement, na_values=["—"]) if os.path.exists(placement) else None
         realisation = os.path.join(self.report_dir, "realisation.json")
         self.realisation = self._json(realisation) if os.path.exists(realisation) else None
         self.snapshot = os.path.join(self.report_dir, "trials.snapshot.sqlite")
@@ -66,7 +66,8 @@ class Run:
         if not os.path.exists(path):
             raise RunDataError(f"{path}: missing (run `lrcal report RUN_DIR`, which prepares it)")
         try:
-            return pd.read_csv(path)
+            # "—" marks a value that does not exist yet (a cell with no trials in a partial run).
+            return pd.read_csv(path, na_values=["—"])
         except Exception as e:  # pandas raises several kinds
             raise RunDataError(f"{path}: not a readable CSV ({e})") from e
 

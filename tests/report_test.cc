@@ -1,0 +1,121 @@
+// lrcal report end to end: the analysis scripts on the output of studies/quick.yaml, the page in
+// headless Chromium (no console errors, every figure decoded, a screenshot written), a partial
+// run said so, and clear errors for missing or malformed run directories.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using testing::LrcalBinary;
+using testing::RunCommand;
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Debian's chromium, started as the probe of this machine does (no sandbox as root, no GPU, no
+// background networking on a closed network).
+std::string Chromium(const std::string& profile) {
+  return "chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --no-first-run "
+         "--disable-background-networking --disable-component-update --disable-sync "
+         "--user-data-dir=" + profile + " ";
+}
+
+TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
+  const std::string dir = testing::TempDir("report_quick");
+  const std::string run = dir + "/run";
+  std::string out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " run " + testing::SourcePath("studies/quick.yaml") +
+                           " --out " + run + " --quiet",
+                       &out),
+            0)
+      << out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " report " + run, &out), 0) << out;
+  const fs::path report = fs::path(run) / "report";
+  ASSERT_TRUE(fs::exists(report / "report.html")) << out;
+  const Json figures = Json::parse(Read(report / "figures.json"));
+  const std::vector<std::string> names = figures["figures"];
+  // One-realisation (2), distributions, sensitivity, parameters and correlation per cell (2 × 2).
+  EXPECT_EQ(names.size(), 8u) << figures.dump();
+  for (const auto& png : names) {
+    EXPECT_GT(fs::file_size(report / "figures" / png), 10000u) << png;
+    EXPECT_TRUE(fs::exists(report / "figures" / (png.substr(0, png.size() - 4) + ".svg"))) << png;
+  }
+  const std::string html = Read(report / "report.html");
+  EXPECT_EQ(html.find("Partial run"), std::string::npos);
+  EXPECT_NE(html.find("The paper"), std::string::npos);  // the placement table is in
+
+  if (RunCommand("command -v chromium", &out) != 0) GTEST_SKIP() << "chromium is not installed";
+  const std::string profile = dir + "/chromium-profile";
+  // Load the page; the page's own script puts "k/n figures" decoded into the title.
+  ASSERT_EQ(RunCommand(Chromium(profile) + "--enable-logging=stderr --v=0 --virtual-time-budget=10000 "
+                                           "--dump-dom file://" + (report / "report.html").string() +
+                           " 2>" + dir + "/console.log",
+                       &out),
+            0);
+  const std::string title = "lrcal report: " + std::to_string(names.size()) + "/" +
+                            std::to_string(names.size()) + " figures";
+  EXPECT_NE(out.find("<title>" + title + "</title>"), std::string::npos)
+      << "expected the title '" << title << "'";
+  const std::string console = Read(dir + "/console.log");
+  EXPECT_EQ(console.find("CONSOLE"), std::string::npos) << "console messages:\n" << console;
+  // A screenshot into the run directory.
+  const fs::path shot = report / "screenshot.png";
+  ASSERT_EQ(RunCommand(Chromium(profile) + "--window-size=1280,2400 --screenshot=" + shot.string() +
+                           " file://" + (report / "report.html").string() + " 2>/dev/null",
+                       &out),
+            0);
+  EXPECT_GT(fs::file_size(shot), 20000u);
+}
+
+TEST(Report, PartialRunIsReportedAsPartial) {
+  const std::string dir = testing::TempDir("report_partial");
+  const std::string run = dir + "/run";
+  std::string out;
+  RunCommand(LrcalBinary() + " run " + testing::SourcePath("studies/quick.yaml") + " --out " + run +
+                 " --quiet --max-trials 60",
+             &out);
+  ASSERT_EQ(RunCommand(LrcalBinary() + " report " + run, &out), 0) << out;
+  EXPECT_NE(out.find("PARTIAL"), std::string::npos) << out;
+  const Json status = Json::parse(Read(fs::path(run) / "report" / "status.json"));
+  EXPECT_FALSE(status["complete"].get<bool>());
+  EXPECT_EQ(status["done"], 60);
+  EXPECT_NE(Read(fs::path(run) / "report" / "report.html").find("Partial run"), std::string::npos);
+}
+
+TEST(Report, MissingOrMalformedRunDirectoriesAreClearErrors) {
+  const std::string dir = testing::TempDir("report_bad");
+  std::string out;
+  EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/nothing", &out), 2);
+  EXPECT_NE(out.find("no such run directory"), std::string::npos) << out;
+  fs::create_directories(dir + "/empty");
+  EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/empty", &out), 2);
+  EXPECT_NE(out.find("manifest.json is missing"), std::string::npos) << out;
+  fs::create_directories(dir + "/broken");
+  std::ofstream(dir + "/broken/manifest.json") << "{ not json";
+  EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/broken", &out), 2);
+  EXPECT_NE(out.find("broken/manifest.json: not valid JSON"), std::string::npos) << out;
+  // The analysis script alone, on a directory lrcal report has not prepared.
+  std::ofstream(dir + "/empty/manifest.json") << "{}";
+  EXPECT_EQ(RunCommand("/usr/bin/python3 " + testing::SourcePath("analysis/report.py") + " " + dir +
+                           "/empty",
+                       &out),
+            2);
+  EXPECT_NE(out.find("summary.json: missing"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace lrcal
