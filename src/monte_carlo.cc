@@ -148,6 +148,14 @@ void MergeRankStores(const fs::path& dir, TrialStore* main_store) {
   }
 }
 
+// The manifest of a run directory; InputError if `dir` is not one.
+Json ReadRunManifest(const fs::path& dir) {
+  if (!fs::exists(dir / "manifest.json") || !fs::exists(dir / "trials.sqlite"))
+    throw InputError(dir.string(), "not an lrcal run directory (expected manifest.json and "
+                                   "trials.sqlite)");
+  return ReadJson(dir / "manifest.json");
+}
+
 // Peak resident set size of this process so far (kB).
 long PeakRssKb() {
   struct rusage usage;
@@ -562,10 +570,7 @@ RunResult RunStudy(const Study& study, const RunOptions& options, Collective* co
 
 void AggregateRun(const std::string& run_dir) {
   const fs::path dir = run_dir;
-  if (!fs::exists(dir / "manifest.json") || !fs::exists(dir / "trials.sqlite"))
-    throw InputError(run_dir, "not an lrcal run directory (expected manifest.json and "
-                              "trials.sqlite)");
-  const Json manifest = ReadJson(dir / "manifest.json");
+  const Json manifest = ReadRunManifest(dir);
   DirectoryLock lock(dir);
   TrialStore store((dir / "trials.sqlite").string());
   MergeRankStores(dir, &store);  // records of an interrupted MPI job
@@ -579,10 +584,7 @@ void MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& ou
   DirectoryLock lock(out);
   Json merged;
   for (const std::string& d : shard_dirs) {
-    const fs::path m = fs::path(d) / "manifest.json";
-    if (!fs::exists(m) || !fs::exists(fs::path(d) / "trials.sqlite"))
-      throw InputError(d, "not an lrcal run directory (expected manifest.json and trials.sqlite)");
-    const Json manifest = ReadJson(m);
+    const Json manifest = ReadRunManifest(d);
     if (merged.is_null()) {
       merged = manifest;
       merged["merged_from"] = Json::array();
@@ -615,10 +617,7 @@ std::string RunStatus(const std::string& run_dir) { return GetRunStatus(run_dir)
 RunStatusInfo GetRunStatus(const std::string& run_dir) {
   RunStatusInfo info;
   const fs::path dir = run_dir;
-  if (!fs::exists(dir / "manifest.json") || !fs::exists(dir / "trials.sqlite"))
-    throw InputError(run_dir, "not an lrcal run directory (expected manifest.json and "
-                              "trials.sqlite)");
-  const Json manifest = ReadJson(dir / "manifest.json");
+  const Json manifest = ReadRunManifest(dir);
   // Open every store of the directory: the main one and any rank stores of an MPI job.
   std::vector<std::unique_ptr<TrialStore>> stores;
   for (const fs::path& path : StorePaths(dir))

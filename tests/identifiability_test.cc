@@ -20,25 +20,8 @@ std::vector<std::string> Sorted(std::vector<std::string> v) {
   return v;
 }
 
-// Configurations of the paper's arm whose beam hits `plane` (any side, h in range).
 ConfigurationSet HittingConfigurations(const Plane& plane, int count) {
-  const RobotModel& robot = PaperRobot();
-  ModelPoint point;
-  PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-M_PI, M_PI);
-  ConfigurationSet out(6);
-  while (out.size() < count) {
-    double q[6];
-    for (double& v : q) v = u(rng);
-    ConfigurationSet one(6);
-    one.Add(q);
-    Pose<double> pose = ToolPose(point, one, 0);
-    double nb = plane.normal.dot(pose.R_BT.col(2));
-    double h = -(plane.SignedDistance(pose.p_BT)) / nb;
-    if (ClassifyReading(h, nb, robot.ranger) == BeamMiss::kNone) out.Add(q);
-  }
-  return out;
+  return testing::HittingConfigurations(plane, count, 5);
 }
 
 TEST(Identifiability, PapersTwentyFiveParametersAreIdentifiableOnThePapersPlane) {

@@ -51,10 +51,10 @@ std::string Study(const std::string& dir, int trials) {
   return path;
 }
 
-TEST(Mpi, TablesAreByteIdenticalToASingleProcessForTwoAndThreeRanks) {
-  if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
-  const std::string dir = testing::TempDir("mpi_np");
-  const std::string study = testing::SourcePath("studies/quick.yaml");
+// Runs `study` in one process and with 2 and 3 ranks (`extra` options added); every run's
+// tables must be those of the single process.
+void ExpectRanksMatchSingleProcess(const std::string& dir, const std::string& study,
+                                   const std::string& extra) {
   std::string out;
   ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + dir +
                                     "/single --quiet",
@@ -65,35 +65,26 @@ TEST(Mpi, TablesAreByteIdenticalToASingleProcessForTwoAndThreeRanks) {
     const std::string run = dir + "/np" + std::to_string(np);
     ASSERT_EQ(testing::RunCommand(kMpirun + " -np " + std::to_string(np) + " " +
                                       testing::LrcalBinary() + " run " + study + " --out " + run +
-                                      " --threads 1 --quiet",
+                                      " --threads 1 --quiet " + extra,
                                   &out),
               0)
         << out;
-    EXPECT_EQ(Tables(dir + "/single"), Tables(run)) << "np " << np;
+    EXPECT_EQ(Tables(dir + "/single"), Tables(run)) << "np " << np << " " << extra;
     EXPECT_FALSE(fs::exists(run + "/trials.rank1.sqlite"));  // merged into trials.sqlite
   }
+}
+
+TEST(Mpi, TablesAreByteIdenticalToASingleProcessForTwoAndThreeRanks) {
+  if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
+  ExpectRanksMatchSingleProcess(testing::TempDir("mpi_np"),
+                                testing::SourcePath("studies/quick.yaml"), "");
 }
 
 TEST(Mpi, DynamicScheduleGivesTheSameTables) {
   if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
   const std::string dir = testing::TempDir("mpi_dynamic");
-  const std::string study = Study(dir, 150);  // 600 trials: 10 chunks of 64 over the ranks
-  std::string out;
-  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + dir +
-                                    "/single --quiet",
-                                &out),
-            0)
-      << out;
-  for (int np : {2, 3}) {
-    const std::string run = dir + "/np" + std::to_string(np);
-    ASSERT_EQ(testing::RunCommand(kMpirun + " -np " + std::to_string(np) + " " +
-                                      testing::LrcalBinary() + " run " + study + " --out " + run +
-                                      " --threads 1 --schedule dynamic --quiet",
-                                  &out),
-              0)
-        << out;
-    EXPECT_EQ(Tables(dir + "/single"), Tables(run)) << "np " << np;
-  }
+  // 600 trials: 10 chunks of 64 over the ranks.
+  ExpectRanksMatchSingleProcess(dir, Study(dir, 150), "--schedule dynamic");
 }
 
 TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {

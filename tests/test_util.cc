@@ -18,25 +18,28 @@ const RobotModel& PaperRobot() {
   return robot;
 }
 
-ConfigurationSet PaperHittingConfigurations(int count, unsigned seed) {
+ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed) {
   const RobotModel& robot = PaperRobot();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-M_PI, M_PI);
   ConfigurationSet out(robot.num_links());
   ModelPoint point;
-  PrepareModelPoint(robot, robot.nominal_values().data(), *robot.default_plane, &point);
+  PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
   while (out.size() < count) {
     double q[6];
     for (double& v : q) v = u(rng);
     ConfigurationSet one(6);
     one.Add(q);
-    Pose<double> pose = ToolPose(point, one, 0);
-    const Plane& pl = point.plane;
-    double nb = pl.normal.dot(pose.R_BT.col(2));
-    double h = -(pl.normal.dot(pose.p_BT) + pl.offset) / nb;
+    const Pose<double> pose = ToolPose(point, one, 0);
+    const double nb = plane.normal.dot(pose.R_BT.col(2));
+    const double h = -plane.SignedDistance(pose.p_BT) / nb;
     if (ClassifyReading(h, nb, robot.ranger) == BeamMiss::kNone) out.Add(q);
   }
   return out;
+}
+
+ConfigurationSet PaperHittingConfigurations(int count, unsigned seed) {
+  return HittingConfigurations(*PaperRobot().default_plane, count, seed);
 }
 
 int RunCommand(const std::string& command, std::string* output) {

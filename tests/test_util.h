@@ -15,8 +15,10 @@ std::string SourcePath(const std::string& relative);
 std::string LrcalBinary();
 /// The paper's robot (studies/robots/paper.yaml).
 const RobotModel& PaperRobot();
-/// `count` configurations of the paper's arm whose nominal beam hits the paper's plane, drawn
-/// from a fixed std::mt19937 seed (test data only; the library uses counter-based streams).
+/// `count` configurations of the paper's arm whose nominal beam hits `plane` (a usable reading),
+/// drawn from a fixed std::mt19937 seed (test data only; the library uses counter-based streams).
+ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed = 1);
+/// The same for the paper's own plane.
 ConfigurationSet PaperHittingConfigurations(int count, unsigned seed = 1);
 /// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
 int RunCommand(const std::string& command, std::string* output);
