@@ -333,17 +333,55 @@ class LaserPlaneCost : public ceres::CostFunction {
   const MeasurementSet& data_;
 };
 
+// One configuration's residual: with a robust loss every configuration needs its own block,
+// because Ceres applies a loss to the squared norm of a whole block.
+class OneConfigurationCost : public ceres::CostFunction {
+ public:
+  OneConfigurationCost(const MeasurementModel& model, const MeasurementSet& data, int i)
+      : model_(model), data_(data), i_(i) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(model.num_parameters());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int n = model_.num_parameters();
+    ModelPoint point;
+    model_.Prepare(parameters[0], &point);
+    double* row = (jacobians && jacobians[0]) ? jacobians[0] : nullptr;
+    double h;
+    const double nb = model_.Evaluate(point, data_.configs, i_, &h, row);
+    if (!(std::fabs(nb) > 1e-12)) return false;
+    const double w = std::sqrt(static_cast<double>(data_.repetitions[i_]));
+    residuals[0] = w * (data_.mean_h[i_] - h);
+    if (row)
+      for (int k = 0; k < n; ++k) row[k] *= -w;
+    return true;
+  }
+
+ private:
+  const MeasurementModel& model_;
+  const MeasurementSet& data_;
+  int i_;
+};
+
 Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
                            const IdentificationOptions& options, Eigen::VectorXd* e,
                            int* iterations, std::string* message) {
   e->setZero(model.num_parameters());
   ceres::Problem::Options problem_options;
   ceres::Problem problem(problem_options);
-  ceres::LossFunction* loss = nullptr;
-  // The loss acts on the squared residual of a mean reading weighted by √R.
-  if (options.loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(options.loss_scale);
-  if (options.loss == RobustLoss::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale);
-  problem.AddResidualBlock(new LaserPlaneCost(model, data), loss, e->data());
+  if (options.loss == RobustLoss::kNone) {
+    // All configurations in one block: Ceres' per-block overhead paid once (DESIGN.md).
+    problem.AddResidualBlock(new LaserPlaneCost(model, data), nullptr, e->data());
+  } else {
+    // One block per configuration, each with its own loss on its weighted residual √R·(h̄ − h).
+    for (int i = 0; i < data.size(); ++i) {
+      ceres::LossFunction* loss = options.loss == RobustLoss::kHuber
+                                      ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
+                                      : new ceres::CauchyLoss(options.loss_scale);
+      problem.AddResidualBlock(new OneConfigurationCost(model, data, i), loss, e->data());
+    }
+  }
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;

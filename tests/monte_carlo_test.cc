@@ -295,6 +295,22 @@ TEST(MonteCarlo, SelectionRedrawnPerTrialVariesTheDesign) {
                          "sweep:\n  axes:\n    - key: selection\n      values:\n"
                          "        - {count: 30, method: random, redraw: true}\n"
                          "        - {count: 30, method: exchange, scaling: unit, criterion: A}\n";
+  // A pool redrawn every trial: every trial has its own candidates, hence its own design.
+  const std::string pool_path = dir + "/pool.yaml";
+  std::ofstream(pool_path) << "name: pool\nseed: 4\ntrials: 8\nrobot: "
+                           << testing::SourcePath("studies/robots/paper.yaml")
+                           << "\npool: {size: 40, redraw: true}\nselection: {count: 30}\n"
+                              "validation: {size: 5}\n";
+  RunSmall(pool_path, dir + "/pool_run", 2);
+  {
+    TrialStore pool_store(dir + "/pool_run/trials.sqlite");
+    std::set<double> pool_sigma;
+    pool_store.ForEachTrial(pool_store.Cells()[0].id, [&](const TrialRecord& r) {
+      EXPECT_EQ(r.status, TrialStatus::kOk);
+      pool_sigma.insert(r.sigma_min);
+    });
+    EXPECT_EQ(pool_sigma.size(), 8u) << "a redrawn pool should give every trial its own design";
+  }
   RunSmall(path, dir + "/run", 2);
   TrialStore store(dir + "/run/trials.sqlite");
   const auto cells = store.Cells();

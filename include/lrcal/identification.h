@@ -39,7 +39,8 @@ struct IdentificationOptions {
   /// lrcal's own LM is the fast default; kCeres is the reference and the only one with losses.
   Solver solver = Solver::kLevenbergMarquardt;
   RobustLoss loss = RobustLoss::kNone;
-  /// Scale of the robust loss (m): residuals (of a mean reading) beyond it are down-weighted.
+  /// Scale of the robust loss (m), applied to each configuration's weighted residual
+  /// √R·(h̄ − h): residuals beyond it are down-weighted.
   double loss_scale = 1e-3;
   int max_iterations = 100;
   /// Stop when the step is below parameter_tolerance·(‖e‖ + parameter_tolerance). Ceres'
