@@ -364,24 +364,7 @@ class OneConfigurationCost : public ceres::CostFunction {
   int i_;
 };
 
-Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
-                           const IdentificationOptions& options, Eigen::VectorXd* e,
-                           int* iterations, std::string* message) {
-  e->setZero(model.num_parameters());
-  ceres::Problem::Options problem_options;
-  ceres::Problem problem(problem_options);
-  if (options.loss == RobustLoss::kNone) {
-    // All configurations in one block: Ceres' per-block overhead paid once (DESIGN.md).
-    problem.AddResidualBlock(new LaserPlaneCost(model, data), nullptr, e->data());
-  } else {
-    // One block per configuration, each with its own loss on its weighted residual √R·(h̄ − h).
-    for (int i = 0; i < data.size(); ++i) {
-      ceres::LossFunction* loss = options.loss == RobustLoss::kHuber
-                                      ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
-                                      : new ceres::CauchyLoss(options.loss_scale);
-      problem.AddResidualBlock(new OneConfigurationCost(model, data, i), loss, e->data());
-    }
-  }
+ceres::Solver::Options CeresOptions(const IdentificationOptions& options) {
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -395,15 +378,49 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
   so.use_nonmonotonic_steps = true;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
-  *iterations = static_cast<int>(summary.iterations.size()) - 1;
-  *message = summary.message;
+  return so;
+}
+
+Termination CeresTermination(const ceres::Solver::Summary& summary) {
   switch (summary.termination_type) {
     case ceres::CONVERGENCE: return Termination::kConverged;
     case ceres::NO_CONVERGENCE: return Termination::kMaxIterations;
     default: return Termination::kNumericalFailure;
   }
+}
+
+Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           int* iterations, std::string* message) {
+  e->setZero(model.num_parameters());
+  const ceres::Solver::Options so = CeresOptions(options);
+  // Least squares first: all configurations in one block, Ceres' per-block overhead paid once
+  // (DESIGN.md).
+  ceres::Problem least_squares;
+  least_squares.AddResidualBlock(new LaserPlaneCost(model, data), nullptr, e->data());
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &least_squares, &summary);
+  *iterations = static_cast<int>(summary.iterations.size()) - 1;
+  *message = summary.message;
+  if (options.loss == RobustLoss::kNone || CeresTermination(summary) != Termination::kConverged)
+    return CeresTermination(summary);
+  // A robust loss then refines from the least-squares estimate (started at the nominal model,
+  // every residual of a few mm would count as an outlier at a sub-mm scale, and the non-convex
+  // Cauchy loss would hardly move). One block per configuration, each with its own loss on its
+  // weighted residual √R·(h̄ − h): Ceres applies a loss to the squared norm of a whole block.
+  ceres::Problem robust;
+  for (int i = 0; i < data.size(); ++i) {
+    ceres::LossFunction* loss =
+        options.loss == RobustLoss::kHuber
+            ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
+            : new ceres::CauchyLoss(options.loss_scale);
+    robust.AddResidualBlock(new OneConfigurationCost(model, data, i), loss, e->data());
+  }
+  ceres::Solver::Summary robust_summary;
+  ceres::Solve(so, &robust, &robust_summary);
+  *iterations += static_cast<int>(robust_summary.iterations.size()) - 1;
+  *message = "least squares: " + summary.message + "; robust refinement: " + robust_summary.message;
+  return CeresTermination(robust_summary);
 }
 
 }  // namespace
