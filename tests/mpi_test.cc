@@ -90,7 +90,7 @@ TEST(Mpi, DynamicScheduleGivesTheSameTables) {
 TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
   if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
   const std::string dir = testing::TempDir("mpi_kill");
-  const std::string study = Study(dir, 1500);  // 6000 trials: seconds on 3 single-thread ranks
+  const std::string study = Study(dir, 6000);  // 24,000 trials: about a second on 3 single-thread ranks
   const std::string run = dir + "/run";
   const pid_t launcher = fork();
   if (launcher == 0) {
