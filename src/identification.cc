@@ -301,6 +301,20 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
 
 namespace {
 
+// Configuration i's residual √R·(h̄ − h) and (if `row`) its Jacobian row −√R·∂h/∂e; false if the
+// beam runs parallel to the plane.
+bool WeightedResidual(const MeasurementModel& model, const ModelPoint& point,
+                      const MeasurementSet& data, int i, double* residual, double* row) {
+  double h;
+  const double nb = model.Evaluate(point, data.configs, i, &h, row);
+  if (!(std::fabs(nb) > 1e-12)) return false;
+  const double w = std::sqrt(static_cast<double>(data.repetitions[i]));
+  *residual = w * (data.mean_h[i] - h);
+  if (row)
+    for (int k = 0; k < model.num_parameters(); ++k) row[k] *= -w;
+  return true;
+}
+
 // All configurations in one residual block: Ceres' per-block overhead and the link trig are
 // paid once per evaluation (DESIGN.md).
 class LaserPlaneCost : public ceres::CostFunction {
@@ -317,13 +331,7 @@ class LaserPlaneCost : public ceres::CostFunction {
     model_.Prepare(parameters[0], &point);
     for (int i = 0; i < data_.size(); ++i) {
       double* row = (jacobians && jacobians[0]) ? jacobians[0] + i * n : nullptr;
-      double h;
-      const double nb = model_.Evaluate(point, data_.configs, i, &h, row);
-      if (!(std::fabs(nb) > 1e-12)) return false;
-      const double w = std::sqrt(static_cast<double>(data_.repetitions[i]));
-      residuals[i] = w * (data_.mean_h[i] - h);
-      if (row)
-        for (int k = 0; k < n; ++k) row[k] *= -w;
+      if (!WeightedResidual(model_, point, data_, i, &residuals[i], row)) return false;
     }
     return true;
   }
@@ -344,18 +352,10 @@ class OneConfigurationCost : public ceres::CostFunction {
   }
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    const int n = model_.num_parameters();
     ModelPoint point;
     model_.Prepare(parameters[0], &point);
-    double* row = (jacobians && jacobians[0]) ? jacobians[0] : nullptr;
-    double h;
-    const double nb = model_.Evaluate(point, data_.configs, i_, &h, row);
-    if (!(std::fabs(nb) > 1e-12)) return false;
-    const double w = std::sqrt(static_cast<double>(data_.repetitions[i_]));
-    residuals[0] = w * (data_.mean_h[i_] - h);
-    if (row)
-      for (int k = 0; k < n; ++k) row[k] *= -w;
-    return true;
+    return WeightedResidual(model_, point, data_, i_, residuals,
+                            (jacobians && jacobians[0]) ? jacobians[0] : nullptr);
   }
 
  private:
