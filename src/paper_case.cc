@@ -75,16 +75,6 @@ PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
                                            ? model.LinkValues(pc.summary.delta.data())
                                            : robot.nominal_values();
     pc.validation = ComparePoses(robot, truth, identified, result.validation);
-    pc.measurement = ComparePoses(robot, truth, identified, pc.data.configs);
-    std::vector<double> h_nom, h_id;
-    std::vector<BeamMiss> unused;
-    ExactReadings(robot, robot.nominal_values(), plane, pc.data.configs, &h_nom, &unused);
-    ExactReadings(robot, identified, model.PlaneAt(pc.summary.delta.data()), pc.data.configs,
-                  &h_id, &unused);
-    for (int i = 0; i < pc.data.size(); ++i) {
-      pc.distance_error_nominal.push_back(pc.data.mean_h[i] - h_nom[i]);
-      pc.distance_error_identified.push_back(pc.data.mean_h[i] - h_id[i]);
-    }
     result.cases.push_back(std::move(pc));
   }
   return result;

@@ -41,9 +41,6 @@ struct PaperCase {
   MeasurementSet data;                  ///< simulated mean readings
   IdentificationSummary summary;
   PoseErrors validation;                ///< identified model vs truth on validation configs
-  PoseErrors measurement;               ///< ... on the case's own measurement configs
-  std::vector<double> distance_error_nominal;     ///< m, h̄ − h_nominal per configuration
-  std::vector<double> distance_error_identified;  ///< m, h̄ − h_identified
 };
 
 struct PaperCasesResult {

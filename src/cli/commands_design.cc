@@ -8,6 +8,7 @@
 #include "lrcal/csv.h"
 #include "lrcal/experiment_design.h"
 #include "lrcal/identifiability.h"
+#include "lrcal/simulation.h"
 #include "lrcal/statistics.h"
 #include "lrcal/table.h"
 
@@ -60,17 +61,13 @@ int DesignCommand(const std::vector<std::string>& args) {
     const ConfigurationSet read = ReadConfigurations(path, robot.num_links());
     std::vector<double> h;
     std::vector<BeamMiss> misses;
-    ModelPoint point;
-    PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
+    ExactReadings(robot, robot.nominal_values(), plane, read, &h, &misses);
     report.requested = report.attempts = read.size();
     for (int i = 0; i < read.size(); ++i) {
-      const Pose<double> pose = ToolPose(point, read, i);
-      const double nb = plane.normal.dot(pose.R_BT.col(2));
-      const BeamMiss miss = ClassifyReading(-plane.SignedDistance(pose.p_BT) / nb, nb, robot.ranger);
-      if (miss != BeamMiss::kNone) {
-        ++report.rejected[BeamMissName(miss)];
+      if (misses[i] != BeamMiss::kNone) {
+        ++report.rejected[BeamMissName(misses[i])];
         std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
-                  << ") rejected: " << BeamMissName(miss) << "\n";
+                  << ") rejected: " << BeamMissName(misses[i]) << "\n";
         continue;
       }
       pool.AddFrom(read, i);
