@@ -156,22 +156,21 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
         RandomStream(study.seed, c->pool_stream, 0, RandomPurpose::kSelection));
     c->selected = sel.indices;
     c->design = c->pool.Subset(sel.indices);
-    c->design_sigma_min = CriterionScore(
-        [&] {
-          Eigen::MatrixXd Gd = IdentificationJacobian(*c->model, c->design);
-          return Eigen::MatrixXd(Gd.transpose() * Gd);
-        }(),
-        c->design.size(), DesignCriterion::kE);
+    // The design's Jacobian at the nominal model: its σ_min, the predicted covariance, and the
+    // first linearisation of every trial all come from this one matrix.
     const int n = c->model->num_parameters();
-    Eigen::MatrixXd Gd = IdentificationJacobian(*c->model, c->design);
-    Eigen::MatrixXd A = s.repetitions * Gd.transpose() * Gd;
-    if (!c->rank_deficient && AnalyzeIdentifiability(*c->model, c->design).full_rank()) {
+    const Eigen::MatrixXd Gd = IdentificationJacobian(*c->model, c->design);
+    const Eigen::MatrixXd GtG = Gd.transpose() * Gd;
+    c->design_sigma_min = CriterionScore(GtG, c->design.size(), DesignCriterion::kE);
+    const IdentifiabilityReport design_report =
+        c->rank_deficient ? IdentifiabilityReport{} : AnalyzeIdentifiability(*c->model, c->design);
+    if (!c->rank_deficient && design_report.full_rank()) {
+      const Eigen::MatrixXd A = s.repetitions * GtG;
       Eigen::MatrixXd cov = s.sigma * s.sigma * A.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
       c->predicted_std = cov.diagonal().cwiseSqrt();
     } else {
+      if (!c->rank_deficient) c->rank_message = design_report.ToString();
       c->rank_deficient = true;
-      if (c->rank_message.empty())
-        c->rank_message = AnalyzeIdentifiability(*c->model, c->design).ToString();
       c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
     }
     // The first linearisation of every trial (the nominal model on the design), once.
@@ -179,7 +178,7 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
       std::vector<BeamMiss> unused;
       ExactReadings(*c->robot, c->robot->nominal_values(), c->plane, c->design,
                     &c->design_nominal.h, &unused);
-      c->design_nominal.G = IdentificationJacobian(*c->model, c->design);
+      c->design_nominal.G = Gd;
       c->design_nominal.Factorize();
     }
     if (!s.truth_random) {
