@@ -6,15 +6,17 @@
 #include <filesystem>
 #include <fstream>
 
-#include "lrcal/batch_evaluation.h"
-#include "lrcal/experiment_design.h"
-#include "lrcal/identifiability.h"
-#include "lrcal/identification.h"
-#include "lrcal/monte_carlo.h"
-#include "lrcal/statistics.h"
-#include "lrcal/study.h"
-#include "lrcal/trial.h"
-#include "lrcal/trial_store.h"
+#include "measurement/batch_evaluation.h"
+#include "lrcal/design/experiment_design.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/report/run_tables.h"
+#include "lrcal/study/run_directory.h"
+#include "lrcal/study/runner.h"
+#include "lrcal/study/statistics.h"
+#include "lrcal/study/study.h"
+#include "study/trial_pipeline.h"
+#include "lrcal/study/trial_store.h"
 
 namespace lrcal {
 namespace {
@@ -59,8 +61,8 @@ void BM_ForwardKinematics(benchmark::State& state) {
   c.model->Prepare(std::vector<double>(c.model->num_parameters(), 0.0).data(), &point);
   int i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(ToolPose(point, c.design, i));
-    i = (i + 1) % c.design.size();
+    benchmark::DoNotOptimize(ToolPose(point, c.design.configs, i));
+    i = (i + 1) % c.design.configs.size();
   }
 }
 BENCHMARK(BM_ForwardKinematics);
@@ -72,24 +74,24 @@ void BM_DistanceAndJacobian100(benchmark::State& state) {
   std::vector<double> e(n, 0.0), row(n);
   c.model->Prepare(e.data(), &point);
   for (auto _ : state) {
-    for (int i = 0; i < c.design.size(); ++i) {
+    for (int i = 0; i < c.design.configs.size(); ++i) {
       double h;
-      c.model->Evaluate(point, c.design, i, &h, row.data());
+      c.model->Evaluate(point, c.design.configs, i, &h, row.data());
       benchmark::DoNotOptimize(row.data());
     }
   }
-  state.SetItemsProcessed(state.iterations() * c.design.size());
+  state.SetItemsProcessed(state.iterations() * c.design.configs.size());
 }
 BENCHMARK(BM_DistanceAndJacobian100);
 
 void BM_BatchDistanceAndJacobian100(benchmark::State& state) {
   const CellContext& c = *Case(100).context;
-  const int n = c.model->num_parameters(), m = c.design.size();
+  const int n = c.model->num_parameters(), m = c.design.configs.size();
   ModelPoint point;
   std::vector<double> e(n, 0.0), h(m), J(static_cast<std::size_t>(m) * n);
   c.model->Prepare(e.data(), &point);
   BatchEvaluator batch;
-  batch.SetConfigurations(c.design);
+  batch.SetConfigurations(c.design.configs);
   for (auto _ : state) {
     benchmark::DoNotOptimize(batch.Evaluate(*c.model, point, h.data(), state.range(0) ? J.data() : nullptr));
     benchmark::ClobberMemory();
@@ -219,7 +221,7 @@ void BM_StudyThroughput(benchmark::State& state) {
     fs::remove_all(o.out_dir);
     o.threads = static_cast<int>(state.range(0));
     o.progress = false;
-    RunResult r = RunStudy(study, o);
+    RunResult r = RunStudyAndWriteTables(study, o);
     state.counters["trials_per_s"] = r.computed / r.seconds;
     state.counters["trial_phase_per_s"] = r.computed / r.run_seconds;
     state.counters["compute_us_per_trial"] = 1e6 * r.trial_seconds / r.computed;

@@ -31,14 +31,14 @@ void AddCommonOptions(po::options_description& options) {
       ("format", po::value<std::string>()->default_value("text"), "output: text or json");
 }
 
-RobotModel LoadRobot(const std::string& name_or_path) {
-  return LoadRobotModel(ResolveRobotPath(name_or_path));
+RobotFile LoadRobot(const std::string& name_or_path) {
+  return LoadRobotFile(ResolveRobotPath(name_or_path));
 }
 
-Plane ResolvePlane(const RobotModel& robot, const po::variables_map& vm) {
+Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm) {
   if (vm.count("plane")) return Plane::Parse(vm["plane"].as<std::string>(), "--plane");
-  if (robot.default_plane) return *robot.default_plane;
-  throw InputError("--plane", "the robot file '" + robot.source +
+  if (rig.plane) return *rig.plane;
+  throw InputError("--plane", "the robot file '" + rig.path +
                                   "' has no plane: give --plane nx,ny,nz,f");
 }
 

@@ -9,9 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "lrcal/error.h"
-#include "lrcal/parameter_set.h"
-#include "lrcal/robot_model.h"
+#include "lrcal/core/error.h"
+#include "lrcal/measurement/parameter_set.h"
+#include "lrcal/core/strings.h"
+#include "lrcal/io/robot_file.h"
 
 namespace lrcal::cli {
 
@@ -33,9 +34,9 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
            const po::positional_options_description* positional = nullptr);
 
 /// --robot: a path or a shipped name ("paper").
-RobotModel LoadRobot(const std::string& name_or_path);
+RobotFile LoadRobot(const std::string& name_or_path);
 /// --plane if given, else the robot file's plane; InputError if neither.
-Plane ResolvePlane(const RobotModel& robot, const po::variables_map& vm);
+Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm);
 /// --estimate-plane and --fix.
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm);
 

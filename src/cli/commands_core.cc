@@ -5,12 +5,12 @@
 #include <sstream>
 
 #include "cli_common.h"
-#include "lrcal/configuration_sampling.h"
-#include "lrcal/csv.h"
-#include "lrcal/identification.h"
-#include "lrcal/paper_case.h"
-#include "lrcal/simulation.h"
-#include "lrcal/table.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/io/csv.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/paper/paper_case.h"
+#include "lrcal/measurement/simulation.h"
+#include "lrcal/core/text_table.h"
 
 namespace lrcal::cli {
 
@@ -55,8 +55,9 @@ int KinematicsCommand(const std::vector<std::string>& args) {
       ("fix", po::value<std::string>(), "parameters left out of the Jacobian, comma-separated");
   po::variables_map vm;
   if (!Parse("kinematics", "--configs C.csv [options]", o, args, &vm)) return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  const Plane plane = ResolvePlane(robot, vm);
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, vm);
   const std::string which = vm["model"].as<std::string>();
   if (which != "nominal" && which != "true")
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
@@ -79,7 +80,7 @@ int KinematicsCommand(const std::vector<std::string>& args) {
   for (int i = 0; i < configs.size(); ++i) {
     double h;
     const double nb = model.Evaluate(point, configs, i, &h, jac ? row.data() : nullptr);
-    const BeamMiss miss = ClassifyReading(h, nb, robot.ranger);
+    const BeamMiss miss = ClassifyReading(h, nb, rig.ranger);
     const Pose<double> pose = ToolPose(point, configs, i);
     Json j;
     j["q"] = std::vector<double>(configs.q(i), configs.q(i) + configs.num_joints());
@@ -130,11 +131,13 @@ int SampleCommand(const std::vector<std::string>& args) {
       ("out", po::value<std::string>()->required(), "output CSV (q1..qN)");
   po::variables_map vm;
   if (!Parse("sample", "--out C.csv [options]", o, args, &vm)) return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  const Plane plane = ResolvePlane(robot, vm);
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, vm);
   const int count = vm["count"].as<int>();
   if (count < 1) throw InputError("--count", "expected a positive number of configurations");
   SamplingOptions options;
+  options.ranger = rig.ranger;
   options.min_jacobian_singular_value = vm["min-singular-value"].as<double>();
   options.require_beam_hit = !vm["validation"].as<bool>();
   SamplingReport report;
@@ -160,8 +163,9 @@ int SimulateCommand(const std::vector<std::string>& args) {
       ("out", po::value<std::string>()->required(), "measurement CSV to write");
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  const Plane plane = ResolvePlane(robot, vm);
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, vm);
   const ConfigurationSet configs =
       ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
   NoiseModel noise;
@@ -172,7 +176,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
-  const int missed = SimulateReadings(robot, robot.true_values(), plane, configs, noise,
+  const int missed = SimulateReadings(robot, robot.true_values(), plane, rig.ranger, configs, noise,
                                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise),
                                       &data, &misses, &raw);
   const std::string path = vm["out"].as<std::string>();
@@ -214,8 +218,9 @@ int IdentifyCommand(const std::vector<std::string>& args) {
        "known noise of one reading (mm) for the given-sigma covariance");
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  const Plane plane = ResolvePlane(robot, vm);
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, vm);
   const MeasurementSet data = ReadMeasurements(vm["data"].as<std::string>(), robot.num_links());
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
   IdentificationOptions options;
@@ -306,8 +311,9 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
        "relative singular value below which a direction is unobservable");
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  const Plane plane = ResolvePlane(robot, vm);
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, vm);
   const ConfigurationSet configs =
       ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
@@ -332,14 +338,16 @@ int PaperCommand(const std::vector<std::string>& args) {
       ("format", po::value<std::string>()->default_value("text"), "text or json");
   po::variables_map vm;
   if (!Parse("paper", "[--seed K] [options]", o, args, &vm)) return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  if (!robot.default_plane) throw InputError("--robot", "the robot file has no plane");
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  if (!rig.plane) throw InputError("--robot", "the robot file '" + rig.path + "' has no plane");
   PaperCaseOptions options;
+  options.sampling.ranger = rig.ranger;
   options.seed = ParseSeed(vm);
   options.case1_selection.method =
       ParseSelectionMethod(vm["case1-selection"].as<std::string>(), "--case1-selection");
   options.case1_selection.samples = vm["samples"].as<int>();
-  const PaperCasesResult r = RunPaperCases(robot, *robot.default_plane, options);
+  const PaperCasesResult r = RunPaperCases(robot, *rig.plane, options);
   const Table params = PaperParameterTable(robot, r);
   const Table validation = PaperValidationTable(r);
   if (ResolveFormat(vm) == Format::kJson) {

@@ -4,13 +4,13 @@
 #include <cmath>
 
 #include "cli_common.h"
-#include "lrcal/configuration_sampling.h"
-#include "lrcal/csv.h"
-#include "lrcal/experiment_design.h"
-#include "lrcal/identifiability.h"
-#include "lrcal/simulation.h"
-#include "lrcal/statistics.h"
-#include "lrcal/table.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/io/csv.h"
+#include "lrcal/design/experiment_design.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/measurement/simulation.h"
+#include "lrcal/study/statistics.h"
+#include "lrcal/core/text_table.h"
 
 namespace lrcal::cli {
 
@@ -38,8 +38,9 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (!Parse("design", "--pool C.csv|--generate N --select K [options] --out chosen.csv", o, args,
              &vm))
     return 0;
-  const RobotModel robot = LoadRobot(vm["robot"].as<std::string>());
-  const Plane plane = ResolvePlane(robot, vm);
+  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, vm);
   const long long seed_value = vm["seed"].as<long long>();
   if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
   const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);
@@ -53,15 +54,17 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (vm.count("generate")) {
     const int n = vm["generate"].as<int>();
     if (n < 1) throw InputError("--generate", "expected a positive number of candidates");
+    SamplingOptions sampling;
+    sampling.ranger = rig.ranger;
     pool = SampleConfigurations(robot, plane, n, RandomStream(seed, 0, 0, RandomPurpose::kPool),
-                                SamplingOptions{}, &report);
+                                sampling, &report);
     pool_source = "generated: " + report.ToString();
   } else {
     const std::string path = vm["pool"].as<std::string>();
     const ConfigurationSet read = ReadConfigurations(path, robot.num_links());
     std::vector<double> h;
     std::vector<BeamMiss> misses;
-    ExactReadings(robot, robot.nominal_values(), plane, read, &h, &misses);
+    ExactReadings(robot, robot.nominal_values(), plane, rig.ranger, read, &h, &misses);
     report.requested = report.attempts = read.size();
     for (int i = 0; i < read.size(); ++i) {
       if (misses[i] != BeamMiss::kNone) {

@@ -7,8 +7,8 @@
 #include <filesystem>
 
 #include "cli_common.h"
-#include "lrcal/study_report_data.h"
-#include "lrcal/table.h"
+#include "lrcal/report/report_data.h"
+#include "lrcal/core/text_table.h"
 
 namespace lrcal::cli {
 

@@ -5,11 +5,13 @@
 #include <thread>
 
 #include "cli_common.h"
-#include "lrcal/collective.h"
-#include "lrcal/monte_carlo.h"
-#include "lrcal/study.h"
-#include "lrcal/table.h"
-#include "lrcal/trial.h"
+#include "lrcal/study/collective.h"
+#include "lrcal/report/run_tables.h"
+#include "lrcal/study/run_directory.h"
+#include "lrcal/study/runner.h"
+#include "lrcal/study/study.h"
+#include "lrcal/core/text_table.h"
+#include "study/trial_pipeline.h"
 
 namespace lrcal::cli {
 
@@ -71,7 +73,7 @@ int RunCommand(const std::vector<std::string>& args) {
     std::cerr << "lrcal run: study '" << study.name << "', " << study.cells.size() << " cells × "
               << study.trials << " trials → " << options.out_dir
               << (ranks > 1 ? " (" + std::to_string(ranks) + " MPI ranks)" : std::string()) << "\n";
-  const RunResult r = RunStudy(study, options, world.get());
+  const RunResult r = RunStudyAndWriteTables(study, options, world.get());
   if (rank != 0) return r.interrupted ? 130 : 0;
   std::cerr << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)
             << " s (" << r.done_before << " already done, " << r.total << " in this run";
@@ -213,7 +215,7 @@ int AggregateCommand(const std::vector<std::string>& args) {
   pos.add("dir", 1);
   po::variables_map vm;
   if (!Parse("aggregate", "RUN_DIR", o, args, &vm, &pos)) return 0;
-  AggregateRun(vm["dir"].as<std::string>());
+  WriteRunTables(vm["dir"].as<std::string>());
   std::cout << "tables: " << vm["dir"].as<std::string>() << "/tables/summary.md\n";
   return 0;
 }

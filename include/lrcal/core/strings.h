@@ -1,0 +1,18 @@
+// Small text utilities shared by every layer: list splitting and the angle expressions that robot
+// files may use ("pi/2").
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace lrcal {
+
+/// Splits "a,b,c" into items, each trimmed of blanks; an empty string gives an empty list, and
+/// an empty item between two separators is kept as "" (callers report it).
+std::vector<std::string> SplitList(const std::string& text, char separator = ',');
+
+/// Parses a number that may be written with pi: "1.5", "-pi/2", "pi", "3*pi/4".
+/// Returns false if `text` is none of those forms (or the value is not finite).
+bool ParseAngleExpression(const std::string& text, double* value);
+
+}  // namespace lrcal

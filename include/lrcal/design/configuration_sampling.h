@@ -1,0 +1,50 @@
+// Sampling measurement and validation configurations.
+//
+// A candidate configuration is drawn uniformly within the joint ranges (robot file q_min..q_max)
+// and accepted only if, for the nominal model (and, when given, the true one too):
+//  - the beam hits the plane within the ranger's range and incidence limit (laser_plane.h);
+//  - the arm is not near a singularity: the smallest singular value of its 6×N geometric
+//    Jacobian (m/rad rows and rad/rad rows together, as is usual for arms of ~1 m reach) is at
+//    least `min_jacobian_singular_value`.
+// Draw a·N + j of the stream is joint j of attempt a, so the result depends only on the stream.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+
+#include "lrcal/measurement/measurement_model.h"
+#include "lrcal/core/random.h"
+
+namespace lrcal {
+
+struct SamplingOptions {
+  /// Reject configurations whose geometric Jacobian's σ_min is below this (non-singular arm).
+  double min_jacobian_singular_value = 0.05;
+  /// Require the beam to hit the plane (h > 0, in range, incidence): off for validation sets,
+  /// which judge the pose over the whole workspace and need no reading.
+  bool require_beam_hit = true;
+  /// Also require the *true* model's beam to hit (simulation), if given.
+  std::optional<Eigen::VectorXd> true_link_values;
+  std::optional<Plane> true_plane;
+  /// The ranger whose limits a reading must meet (the robot file's `ranger:` section).
+  RangerSpec ranger;
+  /// Give up after this many attempts per requested configuration.
+  int max_attempts_per_configuration = 10000;
+};
+
+struct SamplingReport {
+  int requested = 0;
+  int accepted = 0;
+  int attempts = 0;
+  std::map<std::string, int> rejected;  ///< reason → count ("singular", BeamMiss names)
+  std::string ToString() const;
+};
+
+/// Draws `count` accepted configurations. Throws InputError if the constraints reject so many
+/// that `count` cannot be reached within the attempt budget (a plane the beam can never hit).
+ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
+                                      const RandomStream& stream, const SamplingOptions& options,
+                                      SamplingReport* report = nullptr);
+
+}  // namespace lrcal

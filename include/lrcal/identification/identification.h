@@ -1,0 +1,107 @@
+// Identification of the geometric parameters (and plane terms) from laser-plane readings.
+//
+// Least squares on the distance residuals r_i = √R_i·(h̄_i − h(e, q_i)), h̄_i the mean of R_i
+// readings at configuration i (equal-weight readings: the same estimate as using every reading),
+// starting from the nominal model e = 0. Two solvers, tested to agree to 1e-9:
+//  - kLevenbergMarquardt: lrcal's own Levenberg–Marquardt on the analytic Jacobian, normal
+//    equations accumulated in one pass, no allocation per iteration once the workspace is warm.
+//    The Monte-Carlo hot path.
+//  - kCeres: Ceres' Levenberg–Marquardt on the same analytic cost (one residual block for all
+//    configurations). The reference path; it also offers robust losses (Huber, Cauchy).
+// A rank-deficient parameter set is detected before solving (identifiability.h) and reported as
+// Termination::kRankDeficient with the dependencies, unless the options say to fix the suggested
+// parameters and go on.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "lrcal/core/enum_names.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/measurement/measurement_set.h"
+#include "lrcal/measurement/measurement_model.h"
+
+namespace lrcal {
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+struct IdentificationOptions {
+  enum class Solver { kLevenbergMarquardt, kCeres };
+  /// lrcal's own LM is the fast default; kCeres is the reference and the only one with losses.
+  Solver solver = Solver::kLevenbergMarquardt;
+  RobustLoss loss = RobustLoss::kNone;
+  /// Scale of the robust loss (m), applied to each configuration's weighted residual
+  /// √R·(h̄ − h): residuals beyond it are down-weighted.
+  double loss_scale = 1e-3;
+  int max_iterations = 100;
+  /// Stop when the step is below parameter_tolerance·(‖e‖ + parameter_tolerance). Ceres'
+  /// defaults stop measurably short of the minimum on this problem (DESIGN.md); 1e-12 reaches
+  /// it to rounding.
+  double parameter_tolerance = 1e-12;
+  /// Stop when the cost decreases by less than this fraction.
+  double function_tolerance = 1e-16;
+  /// Per-reading standard deviation (m) if known, for the "given σ" covariance; 0 = unknown.
+  double sigma = 0;
+  /// What to do with a rank-deficient parameter set: stop (kRankDeficient) or fix the
+  /// identifiability analysis' suggested parameters at nominal and identify the rest.
+  bool fix_dependent_parameters = false;
+  IdentifiabilityOptions identifiability;
+  /// Checks the fields; returns "" or a message naming the bad field.
+  std::string Validate() const;
+};
+
+enum class Termination {
+  kConverged,        ///< a tolerance was met: the estimate is the least-squares minimum
+  kMaxIterations,    ///< stopped at max_iterations without meeting a tolerance
+  kRankDeficient,    ///< the parameter set is not identifiable from these configurations
+  kBeamMissed,       ///< at some iterate the model's beam ran parallel to the plane
+  kNumericalFailure, ///< non-finite cost or a failed factorisation
+  kInvalidInput,     ///< too few readings, bad options
+};
+inline constexpr EnumName<Termination> kTerminationNames[] = {
+    {Termination::kConverged, "converged"},
+    {Termination::kMaxIterations, "max_iterations"},
+    {Termination::kRankDeficient, "rank_deficient"},
+    {Termination::kBeamMissed, "beam_missed"},
+    {Termination::kNumericalFailure, "numerical_failure"},
+    {Termination::kInvalidInput, "invalid_input"}};
+inline const char* TerminationName(Termination t) { return NameOf(kTerminationNames, t); }
+
+struct IdentificationSummary {
+  std::vector<std::string> names;  ///< estimated quantities (parameter_set.h)
+  Eigen::VectorXd nominal;   ///< their nominal values (link values; 0 for u; f0 for plane_f), SI
+  Eigen::VectorXd estimate;  ///< nominal + delta
+  Eigen::VectorXd delta;     ///< the identified errors e, SI
+  Eigen::VectorXd std_residual;  ///< √diag of covariance_residual
+  Eigen::VectorXd std_given;     ///< √diag of covariance_given (empty unless sigma > 0)
+  Eigen::MatrixXd covariance_residual;  ///< σ̂²·(GᵀWG)⁻¹, σ̂² = Σ r²/(m − n)
+  Eigen::MatrixXd covariance_given;     ///< σ²·(GᵀWG)⁻¹ with the given per-reading σ
+  Eigen::MatrixXd correlation;          ///< from covariance_residual
+  double sigma_hat = 0;        ///< m, residual-based per-reading σ estimate
+  double initial_cost = 0;     ///< ½Σr² at the nominal model (m²)
+  double final_cost = 0;       ///< ½Σr² at the estimate (m²)
+  double residual_rms = 0;     ///< m, RMS of h̄_i − h(e, q_i) over configurations
+  int iterations = 0;
+  int num_configurations = 0;
+  Termination termination = Termination::kInvalidInput;
+  std::string message;                   ///< why it stopped, in words
+  std::vector<std::string> fixed;        ///< parameters fixed because of rank deficiency
+  IdentifiabilityReport identifiability; ///< of the parameter set at the nominal model
+  std::string solver;                    ///< "lrcal-lm" or "ceres"
+
+  bool IsSolutionUsable() const { return termination == Termination::kConverged; }
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+/// The covariance σ²·A⁻¹ of a least-squares estimate from its normal matrix A = GᵀWG (by LDLᵀ);
+/// σ is the per-reading standard deviation (m). The one place both the identification summary
+/// and the Monte-Carlo prediction compute it.
+Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double sigma);
+
+/// Identifies the model's parameter set from `data`.
+IdentificationSummary Identify(const MeasurementModel& model, const MeasurementSet& data,
+                               const IdentificationOptions& options = {});
+
+}  // namespace lrcal

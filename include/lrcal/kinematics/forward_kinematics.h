@@ -1,0 +1,67 @@
+// Forward kinematics of a RobotModel, templated on the scalar so that Ceres' Jets run through it.
+//
+// This is the reference implementation, written as the plain product of the five elementary
+// transforms of each link (robot_model.h). The measurement model's analytic Jacobian is checked
+// against autodiff through this code, so the two are deliberately written independently.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "lrcal/kinematics/robot_model.h"
+
+namespace lrcal {
+
+/// Pose of the tool frame T in the base frame B: p_BT (m) and R_BT.
+template <typename T>
+struct Pose {
+  Eigen::Matrix<T, 3, 3> R_BT = Eigen::Matrix<T, 3, 3>::Identity();
+  Eigen::Matrix<T, 3, 1> p_BT = Eigen::Matrix<T, 3, 1>::Zero();
+};
+
+/// Homogeneous transform of one link: Rot(z,θ)·Trans(z,d)·Trans(x,a)·Rot(x,α)·Rot(y,β).
+template <typename T>
+Eigen::Matrix<T, 4, 4> LinkTransform(const T& theta, const T& d, const T& a, const T& alpha,
+                                     const T& beta) {
+  using std::cos;
+  using std::sin;
+  Eigen::Matrix<T, 4, 4> rz = Eigen::Matrix<T, 4, 4>::Identity();
+  rz(0, 0) = cos(theta); rz(0, 1) = -sin(theta);
+  rz(1, 0) = sin(theta); rz(1, 1) = cos(theta);
+  Eigen::Matrix<T, 4, 4> tz = Eigen::Matrix<T, 4, 4>::Identity();
+  tz(2, 3) = d;
+  Eigen::Matrix<T, 4, 4> tx = Eigen::Matrix<T, 4, 4>::Identity();
+  tx(0, 3) = a;
+  Eigen::Matrix<T, 4, 4> rx = Eigen::Matrix<T, 4, 4>::Identity();
+  rx(1, 1) = cos(alpha); rx(1, 2) = -sin(alpha);
+  rx(2, 1) = sin(alpha); rx(2, 2) = cos(alpha);
+  Eigen::Matrix<T, 4, 4> ry = Eigen::Matrix<T, 4, 4>::Identity();
+  ry(0, 0) = cos(beta); ry(0, 2) = sin(beta);
+  ry(2, 0) = -sin(beta); ry(2, 2) = cos(beta);
+  return rz * tz * tx * rx * ry;
+}
+
+/// Forward kinematics. `link_values` holds the robot's 5N link values (robot_model.h order, SI),
+/// `q` its N joint coordinates (rad, or m for prismatic joints).
+template <typename T>
+Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const double* q) {
+  Eigen::Matrix<T, 4, 4> X = Eigen::Matrix<T, 4, 4>::Identity();
+  for (int i = 0; i < model.num_links(); ++i) {
+    const T* v = link_values + kValuesPerLink * i;
+    T theta = v[kTheta];
+    T d = v[kD];
+    if (model.links()[i].joint == JointType::kRevolute) {
+      theta += T(q[i]);
+    } else {
+      d += T(q[i]);
+    }
+    X = X * LinkTransform<T>(theta, d, v[kA], v[kAlpha], v[kBeta]);
+  }
+  Pose<T> pose;
+  pose.R_BT = X.template block<3, 3>(0, 0);
+  pose.p_BT = X.template block<3, 1>(0, 3);
+  return pose;
+}
+
+}  // namespace lrcal

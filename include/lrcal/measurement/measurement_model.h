@@ -1,0 +1,92 @@
+// The laser-plane measurement model and its analytic identification Jacobian.
+//
+// For an estimate e (parameter_set.h) and a configuration q, the model gives the reading
+// h(e, q) (m) and the row G(q) = ∂h/∂e of the identification Jacobian (the paper's Δh = G·Δe).
+//
+// The Jacobian is computed from the differential motion each parameter causes (all vectors in the
+// base frame B; o_{i-1}, z_{i-1} origin and z axis of frame i-1; x'_i = R_{i-1}·Rz(θ)·e_x the
+// common normal; y''_i = R_{i-1}·Rz(θ)·Rx(α)·e_y; o_i the origin of frame i; p_J = p_BT + h·b the
+// beam's hit point, n the plane normal):
+//     ∂h/∂θ_i = -n·(z_{i-1} × (p_J - o_{i-1})) / (n·b)      ∂h/∂d_i = -n·z_{i-1} / (n·b)
+//     ∂h/∂a_i = -n·x'_i / (n·b)
+//     ∂h/∂α_i = -n·(x'_i × (p_J - o_i)) / (n·b)            ∂h/∂β_i = -n·(y''_i × (p_J - o_i)) / (n·b)
+//     ∂h/∂u   = -p_J·∂n/∂u / (n·b)                          ∂h/∂f   = -1 / (n·b)
+// (differentiate h = -(n·p + f)/(n·b) and use n·p + f = -h·n·b: a motion of the tool moves the
+// hit point, held fixed on the beam, and h changes by minus its normal component over n·b).
+// Tests check this against Ceres autodiff through kinematics.h and against central differences.
+//
+// Speed: joint angles enter only through cos q, sin q, precomputed once per configuration
+// (ConfigurationSet); the link angles' sines and cosines are computed once per estimate
+// (ModelPoint). The per-configuration work is trig-free and allocation-free.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "lrcal/kinematics/chain.h"
+#include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/parameter_set.h"
+#include "lrcal/kinematics/robot_model.h"
+
+namespace lrcal {
+
+/// A robot + plane evaluated at one estimate: the chain's per-link trig (chain.h), the plane and
+/// the chart's derivative, ready for many configurations.
+struct ModelPoint : ChainPoint {
+  Plane plane;
+  Eigen::Matrix<double, 3, 2> dn_du = Eigen::Matrix<double, 3, 2>::Zero();
+};
+
+/// Prepares a ModelPoint from explicit link values (5N, SI) and a plane.
+void PrepareModelPoint(const RobotModel& robot, const double* link_values, const Plane& plane,
+                       ModelPoint* point);
+
+class MeasurementModel {
+ public:
+  MeasurementModel(const RobotModel& robot, const Plane& nominal_plane, ParameterSet parameters);
+
+  const RobotModel& robot() const { return *robot_; }
+  const Plane& nominal_plane() const { return nominal_plane_; }
+  const ParameterSet& parameters() const { return parameters_; }
+  int num_parameters() const { return parameters_.size(); }
+
+  /// Link values (5N) at estimate e: nominal + Δ on the estimated entries.
+  Eigen::VectorXd LinkValues(const double* e) const;
+  /// Plane at estimate e.
+  Plane PlaneAt(const double* e) const;
+  /// Prepares `point` at estimate e (size num_parameters()).
+  void Prepare(const double* e, ModelPoint* point) const;
+
+  /// Reading h (m) for configuration i at `point`, and (if jacobian_row is not null) the
+  /// num_parameters() entries of ∂h/∂e. Returns n·b (the cosine of the beam's incidence, signed)
+  /// so callers can classify the reading; h is finite unless n·b == 0.
+  double Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i, double* h,
+                  double* jacobian_row) const;
+
+  /// Templated reading for autodiff (tests): e has num_parameters() entries.
+  template <typename T>
+  T Distance(const T* e, const double* q) const {
+    std::vector<T> values(robot_->num_values());
+    for (int k = 0; k < robot_->num_values(); ++k) values[k] = T(robot_->nominal_values()[k]);
+    for (int k = 0; k < parameters_.num_robot(); ++k) values[parameters_.robot_values[k]] += e[k];
+    Pose<T> pose = ForwardKinematics<T>(*robot_, values.data(), q);
+    Eigen::Matrix<T, 3, 1> n = nominal_plane_.normal.cast<T>();
+    T f = T(nominal_plane_.offset);
+    if (parameters_.EstimatesNormal()) {
+      const int* u = parameters_.u_index;
+      n = chart_.Normal<T>(u[0] >= 0 ? e[u[0]] : T(0), u[1] >= 0 ? e[u[1]] : T(0));
+    }
+    if (parameters_.f_index >= 0) f += e[parameters_.f_index];
+    return LaserDistance<T>(pose.p_BT, pose.R_BT.col(2), n, f);
+  }
+
+ private:
+  const RobotModel* robot_;
+  Plane nominal_plane_;
+  ParameterSet parameters_;
+  NormalChart chart_;
+};
+
+}  // namespace lrcal

@@ -1,0 +1,59 @@
+// Which quantities an identification estimates: a subset of the robot's geometric parameters and,
+// optionally, the plane's normal (two chart coordinates, laser_plane.h) and offset f.
+//
+// The estimate vector e is laid out as
+//   [Δ(robot link values, robot file order) | u1, u2 (if the normal) | Δf (if the offset)]
+// in SI units (rad, m; u is dimensionless ≈ rad). Its names are the link value names
+// ("theta1", ...), then "plane_u1", "plane_u2", "plane_f".
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lrcal/kinematics/robot_model.h"
+
+namespace lrcal {
+
+/// Which plane terms are estimated along with the robot.
+struct PlaneTerms {
+  bool normal = false;
+  bool offset = false;
+  /// Parses "none", "normal", "offset", "normal,offset" (or "both"). Throws InputError.
+  static PlaneTerms Parse(const std::string& text, const std::string& source = "--estimate-plane");
+  std::string ToString() const;
+};
+
+struct ParameterSet {
+  std::vector<int> robot_values;  ///< indices into the robot's 5N link values
+  PlaneTerms plane;
+  std::vector<std::string> names;  ///< one per entry of e
+
+  int size() const { return static_cast<int>(names.size()); }
+  int num_robot() const { return static_cast<int>(robot_values.size()); }
+  /// Index in e of chart coordinate u1 (c = 0) or u2 (c = 1), or -1 when it is not estimated.
+  /// Each can be fixed on its own (e.g. `--fix plane_u1`), the other staying free.
+  int u_index[2] = {-1, -1};
+  /// Index of Δf in e, or -1 when the offset is not estimated.
+  int f_index = -1;
+  bool EstimatesNormal() const { return u_index[0] >= 0 || u_index[1] >= 0; }
+  /// True for the entries measured in rad (angles, chart coordinates); false for metres.
+  bool IsAngular(int k) const;
+  /// Index of a name, or -1.
+  int Find(const std::string& name) const;
+};
+
+/// All of the robot's geometric parameters except `fixed`, plus the chosen plane terms.
+/// Throws InputError (where = `source`) for an unknown or non-parameter name in `fixed`.
+ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
+                              const std::vector<std::string>& fixed = {},
+                              const std::string& source = "--fix");
+
+/// `in` without the parameters `names` (robot parameters or plane terms): what remains when
+/// an identifiability analysis says to fix them. Throws InputError for an unknown name.
+ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
+                               const std::vector<std::string>& names);
+
+/// True for names of quantities in rad (theta*, alpha*, beta*, plane_u*); false for metres.
+bool IsAngularName(const std::string& name);
+
+}  // namespace lrcal

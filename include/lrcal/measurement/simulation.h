@@ -1,0 +1,54 @@
+// Simulated laser readings from a "true" robot and plane.
+//
+// A reading at configuration i, repetition r is h_true(q_i) + σ·z, z the standard normal at
+// index i·R + r of the noise stream (random.h); the measurand of a configuration is the mean of
+// its R readings (slide 'Measurement Noise'). A configuration whose true beam misses the plane
+// (laser_plane.h) has no reading: it is reported, never filled with a NaN.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "lrcal/identification/identification.h"
+#include "lrcal/measurement/measurement_model.h"
+#include "lrcal/core/random.h"
+
+namespace lrcal {
+
+/// The model readings of (link values, plane) at every configuration, and each one's BeamMiss.
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                   const Plane& plane, const RangerSpec& ranger, const ConfigurationSet& configs,
+                   std::vector<double>* h,
+                   std::vector<BeamMiss>* misses);
+
+struct NoiseModel {
+  double sigma = 0.2e-3;  ///< m, standard deviation of one reading
+  int repetitions = 10;   ///< readings averaged per configuration
+  /// Draw each configuration's mean reading error directly as σ/√R·z (z at index `slot`),
+  /// instead of averaging R drawn readings. The distribution of the mean is exactly the same;
+  /// the cost no longer grows with R. The Monte-Carlo trials use this; `lrcal simulate` writes
+  /// every reading.
+  bool draw_mean = false;
+};
+
+/// Noisy readings of the true model. Fills `data` with the configurations that have a reading
+/// (mean of R) and returns the number of configurations whose true beam missed; `misses` (if
+/// given) gets every configuration's reason. `raw` (if given) gets every single reading,
+/// configuration-major. `noise_slots` (if given) addresses each configuration's noise by a slot
+/// (e.g. its index in the candidate pool: draws slot·R + r) instead of its position i, so that
+/// two designs drawn from one pool see the same noise on the configurations they share.
+int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
+                     const Plane& true_plane, const RangerSpec& ranger,
+                     const ConfigurationSet& configs,
+                     const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
+                     std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr,
+                     const std::vector<int>* noise_slots = nullptr);
+
+/// The noisy part of SimulateReadings, from exact readings already computed (e.g. once per
+/// Monte-Carlo cell when the truth and the design are fixed). Same results as SimulateReadings.
+int AddNoise(const std::vector<double>& exact_h, const std::vector<BeamMiss>& misses,
+             const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
+             MeasurementSet* data, std::vector<double>* raw = nullptr,
+             const std::vector<int>* noise_slots = nullptr);
+
+}  // namespace lrcal

@@ -1,0 +1,28 @@
+// The report layer's side of a run: the tables of a run directory, written from its records.
+// The runner (study/runner.h) never formats results; these functions are what `lrcal run`,
+// `lrcal aggregate` and `lrcal merge` call.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lrcal/report/study_tables.h"
+#include "lrcal/study/runner.h"
+
+namespace lrcal {
+
+/// Writes RUN_DIR/tables/ from the run's store (also for partial runs: the tables say so),
+/// under the directory's lock; MPI rank stores left by an interrupted job are folded in first.
+/// When every trial is there the manifest gets "finished" and the last session the tables'
+/// time and peak memory.
+StudyTablesResult WriteRunTables(const std::string& run_dir);
+
+/// Runs (or resumes) a study and, when the run is complete and not a shard, writes its tables
+/// (rank 0): what `lrcal run` does.
+RunResult RunStudyAndWriteTables(const Study& study, const RunOptions& options,
+                                 Collective* collective = nullptr, StopToken* stop = nullptr);
+
+/// Combines shard run directories into `out_dir` (records, manifest) and writes the tables.
+void MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& out_dir);
+
+}  // namespace lrcal

@@ -1,0 +1,61 @@
+// Aggregation of trial records into per-cell statistics, always in the canonical order (trials
+// ascending within a cell) so that the numbers do not depend on scheduling.
+//
+// Per cell: trials ok / failed by reason; per parameter the bias (mean error) with its Monte-Carlo
+// standard error (std/√n), the empirical std, the predicted std (σ·√diag(GᵀWG)⁻¹ at nominal) and
+// their ratio; the empirical covariance and correlation; and for each validation metric (RMS and
+// max position / orientation error per axis) of the identified and the nominal model: mean, std,
+// p5, p50, p95, max. Percentiles interpolate linearly between order statistics (Hyndman–Fan
+// type 7, numpy's default).
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lrcal/study/trial_store.h"
+
+namespace lrcal {
+
+struct Distribution {
+  long long n = 0;
+  double mean = 0, std = 0, p5 = 0, p50 = 0, p95 = 0, min = 0, max = 0;
+};
+
+/// Sample statistics of `values` (std with n−1; NaN fields when n = 0). Mean and std are summed
+/// in the given (canonical) order.
+Distribution Describe(std::vector<double> values);
+/// The same without a copy: reorders `values`.
+Distribution DescribeInPlace(std::vector<double>* values);
+/// Percentile p in [0, 100] of ascending `sorted` values (type 7).
+double Percentile(const std::vector<double>& sorted, double p);
+/// The same percentile of values in any order, by selection in O(n) (reorders `values`).
+double Quantile(std::vector<double>* values, double p);
+/// Where x falls among `values` (any order), in percent: 100·(#below + ½#equal)/n.
+double PercentileRank(const std::vector<double>& values, double x);
+
+struct ParameterStats {
+  std::string name;
+  double bias = 0, bias_se = 0, std = 0, predicted_std = 0, ratio = 0;  ///< SI
+};
+
+struct CellSummary {
+  StoredCell cell;
+  long long trials = 0, ok = 0;
+  std::map<std::string, long long> failed;  ///< status → count
+  std::vector<ParameterStats> parameters;
+  Eigen::MatrixXd covariance, correlation;  ///< empirical, SI
+  std::array<Distribution, 12> validation;  ///< identified model, SI (layout: trial.h)
+  std::array<Distribution, 12> nominal;     ///< nominal model, SI
+  /// Sorted values, kept for percentile ranks (paper placement): validation metrics and the
+  /// parameter errors. The caller may release them once used (memory is then one cell's worth).
+  std::array<std::vector<double>, 12> validation_values;
+  std::vector<std::vector<double>> error_values;
+  Distribution iterations, sigma_hat;
+};
+
+/// Summarises one cell from the store.
+CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell);
+
+}  // namespace lrcal

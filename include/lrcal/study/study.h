@@ -1,0 +1,95 @@
+// Study files: what a Monte-Carlo study repeats, and over which settings it sweeps.
+//
+// A study file (YAML, schema in docs/STUDIES.md) gives base settings — robot, plane, truth,
+// noise, candidate pool, selection, validation set, identification — plus `trials` per cell, a
+// `seed`, and optional sweep axes. Each axis names a settings key ("noise.sigma_mm", "selection",
+// or "." for the whole settings) and a list of values (a map value is merged into that key). Axes
+// combine as a product or zipped. Every combination is a *cell*, identified by a hash of its
+// resolved settings (not by its position), so that adding a sweep value later keeps the existing
+// cells and their results.
+//
+// Everything is validated before anything runs: unknown keys, wrong types and impossible values
+// are InputErrors naming the file, the line and the key (for sweep values, the line of the value).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lrcal/core/json.h"
+#include "lrcal/design/experiment_design.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/parameter_set.h"
+
+namespace lrcal {
+
+
+/// The typed settings of one cell (all SI except where a name says otherwise).
+struct CellSettings {
+  std::string robot = "paper";  ///< robot file path or shipped name
+  bool plane_from_robot = true;
+  Plane plane;                  ///< when !plane_from_robot
+  // Truth: the robot file's errors × scale, or errors drawn per trial.
+  bool truth_random = false;
+  double truth_scale = 1.0;
+  double truth_angle_sigma = 1e-3;   ///< rad, per-parameter σ of drawn angle errors
+  double truth_length_sigma = 1e-3;  ///< m, per-parameter σ of drawn length errors
+  // Noise.
+  double sigma = 0.2e-3;  ///< m, one reading
+  int repetitions = 10;
+  // Candidate pool.
+  int pool_size = 101;
+  bool pool_redraw = false;  ///< new pool every trial (else one pool per cell, shared by trials)
+  double min_singular_value = 0.05;
+  // Selection.
+  int select_count = 50;
+  SelectionOptions selection;
+  DesignScaling scaling = DesignScaling::kSI;  ///< column scaling of G before selection
+  /// Select anew in every trial (from the cell's pool): a random or sampled design then varies
+  /// from trial to trial, which is the honest baseline for "how much does the design buy".
+  bool selection_redraw = false;
+  // Validation.
+  int validation_size = 20;
+  // Identification.
+  PlaneTerms plane_terms;
+  std::vector<std::string> fixed;
+  bool fix_dependent = false;  ///< on rank deficiency: fix the suggested parameters (else fail)
+  IdentificationOptions identification;
+  /// Which of the paper's cases this cell reproduces (1, 2; 0 = none): its report places the
+  /// published numbers in our distributions.
+  int paper_case = 0;
+};
+
+struct Cell {
+  std::string id;        ///< 16 hex digits: FNV-1a of the canonical settings JSON
+  std::string label;     ///< human label from the axis labels/values ("case 1", "sigma_mm=0.1")
+  int order = 0;         ///< position in the study's canonical order
+  Json settings;         ///< resolved settings (canonical JSON)
+  CellSettings typed;
+  std::map<std::string, std::string> axis_values;  ///< axis key → value label
+};
+
+struct Study {
+  std::string path;
+  std::string name;
+  std::string description;
+  std::uint64_t seed = 0;
+  int trials = 0;
+  Json base;              ///< resolved base settings (before sweeps)
+  Json sweep;             ///< the sweep section as given (canonical JSON)
+  std::vector<std::string> axis_keys;
+  std::vector<Cell> cells;
+  /// The whole resolved study (name, seed, trials, base, sweep): what a run directory records.
+  Json ToJson() const;
+  long long total_trials() const { return static_cast<long long>(trials) * cells.size(); }
+};
+
+/// Loads, validates and expands a study file. Throws InputError.
+Study LoadStudy(const std::string& path);
+
+/// Resolves a study argument: a path, or a shipped name ("quick" → studies/quick.yaml).
+std::string ResolveStudyPath(const std::string& name_or_path);
+
+}  // namespace lrcal

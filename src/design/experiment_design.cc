@@ -1,0 +1,443 @@
+#include "lrcal/design/experiment_design.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "lrcal/core/error.h"
+
+namespace lrcal {
+
+namespace {
+
+constexpr double kMinusInf = -std::numeric_limits<double>::infinity();
+
+// Score from the eigenvalues (ascending) of GᵀG of m configurations.
+double ScoreFromEigenvalues(const Eigen::VectorXd& lambda, int m, DesignCriterion criterion) {
+  const int n = static_cast<int>(lambda.size());
+  const double lmin = lambda[0], lmax = lambda[n - 1];
+  if (!(lmin > 1e-300)) {
+    return criterion == DesignCriterion::kD || criterion == DesignCriterion::kA ? kMinusInf : 0.0;
+  }
+  switch (criterion) {
+    case DesignCriterion::kE: return std::sqrt(lmin);
+    case DesignCriterion::kD: return lambda.array().log().sum();
+    case DesignCriterion::kA: return -lambda.cwiseInverse().sum();
+    case DesignCriterion::kO1:
+      return std::exp(0.5 * lambda.array().log().sum() / n) / std::sqrt(static_cast<double>(m));
+    case DesignCriterion::kO2: return std::sqrt(lmin / lmax);
+    case DesignCriterion::kO4: return lmin / std::sqrt(lmax);
+    case DesignCriterion::kO5: return 1.0 / lambda.cwiseSqrt().cwiseInverse().sum();
+  }
+  return kMinusInf;
+}
+
+// The root of f(μ) = 1 + rho·Σ z_i²/(λ_i − μ) in (lo, hi), where f is monotone: safeguarded
+// Newton (a bisection step whenever Newton would leave the bracket), typically 4–8 iterations.
+double SecularRoot(const Eigen::VectorXd& lambda, const Eigen::VectorXd& z2,
+                   const std::vector<int>& active, double rho, double lo, double hi) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  double mu = 0.5 * (lo + hi);
+  for (int iter = 0; iter < 100; ++iter) {
+    double f = 1, df = 0;
+    for (int i : active) {
+      const double inv = 1.0 / (lambda[i] - mu);
+      f += rho * z2[i] * inv;
+      df += rho * z2[i] * inv * inv;
+    }
+    // rho > 0: f increasing on the interval; rho < 0: decreasing.
+    if (rho > 0 ? f < 0 : f > 0) lo = mu;
+    else hi = mu;
+    double next = mu - f / df;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::fabs(next - mu) <= 4 * eps * std::fabs(next) || hi - lo <= 4 * eps * std::fabs(hi))
+      return next;
+    mu = next;
+  }
+  return mu;
+}
+
+// The candidates' what-if scores for A ± g·gᵀ, from A's eigendecomposition.
+class Spectrum {
+ public:
+  void Compute(const Eigen::MatrixXd& A) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+    lambda_ = eig.eigenvalues();
+    Q_ = eig.eigenvectors();
+    log_det_ = 0;
+    inv_trace_ = 0;
+    for (int i = 0; i < lambda_.size(); ++i) {
+      log_det_ += std::log(std::max(lambda_[i], 1e-300));
+      inv_trace_ += 1.0 / std::max(lambda_[i], 1e-300);
+    }
+  }
+
+  // Score of A + rho·g·gᵀ, a design of m configurations.
+  double Score(const Eigen::VectorXd& g, double rho, int m, DesignCriterion criterion) {
+    z_.noalias() = Q_.transpose() * g;
+    z2_ = z_.cwiseAbs2();
+    const int n = static_cast<int>(lambda_.size());
+    const double zz = z2_.sum();
+    switch (criterion) {
+      case DesignCriterion::kD:
+      case DesignCriterion::kO1: {
+        double s = 0;
+        for (int i = 0; i < n; ++i) s += z2_[i] / lambda_[i];
+        const double factor = 1 + rho * s;  // determinant lemma
+        if (!(factor > 0) || !(lambda_[0] > 1e-300)) return criterion == DesignCriterion::kD ? kMinusInf : 0.0;
+        const double log_det = log_det_ + std::log(factor);
+        return criterion == DesignCriterion::kD
+                   ? log_det
+                   : std::exp(0.5 * log_det / n) / std::sqrt(static_cast<double>(m));
+      }
+      case DesignCriterion::kA: {
+        double s1 = 0, s2 = 0;
+        for (int i = 0; i < n; ++i) {
+          s1 += z2_[i] / lambda_[i];
+          s2 += z2_[i] / (lambda_[i] * lambda_[i]);
+        }
+        const double factor = 1 + rho * s1;  // Sherman–Morrison
+        if (!(factor > 0) || !(lambda_[0] > 1e-300)) return kMinusInf;
+        return -(inv_trace_ - rho * s2 / factor);
+      }
+      default: break;
+    }
+    // σ-based criteria: the extreme eigenvalues (or all of them) from the secular equation.
+    active_.clear();
+    double deflated_min = std::numeric_limits<double>::infinity(), deflated_max = -deflated_min;
+    const double tol = 1e-26 * (zz + std::fabs(lambda_[n - 1]));
+    for (int i = 0; i < n; ++i) {
+      if (z2_[i] > tol) {
+        active_.push_back(i);
+      } else {
+        deflated_min = std::min(deflated_min, lambda_[i]);
+        deflated_max = std::max(deflated_max, lambda_[i]);
+      }
+    }
+    if (criterion == DesignCriterion::kO5) {
+      mu_ = RankOneUpdatedEigenvalues(lambda_, z_, rho);
+      return ScoreFromEigenvalues(mu_, m, criterion);
+    }
+    double mu_min = deflated_min, mu_max = deflated_max;
+    if (!active_.empty()) {
+      const int a = static_cast<int>(active_.size());
+      const int j0 = active_[0], jl = active_[a - 1];
+      double lo, hi;
+      if (rho > 0) {
+        lo = lambda_[j0];
+        hi = a > 1 ? lambda_[active_[1]] : lambda_[j0] + zz;
+      } else {
+        lo = lambda_[j0] - zz;
+        hi = lambda_[j0];
+      }
+      mu_min = std::min(mu_min, SecularRoot(lambda_, z2_, active_, rho, lo, hi));
+      if (criterion == DesignCriterion::kO2 || criterion == DesignCriterion::kO4) {
+        if (rho > 0) {
+          lo = lambda_[jl];
+          hi = lambda_[jl] + zz;
+        } else {
+          lo = a > 1 ? lambda_[active_[a - 2]] : lambda_[jl] - zz;
+          hi = lambda_[jl];
+        }
+        mu_max = std::max(mu_max, SecularRoot(lambda_, z2_, active_, rho, lo, hi));
+      }
+    }
+    if (!(mu_min > 1e-300)) return 0.0;
+    switch (criterion) {
+      case DesignCriterion::kE: return std::sqrt(mu_min);
+      case DesignCriterion::kO2: return std::sqrt(mu_min / mu_max);
+      case DesignCriterion::kO4: return mu_min / std::sqrt(mu_max);
+      default: return kMinusInf;
+    }
+  }
+
+ private:
+  Eigen::VectorXd lambda_, z_, z2_, mu_;
+  Eigen::MatrixXd Q_;
+  std::vector<int> active_;
+  double log_det_ = 0, inv_trace_ = 0;
+};
+
+// k distinct indices of 0..N-1 by a partial Fisher–Yates shuffle on the stream's draws.
+std::vector<int> RandomSubset(int N, int k, const RandomStream& stream, std::uint64_t first) {
+  std::vector<int> p(N);
+  std::iota(p.begin(), p.end(), 0);
+  for (int i = 0; i < k; ++i) {
+    int j = i + static_cast<int>(stream.Uniform(first + i) * (N - i));
+    if (j >= N) j = N - 1;  // u01 may return exactly 1
+    std::swap(p[i], p[j]);
+  }
+  p.resize(k);
+  std::sort(p.begin(), p.end());
+  return p;
+}
+
+Eigen::MatrixXd NormalMatrixOf(const Eigen::MatrixXd& G, const std::vector<int>& rows) {
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+  for (int r : rows) A.selfadjointView<Eigen::Lower>().rankUpdate(G.row(r).transpose());
+  A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
+  return A;
+}
+
+double Binomial(int n, int k) {
+  double c = 1;
+  for (int i = 1; i <= k; ++i) c = c * (n - k + i) / i;
+  return c;
+}
+
+std::vector<int> Backward(const Eigen::MatrixXd& G, int k, DesignCriterion criterion,
+                          long long* evaluations) {
+  const int N = static_cast<int>(G.rows());
+  std::vector<int> kept(N);
+  std::iota(kept.begin(), kept.end(), 0);
+  Eigen::MatrixXd A = NormalMatrixOf(G, kept);
+  Spectrum spectrum;
+  while (static_cast<int>(kept.size()) > k) {
+    spectrum.Compute(A);
+    double best = -std::numeric_limits<double>::infinity();
+    int best_pos = 0;
+    for (int pos = 0; pos < static_cast<int>(kept.size()); ++pos) {
+      const double s = spectrum.Score(G.row(kept[pos]).transpose(), -1.0,
+                                      static_cast<int>(kept.size()) - 1, criterion);
+      ++*evaluations;
+      if (s > best) {  // ties: the lowest index is dropped first
+        best = s;
+        best_pos = pos;
+      }
+    }
+    A.noalias() -= G.row(kept[best_pos]).transpose() * G.row(kept[best_pos]);
+    kept.erase(kept.begin() + best_pos);
+  }
+  return kept;
+}
+
+std::vector<int> Forward(const Eigen::MatrixXd& G, int k, DesignCriterion criterion,
+                         long long* evaluations) {
+  const int N = static_cast<int>(G.rows()), n = static_cast<int>(G.cols());
+  // A small ridge keeps the first n additions well defined; they use D-optimality, which
+  // rewards every new direction (σ-based criteria stay 0 until the design has rank n).
+  const double ridge = 1e-9 * G.squaredNorm() / std::max(n, 1);
+  Eigen::MatrixXd A = ridge * Eigen::MatrixXd::Identity(n, n);
+  std::vector<bool> chosen(N, false);
+  std::vector<int> out;
+  Spectrum spectrum;
+  while (static_cast<int>(out.size()) < k) {
+    spectrum.Compute(A);
+    const DesignCriterion c = static_cast<int>(out.size()) < n ? DesignCriterion::kD : criterion;
+    double best = -std::numeric_limits<double>::infinity();
+    int best_j = -1;
+    for (int j = 0; j < N; ++j) {
+      if (chosen[j]) continue;
+      const double s = spectrum.Score(G.row(j).transpose(), 1.0, static_cast<int>(out.size()) + 1, c);
+      ++*evaluations;
+      if (s > best || best_j < 0) {
+        best = s;
+        best_j = j;
+      }
+    }
+    chosen[best_j] = true;
+    out.push_back(best_j);
+    A.noalias() += G.row(best_j).transpose() * G.row(best_j);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Single swaps (one out, one in), DETMAX style: sweep over the design, and for each member take
+// the best improving replacement at once; stop after a sweep with no improvement.
+std::vector<int> Exchange(const Eigen::MatrixXd& G, std::vector<int> design,
+                          DesignCriterion criterion, long long* evaluations) {
+  const int N = static_cast<int>(G.rows());
+  const int k = static_cast<int>(design.size());
+  std::vector<bool> in(N, false);
+  for (int i : design) in[i] = true;
+  Eigen::MatrixXd A = NormalMatrixOf(G, design);
+  double current = CriterionScore(A, k, criterion);
+  Spectrum spectrum;
+  for (int sweep = 0; sweep < 1000; ++sweep) {
+    bool improved = false;
+    for (int pos = 0; pos < k; ++pos) {
+      const int i = design[pos];
+      const Eigen::MatrixXd without = A - G.row(i).transpose() * G.row(i);
+      spectrum.Compute(without);
+      // A swap must improve by more than the what-if's rounding (relative 1e-10).
+      double best = current + 1e-10 * std::fabs(current);
+      int best_in = -1;
+      for (int j = 0; j < N; ++j) {
+        if (in[j]) continue;
+        const double s = spectrum.Score(G.row(j).transpose(), 1.0, k, criterion);
+        ++*evaluations;
+        if (s > best) {
+          best = s;
+          best_in = j;
+        }
+      }
+      if (best_in < 0) continue;
+      Eigen::MatrixXd swapped = without;
+      swapped.noalias() += G.row(best_in).transpose() * G.row(best_in);
+      const double exact = CriterionScore(swapped, k, criterion);
+      if (!(exact > current)) continue;  // the what-if was wrong at rounding level
+      A = swapped;
+      current = exact;
+      in[i] = false;
+      in[best_in] = true;
+      design[pos] = best_in;
+      improved = true;
+    }
+    if (!improved) break;
+  }
+  std::sort(design.begin(), design.end());
+  return design;
+}
+
+}  // namespace
+
+Eigen::VectorXd RankOneUpdatedEigenvalues(const Eigen::VectorXd& lambda, const Eigen::VectorXd& z,
+                                          double rho) {
+  const int n = static_cast<int>(lambda.size());
+  const Eigen::VectorXd z2 = z.cwiseAbs2();
+  const double zz = z2.sum();
+  const double tol = 1e-26 * (zz + std::fabs(lambda[n - 1]));
+  std::vector<int> active;
+  std::vector<double> mu;
+  for (int i = 0; i < n; ++i) {
+    if (z2[i] > tol) active.push_back(i);
+    else mu.push_back(lambda[i]);
+  }
+  const int a = static_cast<int>(active.size());
+  for (int t = 0; t < a; ++t) {
+    double lo, hi;
+    if (rho > 0) {
+      lo = lambda[active[t]];
+      hi = t + 1 < a ? lambda[active[t + 1]] : lambda[active[t]] + zz;
+    } else {
+      lo = t > 0 ? lambda[active[t - 1]] : lambda[active[0]] - zz;
+      hi = lambda[active[t]];
+    }
+    mu.push_back(lo == hi ? lo : SecularRoot(lambda, z2, active, rho, lo, hi));
+  }
+  std::sort(mu.begin(), mu.end());
+  return Eigen::Map<Eigen::VectorXd>(mu.data(), n);
+}
+
+double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A, Eigen::EigenvaluesOnly);
+  return ScoreFromEigenvalues(eig.eigenvalues(), m, criterion);
+}
+
+Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
+                             const Eigen::VectorXd& expected) {
+  switch (scaling) {
+    case DesignScaling::kSI: return G;
+    case DesignScaling::kUnitColumns: {
+      Eigen::VectorXd norms = G.colwise().norm().transpose();
+      for (int j = 0; j < norms.size(); ++j)
+        if (!(norms[j] > 0)) norms[j] = 1;  // a zero column stays zero
+      return G * norms.cwiseInverse().asDiagonal();
+    }
+    case DesignScaling::kExpectedErrors:
+      if (expected.size() != G.cols())
+        throw InputError("scaling", "expected-error scaling needs one magnitude per parameter");
+      return G * expected.asDiagonal();
+  }
+  return G;
+}
+
+SelectionResult SelectConfigurations(const Eigen::MatrixXd& G, int k,
+                                     const SelectionOptions& options, const RandomStream& stream) {
+  const int N = static_cast<int>(G.rows());
+  const int n = static_cast<int>(G.cols());
+  if (N == 0) throw InputError("selection", "the candidate pool is empty");
+  if (k > N)
+    throw InputError("selection", "cannot select " + std::to_string(k) + " of " +
+                                      std::to_string(N) + " candidates");
+  if (k < n)
+    throw InputError("selection", "selecting " + std::to_string(k) + " configurations for " +
+                                      std::to_string(n) +
+                                      " parameters: need at least as many configurations as "
+                                      "parameters");
+  SelectionResult best;
+  best.score = -std::numeric_limits<double>::infinity();
+  switch (options.method) {
+    case SelectionMethod::kRandom:
+      best.indices = RandomSubset(N, k, stream, 0);
+      best.evaluations = 1;
+      break;
+    case SelectionMethod::kSampled:
+      for (int s = 0; s < options.samples; ++s) {
+        std::vector<int> subset = RandomSubset(N, k, stream, static_cast<std::uint64_t>(s) * N);
+        const double score = CriterionScore(NormalMatrixOf(G, subset), k, options.criterion);
+        ++best.evaluations;
+        if (score > best.score) {
+          best.score = score;
+          best.indices = subset;
+        }
+      }
+      break;
+    case SelectionMethod::kExhaustive: {
+      const double count = Binomial(N, k);
+      if (count > options.exhaustive_limit)
+        throw InputError("selection", "exhaustive search over C(" + std::to_string(N) + "," +
+                                          std::to_string(k) + ") = " + std::to_string(count) +
+                                          " subsets is beyond the limit; use exchange or backward");
+      std::vector<int> all(N);
+      std::iota(all.begin(), all.end(), 0);
+      const Eigen::MatrixXd A_all = NormalMatrixOf(G, all);
+      const int drop = N - k;  // enumerate the left-out sets
+      std::vector<int> out(drop);
+      std::iota(out.begin(), out.end(), 0);
+      while (true) {
+        Eigen::MatrixXd A = A_all;
+        for (int r : out) A.noalias() -= G.row(r).transpose() * G.row(r);
+        const double score = CriterionScore(A, k, options.criterion);
+        ++best.evaluations;
+        if (score > best.score) {
+          best.score = score;
+          best.indices.clear();
+          for (int i = 0, o = 0; i < N; ++i) {
+            if (o < drop && out[o] == i) {
+              ++o;
+              continue;
+            }
+            best.indices.push_back(i);
+          }
+        }
+        int i = drop - 1;
+        while (i >= 0 && out[i] == N - drop + i) --i;
+        if (i < 0) break;
+        ++out[i];
+        for (int j = i + 1; j < drop; ++j) out[j] = out[j - 1] + 1;
+      }
+      break;
+    }
+    case SelectionMethod::kBackward:
+      best.indices = Backward(G, k, options.criterion, &best.evaluations);
+      break;
+    case SelectionMethod::kGreedy:
+      best.indices = Forward(G, k, options.criterion, &best.evaluations);
+      break;
+    case SelectionMethod::kExchange: {
+      // Starts: the backward-greedy design, then random designs; the best end wins.
+      best.start_score = -std::numeric_limits<double>::infinity();
+      for (int r = 0; r < std::max(1, options.restarts); ++r) {
+        std::vector<int> start = r == 0 ? Backward(G, k, options.criterion, &best.evaluations)
+                                        : RandomSubset(N, k, stream, static_cast<std::uint64_t>(r) * N);
+        best.start_score =
+            std::max(best.start_score, CriterionScore(NormalMatrixOf(G, start), k, options.criterion));
+        std::vector<int> end = Exchange(G, start, options.criterion, &best.evaluations);
+        const double score = CriterionScore(NormalMatrixOf(G, end), k, options.criterion);
+        if (score > best.score) {
+          best.score = score;
+          best.indices = end;
+        }
+      }
+      break;
+    }
+  }
+  best.score = CriterionScore(NormalMatrixOf(G, best.indices), k, options.criterion);
+  return best;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,139 @@
+#include "lrcal/identification/identifiability.h"
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace lrcal {
+
+std::string Dependency::ToString() const {
+  std::ostringstream out;
+  out.precision(6);
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    double c = terms[k].second;
+    if (k == 0) {
+      out << terms[k].first;
+    } else {
+      out << (c < 0 ? " - " : " + ") << std::fabs(c) << "*" << terms[k].first;
+    }
+  }
+  out << "  (readings unchanged along this direction)";
+  return out.str();
+}
+
+std::string IdentifiabilityReport::ToString() const {
+  std::ostringstream out;
+  out << "parameters: " << num_params() << ", configurations: " << num_configurations
+      << ", rank: " << rank << (full_rank() ? " (full)" : " (DEFICIENT)") << "\n";
+  out << "condition number (column-scaled): " << condition_number << "\n";
+  out << "singular values (column-scaled):";
+  for (int i = 0; i < singular_values.size(); ++i) out << " " << singular_values[i];
+  out << "\n";
+  if (!unidentifiable.empty()) {
+    out << "unidentifiable (no effect on any reading):";
+    for (const auto& n : unidentifiable) out << " " << n;
+    out << "\n";
+  }
+  for (const auto& d : dependencies) out << "dependence: " << d.ToString() << "\n";
+  if (!suggested_fixed.empty()) {
+    out << "suggested to fix:";
+    for (const auto& n : suggested_fixed) out << " " << n;
+    out << "\n";
+  }
+  return out.str();
+}
+
+Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
+                                       const ConfigurationSet& configs, const double* e) {
+  const int n = model.num_parameters();
+  std::vector<double> zero(n, 0.0);
+  if (!e) e = zero.data();
+  ModelPoint point;
+  model.Prepare(e, &point);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> G(configs.size(), n);
+  for (int i = 0; i < configs.size(); ++i) {
+    double h;
+    model.Evaluate(point, configs, i, &h, G.row(i).data());
+  }
+  return G;
+}
+
+IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
+                                             const ConfigurationSet& configs, const double* e,
+                                             const IdentifiabilityOptions& options) {
+  IdentifiabilityReport report;
+  report.names = model.parameters().names;
+  report.num_configurations = configs.size();
+  const int n = model.num_parameters();
+  const Eigen::MatrixXd G = IdentificationJacobian(model, configs, e);
+  report.column_norms = G.colwise().norm().transpose();
+  const double max_norm = n > 0 ? report.column_norms.maxCoeff() : 0.0;
+
+  std::vector<int> live;
+  for (int j = 0; j < n; ++j) {
+    if (report.column_norms[j] <= options.zero_column_tolerance * max_norm) {
+      report.unidentifiable.push_back(report.names[j]);
+    } else {
+      live.push_back(j);
+    }
+  }
+  const int nl = static_cast<int>(live.size());
+  Eigen::MatrixXd Gs(G.rows(), nl);
+  for (int k = 0; k < nl; ++k) Gs.col(k) = G.col(live[k]) / report.column_norms[live[k]];
+
+  if (nl > 0 && G.rows() > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Gs);
+    report.singular_values = svd.singularValues();
+  } else {
+    report.singular_values.resize(0);
+  }
+  const double smax = report.singular_values.size() ? report.singular_values[0] : 0.0;
+  int rank = 0;
+  for (int i = 0; i < report.singular_values.size(); ++i)
+    if (report.singular_values[i] > options.rank_tolerance * smax) ++rank;
+  report.rank = rank;
+  report.condition_number = (rank == n && rank > 0)
+                                ? smax / report.singular_values[rank - 1]
+                                : std::numeric_limits<double>::infinity();
+
+  // Dependent columns: QR with column pivoting keeps `rank` well-conditioned columns.
+  if (rank < nl) {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Gs);
+    const auto& perm = qr.colsPermutation().indices();
+    std::vector<int> kept(perm.data(), perm.data() + rank);
+    std::sort(kept.begin(), kept.end());
+    Eigen::MatrixXd Gk(Gs.rows(), rank);
+    for (int k = 0; k < rank; ++k) Gk.col(k) = Gs.col(kept[k]);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qk(Gk);
+    std::vector<int> dependent(perm.data() + rank, perm.data() + nl);
+    std::sort(dependent.begin(), dependent.end());
+    for (int jd : dependent) {
+      Eigen::VectorXd c = qk.solve(Gs.col(jd));
+      Dependency dep;
+      const int j = live[jd];
+      dep.terms.emplace_back(report.names[j], 1.0);
+      for (int k = 0; k < rank; ++k) {
+        if (std::fabs(c[k]) < options.coefficient_tolerance) continue;
+        const int jk = live[kept[k]];
+        // Scaled: g_j/|g_j| = Σ c_k g_k/|g_k|  ⇒  g_j = Σ c_k |g_j|/|g_k| g_k.
+        dep.terms.emplace_back(report.names[jk],
+                               -c[k] * report.column_norms[j] / report.column_norms[jk]);
+      }
+      report.dependencies.push_back(dep);
+      report.suggested_fixed.push_back(report.names[j]);
+    }
+  }
+  for (const auto& name : report.unidentifiable) report.suggested_fixed.push_back(name);
+  // Keep suggested_fixed in parameter-set order.
+  std::vector<std::string> ordered;
+  for (const auto& name : report.names)
+    if (std::find(report.suggested_fixed.begin(), report.suggested_fixed.end(), name) !=
+        report.suggested_fixed.end())
+      ordered.push_back(name);
+  report.suggested_fixed = ordered;
+  return report;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,34 @@
+#include "lrcal/kinematics/configuration_set.h"
+
+#include <cmath>
+
+namespace lrcal {
+
+void ConfigurationSet::Add(const double* q) {
+  for (int j = 0; j < num_joints_; ++j) {
+    q_.push_back(q[j]);
+    cos_q_.push_back(std::cos(q[j]));
+    sin_q_.push_back(std::sin(q[j]));
+  }
+}
+
+void ConfigurationSet::AddFrom(const ConfigurationSet& other, int i) {
+  q_.insert(q_.end(), other.q(i), other.q(i) + num_joints_);
+  cos_q_.insert(cos_q_.end(), other.cos_q(i), other.cos_q(i) + num_joints_);
+  sin_q_.insert(sin_q_.end(), other.sin_q(i), other.sin_q(i) + num_joints_);
+}
+
+void ConfigurationSet::Reserve(int n) {
+  q_.reserve(n * num_joints_);
+  cos_q_.reserve(n * num_joints_);
+  sin_q_.reserve(n * num_joints_);
+}
+
+ConfigurationSet ConfigurationSet::Subset(const std::vector<int>& indices) const {
+  ConfigurationSet out(num_joints_);
+  out.Reserve(static_cast<int>(indices.size()));
+  for (int i : indices) out.AddFrom(*this, i);
+  return out;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,59 @@
+#include "lrcal/kinematics/robot_model.h"
+
+#include <cmath>
+
+#include "lrcal/core/error.h"
+
+namespace lrcal {
+
+const char* LinkValueName(int value) {
+  static const char* kNames[] = {"theta", "alpha", "a", "d", "beta"};
+  return kNames[value];
+}
+
+RobotModel::RobotModel(std::string name, std::vector<Link> links, Eigen::VectorXd true_errors,
+                       const std::string& where)
+    : name_(std::move(name)), links_(std::move(links)) {
+  if (links_.empty()) throw InputError(where, "a robot needs at least one link");
+  if (links_.size() > 16) throw InputError(where, "at most 16 links are supported");
+  nominal_values_.resize(num_values());
+  for (int i = 0; i < num_links(); ++i) {
+    const Link& link = links_[i];
+    if (!(link.q_min < link.q_max))
+      throw InputError(where, "link " + std::to_string(i + 1) + ": q_min must be below q_max");
+    for (int v = 0; v < kValuesPerLink; ++v) {
+      nominal_values_[kValuesPerLink * i + v] = link.nominal[v];
+      if (link.is_parameter[v]) parameter_indices_.push_back(kValuesPerLink * i + v);
+    }
+  }
+  if (true_errors.size() == 0) true_errors = Eigen::VectorXd::Zero(num_values());
+  if (true_errors.size() != num_values())
+    throw InputError(where, "true errors: expected " + std::to_string(num_values()) +
+                                " link values, got " + std::to_string(true_errors.size()));
+  for (int k = 0; k < num_values(); ++k) {
+    if (true_errors[k] != 0 && !links_[k / kValuesPerLink].is_parameter[k % kValuesPerLink])
+      throw InputError(where, "true error given for '" + ValueName(k) +
+                                  "', which is fixed (not a parameter) on this robot");
+  }
+  true_errors_ = true_errors;
+}
+
+std::string LinkValueFullName(int index) {
+  return std::string(LinkValueName(index % kValuesPerLink)) +
+         std::to_string(index / kValuesPerLink + 1);
+}
+
+int LinkValueIndex(const std::string& name, int num_links) {
+  for (int k = 0; k < kValuesPerLink * num_links; ++k)
+    if (LinkValueFullName(k) == name) return k;
+  return -1;
+}
+
+std::string RobotModel::ValueName(int index) const { return LinkValueFullName(index); }
+
+int RobotModel::FindValue(const std::string& name) const {
+  return LinkValueIndex(name, num_links());
+}
+
+
+}  // namespace lrcal

@@ -1,0 +1,96 @@
+#include "lrcal/measurement/parameter_set.h"
+#include "lrcal/core/strings.h"
+
+#include <algorithm>
+
+#include "lrcal/core/error.h"
+
+namespace lrcal {
+
+
+PlaneTerms PlaneTerms::Parse(const std::string& text, const std::string& source) {
+  PlaneTerms t;
+  if (text == "none" || text.empty()) return t;
+  if (text == "both") return PlaneTerms{true, true};
+  for (const std::string& s : SplitList(text)) {
+    if (s == "normal") t.normal = true;
+    else if (s == "offset") t.offset = true;
+    else
+      throw InputError(source, "unknown plane term '" + s +
+                                   "'; expected none, normal, offset or normal,offset");
+  }
+  return t;
+}
+
+std::string PlaneTerms::ToString() const {
+  if (normal && offset) return "normal,offset";
+  if (normal) return "normal";
+  if (offset) return "offset";
+  return "none";
+}
+
+ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
+                               const std::vector<std::string>& names) {
+  // Everything `in` already leaves out stays out.
+  std::vector<std::string> fixed = names;
+  for (int k : robot.parameter_indices())
+    if (std::find(in.robot_values.begin(), in.robot_values.end(), k) == in.robot_values.end())
+      fixed.push_back(robot.ValueName(k));
+  if (in.plane.normal && in.u_index[0] < 0) fixed.push_back("plane_u1");
+  if (in.plane.normal && in.u_index[1] < 0) fixed.push_back("plane_u2");
+  if (in.plane.offset && in.f_index < 0) fixed.push_back("plane_f");
+  return MakeParameterSet(robot, in.plane, fixed);
+}
+
+bool IsAngularName(const std::string& name) {
+  for (const char* prefix : {"theta", "alpha", "beta", "plane_u"})
+    if (name.rfind(prefix, 0) == 0) return true;
+  return false;
+}
+
+bool ParameterSet::IsAngular(int k) const { return IsAngularName(names[k]); }
+
+int ParameterSet::Find(const std::string& name) const {
+  auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
+                              const std::vector<std::string>& fixed, const std::string& source) {
+  std::vector<int> fixed_values;
+  bool fix_u[2] = {false, false}, fix_offset = false;
+  for (const std::string& name : fixed) {
+    if (name.empty()) continue;
+    if (name == "plane_u1") { fix_u[0] = true; continue; }
+    if (name == "plane_u2") { fix_u[1] = true; continue; }
+    if (name == "plane_f") { fix_offset = true; continue; }
+    int k = robot.FindValue(name);
+    if (k < 0)
+      throw InputError(source, "unknown parameter '" + name +
+                                   "'; expected a name like theta1, alpha2, a3, d4, beta6");
+    const auto& ids = robot.parameter_indices();
+    if (std::find(ids.begin(), ids.end(), k) == ids.end())
+      throw InputError(source, "'" + name + "' is fixed on this robot already (not a parameter)");
+    fixed_values.push_back(k);
+  }
+  ParameterSet set;
+  set.plane = plane;
+  for (int k : robot.parameter_indices()) {
+    if (std::find(fixed_values.begin(), fixed_values.end(), k) != fixed_values.end()) continue;
+    set.robot_values.push_back(k);
+    set.names.push_back(robot.ValueName(k));
+  }
+  for (int c = 0; c < 2; ++c) {
+    if (plane.normal && !fix_u[c]) {
+      set.u_index[c] = set.size();
+      set.names.push_back(c == 0 ? "plane_u1" : "plane_u2");
+    }
+  }
+  if (plane.offset && !fix_offset) {
+    set.f_index = set.size();
+    set.names.push_back("plane_f");
+  }
+  return set;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,71 @@
+#include "lrcal/measurement/plane.h"
+#include "lrcal/core/strings.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/measurement/parameter_set.h"
+
+namespace lrcal {
+
+Plane Plane::FromCoefficients(double nx, double ny, double nz, double f,
+                              const std::string& source) {
+  Eigen::Vector3d n(nx, ny, nz);
+  if (!n.allFinite() || !std::isfinite(f))
+    throw InputError(source, "plane coefficients must be finite numbers");
+  double norm = n.norm();
+  if (norm < 1e-12)
+    throw InputError(source, "plane normal (nx, ny, nz) is zero; expected a non-zero vector");
+  Plane p;
+  p.normal = n / norm;
+  p.offset = f / norm;
+  return p;
+}
+
+Plane Plane::Parse(const std::string& text, const std::string& source) {
+  std::vector<std::string> parts = SplitList(text);
+  if (parts.size() != 4)
+    throw InputError(source, "expected four numbers nx,ny,nz,f; got '" + text + "'");
+  double v[4];
+  for (int i = 0; i < 4; ++i) {
+    char* end = nullptr;
+    v[i] = std::strtod(parts[i].c_str(), &end);
+    if (parts[i].empty() || *end != '\0')
+      throw InputError(source, "'" + parts[i] + "' is not a number (expected nx,ny,nz,f)");
+  }
+  return FromCoefficients(v[0], v[1], v[2], v[3], source);
+}
+
+void TangentBasis(const Eigen::Vector3d& n0, Eigen::Vector3d* t1, Eigen::Vector3d* t2) {
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::fabs(n0[k]) < std::fabs(n0[axis])) axis = k;
+  Eigen::Vector3d e = Eigen::Vector3d::Unit(axis);
+  *t1 = (e - e.dot(n0) * n0).normalized();
+  *t2 = n0.cross(*t1);
+}
+
+NormalChart::NormalChart(const Eigen::Vector3d& nominal_normal) : n0(nominal_normal) {
+  TangentBasis(n0, &t1, &t2);
+}
+
+void NormalChart::NormalAndJacobian(double u1, double u2, Eigen::Vector3d* n,
+                                    Eigen::Matrix<double, 3, 2>* dn_du) const {
+  Eigen::Vector3d v = n0 + u1 * t1 + u2 * t2;
+  double norm = v.norm();
+  *n = v / norm;
+  Eigen::Matrix3d P = (Eigen::Matrix3d::Identity() - (*n) * n->transpose()) / norm;
+  dn_du->col(0) = P * t1;
+  dn_du->col(1) = P * t2;
+}
+
+BeamMiss ClassifyReading(double h, double n_dot_b, const RangerSpec& ranger) {
+  if (!(std::fabs(n_dot_b) > kParallelBeamThreshold) || !std::isfinite(h)) return BeamMiss::kParallel;
+  if (h <= 0) return BeamMiss::kBehind;
+  if (h < ranger.min_range || h > ranger.max_range) return BeamMiss::kOutOfRange;
+  if (std::fabs(n_dot_b) < std::cos(ranger.max_incidence)) return BeamMiss::kGrazing;
+  return BeamMiss::kNone;
+}
+
+}  // namespace lrcal

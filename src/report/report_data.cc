@@ -1,0 +1,132 @@
+#include "lrcal/report/report_data.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/study/study.h"
+#include "lrcal/report/study_tables.h"
+#include "study/trial_pipeline.h"
+#include "lrcal/study/trial_store.h"
+
+namespace lrcal {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+Json Vector(const std::vector<double>& v, double scale) {
+  Json j = Json::array();
+  for (double x : v) j.push_back(x * scale);
+  return j;
+}
+
+// Per configuration: [x, y, z] rows, scaled.
+Json Columns(const Eigen::Matrix3Xd& m, double scale) {
+  Json j = Json::array();
+  for (int c = 0; c < m.cols(); ++c) j.push_back({m(0, c) * scale, m(1, c) * scale, m(2, c) * scale});
+  return j;
+}
+
+}  // namespace
+
+ReportData PrepareReportData(const std::string& run_dir) {
+  const fs::path dir = run_dir;
+  if (!fs::is_directory(dir)) throw InputError(run_dir, "no such run directory");
+  const fs::path manifest_path = dir / "manifest.json";
+  if (!fs::exists(manifest_path))
+    throw InputError(run_dir, "not an lrcal run directory: manifest.json is missing");
+  Json manifest;
+  try {
+    std::ifstream in(manifest_path);
+    manifest = Json::parse(in);
+  } catch (const Json::exception& e) {
+    throw InputError(manifest_path.string(), std::string("not valid JSON: ") + e.what());
+  }
+  if (!manifest.contains("study") || !manifest["study"].contains("cells") ||
+      !manifest["study"].contains("trials"))
+    throw InputError(manifest_path.string(), "malformed manifest: expected study.cells and study.trials");
+
+  ReportData data;
+  data.dir = (dir / "report").string();
+  fs::create_directories(data.dir);
+  // A consistent snapshot of every store (SQLite readers do not block a running writer).
+  const fs::path snapshot = fs::path(data.dir) / "trials.snapshot.sqlite";
+  for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(snapshot.string() + suffix);
+  {
+    TrialStore snap(snapshot.string());
+    bool any = false;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      const std::string name = e.path().filename().string();
+      if (name == "trials.sqlite" ||
+          (name.rfind("trials.rank", 0) == 0 && name.size() > 7 &&
+           name.compare(name.size() - 7, 7, ".sqlite") == 0)) {
+        snap.MergeFrom(e.path().string());
+        any = true;
+      }
+    }
+    if (!any) throw InputError(run_dir, "no trial store (trials.sqlite): the run has not started");
+    const long long trials = manifest["study"]["trials"];
+    for (const auto& c : manifest["study"]["cells"]) {
+      data.done += snap.CountTrials(c["id"].get<std::string>());
+      data.expected += trials;
+    }
+    data.complete = data.done >= data.expected;
+    WriteStudyTables(snap, manifest["study"], data.dir);
+  }
+
+  // Trial 0 of every cell in detail, recomputed (it is a pure function of the settings).
+  Json realisation;
+  realisation["trial"] = 0;
+  realisation["units"] = "distance errors mm; position errors mm; orientation errors mrad";
+  realisation["cells"] = Json::array();
+  try {
+    const std::string study_file = manifest.value("study_file", std::string());
+    const Study study = LoadStudy(study_file);
+    if (study.seed != manifest["study"]["seed"].get<std::uint64_t>())
+      throw InputError(study_file, "the study file changed since the run (seed)");
+    for (const Cell& cell : study.cells) {
+      bool in_run = false;
+      for (const auto& c : manifest["study"]["cells"]) in_run |= c["id"] == cell.id;
+      if (!in_run) continue;
+      auto context = PrepareCell(study, cell);
+      TrialWorkspace ws;
+      TrialDetails d;
+      const TrialRecord r = RunTrial(*context, 0, &ws, &d);
+      Json cj = {{"id", cell.id}, {"label", cell.label}, {"status", TrialStatusName(r.status)},
+                 {"paper_case", cell.typed.paper_case}};
+      if (r.status == TrialStatus::kOk) {
+        cj["distance_error_nominal"] = Vector(d.distance_error_nominal, 1e3);
+        cj["distance_error_identified"] = Vector(d.distance_error_identified, 1e3);
+        cj["measurement"] = {{"position_nominal", Columns(d.measurement_nominal.position, 1e3)},
+                             {"position_identified", Columns(d.measurement_identified.position, 1e3)},
+                             {"orientation_nominal", Columns(d.measurement_nominal.orientation, 1e3)},
+                             {"orientation_identified",
+                              Columns(d.measurement_identified.orientation, 1e3)}};
+        cj["validation"] = {{"position_nominal", Columns(d.validation_nominal.position, 1e3)},
+                            {"position_identified", Columns(d.validation_identified.position, 1e3)},
+                            {"orientation_nominal", Columns(d.validation_nominal.orientation, 1e3)},
+                            {"orientation_identified",
+                             Columns(d.validation_identified.orientation, 1e3)}};
+      }
+      realisation["cells"].push_back(cj);
+    }
+    if (realisation["cells"].empty())
+      throw InputError(study_file, "none of its cells is in this run (the study file, or lrcal's "
+                                   "settings, changed since the run)");
+    data.realisation = true;
+  } catch (const InputError& e) {
+    data.note = std::string("one-realisation figures left out: ") + e.what();
+  }
+  fs::remove(fs::path(data.dir) / "realisation.json");
+  if (data.realisation) {
+    std::ofstream out(fs::path(data.dir) / "realisation.json");
+    out << realisation.dump(1) << "\n";
+  }
+  Json status = {{"done", data.done}, {"expected", data.expected}, {"complete", data.complete},
+                 {"realisation", data.realisation}, {"note", data.note}};
+  std::ofstream(fs::path(data.dir) / "status.json") << status.dump(2) << "\n";
+  return data;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,294 @@
+#include "lrcal/study/run_directory.h"
+
+#include <ceres/version.h>
+#include <fcntl.h>
+#include <sqlite3.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <ctime>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "lrcal/build_info.h"
+#include "lrcal/core/error.h"
+
+namespace lrcal {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+Json BuildInfo() {
+  return {{"version", LRCAL_VERSION},
+          {"commit", LRCAL_GIT_COMMIT},
+          {"compiler", LRCAL_COMPILER},
+          {"build_type", LRCAL_BUILD_TYPE}};
+}
+
+Json Dependencies() {
+  return {{"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) +
+                        "." + std::to_string(EIGEN_MINOR_VERSION)},
+          {"ceres", CERES_VERSION_STRING},
+          {"sqlite", sqlite3_libversion()},
+          {"random123", "Philox4x64-10, Random123 boxmuller"}};
+}
+
+constexpr const char* kRandomNumbers =
+    "Philox4x64-10 (Random123) addressed by (seed, stream, trial, purpose, index); standard "
+    "normals by Random123's Box-Muller. Common random numbers: the reading noise and drawn "
+    "truths are keyed by the trial index only, so cells that differ in sigma, repetitions, "
+    "configuration count or selection see the same standard normals (noise of a "
+    "configuration is addressed by its index in the candidate pool). Pools and validation "
+    "sets are keyed by a hash of the settings they depend on.";
+
+}  // namespace
+
+std::string UtcNow() {
+  std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+Json StudyFingerprint(const Json& study) {
+  return {{"name", study["name"]}, {"seed", study["seed"]}, {"trials", study["trials"]},
+          {"base", study["base"]}};
+}
+
+DirectoryLock::DirectoryLock(const std::string& dir) {
+  const std::string path = dir + "/lock";
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw InputError(path, "cannot create the lock file");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(dir, "another lrcal process is running on this run directory; wait for it "
+                          "or stop it first");
+  }
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd_, 0) == 0 && ::write(fd_, pid.data(), pid.size()) < 0) {
+    // The pid is a courtesy for people looking at the file; the flock is the lock.
+  }
+}
+
+DirectoryLock::~DirectoryLock() {
+  if (fd_ >= 0) {
+    ::flock(fd_, LOCK_UN);
+    ::close(fd_);
+  }
+}
+
+std::string RunDirectory::RankStorePath(int rank) const {
+  return path_ + "/trials.rank" + std::to_string(rank) + ".sqlite";
+}
+
+void RunDirectory::CreateAndLock() {
+  fs::create_directories(path_);
+  lock_ = std::make_unique<DirectoryLock>(path_);
+}
+
+void RunDirectory::Lock() {
+  ReadManifest();  // refuses what is not a run directory
+  lock_ = std::make_unique<DirectoryLock>(path_);
+}
+
+bool RunDirectory::HasManifest() const { return fs::exists(ManifestPath()); }
+
+Json RunDirectory::ReadManifest() const {
+  if (!fs::exists(ManifestPath()) || !fs::exists(MainStorePath()))
+    throw InputError(path_, "not an lrcal run directory (expected manifest.json and "
+                            "trials.sqlite)");
+  return ReadJsonFile(ManifestPath());
+}
+
+void RunDirectory::WriteManifest(const Json& manifest) const {
+  WriteFileAtomically(ManifestPath(), manifest.dump(2) + "\n");
+}
+
+void RunDirectory::CheckCompatible(const Json& manifest, const Json& study,
+                                   const std::string& study_path, int shard_index,
+                                   int shard_count) {
+  const auto changes = DiffJson(StudyFingerprint(manifest["study"]), StudyFingerprint(study));
+  if (!changes.empty()) {
+    std::string msg = "this run directory holds a different study; changed:";
+    for (const auto& c : changes) msg += "\n  " + c;
+    msg += "\nrun it in a new directory (--out), or restore the study file";
+    throw InputError(study_path, msg);
+  }
+  const Json shard = {{"index", shard_index + 1}, {"count", shard_count}};
+  if (manifest.contains("shard") && manifest["shard"] != shard)
+    throw InputError("--shard", "this run directory is shard " +
+                                    manifest["shard"]["index"].dump() + "/" +
+                                    manifest["shard"]["count"].dump() +
+                                    "; rerun it with that --shard");
+}
+
+Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_index,
+                                int shard_count, int threads, int ranks, std::size_t* session) {
+  if (manifest.is_null()) {
+    manifest["created"] = UtcNow();
+    manifest["sessions"] = Json::array();
+  }
+  manifest["study_file"] = study.path;
+  manifest["study"] = study.ToJson();
+  manifest["seed"] = study.seed;
+  manifest["shard"] = {{"index", shard_index + 1}, {"count", shard_count}};
+  manifest["lrcal"] = BuildInfo();
+  manifest["dependencies"] = Dependencies();
+  manifest["random_numbers"] = kRandomNumbers;
+  manifest["sessions"].push_back(
+      {{"start", UtcNow()}, {"threads", threads}, {"ranks", ranks}, {"ended", "running"}});
+  *session = manifest["sessions"].size() - 1;
+  return manifest;
+}
+
+std::vector<std::string> RunDirectory::RankStorePaths() const {
+  std::vector<std::string> out;
+  if (!fs::exists(path_)) return out;
+  for (const auto& e : fs::directory_iterator(path_)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("trials.rank", 0) == 0 && name.size() > 18 &&
+        name.compare(name.size() - 7, 7, ".sqlite") == 0)
+      out.push_back(e.path().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::string> RunDirectory::StorePaths() const {
+  std::vector<std::string> out;
+  if (fs::exists(MainStorePath())) out.push_back(MainStorePath());
+  for (const auto& p : RankStorePaths()) out.push_back(p);
+  return out;
+}
+
+void RunDirectory::MergeRankStores(TrialStore* main_store) const {
+  for (const std::string& path : RankStorePaths()) {
+    main_store->MergeFrom(path);
+    for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(path + suffix);
+  }
+}
+
+DoneSet RunDirectory::ReadDone(const Study& study, const TrialStore* open_store) const {
+  const long long trials = study.trials;
+  DoneSet done(study.cells.size(), std::vector<bool>(trials, false));
+  for (const std::string& path : StorePaths()) {
+    std::unique_ptr<TrialStore> other;
+    const TrialStore* s = open_store;
+    if (!open_store || path != open_store->path()) {
+      other = std::make_unique<TrialStore>(path);
+      s = other.get();
+    }
+    for (std::size_t c = 0; c < study.cells.size(); ++c)
+      for (long long t : s->DoneTrials(study.cells[c].id))
+        if (t >= 0 && t < trials) done[c][t] = true;
+  }
+  return done;
+}
+
+void ParseShard(const std::string& text, int* index, int* count) {
+  const auto slash = text.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("");
+    std::size_t a = 0, b = 0;
+    const int i = std::stoi(text.substr(0, slash), &a);
+    const int n = std::stoi(text.substr(slash + 1), &b);
+    if (a != slash || b != text.size() - slash - 1 || n < 1 || i < 1 || i > n)
+      throw std::invalid_argument("");
+    *index = i - 1;
+    *count = n;
+  } catch (const std::exception&) {
+    throw InputError("--shard", "expected i/N with 1 <= i <= N (e.g. 2/8), got '" + text + "'");
+  }
+}
+
+void MergeRunStores(const std::vector<std::string>& shard_dirs, const std::string& out_dir) {
+  if (shard_dirs.empty()) throw InputError("merge", "give the shard run directories to merge");
+  RunDirectory out(out_dir);
+  out.CreateAndLock();
+  Json merged;
+  for (const std::string& d : shard_dirs) {
+    const Json manifest = RunDirectory(d).ReadManifest();
+    if (merged.is_null()) {
+      merged = manifest;
+      merged["merged_from"] = Json::array();
+      merged["sessions"] = Json::array();
+      merged["shard"] = {{"index", 1}, {"count", 1}};
+      merged.erase("finished");
+    } else {
+      const auto changes =
+          DiffJson(StudyFingerprint(merged["study"]), StudyFingerprint(manifest["study"]));
+      if (!changes.empty()) {
+        std::string msg = "ran a different study than " + shard_dirs[0] + ":";
+        for (const auto& c : changes) msg += "\n  " + c;
+        throw InputError(d, msg);
+      }
+    }
+    merged["merged_from"].push_back({{"dir", d}, {"shard", manifest["shard"]}});
+    for (const auto& s : manifest["sessions"]) merged["sessions"].push_back(s);
+  }
+  {
+    TrialStore store(out.MainStorePath());
+    store.SetMeta("study", merged["study"].dump());
+    for (const std::string& d : shard_dirs)
+      for (const std::string& path : RunDirectory(d).StorePaths()) store.MergeFrom(path);
+  }
+  out.WriteManifest(merged);
+}
+
+std::string RunStatus(const std::string& run_dir) { return GetRunStatus(run_dir).text; }
+
+RunStatusInfo GetRunStatus(const std::string& run_dir) {
+  RunStatusInfo info;
+  const RunDirectory dir(run_dir);
+  const Json manifest = dir.ReadManifest();
+  // Every store of the directory: the main one and any rank stores of an MPI job.
+  std::vector<std::unique_ptr<TrialStore>> stores;
+  for (const std::string& path : dir.StorePaths())
+    stores.push_back(std::make_unique<TrialStore>(path));
+  const long long trials = manifest["study"]["trials"];
+  const int si = manifest["shard"]["index"], sc = manifest["shard"]["count"];
+  std::ostringstream out;
+  out << "study " << manifest["study"]["name"].get<std::string>() << " in " << run_dir;
+  if (sc > 1) out << " (shard " << si << "/" << sc << ")";
+  out << "\n";
+  long long total_done = 0, total = 0;
+  for (const auto& c : manifest["study"]["cells"]) {
+    const std::string id = c["id"];
+    long long expected = 0;
+    for (long long t = 0; t < trials; ++t)
+      if (t % sc == si - 1) ++expected;
+    std::set<long long> union_done;
+    for (const auto& st : stores)
+      for (long long t : st->DoneTrials(id)) union_done.insert(t);
+    const long long done = static_cast<long long>(union_done.size());
+    total_done += done;
+    total += expected;
+    out << "  " << c["label"].get<std::string>() << " (" << id << "): " << done << "/" << expected
+        << (done >= expected ? " done" : " remaining " + std::to_string(expected - done)) << "\n";
+  }
+  out << "total: " << total_done << "/" << total << (total_done >= total ? " — complete" : "")
+      << "\n";
+  const auto& sessions = manifest["sessions"];
+  if (!sessions.empty())
+    out << "last session: " << sessions.back().value("start", std::string()) << " → "
+        << sessions.back().value("ended", std::string()) << "\n";
+  if (total_done < total) {
+    out << "to finish: lrcal run " << manifest.value("study_file", std::string("STUDY.yaml"))
+        << " --out " << run_dir;
+    if (sc > 1) out << " --shard " << si << "/" << sc;
+    out << "\n";
+  }
+  info.text = out.str();
+  info.complete = total_done >= total;
+  info.shard_index = si;
+  info.shard_count = sc;
+  info.study_file = manifest.value("study_file", std::string("STUDY.yaml"));
+  return info;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,409 @@
+#include "lrcal/study/runner.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <mutex>
+#include <thread>
+
+#include "lrcal/core/error.h"
+#include "lrcal/study/run_directory.h"
+#include "lrcal/study/trial_store.h"
+#include "lrcal/study/work_source.h"
+#include "study/trial_pipeline.h"
+
+namespace lrcal {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
+}
+
+// The signal handlers' view of the run in progress.
+std::atomic<StopToken*> g_active_stop{nullptr};
+std::atomic<int> g_signals{0};
+
+void OnStopSignal(int) {
+  if (g_signals.fetch_add(1) >= 1) _exit(130);  // second signal: stop now
+  if (StopToken* token = g_active_stop.load()) token->RequestStop();
+}
+
+// Registers a run's stop token with the signal handlers for the run's lifetime.
+class ActiveStop {
+ public:
+  explicit ActiveStop(StopToken* token) {
+    g_signals.store(0);
+    g_active_stop.store(token);
+  }
+  ~ActiveStop() { g_active_stop.store(nullptr); }
+};
+
+std::string Duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  char buf[32];
+  const long long t = static_cast<long long>(s + 0.5);
+  std::snprintf(buf, sizeof buf, "%lld:%02lld:%02lld", t / 3600, t / 60 % 60, t % 60);
+  return buf;
+}
+
+// Records handed over by the workers, taken by the writer (the runner's main thread).
+class RecordQueue {
+ public:
+  RecordQueue(int workers, std::size_t batch) : running_(workers), batch_(batch) {}
+  void Push(std::vector<TrialRecord>* records) {
+    bool full;
+    {
+      std::lock_guard<std::mutex> g(mutex_);
+      for (auto& r : *records) pending_.push_back(std::move(r));
+      full = pending_.size() >= batch_;
+    }
+    records->clear();
+    if (full) cv_.notify_one();  // else the writer wakes on its own
+  }
+  // A worker has finished. Under the mutex: the writer checks `running_` under it, so this
+  // wake-up cannot be lost.
+  void WorkerDone() {
+    {
+      std::lock_guard<std::mutex> g(mutex_);
+      --running_;
+    }
+    cv_.notify_one();
+  }
+  // Waits up to `wait` for a full batch or the end of the workers; moves what is pending into
+  // `out`. Returns true when every worker has finished.
+  bool Take(std::chrono::milliseconds wait, std::vector<TrialRecord>* out) {
+    std::unique_lock<std::mutex> g(mutex_);
+    cv_.wait_for(g, wait, [&] { return running_ == 0 || pending_.size() >= batch_; });
+    for (auto& r : pending_) out->push_back(std::move(r));
+    pending_.clear();
+    return running_ == 0;
+  }
+  void Fail(std::exception_ptr e) {
+    std::lock_guard<std::mutex> g(mutex_);
+    if (!failure_) failure_ = e;
+  }
+  std::exception_ptr failure() {
+    std::lock_guard<std::mutex> g(mutex_);
+    return failure_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<TrialRecord> pending_;
+  int running_;
+  std::size_t batch_;
+  std::exception_ptr failure_;
+};
+
+// Progress on stderr: a bar on a terminal, periodic lines otherwise (rank 0 only).
+class ProgressReporter {
+ public:
+  ProgressReporter(bool enabled, int ranks, long long total, long long done_before,
+                   long long expected_total, Clock::time_point start)
+      : enabled_(enabled),
+        tty_(::isatty(STDERR_FILENO) != 0),
+        ranks_(ranks),
+        total_(total),
+        done_before_(done_before),
+        expected_total_(expected_total),
+        start_(start),
+        last_(Clock::now()) {
+    if (const char* e = std::getenv("LRCAL_PROGRESS_SECONDS")) line_every_ = std::atof(e);
+  }
+  void Tick(long long computed) {
+    const auto now = Clock::now();
+    if (Seconds(last_, now) < (tty_ ? 0.25 : line_every_)) return;
+    Report(computed, false);
+    last_ = now;
+  }
+  void Report(long long computed, bool final) const {
+    if (!enabled_) return;
+    const double elapsed = Seconds(start_, Clock::now());
+    const long long done_now = done_before_ + computed * ranks_;
+    const double rate = elapsed > 0 ? computed * ranks_ / elapsed : 0;
+    const double eta = rate > 0 ? (expected_total_ - done_now) / rate : NAN;
+    const long long shown = std::min(done_now, total_);
+    char line[256];
+    if (tty_) {
+      const int width = 30;
+      const int filled = total_ ? static_cast<int>(width * shown / total_) : width;
+      std::snprintf(line, sizeof line, "\r[%s%s] %lld/%lld trials  %.0f/s  ETA %s ",
+                    std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+                    shown, total_, rate, Duration(eta).c_str());
+      std::cerr << line << (final ? "\n" : "") << std::flush;
+    } else {
+      std::snprintf(line, sizeof line, "lrcal run: %lld/%lld trials, %.0f/s, ETA %s%s", shown,
+                    total_, rate, Duration(eta).c_str(),
+                    ranks_ > 1 ? " (estimated from rank 0)" : "");
+      std::cerr << line << "\n";
+    }
+  }
+
+ private:
+  bool enabled_, tty_;
+  int ranks_;
+  long long total_, done_before_, expected_total_;
+  Clock::time_point start_, last_;
+  double line_every_ = 10.0;
+};
+
+class StudyRunner {
+ public:
+  StudyRunner(const Study& study, const RunOptions& options, Collective* collective,
+              StopToken* stop)
+      : study_(study),
+        options_(options),
+        collective_(collective),
+        stop_(stop),
+        rank_(collective->rank()),
+        ranks_(collective->size()),
+        threads_(options.threads > 0 ? options.threads
+                                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
+        dir_(options.out_dir) {}
+
+  RunResult Run() {
+    start_ = Clock::now();
+    PrepareCells();
+    OpenRunDirectory();
+    FindMissingTrials();
+    RunTrials();
+    FinishSession();
+    result_.seconds = Seconds(start_, Clock::now());
+    return result_;
+  }
+
+ private:
+  bool root() const { return rank_ == 0; }
+
+  // Every rank prepares every cell (the same deterministic result).
+  void PrepareCells() {
+    for (const Cell& cell : study_.cells) contexts_.push_back(PrepareCell(study_, cell));
+    result_.prepare_seconds = Seconds(start_, Clock::now());
+  }
+
+  // Rank 0 owns the directory: lock, manifest (and its refusals), main store. Every rank
+  // learns whether that worked; then each opens its own store.
+  void OpenRunDirectory() {
+    std::string refusal;
+    if (root()) {
+      try {
+        dir_.CreateAndLock();
+        Json manifest;
+        if (dir_.HasManifest()) {
+          manifest = dir_.ReadManifest();
+          RunDirectory::CheckCompatible(manifest, study_.ToJson(), study_.path,
+                                        options_.shard_index, options_.shard_count);
+        }
+        manifest_ = RunDirectory::StartSession(manifest, study_, options_.shard_index,
+                                               options_.shard_count, threads_, ranks_, &session_);
+        dir_.WriteManifest(manifest_);
+        TrialStore main_store(dir_.MainStorePath());
+        main_store.SetMeta("study", study_.ToJson().dump());
+        for (const auto& context : contexts_) main_store.PutCell(ToStoredCell(*context));
+      } catch (const std::exception& e) {
+        if (ranks_ == 1) throw;
+        refusal = e.what();
+      }
+    }
+    refusal = collective_->Broadcast(refusal);
+    if (!refusal.empty()) throw InputError("", refusal);
+    // This process's store: the main store, or its own rank store in an MPI job.
+    store_path_ = ranks_ == 1 ? dir_.MainStorePath() : dir_.RankStorePath(rank_);
+    store_ = std::make_unique<TrialStore>(store_path_);
+    if (ranks_ > 1)
+      for (const auto& context : contexts_) store_->PutCell(ToStoredCell(*context));
+    collective_->Barrier();  // every store exists with its tables
+  }
+
+  // Done: the union over every store of the directory (a killed MPI run leaves rank stores
+  // behind; whatever they hold counts, with any number of ranks now).
+  void FindMissingTrials() {
+    done_ = dir_.ReadDone(study_, store_.get());
+    collective_->Barrier();  // nobody writes before every rank has read
+    for (const auto& cell : done_)
+      for (long long t = options_.shard_index; t < study_.trials; t += options_.shard_count) {
+        ++result_.total;
+        if (cell[t]) ++result_.done_before;
+      }
+    MissingTrials missing(&done_, study_.trials, options_.shard_index, options_.shard_count);
+    dynamic_ = options_.dynamic_schedule && ranks_ > 1;
+    work_ = dynamic_ ? MakeDynamicSchedule(std::move(missing), collective_, options_.max_new_trials)
+                     : MakeStaticSchedule(std::move(missing), rank_, ranks_,
+                                          options_.max_new_trials);
+  }
+
+  // One worker thread: claims trials, computes them, hands the records to the writer.
+  void Worker(RecordQueue* queue) {
+    TrialWorkspace ws;
+    std::vector<TrialRecord> local;
+    std::vector<TrialId> chunk;
+    constexpr int kClaim = 8;
+    try {
+      while (!stop_->stop_requested()) {
+        work_->Claim(kClaim, &chunk);
+        if (chunk.empty()) break;
+        for (const auto& [cell, trial] : chunk)
+          local.push_back(RunTrial(*contexts_[cell], trial, &ws));
+        queue->Push(&local);
+      }
+    } catch (...) {
+      queue->Fail(std::current_exception());
+      stop_->RequestStop();
+    }
+    queue->WorkerDone();
+  }
+
+  // Writes one batch of records (the writer's step).
+  void Commit(std::vector<TrialRecord>* batch) {
+    store_->Insert(*batch);
+    for (const auto& r : *batch) result_.trial_seconds += r.seconds;
+    result_.computed += static_cast<long long>(batch->size());
+    batch->clear();
+  }
+
+  // Workers compute; this thread writes batches, reports progress and pumps the schedule.
+  void RunTrials() {
+    const auto t_run = Clock::now();
+    RecordQueue queue(threads_, static_cast<std::size_t>(options_.batch_size));
+    const long long expected = result_.done_before + work_->share() * ranks_;
+    ProgressReporter progress(options_.progress && root(), ranks_, result_.total,
+                              result_.done_before, expected, start_);
+    std::vector<std::thread> pool;
+    std::exception_ptr writer_failure;
+    try {
+      for (int i = 0; i < threads_; ++i) pool.emplace_back([this, &queue] { Worker(&queue); });
+      WriterLoop(&queue, &progress);
+    } catch (...) {
+      // The writer failed (e.g. the disk is full) or a thread could not start: stop the
+      // workers, join them, and report; committed records stay.
+      writer_failure = std::current_exception();
+      stop_->RequestStop();
+      work_->Pump(true, false);
+    }
+    for (auto& t : pool) t.join();
+    result_.run_seconds = Seconds(t_run, Clock::now());
+    progress.Report(result_.computed, true);
+    if (writer_failure) std::rethrow_exception(writer_failure);
+    if (auto failure = queue.failure()) std::rethrow_exception(failure);
+    result_.peak_rss_kb_trials = PeakRssKb();
+  }
+
+  void WriterLoop(RecordQueue* queue, ProgressReporter* progress) {
+    const auto wait = std::chrono::milliseconds(dynamic_ ? 1 : 100);
+    const std::size_t batch_size = static_cast<std::size_t>(options_.batch_size);
+    auto last_flush = Clock::now();
+    std::vector<TrialRecord> batch;
+    work_->Pump(false, false);
+    while (true) {
+      const bool workers_done = queue->Take(wait, &batch);
+      const auto now = Clock::now();
+      if (workers_done || batch.size() >= batch_size || Seconds(last_flush, now) >= 1.0) {
+        Commit(&batch);
+        last_flush = now;
+      }
+      progress->Tick(result_.computed);
+      const bool stopping = stop_->stop_requested() || work_->Exhausted();
+      if (work_->Pump(stopping, workers_done) && workers_done) break;
+    }
+  }
+
+  // Rank 0 folds the rank stores into the main store and closes the session in the manifest.
+  void FinishSession() {
+    result_.ranks_computed = collective_->SumAll(result_.computed);
+    store_.reset();          // close this process's store before rank 0 merges it
+    collective_->Barrier();  // every rank's records are committed
+    if (root()) {
+      TrialStore main_store(dir_.MainStorePath());
+      dir_.MergeRankStores(&main_store);
+      long long done_now = 0;
+      for (const Cell& cell : study_.cells)
+        for (long long t : main_store.DoneTrials(cell.id))
+          if (t >= 0 && t < study_.trials && t % options_.shard_count == options_.shard_index)
+            ++done_now;
+      result_.complete = done_now >= result_.total;
+      result_.interrupted = stop_->stop_requested() || !result_.complete;
+      Json& session = manifest_["sessions"][session_];
+      session["end"] = UtcNow();
+      session["trials_computed"] = result_.ranks_computed;
+      session["ended"] = result_.interrupted ? "interrupted" : "completed";
+      session["seconds"] = {{"prepare", result_.prepare_seconds},
+                            {"trials", result_.run_seconds},
+                            {"sum_of_trial_times", result_.trial_seconds}};
+      result_.peak_rss_kb = PeakRssKb();
+      session["peak_rss_kb"] = {{"after_trials", result_.peak_rss_kb_trials}};
+      dir_.WriteManifest(manifest_);
+      dir_.Unlock();
+    } else {
+      // Completeness is rank 0's to judge (from the merged store); this rank knows its stop
+      // token and, under the static schedule, whether it finished its share.
+      result_.interrupted =
+          stop_->stop_requested() || (!dynamic_ && result_.computed < work_->share());
+    }
+    collective_->Barrier();  // rank 0 has merged: the run directory is consistent
+  }
+
+  const Study& study_;
+  const RunOptions& options_;
+  Collective* collective_;
+  StopToken* stop_;
+  const int rank_, ranks_, threads_;
+  RunDirectory dir_;
+  Clock::time_point start_;
+  RunResult result_;
+  std::vector<std::unique_ptr<CellContext>> contexts_;
+  Json manifest_;
+  std::size_t session_ = 0;
+  std::string store_path_;
+  std::unique_ptr<TrialStore> store_;
+  DoneSet done_;
+  bool dynamic_ = false;
+  std::unique_ptr<WorkSource> work_;
+};
+
+}  // namespace
+
+void RunOptions::Validate() const {
+  if (out_dir.empty()) throw InputError("--out", "expected a run directory, got an empty name");
+  if (threads < 0) throw InputError("--threads", "expected 0 (all cores) or more");
+  if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
+    throw InputError("--shard", "expected i/N with 1 <= i <= N");
+  if (batch_size < 1) throw InputError("batch_size", "expected at least 1 record per batch");
+  if (max_new_trials < 0)
+    throw InputError("--max-trials", "expected 0 (no limit) or a positive number of trials");
+}
+
+long PeakRssKb() {
+  struct rusage usage;
+  return getrusage(RUSAGE_SELF, &usage) == 0 ? usage.ru_maxrss : -1;
+}
+
+void InstallStopHandlers() {
+  std::signal(SIGINT, OnStopSignal);
+  std::signal(SIGTERM, OnStopSignal);
+}
+
+RunResult RunStudy(const Study& study, const RunOptions& options, Collective* collective,
+                   StopToken* stop) {
+  options.Validate();
+  std::unique_ptr<Collective> single;
+  if (!collective) {
+    single = SingleProcess();
+    collective = single.get();
+  }
+  StopToken own_stop;
+  if (!stop) stop = &own_stop;
+  ActiveStop active(stop);
+  return StudyRunner(study, options, collective, stop).Run();
+}
+
+}  // namespace lrcal

@@ -1,0 +1,145 @@
+#include "lrcal/study/statistics.h"
+
+#include <nlohmann/json.hpp>
+
+#include "identification/levenberg_marquardt.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lrcal {
+
+using Json = nlohmann::json;
+
+double Percentile(const std::vector<double>& s, double p) {
+  if (s.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const double h = (s.size() - 1) * p / 100.0;
+  const std::size_t lo = static_cast<std::size_t>(std::floor(h));
+  const std::size_t hi = std::min(lo + 1, s.size() - 1);
+  return s[lo] + (h - lo) * (s[hi] - s[lo]);
+}
+
+double Quantile(std::vector<double>* values, double p) {
+  std::vector<double>& v = *values;
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const double h = (v.size() - 1) * p / 100.0;
+  const std::size_t lo = static_cast<std::size_t>(std::floor(h));
+  std::nth_element(v.begin(), v.begin() + lo, v.end());
+  const double below = v[lo];
+  if (lo + 1 >= v.size()) return below;
+  const double above = *std::min_element(v.begin() + lo + 1, v.end());
+  return below + (h - lo) * (above - below);
+}
+
+double PercentileRank(const std::vector<double>& v, double x) {
+  if (v.empty() || std::isnan(x)) return std::numeric_limits<double>::quiet_NaN();
+  std::size_t below = 0, equal = 0;
+  for (double y : v) {
+    below += y < x;
+    equal += y == x;
+  }
+  return 100.0 * (below + 0.5 * equal) / v.size();
+}
+
+Distribution Describe(std::vector<double> v) { return DescribeInPlace(&v); }
+
+Distribution DescribeInPlace(std::vector<double>* values) {
+  std::vector<double>& v = *values;
+  Distribution d;
+  d.n = static_cast<long long>(v.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (v.empty()) {
+    d.mean = d.std = d.p5 = d.p50 = d.p95 = d.min = d.max = nan;
+    return d;
+  }
+  double sum = 0;
+  for (double x : v) sum += x;  // in the given (canonical) order
+  d.mean = sum / d.n;
+  double ss = 0;
+  for (double x : v) ss += (x - d.mean) * (x - d.mean);
+  d.std = d.n > 1 ? std::sqrt(ss / (d.n - 1)) : nan;
+  // Order statistics by selection (O(n)), not a full sort: the same values.
+  d.min = *std::min_element(v.begin(), v.end());
+  d.max = *std::max_element(v.begin(), v.end());
+  d.p5 = Quantile(&v, 5);
+  d.p50 = Quantile(&v, 50);
+  d.p95 = Quantile(&v, 95);
+  return d;
+}
+
+CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
+  CellSummary s;
+  s.cell = cell;
+  const int n = static_cast<int>(cell.parameter_names.size());
+  // Errors in one column-major matrix (row = ok trial in canonical order): each parameter's
+  // values are contiguous, and the covariance is one fixed-lane normal-matrix product.
+  Eigen::MatrixXd errors;
+  std::array<std::vector<double>, 12> val, nom;
+  std::vector<double> iterations, sigma_hat;
+  const std::size_t expected = static_cast<std::size_t>(store.CountTrials(cell.id));
+  errors.resize(static_cast<Eigen::Index>(expected), n);
+  for (int k = 0; k < 12; ++k) {
+    val[k].reserve(expected);
+    nom[k].reserve(expected);
+  }
+  iterations.reserve(expected);
+  sigma_hat.reserve(expected);
+  store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
+    ++s.trials;
+    for (int k = 0; k < 12; ++k) nom[k].push_back(r.nominal[k]);
+    if (r.status != TrialStatus::kOk) {
+      ++s.failed[TrialStatusName(r.status)];
+      return;
+    }
+    ++s.ok;
+    for (int k = 0; k < n && k < static_cast<int>(r.errors.size()); ++k)
+      errors(s.ok - 1, k) = r.errors[k];
+    for (int k = 0; k < 12; ++k) val[k].push_back(r.validation[k]);
+    iterations.push_back(r.iterations);
+    sigma_hat.push_back(r.sigma_hat);
+  });
+  for (int k = 0; k < 12; ++k) {
+    s.validation[k] = DescribeInPlace(&val[k]);
+    s.nominal[k] = DescribeInPlace(&nom[k]);
+    s.validation_values[k] = std::move(val[k]);
+    std::vector<double>().swap(nom[k]);
+  }
+  s.iterations = DescribeInPlace(&iterations);
+  s.sigma_hat = DescribeInPlace(&sigma_hat);
+  // Parameters: bias, spread, and the empirical covariance (two passes, canonical order).
+  const long long m = s.ok;
+  errors.conservativeResize(m, n);
+  // The paper's placement needs the raw values of paper cells; keep only those.
+  const bool keep_values = Json::parse(cell.settings).value("paper_case", 0) > 0;
+  if (keep_values)
+    for (int k = 0; k < n; ++k)
+      s.error_values.emplace_back(errors.col(k).data(), errors.col(k).data() + m);
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    const double* x = errors.col(k).data();
+    for (long long t = 0; t < m; ++t) mean[k] += x[t];
+    if (m) mean[k] /= m;
+  }
+  for (int k = 0; k < n; ++k) errors.col(k).array() -= mean[k];
+  NormalMatrix(errors, &s.covariance);
+  if (m > 1) s.covariance /= static_cast<double>(m - 1);
+  Eigen::VectorXd sd = s.covariance.diagonal().cwiseSqrt();
+  s.correlation = s.covariance;
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) s.correlation(a, b) /= sd[a] * sd[b];
+  for (int k = 0; k < n; ++k) {
+    ParameterStats p;
+    p.name = cell.parameter_names[k];
+    p.bias = m ? mean[k] : std::nan("");
+    p.std = m > 1 ? sd[k] : std::nan("");
+    p.bias_se = m > 1 ? p.std / std::sqrt(static_cast<double>(m)) : std::nan("");
+    p.predicted_std = k < static_cast<int>(cell.predicted_std.size()) ? cell.predicted_std[k]
+                                                                       : std::nan("");
+    p.ratio = p.std / p.predicted_std;
+    s.parameters.push_back(p);
+  }
+  return s;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,377 @@
+#include <chrono>
+#include <cmath>
+
+#include "lrcal/core/error.h"
+#include "lrcal/core/hash.h"
+#include "lrcal/io/robot_file.h"
+#include "lrcal/measurement/simulation.h"
+#include "study/trial_pipeline.h"
+
+namespace lrcal {
+
+std::array<double, 12> Flatten(const PoseErrorStats& s) {
+  std::array<double, 12> a{};
+  for (int k = 0; k < 3; ++k) {
+    a[k] = s.rms_position[k];
+    a[3 + k] = s.rms_orientation[k];
+    a[6 + k] = s.max_position[k];
+    a[9 + k] = s.max_orientation[k];
+  }
+  return a;
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Steps shared by the cell and the trial.
+
+// Stream id of a draw family: a hash of the settings it depends on.
+std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> keys) {
+  Json part;
+  for (const char* k : keys) part[k] = settings[k];
+  return Fnv1a(part.dump());
+}
+
+// The truth of a trial: the robot file's errors × scale, or errors drawn per trial.
+TrialTruth DrawTruth(const CellContext& c, long long trial) {
+  const CellSettings& s = c.cell->typed;
+  const RobotModel& robot = *c.robot;
+  TrialTruth truth;
+  truth.errors.resize(robot.num_values());
+  if (s.truth_random) {
+    RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kTruth);
+    for (int k = 0; k < robot.num_values(); ++k) {
+      const bool is_param = robot.links()[k / kValuesPerLink].is_parameter[k % kValuesPerLink];
+      const double sigma =
+          IsAngle(k % kValuesPerLink) ? s.truth_angle_sigma : s.truth_length_sigma;
+      truth.errors[k] = is_param ? stream.Normal(k) * sigma : 0.0;
+    }
+  } else {
+    truth.errors = robot.true_errors() * s.truth_scale;
+  }
+  truth.values = robot.nominal_values() + truth.errors;
+  const ParameterSet& ps = c.model->parameters();
+  truth.delta.setZero(ps.size());
+  for (int k = 0; k < ps.num_robot(); ++k) truth.delta[k] = truth.errors[ps.robot_values[k]];
+  return truth;
+}
+
+// G of a candidate pool at the nominal model, scaled as the cell's selection says (the paper:
+// SI). Expected-error scaling uses the truth's prior σ (truth.angle_sigma_mrad,
+// truth.length_sigma_mm) for robot parameters and plane terms alike.
+Eigen::MatrixXd DesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
+  const CellSettings& s = c.cell->typed;
+  const ParameterSet& ps = c.model->parameters();
+  Eigen::VectorXd expected(ps.size());
+  for (int k = 0; k < ps.size(); ++k)
+    expected[k] = ps.IsAngular(k) ? s.truth_angle_sigma : s.truth_length_sigma;
+  return ScaleColumns(IdentificationJacobian(*c.model, pool), s.scaling, expected);
+}
+
+ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::VectorXd& truth,
+                            SamplingReport* report) {
+  const CellSettings& s = c.cell->typed;
+  SamplingOptions o;
+  o.ranger = c.ranger;
+  o.min_jacobian_singular_value = s.min_singular_value;
+  o.true_link_values = truth;
+  o.true_plane = c.plane;
+  const RandomStream stream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
+                            RandomPurpose::kPool);
+  return SampleConfigurations(*c.robot, c.plane, s.pool_size, stream, o, report);
+}
+
+// Selects the design of trial `trial` (0 for the cell's own) from a pool and its scaled G.
+TrialDesign SelectDesign(const CellContext& c, long long trial, const ConfigurationSet& pool,
+                         const Eigen::MatrixXd& pool_G) {
+  const CellSettings& s = c.cell->typed;
+  const RandomStream stream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
+                            RandomPurpose::kSelection);
+  TrialDesign d;
+  d.slots = SelectConfigurations(pool_G, s.select_count, s.selection, stream).indices;
+  d.configs = pool.Subset(d.slots);
+  return d;
+}
+
+double DesignSigmaMin(const Eigen::MatrixXd& GtG, int m) {
+  return CriterionScore(GtG, m, DesignCriterion::kE);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The cell's steps.
+
+void LoadRig(const CellSettings& s, CellContext* c) {
+  RobotFile file = LoadRobotFile(ResolveRobotPath(s.robot));
+  c->robot = std::make_shared<RobotModel>(std::move(file.robot));
+  c->ranger = file.ranger;
+  if (!s.plane_from_robot) {
+    c->plane = s.plane;
+  } else if (file.plane) {
+    c->plane = *file.plane;
+  } else {
+    throw InputError("plane", "the robot file has no plane; give plane: in the study");
+  }
+}
+
+void BuildParameterSet(const CellSettings& s, CellContext* c) {
+  ParameterSet ps = MakeParameterSet(*c->robot, s.plane_terms, s.fixed, "identification.fix");
+  c->model = std::make_unique<MeasurementModel>(*c->robot, c->plane, ps);
+  if (s.select_count < ps.size())
+    throw InputError("selection.count",
+                     "selecting " + std::to_string(s.select_count) + " configurations for " +
+                         std::to_string(ps.size()) + " parameters: need at least as many");
+}
+
+void DrawCellConfigurations(const Study& study, const CellSettings& s, CellContext* c) {
+  c->pool_stream =
+      StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "plane", "pool", "truth"});
+  c->validation_stream =
+      StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "validation", "pool"});
+  // The pool must give readings on the nominal model and, for a fixed truth, on the true one.
+  if (!s.truth_random) c->fixed_truth = DrawTruth(*c, 0);
+  c->pool = SamplePool(*c, 0, s.truth_random ? c->robot->nominal_values() : c->fixed_truth.values,
+                       &c->pool_report);
+  SamplingOptions vo;
+  vo.ranger = c->ranger;
+  vo.min_jacobian_singular_value = s.min_singular_value;
+  vo.require_beam_hit = false;  // validation judges poses over the whole workspace
+  c->validation = SampleConfigurations(
+      *c->robot, c->plane, s.validation_size,
+      RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), vo);
+}
+
+// Identifiability of the parameter set on the whole pool (the design is checked later).
+void CheckIdentifiability(const CellSettings& s, CellContext* c) {
+  const IdentifiabilityReport rep = AnalyzeIdentifiability(*c->model, c->pool);
+  if (rep.full_rank()) return;
+  if (!s.fix_dependent) {
+    c->rank_deficient = true;
+    c->rank_message = rep.ToString();
+    return;
+  }
+  c->fixed_for_rank = rep.suggested_fixed;
+  c->model = std::make_unique<MeasurementModel>(
+      *c->robot, c->plane,
+      WithoutParameters(*c->robot, c->model->parameters(), rep.suggested_fixed));
+  if (!s.truth_random) c->fixed_truth.delta = DrawTruth(*c, 0).delta;
+}
+
+// The selected design, its σ_min and the predicted covariance at the nominal model; the
+// design's Jacobian also gives the first linearisation of every trial, computed once here.
+void SelectCellDesign(const CellSettings& s, CellContext* c) {
+  const Eigen::MatrixXd G = DesignJacobian(*c, c->pool);
+  if (s.selection_redraw) c->pool_design_G = G;
+  c->design = SelectDesign(*c, 0, c->pool, G);
+  const int n = c->model->num_parameters();
+  const Eigen::MatrixXd Gd = IdentificationJacobian(*c->model, c->design.configs);
+  const Eigen::MatrixXd GtG = Gd.transpose() * Gd;
+  c->design.sigma_min = DesignSigmaMin(GtG, c->design.configs.size());
+  const IdentifiabilityReport design_report =
+      c->rank_deficient ? IdentifiabilityReport{}
+                        : AnalyzeIdentifiability(*c->model, c->design.configs);
+  if (!c->rank_deficient && design_report.full_rank()) {
+    c->predicted_std =
+        ParameterCovariance(s.repetitions * GtG, s.sigma).diagonal().cwiseSqrt();
+  } else {
+    if (!c->rank_deficient) c->rank_message = design_report.ToString();
+    c->rank_deficient = true;
+    c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
+  }
+  std::vector<BeamMiss> unused;
+  ExactReadings(*c->robot, c->robot->nominal_values(), c->plane, c->ranger, c->design.configs,
+                &c->design_nominal.h, &unused);
+  c->design_nominal.G = Gd;
+  c->design_nominal.Factorize();
+}
+
+// For a fixed truth: exact true readings and poses, once per cell.
+void CacheTruth(const CellSettings& s, CellContext* c) {
+  if (s.truth_random) return;
+  const Eigen::VectorXd& truth = c->fixed_truth.values;
+  ExactReadings(*c->robot, truth, c->plane, c->ranger, c->design.configs, &c->design_true_h,
+                &c->design_true_miss);
+  if (s.selection_redraw)
+    ExactReadings(*c->robot, truth, c->plane, c->ranger, c->pool, &c->pool_true_h,
+                  &c->pool_true_miss);
+  c->validation_true_poses = ToolPoses(*c->robot, truth, c->validation);
+  c->nominal_validation =
+      ComparePoses(*c->robot, truth, c->robot->nominal_values(), c->validation).stats;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The trial's steps.
+
+// The design of a trial: the cell's, or redrawn (a new pool, or a new selection from the cell's
+// pool). Returns false if a redrawn pool cannot be sampled (the true beam misses too often).
+bool DesignOfTrial(const CellContext& c, long long trial, const TrialTruth& truth,
+                   TrialDesign* redrawn, const TrialDesign** design) {
+  const CellSettings& s = c.cell->typed;
+  *design = &c.design;
+  if (!s.pool_redraw && !s.selection_redraw) return true;
+  if (s.pool_redraw) {
+    ConfigurationSet pool;
+    try {
+      pool = SamplePool(c, trial, truth.values, nullptr);
+    } catch (const InputError&) {
+      return false;
+    }
+    *redrawn = SelectDesign(c, trial, pool, DesignJacobian(c, pool));
+  } else {
+    *redrawn = SelectDesign(c, trial, c.pool, c.pool_design_G);
+  }
+  const Eigen::MatrixXd Gd = IdentificationJacobian(*c.model, redrawn->configs);
+  redrawn->sigma_min = DesignSigmaMin(Gd.transpose() * Gd, redrawn->configs.size());
+  *design = redrawn;
+  return true;
+}
+
+// Noisy mean readings of the design into ws->data; returns the number of missed beams. Exact
+// true readings cached per cell are reused when the truth is fixed.
+int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTruth& truth,
+                          const TrialDesign& design, TrialWorkspace* ws) {
+  const CellSettings& s = c.cell->typed;
+  const NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
+  const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
+  if (s.truth_random || s.pool_redraw)
+    return SimulateReadings(*c.robot, truth.values, c.plane, c.ranger, design.configs, noise,
+                            stream, &ws->data, nullptr, nullptr, &design.slots);
+  if (!s.selection_redraw)
+    return AddNoise(c.design_true_h, c.design_true_miss, design.configs, noise, stream,
+                    &ws->data, nullptr, &design.slots);
+  ws->exact_h.clear();
+  ws->exact_miss.clear();
+  for (int i : design.slots) {
+    ws->exact_h.push_back(c.pool_true_h[i]);
+    ws->exact_miss.push_back(c.pool_true_miss[i]);
+  }
+  return AddNoise(ws->exact_h, ws->exact_miss, design.configs, noise, stream, &ws->data, nullptr,
+                  &design.slots);
+}
+
+struct SolveOutcome {
+  Termination termination = Termination::kInvalidInput;
+  int iterations = 0;
+  double final_cost = 0;
+};
+
+// Identifies from ws->data into ws->e with the cell's solver. lrcal's LM starts from the cell's
+// cached nominal linearisation when the design is the cell's own.
+SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspace* ws) {
+  const CellSettings& s = c.cell->typed;
+  SolveOutcome out;
+  if (s.identification.solver == IdentificationOptions::Solver::kCeres) {
+    const IdentificationSummary summary = Identify(*c.model, ws->data, s.identification);
+    out.termination = summary.termination;
+    out.iterations = summary.iterations;
+    out.final_cost = summary.final_cost;
+    ws->e = summary.delta;
+    return out;
+  }
+  ws->weights.assign(ws->data.repetitions.begin(), ws->data.repetitions.end());
+  const LevenbergMarquardt::Result r = ws->solver.Solve(
+      *c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(), s.identification,
+      &ws->e, cell_design ? &c.design_nominal : nullptr);
+  out.termination = r.termination;
+  out.iterations = r.iterations;
+  out.final_cost = r.final_cost;
+  return out;
+}
+
+TrialStatus StatusOf(Termination t) {
+  switch (t) {
+    case Termination::kConverged: return TrialStatus::kOk;
+    case Termination::kRankDeficient: return TrialStatus::kRankDeficient;
+    case Termination::kMaxIterations: return TrialStatus::kNotConverged;
+    case Termination::kBeamMissed: return TrialStatus::kBeamMissed;
+    default: return TrialStatus::kNumericalFailure;
+  }
+}
+
+void FillDetails(const CellContext& c, const TrialTruth& truth, const Eigen::VectorXd& identified,
+                 const TrialWorkspace& ws, TrialDetails* details) {
+  const Eigen::VectorXd& nominal = c.robot->nominal_values();
+  const ConfigurationSet& configs = ws.data.configs;
+  std::vector<double> h_nominal, h_identified;
+  std::vector<BeamMiss> unused;
+  ExactReadings(*c.robot, nominal, c.plane, c.ranger, configs, &h_nominal, &unused);
+  ExactReadings(*c.robot, identified, c.model->PlaneAt(ws.e.data()), c.ranger, configs,
+                &h_identified, &unused);
+  details->distance_error_nominal.clear();
+  details->distance_error_identified.clear();
+  for (int i = 0; i < ws.data.size(); ++i) {
+    details->distance_error_nominal.push_back(ws.data.mean_h[i] - h_nominal[i]);
+    details->distance_error_identified.push_back(ws.data.mean_h[i] - h_identified[i]);
+  }
+  details->measurement_nominal = ComparePoses(*c.robot, truth.values, nominal, configs);
+  details->measurement_identified = ComparePoses(*c.robot, truth.values, identified, configs);
+  details->validation_nominal = ComparePoses(*c.robot, truth.values, nominal, c.validation);
+  details->validation_identified = ComparePoses(*c.robot, truth.values, identified, c.validation);
+}
+
+}  // namespace
+
+std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
+  auto c = std::make_unique<CellContext>();
+  c->cell = &cell;
+  c->seed = study.seed;
+  const CellSettings& s = cell.typed;
+  try {
+    LoadRig(s, c.get());
+    BuildParameterSet(s, c.get());
+    DrawCellConfigurations(study, s, c.get());
+    CheckIdentifiability(s, c.get());
+    c->parameter_names = c->model->parameters().names;
+    SelectCellDesign(s, c.get());
+    CacheTruth(s, c.get());
+  } catch (const InputError& e) {
+    throw InputError(study.path + " cell '" + cell.label + "' (" + cell.id + ")", e.what());
+  }
+  return c;
+}
+
+TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
+                     TrialDetails* details) {
+  const auto start = std::chrono::steady_clock::now();
+  const CellSettings& s = c.cell->typed;
+  TrialRecord rec;
+  rec.cell_id = c.cell->id;
+  rec.trial = trial;
+  rec.sigma_min = c.design.sigma_min;
+  auto finish = [&](TrialStatus status) {
+    rec.status = status;
+    rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return rec;
+  };
+  const TrialTruth truth = s.truth_random ? DrawTruth(c, trial) : c.fixed_truth;
+  rec.nominal = Flatten(
+      s.truth_random
+          ? ComparePoses(*c.robot, truth.values, c.robot->nominal_values(), c.validation).stats
+          : c.nominal_validation);
+  if (c.rank_deficient) return finish(TrialStatus::kRankDeficient);
+
+  TrialDesign redrawn;
+  const TrialDesign* design = nullptr;
+  if (!DesignOfTrial(c, trial, truth, &redrawn, &design)) return finish(TrialStatus::kBeamMissed);
+  rec.sigma_min = design->sigma_min;
+  if (SimulateTrialReadings(c, trial, truth, *design, ws) > 0)
+    return finish(TrialStatus::kBeamMissed);
+
+  const SolveOutcome r = IdentifyTrial(c, design == &c.design, ws);
+  rec.iterations = r.iterations;
+  const int m = ws->data.size(), n = c.model->num_parameters();
+  rec.residual_rms = std::sqrt(2 * r.final_cost / (m * s.repetitions));  // per-config mean
+  rec.sigma_hat = m > n ? std::sqrt(2 * r.final_cost / (m - n)) : 0.0;
+  if (StatusOf(r.termination) != TrialStatus::kOk) return finish(StatusOf(r.termination));
+
+  rec.errors.resize(n);
+  for (int k = 0; k < n; ++k) rec.errors[k] = ws->e[k] - truth.delta[k];
+  const Eigen::VectorXd identified = c.model->LinkValues(ws->e.data());
+  rec.validation = Flatten(
+      (s.truth_random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
+                      : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation))
+          .stats);
+  if (details) FillDetails(c, truth, identified, *ws, details);
+  return finish(TrialStatus::kOk);
+}
+
+}  // namespace lrcal

@@ -1,0 +1,96 @@
+// One Monte-Carlo trial: a pure function of (cell settings, study seed, trial index), computed as
+// a pipeline of small named steps (trial.cc).
+//
+// Per cell, once (PrepareCell → CellContext): load the rig (robot, plane, ranger); build the
+// parameter set; draw the candidate pool and the validation set; check identifiability on the
+// pool (and fix the suggested parameters if the cell says so); select the design and take its
+// σ_min; predict the covariance σ²·(GᵀWG)⁻¹ at the nominal model (the bound the Monte-Carlo
+// spread is compared with); cache the nominal linearisation and, for a fixed truth, the true
+// readings and poses.
+//
+// Per trial (RunTrial): the truth of the trial; its design (redrawn if the cell says so); the
+// noisy readings; the identification (lrcal's Levenberg–Marquardt, or Ceres if the cell says
+// so); the record: parameter errors (estimate − truth) and the validation errors of the
+// identified and of the nominal model.
+//
+// Random streams (core/random.h): pool and validation draws are keyed by a hash of the settings
+// they depend on, so cells that share those settings share the configurations; noise and truth
+// are keyed by the trial index only (common random numbers across cells).
+//
+// Private to src/: the runner, `lrcal report` and `lrcal plan` use it; tests and benchmarks too.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "identification/levenberg_marquardt.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/kinematics/pose_errors.h"
+#include "lrcal/study/study.h"
+#include "lrcal/study/trial.h"
+
+namespace lrcal {
+
+/// The truth of one trial.
+struct TrialTruth {
+  Eigen::VectorXd errors;  ///< errors of the 5N link values (SI)
+  Eigen::VectorXd values;  ///< nominal + errors
+  Eigen::VectorXd delta;   ///< the errors in the estimate layout (robot deltas; plane terms 0)
+};
+
+/// A design: configurations and their slots in the pool (which address the noise).
+struct TrialDesign {
+  ConfigurationSet configs;
+  std::vector<int> slots;
+  double sigma_min = 0;  ///< σ_min of the design's G (SI)
+};
+
+/// Per-cell prepared data, read-only and shared by all threads.
+struct CellContext {
+  const Cell* cell = nullptr;
+  std::uint64_t seed = 0;
+  std::shared_ptr<const RobotModel> robot;
+  Plane plane;
+  RangerSpec ranger;                        ///< the robot file's ranger limits
+  std::unique_ptr<MeasurementModel> model;  ///< the (possibly reduced) parameter set
+  std::vector<std::string> fixed_for_rank;  ///< parameters fixed because of rank deficiency
+  bool rank_deficient = false;              ///< and not fixed: every trial fails
+  std::string rank_message;
+  std::uint64_t pool_stream = 0, validation_stream = 0;
+  ConfigurationSet pool;  ///< the cell's pool (a trial may redraw its own)
+  SamplingReport pool_report;
+  TrialDesign design;     ///< the cell's selected design
+  LevenbergMarquardt::Nominal design_nominal;  ///< h and G of the nominal model on the design
+  Eigen::MatrixXd pool_design_G;  ///< scaled G of the pool (selection redrawn per trial)
+  std::vector<double> pool_true_h;  ///< exact true readings on the pool (fixed truth)
+  std::vector<BeamMiss> pool_true_miss;
+  std::vector<double> design_true_h;  ///< exact true readings on the design (fixed truth)
+  std::vector<BeamMiss> design_true_miss;
+  std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
+  ConfigurationSet validation;  ///< shared by every trial of the cell
+  Eigen::VectorXd predicted_std;  ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
+  TrialTruth fixed_truth;         ///< when the truth is fixed (robot file × scale)
+  PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
+  std::vector<std::string> parameter_names;
+};
+
+/// Builds the context of a cell. Throws InputError (naming the study and the cell) when the cell
+/// cannot run at all: no pool can be sampled, fewer configurations than parameters, ...
+std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell);
+
+/// Per-thread scratch space: reused by every trial the thread runs.
+struct TrialWorkspace {
+  LevenbergMarquardt solver;
+  MeasurementSet data;
+  Eigen::VectorXd e;
+  std::vector<double> weights;
+  std::vector<double> exact_h;
+  std::vector<BeamMiss> exact_miss;
+};
+
+TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace,
+                     TrialDetails* details = nullptr);
+
+}  // namespace lrcal

@@ -1,0 +1,290 @@
+#include "lrcal/study/trial_store.h"
+
+#include "study/trial_pipeline.h"
+
+#include <sqlite3.h>
+
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace lrcal {
+
+const char* const TrialStore::kMetricColumns[12] = {
+    "rms_pos_x", "rms_pos_y", "rms_pos_z", "rms_ori_x", "rms_ori_y", "rms_ori_z",
+    "max_pos_x", "max_pos_y", "max_pos_z", "max_ori_x", "max_ori_y", "max_ori_z"};
+
+namespace {
+
+class Statement {
+ public:
+  Statement(sqlite3* db, const std::string& sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
+      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db) + " in: " + sql);
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  sqlite3_stmt* get() { return stmt_; }
+  bool Step() {
+    int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db_));
+  }
+  void Reset() {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
+  void Text(int i, const std::string& s) {
+    sqlite3_bind_text(stmt_, i, s.c_str(), static_cast<int>(s.size()), SQLITE_TRANSIENT);
+  }
+  std::string ColumnText(int i) {
+    const unsigned char* t = sqlite3_column_text(stmt_, i);
+    return t ? reinterpret_cast<const char*>(t) : "";
+  }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+constexpr const char* kCellColumns =
+    "cell_id, ord, label, settings, parameter_names, predicted_std, design_sigma_min, "
+    "fixed_for_rank, pool_report, truth_errors";
+
+std::string TrialColumns() {
+  std::string cols =
+      "cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min";
+  for (const char* prefix : {"val_", "nom_"})
+    for (const char* m : TrialStore::kMetricColumns) cols += std::string(", ") + prefix + m;
+  return cols + ", errors, seconds";
+}
+
+}  // namespace
+
+TrialStore::TrialStore(const std::string& path) : path_(path) {
+  // One connection per TrialStore, used by one thread at a time: no per-call mutex.
+  if (sqlite3_open_v2(path.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+                      nullptr) != SQLITE_OK) {
+    std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw std::runtime_error("cannot open trial store " + path + ": " + msg);
+  }
+  sqlite3_busy_timeout(db_, 10000);
+  Exec("PRAGMA journal_mode=WAL");
+  Exec("PRAGMA synchronous=NORMAL");
+  Exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
+  Exec("CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
+       "settings TEXT, parameter_names TEXT, predicted_std TEXT, design_sigma_min REAL, "
+       "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT)");
+  // Stores written before lrcal recorded the truth: add the column (the tables then leave out
+  // what needs the truth rather than re-reading a robot file that may have changed).
+  bool has_truth = false;
+  {
+    Statement info(db_, "PRAGMA table_info(cells)");
+    while (info.Step()) has_truth |= info.ColumnText(1) == "truth_errors";
+  }
+  if (!has_truth) Exec("ALTER TABLE cells ADD COLUMN truth_errors TEXT");
+  std::string trials =
+      "CREATE TABLE IF NOT EXISTS trials(cell_id TEXT NOT NULL, trial INTEGER NOT NULL, "
+      "status TEXT NOT NULL, iterations INTEGER, residual_rms REAL, sigma_hat REAL, sigma_min REAL";
+  for (const char* prefix : {"val_", "nom_"})
+    for (const char* m : kMetricColumns) trials += std::string(", ") + prefix + m + " REAL";
+  trials += ", errors BLOB, seconds REAL, PRIMARY KEY(cell_id, trial)) WITHOUT ROWID";
+  Exec(trials);
+}
+
+TrialStore::~TrialStore() { sqlite3_close(db_); }
+
+void TrialStore::Exec(const std::string& sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+    std::string msg = err ? err : "unknown error";
+    sqlite3_free(err);
+    throw std::runtime_error("sqlite (" + path_ + "): " + msg + " in: " + sql);
+  }
+}
+
+StoredCell ToStoredCell(const CellContext& c) {
+  StoredCell s;
+  s.id = c.cell->id;
+  s.label = c.cell->label;
+  s.order = c.cell->order;
+  s.settings = c.cell->settings.dump();
+  s.parameter_names = c.parameter_names;
+  s.predicted_std.assign(c.predicted_std.data(), c.predicted_std.data() + c.predicted_std.size());
+  s.design_sigma_min = c.design.sigma_min;
+  s.fixed_for_rank = c.fixed_for_rank;
+  s.pool_report = c.pool_report.ToString();
+  if (!c.cell->typed.truth_random)
+    s.truth_errors.assign(c.fixed_truth.errors.data(),
+                          c.fixed_truth.errors.data() + c.fixed_truth.errors.size());
+  return s;
+}
+
+void TrialStore::PutCell(const StoredCell& cell) {
+  Statement st(db_,
+               "INSERT OR REPLACE INTO cells(" + std::string(kCellColumns) +
+                   ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  st.Text(1, cell.id);
+  sqlite3_bind_int(st.get(), 2, cell.order);
+  st.Text(3, cell.label);
+  st.Text(4, cell.settings);
+  st.Text(5, nlohmann::json(cell.parameter_names).dump());
+  nlohmann::json sd = nlohmann::json::array();
+  for (double v : cell.predicted_std) sd.push_back(std::isnan(v) ? nlohmann::json() : nlohmann::json(v));
+  st.Text(6, sd.dump());
+  sqlite3_bind_double(st.get(), 7, cell.design_sigma_min);
+  st.Text(8, nlohmann::json(cell.fixed_for_rank).dump());
+  st.Text(9, cell.pool_report);
+  if (cell.truth_errors.empty()) sqlite3_bind_null(st.get(), 10);
+  else st.Text(10, nlohmann::json(cell.truth_errors).dump());
+  st.Step();
+}
+
+std::vector<StoredCell> TrialStore::Cells() const {
+  Statement st(db_, "SELECT " + std::string(kCellColumns) + " FROM cells ORDER BY ord, cell_id");
+  std::vector<StoredCell> out;
+  while (st.Step()) {
+    StoredCell c;
+    c.id = st.ColumnText(0);
+    c.order = sqlite3_column_int(st.get(), 1);
+    c.label = st.ColumnText(2);
+    c.settings = st.ColumnText(3);
+    c.parameter_names = nlohmann::json::parse(st.ColumnText(4)).get<std::vector<std::string>>();
+    for (const auto& v : nlohmann::json::parse(st.ColumnText(5)))
+      c.predicted_std.push_back(v.is_null() ? std::nan("") : v.get<double>());
+    c.design_sigma_min = sqlite3_column_double(st.get(), 6);
+    c.fixed_for_rank = nlohmann::json::parse(st.ColumnText(7)).get<std::vector<std::string>>();
+    c.pool_report = st.ColumnText(8);
+    if (sqlite3_column_type(st.get(), 9) != SQLITE_NULL)
+      c.truth_errors = nlohmann::json::parse(st.ColumnText(9)).get<std::vector<double>>();
+    out.push_back(c);
+  }
+  return out;
+}
+
+void TrialStore::Insert(const std::vector<TrialRecord>& records) {
+  if (records.empty()) return;
+  Exec("BEGIN IMMEDIATE");
+  try {
+    std::string q = "INSERT OR IGNORE INTO trials(" + TrialColumns() + ") VALUES (?";
+    for (int i = 1; i < 7 + 24 + 2; ++i) q += ", ?";
+    q += ")";
+    Statement st(db_, q);
+    for (const TrialRecord& r : records) {
+      st.Reset();
+      st.Text(1, r.cell_id);
+      sqlite3_bind_int64(st.get(), 2, r.trial);
+      st.Text(3, TrialStatusName(r.status));
+      sqlite3_bind_int(st.get(), 4, r.iterations);
+      sqlite3_bind_double(st.get(), 5, r.residual_rms);
+      sqlite3_bind_double(st.get(), 6, r.sigma_hat);
+      sqlite3_bind_double(st.get(), 7, r.sigma_min);
+      const bool ok = r.status == TrialStatus::kOk;
+      for (int k = 0; k < 12; ++k) {
+        if (ok) sqlite3_bind_double(st.get(), 8 + k, r.validation[k]);
+        else sqlite3_bind_null(st.get(), 8 + k);
+        sqlite3_bind_double(st.get(), 20 + k, r.nominal[k]);
+      }
+      if (ok)
+        sqlite3_bind_blob(st.get(), 32, r.errors.data(),
+                          static_cast<int>(r.errors.size() * sizeof(double)), SQLITE_TRANSIENT);
+      else
+        sqlite3_bind_null(st.get(), 32);
+      sqlite3_bind_double(st.get(), 33, r.seconds);
+      st.Step();
+    }
+  } catch (...) {
+    Exec("ROLLBACK");
+    throw;
+  }
+  Exec("COMMIT");
+}
+
+std::vector<long long> TrialStore::DoneTrials(const std::string& cell_id) const {
+  Statement st(db_, "SELECT trial FROM trials WHERE cell_id = ? ORDER BY trial");
+  st.Text(1, cell_id);
+  std::vector<long long> out;
+  while (st.Step()) out.push_back(sqlite3_column_int64(st.get(), 0));
+  return out;
+}
+
+long long TrialStore::CountTrials(const std::string& cell_id) const {
+  Statement st(db_, "SELECT COUNT(*) FROM trials WHERE cell_id = ?");
+  st.Text(1, cell_id);
+  st.Step();
+  return sqlite3_column_int64(st.get(), 0);
+}
+
+namespace {
+TrialStatus StatusFromName(const std::string& s) {
+  TrialStatus status;
+  if (!TryParseName(kTrialStatusNames, s, &status))
+    throw std::runtime_error("trial store: unknown status '" + s + "'");
+  return status;
+}
+}  // namespace
+
+void TrialStore::ForEachTrial(const std::string& cell_id,
+                              const std::function<void(const TrialRecord&)>& visit) const {
+  Statement st(db_, "SELECT " + TrialColumns() + " FROM trials WHERE cell_id = ? ORDER BY trial");
+  st.Text(1, cell_id);
+  TrialRecord r;
+  r.cell_id = cell_id;  // every row has it: no per-row string
+  while (st.Step()) {
+    r.trial = sqlite3_column_int64(st.get(), 1);
+    r.status = StatusFromName(st.ColumnText(2));
+    r.iterations = sqlite3_column_int(st.get(), 3);
+    r.residual_rms = sqlite3_column_double(st.get(), 4);
+    r.sigma_hat = sqlite3_column_double(st.get(), 5);
+    r.sigma_min = sqlite3_column_double(st.get(), 6);
+    for (int k = 0; k < 12; ++k) {
+      r.validation[k] = sqlite3_column_type(st.get(), 7 + k) == SQLITE_NULL
+                            ? std::nan("")
+                            : sqlite3_column_double(st.get(), 7 + k);
+      r.nominal[k] = sqlite3_column_double(st.get(), 19 + k);
+    }
+    const int bytes = sqlite3_column_bytes(st.get(), 31);
+    r.errors.resize(bytes / sizeof(double));
+    if (bytes) std::memcpy(r.errors.data(), sqlite3_column_blob(st.get(), 31), bytes);
+    r.seconds = sqlite3_column_double(st.get(), 32);
+    visit(r);
+  }
+}
+
+void TrialStore::MergeFrom(const std::string& other_path) {
+  { TrialStore upgraded(other_path); }  // opening brings an older store's schema up to date
+  Statement attach(db_, "ATTACH DATABASE ? AS other");
+  attach.Text(1, other_path);
+  attach.Step();
+  try {
+    Exec("BEGIN IMMEDIATE");
+    Exec("INSERT OR IGNORE INTO cells(" + std::string(kCellColumns) + ") SELECT " +
+         kCellColumns + " FROM other.cells");
+    Exec("INSERT OR IGNORE INTO trials SELECT * FROM other.trials");
+    Exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    Exec("DETACH DATABASE other");
+    throw;
+  }
+  Exec("DETACH DATABASE other");
+}
+
+void TrialStore::SetMeta(const std::string& key, const std::string& value) {
+  Statement st(db_, "INSERT OR REPLACE INTO meta VALUES (?, ?)");
+  st.Text(1, key);
+  st.Text(2, value);
+  st.Step();
+}
+
+std::optional<std::string> TrialStore::GetMeta(const std::string& key) const {
+  Statement st(db_, "SELECT value FROM meta WHERE key = ?");
+  st.Text(1, key);
+  if (!st.Step()) return std::nullopt;
+  return st.ColumnText(0);
+}
+
+}  // namespace lrcal

@@ -1,0 +1,204 @@
+#include "lrcal/study/work_source.h"
+
+#include <algorithm>
+
+namespace lrcal {
+
+MissingTrials::MissingTrials(const DoneSet* done, long long trials, int shard_index,
+                             int shard_count)
+    : done_(done),
+      trials_(trials),
+      space_(static_cast<long long>(done->size()) * trials),
+      shard_index_(shard_index),
+      shard_count_(shard_count) {}
+
+bool MissingTrials::Next(TrialId* id) {
+  while (cursor_ < space_) {
+    const int c = static_cast<int>(cursor_ / trials_);
+    const long long t = cursor_ % trials_;
+    ++cursor_;
+    if (t % shard_count_ != shard_index_ || (*done_)[c][t]) continue;
+    ++seen_;
+    *id = {c, t};
+    return true;
+  }
+  return false;
+}
+
+long long MissingTrials::Count() const {
+  long long n = 0;
+  for (const auto& cell : *done_)
+    for (long long t = shard_index_; t < trials_; t += shard_count_) n += !cell[t];
+  return n;
+}
+
+namespace {
+
+// Every P-th missing trial to rank r; max_new_trials limits this process.
+class StaticSchedule : public WorkSource {
+ public:
+  StaticSchedule(MissingTrials missing, int rank, int ranks, long long max_new)
+      : missing_(std::move(missing)), rank_(rank), ranks_(ranks) {
+    const long long count = missing_.Count();
+    share_ = count / ranks + (rank < count % ranks ? 1 : 0);
+    if (max_new > 0) share_ = std::min(share_, max_new);
+  }
+  void Claim(int max, std::vector<TrialId>* out) override {
+    out->clear();
+    std::lock_guard<std::mutex> g(mutex_);
+    TrialId id;
+    while (static_cast<int>(out->size()) < max && claimed_ < share_) {
+      bool found = false;
+      while (missing_.Next(&id))
+        if ((missing_.seen() - 1) % ranks_ == rank_) {
+          found = true;
+          break;
+        }
+      if (!found) break;
+      out->push_back(id);
+      ++claimed_;
+    }
+  }
+  bool Pump(bool, bool workers_done) override { return workers_done; }
+  long long claimed() const override {
+    std::lock_guard<std::mutex> g(mutex_);
+    return claimed_;
+  }
+  bool Exhausted() const override {
+    std::lock_guard<std::mutex> g(mutex_);
+    return claimed_ >= share_;
+  }
+  long long share() const override { return share_; }
+
+ private:
+  mutable std::mutex mutex_;
+  MissingTrials missing_;
+  int rank_, ranks_;
+  long long share_ = 0, claimed_ = 0;
+};
+
+// Rank 0 hands out chunks of kChunk missing trials, numbered in canonical order; each rank's
+// chunks arrive in increasing order, so its cursor only moves forward. Only the main thread
+// talks to other ranks (Pump); workers wait for chunks under the mutex.
+class DynamicSchedule : public WorkSource {
+ public:
+  static constexpr long long kChunk = 64;
+  enum : int { kTagRequest = 1, kTagChunk = 2, kTagDone = 3 };
+
+  DynamicSchedule(MissingTrials missing, Collective* collective, long long max_new)
+      : missing_(std::move(missing)), collective_(collective) {
+    count_ = missing_.Count();
+    num_chunks_ = (count_ + kChunk - 1) / kChunk;
+    share_ = count_;  // bounded by the chunks this rank receives
+    if (max_new > 0) share_ = std::min(share_, max_new);
+  }
+
+  void Claim(int max, std::vector<TrialId>* out) override {
+    out->clear();
+    std::unique_lock<std::mutex> g(mutex_);
+    TrialId id;
+    while (static_cast<int>(out->size()) < max && claimed_ < share_) {
+      if (chunk_left_ == 0) {
+        if (!out->empty()) break;  // hand out what we have; wait for more later
+        chunk_cv_.wait(g, [&] { return !chunks_.empty() || no_more_chunks_; });
+        if (chunks_.empty()) break;
+        const long long first = chunks_.front() * kChunk;
+        chunks_.pop_front();
+        while (missing_.seen() < first && missing_.Next(&id)) {
+        }
+        chunk_left_ = std::min(kChunk, count_ - first);
+      }
+      if (!missing_.Next(&id)) break;
+      --chunk_left_;
+      out->push_back(id);
+      ++claimed_;
+    }
+  }
+
+  bool Pump(bool stopping, bool workers_done) override {
+    const bool root = collective_->rank() == 0;
+    if (root) Serve(stopping);
+    Supply(stopping, root);
+    if (!workers_done) return false;
+    if (!root) {
+      // Tell rank 0 this rank asks for nothing more (unless it was told so already).
+      if (!requested_done_) collective_->Send(0, kTagDone, 0);
+      return true;
+    }
+    return released_ >= collective_->size() - 1;  // rank 0 serves until every rank is released
+  }
+
+  long long claimed() const override {
+    std::lock_guard<std::mutex> g(mutex_);
+    return claimed_;
+  }
+  bool Exhausted() const override {
+    std::lock_guard<std::mutex> g(mutex_);
+    return claimed_ >= share_;
+  }
+  long long share() const override { return share_; }
+
+ private:
+  // Rank 0: answers the other ranks' requests.
+  void Serve(bool stopping) {
+    int from, tag;
+    long long value;
+    while (collective_->TryReceive(&from, &tag, &value)) {
+      if (tag == kTagDone) {
+        ++released_;
+      } else if (tag == kTagRequest) {
+        const long long id = !stopping && next_chunk_ < num_chunks_ ? next_chunk_++ : -1;
+        if (id < 0) ++released_;
+        collective_->Send(from, kTagChunk, id);
+      }
+    }
+  }
+  // Keeps up to two chunks ready for this rank's workers.
+  void Supply(bool stopping, bool root) {
+    std::lock_guard<std::mutex> g(mutex_);
+    if (no_more_chunks_ || chunks_.size() >= 2) return;
+    if (stopping) {
+      no_more_chunks_ = true;
+    } else if (root) {
+      if (next_chunk_ < num_chunks_) chunks_.push_back(next_chunk_++);
+      else no_more_chunks_ = true;
+    } else {
+      collective_->Send(0, kTagRequest, 0);
+      const long long id = collective_->Receive(0, kTagChunk);
+      if (id < 0) {
+        no_more_chunks_ = true;
+        requested_done_ = true;
+      } else {
+        chunks_.push_back(id);
+      }
+    }
+    chunk_cv_.notify_all();
+  }
+
+  mutable std::mutex mutex_;
+  std::condition_variable chunk_cv_;
+  MissingTrials missing_;
+  Collective* collective_;
+  long long count_ = 0, num_chunks_ = 0, share_ = 0, claimed_ = 0;
+  std::deque<long long> chunks_;  // chunk ids received, not started
+  bool no_more_chunks_ = false;
+  long long chunk_left_ = 0;      // trials left in the chunk being handed out
+  // Main thread only.
+  long long next_chunk_ = 0;      // rank 0: the next chunk to hand out
+  int released_ = 0;              // rank 0: ranks told "no more" or that said they stopped
+  bool requested_done_ = false;   // this rank was told "no more"
+};
+
+}  // namespace
+
+std::unique_ptr<WorkSource> MakeStaticSchedule(MissingTrials missing, int rank, int ranks,
+                                               long long max_new_trials) {
+  return std::make_unique<StaticSchedule>(std::move(missing), rank, ranks, max_new_trials);
+}
+
+std::unique_ptr<WorkSource> MakeDynamicSchedule(MissingTrials missing, Collective* collective,
+                                                long long max_new_trials) {
+  return std::make_unique<DynamicSchedule>(std::move(missing), collective, max_new_trials);
+}
+
+}  // namespace lrcal

@@ -1,0 +1,233 @@
+// The lrcal program as a user runs it: JSON outputs, the sample → simulate → identify round
+// trip, and error messages that name the file, line and field with exit code 2.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "lrcal/kinematics/robot_model.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+using Json = nlohmann::json;
+using testing::LrcalBinary;
+using testing::RunCommand;
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::TempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
+  std::string Write(const std::string& name, const std::string& text) const {
+    std::ofstream(Path(name)) << text;
+    return Path(name);
+  }
+  int Run(const std::string& args, std::string* out) const {
+    return RunCommand(LrcalBinary() + " " + args, out);
+  }
+  std::string dir_;
+};
+
+TEST_F(CliTest, KinematicsJsonHasThePoseBeamAndDistance) {
+  // q = 0: tool at (0, 2.2, 0.62), beam +y0: the paper's plane is behind (h < 0 → no reading).
+  // q2 = π/2: tool at (0, 0.12, -1.7), beam -z0: also behind; q = (0,-π/4,...) hits.
+  Write("c.csv", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n0,1.5707963267948966,0,0,0,0\n");
+  std::string out;
+  ASSERT_EQ(Run("kinematics --robot paper --configs " + Path("c.csv") + " --jacobian --format json",
+                &out),
+            0)
+      << out;
+  Json j = Json::parse(out);
+  ASSERT_EQ(j.size(), 2u);
+  EXPECT_NEAR(j[0]["position"][1].get<double>(), 2.2, 1e-12);
+  EXPECT_NEAR(j[0]["position"][2].get<double>(), 0.62, 1e-12);
+  EXPECT_NEAR(j[0]["beam"][1].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(j[0]["rotation"][2][0].get<double>(), -1.0, 1e-12);
+  EXPECT_TRUE(j[0]["h"].is_null());
+  EXPECT_EQ(j[0]["status"], "plane_behind_ranger");
+  EXPECT_EQ(j[0]["jacobian"].size(), 25u);
+  EXPECT_TRUE(j[0]["jacobian"].contains("beta6"));
+}
+
+TEST_F(CliTest, KinematicsDistanceMatchesTheFormula) {
+  Write("c.csv", "q1,q2,q3,q4,q5,q6\n0.3,-0.7,1.1,0.4,-0.9,0.2\n");
+  std::string out;
+  ASSERT_EQ(Run("kinematics --configs " + Path("c.csv") + " --plane 0,0,1,0.5 --format json", &out), 0)
+      << out;
+  Json j = Json::parse(out)[0];
+  // h = -(n·p + f)/(n·b) with n = e_z, f = 0.5.
+  const double pz = j["position"][2], bz = j["beam"][2];
+  const double h = -(pz + 0.5) / bz;
+  if (h > 0.05 && h < 3.0 && std::fabs(bz) > std::cos(70 * M_PI / 180)) {
+    EXPECT_NEAR(j["h"].get<double>(), h, 1e-12);
+  } else {
+    EXPECT_TRUE(j["h"].is_null());
+  }
+}
+
+TEST_F(CliTest, SampleSimulateIdentifyRoundTrip) {
+  std::string out;
+  ASSERT_EQ(Run("sample --robot paper --count 60 --seed 3 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --robot paper --configs " + Path("c.csv") +
+                    " --sigma-mm 0.2 --repetitions 5 --seed 9 --out " + Path("m.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identify --robot paper --data " + Path("m.csv") + " --sigma-mm 0.2 --format json",
+                &out),
+            0)
+      << out;
+  Json j = Json::parse(out);
+  EXPECT_EQ(j["termination"], "converged");
+  EXPECT_EQ(j["rank"], 25);
+  ASSERT_EQ(j["parameters"].size(), 25u);
+  EXPECT_EQ(j["covariance"].size(), 25u);
+  const RobotModel& robot = testing::PaperRobot();
+  for (const auto& p : j["parameters"]) {
+    const double truth = robot.true_errors()[robot.FindValue(p["name"])];
+    // Within 5 predicted standard deviations of the truth.
+    EXPECT_LT(std::fabs(p["delta"].get<double>() - truth), 5 * p["std_given_sigma"].get<double>())
+        << p["name"];
+    EXPECT_NEAR(p["estimate"].get<double>(), p["nominal"].get<double>() + p["delta"].get<double>(),
+                1e-15);
+  }
+  // The residual RMS of means of 5 readings of 0.2 mm is about 0.2/√5·√(35/60) ≈ 0.07 mm.
+  EXPECT_NEAR(j["residual_rms"].get<double>(), 0.068e-3, 0.03e-3);
+}
+
+TEST_F(CliTest, IdentifiabilityFindsThePapersHorizontalPlaneRemark) {
+  std::string out;
+  ASSERT_EQ(Run("sample --robot paper --plane 0,0,1,0.3 --count 80 --seed 2 --out " + Path("c.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identifiability --robot paper --plane 0,0,1,0.3 --configs " + Path("c.csv") +
+                    " --format json",
+                &out),
+            0)
+      << out;
+  Json j = Json::parse(out);
+  EXPECT_EQ(j["n_params"], 25);
+  EXPECT_EQ(j["rank"], 22);
+  std::vector<std::string> u = j["unidentifiable"];
+  std::sort(u.begin(), u.end());
+  EXPECT_EQ(u, (std::vector<std::string>{"a1", "d3", "theta1"}));
+  EXPECT_TRUE(j["dependencies"].empty());
+}
+
+TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0);
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --estimate-plane normal", &out), 3);
+  EXPECT_NE(out.find("--fix"), std::string::npos) << out;
+  EXPECT_NE(out.find("theta1"), std::string::npos) << out;
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --estimate-plane normal --auto-fix --format json",
+                &out),
+            0)
+      << out;
+  EXPECT_EQ(Json::parse(out)["fixed_for_rank"].size(), 1u);
+}
+
+TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
+  std::string out;
+  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E --baseline 200 "
+                "--format json --out " + Path("chosen.csv"),
+                &out),
+            0)
+      << out;
+  Json j = Json::parse(out);
+  EXPECT_EQ(j["selected"].size(), 30u);
+  EXPECT_EQ(j["pool"]["size"], 60);
+  EXPECT_GT(j["pool"]["tried"].get<int>(), 60);  // some candidates were rejected
+  EXPECT_GE(j["score"].get<double>(), j["indices"]["E"]["random_p95"].get<double>());
+  EXPECT_NEAR(j["indices"]["E"]["chosen"].get<double>(), j["score"].get<double>(), 1e-12);
+  // The chosen configurations were written, and the same call chooses the same set.
+  std::string again;
+  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --baseline 200 --format json",
+                &again),
+            0);
+  EXPECT_EQ(Json::parse(again)["selected"], j["selected"]);
+  ASSERT_EQ(Run("identifiability --configs " + Path("chosen.csv") + " --format json", &out), 0) << out;
+  EXPECT_EQ(Json::parse(out)["rank"], 25);
+}
+
+TEST_F(CliTest, PaperIsDeterministicForASeed) {
+  std::string a, b, c;
+  ASSERT_EQ(Run("paper --seed 5 --format json", &a), 0) << a;
+  ASSERT_EQ(Run("paper --seed 5 --format json", &b), 0);
+  ASSERT_EQ(Run("paper --seed 6 --format json", &c), 0);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  Json j = Json::parse(a);
+  ASSERT_EQ(j["cases"].size(), 2u);
+  EXPECT_EQ(j["cases"][1]["selected"].size(), 100u);
+  EXPECT_EQ(j["cases"][0]["termination"], "converged");
+}
+
+struct BadInput {
+  std::string name;
+  std::string file;      // written to bad.csv
+  std::string args;      // {} replaced by the file's path
+  std::string expected;  // substring of the message
+};
+
+class CliErrorTest : public CliTest, public ::testing::WithParamInterface<BadInput> {};
+
+TEST_P(CliErrorTest, ExitsTwoWithAMessageNamingWhere) {
+  const BadInput& p = GetParam();
+  std::string path = Write("bad.csv", p.file);
+  std::string args = p.args;
+  for (std::size_t at; (at = args.find("{}")) != std::string::npos;) args.replace(at, 2, path);
+  std::string out;
+  EXPECT_EQ(Run(args, &out), 2) << out;
+  EXPECT_NE(out.find(p.expected), std::string::npos) << "message was: " << out;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CliErrorTest,
+    ::testing::Values(
+        BadInput{"MissingJointColumn", "q1,q2,q3,q4,q5\n0,0,0,0,0\n", "kinematics --configs {}",
+                 "bad.csv:1 column 'q6': missing"},
+        BadInput{"NonNumericCell", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n0,0,x,0,0,0\n",
+                 "kinematics --configs {}", "bad.csv:3 column 'q3': expected a finite number"},
+        BadInput{"WrongJointCount", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,0,0,0,0\n",
+                 "kinematics --configs {}", "column 'q7': the robot has only 6 joints"},
+        BadInput{"RaggedRow", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0\n", "kinematics --configs {}",
+                 "bad.csv:2: expected 6 cells"},
+        BadInput{"MissingH", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n", "identify --data {}",
+                 "column 'h': missing"},
+        BadInput{"NegativeH", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,-1\n", "identify --data {}",
+                 "bad.csv:2 column 'h'"},
+        BadInput{"UnknownParameter", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "identifiability --configs {} --fix theta9", "--fix: unknown parameter 'theta9'"},
+        BadInput{"FixedValueNotAParameter", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "identifiability --configs {} --fix d2", "'d2' is fixed on this robot already"},
+        BadInput{"ZeroPlaneNormal", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "kinematics --configs {} --plane 0,0,0,1", "--plane: plane normal (nx, ny, nz) is zero"},
+        BadInput{"PlaneNotFourNumbers", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "kinematics --configs {} --plane 0,0,1", "expected four numbers"},
+        BadInput{"UnknownPlaneTerm", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "identifiability --configs {} --estimate-plane tilt", "unknown plane term 'tilt'"},
+        BadInput{"MissingFile", "", "kinematics --configs /nonexistent/c.csv", "cannot open file"},
+        BadInput{"UnknownRobot", "", "kinematics --robot nosuchrobot --configs {}",
+                 "neither a robot file nor a shipped robot name"},
+        BadInput{"UnknownOption", "", "kinematics --colour red", "unrecognised option"},
+        BadInput{"UnknownCommand", "", "calibrate", "unknown command 'calibrate'"},
+        BadInput{"DesignMoreThanThePool", "", "design --generate 30 --select 40",
+                 "cannot select 40 of 30 candidates"},
+        BadInput{"DesignFewerThanParameters", "", "design --generate 30 --select 10",
+                 "need at least as many configurations as parameters"},
+        BadInput{"DesignEmptyPool", "q1,q2,q3,q4,q5,q6\n", "design --pool {} --select 30",
+                 "no configurations (only a header)"},
+        BadInput{"DesignUnknownCriterion", "", "design --generate 30 --select 26 --criterion F",
+                 "unknown criterion 'F'"},
+        BadInput{"DesignPoolAndGenerate", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "design --pool {} --generate 5 --select 26", "give exactly one"}),
+    [](const ::testing::TestParamInfo<BadInput>& info) { return info.param.name; });
+
+}  // namespace
+}  // namespace lrcal

@@ -1,0 +1,224 @@
+// Selection of k of N configurations: criteria against hand-computed values, exhaustive against
+// brute force, greedy and sampled determinism, and bad requests.
+#include "lrcal/design/experiment_design.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "lrcal/core/error.h"
+
+namespace lrcal {
+namespace {
+
+Eigen::MatrixXd RandomMatrix(int rows, int cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n;  // test data only
+  Eigen::MatrixXd G(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) G(i, j) = n(rng);
+  return G;
+}
+
+TEST(DesignCriteria, MatchHandComputedValuesOnADiagonalDesign) {
+  // G = diag(3, 2) stacked with a zero row: σ = (3, 2), m = 3.
+  Eigen::MatrixXd G(3, 2);
+  G << 3, 0, 0, 2, 0, 0;
+  Eigen::MatrixXd A = G.transpose() * G;
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kE), 2.0, 1e-14);
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kD), std::log(36.0), 1e-14);
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kA), -(1.0 / 9 + 1.0 / 4), 1e-14);
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kO1), std::sqrt(6.0) / std::sqrt(3.0), 1e-14);
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kO2), 2.0 / 3.0, 1e-14);
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kO4), 4.0 / 3.0, 1e-14);
+  EXPECT_NEAR(CriterionScore(A, 3, DesignCriterion::kO5), 1.0 / (1.0 / 3 + 1.0 / 2), 1e-14);
+}
+
+TEST(DesignCriteria, EIsTheSmallestSingularValueOfG) {
+  Eigen::MatrixXd G = RandomMatrix(30, 6, 1);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(G);
+  EXPECT_NEAR(CriterionScore(G.transpose() * G, 30, DesignCriterion::kE),
+              svd.singularValues().minCoeff(), 1e-12);
+}
+
+TEST(Selection, ExhaustiveEqualsBruteForce) {
+  const Eigen::MatrixXd G = RandomMatrix(10, 3, 2);
+  RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
+  for (int k : {3, 5, 9}) {
+    SelectionOptions o;
+    o.method = SelectionMethod::kExhaustive;
+    SelectionResult r = SelectConfigurations(G, k, o, stream);
+    // Brute force over bit masks.
+    double best = -1;
+    for (int mask = 0; mask < (1 << 10); ++mask) {
+      if (__builtin_popcount(mask) != k) continue;
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(3, 3);
+      for (int i = 0; i < 10; ++i)
+        if (mask >> i & 1) A += G.row(i).transpose() * G.row(i);
+      best = std::max(best, CriterionScore(A, k, DesignCriterion::kE));
+    }
+    EXPECT_NEAR(r.score, best, 1e-12) << "k = " << k;
+    EXPECT_EQ(static_cast<int>(r.indices.size()), k);
+  }
+}
+
+TEST(Selection, LeaveOneOutTakesNEvaluations) {
+  const Eigen::MatrixXd G = RandomMatrix(101, 25, 3);
+  SelectionOptions o;
+  o.method = SelectionMethod::kExhaustive;
+  SelectionResult r = SelectConfigurations(G, 100, o, RandomStream(1, 0, 0, RandomPurpose::kSelection));
+  EXPECT_EQ(r.evaluations, 101);
+  EXPECT_EQ(r.indices.size(), 100u);
+}
+
+TEST(Selection, GreedyBeatsRandomAndIsDeterministic) {
+  const Eigen::MatrixXd G = RandomMatrix(60, 8, 4);
+  RandomStream stream(7, 0, 0, RandomPurpose::kSelection);
+  SelectionOptions greedy, random;
+  random.method = SelectionMethod::kRandom;
+  SelectionResult a = SelectConfigurations(G, 20, greedy, stream);
+  SelectionResult b = SelectConfigurations(G, 20, greedy, stream);
+  SelectionResult c = SelectConfigurations(G, 20, random, stream);
+  EXPECT_EQ(a.indices, b.indices);
+  EXPECT_GT(a.score, c.score);
+  SelectionOptions sampled;
+  sampled.method = SelectionMethod::kSampled;
+  sampled.samples = 200;
+  SelectionResult d = SelectConfigurations(G, 20, sampled, stream);
+  SelectionResult e = SelectConfigurations(G, 20, sampled, stream);
+  EXPECT_EQ(d.indices, e.indices);
+  EXPECT_GE(d.score, c.score);  // the first sample is the random subset
+}
+
+TEST(RankOneUpdate, SecularEigenvaluesMatchEigen) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::MatrixXd G = RandomMatrix(40, 8, trial + 100);
+    Eigen::MatrixXd A = G.transpose() * G;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+    Eigen::VectorXd g(8);
+    for (int k = 0; k < 8; ++k) g[k] = u(rng);
+    for (double rho : {1.0, -1.0}) {
+      if (rho < 0) g = G.row(trial % 40).transpose();  // a downdate must stay semi-definite
+      Eigen::VectorXd z = eig.eigenvectors().transpose() * g;
+      Eigen::VectorXd mu = RankOneUpdatedEigenvalues(eig.eigenvalues(), z, rho);
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ref(A + rho * g * g.transpose(),
+                                                         Eigen::EigenvaluesOnly);
+      EXPECT_LT((mu - ref.eigenvalues()).cwiseAbs().maxCoeff(), 1e-10 * ref.eigenvalues().maxCoeff())
+          << "rho " << rho;
+    }
+  }
+}
+
+// Backward elimination written the slow way (an eigendecomposition per candidate): the
+// rank-one what-ifs of the library must make the same choices.
+std::vector<int> BruteBackward(const Eigen::MatrixXd& G, int k, DesignCriterion c) {
+  std::vector<int> kept(G.rows());
+  std::iota(kept.begin(), kept.end(), 0);
+  while (static_cast<int>(kept.size()) > k) {
+    double best = -std::numeric_limits<double>::infinity();
+    int best_pos = 0;
+    for (int pos = 0; pos < static_cast<int>(kept.size()); ++pos) {
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+      for (int q = 0; q < static_cast<int>(kept.size()); ++q)
+        if (q != pos) A += G.row(kept[q]).transpose() * G.row(kept[q]);
+      const double score = CriterionScore(A, static_cast<int>(kept.size()) - 1, c);
+      if (score > best) {
+        best = score;
+        best_pos = pos;
+      }
+    }
+    kept.erase(kept.begin() + best_pos);
+  }
+  return kept;
+}
+
+TEST(Selection, BackwardWithRankOneUpdatesMatchesBruteForceForEveryCriterion) {
+  const Eigen::MatrixXd G = RandomMatrix(30, 5, 21);
+  RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
+  for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA,
+                            DesignCriterion::kO1, DesignCriterion::kO2, DesignCriterion::kO4,
+                            DesignCriterion::kO5}) {
+    SelectionOptions o;
+    o.method = SelectionMethod::kBackward;
+    o.criterion = c;
+    EXPECT_EQ(SelectConfigurations(G, 12, o, stream).indices, BruteBackward(G, 12, c))
+        << DesignCriterionName(c);
+  }
+}
+
+TEST(Selection, ExchangeMatchesExhaustiveOnSmallProblemsAndNeverEndsWorse) {
+  RandomStream stream(3, 0, 0, RandomPurpose::kSelection);
+  for (unsigned seed : {31u, 32u, 33u}) {
+    const Eigen::MatrixXd G = RandomMatrix(12, 3, seed);
+    for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA}) {
+      SelectionOptions ex, xc;
+      ex.method = SelectionMethod::kExhaustive;
+      ex.criterion = xc.criterion = c;
+      xc.method = SelectionMethod::kExchange;
+      xc.restarts = 6;
+      const SelectionResult best = SelectConfigurations(G, 5, ex, stream);
+      const SelectionResult got = SelectConfigurations(G, 5, xc, stream);
+      EXPECT_NEAR(got.score, best.score, 1e-12 * std::fabs(best.score))
+          << DesignCriterionName(c) << " seed " << seed;
+      EXPECT_GE(got.score, got.start_score);
+    }
+  }
+}
+
+TEST(Selection, ExchangeImprovesOnBackwardGreedyForThePaperSizedProblem) {
+  const Eigen::MatrixXd G = RandomMatrix(101, 25, 41);
+  RandomStream stream(5, 0, 0, RandomPurpose::kSelection);
+  SelectionOptions backward, exchange;
+  backward.method = SelectionMethod::kBackward;
+  exchange.method = SelectionMethod::kExchange;
+  const SelectionResult b = SelectConfigurations(G, 50, backward, stream);
+  const SelectionResult x = SelectConfigurations(G, 50, exchange, stream);
+  EXPECT_GE(x.start_score, b.score);  // the backward design is one of the starts
+  EXPECT_GE(x.score, b.score);
+  EXPECT_EQ(x.indices, SelectConfigurations(G, 50, exchange, stream).indices);  // deterministic
+}
+
+TEST(Selection, ForwardGreedyIsDeterministicAndBeatsRandom) {
+  const Eigen::MatrixXd G = RandomMatrix(60, 8, 6);
+  RandomStream stream(2, 0, 0, RandomPurpose::kSelection);
+  SelectionOptions forward, random;
+  forward.method = SelectionMethod::kGreedy;
+  random.method = SelectionMethod::kRandom;
+  const SelectionResult a = SelectConfigurations(G, 20, forward, stream);
+  EXPECT_EQ(a.indices, SelectConfigurations(G, 20, forward, stream).indices);
+  EXPECT_EQ(a.indices.size(), 20u);
+  EXPECT_GT(a.score, SelectConfigurations(G, 20, random, stream).score);
+}
+
+TEST(Scaling, UnitColumnsAndExpectedErrors) {
+  Eigen::MatrixXd G(3, 2);
+  G << 3, 0, 4, 1, 0, 0;
+  Eigen::MatrixXd U = ScaleColumns(G, DesignScaling::kUnitColumns);
+  EXPECT_NEAR(U.col(0).norm(), 1.0, 1e-15);
+  EXPECT_NEAR(U.col(1).norm(), 1.0, 1e-15);
+  Eigen::MatrixXd E = ScaleColumns(G, DesignScaling::kExpectedErrors, Eigen::Vector2d(2, 0.5));
+  EXPECT_DOUBLE_EQ(E(1, 0), 8.0);
+  EXPECT_DOUBLE_EQ(E(1, 1), 0.5);
+  EXPECT_TRUE(ScaleColumns(G, DesignScaling::kSI).isApprox(G));
+  EXPECT_THROW(ScaleColumns(G, DesignScaling::kExpectedErrors, Eigen::Vector3d(1, 1, 1)), InputError);
+}
+
+TEST(Selection, BadRequestsAreClearErrors) {
+  const Eigen::MatrixXd G = RandomMatrix(10, 4, 5);
+  RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
+  SelectionOptions o;
+  EXPECT_THROW(SelectConfigurations(G, 11, o, stream), InputError);
+  EXPECT_THROW(SelectConfigurations(G, 3, o, stream), InputError);
+  EXPECT_THROW(SelectConfigurations(Eigen::MatrixXd(0, 4), 1, o, stream), InputError);
+  o.method = SelectionMethod::kExhaustive;
+  EXPECT_THROW(SelectConfigurations(RandomMatrix(101, 25, 1), 50, o, stream), InputError);
+}
+
+}  // namespace
+}  // namespace lrcal

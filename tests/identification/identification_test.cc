@@ -1,0 +1,246 @@
+// Identification recovers the true parameters from noise-free readings (plane known and
+// estimated), the two solvers agree, and rank deficiency is never a "converged" answer.
+#include "identification/levenberg_marquardt.h"
+#include "lrcal/identification/identification.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lrcal/measurement/simulation.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+using testing::PaperRobot;
+
+// Noise-free data: the least-squares minimum is the truth; the solvers stop at rounding level.
+constexpr double kRecoveryTolerance = 1e-9;  // SI (m or rad), the requirement
+// Two solvers on the same noisy problem reach the same minimum to well below its uncertainty.
+constexpr double kSolverAgreement = 1e-9;    // relative to the largest |estimate error|
+
+MeasurementSet Exact(const RobotModel& robot, const Eigen::VectorXd& values, const Plane& plane,
+                     const ConfigurationSet& configs) {
+  MeasurementSet data;
+  data.configs = configs;
+  std::vector<BeamMiss> misses;
+  ExactReadings(robot, values, plane, testing::PaperRig().ranger, configs, &data.mean_h, &misses);
+  data.repetitions.assign(configs.size(), 10);
+  return data;
+}
+
+class RecoveryTest : public ::testing::TestWithParam<IdentificationOptions::Solver> {};
+
+TEST_P(RecoveryTest, RecoversPapersTrueRobotWithPlaneKnown) {
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  MeasurementSet data = Exact(robot, robot.true_values(), testing::PaperPlane(),
+                              testing::PaperHittingConfigurations(100));
+  IdentificationOptions options;
+  options.solver = GetParam();
+  IdentificationSummary s = Identify(model, data, options);
+  ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
+  for (int k = 0; k < model.num_parameters(); ++k)
+    EXPECT_NEAR(s.delta[k], robot.true_errors()[model.parameters().robot_values[k]],
+                kRecoveryTolerance)
+        << s.names[k];
+  EXPECT_LT(s.residual_rms, 1e-12);
+}
+
+TEST_P(RecoveryTest, RecoversRobotAndPlaneWhenPlaneEstimated) {
+  // Plane normal and offset estimated: theta1 and d1 are then confounded with the plane
+  // (identifiability_test.cc), so the truth keeps them at nominal and the set fixes them.
+  const RobotModel& robot = PaperRobot();
+  Eigen::VectorXd truth = robot.true_values();
+  truth[robot.FindValue("theta1")] = robot.nominal_values()[robot.FindValue("theta1")];
+  truth[robot.FindValue("d1")] = robot.nominal_values()[robot.FindValue("d1")];
+  MeasurementModel model(robot, testing::PaperPlane(),
+                         MakeParameterSet(robot, PlaneTerms{true, true}, {"theta1", "d1"}));
+  ASSERT_EQ(model.num_parameters(), 26);
+  // True plane: the nominal one tilted by chart coordinates (0.004, -0.003), offset +2 mm.
+  std::vector<double> e_true(model.num_parameters(), 0.0);
+  e_true[model.parameters().u_index[0]] = 0.004;
+  e_true[model.parameters().u_index[1]] = -0.003;
+  e_true[model.parameters().f_index] = 0.002;
+  const Plane true_plane = model.PlaneAt(e_true.data());
+  MeasurementSet data =
+      Exact(robot, truth, true_plane, testing::PaperHittingConfigurations(100));
+  IdentificationOptions options;
+  options.solver = GetParam();
+  IdentificationSummary s = Identify(model, data, options);
+  ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
+  const ParameterSet& ps = model.parameters();
+  for (int k = 0; k < ps.num_robot(); ++k)
+    EXPECT_NEAR(s.delta[k], truth[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]],
+                kRecoveryTolerance)
+        << s.names[k];
+  EXPECT_NEAR(s.delta[ps.u_index[0]], 0.004, kRecoveryTolerance);
+  EXPECT_NEAR(s.delta[ps.u_index[1]], -0.003, kRecoveryTolerance);
+  EXPECT_NEAR(s.delta[ps.f_index], 0.002, kRecoveryTolerance);
+}
+
+TEST_P(RecoveryTest, RankDeficientSetIsReportedNotConverged) {
+  const RobotModel& robot = PaperRobot();
+  Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
+  MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
+  // Configurations whose beams hit the horizontal plane.
+  ConfigurationSet configs(6);
+  ConfigurationSet pool = testing::PaperHittingConfigurations(400, 9);
+  std::vector<double> h;
+  std::vector<BeamMiss> misses;
+  ExactReadings(robot, robot.true_values(), horizontal, testing::PaperRig().ranger, pool, &h, &misses);
+  for (int i = 0; i < pool.size() && configs.size() < 100; ++i)
+    if (misses[i] == BeamMiss::kNone) configs.Add(pool.q(i));
+  ASSERT_GE(configs.size(), 40);
+  MeasurementSet data = Exact(robot, robot.true_values(), horizontal, configs);
+  IdentificationOptions options;
+  options.solver = GetParam();
+  IdentificationSummary s = Identify(model, data, options);
+  EXPECT_EQ(s.termination, Termination::kRankDeficient);
+  EXPECT_FALSE(s.IsSolutionUsable());
+  EXPECT_NE(s.message.find("theta1"), std::string::npos) << s.message;
+
+  // Asked to fix the dependent parameters, it identifies the 22 others.
+  options.fix_dependent_parameters = true;
+  s = Identify(model, data, options);
+  EXPECT_TRUE(s.IsSolutionUsable()) << s.FullReport();
+  EXPECT_EQ(s.names.size(), 22u);
+  EXPECT_EQ(s.fixed.size(), 3u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Solvers, RecoveryTest,
+                         ::testing::Values(IdentificationOptions::Solver::kLevenbergMarquardt,
+                                           IdentificationOptions::Solver::kCeres),
+                         [](const auto& info) {
+                           return info.param == IdentificationOptions::Solver::kCeres
+                                      ? "Ceres"
+                                      : "LevenbergMarquardt";
+                         });
+
+TEST(Identification, LevenbergMarquardtAgreesWithCeresOnNoisyPaperCases) {
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  for (int m : {50, 100}) {
+    ConfigurationSet configs = testing::PaperHittingConfigurations(m, 21);
+    MeasurementSet data;
+    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
+                     RandomStream(42, 0, 0, RandomPurpose::kNoise), &data);
+    IdentificationOptions lm_options, ceres_options;
+    ceres_options.solver = IdentificationOptions::Solver::kCeres;
+    IdentificationSummary a = Identify(model, data, lm_options);
+    IdentificationSummary b = Identify(model, data, ceres_options);
+    ASSERT_TRUE(a.IsSolutionUsable()) << a.FullReport();
+    ASSERT_TRUE(b.IsSolutionUsable()) << b.FullReport();
+    const double scale = a.delta.cwiseAbs().maxCoeff();
+    EXPECT_LT((a.delta - b.delta).cwiseAbs().maxCoeff(), kSolverAgreement * scale)
+        << "m = " << m;
+    // The cost itself is resolvable only to ~1e-12 relative near the minimum (0.1 mm residuals
+    // on 1 m readings), so it is compared at 1e-10.
+    EXPECT_NEAR(a.final_cost, b.final_cost, 1e-10 * a.final_cost);
+  }
+}
+
+TEST(Identification, CachedNominalLinearisationGivesTheSameEstimate) {
+  // The Monte-Carlo cells pass the nominal model's h, G, GᵀG and the first factorisation; the
+  // solver must reach the same minimum as without them.
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  ConfigurationSet configs = testing::PaperHittingConfigurations(100, 8);
+  MeasurementSet data;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
+                   RandomStream(5, 0, 0, RandomPurpose::kNoise), &data);
+  LevenbergMarquardt::Nominal nominal;
+  std::vector<BeamMiss> misses;
+  ExactReadings(robot, robot.nominal_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, &nominal.h, &misses);
+  nominal.G = IdentificationJacobian(model, configs);
+  nominal.Factorize();
+  ASSERT_EQ(nominal.L0.rows(), 25);
+  std::vector<double> w(data.size(), 10.0);
+  LevenbergMarquardt a, b;
+  Eigen::VectorXd ea, eb;
+  auto ra = a.Solve(model, data.configs, data.mean_h.data(), w.data(), {}, &ea, &nominal);
+  auto rb = b.Solve(model, data.configs, data.mean_h.data(), w.data(), {}, &eb);
+  ASSERT_EQ(ra.termination, Termination::kConverged);
+  ASSERT_EQ(rb.termination, Termination::kConverged);
+  EXPECT_LT((ea - eb).cwiseAbs().maxCoeff(), 1e-9 * eb.cwiseAbs().maxCoeff());
+}
+
+TEST(Identification, BareSolverReportsRankDeficiencyLikeTheFullPath) {
+  const RobotModel& robot = PaperRobot();
+  // The paper's own Δe (robot + plane normal) is rank-deficient (theta1 ~ plane_u1).
+  MeasurementModel model(robot, testing::PaperPlane(),
+                         MakeParameterSet(robot, PlaneTerms{true, false}));
+  ConfigurationSet configs = testing::PaperHittingConfigurations(100);
+  MeasurementSet data = Exact(robot, robot.true_values(), testing::PaperPlane(), configs);
+  std::vector<double> w(data.size(), 10.0);
+  LevenbergMarquardt lm;
+  Eigen::VectorXd e;
+  auto r = lm.Solve(model, data.configs, data.mean_h.data(), w.data(), IdentificationOptions{}, &e);
+  EXPECT_EQ(r.termination, Termination::kRankDeficient);
+  EXPECT_EQ(Identify(model, data).termination, Termination::kRankDeficient);
+}
+
+TEST(Identification, CovarianceIsSigmaSquaredTimesInverseNormalMatrix) {
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  ConfigurationSet configs = testing::PaperHittingConfigurations(60, 4);
+  MeasurementSet data;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
+                   RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+  IdentificationOptions options;
+  options.sigma = 0.2e-3;
+  IdentificationSummary s = Identify(model, data, options);
+  ASSERT_TRUE(s.IsSolutionUsable());
+  Eigen::MatrixXd G = IdentificationJacobian(model, data.configs, s.delta.data());
+  Eigen::MatrixXd A = 10.0 * G.transpose() * G;
+  Eigen::MatrixXd expected = options.sigma * options.sigma * A.inverse();
+  EXPECT_LT((s.covariance_given - expected).norm(), 1e-9 * expected.norm());
+  EXPECT_NEAR(s.correlation(3, 3), 1.0, 1e-12);
+  // σ̂ estimates the per-reading σ (60 − 25 = 35 degrees of freedom: within ±40 %).
+  EXPECT_NEAR(s.sigma_hat, 0.2e-3, 0.08e-3);
+}
+
+TEST(Identification, RobustLossesResistOutlyingReadings) {
+  // Five of 80 mean readings off by 5 mm (a reflection, a wrong target): least squares is pulled
+  // away from the truth, the Huber and Cauchy losses (Ceres, scale 0.2 mm) much less.
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  ConfigurationSet configs = testing::PaperHittingConfigurations(80, 12);
+  MeasurementSet data;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
+                   RandomStream(8, 0, 0, RandomPurpose::kNoise), &data);
+  for (int i : {3, 17, 31, 52, 66}) data.mean_h[i] += 5e-3;
+  auto error = [&](const IdentificationSummary& s) {
+    double worst = 0;
+    for (int k = 0; k < model.num_parameters(); ++k)
+      worst = std::max(worst, std::fabs(s.delta[k] - robot.true_errors()[model.parameters().robot_values[k]]));
+    return worst;
+  };
+  IdentificationOptions plain;
+  const IdentificationSummary a = Identify(model, data, plain);
+  ASSERT_TRUE(a.IsSolutionUsable());
+  for (RobustLoss loss : {RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    IdentificationOptions robust;
+    robust.solver = IdentificationOptions::Solver::kCeres;
+    robust.loss = loss;
+    robust.loss_scale = 0.2e-3;
+    const IdentificationSummary b = Identify(model, data, robust);
+    ASSERT_TRUE(b.IsSolutionUsable()) << b.FullReport();
+    EXPECT_LT(error(b), 0.3 * error(a))
+        << (loss == RobustLoss::kHuber ? "Huber" : "Cauchy") << ": least squares " << error(a)
+        << ", robust " << error(b);
+  }
+}
+
+TEST(Identification, OptionsValidationNamesTheField) {
+  IdentificationOptions o;
+  o.max_iterations = 0;
+  EXPECT_NE(o.Validate().find("max_iterations"), std::string::npos);
+  o = IdentificationOptions{};
+  o.loss = RobustLoss::kHuber;
+  EXPECT_NE(o.Validate().find("Ceres"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lrcal

@@ -1,0 +1,66 @@
+// Robot files: the paper's file, and bad files named by file, line and key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/io/robot_file.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+TEST(RobotFile, PaperFileHasTheTwentyFiveNamedParameters) {
+  const RobotFile& rig = testing::PaperRig();
+  const RobotModel& robot = rig.robot;
+  std::vector<std::string> names;
+  for (int k : robot.parameter_indices()) names.push_back(robot.ValueName(k));
+  const std::vector<std::string> expected = {
+      "theta1", "alpha1", "a1", "d1", "theta2", "alpha2", "a2", "beta2", "theta3",
+      "alpha3", "a3",     "d3", "theta4", "alpha4", "a4", "d4", "theta5", "alpha5",
+      "a5",     "d5",     "theta6", "alpha6", "a6", "d6", "beta6"};
+  EXPECT_EQ(names, expected);
+  // Errors in SI: theta1 -7.23 mrad, a2 1.94 mm, beta6 -3.36 mrad.
+  EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("theta1")], -7.23e-3);
+  EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("a2")], 1.94e-3);
+  EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("beta6")], -3.36e-3);
+  ASSERT_TRUE(rig.plane.has_value());
+  EXPECT_NEAR(rig.plane->normal.norm(), 1.0, 1e-15);
+  EXPECT_NEAR(rig.plane->offset, -0.69 / std::sqrt(1 + 4.6 * 4.6), 1e-15);
+}
+
+TEST(RobotFile, BadFilesNameFileLineAndKey) {
+  std::string dir = testing::TempDir("robot_bad");
+  auto write = [&](const std::string& text) {
+    std::string path = dir + "/r.yaml";
+    std::ofstream(path) << text;
+    return path;
+  };
+  auto message = [&](const std::string& text) {
+    try {
+      LoadRobotFile(write(text));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: x, d: 0, parameters: [theta]}\n")
+                .find("r.yaml:2 key 'links[0].a'"),
+            std::string::npos);
+  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [gamma]}\n")
+                .find("unknown parameter 'gamma'"),
+            std::string::npos);
+  EXPECT_NE(message("linkz: []\n").find("unknown key"), std::string::npos);
+  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [theta]}\n"
+                    "true_errors:\n  links:\n    - {d: 1}\n")
+                .find("not a parameter"),
+            std::string::npos);
+  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [theta]}\n"
+                    "plane: {normal: [0, 0, 0], offset: 1}\n")
+                .find("zero"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace lrcal

@@ -1,0 +1,72 @@
+// The structure-of-arrays kernel against the per-configuration evaluation, for every choice of
+// plane terms and for a prismatic joint.
+#include "measurement/batch_evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+// Same formulas, different order of operations: agreement to a few ulps of O(1) values.
+constexpr double kTolerance = 1e-13;
+
+void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs) {
+  const int n = model.num_parameters(), m = configs.size();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> ue(-0.01, 0.01);
+  std::vector<double> e(n);
+  for (double& v : e) v = ue(rng);
+  ModelPoint point;
+  model.Prepare(e.data(), &point);
+  BatchEvaluator batch;
+  batch.SetConfigurations(configs);
+  std::vector<double> h(m), J(static_cast<std::size_t>(m) * n), h_only(m);
+  batch.Evaluate(model, point, h.data(), J.data());
+  batch.Evaluate(model, point, h_only.data(), nullptr);
+  std::vector<double> row(n);
+  for (int i = 0; i < m; ++i) {
+    double hi;
+    model.Evaluate(point, configs, i, &hi, row.data());
+    EXPECT_NEAR(h[i], hi, kTolerance);
+    EXPECT_EQ(h[i], h_only[i]);
+    for (int k = 0; k < n; ++k)
+      EXPECT_NEAR(J[static_cast<std::size_t>(k) * m + i], row[k], kTolerance)
+          << model.parameters().names[k] << " at configuration " << i;
+  }
+}
+
+TEST(BatchEvaluator, MatchesPerConfigurationEvaluationForEveryPlaneTerm) {
+  const RobotModel& robot = testing::PaperRobot();
+  const ConfigurationSet configs = testing::PaperHittingConfigurations(37);
+  for (PlaneTerms terms : {PlaneTerms{false, false}, PlaneTerms{true, false},
+                           PlaneTerms{false, true}, PlaneTerms{true, true}}) {
+    MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, terms));
+    ExpectSame(model, configs);
+  }
+}
+
+TEST(BatchEvaluator, MatchesWithAPrismaticJoint) {
+  std::vector<Link> links(3);
+  links[0].nominal = {0.1, -1.2, 0.3, 0.5, 0.0};
+  links[1].joint = JointType::kPrismatic;
+  links[1].nominal = {0.4, 0.7, 0.2, 0.1, 0.05};
+  links[1].q_min = 0;
+  links[1].q_max = 1;
+  links[2].nominal = {-0.3, 0.0, 0.4, 0.2, 0.02};
+  for (auto& l : links) l.is_parameter = {true, true, true, true, true};
+  RobotModel robot("three", links, Eigen::VectorXd());
+  MeasurementModel model(robot, Plane::FromCoefficients(0.1, 0.2, 1.0, 2.0),
+                         MakeParameterSet(robot, PlaneTerms{true, true}));
+  ConfigurationSet configs(3);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 20; ++i) configs.Add(std::vector<double>{u(rng), 0.5 + 0.4 * u(rng), u(rng)});
+  ExpectSame(model, configs);
+}
+
+}  // namespace
+}  // namespace lrcal

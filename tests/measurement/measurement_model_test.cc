@@ -1,0 +1,122 @@
+// The analytic identification Jacobian against Ceres autodiff (through the independent
+// reference kinematics) and against central differences, for every choice of plane terms.
+#include "lrcal/measurement/measurement_model.h"
+
+#include <ceres/jet.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+// Autodiff and the analytic formulas are both exact up to rounding: entries are O(1) m/rad.
+constexpr double kAutodiffTolerance = 1e-11;
+// Central differences with step 1e-6 have truncation error O(step²·h''') ≈ 1e-12 and rounding
+// error O(eps·h/step) ≈ 1e-10.
+constexpr double kFiniteDifferenceTolerance = 1e-8;
+constexpr int kMaxParams = 28;
+using Jet = ceres::Jet<double, kMaxParams>;
+
+struct Case {
+  PlaneTerms terms;
+  std::vector<std::string> fixed;
+};
+
+class JacobianTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(JacobianTest, AnalyticMatchesAutodiffAndCentralDifferences) {
+  const RobotModel& robot = testing::PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(),
+                         MakeParameterSet(robot, GetParam().terms, GetParam().fixed));
+  const int n = model.num_parameters();
+  ASSERT_LE(n, kMaxParams);
+  ConfigurationSet configs = testing::PaperHittingConfigurations(30, 3);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> ue(-0.01, 0.01);
+  for (int point_index = 0; point_index < 3; ++point_index) {
+    std::vector<double> e(n, 0.0);
+    if (point_index > 0)
+      for (double& v : e) v = ue(rng);  // away from nominal too
+    ModelPoint point;
+    model.Prepare(e.data(), &point);
+    for (int i = 0; i < configs.size(); ++i) {
+      double h = 0;
+      std::vector<double> row(n);
+      model.Evaluate(point, configs, i, &h, row.data());
+
+      // Value: fast path against templated reference.
+      EXPECT_NEAR(h, model.Distance<double>(e.data(), configs.q(i)), 1e-12);
+
+      // Ceres Jets through the reference kinematics.
+      std::vector<Jet> ej(n);
+      for (int k = 0; k < n; ++k) ej[k] = Jet(e[k], k);
+      Jet hj = model.Distance<Jet>(ej.data(), configs.q(i));
+      EXPECT_NEAR(hj.a, h, 1e-12);
+      for (int k = 0; k < n; ++k)
+        EXPECT_NEAR(row[k], hj.v[k], kAutodiffTolerance)
+            << "d h / d " << model.parameters().names[k] << " at configuration " << i;
+
+      // Central differences.
+      const double step = 1e-6;
+      for (int k = 0; k < n; ++k) {
+        std::vector<double> ep = e, em = e;
+        ep[k] += step;
+        em[k] -= step;
+        double fd = (model.Distance<double>(ep.data(), configs.q(i)) -
+                     model.Distance<double>(em.data(), configs.q(i))) /
+                    (2 * step);
+        EXPECT_NEAR(row[k], fd, kFiniteDifferenceTolerance)
+            << "d h / d " << model.parameters().names[k];
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(PlaneTerms, JacobianTest,
+                         ::testing::Values(Case{PlaneTerms{false, false}, {}},
+                                           Case{PlaneTerms{true, false}, {}},
+                                           Case{PlaneTerms{false, true}, {}},
+                                           Case{PlaneTerms{true, true}, {}},
+                                           Case{PlaneTerms{true, true}, {"plane_u1", "d1"}}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           std::string name = info.param.terms.normal ? "Normal" : "";
+                           name += info.param.terms.offset ? "Offset" : "";
+                           if (name.empty()) name = "PlaneKnown";
+                           if (!info.param.fixed.empty()) name += "SomeFixed";
+                           return name;
+                         });
+
+TEST(NormalChart, RegularAtThePapersPlaneAndEverywhere) {
+  // The paper's plane has n_x = 0; the chart's Jacobian must still have full rank 2 there and
+  // at the coordinate axes, and n(u) must be a unit vector.
+  for (Eigen::Vector3d n0 : {Eigen::Vector3d(0, 1, 4.6).normalized(), Eigen::Vector3d(1, 0, 0),
+                             Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(1, 1, 1).normalized()}) {
+    NormalChart chart(n0);
+    Eigen::Vector3d n;
+    Eigen::Matrix<double, 3, 2> J;
+    chart.NormalAndJacobian(0, 0, &n, &J);
+    EXPECT_LT((n - n0).norm(), 1e-15);
+    EXPECT_NEAR(J.col(0).norm(), 1.0, 1e-15);
+    EXPECT_NEAR(J.col(1).norm(), 1.0, 1e-15);
+    EXPECT_NEAR(J.col(0).dot(J.col(1)), 0.0, 1e-15);
+    EXPECT_NEAR(J.col(0).dot(n0), 0.0, 1e-15);
+    chart.NormalAndJacobian(0.3, -0.2, &n, &J);
+    EXPECT_NEAR(n.norm(), 1.0, 1e-15);
+  }
+}
+
+TEST(ClassifyReading, ReportsEveryMissReason) {
+  RangerSpec ranger;  // 0.05 .. 3 m, 70°
+  EXPECT_EQ(ClassifyReading(1.0, -0.9, ranger), BeamMiss::kNone);
+  EXPECT_EQ(ClassifyReading(1.0, 0.0, ranger), BeamMiss::kParallel);
+  EXPECT_EQ(ClassifyReading(-1.0, 0.9, ranger), BeamMiss::kBehind);
+  EXPECT_EQ(ClassifyReading(5.0, 0.9, ranger), BeamMiss::kOutOfRange);
+  EXPECT_EQ(ClassifyReading(0.01, 0.9, ranger), BeamMiss::kOutOfRange);
+  EXPECT_EQ(ClassifyReading(1.0, 0.2, ranger), BeamMiss::kGrazing);
+}
+
+}  // namespace
+}  // namespace lrcal

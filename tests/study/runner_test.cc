@@ -1,0 +1,421 @@
+// The Monte-Carlo engine: bit-identical tables whatever the threads, shards, interruptions and
+// restarts; resume and refusal rules; bad study files; and statistics that match the
+// linear-Gaussian theory.
+#include "lrcal/report/run_tables.h"
+#include "lrcal/study/run_directory.h"
+#include "lrcal/study/runner.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "lrcal/core/error.h"
+#include "lrcal/study/statistics.h"
+#include "lrcal/study/trial_store.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Every table file of a run directory, by name.
+std::map<std::string, std::string> Tables(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::directory_iterator(fs::path(dir) / "tables"))
+    out[e.path().filename().string()] = ReadFile(e.path());
+  return out;
+}
+
+// A small study: the paper's arm, two designs and two noise levels, few trials.
+std::string SmallStudy(const std::string& dir, int trials, const std::string& extra = "",
+                       const std::string& sigmas = "[0.1, 0.2]", std::uint64_t seed = 11) {
+  const std::string path = dir + "/small.yaml";
+  std::ofstream(path) << "name: small\nseed: " << seed << "\ntrials: " << trials
+                      << "\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
+                      << "\npool: {size: 60}\nvalidation: {size: 10}\n" << extra
+                      << "sweep:\n  axes:\n"
+                         "    - key: selection.count\n      values: [30, 59]\n"
+                         "    - key: noise.sigma_mm\n      values: "
+                      << sigmas << "\n";
+  return path;
+}
+
+RunResult RunSmall(const std::string& study_path, const std::string& out, int threads,
+              int shard_index = 0, int shard_count = 1, long long max_new = 0) {
+  RunOptions o;
+  o.out_dir = out;
+  o.threads = threads;
+  o.shard_index = shard_index;
+  o.shard_count = shard_count;
+  o.progress = false;
+  o.max_new_trials = max_new;
+  o.batch_size = 7;  // several transactions even in small runs
+  return RunStudyAndWriteTables(LoadStudy(study_path), o);
+}
+
+TEST(MonteCarlo, TablesAreBitIdenticalForOneTwoAndFourThreads) {
+  const std::string dir = testing::TempDir("mc_threads");
+  const std::string study = SmallStudy(dir, 40);
+  RunSmall(study, dir + "/t1", 1);
+  RunSmall(study, dir + "/t2", 2);
+  RunSmall(study, dir + "/t4", 4);
+  const auto t1 = Tables(dir + "/t1");
+  EXPECT_GE(t1.size(), 6u);
+  EXPECT_EQ(t1, Tables(dir + "/t2"));
+  EXPECT_EQ(t1, Tables(dir + "/t4"));
+}
+
+TEST(MonteCarlo, TablesAreBitIdenticalWhicheverInstructionSetRuns) {
+  // A machine without AVX-512 (or a shard on another node) runs the default variant of the hot
+  // kernels: the tables must not change.
+  const std::string dir = testing::TempDir("mc_isa");
+  const std::string study = SmallStudy(dir, 30);
+  std::string out;
+  for (const char* isa : {"default", "avx2", "avx512"}) {
+    ASSERT_EQ(testing::RunCommand(std::string("LRCAL_ISA=") + isa + " " + testing::LrcalBinary() +
+                                      " run " + study + " --out " + dir + "/" + isa + " --quiet",
+                                  &out),
+              0)
+        << out;
+  }
+  EXPECT_EQ(Tables(dir + "/default"), Tables(dir + "/avx2"));
+  EXPECT_EQ(Tables(dir + "/default"), Tables(dir + "/avx512"));
+}
+
+TEST(MonteCarlo, ShardsMergedEqualOneRun) {
+  const std::string dir = testing::TempDir("mc_shards");
+  const std::string study = SmallStudy(dir, 30);
+  RunSmall(study, dir + "/single", 2);
+  std::vector<std::string> shards;
+  for (int i = 0; i < 3; ++i) {
+    shards.push_back(dir + "/shard" + std::to_string(i));
+    RunResult r = RunSmall(study, shards.back(), 1, i, 3);
+    EXPECT_FALSE(r.tables_written);  // a shard alone writes no tables
+    EXPECT_EQ(r.total, 4 * 10);
+  }
+  MergeRuns(shards, dir + "/merged");
+  EXPECT_EQ(Tables(dir + "/single"), Tables(dir + "/merged"));
+}
+
+TEST(MonteCarlo, StatusOfShardsNamesTheTasksToResubmit) {
+  const std::string dir = testing::TempDir("mc_status");
+  const std::string study = SmallStudy(dir, 20);
+  RunSmall(study, dir + "/s1", 1, 0, 4);
+  RunSmall(study, dir + "/s2", 1, 1, 4, 7);  // interrupted
+  RunSmall(study, dir + "/s3", 1, 2, 4);     // shard 4 never ran
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + dir + "/s1 " + dir + "/s2 " +
+                                    dir + "/s3",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("unfinished or missing shards: 2,4"), std::string::npos) << out;
+  EXPECT_NE(out.find("sbatch --array=2,4"), std::string::npos) << out;
+}
+
+TEST(MonteCarlo, ResumedInSlicesEqualsUninterrupted) {
+  const std::string dir = testing::TempDir("mc_slices");
+  const std::string study = SmallStudy(dir, 30);
+  RunSmall(study, dir + "/whole", 2);
+  RunResult a = RunSmall(study, dir + "/sliced", 2, 0, 1, 37);
+  EXPECT_TRUE(a.interrupted);
+  EXPECT_EQ(a.computed, 37);
+  RunResult b = RunSmall(study, dir + "/sliced", 1, 0, 1, 50);
+  EXPECT_EQ(b.done_before, 37);
+  EXPECT_EQ(b.computed, 50);
+  RunResult c = RunSmall(study, dir + "/sliced", 2);
+  EXPECT_EQ(c.done_before, 87);
+  EXPECT_EQ(c.computed, 120 - 87);
+  EXPECT_TRUE(c.tables_written);
+  EXPECT_EQ(Tables(dir + "/whole"), Tables(dir + "/sliced"));
+  // A finished run recomputes nothing.
+  RunResult d = RunSmall(study, dir + "/sliced", 2);
+  EXPECT_EQ(d.computed, 0);
+  EXPECT_EQ(Tables(dir + "/whole"), Tables(dir + "/sliced"));
+}
+
+// Starts `lrcal run` in the background; returns its pid.
+pid_t Spawn(const std::vector<std::string>& args) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    std::string bin = testing::LrcalBinary();
+    argv.push_back(bin.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    freopen("/dev/null", "w", stderr);
+    freopen("/dev/null", "w", stdout);
+    execv(bin.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+long long StoredTrials(const std::string& run_dir) {
+  if (!fs::exists(fs::path(run_dir) / "trials.sqlite")) return 0;
+  try {
+    TrialStore store((fs::path(run_dir) / "trials.sqlite").string());
+    long long n = 0;
+    for (const auto& c : store.Cells()) n += store.CountTrials(c.id);
+    return n;
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
+// Waits until the run has stored some trials (or exited); returns the count seen.
+long long WaitForProgress(pid_t pid, const std::string& run_dir, long long at_least) {
+  for (int i = 0; i < 3000; ++i) {
+    const long long n = StoredTrials(run_dir);
+    if (n >= at_least) return n;
+    int status;
+    if (waitpid(pid, &status, WNOHANG) == pid) return -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return StoredTrials(run_dir);
+}
+
+TEST(MonteCarlo, KilledProcessResumesToTheSameTables) {
+  const std::string dir = testing::TempDir("mc_kill");
+  const std::string study = SmallStudy(dir, 4000);  // 16,000 trials: about a second on one thread
+  const std::string killed = dir + "/killed";
+  pid_t pid = Spawn({"run", study, "--out", killed, "--threads", "1"});
+  const long long seen = WaitForProgress(pid, killed, 100);
+  ASSERT_GT(seen, 0) << "the run ended before it could be killed";
+  kill(pid, SIGKILL);
+  int status;
+  waitpid(pid, &status, 0);
+  const long long stored = StoredTrials(killed);
+  EXPECT_LT(stored, 16000) << "the run finished before the kill: the test proved nothing";
+  // Resume, then compare with an uninterrupted run.
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + killed +
+                                    " --threads 2 --quiet",
+                                &out),
+            0)
+      << out;
+  RunSmall(study, dir + "/whole", 2);
+  EXPECT_EQ(Tables(dir + "/whole"), Tables(killed));
+  const std::string manifest = ReadFile(fs::path(killed) / "manifest.json");
+  EXPECT_NE(manifest.find("\"running\""), std::string::npos);  // the killed session's entry
+  EXPECT_NE(manifest.find("\"completed\""), std::string::npos);
+}
+
+TEST(MonteCarlo, SigintStopsCleanlyAndResumes) {
+  const std::string dir = testing::TempDir("mc_sigint");
+  const std::string study = SmallStudy(dir, 4000);
+  const std::string run = dir + "/run";
+  pid_t pid = Spawn({"run", study, "--out", run, "--threads", "1"});
+  ASSERT_GT(WaitForProgress(pid, run, 50), 0);
+  kill(pid, SIGINT);
+  int status;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);  // interrupted, everything in flight flushed
+  const std::string manifest = ReadFile(fs::path(run) / "manifest.json");
+  EXPECT_NE(manifest.find("\"interrupted\""), std::string::npos);
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + run, &out), 0);
+  EXPECT_NE(out.find("remaining"), std::string::npos) << out;
+  EXPECT_NE(out.find("to finish: lrcal run"), std::string::npos) << out;
+}
+
+TEST(MonteCarlo, SecondProcessOnTheSameDirectoryIsRefused) {
+  const std::string dir = testing::TempDir("mc_lock");
+  const std::string study = SmallStudy(dir, 4000);
+  const std::string run = dir + "/run";
+  pid_t pid = Spawn({"run", study, "--out", run, "--threads", "1"});
+  ASSERT_GT(WaitForProgress(pid, run, 1), 0);
+  std::string out;
+  EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + run, &out), 2);
+  EXPECT_NE(out.find("another lrcal process is running"), std::string::npos) << out;
+  kill(pid, SIGKILL);
+  int status;
+  waitpid(pid, &status, 0);
+}
+
+TEST(MonteCarlo, ChangedStudyIsRefusedWithWhatChanged) {
+  const std::string dir = testing::TempDir("mc_changed");
+  RunSmall(SmallStudy(dir, 10), dir + "/run", 2, 0, 1, 5);
+  try {
+    RunSmall(SmallStudy(dir, 10, "noise: {repetitions: 5}\n"), dir + "/run", 2);
+    FAIL() << "a changed study was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("base.noise.repetitions: 10 -> 5"), std::string::npos)
+        << e.what();
+  }
+  try {
+    RunSmall(SmallStudy(dir, 10, "", "[0.1, 0.2]", 12), dir + "/run", 2);
+    FAIL() << "a changed seed was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("seed: 11 -> 12"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MonteCarlo, AddingASweepValueKeepsExistingCells) {
+  const std::string dir = testing::TempDir("mc_add");
+  const std::string run = dir + "/run";
+  RunResult a = RunSmall(SmallStudy(dir, 10), run, 2);
+  EXPECT_EQ(a.computed, 40);
+  const Study before = LoadStudy(SmallStudy(dir, 10));
+  RunResult b = RunSmall(SmallStudy(dir, 10, "", "[0.1, 0.2, 0.4]"), run, 2);
+  EXPECT_EQ(b.done_before, 40);
+  EXPECT_EQ(b.computed, 20);  // only the two new cells
+  const Study after = LoadStudy(SmallStudy(dir, 10, "", "[0.1, 0.2, 0.4]"));
+  for (const Cell& c : before.cells) {
+    bool found = false;
+    for (const Cell& d : after.cells) found |= d.id == c.id;
+    EXPECT_TRUE(found) << c.label;
+  }
+}
+
+TEST(MonteCarlo, SelectionRedrawnPerTrialVariesTheDesign) {
+  // selection.redraw: a random design per trial (the baseline of studies/design.yaml); a fixed
+  // selection gives one design (one σ_min) for the whole cell.
+  const std::string dir = testing::TempDir("mc_redraw");
+  const std::string path = dir + "/redraw.yaml";
+  std::ofstream(path) << "name: redraw\nseed: 4\ntrials: 12\nrobot: "
+                      << testing::SourcePath("studies/robots/paper.yaml")
+                      << "\npool: {size: 60}\nvalidation: {size: 5}\n"
+                         "sweep:\n  axes:\n    - key: selection\n      values:\n"
+                         "        - {count: 30, method: random, redraw: true}\n"
+                         "        - {count: 30, method: exchange, scaling: unit, criterion: A}\n";
+  // A pool redrawn every trial: every trial has its own candidates, hence its own design.
+  const std::string pool_path = dir + "/pool.yaml";
+  std::ofstream(pool_path) << "name: pool\nseed: 4\ntrials: 8\nrobot: "
+                           << testing::SourcePath("studies/robots/paper.yaml")
+                           << "\npool: {size: 40, redraw: true}\nselection: {count: 30}\n"
+                              "validation: {size: 5}\n";
+  RunSmall(pool_path, dir + "/pool_run", 2);
+  {
+    TrialStore pool_store(dir + "/pool_run/trials.sqlite");
+    std::set<double> pool_sigma;
+    pool_store.ForEachTrial(pool_store.Cells()[0].id, [&](const TrialRecord& r) {
+      EXPECT_EQ(r.status, TrialStatus::kOk);
+      pool_sigma.insert(r.sigma_min);
+    });
+    EXPECT_EQ(pool_sigma.size(), 8u) << "a redrawn pool should give every trial its own design";
+  }
+  RunSmall(path, dir + "/run", 2);
+  TrialStore store(dir + "/run/trials.sqlite");
+  const auto cells = store.Cells();
+  ASSERT_EQ(cells.size(), 2u);
+  for (const auto& cell : cells) {
+    std::set<double> sigma_min;
+    long long ok = 0;
+    store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
+      sigma_min.insert(r.sigma_min);
+      ok += r.status == TrialStatus::kOk;
+    });
+    EXPECT_EQ(ok, 12) << cell.label;
+    if (cell.label.find("random") != std::string::npos) {
+      EXPECT_GT(sigma_min.size(), 6u) << "random designs should differ from trial to trial";
+    } else {
+      EXPECT_EQ(sigma_min.size(), 1u);
+    }
+  }
+}
+
+struct BadStudy {
+  std::string name, text, expected;
+};
+class BadStudyTest : public ::testing::TestWithParam<BadStudy> {};
+
+TEST_P(BadStudyTest, FailsBeforeAnythingRunsNamingLineAndKey) {
+  const std::string dir = testing::TempDir("mc_bad_" + GetParam().name);
+  const std::string path = dir + "/bad.yaml";
+  std::ofstream(path) << "name: bad\nseed: 1\ntrials: 5\nrobot: "
+                      << testing::SourcePath("studies/robots/paper.yaml") << "\n"
+                      << GetParam().text;
+  try {
+    RunSmall(path, dir + "/run", 1);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(GetParam().expected), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir + "/run/trials.sqlite"));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadStudyTest,
+    ::testing::Values(
+        BadStudy{"UnknownKey", "noise: {sigma_mm: 0.2, repetition: 3}\n",
+                 "bad.yaml:5 key 'noise.repetition': unknown key"},
+        BadStudy{"WrongType", "noise: {sigma_mm: high}\n", "bad.yaml:5 key 'noise.sigma_mm': expected a number"},
+        BadStudy{"NegativeSigma", "noise: {sigma_mm: -0.2}\n", "key 'noise.sigma_mm': expected a value >= 0"},
+        BadStudy{"MoreSelectedThanCandidates", "pool: {size: 40}\nselection: {count: 50}\n",
+                 "key 'selection.count': cannot select 50 configurations from a pool of 40"},
+        BadStudy{"FewerThanParameters", "selection: {count: 20}\n",
+                 "need at least as many"},
+        BadStudy{"PlaneNeverHit", "plane: {normal: [0, 0, 1], offset: -100}\n",
+                 "could only accept 0 of 101"},
+        BadStudy{"BadSweepValue",
+                 "sweep:\n  axes:\n    - key: noise.sigma_mm\n      values: [0.1, -1]\n",
+                 "sweep value at"},
+        BadStudy{"UnknownSweepKey", "sweep:\n  axes:\n    - key: noise.sigma\n      values: [1]\n",
+                 "'noise.sigma' is not a study setting"},
+        BadStudy{"UnknownMethod", "selection: {method: best}\n", "unknown selection method 'best'"},
+        BadStudy{"UnknownScaling", "selection: {scaling: log}\n", "unknown scaling 'log'"},
+        BadStudy{"ZipOfUnequalAxes",
+                 "sweep:\n  combine: zip\n  axes:\n    - {key: noise.sigma_mm, values: [0.1, 0.2]}\n"
+                 "    - {key: noise.repetitions, values: [1]}\n",
+                 "zip needs axes of equal length"}),
+    [](const ::testing::TestParamInfo<BadStudy>& info) { return info.param.name; });
+
+TEST(Statistics, DescribeAndPercentilesMatchClosedForms) {
+  Distribution d = Describe({4, 1, 3, 2, 5});
+  EXPECT_DOUBLE_EQ(d.mean, 3.0);
+  EXPECT_DOUBLE_EQ(d.std, std::sqrt(2.5));
+  EXPECT_DOUBLE_EQ(d.p50, 3.0);
+  EXPECT_DOUBLE_EQ(d.p5, 1.2);   // numpy.percentile([1..5], 5) = 1.2
+  EXPECT_DOUBLE_EQ(d.p95, 4.8);
+  EXPECT_DOUBLE_EQ(d.max, 5.0);
+  const std::vector<double> s = {1, 2, 2, 3};
+  EXPECT_DOUBLE_EQ(PercentileRank(s, 2), 50.0);
+  EXPECT_DOUBLE_EQ(PercentileRank(s, 0), 0.0);
+  EXPECT_DOUBLE_EQ(PercentileRank(s, 10), 100.0);
+}
+
+TEST(Statistics, SpreadMatchesTheLinearGaussianPredictionAndBiasIsZero) {
+  // With the truth at the nominal model (scale 0) and σ = 0.2 mm the estimator is linear in the
+  // noise to first order: its covariance is σ²(GᵀWG)⁻¹ and its mean the truth. With n = 2000
+  // trials the empirical std / predicted std has relative standard error 1/√(2n) ≈ 1.6 %; every
+  // parameter must be within 4.5 of those (7 %), and every bias within 4.5 Monte-Carlo SE.
+  const std::string dir = testing::TempDir("mc_gauss");
+  const std::string path = dir + "/gauss.yaml";
+  std::ofstream(path) << "name: gauss\nseed: 3\ntrials: 2000\nrobot: "
+                      << testing::SourcePath("studies/robots/paper.yaml")
+                      << "\ntruth: {scale: 0}\npool: {size: 60}\nselection: {count: 60, method: "
+                         "exhaustive}\nvalidation: {size: 5}\n";
+  RunSmall(path, dir + "/run", 2);
+  TrialStore store(dir + "/run/trials.sqlite");
+  const auto cells = store.Cells();
+  ASSERT_EQ(cells.size(), 1u);
+  CellSummary s = SummarizeCell(store, cells[0]);
+  ASSERT_EQ(s.ok, 2000);
+  const double se_ratio = 1.0 / std::sqrt(2.0 * 2000);
+  for (const auto& p : s.parameters) {
+    EXPECT_NEAR(p.ratio, 1.0, 4.5 * se_ratio) << p.name;
+    EXPECT_LT(std::fabs(p.bias), 4.5 * p.bias_se) << p.name;
+  }
+}
+
+}  // namespace
+}  // namespace lrcal

@@ -1,0 +1,67 @@
+#include "test_util.h"
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <unistd.h>
+
+namespace lrcal::testing {
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(LRCAL_SOURCE_DIR) + "/" + relative;
+}
+
+std::string LrcalBinary() { return std::string(LRCAL_BINARY_DIR) + "/lrcal"; }
+
+const RobotFile& PaperRig() {
+  static const RobotFile rig = LoadRobotFile(SourcePath("studies/robots/paper.yaml"));
+  return rig;
+}
+
+const RobotModel& PaperRobot() { return PaperRig().robot; }
+
+const Plane& PaperPlane() { return *PaperRig().plane; }
+
+ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed) {
+  const RobotModel& robot = PaperRobot();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-M_PI, M_PI);
+  ConfigurationSet out(robot.num_links());
+  ModelPoint point;
+  PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
+  while (out.size() < count) {
+    double q[6];
+    for (double& v : q) v = u(rng);
+    ConfigurationSet one(6);
+    one.Add(q);
+    const Pose<double> pose = ToolPose(point, one, 0);
+    double nb;
+    const double h = BeamReading(pose, plane, &nb);
+    if (ClassifyReading(h, nb, PaperRig().ranger) == BeamMiss::kNone) out.Add(q);
+  }
+  return out;
+}
+
+ConfigurationSet PaperHittingConfigurations(int count, unsigned seed) {
+  return HittingConfigurations(PaperPlane(), count, seed);
+}
+
+int RunCommand(const std::string& command, std::string* output) {
+  output->clear();
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buffer;
+  while (fgets(buffer.data(), buffer.size(), pipe)) *output += buffer.data();
+  int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string TempDir(const std::string& name) {
+  namespace fs = std::filesystem;
+  fs::path p = fs::temp_directory_path() / ("lrcal_test_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+}  // namespace lrcal::testing

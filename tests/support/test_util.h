@@ -1,0 +1,32 @@
+// Shared helpers for lrcal's tests.
+#pragma once
+
+#include <random>
+#include <string>
+
+#include "lrcal/measurement/measurement_model.h"
+#include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/robot_model.h"
+
+namespace lrcal::testing {
+
+/// Path of a file in the source tree (e.g. "studies/robots/paper.yaml").
+std::string SourcePath(const std::string& relative);
+/// Path of the built lrcal program.
+std::string LrcalBinary();
+/// The paper's robot file (studies/robots/paper.yaml): the arm, its plane and its ranger.
+const RobotFile& PaperRig();
+/// The paper's arm and plane.
+const RobotModel& PaperRobot();
+const Plane& PaperPlane();
+/// `count` configurations of the paper's arm whose nominal beam hits `plane` (a usable reading),
+/// drawn from a fixed std::mt19937 seed (test data only; the library uses counter-based streams).
+ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed = 1);
+/// The same for the paper's own plane.
+ConfigurationSet PaperHittingConfigurations(int count, unsigned seed = 1);
+/// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
+int RunCommand(const std::string& command, std::string* output);
+/// A fresh empty temporary directory for one test.
+std::string TempDir(const std::string& name);
+
+}  // namespace lrcal::testing
