@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "lrcal/identification/identification.h"
+#include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/core/random.h"
 
