@@ -22,6 +22,25 @@ std::string ResolveStudyPath(const std::string& name_or_path) {
   return name_or_path;  // LoadStudy reports "cannot open file"
 }
 
+// The one place the study settings' defaults are written (docs/STUDIES.md shows them; a test
+// checks that it shows these).
+const Json& StudyDefaults() {
+  static const Json d = Json::parse(R"({
+    "robot": "paper",
+    "plane": "robot",
+    "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0},
+    "noise": {"sigma_mm": 0.2, "repetitions": 10},
+    "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
+    "selection": {"count": 50, "method": "backward", "criterion": "E", "samples": 1000,
+                  "scaling": "si", "restarts": 4, "redraw": false},
+    "validation": {"size": 20},
+    "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
+                       "max_iterations": 100, "on_rank_deficient": "fail"},
+    "paper_case": 0
+  })");
+  return d;
+}
+
 namespace {
 
 using LineMap = std::map<std::string, int>;
@@ -64,29 +83,15 @@ Json ToJsonNode(const YAML::Node& node, const std::string& path, LineMap* lines)
   return s;
 }
 
-const Json& Defaults() {
-  static const Json d = Json::parse(R"({
-    "robot": "paper",
-    "plane": "robot",
-    "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0},
-    "noise": {"sigma_mm": 0.2, "repetitions": 10},
-    "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
-    "selection": {"count": 50, "method": "backward", "criterion": "E", "samples": 1000,
-                  "scaling": "si", "restarts": 4, "redraw": false},
-    "validation": {"size": 20},
-    "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
-                       "max_iterations": 100, "on_rank_deficient": "fail"},
-    "paper_case": 0
-  })");
-  return d;
-}
 
 // Where a key path was written: "file:line key 'path'".
 struct KeyLocator {
   std::string file;
   const LineMap* lines;
   std::string context;  // e.g. "sweep value" description
-  std::string operator()(const std::string& path) const {
+  std::string prefix;   // key path of the mapping the given paths are relative to
+  std::string operator()(const std::string& relative) const {
+    const std::string path = Join(prefix, relative);
     int line = 0;
     // The deepest recorded prefix of the path.
     for (std::string p = path; !p.empty(); p = p.substr(0, p.find_last_of(".[") == std::string::npos
@@ -105,33 +110,53 @@ struct KeyLocator {
   }
 };
 
+std::string KeyList(const Json& map) {
+  std::string keys;
+  for (auto d = map.begin(); d != map.end(); ++d) keys += (keys.empty() ? "" : ", ") + d.key();
+  return keys;
+}
+
+// Every key of `given` must be a setting; a section (a mapping in the defaults) must be given as
+// a mapping: `noise:` with nothing after it, or `noise: 5`, is an error, not a silent deletion.
 void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string& path,
                       const KeyLocator& where) {
   if (!given.is_object() || !defaults.is_object()) return;
   for (auto it = given.begin(); it != given.end(); ++it) {
     const std::string p = Join(path, it.key());
-    if (path.empty() && (it.key() == "plane" || it.key() == "robot_file_fnv1a")) continue;  // plane: checked by the typed parser; the hash is ours
-    if (!defaults.contains(it.key())) {
-      std::string keys;
-      for (auto d = defaults.begin(); d != defaults.end(); ++d) keys += (keys.empty() ? "" : ", ") + d.key();
-      throw InputError(where(p), "unknown key; expected one of: " + keys);
-    }
-    CheckUnknownKeys(it.value(), defaults[it.key()], p, where);
+    // plane: checked by the typed parser; the robot file's hash is lrcal's own.
+    if (path.empty() && (it.key() == "plane" || it.key() == "robot_file_fnv1a")) continue;
+    if (!defaults.contains(it.key()))
+      throw InputError(where(p), "unknown key; expected one of: " + KeyList(defaults));
+    const Json& d = defaults[it.key()];
+    if (d.is_object() && !it.value().is_object())
+      throw InputError(where(p), "expected a mapping with keys " + KeyList(d) + ", got " +
+                                     (it.value().is_null() ? "nothing" : it.value().dump()));
+    CheckUnknownKeys(it.value(), d, p, where);
   }
 }
 
-double Num(const Json& s, const std::string& path, const KeyLocator& where) {
+// The value at a dotted key path, or null if a part is missing (never inserts).
+const Json& At(const Json& s, const std::string& path) {
+  static const Json kNull;
   const Json* j = &s;
   std::string rest = path;
   while (!rest.empty()) {
     const auto dot = rest.find('.');
     const std::string key = rest.substr(0, dot);
-    j = &(*j)[key];
+    if (!j->is_object()) return kNull;
+    const auto it = j->find(key);
+    if (it == j->end()) return kNull;
+    j = &*it;
     rest = dot == std::string::npos ? "" : rest.substr(dot + 1);
   }
-  if (!j->is_number())
-    throw InputError(where(path), "expected a number, got " + (j->is_null() ? "nothing" : j->dump()));
-  return j->get<double>();
+  return *j;
+}
+
+double Num(const Json& s, const std::string& path, const KeyLocator& where) {
+  const Json& j = At(s, path);
+  if (!j.is_number())
+    throw InputError(where(path), "expected a number, got " + (j.is_null() ? "nothing" : j.dump()));
+  return j.get<double>();
 }
 
 int Int(const Json& s, const std::string& path, const KeyLocator& where, int min) {
@@ -148,110 +173,136 @@ double NonNegative(const Json& s, const std::string& path, const KeyLocator& whe
   return v;
 }
 
-std::string Str(const Json& j, const std::string& path, const KeyLocator& where) {
+std::string Str(const Json& s, const std::string& path, const KeyLocator& where) {
+  const Json& j = At(s, path);
   if (!j.is_string()) throw InputError(where(path), "expected a string, got " + j.dump());
   return j.get<std::string>();
 }
 
-bool Bool(const Json& j, const std::string& path, const KeyLocator& where) {
+bool Bool(const Json& s, const std::string& path, const KeyLocator& where) {
+  const Json& j = At(s, path);
   if (!j.is_boolean()) throw InputError(where(path), "expected true or false, got " + j.dump());
   return j.get<bool>();
 }
 
-CellSettings ParseCell(const Json& s, const KeyLocator& where) {
-  CellSettings c;
-  c.robot = Str(s["robot"], "robot", where);
+// Only `allowed` keys in the mapping at `path`.
+void OnlyKeys(const Json& map, const std::string& path, std::initializer_list<const char*> allowed,
+              const std::string& expected, const KeyLocator& where) {
+  for (auto it = map.begin(); it != map.end(); ++it) {
+    bool ok = false;
+    for (const char* a : allowed) ok |= it.key() == a;
+    if (!ok) throw InputError(where(path + "." + it.key()), "unknown key; expected " + expected);
+  }
+}
+
+Eigen::Vector3d Vector3(const Json& s, const std::string& path, const std::string& expected,
+                        const KeyLocator& where) {
+  const Json& v = At(s, path);
+  if (!v.is_array() || v.size() != 3) throw InputError(where(path), "expected " + expected);
+  Eigen::Vector3d out;
+  for (int k = 0; k < 3; ++k) {
+    if (!v[k].is_number()) throw InputError(where(path), "expected " + expected);
+    out[k] = v[k];
+  }
+  return out;
+}
+
+// plane: 'robot', {normal, offset} or {tilt_deg, azimuth_deg, through}.
+void ParsePlane(const Json& s, const KeyLocator& where, CellSettings* c) {
   const Json& plane = s["plane"];
   if (plane.is_string()) {
     if (plane != "robot")
       throw InputError(where("plane"), "expected 'robot', {normal: [nx, ny, nz], offset: f} or "
                                        "{tilt_deg: t, azimuth_deg: a, through: [x, y, z]}");
-  } else if (plane.is_object()) {
-    c.plane_from_robot = false;
-    if (plane.contains("normal")) {
-      for (auto it = plane.begin(); it != plane.end(); ++it)
-        if (it.key() != "normal" && it.key() != "offset")
-          throw InputError(where("plane." + it.key()), "unknown key; expected normal, offset");
-      const Json& n = plane["normal"];
-      if (!n.is_array() || n.size() != 3 || !n[0].is_number() || !n[1].is_number() ||
-          !n[2].is_number())
-        throw InputError(where("plane.normal"), "expected three numbers [nx, ny, nz]");
-      c.plane = Plane::FromCoefficients(n[0], n[1], n[2], Num(s, "plane.offset", where),
-                                        where("plane"));
-    } else {
-      for (auto it = plane.begin(); it != plane.end(); ++it)
-        if (it.key() != "tilt_deg" && it.key() != "azimuth_deg" && it.key() != "through")
-          throw InputError(where("plane." + it.key()),
-                           "unknown key; expected normal/offset or tilt_deg/azimuth_deg/through");
-      const double tilt = Num(s, "plane.tilt_deg", where) * M_PI / 180;
-      const double az = plane.contains("azimuth_deg") ? Num(s, "plane.azimuth_deg", where) * M_PI / 180 : 0.0;
-      if (tilt < 0 || tilt > M_PI)
-        throw InputError(where("plane.tilt_deg"), "expected an angle in [0, 180] degrees");
-      Eigen::Vector3d through(0, 0, 0);
-      if (plane.contains("through")) {
-        const Json& t = plane["through"];
-        if (!t.is_array() || t.size() != 3)
-          throw InputError(where("plane.through"), "expected a point [x, y, z] in m");
-        for (int k = 0; k < 3; ++k) {
-          if (!t[k].is_number()) throw InputError(where("plane.through"), "expected numbers");
-          through[k] = t[k];
-        }
-      }
-      const Eigen::Vector3d n(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az),
-                              std::cos(tilt));
-      c.plane = Plane::FromCoefficients(n.x(), n.y(), n.z(), -n.dot(through), where("plane"));
-    }
-  } else {
-    throw InputError(where("plane"), "expected 'robot' or a mapping");
+    return;
   }
+  if (!plane.is_object()) throw InputError(where("plane"), "expected 'robot' or a mapping");
+  c->plane_from_robot = false;
+  if (plane.contains("normal")) {
+    OnlyKeys(plane, "plane", {"normal", "offset"}, "normal, offset", where);
+    const Eigen::Vector3d n = Vector3(s, "plane.normal", "three numbers [nx, ny, nz]", where);
+    c->plane = Plane::FromCoefficients(n.x(), n.y(), n.z(), Num(s, "plane.offset", where),
+                                       where("plane"));
+    return;
+  }
+  OnlyKeys(plane, "plane", {"tilt_deg", "azimuth_deg", "through"},
+           "normal/offset or tilt_deg/azimuth_deg/through", where);
+  const double tilt = Num(s, "plane.tilt_deg", where) * M_PI / 180;
+  const double az =
+      plane.contains("azimuth_deg") ? Num(s, "plane.azimuth_deg", where) * M_PI / 180 : 0.0;
+  if (tilt < 0 || tilt > M_PI)
+    throw InputError(where("plane.tilt_deg"), "expected an angle in [0, 180] degrees");
+  const Eigen::Vector3d through =
+      plane.contains("through") ? Vector3(s, "plane.through", "a point [x, y, z] in m", where)
+                                : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d n(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az),
+                          std::cos(tilt));
+  c->plane = Plane::FromCoefficients(n.x(), n.y(), n.z(), -n.dot(through), where("plane"));
+}
 
-  const std::string mode = Str(s["truth"]["mode"], "truth.mode", where);
+void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c) {
+  const std::string mode = Str(s, "truth.mode", where);
   if (mode != "robot_file" && mode != "random")
     throw InputError(where("truth.mode"), "expected robot_file or random, got '" + mode + "'");
-  c.truth_random = mode == "random";
-  c.truth_scale = NonNegative(s, "truth.scale", where);
-  c.truth_angle_sigma = NonNegative(s, "truth.angle_sigma_mrad", where) * 1e-3;
-  c.truth_length_sigma = NonNegative(s, "truth.length_sigma_mm", where) * 1e-3;
+  c->truth_random = mode == "random";
+  c->truth_scale = NonNegative(s, "truth.scale", where);
+  c->truth_angle_sigma = NonNegative(s, "truth.angle_sigma_mrad", where) * 1e-3;
+  c->truth_length_sigma = NonNegative(s, "truth.length_sigma_mm", where) * 1e-3;
+  c->sigma = NonNegative(s, "noise.sigma_mm", where) * 1e-3;
+  c->repetitions = Int(s, "noise.repetitions", where, 1);
+}
 
-  c.sigma = NonNegative(s, "noise.sigma_mm", where) * 1e-3;
-  c.repetitions = Int(s, "noise.repetitions", where, 1);
-
-  c.pool_size = Int(s, "pool.size", where, 1);
-  c.pool_redraw = Bool(s["pool"]["redraw"], "pool.redraw", where);
-  c.min_singular_value = NonNegative(s, "pool.min_singular_value", where);
-
-  c.select_count = Int(s, "selection.count", where, 1);
-  if (c.select_count > c.pool_size)
+void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings* c) {
+  c->pool_size = Int(s, "pool.size", where, 1);
+  c->pool_redraw = Bool(s, "pool.redraw", where);
+  c->min_singular_value = NonNegative(s, "pool.min_singular_value", where);
+  c->select_count = Int(s, "selection.count", where, 1);
+  if (c->select_count > c->pool_size)
     throw InputError(where("selection.count"),
-                     "cannot select " + std::to_string(c.select_count) + " configurations from a pool of " +
-                         std::to_string(c.pool_size) + " (pool.size)");
-  c.selection.method = ParseSelectionMethod(Str(s["selection"]["method"], "selection.method", where),
-                                            where("selection.method"));
-  c.selection.criterion = ParseDesignCriterion(
-      Str(s["selection"]["criterion"], "selection.criterion", where), where("selection.criterion"));
-  c.selection.samples = Int(s, "selection.samples", where, 1);
-  c.selection.restarts = Int(s, "selection.restarts", where, 1);
-  c.selection_redraw = Bool(s["selection"]["redraw"], "selection.redraw", where);
-  c.scaling = ParseDesignScaling(Str(s["selection"]["scaling"], "selection.scaling", where),
-                                 where("selection.scaling"));
+                     "cannot select " + std::to_string(c->select_count) +
+                         " configurations from a pool of " + std::to_string(c->pool_size) +
+                         " (pool.size)");
+  c->selection.method = ParseSelectionMethod(Str(s, "selection.method", where),
+                                             where("selection.method"));
+  c->selection.criterion = ParseDesignCriterion(Str(s, "selection.criterion", where),
+                                                where("selection.criterion"));
+  c->selection.samples = Int(s, "selection.samples", where, 1);
+  c->selection.restarts = Int(s, "selection.restarts", where, 1);
+  c->selection_redraw = Bool(s, "selection.redraw", where);
+  c->scaling = ParseDesignScaling(Str(s, "selection.scaling", where), where("selection.scaling"));
+  c->validation_size = Int(s, "validation.size", where, 1);
+}
 
-  c.validation_size = Int(s, "validation.size", where, 1);
-
-  const Json& id = s["identification"];
-  c.plane_terms = PlaneTerms::Parse(Str(id["estimate_plane"], "identification.estimate_plane", where),
-                                    where("identification.estimate_plane"));
-  if (!id["fix"].is_array())
+void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c) {
+  c->plane_terms = PlaneTerms::Parse(Str(s, "identification.estimate_plane", where),
+                                     where("identification.estimate_plane"));
+  const Json& fix = At(s, "identification.fix");
+  if (!fix.is_array())
     throw InputError(where("identification.fix"), "expected a list of parameter names");
-  for (const auto& f : id["fix"]) c.fixed.push_back(Str(f, "identification.fix", where));
-  const std::string solver = Str(id["solver"], "identification.solver", where);
-  if (solver == "ceres") c.identification.solver = IdentificationOptions::Solver::kCeres;
-  else if (solver != "lm")
-    throw InputError(where("identification.solver"), "expected lm or ceres, got '" + solver + "'");
-  c.identification.max_iterations = Int(s, "identification.max_iterations", where, 1);
-  const std::string rank = Str(id["on_rank_deficient"], "identification.on_rank_deficient", where);
+  for (std::size_t i = 0; i < fix.size(); ++i) {
+    if (!fix[i].is_string())
+      throw InputError(where("identification.fix[" + std::to_string(i) + "]"),
+                       "expected a parameter name, got " + fix[i].dump());
+    c->fixed.push_back(fix[i].get<std::string>());
+  }
+  c->identification.solver =
+      ParseName(kSolverNames, Str(s, "identification.solver", where), where("identification.solver"),
+                "solver");
+  c->identification.max_iterations = Int(s, "identification.max_iterations", where, 1);
+  const std::string rank = Str(s, "identification.on_rank_deficient", where);
   if (rank != "fail" && rank != "fix")
-    throw InputError(where("identification.on_rank_deficient"), "expected fail or fix, got '" + rank + "'");
-  c.fix_dependent = rank == "fix";
+    throw InputError(where("identification.on_rank_deficient"),
+                     "expected fail or fix, got '" + rank + "'");
+  c->fix_dependent = rank == "fix";
+}
+
+CellSettings ParseCell(const Json& s, const KeyLocator& where) {
+  CellSettings c;
+  c.robot = Str(s, "robot", where);
+  ParsePlane(s, where, &c);
+  ParseTruthAndNoise(s, where, &c);
+  ParsePoolAndSelection(s, where, &c);
+  ParseIdentification(s, where, &c);
   c.paper_case = Int(s, "paper_case", where, 0);
   if (c.paper_case > 2) throw InputError(where("paper_case"), "expected 0 (none), 1 or 2");
   return c;
@@ -311,138 +362,160 @@ Json Study::ToJson() const {
   return j;
 }
 
+namespace {
+
+struct Axis {
+  std::string key;
+  std::vector<Json> values;
+  std::vector<std::string> labels;
+  std::vector<std::string> value_paths;  // for line lookup
+};
+
+// name, description, seed, trials.
+void ParseHeader(const Json& given, const std::string& path, const KeyLocator& where,
+                 Study* study) {
+  for (const char* required : {"name", "seed", "trials"})
+    if (!given.contains(required))
+      throw InputError(Location(path, 1) + " key '" + required + "'", "missing (required)");
+  study->name = Str(given, "name", where);
+  if (study->name.empty() || study->name.find_first_of("/\\ ") != std::string::npos)
+    throw InputError(where("name"), "expected a non-empty name without spaces or slashes");
+  if (given.contains("description")) study->description = Str(given, "description", where);
+  const double seed = Num(given, "seed", where);
+  if (seed < 0 || seed != std::floor(seed) || seed > 9e15)
+    throw InputError(where("seed"), "expected a whole number >= 0");
+  study->seed = static_cast<std::uint64_t>(seed);
+  study->trials = Int(given, "trials", where, 1);
+}
+
+// The defaults with the file's settings merged in, and the robot file's content hash: a changed
+// robot is a new cell.
+Json ResolveBase(const Json& given, const KeyLocator& where) {
+  Json settings = given;
+  for (const char* k : {"name", "description", "seed", "trials", "sweep"}) settings.erase(k);
+  CheckUnknownKeys(settings, StudyDefaults(), "", where);
+  Json base = StudyDefaults();
+  base.merge_patch(settings);
+  const std::string robot_path = ResolveRobotPath(Str(base, "robot", where));
+  std::ifstream in(robot_path);
+  if (!in || std::filesystem::is_directory(robot_path))
+    throw InputError(where("robot"), "cannot open robot file '" + robot_path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  base["robot_file_fnv1a"] = HashHex(ss.str());
+  ParseCell(base, where);  // the base itself must be valid
+  return base;
+}
+
+Axis ParseAxis(const Json& ax, const std::string& ap, const KeyLocator& where) {
+  if (!ax.is_object()) throw InputError(where(ap), "expected {key: ..., values: [...]}");
+  OnlyKeys(ax, ap, {"key", "values", "labels"}, "key, values, labels", where);
+  Axis axis;
+  if (!ax.contains("key")) throw InputError(where(ap), "missing 'key'");
+  axis.key = Str(ax, "key", KeyLocator{where.file, where.lines, where.context, ap});
+  if (!KeyExists(StudyDefaults(), axis.key))
+    throw InputError(where(ap + ".key"), "'" + axis.key + "' is not a study setting (e.g. "
+                                         "noise.sigma_mm, selection.count, plane, '.')");
+  if (!ax.contains("values") || !ax["values"].is_array() || ax["values"].empty())
+    throw InputError(where(ap + ".values"), "expected a non-empty list of values");
+  for (std::size_t v = 0; v < ax["values"].size(); ++v) {
+    axis.values.push_back(ax["values"][v]);
+    axis.value_paths.push_back(ap + ".values[" + std::to_string(v) + "]");
+  }
+  if (ax.contains("labels")) {
+    if (!ax["labels"].is_array() || ax["labels"].size() != axis.values.size())
+      throw InputError(where(ap + ".labels"), "expected one label per value");
+    for (const auto& l : ax["labels"]) axis.labels.push_back(ValueLabel(l));
+  } else {
+    for (const auto& v : axis.values) axis.labels.push_back(axis.key + "=" + ValueLabel(v));
+  }
+  return axis;
+}
+
+// The sweep section: axes and how they combine.
+std::vector<Axis> ParseSweep(const Json& given, const KeyLocator& where, Study* study,
+                             std::string* combine) {
+  std::vector<Axis> axes;
+  *combine = "product";
+  if (!given.contains("sweep")) return axes;
+  const Json& sw = given["sweep"];
+  study->sweep = sw;
+  if (!sw.is_object()) throw InputError(where("sweep"), "expected a mapping with 'axes'");
+  OnlyKeys(sw, "sweep", {"combine", "axes"}, "combine, axes", where);
+  if (sw.contains("combine")) {
+    *combine = Str(sw, "combine", KeyLocator{where.file, where.lines, where.context, "sweep"});
+    if (*combine != "product" && *combine != "zip")
+      throw InputError(where("sweep.combine"), "expected product or zip, got '" + *combine + "'");
+  }
+  if (!sw.contains("axes") || !sw["axes"].is_array() || sw["axes"].empty())
+    throw InputError(where("sweep.axes"), "expected a non-empty list of axes");
+  for (std::size_t a = 0; a < sw["axes"].size(); ++a) {
+    axes.push_back(ParseAxis(sw["axes"][a], "sweep.axes[" + std::to_string(a) + "]", where));
+    study->axis_keys.push_back(axes.back().key);
+  }
+  if (*combine == "zip")
+    for (const auto& a : axes)
+      if (a.values.size() != axes[0].values.size())
+        throw InputError(where("sweep.axes"), "zip needs axes of equal length");
+  return axes;
+}
+
+// Value indices of every cell in canonical order (first axis slowest).
+std::vector<std::vector<int>> Combinations(const std::vector<Axis>& axes,
+                                           const std::string& combine) {
+  std::vector<std::vector<int>> combos;
+  if (axes.empty()) return {{}};
+  if (combine == "zip") {
+    for (std::size_t v = 0; v < axes[0].values.size(); ++v)
+      combos.push_back(std::vector<int>(axes.size(), static_cast<int>(v)));
+    return combos;
+  }
+  std::vector<int> idx(axes.size(), 0);
+  while (true) {
+    combos.push_back(idx);
+    int a = static_cast<int>(axes.size()) - 1;
+    while (a >= 0 && ++idx[a] == static_cast<int>(axes[a].values.size())) idx[a--] = 0;
+    if (a < 0) return combos;
+  }
+}
+
+Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector<int>& combo,
+              const std::string& path, const LineMap& lines) {
+  Cell cell;
+  cell.settings = base;
+  std::string context;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    Apply(&cell.settings, axes[a].key, axes[a].values[combo[a]]);
+    cell.label += (a ? ", " : "") + axes[a].labels[combo[a]];
+    cell.axis_values[axes[a].key] = axes[a].labels[combo[a]];
+    const auto line = lines.find(axes[a].value_paths[combo[a]]);
+    context += (a ? "; " : "") + std::string("sweep value at ") +
+               Location(path, line == lines.end() ? 0 : line->second);
+  }
+  if (cell.label.empty()) cell.label = "base";
+  CheckUnknownKeys(cell.settings, StudyDefaults(), "", KeyLocator{path, &lines, context});
+  cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context});
+  cell.id = HashHex(cell.settings.dump());
+  return cell;
+}
+
+}  // namespace
+
 Study LoadStudy(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);
   yaml::RequireMap(root, path, "");
   LineMap lines;
-  Json given = ToJsonNode(root, "", &lines);
-  KeyLocator where{path, &lines, ""};
-
+  const Json given = ToJsonNode(root, "", &lines);
+  const KeyLocator where{path, &lines, ""};
   Study study;
   study.path = path;
-  for (const char* required : {"name", "seed", "trials"})
-    if (!given.contains(required))
-      throw InputError(Location(path, 1) + " key '" + required + "'", "missing (required)");
-  study.name = Str(given["name"], "name", where);
-  if (study.name.empty() || study.name.find_first_of("/\\ ") != std::string::npos)
-    throw InputError(where("name"), "expected a non-empty name without spaces or slashes");
-  if (given.contains("description"))
-    study.description = Str(given["description"], "description", where);
-  const double seed = Num(given, "seed", where);
-  if (seed < 0 || seed != std::floor(seed) || seed > 9e15)
-    throw InputError(where("seed"), "expected a whole number >= 0");
-  study.seed = static_cast<std::uint64_t>(seed);
-  study.trials = Int(given, "trials", where, 1);
-
-  Json settings = given;
-  for (const char* k : {"name", "description", "seed", "trials", "sweep"}) settings.erase(k);
-  CheckUnknownKeys(settings, Defaults(), "", where);
-  Json base = Defaults();
-  base.merge_patch(settings);
-  // The robot file's content is part of every cell's settings: a changed robot is a new cell.
-  const std::string robot_path = ResolveRobotPath(base["robot"].get<std::string>());
-  {
-    std::ifstream in(robot_path);
-    if (!in) throw InputError(where("robot"), "cannot open robot file '" + robot_path + "'");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    base["robot_file_fnv1a"] = HashHex(ss.str());
-  }
-  ParseCell(base, where);  // the base itself must be valid
-  study.base = base;
-
-  // Sweep axes.
-  struct Axis {
-    std::string key;
-    std::vector<Json> values;
-    std::vector<std::string> labels;
-    std::vector<std::string> value_paths;  // for line lookup
-  };
-  std::vector<Axis> axes;
-  std::string combine = "product";
-  if (given.contains("sweep")) {
-    const Json& sw = given["sweep"];
-    study.sweep = sw;
-    if (!sw.is_object()) throw InputError(where("sweep"), "expected a mapping with 'axes'");
-    for (auto it = sw.begin(); it != sw.end(); ++it)
-      if (it.key() != "combine" && it.key() != "axes")
-        throw InputError(where("sweep." + it.key()), "unknown key; expected combine, axes");
-    if (sw.contains("combine")) {
-      combine = Str(sw["combine"], "sweep.combine", where);
-      if (combine != "product" && combine != "zip")
-        throw InputError(where("sweep.combine"), "expected product or zip, got '" + combine + "'");
-    }
-    if (!sw.contains("axes") || !sw["axes"].is_array() || sw["axes"].empty())
-      throw InputError(where("sweep.axes"), "expected a non-empty list of axes");
-    for (std::size_t a = 0; a < sw["axes"].size(); ++a) {
-      const Json& ax = sw["axes"][a];
-      const std::string ap = "sweep.axes[" + std::to_string(a) + "]";
-      if (!ax.is_object()) throw InputError(where(ap), "expected {key: ..., values: [...]}");
-      for (auto it = ax.begin(); it != ax.end(); ++it)
-        if (it.key() != "key" && it.key() != "values" && it.key() != "labels")
-          throw InputError(where(ap + "." + it.key()), "unknown key; expected key, values, labels");
-      Axis axis;
-      if (!ax.contains("key")) throw InputError(where(ap), "missing 'key'");
-      axis.key = Str(ax["key"], ap + ".key", where);
-      if (!KeyExists(Defaults(), axis.key))
-        throw InputError(where(ap + ".key"), "'" + axis.key + "' is not a study setting (e.g. "
-                                             "noise.sigma_mm, selection.count, plane, '.')");
-      if (!ax.contains("values") || !ax["values"].is_array() || ax["values"].empty())
-        throw InputError(where(ap + ".values"), "expected a non-empty list of values");
-      for (std::size_t v = 0; v < ax["values"].size(); ++v) {
-        axis.values.push_back(ax["values"][v]);
-        axis.value_paths.push_back(ap + ".values[" + std::to_string(v) + "]");
-      }
-      if (ax.contains("labels")) {
-        if (!ax["labels"].is_array() || ax["labels"].size() != axis.values.size())
-          throw InputError(where(ap + ".labels"), "expected one label per value");
-        for (const auto& l : ax["labels"]) axis.labels.push_back(ValueLabel(l));
-      } else {
-        for (const auto& v : axis.values) axis.labels.push_back(axis.key + "=" + ValueLabel(v));
-      }
-      study.axis_keys.push_back(axis.key);
-      axes.push_back(axis);
-    }
-    if (combine == "zip")
-      for (const auto& a : axes)
-        if (a.values.size() != axes[0].values.size())
-          throw InputError(where("sweep.axes"), "zip needs axes of equal length");
-  }
-
-  // Expand the cells in canonical order (first axis slowest).
-  std::vector<std::vector<int>> combos;
-  if (axes.empty()) {
-    combos.push_back({});
-  } else if (combine == "zip") {
-    for (std::size_t v = 0; v < axes[0].values.size(); ++v)
-      combos.push_back(std::vector<int>(axes.size(), static_cast<int>(v)));
-  } else {
-    std::vector<int> idx(axes.size(), 0);
-    while (true) {
-      combos.push_back(idx);
-      int a = static_cast<int>(axes.size()) - 1;
-      while (a >= 0 && ++idx[a] == static_cast<int>(axes[a].values.size())) idx[a--] = 0;
-      if (a < 0) break;
-    }
-  }
+  ParseHeader(given, path, where, &study);
+  study.base = ResolveBase(given, where);
+  std::string combine;
+  const std::vector<Axis> axes = ParseSweep(given, where, &study, &combine);
   std::map<std::string, std::string> seen;
-  for (const auto& combo : combos) {
-    Cell cell;
-    cell.settings = base;
-    std::string context;
-    for (std::size_t a = 0; a < axes.size(); ++a) {
-      Apply(&cell.settings, axes[a].key, axes[a].values[combo[a]]);
-      cell.label += (a ? ", " : "") + axes[a].labels[combo[a]];
-      cell.axis_values[axes[a].key] = axes[a].labels[combo[a]];
-      context += (a ? "; " : "") + std::string("sweep value at ") +
-                 Location(path, lines.count(axes[a].value_paths[combo[a]])
-                                    ? lines[axes[a].value_paths[combo[a]]]
-                                    : 0);
-    }
-    if (cell.label.empty()) cell.label = "base";
-    CheckUnknownKeys(cell.settings, Defaults(), "", KeyLocator{path, &lines, context});
-    cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context});
-    cell.id = HashHex(cell.settings.dump());
+  for (const auto& combo : Combinations(axes, combine)) {
+    Cell cell = MakeCell(study.base, axes, combo, path, lines);
     if (seen.count(cell.id))
       throw InputError(path, "sweep cells '" + seen[cell.id] + "' and '" + cell.label +
                                  "' have identical settings");

@@ -27,7 +27,7 @@ namespace lrcal {
 enum class RobustLoss { kNone, kHuber, kCauchy };
 
 struct IdentificationOptions {
-  enum class Solver { kLevenbergMarquardt, kCeres };
+  enum class Solver { kLevenbergMarquardt, kCeres };  ///< names: kSolverNames
   /// lrcal's own LM is the fast default; kCeres is the reference and the only one with losses.
   Solver solver = Solver::kLevenbergMarquardt;
   RobustLoss loss = RobustLoss::kNone;
@@ -50,6 +50,11 @@ struct IdentificationOptions {
   /// Checks the fields; returns "" or a message naming the bad field.
   std::string Validate() const;
 };
+
+/// Solver names in study files and options.
+inline constexpr EnumName<IdentificationOptions::Solver> kSolverNames[] = {
+    {IdentificationOptions::Solver::kLevenbergMarquardt, "lm"},
+    {IdentificationOptions::Solver::kCeres, "ceres"}};
 
 enum class Termination {
   kConverged,        ///< a tolerance was met: the estimate is the least-squares minimum

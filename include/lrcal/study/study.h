@@ -26,32 +26,34 @@
 namespace lrcal {
 
 
-/// The typed settings of one cell (all SI except where a name says otherwise).
+/// The typed settings of one cell (all SI except where a name says otherwise), parsed from the
+/// resolved settings JSON. The defaults live in one place, StudyDefaults(); the initial values
+/// here are only neutral zeros.
 struct CellSettings {
-  std::string robot = "paper";  ///< robot file path or shipped name
-  bool plane_from_robot = true;
-  Plane plane;                  ///< when !plane_from_robot
+  std::string robot;             ///< robot file path or shipped name
+  bool plane_from_robot = true;  ///< plane: robot
+  Plane plane;                   ///< when !plane_from_robot
   // Truth: the robot file's errors × scale, or errors drawn per trial.
   bool truth_random = false;
-  double truth_scale = 1.0;
-  double truth_angle_sigma = 1e-3;   ///< rad, per-parameter σ of drawn angle errors
-  double truth_length_sigma = 1e-3;  ///< m, per-parameter σ of drawn length errors
+  double truth_scale = 0;
+  double truth_angle_sigma = 0;   ///< rad, per-parameter σ of drawn angle errors
+  double truth_length_sigma = 0;  ///< m, per-parameter σ of drawn length errors
   // Noise.
-  double sigma = 0.2e-3;  ///< m, one reading
-  int repetitions = 10;
+  double sigma = 0;     ///< m, one reading
+  int repetitions = 0;  ///< readings averaged per configuration
   // Candidate pool.
-  int pool_size = 101;
+  int pool_size = 0;
   bool pool_redraw = false;  ///< new pool every trial (else one pool per cell, shared by trials)
-  double min_singular_value = 0.05;
+  double min_singular_value = 0;
   // Selection.
-  int select_count = 50;
+  int select_count = 0;
   SelectionOptions selection;
   DesignScaling scaling = DesignScaling::kSI;  ///< column scaling of G before selection
   /// Select anew in every trial (from the cell's pool): a random or sampled design then varies
   /// from trial to trial, which is the honest baseline for "how much does the design buy".
   bool selection_redraw = false;
   // Validation.
-  int validation_size = 20;
+  int validation_size = 0;
   // Identification.
   PlaneTerms plane_terms;
   std::vector<std::string> fixed;
@@ -85,6 +87,10 @@ struct Study {
   Json ToJson() const;
   long long total_trials() const { return static_cast<long long>(trials) * cells.size(); }
 };
+
+/// The defaults of every study setting (the schema's one source of them), as the JSON that
+/// cell settings are resolved from: a study file's settings are merged into it.
+const Json& StudyDefaults();
 
 /// Loads, validates and expands a study file. Throws InputError.
 Study LoadStudy(const std::string& path);
