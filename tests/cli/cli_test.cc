@@ -174,6 +174,8 @@ struct BadInput {
   std::string args;      // {} replaced by the file's path
   std::string expected;  // substring of the message
 };
+// Short, stable test names in ctest (not the struct's bytes).
+void PrintTo(const BadInput& b, std::ostream* os) { *os << b.name; }
 
 class CliErrorTest : public CliTest, public ::testing::WithParamInterface<BadInput> {};
 

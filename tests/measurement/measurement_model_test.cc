@@ -24,6 +24,11 @@ struct Case {
   PlaneTerms terms;
   std::vector<std::string> fixed;
 };
+// Short, stable test names in ctest (not the struct's bytes).
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.terms.ToString();
+  for (const auto& f : c.fixed) *os << " -" << f;
+}
 
 class JacobianTest : public ::testing::TestWithParam<Case> {};
 

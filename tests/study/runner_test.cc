@@ -336,6 +336,8 @@ TEST(MonteCarlo, SelectionRedrawnPerTrialVariesTheDesign) {
 struct BadStudy {
   std::string name, text, expected;
 };
+// Short, stable test names in ctest (not the struct's bytes).
+void PrintTo(const BadStudy& s, std::ostream* os) { *os << s.name; }
 class BadStudyTest : public ::testing::TestWithParam<BadStudy> {};
 
 TEST_P(BadStudyTest, FailsBeforeAnythingRunsNamingLineAndKey) {

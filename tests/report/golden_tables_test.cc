@@ -1,0 +1,50 @@
+// The tables of studies/quick.yaml against the checked-in golden copy (tests/golden/), byte for
+// byte: a refactoring must not move a single digit; a change meant to alter numbers regenerates
+// the copy on purpose (scripts/update_golden.sh).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadAll(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(GoldenTables, QuickStudyTablesAreByteIdentical) {
+  const std::string dir = testing::TempDir("golden_quick");
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " +
+                                    testing::SourcePath("studies/quick.yaml") + " --out " + dir +
+                                    "/run --threads 2 --quiet",
+                                &out),
+            0)
+      << out;
+  const fs::path golden = testing::SourcePath("tests/golden/quick");
+  int compared = 0;
+  for (const auto& entry : fs::directory_iterator(golden)) {
+    const fs::path produced = fs::path(dir) / "run" / "tables" / entry.path().filename();
+    ASSERT_TRUE(fs::exists(produced)) << produced << " was not written";
+    EXPECT_EQ(ReadAll(produced), ReadAll(entry.path()))
+        << entry.path().filename() << " differs from the golden copy; if the change is meant to "
+        << "alter the tables, run scripts/update_golden.sh and say why in the commit";
+    ++compared;
+  }
+  EXPECT_EQ(compared, 8);  // summary.md/.json, cells/validation/parameters/paper_placement.csv, 2 .tex
+  for (const auto& entry : fs::directory_iterator(fs::path(dir) / "run" / "tables"))
+    EXPECT_TRUE(fs::exists(golden / entry.path().filename()))
+        << entry.path().filename() << " is new: add it to tests/golden/quick";
+}
+
+}  // namespace
+}  // namespace lrcal

@@ -1,0 +1,109 @@
+// Study files: the schema's defaults as documented, sections that must be mappings, and the
+// identification solver a study names actually running in its trials.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/study/study.h"
+#include "study/trial_pipeline.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+// Every default in StudyDefaults() must appear, with the same value, in the first YAML block of
+// docs/STUDIES.md (which says "Defaults are those shown").
+void ExpectDocumented(const Json& defaults, const YAML::Node& doc, const std::string& path) {
+  for (auto it = defaults.begin(); it != defaults.end(); ++it) {
+    const std::string key = path.empty() ? it.key() : path + "." + it.key();
+    const YAML::Node node = doc[it.key()];
+    ASSERT_TRUE(node.IsDefined()) << "docs/STUDIES.md does not show '" << key << "'";
+    const Json& value = it.value();
+    if (value.is_object()) {
+      ExpectDocumented(value, node, key);
+    } else if (value.is_array()) {
+      EXPECT_TRUE(node.IsSequence() && node.size() == value.size()) << key;
+    } else if (value.is_string()) {
+      EXPECT_EQ(node.Scalar(), value.get<std::string>()) << key;
+    } else if (value.is_boolean()) {
+      EXPECT_EQ(node.Scalar(), value.get<bool>() ? "true" : "false") << key;
+    } else {
+      EXPECT_DOUBLE_EQ(std::stod(node.Scalar()), value.get<double>()) << key;
+    }
+  }
+}
+
+TEST(StudySchema, DocumentedDefaultsAreTheSchemasDefaults) {
+  std::ifstream in(testing::SourcePath("docs/STUDIES.md"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  const auto begin = text.find("```yaml\n");
+  ASSERT_NE(begin, std::string::npos);
+  const auto end = text.find("```", begin + 8);
+  const YAML::Node doc = YAML::Load(text.substr(begin + 8, end - begin - 8));
+  ExpectDocumented(StudyDefaults(), doc, "");
+}
+
+std::string WriteStudy(const std::string& name, const std::string& body) {
+  const std::string path = testing::TempDir("study_" + name) + "/s.yaml";
+  std::ofstream(path) << "name: s\nseed: 1\ntrials: 3\nrobot: "
+                      << testing::SourcePath("studies/robots/paper.yaml") << "\n"
+                      << body;
+  return path;
+}
+
+std::string LoadError(const std::string& name, const std::string& body) {
+  try {
+    LoadStudy(WriteStudy(name, body));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(StudySchema, SectionsGivenAsNothingOrScalarsAreErrorsNamingTheKey) {
+  const std::string empty = LoadError("null_section", "noise:\npool: {size: 60}\n");
+  EXPECT_NE(empty.find("s.yaml:5 key 'noise'"), std::string::npos) << empty;
+  EXPECT_NE(empty.find("expected a mapping with keys repetitions, sigma_mm, got nothing"),
+            std::string::npos)
+      << empty;
+  const std::string scalar = LoadError("scalar_section", "selection: 5\n");
+  EXPECT_NE(scalar.find("key 'selection'"), std::string::npos) << scalar;
+  EXPECT_NE(scalar.find("got 5"), std::string::npos) << scalar;
+  const std::string solver = LoadError("bad_solver", "identification: {solver: gauss}\n");
+  EXPECT_NE(solver.find("unknown solver 'gauss'; expected lm or ceres"), std::string::npos)
+      << solver;
+}
+
+// identification.solver: ceres changes the cell and runs Ceres in every trial; both solvers
+// reach the same least-squares minimum (to ~1e-9 of the parameters).
+TEST(StudySchema, CeresSolverRunsInTheTrialsAndAgreesWithLm) {
+  const std::string common = "pool: {size: 40}\nselection: {count: 35}\nvalidation: {size: 5}\n";
+  const Study lm = LoadStudy(WriteStudy("lm", common + "identification: {solver: lm}\n"));
+  const Study ceres = LoadStudy(WriteStudy("ceres", common + "identification: {solver: ceres}\n"));
+  EXPECT_NE(lm.cells[0].id, ceres.cells[0].id);
+  ASSERT_EQ(ceres.cells[0].typed.identification.solver, IdentificationOptions::Solver::kCeres);
+  const auto lm_cell = PrepareCell(lm, lm.cells[0]);
+  const auto ceres_cell = PrepareCell(ceres, ceres.cells[0]);
+  TrialWorkspace ws;
+  for (long long trial = 0; trial < 3; ++trial) {
+    const TrialRecord a = RunTrial(*lm_cell, trial, &ws);
+    const TrialRecord b = RunTrial(*ceres_cell, trial, &ws);
+    ASSERT_EQ(a.status, TrialStatus::kOk);
+    ASSERT_EQ(b.status, TrialStatus::kOk);
+    ASSERT_EQ(a.errors.size(), b.errors.size());
+    bool identical = true;
+    for (std::size_t k = 0; k < a.errors.size(); ++k) {
+      EXPECT_NEAR(a.errors[k], b.errors[k], 1e-9) << lm_cell->parameter_names[k];
+      identical &= a.errors[k] == b.errors[k];
+    }
+    EXPECT_FALSE(identical) << "the Ceres cell gave LM's bits: is the solver key ignored?";
+  }
+}
+
+}  // namespace
+}  // namespace lrcal
