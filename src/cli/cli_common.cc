@@ -42,6 +42,12 @@ Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm) {
                                   "' has no plane: give --plane nx,ny,nz,f");
 }
 
+Setup ResolveSetup(const po::variables_map& vm) {
+  Setup setup{LoadRobot(vm["robot"].as<std::string>()), Plane{}};
+  setup.plane = ResolvePlane(setup.rig, vm);
+  return setup;
+}
+
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm) {
   PlaneTerms terms;
   if (vm.count("estimate-plane"))

@@ -37,6 +37,13 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 RobotFile LoadRobot(const std::string& name_or_path);
 /// --plane if given, else the robot file's plane; InputError if neither.
 Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm);
+
+/// What every science command starts from: the robot file (--robot) and the plane (--plane).
+struct Setup {
+  RobotFile rig;
+  Plane plane;
+};
+Setup ResolveSetup(const po::variables_map& vm);
 /// --estimate-plane and --fix.
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm);
 

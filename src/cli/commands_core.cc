@@ -42,6 +42,69 @@ Json IdentifiabilityJson(const IdentifiabilityReport& r) {
   return j;
 }
 
+Json IdentificationJson(const IdentificationSummary& s) {
+  Json j;
+  Json params = Json::array();
+  for (std::size_t k = 0; k < s.names.size() && s.IsSolutionUsable(); ++k) {
+    params.push_back({{"name", s.names[k]},
+                      {"nominal", s.nominal[k]},
+                      {"estimate", s.estimate[k]},
+                      {"delta", s.delta[k]},
+                      {"std", s.std_residual[k]},
+                      {"std_given_sigma", s.std_given.size() ? Json(s.std_given[k]) : Json()}});
+  }
+  j["parameters"] = params;
+  j["covariance"] = s.IsSolutionUsable() ? ToJson(s.covariance_residual) : Json();
+  j["covariance_given_sigma"] = s.covariance_given.size() ? ToJson(s.covariance_given) : Json();
+  j["correlation"] = s.IsSolutionUsable() ? ToJson(s.correlation) : Json();
+  j["rank"] = s.identifiability.rank;
+  j["n_params"] = s.identifiability.num_params();
+  j["fixed_for_rank"] = s.fixed;
+  j["iterations"] = s.iterations;
+  j["termination"] = TerminationName(s.termination);
+  j["usable"] = s.IsSolutionUsable();
+  j["message"] = s.message;
+  j["residual_rms"] = s.residual_rms;
+  j["sigma_hat"] = s.sigma_hat;
+  j["n_configurations"] = s.num_configurations;
+  j["solver"] = s.solver;
+  if (!s.identifiability.full_rank()) j["identifiability"] = IdentifiabilityJson(s.identifiability);
+  return j;
+}
+
+void PrintIdentification(const IdentificationSummary& s) {
+  std::cout << s.BriefReport() << "\n";
+  if (!s.IsSolutionUsable()) {
+    std::cout << s.message << "\n";
+    if (!s.identifiability.full_rank()) std::cout << s.identifiability.ToString();
+    return;
+  }
+  Table t({"parameter", "unit", "nominal (SI)", "delta", "std", "std (given sigma)"},
+          "Identified parameters (delta and std in mrad / mm)");
+  for (std::size_t k = 0; k < s.names.size(); ++k) {
+    t.AddRow({s.names[k], IsAngularName(s.names[k]) ? "mrad" : "mm", Fixed(s.nominal[k], 6),
+              Fixed(s.delta[k] * 1e3), Fixed(s.std_residual[k] * 1e3),
+              s.std_given.size() ? Fixed(s.std_given[k] * 1e3) : "—"});
+  }
+  std::cout << t.ToText();
+  if (!s.fixed.empty()) {
+    std::cout << "fixed at nominal because of rank deficiency:";
+    for (const auto& f : s.fixed) std::cout << " " << f;
+    std::cout << "\n";
+  }
+}
+
+IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) {
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, vm["solver"].as<std::string>(), "--solver", "solver");
+  options.loss = ParseName(kRobustLossNames, vm["loss"].as<std::string>(), "--loss", "loss");
+  options.loss_scale = vm["loss-scale-mm"].as<double>() * 1e-3;
+  options.sigma = vm["sigma-mm"].as<double>() * 1e-3;
+  options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
+  if (std::string bad = options.Validate(); !bad.empty()) throw InputError("options", bad);
+  return options;
+}
+
 }  // namespace
 
 int KinematicsCommand(const std::vector<std::string>& args) {
@@ -55,9 +118,10 @@ int KinematicsCommand(const std::vector<std::string>& args) {
       ("fix", po::value<std::string>(), "parameters left out of the Jacobian, comma-separated");
   po::variables_map vm;
   if (!Parse("kinematics", "--configs C.csv [options]", o, args, &vm)) return 0;
-  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, vm);
+  const Plane& plane = setup.plane;
   const std::string which = vm["model"].as<std::string>();
   if (which != "nominal" && which != "true")
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
@@ -131,9 +195,10 @@ int SampleCommand(const std::vector<std::string>& args) {
       ("out", po::value<std::string>()->required(), "output CSV (q1..qN)");
   po::variables_map vm;
   if (!Parse("sample", "--out C.csv [options]", o, args, &vm)) return 0;
-  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, vm);
+  const Plane& plane = setup.plane;
   const int count = vm["count"].as<int>();
   if (count < 1) throw InputError("--count", "expected a positive number of configurations");
   SamplingOptions options;
@@ -163,9 +228,10 @@ int SimulateCommand(const std::vector<std::string>& args) {
       ("out", po::value<std::string>()->required(), "measurement CSV to write");
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
-  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, vm);
+  const Plane& plane = setup.plane;
   const ConfigurationSet configs =
       ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
   NoiseModel noise;
@@ -180,16 +246,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
                                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise),
                                       &data, &misses, &raw);
   const std::string path = vm["out"].as<std::string>();
-  std::ofstream out(path);
-  if (!out) throw InputError(path, "cannot write file");
-  for (int j = 0; j < robot.num_links(); ++j) out << "q" << j + 1 << ",";
-  out << "h,repetition\n";
-  for (int i = 0, k = 0; i < data.size(); ++i) {
-    for (int r = 0; r < noise.repetitions; ++r, ++k) {
-      for (int j = 0; j < robot.num_links(); ++j) out << FormatExact(data.configs.q(i)[j]) << ",";
-      out << FormatExact(raw[k]) << "," << r + 1 << "\n";
-    }
-  }
+  WriteReadings(path, data.configs, raw, noise.repetitions);
   for (int i = 0; i < configs.size(); ++i)
     if (misses[i] != BeamMiss::kNone)
       std::cerr << "lrcal simulate: configuration " << i + 1 << " (line " << i + 2
@@ -218,73 +275,19 @@ int IdentifyCommand(const std::vector<std::string>& args) {
        "known noise of one reading (mm) for the given-sigma covariance");
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
-  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, vm);
+  const Plane& plane = setup.plane;
   const MeasurementSet data = ReadMeasurements(vm["data"].as<std::string>(), robot.num_links());
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
-  IdentificationOptions options;
-  const std::string solver = vm["solver"].as<std::string>();
-  if (solver == "ceres") options.solver = IdentificationOptions::Solver::kCeres;
-  else if (solver != "lm") throw InputError("--solver", "expected lm or ceres, got '" + solver + "'");
-  const std::string loss = vm["loss"].as<std::string>();
-  if (loss == "huber") options.loss = RobustLoss::kHuber;
-  else if (loss == "cauchy") options.loss = RobustLoss::kCauchy;
-  else if (loss != "none") throw InputError("--loss", "expected none, huber or cauchy");
-  options.loss_scale = vm["loss-scale-mm"].as<double>() * 1e-3;
-  options.sigma = vm["sigma-mm"].as<double>() * 1e-3;
-  options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
-  if (std::string bad = options.Validate(); !bad.empty()) throw InputError("options", bad);
+  const IdentificationOptions options = ResolveIdentificationOptions(vm);
   const IdentificationSummary s = Identify(model, data, options);
 
   if (ResolveFormat(vm) == Format::kJson) {
-    Json j;
-    Json params = Json::array();
-    for (std::size_t k = 0; k < s.names.size() && s.IsSolutionUsable(); ++k) {
-      params.push_back({{"name", s.names[k]},
-                        {"nominal", s.nominal[k]},
-                        {"estimate", s.estimate[k]},
-                        {"delta", s.delta[k]},
-                        {"std", s.std_residual[k]},
-                        {"std_given_sigma", s.std_given.size() ? Json(s.std_given[k]) : Json()}});
-    }
-    j["parameters"] = params;
-    j["covariance"] = s.IsSolutionUsable() ? ToJson(s.covariance_residual) : Json();
-    j["covariance_given_sigma"] = s.covariance_given.size() ? ToJson(s.covariance_given) : Json();
-    j["correlation"] = s.IsSolutionUsable() ? ToJson(s.correlation) : Json();
-    j["rank"] = s.identifiability.rank;
-    j["n_params"] = s.identifiability.num_params();
-    j["fixed_for_rank"] = s.fixed;
-    j["iterations"] = s.iterations;
-    j["termination"] = TerminationName(s.termination);
-    j["usable"] = s.IsSolutionUsable();
-    j["message"] = s.message;
-    j["residual_rms"] = s.residual_rms;
-    j["sigma_hat"] = s.sigma_hat;
-    j["n_configurations"] = s.num_configurations;
-    j["solver"] = s.solver;
-    if (!s.identifiability.full_rank()) j["identifiability"] = IdentifiabilityJson(s.identifiability);
-    std::cout << j.dump(2) << "\n";
+    std::cout << IdentificationJson(s).dump(2) << "\n";
   } else {
-    std::cout << s.BriefReport() << "\n";
-    if (s.IsSolutionUsable()) {
-      Table t({"parameter", "unit", "nominal (SI)", "delta", "std", "std (given sigma)"},
-              "Identified parameters (delta and std in mrad / mm)");
-      for (std::size_t k = 0; k < s.names.size(); ++k) {
-        t.AddRow({s.names[k], IsAngularName(s.names[k]) ? "mrad" : "mm", Fixed(s.nominal[k], 6),
-                  Fixed(s.delta[k] * 1e3), Fixed(s.std_residual[k] * 1e3),
-                  s.std_given.size() ? Fixed(s.std_given[k] * 1e3) : "—"});
-      }
-      std::cout << t.ToText();
-      if (!s.fixed.empty()) {
-        std::cout << "fixed at nominal because of rank deficiency:";
-        for (const auto& f : s.fixed) std::cout << " " << f;
-        std::cout << "\n";
-      }
-    } else {
-      std::cout << s.message << "\n";
-      if (!s.identifiability.full_rank()) std::cout << s.identifiability.ToString();
-    }
+    PrintIdentification(s);
   }
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "
@@ -311,14 +314,16 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
        "relative singular value below which a direction is unobservable");
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
-  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, vm);
+  const Plane& plane = setup.plane;
   const ConfigurationSet configs =
       ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
   IdentifiabilityOptions options;
   options.rank_tolerance = vm["rank-tolerance"].as<double>();
+  options.Validate("--rank-tolerance");
   const IdentifiabilityReport r = AnalyzeIdentifiability(model, configs, nullptr, options);
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << IdentifiabilityJson(r).dump(2) << "\n";

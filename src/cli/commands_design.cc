@@ -38,9 +38,10 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (!Parse("design", "--pool C.csv|--generate N --select K [options] --out chosen.csv", o, args,
              &vm))
     return 0;
-  const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, vm);
+  const Plane& plane = setup.plane;
   const long long seed_value = vm["seed"].as<long long>();
   if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
   const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);

@@ -78,71 +78,65 @@ class Spectrum {
   double Score(const Eigen::VectorXd& g, double rho, int m, DesignCriterion criterion) {
     z_.noalias() = Q_.transpose() * g;
     z2_ = z_.cwiseAbs2();
-    const int n = static_cast<int>(lambda_.size());
-    const double zz = z2_.sum();
     switch (criterion) {
       case DesignCriterion::kD:
-      case DesignCriterion::kO1: {
-        double s = 0;
-        for (int i = 0; i < n; ++i) s += z2_[i] / lambda_[i];
-        const double factor = 1 + rho * s;  // determinant lemma
-        if (!(factor > 0) || !(lambda_[0] > 1e-300)) return criterion == DesignCriterion::kD ? kMinusInf : 0.0;
-        const double log_det = log_det_ + std::log(factor);
-        return criterion == DesignCriterion::kD
-                   ? log_det
-                   : std::exp(0.5 * log_det / n) / std::sqrt(static_cast<double>(m));
-      }
-      case DesignCriterion::kA: {
-        double s1 = 0, s2 = 0;
-        for (int i = 0; i < n; ++i) {
-          s1 += z2_[i] / lambda_[i];
-          s2 += z2_[i] / (lambda_[i] * lambda_[i]);
-        }
-        const double factor = 1 + rho * s1;  // Sherman–Morrison
-        if (!(factor > 0) || !(lambda_[0] > 1e-300)) return kMinusInf;
-        return -(inv_trace_ - rho * s2 / factor);
-      }
-      default: break;
+      case DesignCriterion::kO1: return DeterminantScore(rho, m, criterion);
+      case DesignCriterion::kA: return TraceScore(rho);
+      case DesignCriterion::kO5:
+        mu_ = RankOneUpdatedEigenvalues(lambda_, z_, rho);
+        return ScoreFromEigenvalues(mu_, m, criterion);
+      default: return ExtremeEigenvalueScore(rho, criterion);
     }
-    // σ-based criteria: the extreme eigenvalues (or all of them) from the secular equation.
+  }
+
+ private:
+  // D and O1 by the matrix determinant lemma.
+  double DeterminantScore(double rho, int m, DesignCriterion criterion) const {
+    const int n = static_cast<int>(lambda_.size());
+    double s = 0;
+    for (int i = 0; i < n; ++i) s += z2_[i] / lambda_[i];
+    const double factor = 1 + rho * s;
+    if (!(factor > 0) || !(lambda_[0] > 1e-300))
+      return criterion == DesignCriterion::kD ? kMinusInf : 0.0;
+    const double log_det = log_det_ + std::log(factor);
+    return criterion == DesignCriterion::kD
+               ? log_det
+               : std::exp(0.5 * log_det / n) / std::sqrt(static_cast<double>(m));
+  }
+
+  // A by Sherman–Morrison.
+  double TraceScore(double rho) const {
+    const int n = static_cast<int>(lambda_.size());
+    double s1 = 0, s2 = 0;
+    for (int i = 0; i < n; ++i) {
+      s1 += z2_[i] / lambda_[i];
+      s2 += z2_[i] / (lambda_[i] * lambda_[i]);
+    }
+    const double factor = 1 + rho * s1;
+    if (!(factor > 0) || !(lambda_[0] > 1e-300)) return kMinusInf;
+    return -(inv_trace_ - rho * s2 / factor);
+  }
+
+  // E, O2, O4: the extreme eigenvalues of the update from the secular equation; eigenvalues
+  // whose direction g does not touch (z_i ≈ 0) are deflated and stay as they are.
+  double ExtremeEigenvalueScore(double rho, DesignCriterion criterion) {
+    const int n = static_cast<int>(lambda_.size());
+    const double zz = z2_.sum();
     active_.clear();
-    double deflated_min = std::numeric_limits<double>::infinity(), deflated_max = -deflated_min;
+    double mu_min = std::numeric_limits<double>::infinity(), mu_max = -mu_min;
     const double tol = 1e-26 * (zz + std::fabs(lambda_[n - 1]));
     for (int i = 0; i < n; ++i) {
       if (z2_[i] > tol) {
         active_.push_back(i);
       } else {
-        deflated_min = std::min(deflated_min, lambda_[i]);
-        deflated_max = std::max(deflated_max, lambda_[i]);
+        mu_min = std::min(mu_min, lambda_[i]);
+        mu_max = std::max(mu_max, lambda_[i]);
       }
     }
-    if (criterion == DesignCriterion::kO5) {
-      mu_ = RankOneUpdatedEigenvalues(lambda_, z_, rho);
-      return ScoreFromEigenvalues(mu_, m, criterion);
-    }
-    double mu_min = deflated_min, mu_max = deflated_max;
     if (!active_.empty()) {
-      const int a = static_cast<int>(active_.size());
-      const int j0 = active_[0], jl = active_[a - 1];
-      double lo, hi;
-      if (rho > 0) {
-        lo = lambda_[j0];
-        hi = a > 1 ? lambda_[active_[1]] : lambda_[j0] + zz;
-      } else {
-        lo = lambda_[j0] - zz;
-        hi = lambda_[j0];
-      }
-      mu_min = std::min(mu_min, SecularRoot(lambda_, z2_, active_, rho, lo, hi));
-      if (criterion == DesignCriterion::kO2 || criterion == DesignCriterion::kO4) {
-        if (rho > 0) {
-          lo = lambda_[jl];
-          hi = lambda_[jl] + zz;
-        } else {
-          lo = a > 1 ? lambda_[active_[a - 2]] : lambda_[jl] - zz;
-          hi = lambda_[jl];
-        }
-        mu_max = std::max(mu_max, SecularRoot(lambda_, z2_, active_, rho, lo, hi));
-      }
+      mu_min = std::min(mu_min, SmallestRoot(rho, zz));
+      if (criterion == DesignCriterion::kO2 || criterion == DesignCriterion::kO4)
+        mu_max = std::max(mu_max, LargestRoot(rho, zz));
     }
     if (!(mu_min > 1e-300)) return 0.0;
     switch (criterion) {
@@ -153,7 +147,23 @@ class Spectrum {
     }
   }
 
- private:
+  // The smallest and largest roots of the secular equation, bracketed by the interlacing of
+  // the old and new eigenvalues (rank-one update of sign rho).
+  double SmallestRoot(double rho, double zz) const {
+    const int a = static_cast<int>(active_.size());
+    const int j0 = active_[0];
+    const double lo = rho > 0 ? lambda_[j0] : lambda_[j0] - zz;
+    const double hi = rho > 0 ? (a > 1 ? lambda_[active_[1]] : lambda_[j0] + zz) : lambda_[j0];
+    return SecularRoot(lambda_, z2_, active_, rho, lo, hi);
+  }
+  double LargestRoot(double rho, double zz) const {
+    const int a = static_cast<int>(active_.size());
+    const int jl = active_[a - 1];
+    const double lo = rho > 0 ? lambda_[jl] : (a > 1 ? lambda_[active_[a - 2]] : lambda_[jl] - zz);
+    const double hi = rho > 0 ? lambda_[jl] + zz : lambda_[jl];
+    return SecularRoot(lambda_, z2_, active_, rho, lo, hi);
+  }
+
   Eigen::VectorXd lambda_, z_, z2_, mu_;
   Eigen::MatrixXd Q_;
   std::vector<int> active_;
@@ -345,10 +355,9 @@ Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
   return G;
 }
 
-SelectionResult SelectConfigurations(const Eigen::MatrixXd& G, int k,
-                                     const SelectionOptions& options, const RandomStream& stream) {
-  const int N = static_cast<int>(G.rows());
-  const int n = static_cast<int>(G.cols());
+namespace {
+
+void CheckSelectionSize(int N, int n, int k) {
   if (N == 0) throw InputError("selection", "the candidate pool is empty");
   if (k > N)
     throw InputError("selection", "cannot select " + std::to_string(k) + " of " +
@@ -358,83 +367,109 @@ SelectionResult SelectConfigurations(const Eigen::MatrixXd& G, int k,
                                       std::to_string(n) +
                                       " parameters: need at least as many configurations as "
                                       "parameters");
+}
+
+// The paper's case 1: the best of `samples` random subsets.
+void SelectSampled(const Eigen::MatrixXd& G, int k, const SelectionOptions& options,
+                   const RandomStream& stream, SelectionResult* best) {
+  const int N = static_cast<int>(G.rows());
+  for (int s = 0; s < options.samples; ++s) {
+    std::vector<int> subset = RandomSubset(N, k, stream, static_cast<std::uint64_t>(s) * N);
+    const double score = CriterionScore(NormalMatrixOf(G, subset), k, options.criterion);
+    ++best->evaluations;
+    if (score > best->score) {
+      best->score = score;
+      best->indices = subset;
+    }
+  }
+}
+
+// Every k-subset, enumerated by its left-out set (N − k candidates) in lexicographic order.
+void SelectExhaustive(const Eigen::MatrixXd& G, int k, const SelectionOptions& options,
+                      SelectionResult* best) {
+  const int N = static_cast<int>(G.rows());
+  const double count = Binomial(N, k);
+  if (count > options.exhaustive_limit)
+    throw InputError("selection", "exhaustive search over C(" + std::to_string(N) + "," +
+                                      std::to_string(k) + ") = " + std::to_string(count) +
+                                      " subsets is beyond the limit; use exchange or backward");
+  std::vector<int> all(N);
+  std::iota(all.begin(), all.end(), 0);
+  const Eigen::MatrixXd A_all = NormalMatrixOf(G, all);
+  const int drop = N - k;
+  std::vector<int> out(drop);
+  std::iota(out.begin(), out.end(), 0);
+  while (true) {
+    Eigen::MatrixXd A = A_all;
+    for (int r : out) A.noalias() -= G.row(r).transpose() * G.row(r);
+    const double score = CriterionScore(A, k, options.criterion);
+    ++best->evaluations;
+    if (score > best->score) {
+      best->score = score;
+      best->indices.clear();
+      for (int i = 0, o = 0; i < N; ++i) {
+        if (o < drop && out[o] == i) {
+          ++o;
+          continue;
+        }
+        best->indices.push_back(i);
+      }
+    }
+    int i = drop - 1;
+    while (i >= 0 && out[i] == N - drop + i) --i;
+    if (i < 0) return;
+    ++out[i];
+    for (int j = i + 1; j < drop; ++j) out[j] = out[j - 1] + 1;
+  }
+}
+
+// Exchange from several starts (the backward-greedy design, then random designs); the best end
+// wins.
+void SelectExchange(const Eigen::MatrixXd& G, int k, const SelectionOptions& options,
+                    const RandomStream& stream, SelectionResult* best) {
+  const int N = static_cast<int>(G.rows());
+  best->start_score = -std::numeric_limits<double>::infinity();
+  for (int r = 0; r < std::max(1, options.restarts); ++r) {
+    std::vector<int> start = r == 0 ? Backward(G, k, options.criterion, &best->evaluations)
+                                    : RandomSubset(N, k, stream, static_cast<std::uint64_t>(r) * N);
+    best->start_score = std::max(best->start_score,
+                                 CriterionScore(NormalMatrixOf(G, start), k, options.criterion));
+    std::vector<int> end = Exchange(G, start, options.criterion, &best->evaluations);
+    const double score = CriterionScore(NormalMatrixOf(G, end), k, options.criterion);
+    if (score > best->score) {
+      best->score = score;
+      best->indices = end;
+    }
+  }
+}
+
+}  // namespace
+
+SelectionResult SelectConfigurations(const Eigen::MatrixXd& G, int k,
+                                     const SelectionOptions& options, const RandomStream& stream) {
+  CheckSelectionSize(static_cast<int>(G.rows()), static_cast<int>(G.cols()), k);
   SelectionResult best;
   best.score = -std::numeric_limits<double>::infinity();
   switch (options.method) {
     case SelectionMethod::kRandom:
-      best.indices = RandomSubset(N, k, stream, 0);
+      best.indices = RandomSubset(static_cast<int>(G.rows()), k, stream, 0);
       best.evaluations = 1;
       break;
     case SelectionMethod::kSampled:
-      for (int s = 0; s < options.samples; ++s) {
-        std::vector<int> subset = RandomSubset(N, k, stream, static_cast<std::uint64_t>(s) * N);
-        const double score = CriterionScore(NormalMatrixOf(G, subset), k, options.criterion);
-        ++best.evaluations;
-        if (score > best.score) {
-          best.score = score;
-          best.indices = subset;
-        }
-      }
+      SelectSampled(G, k, options, stream, &best);
       break;
-    case SelectionMethod::kExhaustive: {
-      const double count = Binomial(N, k);
-      if (count > options.exhaustive_limit)
-        throw InputError("selection", "exhaustive search over C(" + std::to_string(N) + "," +
-                                          std::to_string(k) + ") = " + std::to_string(count) +
-                                          " subsets is beyond the limit; use exchange or backward");
-      std::vector<int> all(N);
-      std::iota(all.begin(), all.end(), 0);
-      const Eigen::MatrixXd A_all = NormalMatrixOf(G, all);
-      const int drop = N - k;  // enumerate the left-out sets
-      std::vector<int> out(drop);
-      std::iota(out.begin(), out.end(), 0);
-      while (true) {
-        Eigen::MatrixXd A = A_all;
-        for (int r : out) A.noalias() -= G.row(r).transpose() * G.row(r);
-        const double score = CriterionScore(A, k, options.criterion);
-        ++best.evaluations;
-        if (score > best.score) {
-          best.score = score;
-          best.indices.clear();
-          for (int i = 0, o = 0; i < N; ++i) {
-            if (o < drop && out[o] == i) {
-              ++o;
-              continue;
-            }
-            best.indices.push_back(i);
-          }
-        }
-        int i = drop - 1;
-        while (i >= 0 && out[i] == N - drop + i) --i;
-        if (i < 0) break;
-        ++out[i];
-        for (int j = i + 1; j < drop; ++j) out[j] = out[j - 1] + 1;
-      }
+    case SelectionMethod::kExhaustive:
+      SelectExhaustive(G, k, options, &best);
       break;
-    }
     case SelectionMethod::kBackward:
       best.indices = Backward(G, k, options.criterion, &best.evaluations);
       break;
     case SelectionMethod::kGreedy:
       best.indices = Forward(G, k, options.criterion, &best.evaluations);
       break;
-    case SelectionMethod::kExchange: {
-      // Starts: the backward-greedy design, then random designs; the best end wins.
-      best.start_score = -std::numeric_limits<double>::infinity();
-      for (int r = 0; r < std::max(1, options.restarts); ++r) {
-        std::vector<int> start = r == 0 ? Backward(G, k, options.criterion, &best.evaluations)
-                                        : RandomSubset(N, k, stream, static_cast<std::uint64_t>(r) * N);
-        best.start_score =
-            std::max(best.start_score, CriterionScore(NormalMatrixOf(G, start), k, options.criterion));
-        std::vector<int> end = Exchange(G, start, options.criterion, &best.evaluations);
-        const double score = CriterionScore(NormalMatrixOf(G, end), k, options.criterion);
-        if (score > best.score) {
-          best.score = score;
-          best.indices = end;
-        }
-      }
+    case SelectionMethod::kExchange:
+      SelectExchange(G, k, options, stream, &best);
       break;
-    }
   }
   best.score = CriterionScore(NormalMatrixOf(G, best.indices), k, options.criterion);
   return best;

@@ -1,5 +1,9 @@
 #include "lrcal/identification/identifiability.h"
 
+#include <memory>
+
+#include "lrcal/core/error.h"
+
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <cmath>
@@ -60,71 +64,102 @@ Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
   return G;
 }
 
+void IdentifiabilityOptions::Validate(const std::string& source) const {
+  const auto check = [&](double v, const char* name) {
+    if (!(v >= 0 && v < 1))
+      throw InputError(source, std::string(name) + ": expected a relative tolerance in [0, 1), "
+                                                    "got " + std::to_string(v));
+  };
+  check(rank_tolerance, "rank tolerance");
+  check(zero_column_tolerance, "zero-column tolerance");
+  check(coefficient_tolerance, "coefficient tolerance");
+}
+
+namespace {
+
+// Parameters with (numerically) no effect are set aside before scaling, so that rounding is never
+// scaled into a fake dependence; the rest are scaled to unit columns.
+Eigen::MatrixXd ScaledLiveColumns(const Eigen::MatrixXd& G, const IdentifiabilityOptions& options,
+                                  IdentifiabilityReport* report, std::vector<int>* live) {
+  const int n = static_cast<int>(G.cols());
+  report->column_norms = G.colwise().norm().transpose();
+  const double max_norm = n > 0 ? report->column_norms.maxCoeff() : 0.0;
+  for (int j = 0; j < n; ++j) {
+    if (report->column_norms[j] <= options.zero_column_tolerance * max_norm)
+      report->unidentifiable.push_back(report->names[j]);
+    else
+      live->push_back(j);
+  }
+  const int nl = static_cast<int>(live->size());
+  Eigen::MatrixXd Gs(G.rows(), nl);
+  for (int k = 0; k < nl; ++k) Gs.col(k) = G.col((*live)[k]) / report->column_norms[(*live)[k]];
+  return Gs;
+}
+
+// Rank and condition number from the singular values of the scaled live columns.
+void RankFromSingularValues(const Eigen::MatrixXd& Gs, int n,
+                            const IdentifiabilityOptions& options, IdentifiabilityReport* report) {
+  if (Gs.cols() > 0 && Gs.rows() > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Gs);
+    report->singular_values = svd.singularValues();
+  } else {
+    report->singular_values.resize(0);
+  }
+  const double smax = report->singular_values.size() ? report->singular_values[0] : 0.0;
+  int rank = 0;
+  for (int i = 0; i < report->singular_values.size(); ++i)
+    if (report->singular_values[i] > options.rank_tolerance * smax) ++rank;
+  report->rank = rank;
+  report->condition_number = (rank == n && rank > 0) ? smax / report->singular_values[rank - 1]
+                                                     : std::numeric_limits<double>::infinity();
+}
+
+// Dependent columns: QR with column pivoting keeps `rank` well-conditioned columns; each other
+// column is written as a combination of the kept ones (none kept: a column depends on nothing).
+void FindDependencies(const Eigen::MatrixXd& Gs, const std::vector<int>& live,
+                      const IdentifiabilityOptions& options, IdentifiabilityReport* report) {
+  const int rank = report->rank, nl = static_cast<int>(live.size());
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Gs);
+  const auto& perm = qr.colsPermutation().indices();
+  std::vector<int> kept(perm.data(), perm.data() + rank);
+  std::sort(kept.begin(), kept.end());
+  Eigen::MatrixXd Gk(Gs.rows(), rank);
+  for (int k = 0; k < rank; ++k) Gk.col(k) = Gs.col(kept[k]);
+  std::unique_ptr<Eigen::ColPivHouseholderQR<Eigen::MatrixXd>> qk;
+  if (rank > 0) qk = std::make_unique<Eigen::ColPivHouseholderQR<Eigen::MatrixXd>>(Gk);
+  std::vector<int> dependent(perm.data() + rank, perm.data() + nl);
+  std::sort(dependent.begin(), dependent.end());
+  for (int jd : dependent) {
+    const int j = live[jd];
+    Dependency dep;
+    dep.terms.emplace_back(report->names[j], 1.0);
+    const Eigen::VectorXd c = qk ? Eigen::VectorXd(qk->solve(Gs.col(jd))) : Eigen::VectorXd();
+    for (int k = 0; k < c.size(); ++k) {
+      if (std::fabs(c[k]) < options.coefficient_tolerance) continue;
+      const int jk = live[kept[k]];
+      // Scaled: g_j/|g_j| = Σ c_k g_k/|g_k|  ⇒  g_j = Σ c_k |g_j|/|g_k| g_k.
+      dep.terms.emplace_back(report->names[jk],
+                             -c[k] * report->column_norms[j] / report->column_norms[jk]);
+    }
+    report->dependencies.push_back(dep);
+    report->suggested_fixed.push_back(report->names[j]);
+  }
+}
+
+}  // namespace
+
 IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
                                              const ConfigurationSet& configs, const double* e,
                                              const IdentifiabilityOptions& options) {
+  options.Validate();
   IdentifiabilityReport report;
   report.names = model.parameters().names;
   report.num_configurations = configs.size();
-  const int n = model.num_parameters();
   const Eigen::MatrixXd G = IdentificationJacobian(model, configs, e);
-  report.column_norms = G.colwise().norm().transpose();
-  const double max_norm = n > 0 ? report.column_norms.maxCoeff() : 0.0;
-
   std::vector<int> live;
-  for (int j = 0; j < n; ++j) {
-    if (report.column_norms[j] <= options.zero_column_tolerance * max_norm) {
-      report.unidentifiable.push_back(report.names[j]);
-    } else {
-      live.push_back(j);
-    }
-  }
-  const int nl = static_cast<int>(live.size());
-  Eigen::MatrixXd Gs(G.rows(), nl);
-  for (int k = 0; k < nl; ++k) Gs.col(k) = G.col(live[k]) / report.column_norms[live[k]];
-
-  if (nl > 0 && G.rows() > 0) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Gs);
-    report.singular_values = svd.singularValues();
-  } else {
-    report.singular_values.resize(0);
-  }
-  const double smax = report.singular_values.size() ? report.singular_values[0] : 0.0;
-  int rank = 0;
-  for (int i = 0; i < report.singular_values.size(); ++i)
-    if (report.singular_values[i] > options.rank_tolerance * smax) ++rank;
-  report.rank = rank;
-  report.condition_number = (rank == n && rank > 0)
-                                ? smax / report.singular_values[rank - 1]
-                                : std::numeric_limits<double>::infinity();
-
-  // Dependent columns: QR with column pivoting keeps `rank` well-conditioned columns.
-  if (rank < nl) {
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Gs);
-    const auto& perm = qr.colsPermutation().indices();
-    std::vector<int> kept(perm.data(), perm.data() + rank);
-    std::sort(kept.begin(), kept.end());
-    Eigen::MatrixXd Gk(Gs.rows(), rank);
-    for (int k = 0; k < rank; ++k) Gk.col(k) = Gs.col(kept[k]);
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qk(Gk);
-    std::vector<int> dependent(perm.data() + rank, perm.data() + nl);
-    std::sort(dependent.begin(), dependent.end());
-    for (int jd : dependent) {
-      Eigen::VectorXd c = qk.solve(Gs.col(jd));
-      Dependency dep;
-      const int j = live[jd];
-      dep.terms.emplace_back(report.names[j], 1.0);
-      for (int k = 0; k < rank; ++k) {
-        if (std::fabs(c[k]) < options.coefficient_tolerance) continue;
-        const int jk = live[kept[k]];
-        // Scaled: g_j/|g_j| = Σ c_k g_k/|g_k|  ⇒  g_j = Σ c_k |g_j|/|g_k| g_k.
-        dep.terms.emplace_back(report.names[jk],
-                               -c[k] * report.column_norms[j] / report.column_norms[jk]);
-      }
-      report.dependencies.push_back(dep);
-      report.suggested_fixed.push_back(report.names[j]);
-    }
-  }
+  const Eigen::MatrixXd Gs = ScaledLiveColumns(G, options, &report, &live);
+  RankFromSingularValues(Gs, model.num_parameters(), options, &report);
+  if (report.rank < static_cast<int>(live.size())) FindDependencies(Gs, live, options, &report);
   for (const auto& name : report.unidentifiable) report.suggested_fixed.push_back(name);
   // Keep suggested_fixed in parameter-set order.
   std::vector<std::string> ordered;

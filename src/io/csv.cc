@@ -1,4 +1,6 @@
 #include "lrcal/io/csv.h"
+
+#include "lrcal/core/json.h"
 #include "lrcal/core/strings.h"
 
 #include <cmath>
@@ -137,9 +139,17 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints) {
   return data;
 }
 
+// The file is written whole or not at all: a failed or full disk is an error naming it.
+void WriteOutputFile(const std::string& path, const std::string& text) {
+  try {
+    WriteFileAtomically(path, text);
+  } catch (const std::runtime_error& e) {
+    throw InputError(path, std::string("cannot write the output file: ") + e.what());
+  }
+}
+
 void WriteConfigurations(const std::string& path, const ConfigurationSet& configs) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path, "cannot write file");
+  std::ostringstream out;
   for (int j = 0; j < configs.num_joints(); ++j) out << (j ? "," : "") << "q" << j + 1;
   out << "\n";
   for (int i = 0; i < configs.size(); ++i) {
@@ -147,6 +157,20 @@ void WriteConfigurations(const std::string& path, const ConfigurationSet& config
       out << (j ? "," : "") << FormatExact(configs.q(i)[j]);
     out << "\n";
   }
+  WriteOutputFile(path, out.str());
+}
+
+void WriteReadings(const std::string& path, const ConfigurationSet& configs,
+                   const std::vector<double>& readings, int repetitions) {
+  std::ostringstream out;
+  for (int j = 0; j < configs.num_joints(); ++j) out << "q" << j + 1 << ",";
+  out << "h,repetition\n";
+  for (int i = 0, k = 0; i < configs.size(); ++i)
+    for (int r = 0; r < repetitions; ++r, ++k) {
+      for (int j = 0; j < configs.num_joints(); ++j) out << FormatExact(configs.q(i)[j]) << ",";
+      out << FormatExact(readings[k]) << "," << r + 1 << "\n";
+    }
+  WriteOutputFile(path, out.str());
 }
 
 }  // namespace lrcal

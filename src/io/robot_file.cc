@@ -43,110 +43,135 @@ double LengthScale(const std::string& unit, const std::string& where) {
 
 }  // namespace
 
-RobotFile LoadRobotFile(const std::string& path) {
+namespace {
+
+JointType ParseJoint(const YAML::Node& node, const std::string& path, const std::string& key) {
+  const std::string j = yaml::String(node, path, key);
+  if (j == "revolute") return JointType::kRevolute;
+  if (j == "prismatic") return JointType::kPrismatic;
+  throw InputError(yaml::Where(path, node, key), "expected revolute or prismatic; got '" + j + "'");
+}
+
+// links[i]: joint, the five nominal values (β defaults to 0), which are parameters, joint range.
+Link ParseLink(const YAML::Node& ln, const std::string& path, const std::string& ctx) {
   using namespace yaml;
-  YAML::Node root = LoadFile(path);
-  CheckKeys(root, {"name", "description", "links", "true_errors", "plane", "ranger"}, path, "");
-  std::string name = root["name"] ? String(root["name"], path, "name") : path;
+  CheckKeys(ln, {"joint", "theta", "alpha", "a", "d", "beta", "parameters", "q_min", "q_max"},
+            path, ctx);
+  Link link;
+  if (ln["joint"]) link.joint = ParseJoint(ln["joint"], path, ctx + ".joint");
+  for (int v = 0; v < kValuesPerLink; ++v) {
+    const char* vn = LinkValueName(v);
+    YAML::Node node = ln[vn];
+    if (!node) {
+      if (v == kBeta) continue;  // β defaults to 0
+      throw InputError(Where(path, ln, ctx + "." + vn), "missing value");
+    }
+    link.nominal[v] = Number(node, path, ctx + "." + vn, /*allow_pi=*/IsAngle(v));
+  }
+  if (!ln["parameters"])
+    throw InputError(Where(path, ln, ctx + ".parameters"),
+                     "missing: list which of theta, alpha, a, d, beta are parameters");
+  for (const std::string& p : StringList(ln["parameters"], path, ctx + ".parameters")) {
+    const int v = LinkValueIndex(p + "1", 1);
+    if (v < 0)
+      throw InputError(Where(path, ln["parameters"], ctx + ".parameters"),
+                       "unknown parameter '" + p + "'; expected theta, alpha, a, d or beta");
+    link.is_parameter[v] = true;
+  }
+  if (ln["q_min"]) link.q_min = Number(ln["q_min"], path, ctx + ".q_min", true);
+  if (ln["q_max"]) link.q_max = Number(ln["q_max"], path, ctx + ".q_max", true);
+  if (!(link.q_min < link.q_max)) throw InputError(Where(path, ln, ctx), "q_min must be below q_max");
+  return link;
+}
+
+std::vector<Link> ParseLinks(const YAML::Node& root, const std::string& path) {
   YAML::Node links_node = root["links"];
   if (!links_node || !links_node.IsSequence() || links_node.size() == 0)
-    throw InputError(Where(path, root, "links"), "expected a non-empty list of links");
-
+    throw InputError(yaml::Where(path, root, "links"), "expected a non-empty list of links");
   std::vector<Link> links;
-  for (std::size_t i = 0; i < links_node.size(); ++i) {
-    const YAML::Node ln = links_node[i];
-    const std::string ctx = "links[" + std::to_string(i) + "]";
-    CheckKeys(ln, {"joint", "theta", "alpha", "a", "d", "beta", "parameters", "q_min", "q_max"},
-              path, ctx);
-    Link link;
-    if (ln["joint"]) {
-      std::string j = String(ln["joint"], path, ctx + ".joint");
-      if (j == "revolute") link.joint = JointType::kRevolute;
-      else if (j == "prismatic") link.joint = JointType::kPrismatic;
-      else throw InputError(Where(path, ln["joint"], ctx + ".joint"),
-                            "expected revolute or prismatic; got '" + j + "'");
-    }
-    for (int v = 0; v < kValuesPerLink; ++v) {
-      const char* vn = LinkValueName(v);
-      YAML::Node node = ln[vn];
-      if (!node) {
-        if (v == kBeta) continue;  // β defaults to 0
-        throw InputError(Where(path, ln, ctx + "." + vn), "missing value");
-      }
-      link.nominal[v] = Number(node, path, ctx + "." + vn, /*allow_pi=*/IsAngle(v));
-    }
-    if (!ln["parameters"])
-      throw InputError(Where(path, ln, ctx + ".parameters"),
-                       "missing: list which of theta, alpha, a, d, beta are parameters");
-    for (const std::string& p : StringList(ln["parameters"], path, ctx + ".parameters")) {
-      int v = -1;
-      for (int k = 0; k < kValuesPerLink; ++k)
-        if (p == LinkValueName(k)) v = k;
-      if (v < 0)
-        throw InputError(Where(path, ln["parameters"], ctx + ".parameters"),
-                         "unknown parameter '" + p + "'; expected theta, alpha, a, d or beta");
-      link.is_parameter[v] = true;
-    }
-    if (ln["q_min"]) link.q_min = Number(ln["q_min"], path, ctx + ".q_min", true);
-    if (ln["q_max"]) link.q_max = Number(ln["q_max"], path, ctx + ".q_max", true);
-    if (!(link.q_min < link.q_max))
-      throw InputError(Where(path, ln, ctx), "q_min must be below q_max");
-    links.push_back(link);
-  }
+  for (std::size_t i = 0; i < links_node.size(); ++i)
+    links.push_back(ParseLink(links_node[i], path, "links[" + std::to_string(i) + "]"));
+  return links;
+}
 
+// true_errors: units, then per link the errors of its parameters (SI out).
+Eigen::VectorXd ParseTrueErrors(const YAML::Node& root, const std::string& path,
+                                const std::vector<Link>& links) {
+  using namespace yaml;
   Eigen::VectorXd errors = Eigen::VectorXd::Zero(kValuesPerLink * links.size());
-  if (YAML::Node te = root["true_errors"]) {
-    CheckKeys(te, {"angle_unit", "length_unit", "links"}, path, "true_errors");
-    double as = AngleScale(te["angle_unit"] ? String(te["angle_unit"], path, "true_errors.angle_unit")
-                                            : "rad",
-                           Where(path, te["angle_unit"], "true_errors.angle_unit"));
-    double ls = LengthScale(te["length_unit"]
-                                ? String(te["length_unit"], path, "true_errors.length_unit")
-                                : "m",
-                            Where(path, te["length_unit"], "true_errors.length_unit"));
-    YAML::Node tl = te["links"];
-    if (!tl || !tl.IsSequence() || tl.size() != links.size())
-      throw InputError(Where(path, te, "true_errors.links"),
-                       "expected a list of " + std::to_string(links.size()) +
-                           " entries, one per link");
-    for (std::size_t i = 0; i < tl.size(); ++i) {
-      const std::string ctx = "true_errors.links[" + std::to_string(i) + "]";
-      CheckKeys(tl[i], {"theta", "alpha", "a", "d", "beta"}, path, ctx);
-      for (int v = 0; v < kValuesPerLink; ++v) {
-        YAML::Node node = tl[i][LinkValueName(v)];
-        if (!node) continue;
-        if (!links[i].is_parameter[v])
-          throw InputError(Where(path, node, ctx + "." + LinkValueName(v)),
-                           "an error is given for a value that is not a parameter of link " +
-                               std::to_string(i + 1));
-        errors[kValuesPerLink * i + v] =
-            Number(node, path, ctx + "." + LinkValueName(v)) * (IsAngle(v) ? as : ls);
-      }
+  const YAML::Node te = root["true_errors"];
+  if (!te) return errors;
+  CheckKeys(te, {"angle_unit", "length_unit", "links"}, path, "true_errors");
+  const double as =
+      AngleScale(te["angle_unit"] ? String(te["angle_unit"], path, "true_errors.angle_unit") : "rad",
+                 Where(path, te["angle_unit"], "true_errors.angle_unit"));
+  const double ls =
+      LengthScale(te["length_unit"] ? String(te["length_unit"], path, "true_errors.length_unit")
+                                    : "m",
+                  Where(path, te["length_unit"], "true_errors.length_unit"));
+  const YAML::Node tl = te["links"];
+  if (!tl || !tl.IsSequence() || tl.size() != links.size())
+    throw InputError(Where(path, te, "true_errors.links"),
+                     "expected a list of " + std::to_string(links.size()) +
+                         " entries, one per link");
+  for (std::size_t i = 0; i < tl.size(); ++i) {
+    const std::string ctx = "true_errors.links[" + std::to_string(i) + "]";
+    CheckKeys(tl[i], {"theta", "alpha", "a", "d", "beta"}, path, ctx);
+    for (int v = 0; v < kValuesPerLink; ++v) {
+      const YAML::Node node = tl[i][LinkValueName(v)];
+      if (!node) continue;
+      if (!links[i].is_parameter[v])
+        throw InputError(Where(path, node, ctx + "." + LinkValueName(v)),
+                         "an error is given for a value that is not a parameter of link " +
+                             std::to_string(i + 1));
+      errors[kValuesPerLink * i + v] =
+          Number(node, path, ctx + "." + LinkValueName(v)) * (IsAngle(v) ? as : ls);
     }
   }
+  return errors;
+}
 
-  RobotFile file{RobotModel(name, links, errors, path), std::nullopt, RangerSpec{}, path};
+std::optional<Plane> ParsePlane(const YAML::Node& root, const std::string& path) {
+  using namespace yaml;
+  const YAML::Node pl = root["plane"];
+  if (!pl) return std::nullopt;
+  CheckKeys(pl, {"normal", "offset"}, path, "plane");
+  const std::vector<double> n = NumberList(pl["normal"], path, "plane.normal");
+  if (n.size() != 3)
+    throw InputError(Where(path, pl["normal"], "plane.normal"), "expected 3 numbers");
+  const double f = Number(pl["offset"], path, "plane.offset");
+  return Plane::FromCoefficients(n[0], n[1], n[2], f, Where(path, pl, "plane"));
+}
+
+RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
+  using namespace yaml;
+  RangerSpec ranger;
+  const YAML::Node rg = root["ranger"];
+  if (!rg) return ranger;
+  CheckKeys(rg, {"min_range", "max_range", "max_incidence_deg"}, path, "ranger");
+  if (rg["min_range"]) ranger.min_range = Number(rg["min_range"], path, "ranger.min_range");
+  if (rg["max_range"]) ranger.max_range = Number(rg["max_range"], path, "ranger.max_range");
+  if (rg["max_incidence_deg"])
+    ranger.max_incidence =
+        Number(rg["max_incidence_deg"], path, "ranger.max_incidence_deg") * M_PI / 180.0;
+  if (!(ranger.min_range >= 0 && ranger.min_range < ranger.max_range))
+    throw InputError(Where(path, rg, "ranger"), "expected 0 <= min_range < max_range (m)");
+  if (!(ranger.max_incidence > 0 && ranger.max_incidence <= M_PI / 2))
+    throw InputError(Where(path, rg, "ranger.max_incidence_deg"), "expected a value in (0, 90]");
+  return ranger;
+}
+
+}  // namespace
+
+RobotFile LoadRobotFile(const std::string& path) {
+  YAML::Node root = yaml::LoadFile(path);
+  yaml::CheckKeys(root, {"name", "description", "links", "true_errors", "plane", "ranger"}, path,
+                  "");
+  const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
+  const std::vector<Link> links = ParseLinks(root, path);
+  RobotFile file{RobotModel(name, links, ParseTrueErrors(root, path, links), path),
+                 ParsePlane(root, path), ParseRanger(root, path), path};
   file.robot.source = path;
-  RangerSpec& ranger = file.ranger;
-  if (YAML::Node pl = root["plane"]) {
-    CheckKeys(pl, {"normal", "offset"}, path, "plane");
-    std::vector<double> n = NumberList(pl["normal"], path, "plane.normal");
-    if (n.size() != 3) throw InputError(Where(path, pl["normal"], "plane.normal"), "expected 3 numbers");
-    double f = Number(pl["offset"], path, "plane.offset");
-    file.plane = Plane::FromCoefficients(n[0], n[1], n[2], f, Where(path, pl, "plane"));
-  }
-  if (YAML::Node rg = root["ranger"]) {
-    CheckKeys(rg, {"min_range", "max_range", "max_incidence_deg"}, path, "ranger");
-    if (rg["min_range"]) ranger.min_range = Number(rg["min_range"], path, "ranger.min_range");
-    if (rg["max_range"]) ranger.max_range = Number(rg["max_range"], path, "ranger.max_range");
-    if (rg["max_incidence_deg"])
-      ranger.max_incidence =
-          Number(rg["max_incidence_deg"], path, "ranger.max_incidence_deg") * M_PI / 180.0;
-    if (!(ranger.min_range >= 0 && ranger.min_range < ranger.max_range))
-      throw InputError(Where(path, rg, "ranger"), "expected 0 <= min_range < max_range (m)");
-    if (!(ranger.max_incidence > 0 && ranger.max_incidence <= M_PI / 2))
-      throw InputError(Where(path, rg, "ranger.max_incidence_deg"), "expected a value in (0, 90]");
-  }
   return file;
 }
 

@@ -7,6 +7,7 @@
 #include "lrcal/study/study.h"
 #include "lrcal/report/study_tables.h"
 #include "study/trial_pipeline.h"
+#include "lrcal/study/run_directory.h"
 #include "lrcal/study/trial_store.h"
 
 namespace lrcal {
@@ -30,102 +31,109 @@ Json Columns(const Eigen::Matrix3Xd& m, double scale) {
 
 }  // namespace
 
-ReportData PrepareReportData(const std::string& run_dir) {
+namespace {
+
+Json ReadReportManifest(const std::string& run_dir) {
   const fs::path dir = run_dir;
   if (!fs::is_directory(dir)) throw InputError(run_dir, "no such run directory");
   const fs::path manifest_path = dir / "manifest.json";
   if (!fs::exists(manifest_path))
     throw InputError(run_dir, "not an lrcal run directory: manifest.json is missing");
-  Json manifest;
-  try {
-    std::ifstream in(manifest_path);
-    manifest = Json::parse(in);
-  } catch (const Json::exception& e) {
-    throw InputError(manifest_path.string(), std::string("not valid JSON: ") + e.what());
-  }
+  const Json manifest = ReadJsonFile(manifest_path.string());
   if (!manifest.contains("study") || !manifest["study"].contains("cells") ||
       !manifest["study"].contains("trials"))
-    throw InputError(manifest_path.string(), "malformed manifest: expected study.cells and study.trials");
+    throw InputError(manifest_path.string(),
+                     "malformed manifest: expected study.cells and study.trials");
+  return manifest;
+}
 
-  ReportData data;
-  data.dir = (dir / "report").string();
-  fs::create_directories(data.dir);
-  // A consistent snapshot of every store (SQLite readers do not block a running writer).
-  const fs::path snapshot = fs::path(data.dir) / "trials.snapshot.sqlite";
+// A consistent snapshot of every store (SQLite readers do not block a running writer), and the
+// tables from it.
+void SnapshotAndTables(const std::string& run_dir, const Json& manifest, ReportData* data) {
+  const fs::path snapshot = fs::path(data->dir) / "trials.snapshot.sqlite";
   for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(snapshot.string() + suffix);
-  {
-    TrialStore snap(snapshot.string());
-    bool any = false;
-    for (const auto& e : fs::directory_iterator(dir)) {
-      const std::string name = e.path().filename().string();
-      if (name == "trials.sqlite" ||
-          (name.rfind("trials.rank", 0) == 0 && name.size() > 7 &&
-           name.compare(name.size() - 7, 7, ".sqlite") == 0)) {
-        snap.MergeFrom(e.path().string());
-        any = true;
-      }
-    }
-    if (!any) throw InputError(run_dir, "no trial store (trials.sqlite): the run has not started");
-    const long long trials = manifest["study"]["trials"];
-    for (const auto& c : manifest["study"]["cells"]) {
-      data.done += snap.CountTrials(c["id"].get<std::string>());
-      data.expected += trials;
-    }
-    data.complete = data.done >= data.expected;
-    WriteStudyTables(snap, manifest["study"], data.dir);
+  TrialStore snap(snapshot.string());
+  const std::vector<std::string> stores = RunDirectory(run_dir).StorePaths();
+  if (stores.empty())
+    throw InputError(run_dir, "no trial store (trials.sqlite): the run has not started");
+  for (const std::string& path : stores) snap.MergeFrom(path);
+  const long long trials = manifest["study"]["trials"];
+  for (const auto& c : manifest["study"]["cells"]) {
+    data->done += snap.CountTrials(c["id"].get<std::string>());
+    data->expected += trials;
   }
+  data->complete = data->done >= data->expected;
+  WriteStudyTables(snap, manifest["study"], data->dir);
+}
 
-  // Trial 0 of every cell in detail, recomputed (it is a pure function of the settings).
+Json PoseErrorsJson(const PoseErrors& nominal, const PoseErrors& identified) {
+  return {{"position_nominal", Columns(nominal.position, 1e3)},
+          {"position_identified", Columns(identified.position, 1e3)},
+          {"orientation_nominal", Columns(nominal.orientation, 1e3)},
+          {"orientation_identified", Columns(identified.orientation, 1e3)}};
+}
+
+// Trial 0 of a cell in detail, recomputed (it is a pure function of the settings).
+Json CellRealisation(const Study& study, const Cell& cell) {
+  auto context = PrepareCell(study, cell);
+  TrialWorkspace ws;
+  TrialDetails d;
+  const TrialRecord r = RunTrial(*context, 0, &ws, &d);
+  Json cj = {{"id", cell.id}, {"label", cell.label}, {"status", TrialStatusName(r.status)},
+             {"paper_case", cell.typed.paper_case}};
+  if (r.status == TrialStatus::kOk) {
+    cj["distance_error_nominal"] = Vector(d.distance_error_nominal, 1e3);
+    cj["distance_error_identified"] = Vector(d.distance_error_identified, 1e3);
+    cj["measurement"] = PoseErrorsJson(d.measurement_nominal, d.measurement_identified);
+    cj["validation"] = PoseErrorsJson(d.validation_nominal, d.validation_identified);
+  }
+  return cj;
+}
+
+// Every cell of the run that the study file still has; InputError when none can be recomputed.
+Json Realisation(const Json& manifest) {
   Json realisation;
   realisation["trial"] = 0;
   realisation["units"] = "distance errors mm; position errors mm; orientation errors mrad";
   realisation["cells"] = Json::array();
+  const std::string study_file = manifest.value("study_file", std::string());
+  const Study study = LoadStudy(study_file);
+  if (study.seed != manifest["study"]["seed"].get<std::uint64_t>())
+    throw InputError(study_file, "the study file changed since the run (seed)");
+  for (const Cell& cell : study.cells) {
+    bool in_run = false;
+    for (const auto& c : manifest["study"]["cells"]) in_run |= c["id"] == cell.id;
+    if (in_run) realisation["cells"].push_back(CellRealisation(study, cell));
+  }
+  if (realisation["cells"].empty())
+    throw InputError(study_file, "none of its cells is in this run (the study file, or lrcal's "
+                                 "settings, changed since the run)");
+  return realisation;
+}
+
+}  // namespace
+
+ReportData PrepareReportData(const std::string& run_dir) {
+  const Json manifest = ReadReportManifest(run_dir);
+  ReportData data;
+  data.dir = (fs::path(run_dir) / "report").string();
+  fs::create_directories(data.dir);
+  SnapshotAndTables(run_dir, manifest, &data);
+  const fs::path realisation_path = fs::path(data.dir) / "realisation.json";
+  fs::remove(realisation_path);
   try {
-    const std::string study_file = manifest.value("study_file", std::string());
-    const Study study = LoadStudy(study_file);
-    if (study.seed != manifest["study"]["seed"].get<std::uint64_t>())
-      throw InputError(study_file, "the study file changed since the run (seed)");
-    for (const Cell& cell : study.cells) {
-      bool in_run = false;
-      for (const auto& c : manifest["study"]["cells"]) in_run |= c["id"] == cell.id;
-      if (!in_run) continue;
-      auto context = PrepareCell(study, cell);
-      TrialWorkspace ws;
-      TrialDetails d;
-      const TrialRecord r = RunTrial(*context, 0, &ws, &d);
-      Json cj = {{"id", cell.id}, {"label", cell.label}, {"status", TrialStatusName(r.status)},
-                 {"paper_case", cell.typed.paper_case}};
-      if (r.status == TrialStatus::kOk) {
-        cj["distance_error_nominal"] = Vector(d.distance_error_nominal, 1e3);
-        cj["distance_error_identified"] = Vector(d.distance_error_identified, 1e3);
-        cj["measurement"] = {{"position_nominal", Columns(d.measurement_nominal.position, 1e3)},
-                             {"position_identified", Columns(d.measurement_identified.position, 1e3)},
-                             {"orientation_nominal", Columns(d.measurement_nominal.orientation, 1e3)},
-                             {"orientation_identified",
-                              Columns(d.measurement_identified.orientation, 1e3)}};
-        cj["validation"] = {{"position_nominal", Columns(d.validation_nominal.position, 1e3)},
-                            {"position_identified", Columns(d.validation_identified.position, 1e3)},
-                            {"orientation_nominal", Columns(d.validation_nominal.orientation, 1e3)},
-                            {"orientation_identified",
-                             Columns(d.validation_identified.orientation, 1e3)}};
-      }
-      realisation["cells"].push_back(cj);
-    }
-    if (realisation["cells"].empty())
-      throw InputError(study_file, "none of its cells is in this run (the study file, or lrcal's "
-                                   "settings, changed since the run)");
+    const Json realisation = Realisation(manifest);
+    WriteFileAtomically(realisation_path.string(), realisation.dump(1) + "\n");
     data.realisation = true;
   } catch (const InputError& e) {
     data.note = std::string("one-realisation figures left out: ") + e.what();
   }
-  fs::remove(fs::path(data.dir) / "realisation.json");
-  if (data.realisation) {
-    std::ofstream out(fs::path(data.dir) / "realisation.json");
-    out << realisation.dump(1) << "\n";
-  }
-  Json status = {{"done", data.done}, {"expected", data.expected}, {"complete", data.complete},
-                 {"realisation", data.realisation}, {"note", data.note}};
-  std::ofstream(fs::path(data.dir) / "status.json") << status.dump(2) << "\n";
+  const Json status = {{"done", data.done},
+                       {"expected", data.expected},
+                       {"complete", data.complete},
+                       {"realisation", data.realisation},
+                       {"note", data.note}};
+  WriteFileAtomically((fs::path(data.dir) / "status.json").string(), status.dump(2) + "\n");
   return data;
 }
 

@@ -33,6 +33,8 @@ struct IdentifiabilityOptions {
   double zero_column_tolerance = 1e-10;
   /// Coefficients of a dependence smaller than this (in the scaled problem) are dropped.
   double coefficient_tolerance = 1e-7;
+  /// Throws InputError (where = `source`) unless every tolerance is finite and in [0, 1).
+  void Validate(const std::string& source = "identifiability options") const;
 };
 
 /// One exact dependence among parameters: moving the parameters along the direction whose

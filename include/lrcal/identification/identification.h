@@ -25,6 +25,8 @@
 namespace lrcal {
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
+inline constexpr EnumName<RobustLoss> kRobustLossNames[] = {
+    {RobustLoss::kNone, "none"}, {RobustLoss::kHuber, "huber"}, {RobustLoss::kCauchy, "cauchy"}};
 
 struct IdentificationOptions {
   enum class Solver { kLevenbergMarquardt, kCeres };  ///< names: kSolverNames

@@ -30,7 +30,13 @@ ConfigurationSet ReadConfigurations(const std::string& path, int num_joints);
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints);
 
 /// Writes `q1..qN` rows with 17 significant digits (exact round trip).
+/// Writes configurations (header q1..qN) at full precision. The file is written whole or not at
+/// all; any failure (a full disk, a folder that cannot be written) is an InputError naming it.
 void WriteConfigurations(const std::string& path, const ConfigurationSet& configs);
+/// Writes single readings (header q1..qN,h,repetition): `readings` holds `repetitions` readings
+/// per configuration, configuration-major. Whole or not at all, like WriteConfigurations.
+void WriteReadings(const std::string& path, const ConfigurationSet& configs,
+                   const std::vector<double>& readings, int repetitions);
 
 /// Formats a double with 17 significant digits.
 std::string FormatExact(double v);
