@@ -105,6 +105,48 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) 
   return options;
 }
 
+// Tool pose, beam and reading (and the Jacobian row) of configuration i, as JSON and a row of
+// `table`.
+Json KinematicsRow(const MeasurementModel& model, const ModelPoint& point,
+                   const ConfigurationSet& configs, int i, const RangerSpec& ranger, bool jacobian,
+                   Table* table) {
+  const ParameterSet& ps = model.parameters();
+  std::vector<double> row(ps.size());
+  double h;
+  const double nb = model.Evaluate(point, configs, i, &h, jacobian ? row.data() : nullptr);
+  const BeamMiss miss = ClassifyReading(h, nb, ranger);
+  const Pose<double> pose = ToolPose(point, configs, i);
+  Json j;
+  j["q"] = std::vector<double>(configs.q(i), configs.q(i) + configs.num_joints());
+  j["position"] = {pose.p_BT.x(), pose.p_BT.y(), pose.p_BT.z()};
+  j["rotation"] = ToJson(Eigen::MatrixXd(pose.R_BT));
+  j["beam"] = {pose.R_BT(0, 2), pose.R_BT(1, 2), pose.R_BT(2, 2)};
+  j["h"] = miss == BeamMiss::kNone ? Json(h) : Json();
+  j["status"] = BeamMissName(miss);
+  if (jacobian) {
+    Json g = Json::object();
+    for (int k = 0; k < ps.size(); ++k) g[ps.names[k]] = row[k];
+    j["jacobian"] = g;
+  }
+  table->AddRow({std::to_string(i + 1), Fixed(pose.p_BT.x(), 6), Fixed(pose.p_BT.y(), 6),
+                 Fixed(pose.p_BT.z(), 6), Fixed(pose.R_BT(0, 2), 6), Fixed(pose.R_BT(1, 2), 6),
+                 Fixed(pose.R_BT(2, 2), 6), miss == BeamMiss::kNone ? Fixed(h, 6) : std::string("—"),
+                 BeamMissName(miss)});
+  return j;
+}
+
+Table JacobianTable(const std::vector<std::string>& names, const Json& rows) {
+  std::vector<std::string> header = {"#"};
+  for (const auto& n : names) header.push_back(n);
+  Table t(header, "Identification Jacobian rows dh/de (m/rad for angles, m/m for lengths)");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::vector<std::string> r = {std::to_string(i + 1)};
+    for (const auto& n : names) r.push_back(Fixed(rows[i]["jacobian"][n].get<double>(), 5));
+    t.AddRow(r);
+  }
+  return t;
+}
+
 }  // namespace
 
 int KinematicsCommand(const std::vector<std::string>& args) {
@@ -137,48 +179,16 @@ int KinematicsCommand(const std::vector<std::string>& args) {
   ModelPoint point;
   model.Prepare(e.data(), &point);
   const bool jac = vm["jacobian"].as<bool>();
-  Json out = Json::array();
   Table table({"#", "x (m)", "y (m)", "z (m)", "beam x", "beam y", "beam z", "h (m)", "status"},
               "Tool pose and laser reading per configuration (" + which + " model)");
-  std::vector<double> row(ps.size());
-  for (int i = 0; i < configs.size(); ++i) {
-    double h;
-    const double nb = model.Evaluate(point, configs, i, &h, jac ? row.data() : nullptr);
-    const BeamMiss miss = ClassifyReading(h, nb, rig.ranger);
-    const Pose<double> pose = ToolPose(point, configs, i);
-    Json j;
-    j["q"] = std::vector<double>(configs.q(i), configs.q(i) + configs.num_joints());
-    j["position"] = {pose.p_BT.x(), pose.p_BT.y(), pose.p_BT.z()};
-    j["rotation"] = ToJson(Eigen::MatrixXd(pose.R_BT));
-    j["beam"] = {pose.R_BT(0, 2), pose.R_BT(1, 2), pose.R_BT(2, 2)};
-    j["h"] = miss == BeamMiss::kNone ? Json(h) : Json();
-    j["status"] = BeamMissName(miss);
-    if (jac) {
-      Json g = Json::object();
-      for (int k = 0; k < ps.size(); ++k) g[ps.names[k]] = row[k];
-      j["jacobian"] = g;
-    }
-    out.push_back(j);
-    table.AddRow({std::to_string(i + 1), Fixed(pose.p_BT.x(), 6), Fixed(pose.p_BT.y(), 6),
-                  Fixed(pose.p_BT.z(), 6), Fixed(pose.R_BT(0, 2), 6), Fixed(pose.R_BT(1, 2), 6),
-                  Fixed(pose.R_BT(2, 2), 6),
-                  miss == BeamMiss::kNone ? Fixed(h, 6) : std::string("—"), BeamMissName(miss)});
-  }
+  Json out = Json::array();
+  for (int i = 0; i < configs.size(); ++i)
+    out.push_back(KinematicsRow(model, point, configs, i, rig.ranger, jac, &table));
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << table.ToText();
-    if (jac) {
-      std::vector<std::string> header = {"#"};
-      for (const auto& n : ps.names) header.push_back(n);
-      Table jtable(header, "Identification Jacobian rows dh/de (m/rad for angles, m/m for lengths)");
-      for (std::size_t i = 0; i < out.size(); ++i) {
-        std::vector<std::string> r = {std::to_string(i + 1)};
-        for (const auto& n : ps.names) r.push_back(Fixed(out[i]["jacobian"][n].get<double>(), 5));
-        jtable.AddRow(r);
-      }
-      std::cout << "\n" << jtable.ToText();
-    }
+    if (jac) std::cout << "\n" << JacobianTable(ps.names, out).ToText();
   }
   return 0;
 }

@@ -14,8 +14,15 @@
 
 namespace lrcal::cli {
 
-int DesignCommand(const std::vector<std::string>& args) {
-  po::options_description o("lrcal design options");
+namespace {
+
+// The criteria compared against random designs (O3 is E).
+constexpr DesignCriterion kAllCriteria[] = {DesignCriterion::kE,  DesignCriterion::kD,
+                                            DesignCriterion::kA,  DesignCriterion::kO1,
+                                            DesignCriterion::kO2, DesignCriterion::kO4,
+                                            DesignCriterion::kO5};
+
+void AddDesignOptions(po::options_description& o) {
   AddCommonOptions(o);
   o.add_options()("pool", po::value<std::string>(), "candidate configurations CSV (q1..qN)")
       ("generate", po::value<int>(), "or: generate this many candidates (beam hits, non-singular)")
@@ -34,55 +41,54 @@ int DesignCommand(const std::vector<std::string>& args) {
       ("estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")
       ("fix", po::value<std::string>(), "parameters left out, comma-separated")
       ("out", po::value<std::string>(), "write the chosen configurations (CSV)");
-  po::variables_map vm;
-  if (!Parse("design", "--pool C.csv|--generate N --select K [options] --out chosen.csv", o, args,
-             &vm))
-    return 0;
-  const Setup setup = ResolveSetup(vm);
-  const RobotFile& rig = setup.rig;
-  const RobotModel& robot = rig.robot;
-  const Plane& plane = setup.plane;
-  const long long seed_value = vm["seed"].as<long long>();
-  if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
-  const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);
+}
+
+struct CandidatePool {
+  ConfigurationSet configs;
+  SamplingReport report;
+  std::string source;
+};
+
+// The candidate pool (generated, or read and filtered by the nominal beam), with what was
+// rejected and why.
+CandidatePool ResolvePool(const po::variables_map& vm, const Setup& setup, std::uint64_t seed) {
+  const RobotModel& robot = setup.rig.robot;
   if (vm.count("pool") == vm.count("generate"))
     throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
-
-  // The candidate pool, with what was rejected and why.
-  ConfigurationSet pool(robot.num_links());
-  SamplingReport report;
-  std::string pool_source;
+  CandidatePool pool{ConfigurationSet(robot.num_links()), {}, ""};
   if (vm.count("generate")) {
     const int n = vm["generate"].as<int>();
     if (n < 1) throw InputError("--generate", "expected a positive number of candidates");
     SamplingOptions sampling;
-    sampling.ranger = rig.ranger;
-    pool = SampleConfigurations(robot, plane, n, RandomStream(seed, 0, 0, RandomPurpose::kPool),
-                                sampling, &report);
-    pool_source = "generated: " + report.ToString();
-  } else {
-    const std::string path = vm["pool"].as<std::string>();
-    const ConfigurationSet read = ReadConfigurations(path, robot.num_links());
-    std::vector<double> h;
-    std::vector<BeamMiss> misses;
-    ExactReadings(robot, robot.nominal_values(), plane, rig.ranger, read, &h, &misses);
-    report.requested = report.attempts = read.size();
-    for (int i = 0; i < read.size(); ++i) {
-      if (misses[i] != BeamMiss::kNone) {
-        ++report.rejected[BeamMissName(misses[i])];
-        std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
-                  << ") rejected: " << BeamMissName(misses[i]) << "\n";
-        continue;
-      }
-      pool.AddFrom(read, i);
-    }
-    report.accepted = pool.size();
-    pool_source = path + ": " + report.ToString();
+    sampling.ranger = setup.rig.ranger;
+    pool.configs = SampleConfigurations(robot, setup.plane, n,
+                                        RandomStream(seed, 0, 0, RandomPurpose::kPool), sampling,
+                                        &pool.report);
+    pool.source = "generated: " + pool.report.ToString();
+    return pool;
   }
-  if (pool.size() == 0) throw InputError("--pool", "no usable candidate configurations");
+  const std::string path = vm["pool"].as<std::string>();
+  const ConfigurationSet read = ReadConfigurations(path, robot.num_links());
+  std::vector<double> h;
+  std::vector<BeamMiss> misses;
+  ExactReadings(robot, robot.nominal_values(), setup.plane, setup.rig.ranger, read, &h, &misses);
+  pool.report.requested = pool.report.attempts = read.size();
+  for (int i = 0; i < read.size(); ++i) {
+    if (misses[i] != BeamMiss::kNone) {
+      ++pool.report.rejected[BeamMissName(misses[i])];
+      std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
+                << ") rejected: " << BeamMissName(misses[i]) << "\n";
+      continue;
+    }
+    pool.configs.AddFrom(read, i);
+  }
+  pool.report.accepted = pool.configs.size();
+  pool.source = path + ": " + pool.report.ToString();
+  if (pool.configs.size() == 0) throw InputError("--pool", "no usable candidate configurations");
+  return pool;
+}
 
-  const ParameterSet ps = ResolveParameterSet(robot, vm);
-  MeasurementModel model(robot, plane, ps);
+SelectionOptions ResolveSelection(const po::variables_map& vm) {
   SelectionOptions options;
   options.criterion = ParseDesignCriterion(vm["criterion"].as<std::string>(), "--criterion");
   options.method = ParseSelectionMethod(vm["method"].as<std::string>(), "--method");
@@ -90,61 +96,93 @@ int DesignCommand(const std::vector<std::string>& args) {
   options.samples = vm["samples"].as<int>();
   if (options.restarts < 1) throw InputError("--restarts", "expected at least 1");
   if (options.samples < 1) throw InputError("--samples", "expected at least 1");
-  const DesignScaling scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
+  return options;
+}
+
+// G of the pool at the nominal model, columns scaled as asked.
+Eigen::MatrixXd ScaledJacobian(const po::variables_map& vm, const MeasurementModel& model,
+                               const ConfigurationSet& pool, DesignScaling scaling) {
+  const ParameterSet& ps = model.parameters();
   Eigen::VectorXd expected(ps.size());
   for (int k = 0; k < ps.size(); ++k)
     expected[k] = ps.IsAngular(k) ? vm["expected-angle-mrad"].as<double>() * 1e-3
                                   : vm["expected-length-mm"].as<double>() * 1e-3;
-  const Eigen::MatrixXd G_si = IdentificationJacobian(model, pool);
-  const Eigen::MatrixXd G = ScaleColumns(G_si, scaling, expected);
+  return ScaleColumns(IdentificationJacobian(model, pool), scaling, expected);
+}
+
+Eigen::MatrixXd NormalMatrixOfRows(const Eigen::MatrixXd& G, const std::vector<int>& rows) {
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+  for (int r : rows) A += G.row(r).transpose() * G.row(r);
+  return A;
+}
+
+// Every index of the chosen set against `baseline` random designs of the same size.
+void CompareWithRandomDesigns(const Eigen::MatrixXd& G, const SelectionResult& chosen, int k,
+                              int baseline, std::uint64_t seed, Table* table, Json* indices) {
+  const Eigen::MatrixXd A_chosen = NormalMatrixOfRows(G, chosen.indices);
+  std::vector<std::vector<double>> random_scores(std::size(kAllCriteria));
+  SelectionOptions random_options;
+  random_options.method = SelectionMethod::kRandom;
+  for (int b = 0; b < baseline; ++b) {
+    const SelectionResult r = SelectConfigurations(
+        G, k, random_options,
+        RandomStream(seed, 2, static_cast<std::uint64_t>(b), RandomPurpose::kSelection));
+    const Eigen::MatrixXd A = NormalMatrixOfRows(G, r.indices);
+    for (std::size_t c = 0; c < std::size(kAllCriteria); ++c)
+      random_scores[c].push_back(CriterionScore(A, k, kAllCriteria[c]));
+  }
+  *indices = Json::object();
+  for (std::size_t c = 0; c < std::size(kAllCriteria); ++c) {
+    const char* name = DesignCriterionName(kAllCriteria[c]);
+    const double value = CriterionScore(A_chosen, k, kAllCriteria[c]);
+    const Distribution d = Describe(random_scores[c]);
+    const double rank = PercentileRank(random_scores[c], value);
+    table->AddRow({name, Fixed(value, 6), Fixed(d.mean, 6), Fixed(d.p5, 6), Fixed(d.p95, 6),
+                   Fixed(rank, 1)});
+    (*indices)[name] = {{"chosen", value},   {"random_mean", d.mean}, {"random_p5", d.p5},
+                        {"random_p95", d.p95}, {"percentile", rank}};
+  }
+}
+
+}  // namespace
+
+int DesignCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal design options");
+  AddDesignOptions(o);
+  po::variables_map vm;
+  if (!Parse("design", "--pool C.csv|--generate N --select K [options] --out chosen.csv", o, args,
+             &vm))
+    return 0;
+  const Setup setup = ResolveSetup(vm);
+  const long long seed_value = vm["seed"].as<long long>();
+  if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
+  const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);
+  const CandidatePool pool = ResolvePool(vm, setup, seed);
+  MeasurementModel model(setup.rig.robot, setup.plane, ResolveParameterSet(setup.rig.robot, vm));
+  const SelectionOptions options = ResolveSelection(vm);
+  const DesignScaling scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
+  const Eigen::MatrixXd G = ScaledJacobian(vm, model, pool.configs, scaling);
   const int k = vm["select"].as<int>();
 
   const auto t0 = std::chrono::steady_clock::now();
   const SelectionResult chosen =
       SelectConfigurations(G, k, options, RandomStream(seed, 1, 0, RandomPurpose::kSelection));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-  // Every index of the chosen set and of random designs of the same size.
-  const DesignCriterion all[] = {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA,
-                                 DesignCriterion::kO1, DesignCriterion::kO2, DesignCriterion::kO4,
-                                 DesignCriterion::kO5};
-  auto normal = [&](const std::vector<int>& rows) {
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
-    for (int r : rows) A += G.row(r).transpose() * G.row(r);
-    return A;
-  };
-  const Eigen::MatrixXd A_chosen = normal(chosen.indices);
   const int baseline = vm["baseline"].as<int>();
-  std::vector<std::vector<double>> random_scores(std::size(all));
-  SelectionOptions random_options;
-  random_options.method = SelectionMethod::kRandom;
-  for (int b = 0; b < baseline; ++b) {
-    const SelectionResult r = SelectConfigurations(
-        G, k, random_options, RandomStream(seed, 2, static_cast<std::uint64_t>(b), RandomPurpose::kSelection));
-    const Eigen::MatrixXd A = normal(r.indices);
-    for (std::size_t c = 0; c < std::size(all); ++c) random_scores[c].push_back(CriterionScore(A, k, all[c]));
-  }
   Table t({"index", "chosen", "random mean", "random p5", "random p95", "percentile of chosen"},
-          "Observability of the chosen " + std::to_string(k) + " of " + std::to_string(pool.size()) +
-              " against " + std::to_string(baseline) + " random designs (G scaled: " +
-              DesignScalingName(scaling) + "; E = sigma_min, D = log det, A = -trace inv)");
-  Json indices = Json::object();
-  for (std::size_t c = 0; c < std::size(all); ++c) {
-    const double value = CriterionScore(A_chosen, k, all[c]);
-    const Distribution d = Describe(random_scores[c]);
-    const double rank = PercentileRank(random_scores[c], value);
-    t.AddRow({DesignCriterionName(all[c]), Fixed(value, 6), Fixed(d.mean, 6), Fixed(d.p5, 6),
-              Fixed(d.p95, 6), Fixed(rank, 1)});
-    indices[DesignCriterionName(all[c])] = {{"chosen", value}, {"random_mean", d.mean},
-                                            {"random_p5", d.p5}, {"random_p95", d.p95},
-                                            {"percentile", rank}};
-  }
-  if (vm.count("out")) WriteConfigurations(vm["out"].as<std::string>(), pool.Subset(chosen.indices));
+          "Observability of the chosen " + std::to_string(k) + " of " +
+              std::to_string(pool.configs.size()) + " against " + std::to_string(baseline) +
+              " random designs (G scaled: " + DesignScalingName(scaling) +
+              "; E = sigma_min, D = log det, A = -trace inv)");
+  Json indices;
+  CompareWithRandomDesigns(G, chosen, k, baseline, seed, &t, &indices);
+  if (vm.count("out"))
+    WriteConfigurations(vm["out"].as<std::string>(), pool.configs.Subset(chosen.indices));
 
   if (ResolveFormat(vm) == Format::kJson) {
     Json j;
-    j["pool"] = {{"size", pool.size()}, {"source", pool_source}, {"rejected", report.rejected},
-                 {"tried", report.attempts}};
+    j["pool"] = {{"size", pool.configs.size()}, {"source", pool.source},
+                 {"rejected", pool.report.rejected}, {"tried", pool.report.attempts}};
     j["method"] = SelectionMethodName(options.method);
     j["criterion"] = DesignCriterionName(options.criterion);
     j["scaling"] = DesignScalingName(scaling);
@@ -156,10 +194,11 @@ int DesignCommand(const std::vector<std::string>& args) {
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  std::cout << "candidate pool: " << pool_source << "\n"
-            << "chose " << k << " of " << pool.size() << " by " << SelectionMethodName(options.method)
-            << ", criterion " << DesignCriterionName(options.criterion) << " = " << chosen.score
-            << " (" << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
+  std::cout << "candidate pool: " << pool.source << "\n"
+            << "chose " << k << " of " << pool.configs.size() << " by "
+            << SelectionMethodName(options.method) << ", criterion "
+            << DesignCriterionName(options.criterion) << " = " << chosen.score << " ("
+            << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
             << "chosen (0-based pool indices):";
   for (int i : chosen.indices) std::cout << " " << i;
   std::cout << "\n\n" << t.ToText();

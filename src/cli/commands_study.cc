@@ -26,6 +26,76 @@ Study LoadStudyArg(const po::variables_map& vm) {
 
 std::string DefaultOut(const Study& study) { return "output/" + study.name; }
 
+RunOptions ResolveRunOptions(const po::variables_map& vm, const Study& study) {
+  RunOptions options;
+  options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : DefaultOut(study);
+  options.threads = vm["threads"].as<int>();
+  if (vm.count("shard"))
+    ParseShard(vm["shard"].as<std::string>(), &options.shard_index, &options.shard_count);
+  options.max_new_trials = vm["max-trials"].as<long long>();
+  options.progress = !vm["quiet"].as<bool>();
+  const std::string schedule = vm["schedule"].as<std::string>();
+  if (schedule != "static" && schedule != "dynamic")
+    throw InputError("--schedule", "expected static or dynamic, got '" + schedule + "'");
+  options.dynamic_schedule = schedule == "dynamic";
+  options.Validate();
+  return options;
+}
+
+// The MPI world when started by mpirun (refused with the way out if built without MPI).
+std::unique_ptr<Collective> MpiWorldIfLaunched() {
+  if (!LaunchedUnderMpi()) return nullptr;
+  if (!BuiltWithMpi())
+    throw InputError("mpirun", "this lrcal was built without MPI (CMake found no MPI when it "
+                               "was configured): install OpenMPI (libopenmpi-dev) and rebuild, "
+                               "or run without mpirun (threads: --threads N; several machines: "
+                               "--shard i/N and lrcal merge)");
+  return MpiWorld(nullptr, nullptr);
+}
+
+void PrintRunSummary(const RunResult& r, const RunOptions& options, int ranks) {
+  std::cerr << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)
+            << " s (" << r.done_before << " already done, " << r.total << " in this run";
+  if (r.computed > 0)
+    std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial"
+              << (ranks > 1 ? " on rank 0" : "");
+  std::cerr << ")\n";
+  if (r.computed == 0) return;
+  const int threads =
+      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
+            << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
+            << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string())
+            << "; runner overhead "
+            << Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1)
+            << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3)
+            << " s; peak memory " << r.peak_rss_kb_trials / 1024 << " MiB after the trials, "
+            << r.peak_rss_kb / 1024 << " MiB with the tables\n";
+}
+
+// Shards of one study: which array tasks to resubmit, or how to merge.
+void PrintShardAdvice(const std::vector<std::string>& dirs,
+                      const std::vector<RunStatusInfo>& infos) {
+  std::string unfinished;
+  std::set<int> present;
+  for (const auto& i : infos) {
+    present.insert(i.shard_index);
+    if (!i.complete) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i.shard_index);
+  }
+  const int n = infos.front().shard_count;
+  for (int i = 1; i <= n; ++i)
+    if (!present.count(i)) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i);
+  if (unfinished.empty()) {
+    std::cout << "all " << n << " shards complete: lrcal merge ";
+    for (const auto& d : dirs) std::cout << d << " ";
+    std::cout << "--out DIR\n";
+    return;
+  }
+  std::cout << "unfinished or missing shards: " << unfinished << "\n"
+            << "resubmit: sbatch --array=" << unfinished << " studies/slurm/lrcal_array.sbatch "
+            << infos.front().study_file << " " << n << "\n";
+}
+
 }  // namespace
 
 int RunCommand(const std::vector<std::string>& args) {
@@ -45,27 +115,9 @@ int RunCommand(const std::vector<std::string>& args) {
   if (!Parse("run", "[STUDY.yaml] [--out DIR] [--threads N] [--shard i/N]", o, args, &vm, &pos))
     return 0;
   const Study study = LoadStudyArg(vm);
-  RunOptions options;
-  options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : DefaultOut(study);
-  options.threads = vm["threads"].as<int>();
-  if (options.threads < 0) throw InputError("--threads", "expected 0 (all cores) or more");
-  if (vm.count("shard")) ParseShard(vm["shard"].as<std::string>(), &options.shard_index, &options.shard_count);
-  options.max_new_trials = vm["max-trials"].as<long long>();
-  options.progress = !vm["quiet"].as<bool>();
-  const std::string schedule = vm["schedule"].as<std::string>();
-  if (schedule != "static" && schedule != "dynamic")
-    throw InputError("--schedule", "expected static or dynamic, got '" + schedule + "'");
-  options.dynamic_schedule = schedule == "dynamic";
+  const RunOptions options = ResolveRunOptions(vm, study);
   // Under mpirun: every rank runs this command; trials are dealt to the ranks.
-  std::unique_ptr<Collective> world;
-  if (LaunchedUnderMpi()) {
-    if (!BuiltWithMpi())
-      throw InputError("mpirun", "this lrcal was built without MPI (CMake found no MPI when it "
-                                 "was configured): install OpenMPI (libopenmpi-dev) and rebuild, "
-                                 "or run without mpirun (threads: --threads N; several machines: "
-                                 "--shard i/N and lrcal merge)");
-    world = MpiWorld(nullptr, nullptr);
-  }
+  std::unique_ptr<Collective> world = MpiWorldIfLaunched();
   const int rank = world ? world->rank() : 0;
   const int ranks = world ? world->size() : 1;
   InstallStopHandlers();
@@ -75,24 +127,7 @@ int RunCommand(const std::vector<std::string>& args) {
               << (ranks > 1 ? " (" + std::to_string(ranks) + " MPI ranks)" : std::string()) << "\n";
   const RunResult r = RunStudyAndWriteTables(study, options, world.get());
   if (rank != 0) return r.interrupted ? 130 : 0;
-  std::cerr << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)
-            << " s (" << r.done_before << " already done, " << r.total << " in this run";
-  if (r.computed > 0)
-    std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial"
-              << (ranks > 1 ? " on rank 0" : "");
-  std::cerr << ")\n";
-  if (r.computed > 0) {
-    const int threads = options.threads > 0 ? options.threads
-                                            : std::max(1u, std::thread::hardware_concurrency());
-    std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
-              << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
-              << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string())
-              << "; runner overhead "
-              << Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1)
-              << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3)
-              << " s; peak memory " << r.peak_rss_kb_trials / 1024 << " MiB after the trials, "
-              << r.peak_rss_kb / 1024 << " MiB with the tables\n";
-  }
+  PrintRunSummary(r, options, ranks);
   if (r.tables_written) {
     std::cout << "tables: " << options.out_dir << "/tables/summary.md (also .csv, .json, .tex)\n";
   } else if (r.interrupted) {
@@ -166,30 +201,7 @@ int StatusCommand(const std::vector<std::string>& args) {
     infos.push_back(GetRunStatus(d));
     std::cout << infos.back().text;
   }
-  // Shards of one study: which array tasks to resubmit.
-  if (infos.size() > 1 && infos.front().shard_count > 1) {
-    std::string unfinished;
-    std::set<int> present;
-    for (const auto& i : infos) {
-      present.insert(i.shard_index);
-      if (!i.complete) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i.shard_index);
-    }
-    const int n = infos.front().shard_count;
-    for (int i = 1; i <= n; ++i)
-      if (!present.count(i)) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i);
-    if (unfinished.empty()) {
-      std::cout << "all " << n << " shards complete: lrcal merge " << [&] {
-        std::string l;
-        for (const auto& d : dirs) l += d + " ";
-        return l;
-      }() << "--out DIR\n";
-    } else {
-      std::cout << "unfinished or missing shards: " << unfinished << "\n"
-                << "resubmit: sbatch --array=" << unfinished
-                << " studies/slurm/lrcal_array.sbatch " << infos.front().study_file << " " << n
-                << "\n";
-    }
-  }
+  if (infos.size() > 1 && infos.front().shard_count > 1) PrintShardAdvice(dirs, infos);
   return 0;
 }
 

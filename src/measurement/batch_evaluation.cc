@@ -48,7 +48,11 @@ struct KernelArgs {
   double* J;
 };
 
+// The vectorised kernel: structure-of-arrays loops over all configurations, inlined into one
+// variant per instruction set (cpu_dispatch.h). Kept in one function on purpose: the compiler
+// vectorises and inlines it whole, and the variants must give the same bits.
 template <bool kJacobian>
+// NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
 [[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
   const int m = args.m;
   const ModelPoint& point = *args.point;

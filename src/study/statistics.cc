@@ -68,66 +68,62 @@ Distribution DescribeInPlace(std::vector<double>* values) {
   return d;
 }
 
-CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
-  CellSummary s;
-  s.cell = cell;
-  const int n = static_cast<int>(cell.parameter_names.size());
-  // Errors in one column-major matrix (row = ok trial in canonical order): each parameter's
-  // values are contiguous, and the covariance is one fixed-lane normal-matrix product.
-  Eigen::MatrixXd errors;
-  std::array<std::vector<double>, 12> val, nom;
+namespace {
+
+// One pass over a cell's records in canonical order: counts, metric values, parameter errors.
+struct CellValues {
+  Eigen::MatrixXd errors;  ///< row = ok trial in canonical order, column-major
+  std::array<std::vector<double>, 12> validation, nominal;
   std::vector<double> iterations, sigma_hat;
+};
+
+CellValues ReadCellValues(const TrialStore& store, const StoredCell& cell, CellSummary* s) {
+  const int n = static_cast<int>(cell.parameter_names.size());
+  CellValues v;
   const std::size_t expected = static_cast<std::size_t>(store.CountTrials(cell.id));
-  errors.resize(static_cast<Eigen::Index>(expected), n);
+  v.errors.resize(static_cast<Eigen::Index>(expected), n);
   for (int k = 0; k < 12; ++k) {
-    val[k].reserve(expected);
-    nom[k].reserve(expected);
+    v.validation[k].reserve(expected);
+    v.nominal[k].reserve(expected);
   }
-  iterations.reserve(expected);
-  sigma_hat.reserve(expected);
+  v.iterations.reserve(expected);
+  v.sigma_hat.reserve(expected);
   store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
-    ++s.trials;
-    for (int k = 0; k < 12; ++k) nom[k].push_back(r.nominal[k]);
+    ++s->trials;
+    for (int k = 0; k < 12; ++k) v.nominal[k].push_back(r.nominal[k]);
     if (r.status != TrialStatus::kOk) {
-      ++s.failed[TrialStatusName(r.status)];
+      ++s->failed[TrialStatusName(r.status)];
       return;
     }
-    ++s.ok;
+    ++s->ok;
     for (int k = 0; k < n && k < static_cast<int>(r.errors.size()); ++k)
-      errors(s.ok - 1, k) = r.errors[k];
-    for (int k = 0; k < 12; ++k) val[k].push_back(r.validation[k]);
-    iterations.push_back(r.iterations);
-    sigma_hat.push_back(r.sigma_hat);
+      v.errors(s->ok - 1, k) = r.errors[k];
+    for (int k = 0; k < 12; ++k) v.validation[k].push_back(r.validation[k]);
+    v.iterations.push_back(r.iterations);
+    v.sigma_hat.push_back(r.sigma_hat);
   });
-  for (int k = 0; k < 12; ++k) {
-    s.validation[k] = DescribeInPlace(&val[k]);
-    s.nominal[k] = DescribeInPlace(&nom[k]);
-    s.validation_values[k] = std::move(val[k]);
-    std::vector<double>().swap(nom[k]);
-  }
-  s.iterations = DescribeInPlace(&iterations);
-  s.sigma_hat = DescribeInPlace(&sigma_hat);
-  // Parameters: bias, spread, and the empirical covariance (two passes, canonical order).
-  const long long m = s.ok;
-  errors.conservativeResize(m, n);
-  // The paper's placement needs the raw values of paper cells; keep only those.
-  const bool keep_values = Json::parse(cell.settings).value("paper_case", 0) > 0;
-  if (keep_values)
-    for (int k = 0; k < n; ++k)
-      s.error_values.emplace_back(errors.col(k).data(), errors.col(k).data() + m);
+  v.errors.conservativeResize(s->ok, n);
+  return v;
+}
+
+// Bias, spread and the empirical covariance of the parameter errors (two passes, canonical
+// order; the covariance is one fixed-lane normal-matrix product of the centred errors).
+void SummarizeParameters(const StoredCell& cell, Eigen::MatrixXd* errors, CellSummary* s) {
+  const int n = static_cast<int>(cell.parameter_names.size());
+  const long long m = s->ok;
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(n);
   for (int k = 0; k < n; ++k) {
-    const double* x = errors.col(k).data();
+    const double* x = errors->col(k).data();
     for (long long t = 0; t < m; ++t) mean[k] += x[t];
     if (m) mean[k] /= m;
   }
-  for (int k = 0; k < n; ++k) errors.col(k).array() -= mean[k];
-  NormalMatrix(errors, &s.covariance);
-  if (m > 1) s.covariance /= static_cast<double>(m - 1);
-  Eigen::VectorXd sd = s.covariance.diagonal().cwiseSqrt();
-  s.correlation = s.covariance;
+  for (int k = 0; k < n; ++k) errors->col(k).array() -= mean[k];
+  NormalMatrix(*errors, &s->covariance);
+  if (m > 1) s->covariance /= static_cast<double>(m - 1);
+  const Eigen::VectorXd sd = s->covariance.diagonal().cwiseSqrt();
+  s->correlation = s->covariance;
   for (int a = 0; a < n; ++a)
-    for (int b = 0; b < n; ++b) s.correlation(a, b) /= sd[a] * sd[b];
+    for (int b = 0; b < n; ++b) s->correlation(a, b) /= sd[a] * sd[b];
   for (int k = 0; k < n; ++k) {
     ParameterStats p;
     p.name = cell.parameter_names[k];
@@ -137,8 +133,29 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
     p.predicted_std = k < static_cast<int>(cell.predicted_std.size()) ? cell.predicted_std[k]
                                                                        : std::nan("");
     p.ratio = p.std / p.predicted_std;
-    s.parameters.push_back(p);
+    s->parameters.push_back(p);
   }
+}
+
+}  // namespace
+
+CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
+  CellSummary s;
+  s.cell = cell;
+  CellValues v = ReadCellValues(store, cell, &s);
+  for (int k = 0; k < 12; ++k) {
+    s.validation[k] = DescribeInPlace(&v.validation[k]);
+    s.nominal[k] = DescribeInPlace(&v.nominal[k]);
+    s.validation_values[k] = std::move(v.validation[k]);
+    std::vector<double>().swap(v.nominal[k]);
+  }
+  s.iterations = DescribeInPlace(&v.iterations);
+  s.sigma_hat = DescribeInPlace(&v.sigma_hat);
+  // The paper's placement needs the raw errors of paper cells; keep only those.
+  if (Json::parse(cell.settings).value("paper_case", 0) > 0)
+    for (int k = 0; k < v.errors.cols(); ++k)
+      s.error_values.emplace_back(v.errors.col(k).data(), v.errors.col(k).data() + s.ok);
+  SummarizeParameters(cell, &v.errors, &s);
   return s;
 }
 
