@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <fstream>
 
-#include "measurement/batch_evaluation.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
@@ -15,28 +14,33 @@
 #include "lrcal/study/runner.h"
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
-#include "study/trial_pipeline.h"
 #include "lrcal/study/trial_store.h"
+#include "measurement/batch_evaluation.h"
+#include "study/trial_pipeline.h"
 
 namespace lrcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string PaperRobotPath() { return std::string(LRCAL_SOURCE_DIR) + "/studies/robots/paper.yaml"; }
+std::string PaperRobotPath() {
+  return std::string(LRCAL_SOURCE_DIR) + "/studies/robots/paper.yaml";
+}
 
 // A one-cell study of the paper's arm: `count` of 101 (exhaustive leave-one-out for 100, greedy
 // otherwise), `repetitions` readings.
 std::string WriteStudy(int count, int repetitions, int trials = 1000, int pool = 101) {
   const fs::path dir = fs::temp_directory_path() / "lrcal_bench";
   fs::create_directories(dir);
-  const std::string path = (dir / ("s_" + std::to_string(count) + "_" + std::to_string(repetitions) +
-                                   "_" + std::to_string(trials) + "_" + std::to_string(pool) + ".yaml"))
-                               .string();
-  std::ofstream(path) << "name: bench\nseed: 1\ntrials: " << trials << "\nrobot: " << PaperRobotPath()
-                      << "\nnoise: {sigma_mm: 0.2, repetitions: " << repetitions << "}\npool: {size: "
-                      << pool << "}\nselection: {count: " << count << ", method: "
-                      << (count == pool - 1 ? "exhaustive" : "backward") << "}\n";
+  const std::string path =
+      (dir / ("s_" + std::to_string(count) + "_" + std::to_string(repetitions) + "_" +
+              std::to_string(trials) + "_" + std::to_string(pool) + ".yaml"))
+          .string();
+  std::ofstream(path) << "name: bench\nseed: 1\ntrials: " << trials
+                      << "\nrobot: " << PaperRobotPath()
+                      << "\nnoise: {sigma_mm: 0.2, repetitions: " << repetitions
+                      << "}\npool: {size: " << pool << "}\nselection: {count: " << count
+                      << ", method: " << (count == pool - 1 ? "exhaustive" : "backward") << "}\n";
   return path;
 }
 
@@ -93,7 +97,8 @@ void BM_BatchDistanceAndJacobian100(benchmark::State& state) {
   BatchEvaluator batch;
   batch.SetConfigurations(c.design.configs);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(batch.Evaluate(*c.model, point, h.data(), state.range(0) ? J.data() : nullptr));
+    benchmark::DoNotOptimize(
+        batch.Evaluate(*c.model, point, h.data(), state.range(0) ? J.data() : nullptr));
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(state.iterations() * m);
@@ -163,14 +168,23 @@ void Identify(benchmark::State& state, int count, IdentificationOptions::Solver 
     if (solver == IdentificationOptions::Solver::kCeres) {
       benchmark::DoNotOptimize(lrcal::Identify(*c.model, data, options));
     } else {
-      benchmark::DoNotOptimize(lm.Solve(*c.model, data.configs, data.mean_h.data(), w.data(), options, &e));
+      benchmark::DoNotOptimize(
+          lm.Solve(*c.model, data.configs, data.mean_h.data(), w.data(), options, &e));
     }
   }
 }
-void BM_IdentifyCase1_LM(benchmark::State& s) { Identify(s, 50, IdentificationOptions::Solver::kLevenbergMarquardt); }
-void BM_IdentifyCase2_LM(benchmark::State& s) { Identify(s, 100, IdentificationOptions::Solver::kLevenbergMarquardt); }
-void BM_IdentifyCase1_Ceres(benchmark::State& s) { Identify(s, 50, IdentificationOptions::Solver::kCeres); }
-void BM_IdentifyCase2_Ceres(benchmark::State& s) { Identify(s, 100, IdentificationOptions::Solver::kCeres); }
+void BM_IdentifyCase1_LM(benchmark::State& s) {
+  Identify(s, 50, IdentificationOptions::Solver::kLevenbergMarquardt);
+}
+void BM_IdentifyCase2_LM(benchmark::State& s) {
+  Identify(s, 100, IdentificationOptions::Solver::kLevenbergMarquardt);
+}
+void BM_IdentifyCase1_Ceres(benchmark::State& s) {
+  Identify(s, 50, IdentificationOptions::Solver::kCeres);
+}
+void BM_IdentifyCase2_Ceres(benchmark::State& s) {
+  Identify(s, 100, IdentificationOptions::Solver::kCeres);
+}
 BENCHMARK(BM_IdentifyCase1_LM)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_IdentifyCase2_LM)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_IdentifyCase1_Ceres)->Unit(benchmark::kMicrosecond);
@@ -195,7 +209,13 @@ void BM_TrialVsConfigurations(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(RunTrial(c, t++, &ws));
   state.counters["configurations"] = n;
 }
-BENCHMARK(BM_TrialVsConfigurations)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TrialVsConfigurations)
+    ->Arg(25)
+    ->Arg(50)
+    ->Arg(100)
+    ->Arg(200)
+    ->Arg(400)
+    ->Unit(benchmark::kMicrosecond);
 
 // Cost against the number of readings per configuration (case 2 design).
 void BM_TrialVsRepetitions(benchmark::State& state) {
@@ -217,7 +237,8 @@ void BM_StudyThroughput(benchmark::State& state) {
   int run = 0;
   for (auto _ : state) {
     RunOptions o;
-    o.out_dir = (fs::temp_directory_path() / "lrcal_bench" / ("run" + std::to_string(run++))).string();
+    o.out_dir =
+        (fs::temp_directory_path() / "lrcal_bench" / ("run" + std::to_string(run++))).string();
     fs::remove_all(o.out_dir);
     o.threads = static_cast<int>(state.range(0));
     o.progress = false;
@@ -231,7 +252,12 @@ void BM_StudyThroughput(benchmark::State& state) {
     fs::remove_all(o.out_dir);
   }
 }
-BENCHMARK(BM_StudyThroughput)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_StudyThroughput)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 // Aggregation of 10^5 records (one cell).
 void BM_Aggregate1e5(benchmark::State& state) {

@@ -23,12 +23,11 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 }
 
 void AddCommonOptions(po::options_description& options) {
-  options.add_options()
-      ("robot", po::value<std::string>()->default_value("paper"),
-       "robot file (YAML) or shipped robot name")
-      ("plane", po::value<std::string>(),
-       "plane nx,ny,nz,f in the base frame (normalised); default: the robot file's plane")
-      ("format", po::value<std::string>()->default_value("text"), "output: text or json");
+  options.add_options()("robot", po::value<std::string>()->default_value("paper"),
+                        "robot file (YAML) or shipped robot name")(
+      "plane", po::value<std::string>(),
+      "plane nx,ny,nz,f in the base frame (normalised); default: the robot file's plane")(
+      "format", po::value<std::string>()->default_value("text"), "output: text or json");
 }
 
 RobotFile LoadRobot(const std::string& name_or_path) {
@@ -38,8 +37,8 @@ RobotFile LoadRobot(const std::string& name_or_path) {
 Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm) {
   if (vm.count("plane")) return Plane::Parse(vm["plane"].as<std::string>(), "--plane");
   if (rig.plane) return *rig.plane;
-  throw InputError("--plane", "the robot file '" + rig.path +
-                                  "' has no plane: give --plane nx,ny,nz,f");
+  throw InputError("--plane",
+                   "the robot file '" + rig.path + "' has no plane: give --plane nx,ny,nz,f");
 }
 
 Setup ResolveSetup(const po::variables_map& vm) {

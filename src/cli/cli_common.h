@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "lrcal/core/error.h"
-#include "lrcal/measurement/parameter_set.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal::cli {
 

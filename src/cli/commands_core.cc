@@ -5,12 +5,12 @@
 #include <sstream>
 
 #include "cli_common.h"
-#include "lrcal/design/configuration_sampling.h"
-#include "lrcal/io/csv.h"
-#include "lrcal/identification/identification.h"
-#include "lrcal/paper/paper_case.h"
-#include "lrcal/measurement/simulation.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/io/csv.h"
+#include "lrcal/measurement/simulation.h"
+#include "lrcal/paper/paper_case.h"
 
 namespace lrcal::cli {
 
@@ -130,8 +130,8 @@ Json KinematicsRow(const MeasurementModel& model, const ModelPoint& point,
   }
   table->AddRow({std::to_string(i + 1), Fixed(pose.p_BT.x(), 6), Fixed(pose.p_BT.y(), 6),
                  Fixed(pose.p_BT.z(), 6), Fixed(pose.R_BT(0, 2), 6), Fixed(pose.R_BT(1, 2), 6),
-                 Fixed(pose.R_BT(2, 2), 6), miss == BeamMiss::kNone ? Fixed(h, 6) : std::string("—"),
-                 BeamMissName(miss)});
+                 Fixed(pose.R_BT(2, 2), 6),
+                 miss == BeamMiss::kNone ? Fixed(h, 6) : std::string("—"), BeamMissName(miss)});
   return j;
 }
 
@@ -152,12 +152,13 @@ Table JacobianTable(const std::vector<std::string>& names, const Json& rows) {
 int KinematicsCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal kinematics options");
   AddCommonOptions(o);
-  o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV (q1..qN, rad)")
-      ("model", po::value<std::string>()->default_value("nominal"), "nominal or true")
-      ("jacobian", po::bool_switch(), "also print the identification Jacobian row")
-      ("estimate-plane", po::value<std::string>()->default_value("none"),
-       "plane terms in the Jacobian: none, normal, offset, normal,offset")
-      ("fix", po::value<std::string>(), "parameters left out of the Jacobian, comma-separated");
+  o.add_options()("configs", po::value<std::string>()->required(),
+                  "configurations CSV (q1..qN, rad)")(
+      "model", po::value<std::string>()->default_value("nominal"), "nominal or true")(
+      "jacobian", po::bool_switch(), "also print the identification Jacobian row")(
+      "estimate-plane", po::value<std::string>()->default_value("none"),
+      "plane terms in the Jacobian: none, normal, offset, normal,offset")(
+      "fix", po::value<std::string>(), "parameters left out of the Jacobian, comma-separated");
   po::variables_map vm;
   if (!Parse("kinematics", "--configs C.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -196,13 +197,12 @@ int KinematicsCommand(const std::vector<std::string>& args) {
 int SampleCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal sample options");
   AddCommonOptions(o);
-  o.add_options()("count", po::value<int>()->default_value(101), "configurations to draw")
-      ("seed", po::value<long long>()->default_value(1), "random seed")
-      ("validation", po::bool_switch(),
-       "validation set: anywhere in the workspace, no beam needed")
-      ("min-singular-value", po::value<double>()->default_value(0.05),
-       "reject arm configurations whose geometric Jacobian has a smaller singular value")
-      ("out", po::value<std::string>()->required(), "output CSV (q1..qN)");
+  o.add_options()("count", po::value<int>()->default_value(101), "configurations to draw")(
+      "seed", po::value<long long>()->default_value(1), "random seed")(
+      "validation", po::bool_switch(), "validation set: anywhere in the workspace, no beam needed")(
+      "min-singular-value", po::value<double>()->default_value(0.05),
+      "reject arm configurations whose geometric Jacobian has a smaller singular value")(
+      "out", po::value<std::string>()->required(), "output CSV (q1..qN)");
   po::variables_map vm;
   if (!Parse("sample", "--out C.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -231,11 +231,11 @@ int SampleCommand(const std::vector<std::string>& args) {
 int SimulateCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal simulate options");
   AddCommonOptions(o);
-  o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")
-      ("sigma-mm", po::value<double>()->default_value(0.2), "noise of one reading (mm)")
-      ("repetitions", po::value<int>()->default_value(10), "readings per configuration")
-      ("seed", po::value<long long>()->default_value(1), "random seed")
-      ("out", po::value<std::string>()->required(), "measurement CSV to write");
+  o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
+      "sigma-mm", po::value<double>()->default_value(0.2), "noise of one reading (mm)")(
+      "repetitions", po::value<int>()->default_value(10), "readings per configuration")(
+      "seed", po::value<long long>()->default_value(1), "random seed")(
+      "out", po::value<std::string>()->required(), "measurement CSV to write");
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -271,18 +271,18 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddCommonOptions(o);
   o.add_options()("data", po::value<std::string>()->required(),
-                  "measurement CSV (q1..qN, h in m; rows with equal q are averaged)")
-      ("estimate-plane", po::value<std::string>()->default_value("none"),
-       "plane terms to estimate: none, normal, offset, normal,offset")
-      ("fix", po::value<std::string>(), "parameters to keep at nominal, comma-separated")
-      ("auto-fix", po::bool_switch(),
-       "if the set is rank-deficient, fix the suggested parameters and go on")
-      ("solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")
-      ("loss", po::value<std::string>()->default_value("none"),
-       "robust loss: none, huber, cauchy (needs --solver ceres)")
-      ("loss-scale-mm", po::value<double>()->default_value(1.0), "robust loss scale (mm)")
-      ("sigma-mm", po::value<double>()->default_value(0.0),
-       "known noise of one reading (mm) for the given-sigma covariance");
+                  "measurement CSV (q1..qN, h in m; rows with equal q are averaged)")(
+      "estimate-plane", po::value<std::string>()->default_value("none"),
+      "plane terms to estimate: none, normal, offset, normal,offset")(
+      "fix", po::value<std::string>(), "parameters to keep at nominal, comma-separated")(
+      "auto-fix", po::bool_switch(),
+      "if the set is rank-deficient, fix the suggested parameters and go on")(
+      "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
+      "loss", po::value<std::string>()->default_value("none"),
+      "robust loss: none, huber, cauchy (needs --solver ceres)")(
+      "loss-scale-mm", po::value<double>()->default_value(1.0), "robust loss scale (mm)")(
+      "sigma-mm", po::value<double>()->default_value(0.0),
+      "known noise of one reading (mm) for the given-sigma covariance");
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -302,12 +302,12 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "
                  "configurations; fix the suggested parameters (--fix "
-              << [&] {
-                   std::string l;
-                   for (const auto& f : s.identifiability.suggested_fixed) l += (l.empty() ? "" : ",") + f;
-                   return l;
-                 }()
-              << ") or pass --auto-fix\n";
+              <<
+        [&] {
+          std::string l;
+          for (const auto& f : s.identifiability.suggested_fixed) l += (l.empty() ? "" : ",") + f;
+          return l;
+        }() << ") or pass --auto-fix\n";
     return 3;
   }
   return s.IsSolutionUsable() ? 0 : 1;
@@ -316,12 +316,12 @@ int IdentifyCommand(const std::vector<std::string>& args) {
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identifiability options");
   AddCommonOptions(o);
-  o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")
-      ("estimate-plane", po::value<std::string>()->default_value("none"),
-       "plane terms in the set: none, normal, offset, normal,offset")
-      ("fix", po::value<std::string>(), "parameters to leave out, comma-separated")
-      ("rank-tolerance", po::value<double>()->default_value(1e-8),
-       "relative singular value below which a direction is unobservable");
+  o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
+      "estimate-plane", po::value<std::string>()->default_value("none"),
+      "plane terms in the set: none, normal, offset, normal,offset")(
+      "fix", po::value<std::string>(), "parameters to leave out, comma-separated")(
+      "rank-tolerance", po::value<double>()->default_value(1e-8),
+      "relative singular value below which a direction is unobservable");
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -345,12 +345,12 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
 
 int PaperCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal paper options");
-  o.add_options()("robot", po::value<std::string>()->default_value("paper"), "robot file or name")
-      ("seed", po::value<long long>()->default_value(1), "random seed of the realisation")
-      ("case1-selection", po::value<std::string>()->default_value("backward"),
-       "how case 1 picks 50 of 101: backward, exchange, greedy, sampled (the paper's), random")
-      ("samples", po::value<int>()->default_value(1000), "subsets tried by 'sampled'")
-      ("format", po::value<std::string>()->default_value("text"), "text or json");
+  o.add_options()("robot", po::value<std::string>()->default_value("paper"), "robot file or name")(
+      "seed", po::value<long long>()->default_value(1), "random seed of the realisation")(
+      "case1-selection", po::value<std::string>()->default_value("backward"),
+      "how case 1 picks 50 of 101: backward, exchange, greedy, sampled (the paper's), random")(
+      "samples", po::value<int>()->default_value(1000), "subsets tried by 'sampled'")(
+      "format", po::value<std::string>()->default_value("text"), "text or json");
   po::variables_map vm;
   if (!Parse("paper", "[--seed K] [options]", o, args, &vm)) return 0;
   const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
@@ -388,13 +388,16 @@ int PaperCommand(const std::vector<std::string>& args) {
         sd[c.summary.names[k]] = c.summary.std_given[k];
       cj["std_given_sigma"] = sd;
       cj["validation_rms_position"] = ToJson(Eigen::VectorXd(c.validation.stats.rms_position));
-      cj["validation_rms_orientation"] = ToJson(Eigen::VectorXd(c.validation.stats.rms_orientation));
+      cj["validation_rms_orientation"] =
+          ToJson(Eigen::VectorXd(c.validation.stats.rms_orientation));
       cj["validation_max_position"] = ToJson(Eigen::VectorXd(c.validation.stats.max_position));
-      cj["validation_max_orientation"] = ToJson(Eigen::VectorXd(c.validation.stats.max_orientation));
+      cj["validation_max_orientation"] =
+          ToJson(Eigen::VectorXd(c.validation.stats.max_orientation));
       cases.push_back(cj);
     }
     j["cases"] = cases;
-    j["nominal_validation_rms_position"] = ToJson(Eigen::VectorXd(r.nominal_validation.stats.rms_position));
+    j["nominal_validation_rms_position"] =
+        ToJson(Eigen::VectorXd(r.nominal_validation.stats.rms_position));
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -406,8 +409,9 @@ int PaperCommand(const std::vector<std::string>& args) {
               << " by E-optimality ("
               << SelectionMethodName(c.label == "case 1" ? options.case1_selection.method
                                                          : options.case2_selection.method)
-              << ", " << c.selection.evaluations << " evaluations), sigma_min(G) = "
-              << c.selection.score << "; " << c.summary.BriefReport() << "\n";
+              << ", " << c.selection.evaluations
+              << " evaluations), sigma_min(G) = " << c.selection.score << "; "
+              << c.summary.BriefReport() << "\n";
   }
   std::cout << "\n" << params.ToText() << "\n" << validation.ToText();
   std::cout << "\nOne realisation cannot reproduce the paper's digits; `lrcal run "

@@ -4,43 +4,45 @@
 #include <cmath>
 
 #include "cli_common.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
-#include "lrcal/io/csv.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identifiability.h"
+#include "lrcal/io/csv.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/study/statistics.h"
-#include "lrcal/core/text_table.h"
 
 namespace lrcal::cli {
 
 namespace {
 
 // The criteria compared against random designs (O3 is E).
-constexpr DesignCriterion kAllCriteria[] = {DesignCriterion::kE,  DesignCriterion::kD,
-                                            DesignCriterion::kA,  DesignCriterion::kO1,
-                                            DesignCriterion::kO2, DesignCriterion::kO4,
-                                            DesignCriterion::kO5};
+constexpr DesignCriterion kAllCriteria[] = {
+    DesignCriterion::kE,  DesignCriterion::kD,  DesignCriterion::kA, DesignCriterion::kO1,
+    DesignCriterion::kO2, DesignCriterion::kO4, DesignCriterion::kO5};
 
 void AddDesignOptions(po::options_description& o) {
   AddCommonOptions(o);
-  o.add_options()("pool", po::value<std::string>(), "candidate configurations CSV (q1..qN)")
-      ("generate", po::value<int>(), "or: generate this many candidates (beam hits, non-singular)")
-      ("seed", po::value<long long>()->default_value(1), "seed for --generate, random starts, baseline")
-      ("select", po::value<int>()->required(), "configurations to choose (k)")
-      ("criterion", po::value<std::string>()->default_value("E"), "E (=O3), D, A, O1, O2, O4, O5")
-      ("method", po::value<std::string>()->default_value("exchange"),
-       "exhaustive, greedy (forward), backward, exchange, sampled, random")
-      ("scaling", po::value<std::string>()->default_value("si"),
-       "columns of G: si (the paper), unit (unit-norm), expected (× expected error)")
-      ("expected-angle-mrad", po::value<double>()->default_value(1.0), "expected angle error (mrad)")
-      ("expected-length-mm", po::value<double>()->default_value(1.0), "expected length error (mm)")
-      ("restarts", po::value<int>()->default_value(4), "exchange: starts (backward design + random)")
-      ("samples", po::value<int>()->default_value(1000), "sampled: random subsets tried")
-      ("baseline", po::value<int>()->default_value(1000), "random designs for the baseline")
-      ("estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")
-      ("fix", po::value<std::string>(), "parameters left out, comma-separated")
-      ("out", po::value<std::string>(), "write the chosen configurations (CSV)");
+  o.add_options()("pool", po::value<std::string>(), "candidate configurations CSV (q1..qN)")(
+      "generate", po::value<int>(), "or: generate this many candidates (beam hits, non-singular)")(
+      "seed", po::value<long long>()->default_value(1),
+      "seed for --generate, random starts, baseline")("select", po::value<int>()->required(),
+                                                      "configurations to choose (k)")(
+      "criterion", po::value<std::string>()->default_value("E"), "E (=O3), D, A, O1, O2, O4, O5")(
+      "method", po::value<std::string>()->default_value("exchange"),
+      "exhaustive, greedy (forward), backward, exchange, sampled, random")(
+      "scaling", po::value<std::string>()->default_value("si"),
+      "columns of G: si (the paper), unit (unit-norm), expected (× expected error)")(
+      "expected-angle-mrad", po::value<double>()->default_value(1.0),
+      "expected angle error (mrad)")("expected-length-mm", po::value<double>()->default_value(1.0),
+                                     "expected length error (mm)")(
+      "restarts", po::value<int>()->default_value(4),
+      "exchange: starts (backward design + random)")(
+      "samples", po::value<int>()->default_value(1000), "sampled: random subsets tried")(
+      "baseline", po::value<int>()->default_value(1000), "random designs for the baseline")(
+      "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
+      "fix", po::value<std::string>(), "parameters left out, comma-separated")(
+      "out", po::value<std::string>(), "write the chosen configurations (CSV)");
 }
 
 struct CandidatePool {
@@ -61,9 +63,9 @@ CandidatePool ResolvePool(const po::variables_map& vm, const Setup& setup, std::
     if (n < 1) throw InputError("--generate", "expected a positive number of candidates");
     SamplingOptions sampling;
     sampling.ranger = setup.rig.ranger;
-    pool.configs = SampleConfigurations(robot, setup.plane, n,
-                                        RandomStream(seed, 0, 0, RandomPurpose::kPool), sampling,
-                                        &pool.report);
+    pool.configs =
+        SampleConfigurations(robot, setup.plane, n, RandomStream(seed, 0, 0, RandomPurpose::kPool),
+                             sampling, &pool.report);
     pool.source = "generated: " + pool.report.ToString();
     return pool;
   }
@@ -137,10 +139,13 @@ void CompareWithRandomDesigns(const Eigen::MatrixXd& G, const SelectionResult& c
     const double value = CriterionScore(A_chosen, k, kAllCriteria[c]);
     const Distribution d = Describe(random_scores[c]);
     const double rank = PercentileRank(random_scores[c], value);
-    table->AddRow({name, Fixed(value, 6), Fixed(d.mean, 6), Fixed(d.p5, 6), Fixed(d.p95, 6),
-                   Fixed(rank, 1)});
-    (*indices)[name] = {{"chosen", value},   {"random_mean", d.mean}, {"random_p5", d.p5},
-                        {"random_p95", d.p95}, {"percentile", rank}};
+    table->AddRow(
+        {name, Fixed(value, 6), Fixed(d.mean, 6), Fixed(d.p5, 6), Fixed(d.p95, 6), Fixed(rank, 1)});
+    (*indices)[name] = {{"chosen", value},
+                        {"random_mean", d.mean},
+                        {"random_p5", d.p5},
+                        {"random_p95", d.p95},
+                        {"percentile", rank}};
   }
 }
 
@@ -167,7 +172,8 @@ int DesignCommand(const std::vector<std::string>& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const SelectionResult chosen =
       SelectConfigurations(G, k, options, RandomStream(seed, 1, 0, RandomPurpose::kSelection));
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const int baseline = vm["baseline"].as<int>();
   Table t({"index", "chosen", "random mean", "random p5", "random p95", "percentile of chosen"},
           "Observability of the chosen " + std::to_string(k) + " of " +
@@ -181,8 +187,10 @@ int DesignCommand(const std::vector<std::string>& args) {
 
   if (ResolveFormat(vm) == Format::kJson) {
     Json j;
-    j["pool"] = {{"size", pool.configs.size()}, {"source", pool.source},
-                 {"rejected", pool.report.rejected}, {"tried", pool.report.attempts}};
+    j["pool"] = {{"size", pool.configs.size()},
+                 {"source", pool.source},
+                 {"rejected", pool.report.rejected},
+                 {"tried", pool.report.attempts}};
     j["method"] = SelectionMethodName(options.method);
     j["criterion"] = DesignCriterionName(options.criterion);
     j["scaling"] = DesignScalingName(scaling);

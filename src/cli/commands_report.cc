@@ -7,8 +7,8 @@
 #include <filesystem>
 
 #include "cli_common.h"
-#include "lrcal/report/report_data.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/report/report_data.h"
 
 namespace lrcal::cli {
 
@@ -26,8 +26,9 @@ std::string FindReportScript() {
     const fs::path p = base / "analysis" / "report.py";
     if (fs::exists(p)) return p.string();
   }
-  throw InputError("analysis/report.py", "not found next to the working directory or in the "
-                                         "source tree " LRCAL_SOURCE_DIR);
+  throw InputError("analysis/report.py",
+                   "not found next to the working directory or in the "
+                   "source tree " LRCAL_SOURCE_DIR);
 }
 
 }  // namespace

@@ -5,12 +5,12 @@
 #include <thread>
 
 #include "cli_common.h"
-#include "lrcal/study/collective.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/report/run_tables.h"
+#include "lrcal/study/collective.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/study.h"
-#include "lrcal/core/text_table.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal::cli {
@@ -46,10 +46,11 @@ RunOptions ResolveRunOptions(const po::variables_map& vm, const Study& study) {
 std::unique_ptr<Collective> MpiWorldIfLaunched() {
   if (!LaunchedUnderMpi()) return nullptr;
   if (!BuiltWithMpi())
-    throw InputError("mpirun", "this lrcal was built without MPI (CMake found no MPI when it "
-                               "was configured): install OpenMPI (libopenmpi-dev) and rebuild, "
-                               "or run without mpirun (threads: --threads N; several machines: "
-                               "--shard i/N and lrcal merge)");
+    throw InputError("mpirun",
+                     "this lrcal was built without MPI (CMake found no MPI when it "
+                     "was configured): install OpenMPI (libopenmpi-dev) and rebuild, "
+                     "or run without mpirun (threads: --threads N; several machines: "
+                     "--shard i/N and lrcal merge)");
   return MpiWorld(nullptr, nullptr);
 }
 
@@ -61,8 +62,9 @@ void PrintRunSummary(const RunResult& r, const RunOptions& options, int ranks) {
               << (ranks > 1 ? " on rank 0" : "");
   std::cerr << ")\n";
   if (r.computed == 0) return;
-  const int threads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0
+                          ? options.threads
+                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
             << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
             << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string())
@@ -100,15 +102,15 @@ void PrintShardAdvice(const std::vector<std::string>& dirs,
 
 int RunCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal run options");
-  o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")
-      ("out", po::value<std::string>(), "run directory (default: output/<study name>)")
-      ("threads", po::value<int>()->default_value(0), "worker threads (0: all cores)")
-      ("shard", po::value<std::string>(), "run only shard i/N of the trials (batch schedulers)")
-      ("max-trials", po::value<long long>()->default_value(0),
-       "stop after this many new trials (0: no limit); rerun to continue")
-      ("schedule", po::value<std::string>()->default_value("static"),
-       "MPI only: static (every P-th trial per rank) or dynamic (chunks from rank 0)")
-      ("quiet", po::bool_switch(), "no progress output");
+  o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")(
+      "out", po::value<std::string>(), "run directory (default: output/<study name>)")(
+      "threads", po::value<int>()->default_value(0), "worker threads (0: all cores)")(
+      "shard", po::value<std::string>(), "run only shard i/N of the trials (batch schedulers)")(
+      "max-trials", po::value<long long>()->default_value(0),
+      "stop after this many new trials (0: no limit); rerun to continue")(
+      "schedule", po::value<std::string>()->default_value("static"),
+      "MPI only: static (every P-th trial per rank) or dynamic (chunks from rank 0)")(
+      "quiet", po::bool_switch(), "no progress output");
   po::positional_options_description pos;
   pos.add("study", 1);
   po::variables_map vm;
@@ -142,16 +144,17 @@ int RunCommand(const std::vector<std::string>& args) {
 
 int PlanCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal plan options");
-  o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")
-      ("threads", po::value<int>()->default_value(0), "threads the run would use (0: all cores)")
-      ("format", po::value<std::string>()->default_value("text"), "text or json");
+  o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")(
+      "threads", po::value<int>()->default_value(0), "threads the run would use (0: all cores)")(
+      "format", po::value<std::string>()->default_value("text"), "text or json");
   po::positional_options_description pos;
   pos.add("study", 1);
   po::variables_map vm;
   if (!Parse("plan", "[STUDY.yaml]", o, args, &vm, &pos)) return 0;
   const Study study = LoadStudyArg(vm);
-  const int threads = vm["threads"].as<int>() > 0 ? vm["threads"].as<int>()
-                                                  : std::max(1u, std::thread::hardware_concurrency());
+  const int threads = vm["threads"].as<int>() > 0
+                          ? vm["threads"].as<int>()
+                          : std::max(1u, std::thread::hardware_concurrency());
   Table t({"cell", "id", "trials", "prepare (s)", "µs/trial (measured)", "estimate (s)"},
           "Plan of study '" + study.name + "' (dry run: each cell prepared, a few trials timed)");
   Json j = Json::array();
@@ -168,21 +171,28 @@ int PlanCommand(const std::vector<std::string>& args) {
     const double per = std::chrono::duration<double>(t2 - t1).count() / probe;
     const double est = prep + per * study.trials / threads;
     total_seconds += est;
-    t.AddRow({cell.label, cell.id, std::to_string(study.trials), Fixed(prep, 3), Fixed(per * 1e6, 1),
-              Fixed(est, 1)});
-    j.push_back({{"label", cell.label}, {"id", cell.id}, {"trials", study.trials},
-                 {"prepare_seconds", prep}, {"seconds_per_trial", per}, {"estimate_seconds", est},
+    t.AddRow({cell.label, cell.id, std::to_string(study.trials), Fixed(prep, 3),
+              Fixed(per * 1e6, 1), Fixed(est, 1)});
+    j.push_back({{"label", cell.label},
+                 {"id", cell.id},
+                 {"trials", study.trials},
+                 {"prepare_seconds", prep},
+                 {"seconds_per_trial", per},
+                 {"estimate_seconds", est},
                  {"settings", cell.settings}});
   }
   if (vm["format"].as<std::string>() == "json") {
-    std::cout << Json{{"study", study.name}, {"cells", j}, {"threads", threads},
-                      {"total_trials", study.total_trials()}, {"estimate_seconds", total_seconds}}
+    std::cout << Json{{"study", study.name},
+                      {"cells", j},
+                      {"threads", threads},
+                      {"total_trials", study.total_trials()},
+                      {"estimate_seconds", total_seconds}}
                      .dump(2)
               << "\n";
   } else {
-    std::cout << t.ToText() << "total: " << study.cells.size() << " cells, "
-              << study.total_trials() << " trials, about " << Fixed(total_seconds, 0) << " s on "
-              << threads << " threads\n";
+    std::cout << t.ToText() << "total: " << study.cells.size() << " cells, " << study.total_trials()
+              << " trials, about " << Fixed(total_seconds, 0) << " s on " << threads
+              << " threads\n";
   }
   return 0;
 }
@@ -208,8 +218,8 @@ int StatusCommand(const std::vector<std::string>& args) {
 int MergeCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal merge options");
   o.add_options()("dirs", po::value<std::vector<std::string>>()->multitoken()->required(),
-                  "shard run directories")
-      ("out", po::value<std::string>()->required(), "merged run directory");
+                  "shard run directories")("out", po::value<std::string>()->required(),
+                                           "merged run directory");
   po::positional_options_description pos;
   pos.add("dirs", -1);
   po::variables_map vm;

@@ -11,7 +11,8 @@ namespace lrcal::cli {
 
 const std::vector<Command>& Commands() {
   static const std::vector<Command> commands = {
-      {"run", "run (or resume) a Monte-Carlo study: lrcal run [STUDY.yaml] [--out DIR]", RunCommand},
+      {"run", "run (or resume) a Monte-Carlo study: lrcal run [STUDY.yaml] [--out DIR]",
+       RunCommand},
       {"plan", "dry run: cells, trials and an estimated run time of a study", PlanCommand},
       {"status", "done / remaining trials per cell of a run directory", StatusCommand},
       {"merge", "combine shard run directories into one run", MergeCommand},

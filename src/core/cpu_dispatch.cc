@@ -7,9 +7,12 @@ namespace lrcal {
 
 const char* IsaName(Isa isa) {
   switch (isa) {
-    case Isa::kDefault: return "default";
-    case Isa::kAvx2: return "avx2";
-    case Isa::kAvx512: return "avx512";
+    case Isa::kDefault:
+      return "default";
+    case Isa::kAvx2:
+      return "avx2";
+    case Isa::kAvx512:
+      return "avx512";
   }
   return "?";
 }

@@ -30,17 +30,20 @@ std::vector<std::string> DiffJson(const Json& a, const Json& b, const std::strin
   if (a.is_object() && b.is_object()) {
     for (auto it = a.begin(); it != a.end(); ++it) {
       const std::string p = Join(prefix, it.key());
-      if (!b.contains(it.key())) out.push_back(p + ": removed (was " + it.value().dump() + ")");
+      if (!b.contains(it.key()))
+        out.push_back(p + ": removed (was " + it.value().dump() + ")");
       else {
         auto sub = DiffJson(it.value(), b[it.key()], p);
         out.insert(out.end(), sub.begin(), sub.end());
       }
     }
     for (auto it = b.begin(); it != b.end(); ++it)
-      if (!a.contains(it.key())) out.push_back(Join(prefix, it.key()) + ": added " + it.value().dump());
+      if (!a.contains(it.key()))
+        out.push_back(Join(prefix, it.key()) + ": added " + it.value().dump());
     return out;
   }
-  if (a != b) out.push_back((prefix.empty() ? "(root)" : prefix) + ": " + a.dump() + " -> " + b.dump());
+  if (a != b)
+    out.push_back((prefix.empty() ? "(root)" : prefix) + ": " + a.dump() + " -> " + b.dump());
   return out;
 }
 

@@ -40,8 +40,10 @@ std::vector<std::string> SplitList(const std::string& text, char separator) {
   };
   if (text.empty()) return out;
   for (char c : text) {
-    if (c == separator) flush();
-    else item += c;
+    if (c == separator)
+      flush();
+    else
+      item += c;
   }
   flush();
   return out;

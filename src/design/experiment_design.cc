@@ -22,14 +22,20 @@ double ScoreFromEigenvalues(const Eigen::VectorXd& lambda, int m, DesignCriterio
     return criterion == DesignCriterion::kD || criterion == DesignCriterion::kA ? kMinusInf : 0.0;
   }
   switch (criterion) {
-    case DesignCriterion::kE: return std::sqrt(lmin);
-    case DesignCriterion::kD: return lambda.array().log().sum();
-    case DesignCriterion::kA: return -lambda.cwiseInverse().sum();
+    case DesignCriterion::kE:
+      return std::sqrt(lmin);
+    case DesignCriterion::kD:
+      return lambda.array().log().sum();
+    case DesignCriterion::kA:
+      return -lambda.cwiseInverse().sum();
     case DesignCriterion::kO1:
       return std::exp(0.5 * lambda.array().log().sum() / n) / std::sqrt(static_cast<double>(m));
-    case DesignCriterion::kO2: return std::sqrt(lmin / lmax);
-    case DesignCriterion::kO4: return lmin / std::sqrt(lmax);
-    case DesignCriterion::kO5: return 1.0 / lambda.cwiseSqrt().cwiseInverse().sum();
+    case DesignCriterion::kO2:
+      return std::sqrt(lmin / lmax);
+    case DesignCriterion::kO4:
+      return lmin / std::sqrt(lmax);
+    case DesignCriterion::kO5:
+      return 1.0 / lambda.cwiseSqrt().cwiseInverse().sum();
   }
   return kMinusInf;
 }
@@ -48,8 +54,10 @@ double SecularRoot(const Eigen::VectorXd& lambda, const Eigen::VectorXd& z2,
       df += rho * z2[i] * inv * inv;
     }
     // rho > 0: f increasing on the interval; rho < 0: decreasing.
-    if (rho > 0 ? f < 0 : f > 0) lo = mu;
-    else hi = mu;
+    if (rho > 0 ? f < 0 : f > 0)
+      lo = mu;
+    else
+      hi = mu;
     double next = mu - f / df;
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     if (std::fabs(next - mu) <= 4 * eps * std::fabs(next) || hi - lo <= 4 * eps * std::fabs(hi))
@@ -80,12 +88,15 @@ class Spectrum {
     z2_ = z_.cwiseAbs2();
     switch (criterion) {
       case DesignCriterion::kD:
-      case DesignCriterion::kO1: return DeterminantScore(rho, m, criterion);
-      case DesignCriterion::kA: return TraceScore(rho);
+      case DesignCriterion::kO1:
+        return DeterminantScore(rho, m, criterion);
+      case DesignCriterion::kA:
+        return TraceScore(rho);
       case DesignCriterion::kO5:
         mu_ = RankOneUpdatedEigenvalues(lambda_, z_, rho);
         return ScoreFromEigenvalues(mu_, m, criterion);
-      default: return ExtremeEigenvalueScore(rho, criterion);
+      default:
+        return ExtremeEigenvalueScore(rho, criterion);
     }
   }
 
@@ -140,10 +151,14 @@ class Spectrum {
     }
     if (!(mu_min > 1e-300)) return 0.0;
     switch (criterion) {
-      case DesignCriterion::kE: return std::sqrt(mu_min);
-      case DesignCriterion::kO2: return std::sqrt(mu_min / mu_max);
-      case DesignCriterion::kO4: return mu_min / std::sqrt(mu_max);
-      default: return kMinusInf;
+      case DesignCriterion::kE:
+        return std::sqrt(mu_min);
+      case DesignCriterion::kO2:
+        return std::sqrt(mu_min / mu_max);
+      case DesignCriterion::kO4:
+        return mu_min / std::sqrt(mu_max);
+      default:
+        return kMinusInf;
     }
   }
 
@@ -240,7 +255,8 @@ std::vector<int> Forward(const Eigen::MatrixXd& G, int k, DesignCriterion criter
     int best_j = -1;
     for (int j = 0; j < N; ++j) {
       if (chosen[j]) continue;
-      const double s = spectrum.Score(G.row(j).transpose(), 1.0, static_cast<int>(out.size()) + 1, c);
+      const double s =
+          spectrum.Score(G.row(j).transpose(), 1.0, static_cast<int>(out.size()) + 1, c);
       ++*evaluations;
       if (s > best || best_j < 0) {
         best = s;
@@ -313,8 +329,10 @@ Eigen::VectorXd RankOneUpdatedEigenvalues(const Eigen::VectorXd& lambda, const E
   std::vector<int> active;
   std::vector<double> mu;
   for (int i = 0; i < n; ++i) {
-    if (z2[i] > tol) active.push_back(i);
-    else mu.push_back(lambda[i]);
+    if (z2[i] > tol)
+      active.push_back(i);
+    else
+      mu.push_back(lambda[i]);
   }
   const int a = static_cast<int>(active.size());
   for (int t = 0; t < a; ++t) {
@@ -340,7 +358,8 @@ double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion
 Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
                              const Eigen::VectorXd& expected) {
   switch (scaling) {
-    case DesignScaling::kSI: return G;
+    case DesignScaling::kSI:
+      return G;
     case DesignScaling::kUnitColumns: {
       Eigen::VectorXd norms = G.colwise().norm().transpose();
       for (int j = 0; j < norms.size(); ++j)
@@ -432,8 +451,8 @@ void SelectExchange(const Eigen::MatrixXd& G, int k, const SelectionOptions& opt
   for (int r = 0; r < std::max(1, options.restarts); ++r) {
     std::vector<int> start = r == 0 ? Backward(G, k, options.criterion, &best->evaluations)
                                     : RandomSubset(N, k, stream, static_cast<std::uint64_t>(r) * N);
-    best->start_score = std::max(best->start_score,
-                                 CriterionScore(NormalMatrixOf(G, start), k, options.criterion));
+    best->start_score =
+        std::max(best->start_score, CriterionScore(NormalMatrixOf(G, start), k, options.criterion));
     std::vector<int> end = Exchange(G, start, options.criterion, &best->evaluations);
     const double score = CriterionScore(NormalMatrixOf(G, end), k, options.criterion);
     if (score > best->score) {

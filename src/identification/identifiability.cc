@@ -1,14 +1,13 @@
 #include "lrcal/identification/identifiability.h"
 
-#include <memory>
-
-#include "lrcal/core/error.h"
-
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
+
+#include "lrcal/core/error.h"
 
 namespace lrcal {
 
@@ -67,8 +66,10 @@ Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
 void IdentifiabilityOptions::Validate(const std::string& source) const {
   const auto check = [&](double v, const char* name) {
     if (!(v >= 0 && v < 1))
-      throw InputError(source, std::string(name) + ": expected a relative tolerance in [0, 1), "
-                                                    "got " + std::to_string(v));
+      throw InputError(source, std::string(name) +
+                                   ": expected a relative tolerance in [0, 1), "
+                                   "got " +
+                                   std::to_string(v));
   };
   check(rank_tolerance, "rank tolerance");
   check(zero_column_tolerance, "zero-column tolerance");
@@ -97,8 +98,8 @@ Eigen::MatrixXd ScaledLiveColumns(const Eigen::MatrixXd& G, const Identifiabilit
 }
 
 // Rank and condition number from the singular values of the scaled live columns.
-void RankFromSingularValues(const Eigen::MatrixXd& Gs, int n,
-                            const IdentifiabilityOptions& options, IdentifiabilityReport* report) {
+void RankFromSingularValues(const Eigen::MatrixXd& Gs, int n, const IdentifiabilityOptions& options,
+                            IdentifiabilityReport* report) {
   if (Gs.cols() > 0 && Gs.rows() > 0) {
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(Gs);
     report->singular_values = svd.singularValues();

@@ -1,15 +1,14 @@
 #include "lrcal/identification/identification.h"
 
-#include "identification/levenberg_marquardt.h"
-
-#include "core/cpu_dispatch.h"
-
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <memory>
 #include <sstream>
+
+#include "core/cpu_dispatch.h"
+#include "identification/levenberg_marquardt.h"
 
 namespace lrcal {
 
@@ -52,8 +51,9 @@ bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
   return true;
 }
 
-void CholeskySubstitute(const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& L_in,
-                        const Eigen::VectorXd& b, Eigen::VectorXd* x) {
+void CholeskySubstitute(
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& L_in,
+    const Eigen::VectorXd& b, Eigen::VectorXd* x) {
   const int n = static_cast<int>(L_in.rows());
   const double* L = L_in.data();
   x->resize(n);
@@ -103,7 +103,8 @@ double LevenbergMarquardt::Cost(const MeasurementModel& model, const double* mea
   h_.resize(m);
   if (!batch_.Evaluate(model, point_, h_.data(), nullptr))
     return std::numeric_limits<double>::quiet_NaN();
-  return 0.5 * sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_).squaredNorm();
+  return 0.5 *
+         sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_).squaredNorm();
 }
 
 namespace {
@@ -135,7 +136,7 @@ __attribute__((target("avx2"))) void NormalMatrixAvx2(const double* J, int m, in
   NormalMatrixBody(J, m, n, A);
 }
 __attribute__((target("avx512f"))) void NormalMatrixAvx512(const double* J, int m, int n,
-                                                            double* A) {
+                                                           double* A) {
   NormalMatrixBody(J, m, n, A);
 }
 #endif
@@ -147,10 +148,16 @@ void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa) {
   A->resize(n, n);
   switch (isa) {
 #if defined(__x86_64__)
-    case Isa::kAvx512: NormalMatrixAvx512(J.data(), m, n, A->data()); return;
-    case Isa::kAvx2: NormalMatrixAvx2(J.data(), m, n, A->data()); return;
+    case Isa::kAvx512:
+      NormalMatrixAvx512(J.data(), m, n, A->data());
+      return;
+    case Isa::kAvx2:
+      NormalMatrixAvx2(J.data(), m, n, A->data());
+      return;
 #endif
-    default: NormalMatrixDefault(J.data(), m, n, A->data()); return;
+    default:
+      NormalMatrixDefault(J.data(), m, n, A->data());
+      return;
   }
 }
 
@@ -240,12 +247,13 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
     step_ = scale_.cwiseProduct(step_);
     e_trial_ = *e + step_;
     const double step_norm = step_.norm();
-    const double tolerance = options.parameter_tolerance * (e->norm() + options.parameter_tolerance);
+    const double tolerance =
+        options.parameter_tolerance * (e->norm() + options.parameter_tolerance);
     const bool small_step = step_norm <= tolerance;
     // Predicted error left after this step: the step times the observed contraction.
     const double contraction = step_norm / previous_step;
-    const bool last_step = std::isfinite(previous_step) && contraction < 0.5 &&
-                           contraction * step_norm <= tolerance;
+    const bool last_step =
+        std::isfinite(previous_step) && contraction < 0.5 && contraction * step_norm <= tolerance;
     const double predicted_decrease = 0.5 * step_.dot(g_);
     if (small_step || last_step) {
       // The final step: check it on residuals alone.
@@ -378,9 +386,12 @@ ceres::Solver::Options CeresOptions(const IdentificationOptions& options) {
 
 Termination CeresTermination(const ceres::Solver::Summary& summary) {
   switch (summary.termination_type) {
-    case ceres::CONVERGENCE: return Termination::kConverged;
-    case ceres::NO_CONVERGENCE: return Termination::kMaxIterations;
-    default: return Termination::kNumericalFailure;
+    case ceres::CONVERGENCE:
+      return Termination::kConverged;
+    case ceres::NO_CONVERGENCE:
+      return Termination::kMaxIterations;
+    default:
+      return Termination::kNumericalFailure;
   }
 }
 
@@ -432,7 +443,8 @@ const MeasurementModel* CheckIdentifiable(const MeasurementModel& model_in,
                                           IdentificationSummary* summary) {
   IdentificationSummary& s = *summary;
   const MeasurementModel* model = &model_in;
-  s.identifiability = AnalyzeIdentifiability(*model, data.configs, nullptr, options.identifiability);
+  s.identifiability =
+      AnalyzeIdentifiability(*model, data.configs, nullptr, options.identifiability);
   if (s.identifiability.full_rank()) return model;
   std::ostringstream msg;
   msg << "the parameter set is rank-deficient on these configurations (rank "
@@ -450,7 +462,8 @@ const MeasurementModel* CheckIdentifiable(const MeasurementModel& model_in,
       model_in.robot(), model_in.nominal_plane(),
       WithoutParameters(model_in.robot(), model_in.parameters(), s.fixed));
   model = reduced->get();
-  s.identifiability = AnalyzeIdentifiability(*model, data.configs, nullptr, options.identifiability);
+  s.identifiability =
+      AnalyzeIdentifiability(*model, data.configs, nullptr, options.identifiability);
   if (s.identifiability.full_rank()) return model;
   s.names = model->parameters().names;
   s.termination = Termination::kRankDeficient;
@@ -494,8 +507,9 @@ void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet&
   s.estimate = s.nominal + s.delta;
 
   Eigen::MatrixXd G = IdentificationJacobian(*model, data.configs, e.data());
-  Eigen::MatrixXd A = G.transpose() * Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
-                                          weights.data(), m)).asDiagonal() * G;
+  Eigen::MatrixXd A =
+      G.transpose() *
+      Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(weights.data(), m)).asDiagonal() * G;
   const Eigen::MatrixXd Ainv = ParameterCovariance(A, 1.0);
   s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : 0.0;
   s.covariance_residual = s.sigma_hat * s.sigma_hat * Ainv;
@@ -563,8 +577,8 @@ std::string IdentificationSummary::BriefReport() const {
   std::ostringstream out;
   out << "lrcal identification (" << solver << "): " << TerminationName(termination) << ", "
       << iterations << " iterations, " << names.size() << " parameters, " << num_configurations
-      << " configurations, cost " << initial_cost << " -> " << final_cost
-      << " m^2, residual RMS " << residual_rms * 1e3 << " mm";
+      << " configurations, cost " << initial_cost << " -> " << final_cost << " m^2, residual RMS "
+      << residual_rms * 1e3 << " mm";
   return out.str();
 }
 

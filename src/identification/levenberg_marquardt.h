@@ -44,9 +44,9 @@ class LevenbergMarquardt {
   /// have configs.size() entries (weights = repetitions). `nominal`, if given, must be the model
   /// at e = 0 on these configurations. On return `normal_matrix()` holds GᵀWG at the last
   /// linearisation point (within one final step of e).
-  Result Solve(const MeasurementModel& model, const ConfigurationSet& configs,
-               const double* mean_h, const double* weights, const IdentificationOptions& options,
-               Eigen::VectorXd* e, const Nominal* nominal = nullptr);
+  Result Solve(const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
+               const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
+               const Nominal* nominal = nullptr);
   const Eigen::MatrixXd& normal_matrix() const { return A_; }
 
  private:
@@ -69,8 +69,9 @@ class LevenbergMarquardt {
 };
 
 /// Solves L·Lᵀ·x = b for a row-major Cholesky factor L (from CholeskySolve).
-void CholeskySubstitute(const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& L,
-                        const Eigen::VectorXd& b, Eigen::VectorXd* x);
+void CholeskySubstitute(
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& L,
+    const Eigen::VectorXd& b, Eigen::VectorXd* x);
 
 /// A = JᵀJ (n×n, both triangles) for a column-major m×n J. Each entry is summed in 8 fixed
 /// partial sums (index mod 8) added in a fixed order, so the result has the same bits whatever

@@ -1,8 +1,5 @@
 #include "lrcal/io/csv.h"
 
-#include "lrcal/core/json.h"
-#include "lrcal/core/strings.h"
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -10,6 +7,8 @@
 #include <sstream>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/json.h"
+#include "lrcal/core/strings.h"
 #include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
@@ -46,9 +45,9 @@ CsvTable ReadCsv(const std::string& path) {
     }
     if (cells.size() != t.header.size())
       throw InputError(Location(path, number),
-                       "expected " + std::to_string(t.header.size()) + " cells (header: " +
-                           std::to_string(t.header.size()) + " columns), got " +
-                           std::to_string(cells.size()));
+                       "expected " + std::to_string(t.header.size()) +
+                           " cells (header: " + std::to_string(t.header.size()) +
+                           " columns), got " + std::to_string(cells.size()));
     std::vector<double> row(cells.size());
     for (std::size_t c = 0; c < cells.size(); ++c) {
       char* end = nullptr;
@@ -77,7 +76,8 @@ std::vector<int> JointColumns(const CsvTable& t, int num_joints) {
     cols.push_back(c);
   }
   for (const std::string& name : t.header) {
-    if (name.size() > 1 && name[0] == 'q' && name.find_first_not_of("0123456789", 1) == std::string::npos &&
+    if (name.size() > 1 && name[0] == 'q' &&
+        name.find_first_not_of("0123456789", 1) == std::string::npos &&
         std::stoi(name.substr(1)) > num_joints)
       throw InputError(Location(t.path, 1) + " column '" + name + "'",
                        "the robot has only " + std::to_string(num_joints) +

@@ -55,8 +55,8 @@ JointType ParseJoint(const YAML::Node& node, const std::string& path, const std:
 // links[i]: joint, the five nominal values (β defaults to 0), which are parameters, joint range.
 Link ParseLink(const YAML::Node& ln, const std::string& path, const std::string& ctx) {
   using namespace yaml;
-  CheckKeys(ln, {"joint", "theta", "alpha", "a", "d", "beta", "parameters", "q_min", "q_max"},
-            path, ctx);
+  CheckKeys(ln, {"joint", "theta", "alpha", "a", "d", "beta", "parameters", "q_min", "q_max"}, path,
+            ctx);
   Link link;
   if (ln["joint"]) link.joint = ParseJoint(ln["joint"], path, ctx + ".joint");
   for (int v = 0; v < kValuesPerLink; ++v) {
@@ -80,7 +80,8 @@ Link ParseLink(const YAML::Node& ln, const std::string& path, const std::string&
   }
   if (ln["q_min"]) link.q_min = Number(ln["q_min"], path, ctx + ".q_min", true);
   if (ln["q_max"]) link.q_max = Number(ln["q_max"], path, ctx + ".q_max", true);
-  if (!(link.q_min < link.q_max)) throw InputError(Where(path, ln, ctx), "q_min must be below q_max");
+  if (!(link.q_min < link.q_max))
+    throw InputError(Where(path, ln, ctx), "q_min must be below q_max");
   return link;
 }
 
@@ -102,18 +103,17 @@ Eigen::VectorXd ParseTrueErrors(const YAML::Node& root, const std::string& path,
   const YAML::Node te = root["true_errors"];
   if (!te) return errors;
   CheckKeys(te, {"angle_unit", "length_unit", "links"}, path, "true_errors");
-  const double as =
-      AngleScale(te["angle_unit"] ? String(te["angle_unit"], path, "true_errors.angle_unit") : "rad",
-                 Where(path, te["angle_unit"], "true_errors.angle_unit"));
-  const double ls =
-      LengthScale(te["length_unit"] ? String(te["length_unit"], path, "true_errors.length_unit")
-                                    : "m",
-                  Where(path, te["length_unit"], "true_errors.length_unit"));
+  const double as = AngleScale(
+      te["angle_unit"] ? String(te["angle_unit"], path, "true_errors.angle_unit") : "rad",
+      Where(path, te["angle_unit"], "true_errors.angle_unit"));
+  const double ls = LengthScale(
+      te["length_unit"] ? String(te["length_unit"], path, "true_errors.length_unit") : "m",
+      Where(path, te["length_unit"], "true_errors.length_unit"));
   const YAML::Node tl = te["links"];
   if (!tl || !tl.IsSequence() || tl.size() != links.size())
-    throw InputError(Where(path, te, "true_errors.links"),
-                     "expected a list of " + std::to_string(links.size()) +
-                         " entries, one per link");
+    throw InputError(
+        Where(path, te, "true_errors.links"),
+        "expected a list of " + std::to_string(links.size()) + " entries, one per link");
   for (std::size_t i = 0; i < tl.size(); ++i) {
     const std::string ctx = "true_errors.links[" + std::to_string(i) + "]";
     CheckKeys(tl[i], {"theta", "alpha", "a", "d", "beta"}, path, ctx);

@@ -22,8 +22,8 @@ void RequireMap(const YAML::Node& node, const std::string& file, const std::stri
   if (!node.IsMap()) throw InputError(Where(file, node, key), "expected a mapping of keys");
 }
 
-void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed,
-               const std::string& file, const std::string& context) {
+void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& file,
+               const std::string& context) {
   RequireMap(map, file, context);
   for (const auto& kv : map) {
     std::string key = kv.first.as<std::string>();
@@ -44,8 +44,9 @@ double Number(const YAML::Node& node, const std::string& file, const std::string
   double value = 0;
   if (allow_pi) {
     if (ParseAngleExpression(text, &value)) return value;
-    throw InputError(Where(file, node, key),
-                     "expected a number or an expression like pi/2, -pi, 3*pi/4; got '" + text + "'");
+    throw InputError(
+        Where(file, node, key),
+        "expected a number or an expression like pi/2, -pi, 3*pi/4; got '" + text + "'");
   }
   char* end = nullptr;
   value = std::strtod(text.c_str(), &end);
@@ -57,7 +58,8 @@ double Number(const YAML::Node& node, const std::string& file, const std::string
 int Integer(const YAML::Node& node, const std::string& file, const std::string& key) {
   double v = Number(node, file, key);
   if (v != std::floor(v) || std::fabs(v) > 2e9)
-    throw InputError(Where(file, node, key), "expected a whole number; got '" + node.Scalar() + "'");
+    throw InputError(Where(file, node, key),
+                     "expected a whole number; got '" + node.Scalar() + "'");
   return static_cast<int>(v);
 }
 

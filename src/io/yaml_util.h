@@ -23,8 +23,8 @@ inline std::string Where(const std::string& file, const YAML::Node& node, const 
 YAML::Node LoadFile(const std::string& path);
 
 /// Every key of `map` must be in `allowed`.
-void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed,
-               const std::string& file, const std::string& context);
+void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& file,
+               const std::string& context);
 
 void RequireMap(const YAML::Node& node, const std::string& file, const std::string& key);
 

@@ -40,9 +40,9 @@ Pose<double> ToolPose(const ChainPoint& point, const ConfigurationSet& configs, 
       ct = t.cos_theta0 * cq[i] - t.sin_theta0 * sq[i];
       st = t.sin_theta0 * cq[i] + t.cos_theta0 * sq[i];
     }
-    const Eigen::Vector3d x_common = ct * x + st * y;   // R_{i-1}·Rz(θ)·e_x
-    const Eigen::Vector3d y_rotz = -st * x + ct * y;    // R_{i-1}·Rz(θ)·e_y
-    const Eigen::Vector3d y_twist = t.cos_alpha * y_rotz + t.sin_alpha * z;   // ·Rx(α)·e_y
+    const Eigen::Vector3d x_common = ct * x + st * y;                        // R_{i-1}·Rz(θ)·e_x
+    const Eigen::Vector3d y_rotz = -st * x + ct * y;                         // R_{i-1}·Rz(θ)·e_y
+    const Eigen::Vector3d y_twist = t.cos_alpha * y_rotz + t.sin_alpha * z;  // ·Rx(α)·e_y
     const Eigen::Vector3d z_alpha = -t.sin_alpha * y_rotz + t.cos_alpha * z;  // ·Rx(α)·e_z
     if (frames) {
       frames->o_prev[i] = o;

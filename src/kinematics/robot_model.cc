@@ -55,5 +55,4 @@ int RobotModel::FindValue(const std::string& name) const {
   return LinkValueIndex(name, num_links());
 }
 
-
 }  // namespace lrcal

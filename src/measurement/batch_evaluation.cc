@@ -1,10 +1,10 @@
 #include "measurement/batch_evaluation.h"
 
-#include "core/cpu_dispatch.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "core/cpu_dispatch.h"
 
 namespace lrcal {
 
@@ -99,7 +99,7 @@ template <bool kJacobian>
     const double ct0 = t.cos_theta0, st0 = t.sin_theta0, ca = t.cos_alpha, sa = t.sin_alpha,
                  cb = t.cos_beta, sb = t.sin_beta, a = t.a, d0 = t.d;
     const double revolute = t.prismatic ? 0.0 : 1.0;
-    #pragma GCC ivdep
+#pragma GCC ivdep
     for (int i = 0; i < m; ++i) {
       // cos/sin(θ0 + q) by the addition theorem (revolute); θ0 alone and d0 + q (prismatic).
       const double ct = revolute * (ct0 * cq[i] - st0 * sq[i]) + (1 - revolute) * ct0;
@@ -118,16 +118,26 @@ template <bool kJacobian>
       const double za1 = ca * z1[i] - sa * yr1;
       const double za2 = ca * z2[i] - sa * yr2;
       if constexpr (kJacobian) {
-        fz0[i] = z0[i]; fz1[i] = z1[i]; fz2[i] = z2[i];
-        fp0[i] = o0[i]; fp1[i] = o1[i]; fp2[i] = o2[i];
-        fx0[i] = xc0; fx1[i] = xc1; fx2[i] = xc2;
-        fy0[i] = yt0; fy1[i] = yt1; fy2[i] = yt2;
+        fz0[i] = z0[i];
+        fz1[i] = z1[i];
+        fz2[i] = z2[i];
+        fp0[i] = o0[i];
+        fp1[i] = o1[i];
+        fp2[i] = o2[i];
+        fx0[i] = xc0;
+        fx1[i] = xc1;
+        fx2[i] = xc2;
+        fy0[i] = yt0;
+        fy1[i] = yt1;
+        fy2[i] = yt2;
       }
       o0[i] += a * xc0 + d * z0[i];
       o1[i] += a * xc1 + d * z1[i];
       o2[i] += a * xc2 + d * z2[i];
       if constexpr (kJacobian) {
-        fo0[i] = o0[i]; fo1[i] = o1[i]; fo2[i] = o2[i];
+        fo0[i] = o0[i];
+        fo1[i] = o1[i];
+        fo2[i] = o2[i];
       }
       x0[i] = cb * xc0 - sb * za0;
       x1[i] = cb * xc1 - sb * za1;
@@ -135,7 +145,9 @@ template <bool kJacobian>
       z0[i] = sb * xc0 + cb * za0;
       z1[i] = sb * xc1 + cb * za1;
       z2[i] = sb * xc2 + cb * za2;
-      y0[i] = yt0; y1[i] = yt1; y2[i] = yt2;
+      y0[i] = yt0;
+      y1[i] = yt1;
+      y2[i] = yt2;
     }
   }
 
@@ -173,7 +185,7 @@ template <bool kJacobian>
       const double* __restrict a0 = f + (v == kD ? kZPrev : kXCommon) * m;
       const double* __restrict a1 = a0 + m;
       const double* __restrict a2 = a1 + m;
-      #pragma GCC ivdep
+#pragma GCC ivdep
       for (int i = 0; i < m; ++i) col[i] = (n0 * a0[i] + n1 * a1[i] + n2 * a2[i]) * inv[i];
       continue;
     }
@@ -184,12 +196,12 @@ template <bool kJacobian>
     const double* __restrict a0 = f + (v == kTheta ? kZPrev : v == kAlpha ? kXCommon : kYTwist) * m;
     const double* __restrict a1 = a0 + m;
     const double* __restrict a2 = a1 + m;
-    #pragma GCC ivdep
+#pragma GCC ivdep
     for (int i = 0; i < m; ++i) {
       const double r0 = ph0[i] - c0[i], r1 = ph1[i] - c1[i], r2 = ph2[i] - c2[i];
       // (r × n)·axis
-      const double g = (r1 * n2 - r2 * n1) * a0[i] + (r2 * n0 - r0 * n2) * a1[i] +
-                       (r0 * n1 - r1 * n0) * a2[i];
+      const double g =
+          (r1 * n2 - r2 * n1) * a0[i] + (r2 * n0 - r0 * n2) * a1[i] + (r0 * n1 - r1 * n0) * a2[i];
       col[i] = g * inv[i];
     }
   }
@@ -197,12 +209,12 @@ template <bool kJacobian>
     if (ps.u_index[c] < 0) continue;
     double* __restrict col = J + static_cast<std::size_t>(ps.u_index[c]) * m;
     const double d0 = point.dn_du(0, c), d1 = point.dn_du(1, c), d2 = point.dn_du(2, c);
-    #pragma GCC ivdep
+#pragma GCC ivdep
     for (int i = 0; i < m; ++i) col[i] = (ph0[i] * d0 + ph1[i] * d1 + ph2[i] * d2) * inv[i];
   }
   if (ps.f_index >= 0) {
     double* __restrict col = J + static_cast<std::size_t>(ps.f_index) * m;
-    #pragma GCC ivdep
+#pragma GCC ivdep
     for (int i = 0; i < m; ++i) col[i] = inv[i];
   }
   return parallel == 0;
@@ -227,15 +239,18 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
 
 bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
                               double* J, Isa isa) {
-  const KernelArgs args{m_,          &point,        &model.parameters(), q_.data(),
-                        cq_.data(),  sq_.data(),    state_.data(),       frames_.data(),
-                        scratch_.data(), h,         J};
+  const KernelArgs args{m_,         &point,        &model.parameters(), q_.data(),       cq_.data(),
+                        sq_.data(), state_.data(), frames_.data(),      scratch_.data(), h,
+                        J};
   switch (isa) {
 #if defined(__x86_64__)
-    case Isa::kAvx512: return KernelAvx512(args);
-    case Isa::kAvx2: return KernelAvx2(args);
+    case Isa::kAvx512:
+      return KernelAvx512(args);
+    case Isa::kAvx2:
+      return KernelAvx2(args);
 #endif
-    default: return KernelDefault(args);
+    default:
+      return KernelDefault(args);
   }
 }
 

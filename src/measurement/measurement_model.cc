@@ -45,15 +45,15 @@ void MeasurementModel::Prepare(const double* e, ModelPoint* point) const {
   Plane plane = nominal_plane_;
   if (parameters_.EstimatesNormal()) {
     const int* u = parameters_.u_index;
-    chart_.NormalAndJacobian(u[0] >= 0 ? e[u[0]] : 0.0, u[1] >= 0 ? e[u[1]] : 0.0,
-                             &plane.normal, &point->dn_du);
+    chart_.NormalAndJacobian(u[0] >= 0 ? e[u[0]] : 0.0, u[1] >= 0 ? e[u[1]] : 0.0, &plane.normal,
+                             &point->dn_du);
   }
   if (parameters_.f_index >= 0) plane.offset += e[parameters_.f_index];
   PrepareModelPoint(*robot_, v, plane, point);
 }
 
-double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSet& configs,
-                                  int i, double* h, double* row) const {
+double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i,
+                                  double* h, double* row) const {
   ChainFrames frames;
   const Pose<double> pose = ToolPose(point, configs, i, row ? &frames : nullptr);
   const Eigen::Vector3d& n = point.plane.normal;
@@ -89,7 +89,8 @@ double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSe
     row[col] = g * inv;
   }
   for (int c = 0; c < 2; ++c)
-    if (parameters_.u_index[c] >= 0) row[parameters_.u_index[c]] = inv * p_hit.dot(point.dn_du.col(c));
+    if (parameters_.u_index[c] >= 0)
+      row[parameters_.u_index[c]] = inv * p_hit.dot(point.dn_du.col(c));
   if (parameters_.f_index >= 0) row[parameters_.f_index] = inv;
   return nb;
 }

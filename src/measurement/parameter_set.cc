@@ -1,23 +1,24 @@
 #include "lrcal/measurement/parameter_set.h"
-#include "lrcal/core/strings.h"
 
 #include <algorithm>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/strings.h"
 
 namespace lrcal {
-
 
 PlaneTerms PlaneTerms::Parse(const std::string& text, const std::string& source) {
   PlaneTerms t;
   if (text == "none" || text.empty()) return t;
   if (text == "both") return PlaneTerms{true, true};
   for (const std::string& s : SplitList(text)) {
-    if (s == "normal") t.normal = true;
-    else if (s == "offset") t.offset = true;
+    if (s == "normal")
+      t.normal = true;
+    else if (s == "offset")
+      t.offset = true;
     else
-      throw InputError(source, "unknown plane term '" + s +
-                                   "'; expected none, normal, offset or normal,offset");
+      throw InputError(
+          source, "unknown plane term '" + s + "'; expected none, normal, offset or normal,offset");
   }
   return t;
 }
@@ -61,9 +62,18 @@ ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
   bool fix_u[2] = {false, false}, fix_offset = false;
   for (const std::string& name : fixed) {
     if (name.empty()) continue;
-    if (name == "plane_u1") { fix_u[0] = true; continue; }
-    if (name == "plane_u2") { fix_u[1] = true; continue; }
-    if (name == "plane_f") { fix_offset = true; continue; }
+    if (name == "plane_u1") {
+      fix_u[0] = true;
+      continue;
+    }
+    if (name == "plane_u2") {
+      fix_u[1] = true;
+      continue;
+    }
+    if (name == "plane_f") {
+      fix_offset = true;
+      continue;
+    }
     int k = robot.FindValue(name);
     if (k < 0)
       throw InputError(source, "unknown parameter '" + name +

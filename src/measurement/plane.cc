@@ -1,10 +1,10 @@
 #include "lrcal/measurement/plane.h"
-#include "lrcal/core/strings.h"
 
 #include <cmath>
 #include <sstream>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/strings.h"
 #include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
@@ -61,7 +61,8 @@ void NormalChart::NormalAndJacobian(double u1, double u2, Eigen::Vector3d* n,
 }
 
 BeamMiss ClassifyReading(double h, double n_dot_b, const RangerSpec& ranger) {
-  if (!(std::fabs(n_dot_b) > kParallelBeamThreshold) || !std::isfinite(h)) return BeamMiss::kParallel;
+  if (!(std::fabs(n_dot_b) > kParallelBeamThreshold) || !std::isfinite(h))
+    return BeamMiss::kParallel;
   if (h <= 0) return BeamMiss::kBehind;
   if (h < ranger.min_range || h > ranger.max_range) return BeamMiss::kOutOfRange;
   if (std::fabs(n_dot_b) < std::cos(ranger.max_incidence)) return BeamMiss::kGrazing;

@@ -4,10 +4,9 @@
 
 namespace lrcal {
 
-void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
-                   const Plane& plane, const RangerSpec& ranger, const ConfigurationSet& configs,
-                   std::vector<double>* h,
-                   std::vector<BeamMiss>* misses) {
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values, const Plane& plane,
+                   const RangerSpec& ranger, const ConfigurationSet& configs,
+                   std::vector<double>* h, std::vector<BeamMiss>* misses) {
   ModelPoint point;
   PrepareModelPoint(robot, link_values.data(), plane, &point);
   h->resize(configs.size());
@@ -22,8 +21,8 @@ void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
 
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const Plane& true_plane, const RangerSpec& ranger,
-                     const ConfigurationSet& configs,
-                     const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
+                     const ConfigurationSet& configs, const NoiseModel& noise,
+                     const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses, std::vector<double>* raw,
                      const std::vector<int>* noise_slots) {
   std::vector<double> h;
@@ -37,7 +36,8 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
              const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
              MeasurementSet* data, std::vector<double>* raw, const std::vector<int>* noise_slots) {
   // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial).
-  if (data->configs.num_joints() != configs.num_joints()) data->configs = ConfigurationSet(configs.num_joints());
+  if (data->configs.num_joints() != configs.num_joints())
+    data->configs = ConfigurationSet(configs.num_joints());
   data->configs.Clear();
   data->configs.Reserve(configs.size());
   data->mean_h.clear();

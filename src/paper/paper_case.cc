@@ -11,30 +11,28 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
-const double kPaperIdentified[2][6][5] = {
-    {{-7.8525, -2.4425, -2.1491, 0.5724, kNaN},
-     {1.2119, 0.0553, 1.6291, kNaN, 1.1436},
-     {0.0949, -1.5013, 1.3863, 0.2838, kNaN},
-     {0.2936, 2.6439, 0.3531, 1.2179, kNaN},
-     {-5.2130, -3.8485, -0.0797, 0.2895, kNaN},
-     {0.5628, 0.5207, 0.8714, 0.7422, -3.7951}},
-    {{-7.0607, -2.8193, -0.1191, 0.1555, kNaN},
-     {0.8234, 0.2574, 1.6439, kNaN, 1.4527},
-     {0.3428, -2.0967, 1.0172, -0.5597, kNaN},
-     {0.5364, 2.2958, 0.0014, 1.4096, kNaN},
-     {-5.6786, -4.2081, 0.3607, 0.6214, kNaN},
-     {1.4004, 0.4974, 0.4545, 0.4274, -3.3556}}};
+const double kPaperIdentified[2][6][5] = {{{-7.8525, -2.4425, -2.1491, 0.5724, kNaN},
+                                           {1.2119, 0.0553, 1.6291, kNaN, 1.1436},
+                                           {0.0949, -1.5013, 1.3863, 0.2838, kNaN},
+                                           {0.2936, 2.6439, 0.3531, 1.2179, kNaN},
+                                           {-5.2130, -3.8485, -0.0797, 0.2895, kNaN},
+                                           {0.5628, 0.5207, 0.8714, 0.7422, -3.7951}},
+                                          {{-7.0607, -2.8193, -0.1191, 0.1555, kNaN},
+                                           {0.8234, 0.2574, 1.6439, kNaN, 1.4527},
+                                           {0.3428, -2.0967, 1.0172, -0.5597, kNaN},
+                                           {0.5364, 2.2958, 0.0014, 1.4096, kNaN},
+                                           {-5.6786, -4.2081, 0.3607, 0.6214, kNaN},
+                                           {1.4004, 0.4974, 0.4545, 0.4274, -3.3556}}};
 
-const double kPaperValidation[3][3][4] = {
-    {{2.7612, 3.1491, 11.7347, 16.1688},
-     {2.5917, 3.2196, 18.6857, 17.0006},
-     {2.2119, 2.3480, 8.5899, 9.9512}},
-    {{0.9921, 0.7003, 4.9654, 3.2981},
-     {1.0148, 1.6199, 4.6951, 7.3035},
-     {1.0524, 0.5910, 4.3151, 2.7741}},
-    {{0.3427, 0.2273, 1.9067, 0.9378},
-     {0.2974, 0.3374, 1.4779, 1.2271},
-     {0.3785, 0.7671, 1.5664, 2.3669}}};
+const double kPaperValidation[3][3][4] = {{{2.7612, 3.1491, 11.7347, 16.1688},
+                                           {2.5917, 3.2196, 18.6857, 17.0006},
+                                           {2.2119, 2.3480, 8.5899, 9.9512}},
+                                          {{0.9921, 0.7003, 4.9654, 3.2981},
+                                           {1.0148, 1.6199, 4.6951, 7.3035},
+                                           {1.0524, 0.5910, 4.3151, 2.7741}},
+                                          {{0.3427, 0.2273, 1.9067, 0.9378},
+                                           {0.2974, 0.3374, 1.4779, 1.2271},
+                                           {0.3785, 0.7671, 1.5664, 2.3669}}};
 
 PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
                                const PaperCaseOptions& options) {
@@ -48,12 +46,11 @@ PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
                                      pool_options, &result.pool_report);
   SamplingOptions validation_options = options.sampling;
   validation_options.require_beam_hit = false;  // the whole workspace
-  result.validation = SampleConfigurations(
-      robot, plane, options.validation_size,
-      RandomStream(options.seed, 0, 0, RandomPurpose::kValidation), validation_options,
-      &result.validation_report);
-  result.nominal_validation =
-      ComparePoses(robot, truth, robot.nominal_values(), result.validation);
+  result.validation =
+      SampleConfigurations(robot, plane, options.validation_size,
+                           RandomStream(options.seed, 0, 0, RandomPurpose::kValidation),
+                           validation_options, &result.validation_report);
+  result.nominal_validation = ComparePoses(robot, truth, robot.nominal_values(), result.validation);
 
   MeasurementModel model(robot, plane, MakeParameterSet(robot, options.plane_terms));
   const Eigen::MatrixXd G = IdentificationJacobian(model, result.pool);
@@ -63,11 +60,11 @@ PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
   for (int c = 0; c < 2; ++c) {
     PaperCase pc;
     pc.label = "case " + std::to_string(c + 1);
-    pc.selection = SelectConfigurations(G, counts[c], *selections[c],
-                                        RandomStream(options.seed, c, 0, RandomPurpose::kSelection));
+    pc.selection = SelectConfigurations(
+        G, counts[c], *selections[c], RandomStream(options.seed, c, 0, RandomPurpose::kSelection));
     ConfigurationSet chosen = result.pool.Subset(pc.selection.indices);
-    SimulateReadings(robot, truth, plane, options.sampling.ranger, chosen, options.noise, noise, &pc.data, nullptr,
-                     nullptr, &pc.selection.indices);
+    SimulateReadings(robot, truth, plane, options.sampling.ranger, chosen, options.noise, noise,
+                     &pc.data, nullptr, nullptr, &pc.selection.indices);
     IdentificationOptions id = options.identification;
     id.sigma = options.noise.sigma;
     pc.summary = Identify(model, pc.data, id);
@@ -88,7 +85,8 @@ Table PaperParameterTable(const RobotModel& robot, const PaperCasesResult& resul
     const int link = k / kValuesPerLink, v = k % kValuesPerLink;
     const double unit = 1e3;  // rad → mrad, m → mm
     std::vector<std::string> row = {std::to_string(link + 1), robot.ValueName(k),
-                                    IsAngle(v) ? "mrad" : "mm", Fixed(robot.true_errors()[k] * unit)};
+                                    IsAngle(v) ? "mrad" : "mm",
+                                    Fixed(robot.true_errors()[k] * unit)};
     for (int c = 0; c < 2; ++c) {
       double ours = std::numeric_limits<double>::quiet_NaN();
       if (c < static_cast<int>(result.cases.size())) {
@@ -97,8 +95,7 @@ Table PaperParameterTable(const RobotModel& robot, const PaperCasesResult& resul
           if (s.names[j] == robot.ValueName(k) && s.IsSolutionUsable()) ours = s.delta[j] * unit;
       }
       row.push_back(Fixed(ours));
-      row.push_back(link < 6 && robot.num_links() == 6 ? Fixed(kPaperIdentified[c][link][v])
-                                                       : "—");
+      row.push_back(link < 6 && robot.num_links() == 6 ? Fixed(kPaperIdentified[c][link][v]) : "—");
     }
     t.AddRow(row);
   }

@@ -4,11 +4,11 @@
 #include <fstream>
 
 #include "lrcal/core/error.h"
-#include "lrcal/study/study.h"
 #include "lrcal/report/study_tables.h"
-#include "study/trial_pipeline.h"
 #include "lrcal/study/run_directory.h"
+#include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
+#include "study/trial_pipeline.h"
 
 namespace lrcal {
 
@@ -25,7 +25,8 @@ Json Vector(const std::vector<double>& v, double scale) {
 // Per configuration: [x, y, z] rows, scaled.
 Json Columns(const Eigen::Matrix3Xd& m, double scale) {
   Json j = Json::array();
-  for (int c = 0; c < m.cols(); ++c) j.push_back({m(0, c) * scale, m(1, c) * scale, m(2, c) * scale});
+  for (int c = 0; c < m.cols(); ++c)
+    j.push_back({m(0, c) * scale, m(1, c) * scale, m(2, c) * scale});
   return j;
 }
 
@@ -79,7 +80,9 @@ Json CellRealisation(const Study& study, const Cell& cell) {
   TrialWorkspace ws;
   TrialDetails d;
   const TrialRecord r = RunTrial(*context, 0, &ws, &d);
-  Json cj = {{"id", cell.id}, {"label", cell.label}, {"status", TrialStatusName(r.status)},
+  Json cj = {{"id", cell.id},
+             {"label", cell.label},
+             {"status", TrialStatusName(r.status)},
              {"paper_case", cell.typed.paper_case}};
   if (r.status == TrialStatus::kOk) {
     cj["distance_error_nominal"] = Vector(d.distance_error_nominal, 1e3);
@@ -106,8 +109,9 @@ Json Realisation(const Json& manifest) {
     if (in_run) realisation["cells"].push_back(CellRealisation(study, cell));
   }
   if (realisation["cells"].empty())
-    throw InputError(study_file, "none of its cells is in this run (the study file, or lrcal's "
-                                 "settings, changed since the run)");
+    throw InputError(study_file,
+                     "none of its cells is in this run (the study file, or lrcal's "
+                     "settings, changed since the run)");
   return realisation;
 }
 

@@ -19,8 +19,7 @@ namespace {
 using Rows = std::vector<std::vector<std::string>>;
 
 const char* kMetricNames[4] = {"rms_pos", "rms_ori", "max_pos", "max_ori"};
-const char* kMetricTitles[4] = {"RMS pos (mm)", "RMS ori (mrad)", "max pos (mm)",
-                                "max ori (mrad)"};
+const char* kMetricTitles[4] = {"RMS pos (mm)", "RMS ori (mrad)", "max pos (mm)", "max ori (mrad)"};
 const char* kAxes[3] = {"x", "y", "z"};
 
 std::string MeanRange(const Distribution& d, double scale) {
@@ -34,7 +33,7 @@ std::string UnitOf(const std::string& parameter) {
 
 Json DistJson(const Distribution& d, double scale) {
   auto v = [&](double x) { return std::isnan(x) ? Json() : Json(x * scale); };
-  return {{"n", d.n},         {"mean", v(d.mean)}, {"std", v(d.std)}, {"p5", v(d.p5)},
+  return {{"n", d.n},        {"mean", v(d.mean)}, {"std", v(d.std)}, {"p5", v(d.p5)},
           {"p50", v(d.p50)}, {"p95", v(d.p95)},   {"max", v(d.max)}};
 }
 
@@ -281,8 +280,12 @@ Json CellJson(const CellSummary& s) {
   c["settings"] = Json::parse(s.cell.settings);
   Json params = Json::array();
   for (const auto& p : s.parameters)
-    params.push_back({{"name", p.name}, {"bias", p.bias}, {"bias_se", p.bias_se}, {"std", p.std},
-                      {"predicted_std", NullIfNan(p.predicted_std)}, {"ratio", NullIfNan(p.ratio)}});
+    params.push_back({{"name", p.name},
+                      {"bias", p.bias},
+                      {"bias_se", p.bias_se},
+                      {"std", p.std},
+                      {"predicted_std", NullIfNan(p.predicted_std)},
+                      {"ratio", NullIfNan(p.ratio)}});
   c["parameters"] = params;
   c["covariance"] = MatrixJson(s.covariance);
   c["correlation"] = MatrixJson(s.correlation);
@@ -326,8 +329,8 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
     for (const auto& row : rows) place.AddRow(row);
   const bool any_paper = place.num_rows() > 0;
 
-  Table val({"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2],
-             kMetricTitles[3]});
+  Table val(
+      {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
   Table val_csv({"cell_id", "cell_label", "model", "metric", "axis", "unit", "n", "mean", "std",
                  "p5", "p50", "p95", "max"});
   ValidationTables(result.cells, &val, &val_csv);

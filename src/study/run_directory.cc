@@ -30,11 +30,12 @@ Json BuildInfo() {
 }
 
 Json Dependencies() {
-  return {{"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) +
-                        "." + std::to_string(EIGEN_MINOR_VERSION)},
-          {"ceres", CERES_VERSION_STRING},
-          {"sqlite", sqlite3_libversion()},
-          {"random123", "Philox4x64-10, Random123 boxmuller"}};
+  return {
+      {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) +
+                    "." + std::to_string(EIGEN_MINOR_VERSION)},
+      {"ceres", CERES_VERSION_STRING},
+      {"sqlite", sqlite3_libversion()},
+      {"random123", "Philox4x64-10, Random123 boxmuller"}};
 }
 
 constexpr const char* kRandomNumbers =
@@ -55,7 +56,9 @@ std::string UtcNow() {
 }
 
 Json StudyFingerprint(const Json& study) {
-  return {{"name", study["name"]}, {"seed", study["seed"]}, {"trials", study["trials"]},
+  return {{"name", study["name"]},
+          {"seed", study["seed"]},
+          {"trials", study["trials"]},
           {"base", study["base"]}};
 }
 
@@ -66,8 +69,9 @@ DirectoryLock::DirectoryLock(const std::string& dir) {
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     ::close(fd_);
     fd_ = -1;
-    throw InputError(dir, "another lrcal process is running on this run directory; wait for it "
-                          "or stop it first");
+    throw InputError(dir,
+                     "another lrcal process is running on this run directory; wait for it "
+                     "or stop it first");
   }
   const std::string pid = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd_, 0) == 0 && ::write(fd_, pid.data(), pid.size()) < 0) {
@@ -100,8 +104,9 @@ bool RunDirectory::HasManifest() const { return fs::exists(ManifestPath()); }
 
 Json RunDirectory::ReadManifest() const {
   if (!fs::exists(ManifestPath()) || !fs::exists(MainStorePath()))
-    throw InputError(path_, "not an lrcal run directory (expected manifest.json and "
-                            "trials.sqlite)");
+    throw InputError(path_,
+                     "not an lrcal run directory (expected manifest.json and "
+                     "trials.sqlite)");
   return ReadJsonFile(ManifestPath());
 }
 
@@ -121,14 +126,13 @@ void RunDirectory::CheckCompatible(const Json& manifest, const Json& study,
   }
   const Json shard = {{"index", shard_index + 1}, {"count", shard_count}};
   if (manifest.contains("shard") && manifest["shard"] != shard)
-    throw InputError("--shard", "this run directory is shard " +
-                                    manifest["shard"]["index"].dump() + "/" +
-                                    manifest["shard"]["count"].dump() +
+    throw InputError("--shard", "this run directory is shard " + manifest["shard"]["index"].dump() +
+                                    "/" + manifest["shard"]["count"].dump() +
                                     "; rerun it with that --shard");
 }
 
-Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_index,
-                                int shard_count, int threads, int ranks, std::size_t* session) {
+Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_index, int shard_count,
+                                int threads, int ranks, std::size_t* session) {
   if (manifest.is_null()) {
     manifest["created"] = UtcNow();
     manifest["sessions"] = Json::array();

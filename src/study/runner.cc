@@ -167,8 +167,9 @@ class StudyRunner {
         stop_(stop),
         rank_(collective->rank()),
         ranks_(collective->size()),
-        threads_(options.threads > 0 ? options.threads
-                                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
+        threads_(options.threads > 0
+                     ? options.threads
+                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
         dir_(options.out_dir) {}
 
   RunResult Run() {
@@ -237,9 +238,9 @@ class StudyRunner {
       }
     MissingTrials missing(&done_, study_.trials, options_.shard_index, options_.shard_count);
     dynamic_ = options_.dynamic_schedule && ranks_ > 1;
-    work_ = dynamic_ ? MakeDynamicSchedule(std::move(missing), collective_, options_.max_new_trials)
-                     : MakeStaticSchedule(std::move(missing), rank_, ranks_,
-                                          options_.max_new_trials);
+    work_ = dynamic_
+                ? MakeDynamicSchedule(std::move(missing), collective_, options_.max_new_trials)
+                : MakeStaticSchedule(std::move(missing), rank_, ranks_, options_.max_new_trials);
   }
 
   // One worker thread: claims trials, computes them, hands the records to the writer.

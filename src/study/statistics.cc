@@ -1,12 +1,11 @@
 #include "lrcal/study/statistics.h"
 
-#include <nlohmann/json.hpp>
-
-#include "identification/levenberg_marquardt.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <nlohmann/json.hpp>
+
+#include "identification/levenberg_marquardt.h"
 
 namespace lrcal {
 
@@ -130,8 +129,8 @@ void SummarizeParameters(const StoredCell& cell, Eigen::MatrixXd* errors, CellSu
     p.bias = m ? mean[k] : std::nan("");
     p.std = m > 1 ? sd[k] : std::nan("");
     p.bias_se = m > 1 ? p.std / std::sqrt(static_cast<double>(m)) : std::nan("");
-    p.predicted_std = k < static_cast<int>(cell.predicted_std.size()) ? cell.predicted_std[k]
-                                                                       : std::nan("");
+    p.predicted_std =
+        k < static_cast<int>(cell.predicted_std.size()) ? cell.predicted_std[k] : std::nan("");
     p.ratio = p.std / p.predicted_std;
     s->parameters.push_back(p);
   }

@@ -5,10 +5,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/yaml_util.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
 #include "lrcal/io/robot_file.h"
-#include "io/yaml_util.h"
 
 namespace lrcal {
 
@@ -70,7 +70,7 @@ Json ToJsonNode(const YAML::Node& node, const std::string& path, LineMap* lines)
   }
   if (node.IsNull()) return Json();
   const std::string s = node.Scalar();
-  if (node.Tag() == "!" ) return s;  // quoted: a string
+  if (node.Tag() == "!") return s;  // quoted: a string
   if (s == "true" || s == "yes") return true;
   if (s == "false" || s == "no") return false;
   char* end = nullptr;
@@ -83,7 +83,6 @@ Json ToJsonNode(const YAML::Node& node, const std::string& path, LineMap* lines)
   return s;
 }
 
-
 // Where a key path was written: "file:line key 'path'".
 struct KeyLocator {
   std::string file;
@@ -94,9 +93,8 @@ struct KeyLocator {
     const std::string path = Join(prefix, relative);
     int line = 0;
     // The deepest recorded prefix of the path.
-    for (std::string p = path; !p.empty(); p = p.substr(0, p.find_last_of(".[") == std::string::npos
-                                                                ? 0
-                                                                : p.find_last_of(".["))) {
+    for (std::string p = path; !p.empty();
+         p = p.substr(0, p.find_last_of(".[") == std::string::npos ? 0 : p.find_last_of(".["))) {
       auto it = lines->find(p);
       if (it != lines->end()) {
         line = it->second;
@@ -162,8 +160,8 @@ double Num(const Json& s, const std::string& path, const KeyLocator& where) {
 int Int(const Json& s, const std::string& path, const KeyLocator& where, int min) {
   const double v = Num(s, path, where);
   if (v != std::floor(v) || v < min || v > 1e9)
-    throw InputError(where(path), "expected a whole number >= " + std::to_string(min) +
-                                      ", got " + Json(v).dump());
+    throw InputError(where(path), "expected a whole number >= " + std::to_string(min) + ", got " +
+                                      Json(v).dump());
   return static_cast<int>(v);
 }
 
@@ -212,8 +210,9 @@ void ParsePlane(const Json& s, const KeyLocator& where, CellSettings* c) {
   const Json& plane = s["plane"];
   if (plane.is_string()) {
     if (plane != "robot")
-      throw InputError(where("plane"), "expected 'robot', {normal: [nx, ny, nz], offset: f} or "
-                                       "{tilt_deg: t, azimuth_deg: a, through: [x, y, z]}");
+      throw InputError(where("plane"),
+                       "expected 'robot', {normal: [nx, ny, nz], offset: f} or "
+                       "{tilt_deg: t, azimuth_deg: a, through: [x, y, z]}");
     return;
   }
   if (!plane.is_object()) throw InputError(where("plane"), "expected 'robot' or a mapping");
@@ -221,8 +220,8 @@ void ParsePlane(const Json& s, const KeyLocator& where, CellSettings* c) {
   if (plane.contains("normal")) {
     OnlyKeys(plane, "plane", {"normal", "offset"}, "normal, offset", where);
     const Eigen::Vector3d n = Vector3(s, "plane.normal", "three numbers [nx, ny, nz]", where);
-    c->plane = Plane::FromCoefficients(n.x(), n.y(), n.z(), Num(s, "plane.offset", where),
-                                       where("plane"));
+    c->plane =
+        Plane::FromCoefficients(n.x(), n.y(), n.z(), Num(s, "plane.offset", where), where("plane"));
     return;
   }
   OnlyKeys(plane, "plane", {"tilt_deg", "azimuth_deg", "through"},
@@ -232,9 +231,9 @@ void ParsePlane(const Json& s, const KeyLocator& where, CellSettings* c) {
       plane.contains("azimuth_deg") ? Num(s, "plane.azimuth_deg", where) * M_PI / 180 : 0.0;
   if (tilt < 0 || tilt > M_PI)
     throw InputError(where("plane.tilt_deg"), "expected an angle in [0, 180] degrees");
-  const Eigen::Vector3d through =
-      plane.contains("through") ? Vector3(s, "plane.through", "a point [x, y, z] in m", where)
-                                : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d through = plane.contains("through")
+                                      ? Vector3(s, "plane.through", "a point [x, y, z] in m", where)
+                                      : Eigen::Vector3d::Zero();
   const Eigen::Vector3d n(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az),
                           std::cos(tilt));
   c->plane = Plane::FromCoefficients(n.x(), n.y(), n.z(), -n.dot(through), where("plane"));
@@ -258,14 +257,13 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
   c->min_singular_value = NonNegative(s, "pool.min_singular_value", where);
   c->select_count = Int(s, "selection.count", where, 1);
   if (c->select_count > c->pool_size)
-    throw InputError(where("selection.count"),
-                     "cannot select " + std::to_string(c->select_count) +
-                         " configurations from a pool of " + std::to_string(c->pool_size) +
-                         " (pool.size)");
-  c->selection.method = ParseSelectionMethod(Str(s, "selection.method", where),
-                                             where("selection.method"));
-  c->selection.criterion = ParseDesignCriterion(Str(s, "selection.criterion", where),
-                                                where("selection.criterion"));
+    throw InputError(where("selection.count"), "cannot select " + std::to_string(c->select_count) +
+                                                   " configurations from a pool of " +
+                                                   std::to_string(c->pool_size) + " (pool.size)");
+  c->selection.method =
+      ParseSelectionMethod(Str(s, "selection.method", where), where("selection.method"));
+  c->selection.criterion =
+      ParseDesignCriterion(Str(s, "selection.criterion", where), where("selection.criterion"));
   c->selection.samples = Int(s, "selection.samples", where, 1);
   c->selection.restarts = Int(s, "selection.restarts", where, 1);
   c->selection_redraw = Bool(s, "selection.redraw", where);
@@ -285,9 +283,8 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
                        "expected a parameter name, got " + fix[i].dump());
     c->fixed.push_back(fix[i].get<std::string>());
   }
-  c->identification.solver =
-      ParseName(kSolverNames, Str(s, "identification.solver", where), where("identification.solver"),
-                "solver");
+  c->identification.solver = ParseName(kSolverNames, Str(s, "identification.solver", where),
+                                       where("identification.solver"), "solver");
   c->identification.max_iterations = Int(s, "identification.max_iterations", where, 1);
   const std::string rank = Str(s, "identification.on_rank_deficient", where);
   if (rank != "fail" && rank != "fix")
@@ -323,8 +320,10 @@ void Apply(Json* settings, const std::string& key, const Json& value) {
     if (dot == std::string::npos) break;
     rest = rest.substr(dot + 1);
   }
-  if (value.is_object() && target->is_object()) target->merge_patch(value);
-  else *target = value;
+  if (value.is_object() && target->is_object())
+    target->merge_patch(value);
+  else
+    *target = value;
 }
 
 bool KeyExists(const Json& defaults, const std::string& key) {
@@ -414,8 +413,9 @@ Axis ParseAxis(const Json& ax, const std::string& ap, const KeyLocator& where) {
   if (!ax.contains("key")) throw InputError(where(ap), "missing 'key'");
   axis.key = Str(ax, "key", KeyLocator{where.file, where.lines, where.context, ap});
   if (!KeyExists(StudyDefaults(), axis.key))
-    throw InputError(where(ap + ".key"), "'" + axis.key + "' is not a study setting (e.g. "
-                                         "noise.sigma_mm, selection.count, plane, '.')");
+    throw InputError(where(ap + ".key"), "'" + axis.key +
+                                             "' is not a study setting (e.g. "
+                                             "noise.sigma_mm, selection.count, plane, '.')");
   if (!ax.contains("values") || !ax["values"].is_array() || ax["values"].empty())
     throw InputError(where(ap + ".values"), "expected a non-empty list of values");
   for (std::size_t v = 0; v < ax["values"].size(); ++v) {

@@ -42,8 +42,7 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
     RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kTruth);
     for (int k = 0; k < robot.num_values(); ++k) {
       const bool is_param = robot.links()[k / kValuesPerLink].is_parameter[k % kValuesPerLink];
-      const double sigma =
-          IsAngle(k % kValuesPerLink) ? s.truth_angle_sigma : s.truth_length_sigma;
+      const double sigma = IsAngle(k % kValuesPerLink) ? s.truth_angle_sigma : s.truth_length_sigma;
       truth.errors[k] = is_param ? stream.Normal(k) * sigma : 0.0;
     }
   } else {
@@ -117,9 +116,9 @@ void BuildParameterSet(const CellSettings& s, CellContext* c) {
   ParameterSet ps = MakeParameterSet(*c->robot, s.plane_terms, s.fixed, "identification.fix");
   c->model = std::make_unique<MeasurementModel>(*c->robot, c->plane, ps);
   if (s.select_count < ps.size())
-    throw InputError("selection.count",
-                     "selecting " + std::to_string(s.select_count) + " configurations for " +
-                         std::to_string(ps.size()) + " parameters: need at least as many");
+    throw InputError("selection.count", "selecting " + std::to_string(s.select_count) +
+                                            " configurations for " + std::to_string(ps.size()) +
+                                            " parameters: need at least as many");
 }
 
 void DrawCellConfigurations(const Study& study, const CellSettings& s, CellContext* c) {
@@ -170,8 +169,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->model, c->design.configs);
   if (!c->rank_deficient && design_report.full_rank()) {
-    c->predicted_std =
-        ParameterCovariance(s.repetitions * GtG, s.sigma).diagonal().cwiseSqrt();
+    c->predicted_std = ParameterCovariance(s.repetitions * GtG, s.sigma).diagonal().cwiseSqrt();
   } else {
     if (!c->rank_deficient) c->rank_message = design_report.ToString();
     c->rank_deficient = true;
@@ -236,8 +234,8 @@ int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTrut
     return SimulateReadings(*c.robot, truth.values, c.plane, c.ranger, design.configs, noise,
                             stream, &ws->data, nullptr, nullptr, &design.slots);
   if (!s.selection_redraw)
-    return AddNoise(c.design_true_h, c.design_true_miss, design.configs, noise, stream,
-                    &ws->data, nullptr, &design.slots);
+    return AddNoise(c.design_true_h, c.design_true_miss, design.configs, noise, stream, &ws->data,
+                    nullptr, &design.slots);
   ws->exact_h.clear();
   ws->exact_miss.clear();
   for (int i : design.slots) {
@@ -268,9 +266,9 @@ SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspac
     return out;
   }
   ws->weights.assign(ws->data.repetitions.begin(), ws->data.repetitions.end());
-  const LevenbergMarquardt::Result r = ws->solver.Solve(
-      *c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(), s.identification,
-      &ws->e, cell_design ? &c.design_nominal : nullptr);
+  const LevenbergMarquardt::Result r =
+      ws->solver.Solve(*c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(),
+                       s.identification, &ws->e, cell_design ? &c.design_nominal : nullptr);
   out.termination = r.termination;
   out.iterations = r.iterations;
   out.final_cost = r.final_cost;
@@ -279,11 +277,16 @@ SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspac
 
 TrialStatus StatusOf(Termination t) {
   switch (t) {
-    case Termination::kConverged: return TrialStatus::kOk;
-    case Termination::kRankDeficient: return TrialStatus::kRankDeficient;
-    case Termination::kMaxIterations: return TrialStatus::kNotConverged;
-    case Termination::kBeamMissed: return TrialStatus::kBeamMissed;
-    default: return TrialStatus::kNumericalFailure;
+    case Termination::kConverged:
+      return TrialStatus::kOk;
+    case Termination::kRankDeficient:
+      return TrialStatus::kRankDeficient;
+    case Termination::kMaxIterations:
+      return TrialStatus::kNotConverged;
+    case Termination::kBeamMissed:
+      return TrialStatus::kBeamMissed;
+    default:
+      return TrialStatus::kNumericalFailure;
   }
 }
 

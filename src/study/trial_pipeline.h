@@ -61,15 +61,15 @@ struct CellContext {
   std::uint64_t pool_stream = 0, validation_stream = 0;
   ConfigurationSet pool;  ///< the cell's pool (a trial may redraw its own)
   SamplingReport pool_report;
-  TrialDesign design;     ///< the cell's selected design
+  TrialDesign design;                          ///< the cell's selected design
   LevenbergMarquardt::Nominal design_nominal;  ///< h and G of the nominal model on the design
-  Eigen::MatrixXd pool_design_G;  ///< scaled G of the pool (selection redrawn per trial)
+  Eigen::MatrixXd pool_design_G;    ///< scaled G of the pool (selection redrawn per trial)
   std::vector<double> pool_true_h;  ///< exact true readings on the pool (fixed truth)
   std::vector<BeamMiss> pool_true_miss;
   std::vector<double> design_true_h;  ///< exact true readings on the design (fixed truth)
   std::vector<BeamMiss> design_true_miss;
   std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
-  ConfigurationSet validation;  ///< shared by every trial of the cell
+  ConfigurationSet validation;                      ///< shared by every trial of the cell
   Eigen::VectorXd predicted_std;  ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
   TrialTruth fixed_truth;         ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)

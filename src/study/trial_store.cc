@@ -1,12 +1,12 @@
 #include "lrcal/study/trial_store.h"
 
-#include "study/trial_pipeline.h"
-
 #include <sqlite3.h>
 
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+
+#include "study/trial_pipeline.h"
 
 namespace lrcal {
 
@@ -52,8 +52,7 @@ constexpr const char* kCellColumns =
     "fixed_for_rank, pool_report, truth_errors";
 
 std::string TrialColumns() {
-  std::string cols =
-      "cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min";
+  std::string cols = "cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min";
   for (const char* prefix : {"val_", "nom_"})
     for (const char* m : TrialStore::kMetricColumns) cols += std::string(", ") + prefix + m;
   return cols + ", errors, seconds";
@@ -75,9 +74,10 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
   Exec("PRAGMA journal_mode=WAL");
   Exec("PRAGMA synchronous=NORMAL");
   Exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
-  Exec("CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
-       "settings TEXT, parameter_names TEXT, predicted_std TEXT, design_sigma_min REAL, "
-       "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT)");
+  Exec(
+      "CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
+      "settings TEXT, parameter_names TEXT, predicted_std TEXT, design_sigma_min REAL, "
+      "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT)");
   // Stores written before lrcal recorded the truth: add the column (the tables then leave out
   // what needs the truth rather than re-reading a robot file that may have changed).
   bool has_truth = false;
@@ -124,22 +124,24 @@ StoredCell ToStoredCell(const CellContext& c) {
 }
 
 void TrialStore::PutCell(const StoredCell& cell) {
-  Statement st(db_,
-               "INSERT OR REPLACE INTO cells(" + std::string(kCellColumns) +
-                   ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  Statement st(db_, "INSERT OR REPLACE INTO cells(" + std::string(kCellColumns) +
+                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   st.Text(1, cell.id);
   sqlite3_bind_int(st.get(), 2, cell.order);
   st.Text(3, cell.label);
   st.Text(4, cell.settings);
   st.Text(5, nlohmann::json(cell.parameter_names).dump());
   nlohmann::json sd = nlohmann::json::array();
-  for (double v : cell.predicted_std) sd.push_back(std::isnan(v) ? nlohmann::json() : nlohmann::json(v));
+  for (double v : cell.predicted_std)
+    sd.push_back(std::isnan(v) ? nlohmann::json() : nlohmann::json(v));
   st.Text(6, sd.dump());
   sqlite3_bind_double(st.get(), 7, cell.design_sigma_min);
   st.Text(8, nlohmann::json(cell.fixed_for_rank).dump());
   st.Text(9, cell.pool_report);
-  if (cell.truth_errors.empty()) sqlite3_bind_null(st.get(), 10);
-  else st.Text(10, nlohmann::json(cell.truth_errors).dump());
+  if (cell.truth_errors.empty())
+    sqlite3_bind_null(st.get(), 10);
+  else
+    st.Text(10, nlohmann::json(cell.truth_errors).dump());
   st.Step();
 }
 
@@ -184,8 +186,10 @@ void TrialStore::Insert(const std::vector<TrialRecord>& records) {
       sqlite3_bind_double(st.get(), 7, r.sigma_min);
       const bool ok = r.status == TrialStatus::kOk;
       for (int k = 0; k < 12; ++k) {
-        if (ok) sqlite3_bind_double(st.get(), 8 + k, r.validation[k]);
-        else sqlite3_bind_null(st.get(), 8 + k);
+        if (ok)
+          sqlite3_bind_double(st.get(), 8 + k, r.validation[k]);
+        else
+          sqlite3_bind_null(st.get(), 8 + k);
         sqlite3_bind_double(st.get(), 20 + k, r.nominal[k]);
       }
       if (ok)
@@ -261,8 +265,8 @@ void TrialStore::MergeFrom(const std::string& other_path) {
   attach.Step();
   try {
     Exec("BEGIN IMMEDIATE");
-    Exec("INSERT OR IGNORE INTO cells(" + std::string(kCellColumns) + ") SELECT " +
-         kCellColumns + " FROM other.cells");
+    Exec("INSERT OR IGNORE INTO cells(" + std::string(kCellColumns) + ") SELECT " + kCellColumns +
+         " FROM other.cells");
     Exec("INSERT OR IGNORE INTO trials SELECT * FROM other.trials");
     Exec("COMMIT");
   } catch (...) {

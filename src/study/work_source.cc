@@ -160,8 +160,10 @@ class DynamicSchedule : public WorkSource {
     if (stopping) {
       no_more_chunks_ = true;
     } else if (root) {
-      if (next_chunk_ < num_chunks_) chunks_.push_back(next_chunk_++);
-      else no_more_chunks_ = true;
+      if (next_chunk_ < num_chunks_)
+        chunks_.push_back(next_chunk_++);
+      else
+        no_more_chunks_ = true;
     } else {
       collective_->Send(0, kTagRequest, 0);
       const long long id = collective_->Receive(0, kTagChunk);
@@ -182,11 +184,11 @@ class DynamicSchedule : public WorkSource {
   long long count_ = 0, num_chunks_ = 0, share_ = 0, claimed_ = 0;
   std::deque<long long> chunks_;  // chunk ids received, not started
   bool no_more_chunks_ = false;
-  long long chunk_left_ = 0;      // trials left in the chunk being handed out
+  long long chunk_left_ = 0;  // trials left in the chunk being handed out
   // Main thread only.
-  long long next_chunk_ = 0;      // rank 0: the next chunk to hand out
-  int released_ = 0;              // rank 0: ranks told "no more" or that said they stopped
-  bool requested_done_ = false;   // this rank was told "no more"
+  long long next_chunk_ = 0;     // rank 0: the next chunk to hand out
+  int released_ = 0;             // rank 0: ranks told "no more" or that said they stopped
+  bool requested_done_ = false;  // this rank was told "no more"
 };
 
 }  // namespace

@@ -55,7 +55,8 @@ TEST_F(CliTest, KinematicsJsonHasThePoseBeamAndDistance) {
 TEST_F(CliTest, KinematicsDistanceMatchesTheFormula) {
   Write("c.csv", "q1,q2,q3,q4,q5,q6\n0.3,-0.7,1.1,0.4,-0.9,0.2\n");
   std::string out;
-  ASSERT_EQ(Run("kinematics --configs " + Path("c.csv") + " --plane 0,0,1,0.5 --format json", &out), 0)
+  ASSERT_EQ(Run("kinematics --configs " + Path("c.csv") + " --plane 0,0,1,0.5 --format json", &out),
+            0)
       << out;
   Json j = Json::parse(out)[0];
   // h = -(n·p + f)/(n·b) with n = e_z, f = 0.5.
@@ -76,9 +77,9 @@ TEST_F(CliTest, SampleSimulateIdentifyRoundTrip) {
                 &out),
             0)
       << out;
-  ASSERT_EQ(Run("identify --robot paper --data " + Path("m.csv") + " --sigma-mm 0.2 --format json",
-                &out),
-            0)
+  ASSERT_EQ(
+      Run("identify --robot paper --data " + Path("m.csv") + " --sigma-mm 0.2 --format json", &out),
+      0)
       << out;
   Json j = Json::parse(out);
   EXPECT_EQ(j["termination"], "converged");
@@ -125,17 +126,20 @@ TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --estimate-plane normal", &out), 3);
   EXPECT_NE(out.find("--fix"), std::string::npos) << out;
   EXPECT_NE(out.find("theta1"), std::string::npos) << out;
-  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --estimate-plane normal --auto-fix --format json",
-                &out),
-            0)
+  EXPECT_EQ(
+      Run("identify --data " + Path("m.csv") + " --estimate-plane normal --auto-fix --format json",
+          &out),
+      0)
       << out;
   EXPECT_EQ(Json::parse(out)["fixed_for_rank"].size(), 1u);
 }
 
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
   std::string out;
-  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E --baseline 200 "
-                "--format json --out " + Path("chosen.csv"),
+  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E "
+                "--baseline 200 "
+                "--format json --out " +
+                    Path("chosen.csv"),
                 &out),
             0)
       << out;
@@ -147,11 +151,13 @@ TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
   EXPECT_NEAR(j["indices"]["E"]["chosen"].get<double>(), j["score"].get<double>(), 1e-12);
   // The chosen configurations were written, and the same call chooses the same set.
   std::string again;
-  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --baseline 200 --format json",
+  ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --baseline 200 "
+                "--format json",
                 &again),
             0);
   EXPECT_EQ(Json::parse(again)["selected"], j["selected"]);
-  ASSERT_EQ(Run("identifiability --configs " + Path("chosen.csv") + " --format json", &out), 0) << out;
+  ASSERT_EQ(Run("identifiability --configs " + Path("chosen.csv") + " --format json", &out), 0)
+      << out;
   EXPECT_EQ(Json::parse(out)["rank"], 25);
 }
 
@@ -209,7 +215,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"FixedValueNotAParameter", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
                  "identifiability --configs {} --fix d2", "'d2' is fixed on this robot already"},
         BadInput{"ZeroPlaneNormal", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
-                 "kinematics --configs {} --plane 0,0,0,1", "--plane: plane normal (nx, ny, nz) is zero"},
+                 "kinematics --configs {} --plane 0,0,0,1",
+                 "--plane: plane normal (nx, ny, nz) is zero"},
         BadInput{"PlaneNotFourNumbers", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
                  "kinematics --configs {} --plane 0,0,1", "expected four numbers"},
         BadInput{"UnknownPlaneTerm", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",

@@ -36,7 +36,8 @@ TEST(RandomStream, NormalIsBoxMullerOfTheAddressedWords) {
     s.Block(block, w);
     for (int pair = 0; pair < 2; ++pair) {
       const double u1 = static_cast<double>(w[2 * pair + 1]) * 0x1p-64 + 0x1p-65;
-      const double v = static_cast<double>(static_cast<std::int64_t>(w[2 * pair])) * 0x1p-63 + 0x1p-64;
+      const double v =
+          static_cast<double>(static_cast<std::int64_t>(w[2 * pair])) * 0x1p-63 + 0x1p-64;
       const double r = std::sqrt(-2.0 * std::log(u1));
       const double x = r * std::sin(M_PI * v), y = r * std::cos(M_PI * v);
       EXPECT_NEAR(s.Normal(4 * block + 2 * pair), x, 1e-12);

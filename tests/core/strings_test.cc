@@ -1,9 +1,9 @@
 // Text utilities: angle expressions and list splitting.
+#include "lrcal/core/strings.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "lrcal/core/strings.h"
 
 namespace lrcal {
 namespace {

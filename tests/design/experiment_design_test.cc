@@ -70,7 +70,8 @@ TEST(Selection, LeaveOneOutTakesNEvaluations) {
   const Eigen::MatrixXd G = RandomMatrix(101, 25, 3);
   SelectionOptions o;
   o.method = SelectionMethod::kExhaustive;
-  SelectionResult r = SelectConfigurations(G, 100, o, RandomStream(1, 0, 0, RandomPurpose::kSelection));
+  SelectionResult r =
+      SelectConfigurations(G, 100, o, RandomStream(1, 0, 0, RandomPurpose::kSelection));
   EXPECT_EQ(r.evaluations, 101);
   EXPECT_EQ(r.indices.size(), 100u);
 }
@@ -109,7 +110,8 @@ TEST(RankOneUpdate, SecularEigenvaluesMatchEigen) {
       Eigen::VectorXd mu = RankOneUpdatedEigenvalues(eig.eigenvalues(), z, rho);
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ref(A + rho * g * g.transpose(),
                                                          Eigen::EigenvaluesOnly);
-      EXPECT_LT((mu - ref.eigenvalues()).cwiseAbs().maxCoeff(), 1e-10 * ref.eigenvalues().maxCoeff())
+      EXPECT_LT((mu - ref.eigenvalues()).cwiseAbs().maxCoeff(),
+                1e-10 * ref.eigenvalues().maxCoeff())
           << "rho " << rho;
     }
   }
@@ -141,9 +143,9 @@ std::vector<int> BruteBackward(const Eigen::MatrixXd& G, int k, DesignCriterion 
 TEST(Selection, BackwardWithRankOneUpdatesMatchesBruteForceForEveryCriterion) {
   const Eigen::MatrixXd G = RandomMatrix(30, 5, 21);
   RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
-  for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA,
-                            DesignCriterion::kO1, DesignCriterion::kO2, DesignCriterion::kO4,
-                            DesignCriterion::kO5}) {
+  for (DesignCriterion c :
+       {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA, DesignCriterion::kO1,
+        DesignCriterion::kO2, DesignCriterion::kO4, DesignCriterion::kO5}) {
     SelectionOptions o;
     o.method = SelectionMethod::kBackward;
     o.criterion = c;
@@ -206,7 +208,8 @@ TEST(Scaling, UnitColumnsAndExpectedErrors) {
   EXPECT_DOUBLE_EQ(E(1, 0), 8.0);
   EXPECT_DOUBLE_EQ(E(1, 1), 0.5);
   EXPECT_TRUE(ScaleColumns(G, DesignScaling::kSI).isApprox(G));
-  EXPECT_THROW(ScaleColumns(G, DesignScaling::kExpectedErrors, Eigen::Vector3d(1, 1, 1)), InputError);
+  EXPECT_THROW(ScaleColumns(G, DesignScaling::kExpectedErrors, Eigen::Vector3d(1, 1, 1)),
+               InputError);
 }
 
 TEST(Selection, BadRequestsAreClearErrors) {

@@ -7,9 +7,9 @@
 #include <cstring>
 #include <random>
 
-#include "measurement/batch_evaluation.h"
 #include "identification/levenberg_marquardt.h"
 #include "lrcal/identification/identification.h"
+#include "measurement/batch_evaluation.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -48,7 +48,8 @@ TEST(CpuDispatch, NormalMatrixHasTheSameBitsInEveryVariant) {
 
 TEST(CpuDispatch, BatchKernelHasTheSameBitsInEveryVariant) {
   const RobotModel& robot = testing::PaperRobot();
-  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{true, true}));
+  MeasurementModel model(robot, testing::PaperPlane(),
+                         MakeParameterSet(robot, PlaneTerms{true, true}));
   const ConfigurationSet configs = testing::PaperHittingConfigurations(101);
   std::vector<double> e(model.num_parameters(), 1e-3);
   ModelPoint point;

@@ -1,12 +1,12 @@
 // Identification recovers the true parameters from noise-free readings (plane known and
 // estimated), the two solvers agree, and rank deficiency is never a "converged" answer.
-#include "identification/levenberg_marquardt.h"
 #include "lrcal/identification/identification.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "identification/levenberg_marquardt.h"
 #include "lrcal/measurement/simulation.h"
 #include "test_util.h"
 
@@ -18,7 +18,7 @@ using testing::PaperRobot;
 // Noise-free data: the least-squares minimum is the truth; the solvers stop at rounding level.
 constexpr double kRecoveryTolerance = 1e-9;  // SI (m or rad), the requirement
 // Two solvers on the same noisy problem reach the same minimum to well below its uncertainty.
-constexpr double kSolverAgreement = 1e-9;    // relative to the largest |estimate error|
+constexpr double kSolverAgreement = 1e-9;  // relative to the largest |estimate error|
 
 MeasurementSet Exact(const RobotModel& robot, const Eigen::VectorXd& values, const Plane& plane,
                      const ConfigurationSet& configs) {
@@ -64,8 +64,7 @@ TEST_P(RecoveryTest, RecoversRobotAndPlaneWhenPlaneEstimated) {
   e_true[model.parameters().u_index[1]] = -0.003;
   e_true[model.parameters().f_index] = 0.002;
   const Plane true_plane = model.PlaneAt(e_true.data());
-  MeasurementSet data =
-      Exact(robot, truth, true_plane, testing::PaperHittingConfigurations(100));
+  MeasurementSet data = Exact(robot, truth, true_plane, testing::PaperHittingConfigurations(100));
   IdentificationOptions options;
   options.solver = GetParam();
   IdentificationSummary s = Identify(model, data, options);
@@ -89,7 +88,8 @@ TEST_P(RecoveryTest, RankDeficientSetIsReportedNotConverged) {
   ConfigurationSet pool = testing::PaperHittingConfigurations(400, 9);
   std::vector<double> h;
   std::vector<BeamMiss> misses;
-  ExactReadings(robot, robot.true_values(), horizontal, testing::PaperRig().ranger, pool, &h, &misses);
+  ExactReadings(robot, robot.true_values(), horizontal, testing::PaperRig().ranger, pool, &h,
+                &misses);
   for (int i = 0; i < pool.size() && configs.size() < 100; ++i)
     if (misses[i] == BeamMiss::kNone) configs.Add(pool.q(i));
   ASSERT_GE(configs.size(), 40);
@@ -124,8 +124,8 @@ TEST(Identification, LevenbergMarquardtAgreesWithCeresOnNoisyPaperCases) {
   for (int m : {50, 100}) {
     ConfigurationSet configs = testing::PaperHittingConfigurations(m, 21);
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
-                     RandomStream(42, 0, 0, RandomPurpose::kNoise), &data);
+    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                     configs, NoiseModel{}, RandomStream(42, 0, 0, RandomPurpose::kNoise), &data);
     IdentificationOptions lm_options, ceres_options;
     ceres_options.solver = IdentificationOptions::Solver::kCeres;
     IdentificationSummary a = Identify(model, data, lm_options);
@@ -133,8 +133,7 @@ TEST(Identification, LevenbergMarquardtAgreesWithCeresOnNoisyPaperCases) {
     ASSERT_TRUE(a.IsSolutionUsable()) << a.FullReport();
     ASSERT_TRUE(b.IsSolutionUsable()) << b.FullReport();
     const double scale = a.delta.cwiseAbs().maxCoeff();
-    EXPECT_LT((a.delta - b.delta).cwiseAbs().maxCoeff(), kSolverAgreement * scale)
-        << "m = " << m;
+    EXPECT_LT((a.delta - b.delta).cwiseAbs().maxCoeff(), kSolverAgreement * scale) << "m = " << m;
     // The cost itself is resolvable only to ~1e-12 relative near the minimum (0.1 mm residuals
     // on 1 m readings), so it is compared at 1e-10.
     EXPECT_NEAR(a.final_cost, b.final_cost, 1e-10 * a.final_cost);
@@ -148,11 +147,12 @@ TEST(Identification, CachedNominalLinearisationGivesTheSameEstimate) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(100, 8);
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
-                   RandomStream(5, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   configs, NoiseModel{}, RandomStream(5, 0, 0, RandomPurpose::kNoise), &data);
   LevenbergMarquardt::Nominal nominal;
   std::vector<BeamMiss> misses;
-  ExactReadings(robot, robot.nominal_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, &nominal.h, &misses);
+  ExactReadings(robot, robot.nominal_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                configs, &nominal.h, &misses);
   nominal.G = IdentificationJacobian(model, configs);
   nominal.Factorize();
   ASSERT_EQ(nominal.L0.rows(), 25);
@@ -186,8 +186,8 @@ TEST(Identification, CovarianceIsSigmaSquaredTimesInverseNormalMatrix) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(60, 4);
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
-                   RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   configs, NoiseModel{}, RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
   IdentificationOptions options;
   options.sigma = 0.2e-3;
   IdentificationSummary s = Identify(model, data, options);
@@ -208,13 +208,14 @@ TEST(Identification, RobustLossesResistOutlyingReadings) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(80, 12);
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger, configs, NoiseModel{},
-                   RandomStream(8, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   configs, NoiseModel{}, RandomStream(8, 0, 0, RandomPurpose::kNoise), &data);
   for (int i : {3, 17, 31, 52, 66}) data.mean_h[i] += 5e-3;
   auto error = [&](const IdentificationSummary& s) {
     double worst = 0;
     for (int k = 0; k < model.num_parameters(); ++k)
-      worst = std::max(worst, std::fabs(s.delta[k] - robot.true_errors()[model.parameters().robot_values[k]]));
+      worst = std::max(
+          worst, std::fabs(s.delta[k] - robot.true_errors()[model.parameters().robot_values[k]]));
     return worst;
   };
   IdentificationOptions plain;

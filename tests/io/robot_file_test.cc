@@ -1,11 +1,12 @@
 // Robot files: the paper's file, and bad files named by file, line and key.
+#include "lrcal/io/robot_file.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 
 #include "lrcal/core/error.h"
-#include "lrcal/io/robot_file.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -17,9 +18,9 @@ TEST(RobotFile, PaperFileHasTheTwentyFiveNamedParameters) {
   std::vector<std::string> names;
   for (int k : robot.parameter_indices()) names.push_back(robot.ValueName(k));
   const std::vector<std::string> expected = {
-      "theta1", "alpha1", "a1", "d1", "theta2", "alpha2", "a2", "beta2", "theta3",
-      "alpha3", "a3",     "d3", "theta4", "alpha4", "a4", "d4", "theta5", "alpha5",
-      "a5",     "d5",     "theta6", "alpha6", "a6", "d6", "beta6"};
+      "theta1", "alpha1", "a1",     "d1",     "theta2", "alpha2", "a2",   "beta2",  "theta3",
+      "alpha3", "a3",     "d3",     "theta4", "alpha4", "a4",     "d4",   "theta5", "alpha5",
+      "a5",     "d5",     "theta6", "alpha6", "a6",     "d6",     "beta6"};
   EXPECT_EQ(names, expected);
   // Errors in SI: theta1 -7.23 mrad, a2 1.94 mm, beta6 -3.36 mrad.
   EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("theta1")], -7.23e-3);

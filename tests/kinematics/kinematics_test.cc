@@ -1,13 +1,12 @@
 // Forward kinematics of the paper's arm against poses computed by hand, and the fast
 // (trig-free) chain against the reference product of elementary transforms.
-#include "lrcal/kinematics/forward_kinematics.h"
-
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <random>
 
 #include "lrcal/core/error.h"
+#include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "test_util.h"
 

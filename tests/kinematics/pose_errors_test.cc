@@ -32,7 +32,8 @@ TEST(Validation, BaseTranslationErrorIsExactlyThatTranslation) {
   const RobotModel& robot = testing::PaperRobot();
   Eigen::VectorXd lifted = robot.nominal_values();
   lifted[robot.FindValue("d1")] += 1e-3;
-  auto e = ComparePoses(robot, lifted, robot.nominal_values(), testing::PaperHittingConfigurations(10));
+  auto e =
+      ComparePoses(robot, lifted, robot.nominal_values(), testing::PaperHittingConfigurations(10));
   EXPECT_NEAR(e.stats.rms_position.z(), 1e-3, 1e-15);
   EXPECT_NEAR(e.stats.max_position.z(), 1e-3, 1e-15);
   EXPECT_LT(e.stats.max_position.head<2>().norm(), 1e-15);
@@ -44,7 +45,8 @@ TEST(Validation, Theta1ErrorIsARotationAboutBaseZ) {
   const RobotModel& robot = testing::PaperRobot();
   Eigen::VectorXd turned = robot.nominal_values();
   turned[robot.FindValue("theta1")] += 2e-3;
-  auto e = ComparePoses(robot, turned, robot.nominal_values(), testing::PaperHittingConfigurations(10));
+  auto e =
+      ComparePoses(robot, turned, robot.nominal_values(), testing::PaperHittingConfigurations(10));
   EXPECT_NEAR(e.stats.rms_orientation.z(), 2e-3, 1e-12);
   EXPECT_LT(e.stats.max_orientation.head<2>().norm(), 1e-12);
 }

@@ -40,7 +40,8 @@ TEST(GoldenTables, QuickStudyTablesAreByteIdentical) {
         << "alter the tables, run scripts/update_golden.sh and say why in the commit";
     ++compared;
   }
-  EXPECT_EQ(compared, 8);  // summary.md/.json, cells/validation/parameters/paper_placement.csv, 2 .tex
+  EXPECT_EQ(compared,
+            8);  // summary.md/.json, cells/validation/parameters/paper_placement.csv, 2 .tex
   for (const auto& entry : fs::directory_iterator(fs::path(dir) / "run" / "tables"))
     EXPECT_TRUE(fs::exists(golden / entry.path().filename()))
         << entry.path().filename() << " is new: add it to tests/golden/quick";

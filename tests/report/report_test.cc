@@ -31,7 +31,8 @@ std::string Read(const fs::path& p) {
 std::string Chromium(const std::string& profile) {
   return "chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --no-first-run "
          "--disable-background-networking --disable-component-update --disable-sync "
-         "--user-data-dir=" + profile + " ";
+         "--user-data-dir=" +
+         profile + " ";
 }
 
 TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
@@ -61,9 +62,10 @@ TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
   if (RunCommand("command -v chromium", &out) != 0) GTEST_SKIP() << "chromium is not installed";
   const std::string profile = dir + "/chromium-profile";
   // Load the page; the page's own script puts "k/n figures" decoded into the title.
-  ASSERT_EQ(RunCommand(Chromium(profile) + "--enable-logging=stderr --v=0 --virtual-time-budget=10000 "
-                                           "--dump-dom file://" + (report / "report.html").string() +
-                           " 2>" + dir + "/console.log",
+  ASSERT_EQ(RunCommand(Chromium(profile) +
+                           "--enable-logging=stderr --v=0 --virtual-time-budget=10000 "
+                           "--dump-dom file://" +
+                           (report / "report.html").string() + " 2>" + dir + "/console.log",
                        &out),
             0);
   const std::string title = "lrcal report: " + std::to_string(names.size()) + "/" +

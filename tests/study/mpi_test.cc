@@ -43,8 +43,8 @@ std::map<std::string, std::string> Tables(const std::string& dir) {
 
 std::string Study(const std::string& dir, int trials) {
   const std::string path = dir + "/mpi.yaml";
-  std::ofstream(path) << "name: mpi\nseed: 5\ntrials: " << trials << "\nrobot: "
-                      << testing::SourcePath("studies/robots/paper.yaml")
+  std::ofstream(path) << "name: mpi\nseed: 5\ntrials: " << trials
+                      << "\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
                       << "\npool: {size: 60}\nvalidation: {size: 10}\n"
                          "sweep:\n  axes:\n    - key: selection.count\n      values: [30, 59]\n"
                          "    - key: noise.sigma_mm\n      values: [0.1, 0.2]\n";
@@ -56,18 +56,18 @@ std::string Study(const std::string& dir, int trials) {
 void ExpectRanksMatchSingleProcess(const std::string& dir, const std::string& study,
                                    const std::string& extra) {
   std::string out;
-  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + dir +
-                                    "/single --quiet",
-                                &out),
-            0)
+  ASSERT_EQ(
+      testing::RunCommand(
+          testing::LrcalBinary() + " run " + study + " --out " + dir + "/single --quiet", &out),
+      0)
       << out;
   for (int np : {2, 3}) {
     const std::string run = dir + "/np" + std::to_string(np);
-    ASSERT_EQ(testing::RunCommand(kMpirun + " -np " + std::to_string(np) + " " +
-                                      testing::LrcalBinary() + " run " + study + " --out " + run +
-                                      " --threads 1 --quiet " + extra,
-                                  &out),
-              0)
+    ASSERT_EQ(
+        testing::RunCommand(kMpirun + " -np " + std::to_string(np) + " " + testing::LrcalBinary() +
+                                " run " + study + " --out " + run + " --threads 1 --quiet " + extra,
+                            &out),
+        0)
         << out;
     EXPECT_EQ(Tables(dir + "/single"), Tables(run)) << "np " << np << " " << extra;
     EXPECT_FALSE(fs::exists(run + "/trials.rank1.sqlite"));  // merged into trials.sqlite
@@ -90,7 +90,8 @@ TEST(Mpi, DynamicScheduleGivesTheSameTables) {
 TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
   if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
   const std::string dir = testing::TempDir("mpi_kill");
-  const std::string study = Study(dir, 6000);  // 24,000 trials: about a second on 3 single-thread ranks
+  const std::string study =
+      Study(dir, 6000);  // 24,000 trials: about a second on 3 single-thread ranks
   const std::string run = dir + "/run";
   const pid_t launcher = fork();
   if (launcher == 0) {
@@ -116,8 +117,9 @@ TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
   testing::RunCommand("pgrep -f 'lrcal run " + study + "' | tr '\\n' ' '", &pids);
   // Kill every lrcal rank process whose store is rank 1's: find it by its open file.
   std::string victim;
-  testing::RunCommand("for p in " + pids + "; do ls -l /proc/$p/fd 2>/dev/null | grep -q "
-                      "'trials.rank1.sqlite' && echo $p; done | head -1 | tr -d '\\n'",
+  testing::RunCommand("for p in " + pids +
+                          "; do ls -l /proc/$p/fd 2>/dev/null | grep -q "
+                          "'trials.rank1.sqlite' && echo $p; done | head -1 | tr -d '\\n'",
                       &victim);
   ASSERT_FALSE(victim.empty()) << "no process holds rank 1's store; pids: " << pids;
   kill(std::stoi(victim), SIGKILL);
@@ -134,10 +136,10 @@ TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
                                 &out),
             0)
       << out;
-  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + dir +
-                                    "/single --quiet",
-                                &out),
-            0)
+  ASSERT_EQ(
+      testing::RunCommand(
+          testing::LrcalBinary() + " run " + study + " --out " + dir + "/single --quiet", &out),
+      0)
       << out;
   EXPECT_EQ(Tables(dir + "/single"), Tables(run));
 }

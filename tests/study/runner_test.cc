@@ -1,8 +1,6 @@
 // The Monte-Carlo engine: bit-identical tables whatever the threads, shards, interruptions and
 // restarts; resume and refusal rules; bad study files; and statistics that match the
 // linear-Gaussian theory.
-#include "lrcal/report/run_tables.h"
-#include "lrcal/study/run_directory.h"
 #include "lrcal/study/runner.h"
 
 #include <gtest/gtest.h>
@@ -18,6 +16,8 @@
 #include <thread>
 
 #include "lrcal/core/error.h"
+#include "lrcal/report/run_tables.h"
+#include "lrcal/study/run_directory.h"
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/trial_store.h"
 #include "test_util.h"
@@ -48,7 +48,8 @@ std::string SmallStudy(const std::string& dir, int trials, const std::string& ex
   const std::string path = dir + "/small.yaml";
   std::ofstream(path) << "name: small\nseed: " << seed << "\ntrials: " << trials
                       << "\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
-                      << "\npool: {size: 60}\nvalidation: {size: 10}\n" << extra
+                      << "\npool: {size: 60}\nvalidation: {size: 10}\n"
+                      << extra
                       << "sweep:\n  axes:\n"
                          "    - key: selection.count\n      values: [30, 59]\n"
                          "    - key: noise.sigma_mm\n      values: "
@@ -57,7 +58,7 @@ std::string SmallStudy(const std::string& dir, int trials, const std::string& ex
 }
 
 RunResult RunSmall(const std::string& study_path, const std::string& out, int threads,
-              int shard_index = 0, int shard_count = 1, long long max_new = 0) {
+                   int shard_index = 0, int shard_count = 1, long long max_new = 0) {
   RunOptions o;
   o.out_dir = out;
   o.threads = threads;
@@ -120,10 +121,10 @@ TEST(MonteCarlo, StatusOfShardsNamesTheTasksToResubmit) {
   RunSmall(study, dir + "/s2", 1, 1, 4, 7);  // interrupted
   RunSmall(study, dir + "/s3", 1, 2, 4);     // shard 4 never ran
   std::string out;
-  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + dir + "/s1 " + dir + "/s2 " +
-                                    dir + "/s3",
-                                &out),
-            0)
+  ASSERT_EQ(
+      testing::RunCommand(
+          testing::LrcalBinary() + " status " + dir + "/s1 " + dir + "/s2 " + dir + "/s3", &out),
+      0)
       << out;
   EXPECT_NE(out.find("unfinished or missing shards: 2,4"), std::string::npos) << out;
   EXPECT_NE(out.find("sbatch --array=2,4"), std::string::npos) << out;
@@ -244,7 +245,8 @@ TEST(MonteCarlo, SecondProcessOnTheSameDirectoryIsRefused) {
   pid_t pid = Spawn({"run", study, "--out", run, "--threads", "1"});
   ASSERT_GT(WaitForProgress(pid, run, 1), 0);
   std::string out;
-  EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + run, &out), 2);
+  EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + run, &out),
+            2);
   EXPECT_NE(out.find("another lrcal process is running"), std::string::npos) << out;
   kill(pid, SIGKILL);
   int status;
@@ -360,12 +362,13 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadStudy{"UnknownKey", "noise: {sigma_mm: 0.2, repetition: 3}\n",
                  "bad.yaml:5 key 'noise.repetition': unknown key"},
-        BadStudy{"WrongType", "noise: {sigma_mm: high}\n", "bad.yaml:5 key 'noise.sigma_mm': expected a number"},
-        BadStudy{"NegativeSigma", "noise: {sigma_mm: -0.2}\n", "key 'noise.sigma_mm': expected a value >= 0"},
+        BadStudy{"WrongType", "noise: {sigma_mm: high}\n",
+                 "bad.yaml:5 key 'noise.sigma_mm': expected a number"},
+        BadStudy{"NegativeSigma", "noise: {sigma_mm: -0.2}\n",
+                 "key 'noise.sigma_mm': expected a value >= 0"},
         BadStudy{"MoreSelectedThanCandidates", "pool: {size: 40}\nselection: {count: 50}\n",
                  "key 'selection.count': cannot select 50 configurations from a pool of 40"},
-        BadStudy{"FewerThanParameters", "selection: {count: 20}\n",
-                 "need at least as many"},
+        BadStudy{"FewerThanParameters", "selection: {count: 20}\n", "need at least as many"},
         BadStudy{"PlaneNeverHit", "plane: {normal: [0, 0, 1], offset: -100}\n",
                  "could only accept 0 of 101"},
         BadStudy{"BadSweepValue",
@@ -375,10 +378,11 @@ INSTANTIATE_TEST_SUITE_P(
                  "'noise.sigma' is not a study setting"},
         BadStudy{"UnknownMethod", "selection: {method: best}\n", "unknown selection method 'best'"},
         BadStudy{"UnknownScaling", "selection: {scaling: log}\n", "unknown scaling 'log'"},
-        BadStudy{"ZipOfUnequalAxes",
-                 "sweep:\n  combine: zip\n  axes:\n    - {key: noise.sigma_mm, values: [0.1, 0.2]}\n"
-                 "    - {key: noise.repetitions, values: [1]}\n",
-                 "zip needs axes of equal length"}),
+        BadStudy{
+            "ZipOfUnequalAxes",
+            "sweep:\n  combine: zip\n  axes:\n    - {key: noise.sigma_mm, values: [0.1, 0.2]}\n"
+            "    - {key: noise.repetitions, values: [1]}\n",
+            "zip needs axes of equal length"}),
     [](const ::testing::TestParamInfo<BadStudy>& info) { return info.param.name; });
 
 TEST(Statistics, DescribeAndPercentilesMatchClosedForms) {
@@ -386,7 +390,7 @@ TEST(Statistics, DescribeAndPercentilesMatchClosedForms) {
   EXPECT_DOUBLE_EQ(d.mean, 3.0);
   EXPECT_DOUBLE_EQ(d.std, std::sqrt(2.5));
   EXPECT_DOUBLE_EQ(d.p50, 3.0);
-  EXPECT_DOUBLE_EQ(d.p5, 1.2);   // numpy.percentile([1..5], 5) = 1.2
+  EXPECT_DOUBLE_EQ(d.p5, 1.2);  // numpy.percentile([1..5], 5) = 1.2
   EXPECT_DOUBLE_EQ(d.p95, 4.8);
   EXPECT_DOUBLE_EQ(d.max, 5.0);
   const std::vector<double> s = {1, 2, 2, 3};

@@ -1,5 +1,7 @@
 // Study files: the schema's defaults as documented, sections that must be mappings, and the
 // identification solver a study names actually running in its trials.
+#include "lrcal/study/study.h"
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -7,7 +9,6 @@
 #include <sstream>
 
 #include "lrcal/core/error.h"
-#include "lrcal/study/study.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
 

@@ -1,9 +1,10 @@
 #include "test_util.h"
 
+#include <unistd.h>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 namespace lrcal::testing {
 

@@ -4,9 +4,9 @@
 #include <random>
 #include <string>
 
-#include "lrcal/measurement/measurement_model.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/measurement_model.h"
 
 namespace lrcal::testing {
 

@@ -1,9 +1,9 @@
 // One list of (value, name) pairs per enum, and the conversions both ways, so that every enum
 // that appears in files, tables or options is spelled in exactly one place.
 //
-//   inline constexpr EnumName<Color> kColorNames[] = {{Color::kRed, "red"}, {Color::kBlue, "blue"}};
-//   NameOf(kColorNames, Color::kRed)         → "red"
-//   ParseName(kColorNames, "blue", "--color", "color") → Color::kBlue, or InputError
+//   inline constexpr EnumName<Color> kColorNames[] = {{Color::kRed, "red"}, {Color::kBlue,
+//   "blue"}}; NameOf(kColorNames, Color::kRed)         → "red" ParseName(kColorNames, "blue",
+//   "--color", "color") → Color::kBlue, or InputError
 //       "--color: unknown color 'green'; expected red or blue"
 #pragma once
 
@@ -56,8 +56,8 @@ Enum ParseName(const EnumName<Enum> (&names)[N], std::string_view text, const st
                const std::string& what) {
   Enum value{};
   if (!TryParseName(names, text, &value))
-    throw InputError(source, "unknown " + what + " '" + std::string(text) + "'; expected " +
-                                 NameList(names));
+    throw InputError(
+        source, "unknown " + what + " '" + std::string(text) + "'; expected " + NameList(names));
   return value;
 }
 

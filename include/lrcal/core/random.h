@@ -30,9 +30,11 @@ enum class RandomPurpose : std::uint32_t {
 class RandomStream {
  public:
   /// `stream` separates independent families (e.g. a cell-specific pool); 0 for common numbers.
-  RandomStream(std::uint64_t seed, std::uint64_t stream, std::uint64_t trial,
-               RandomPurpose purpose)
-      : seed_(seed), stream_(stream), trial_(trial), purpose_(static_cast<std::uint64_t>(purpose)) {}
+  RandomStream(std::uint64_t seed, std::uint64_t stream, std::uint64_t trial, RandomPurpose purpose)
+      : seed_(seed),
+        stream_(stream),
+        trial_(trial),
+        purpose_(static_cast<std::uint64_t>(purpose)) {}
 
   /// The four raw words of counter block `block`.
   void Block(std::uint64_t block, std::uint64_t out[4]) const;

@@ -13,8 +13,8 @@
 #include <optional>
 #include <string>
 
-#include "lrcal/measurement/measurement_model.h"
 #include "lrcal/core/random.h"
+#include "lrcal/measurement/measurement_model.h"
 
 namespace lrcal {
 

@@ -40,7 +40,9 @@ inline constexpr EnumName<DesignCriterion> kDesignCriterionNames[] = {
 inline DesignCriterion ParseDesignCriterion(const std::string& text, const std::string& source) {
   return ParseName(kDesignCriterionNames, text, source, "criterion");
 }
-inline const char* DesignCriterionName(DesignCriterion c) { return NameOf(kDesignCriterionNames, c); }
+inline const char* DesignCriterionName(DesignCriterion c) {
+  return NameOf(kDesignCriterionNames, c);
+}
 
 enum class SelectionMethod {
   kExhaustive,  ///< every subset (k = N−1 is the paper's case 2: N evaluations)
@@ -59,12 +61,16 @@ inline constexpr EnumName<SelectionMethod> kSelectionMethodNames[] = {
 inline SelectionMethod ParseSelectionMethod(const std::string& text, const std::string& source) {
   return ParseName(kSelectionMethodNames, text, source, "selection method");
 }
-inline const char* SelectionMethodName(SelectionMethod m) { return NameOf(kSelectionMethodNames, m); }
+inline const char* SelectionMethodName(SelectionMethod m) {
+  return NameOf(kSelectionMethodNames, m);
+}
 
 enum class DesignScaling { kSI, kUnitColumns, kExpectedErrors };
 inline constexpr EnumName<DesignScaling> kDesignScalingNames[] = {
-    {DesignScaling::kSI, "si"}, {DesignScaling::kUnitColumns, "unit"},
-    {DesignScaling::kExpectedErrors, "expected"}, {DesignScaling::kSI, "SI"}};
+    {DesignScaling::kSI, "si"},
+    {DesignScaling::kUnitColumns, "unit"},
+    {DesignScaling::kExpectedErrors, "expected"},
+    {DesignScaling::kSI, "SI"}};
 inline DesignScaling ParseDesignScaling(const std::string& text, const std::string& source) {
   return ParseName(kDesignScalingNames, text, source, "scaling");
 }
@@ -73,8 +79,8 @@ inline const char* DesignScalingName(DesignScaling s) { return NameOf(kDesignSca
 struct SelectionOptions {
   DesignCriterion criterion = DesignCriterion::kE;
   SelectionMethod method = SelectionMethod::kBackward;
-  int samples = 1000;             ///< subsets tried by kSampled
-  int restarts = 4;               ///< kExchange: starts = backward-greedy design + (restarts−1) random
+  int samples = 1000;  ///< subsets tried by kSampled
+  int restarts = 4;    ///< kExchange: starts = backward-greedy design + (restarts−1) random
   double exhaustive_limit = 5e6;  ///< most subsets kExhaustive will enumerate
 };
 

@@ -46,15 +46,15 @@ struct Dependency {
 };
 
 struct IdentifiabilityReport {
-  std::vector<std::string> names;   ///< the parameter set analysed
+  std::vector<std::string> names;  ///< the parameter set analysed
   int num_configurations = 0;
   int rank = 0;                     ///< numerical rank of G (zero columns count as rank-less)
   Eigen::VectorXd column_norms;     ///< ‖G_j‖ in SI (m/rad or m/m)
   Eigen::VectorXd singular_values;  ///< of the column-scaled non-zero columns, descending
   double condition_number = 0;      ///< σ_max/σ_min of those (infinite when rank-deficient)
-  std::vector<std::string> unidentifiable;  ///< parameters with a zero column
-  std::vector<Dependency> dependencies;     ///< one per dependent parameter
-  std::vector<std::string> suggested_fixed; ///< fix these to obtain a full-rank set
+  std::vector<std::string> unidentifiable;   ///< parameters with a zero column
+  std::vector<Dependency> dependencies;      ///< one per dependent parameter
+  std::vector<std::string> suggested_fixed;  ///< fix these to obtain a full-rank set
   int num_params() const { return static_cast<int>(names.size()); }
   bool full_rank() const { return rank == num_params(); }
   std::string ToString() const;
@@ -69,7 +69,6 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
 /// The identification Jacobian G (m×n) at `e` (nullptr: nominal). Readings that miss the
 /// plane still give their row (the formula is finite unless the beam is parallel).
 Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
-                                       const ConfigurationSet& configs,
-                                       const double* e = nullptr);
+                                       const ConfigurationSet& configs, const double* e = nullptr);
 
 }  // namespace lrcal

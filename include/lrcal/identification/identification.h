@@ -19,8 +19,8 @@
 
 #include "lrcal/core/enum_names.h"
 #include "lrcal/identification/identifiability.h"
-#include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/measurement_model.h"
+#include "lrcal/measurement/measurement_set.h"
 
 namespace lrcal {
 
@@ -59,12 +59,12 @@ inline constexpr EnumName<IdentificationOptions::Solver> kSolverNames[] = {
     {IdentificationOptions::Solver::kCeres, "ceres"}};
 
 enum class Termination {
-  kConverged,        ///< a tolerance was met: the estimate is the least-squares minimum
-  kMaxIterations,    ///< stopped at max_iterations without meeting a tolerance
-  kRankDeficient,    ///< the parameter set is not identifiable from these configurations
-  kBeamMissed,       ///< at some iterate the model's beam ran parallel to the plane
-  kNumericalFailure, ///< non-finite cost or a failed factorisation
-  kInvalidInput,     ///< too few readings, bad options
+  kConverged,         ///< a tolerance was met: the estimate is the least-squares minimum
+  kMaxIterations,     ///< stopped at max_iterations without meeting a tolerance
+  kRankDeficient,     ///< the parameter set is not identifiable from these configurations
+  kBeamMissed,        ///< at some iterate the model's beam ran parallel to the plane
+  kNumericalFailure,  ///< non-finite cost or a failed factorisation
+  kInvalidInput,      ///< too few readings, bad options
 };
 inline constexpr EnumName<Termination> kTerminationNames[] = {
     {Termination::kConverged, "converged"},
@@ -80,22 +80,22 @@ struct IdentificationSummary {
   Eigen::VectorXd nominal;   ///< their nominal values (link values; 0 for u; f0 for plane_f), SI
   Eigen::VectorXd estimate;  ///< nominal + delta
   Eigen::VectorXd delta;     ///< the identified errors e, SI
-  Eigen::VectorXd std_residual;  ///< √diag of covariance_residual
-  Eigen::VectorXd std_given;     ///< √diag of covariance_given (empty unless sigma > 0)
+  Eigen::VectorXd std_residual;         ///< √diag of covariance_residual
+  Eigen::VectorXd std_given;            ///< √diag of covariance_given (empty unless sigma > 0)
   Eigen::MatrixXd covariance_residual;  ///< σ̂²·(GᵀWG)⁻¹, σ̂² = Σ r²/(m − n)
   Eigen::MatrixXd covariance_given;     ///< σ²·(GᵀWG)⁻¹ with the given per-reading σ
   Eigen::MatrixXd correlation;          ///< from covariance_residual
-  double sigma_hat = 0;        ///< m, residual-based per-reading σ estimate
-  double initial_cost = 0;     ///< ½Σr² at the nominal model (m²)
-  double final_cost = 0;       ///< ½Σr² at the estimate (m²)
-  double residual_rms = 0;     ///< m, RMS of h̄_i − h(e, q_i) over configurations
+  double sigma_hat = 0;                 ///< m, residual-based per-reading σ estimate
+  double initial_cost = 0;              ///< ½Σr² at the nominal model (m²)
+  double final_cost = 0;                ///< ½Σr² at the estimate (m²)
+  double residual_rms = 0;              ///< m, RMS of h̄_i − h(e, q_i) over configurations
   int iterations = 0;
   int num_configurations = 0;
   Termination termination = Termination::kInvalidInput;
-  std::string message;                   ///< why it stopped, in words
-  std::vector<std::string> fixed;        ///< parameters fixed because of rank deficiency
-  IdentifiabilityReport identifiability; ///< of the parameter set at the nominal model
-  std::string solver;                    ///< "lrcal-lm" or "ceres"
+  std::string message;                    ///< why it stopped, in words
+  std::vector<std::string> fixed;         ///< parameters fixed because of rank deficiency
+  IdentifiabilityReport identifiability;  ///< of the parameter set at the nominal model
+  std::string solver;                     ///< "lrcal-lm" or "ceres"
 
   bool IsSolutionUsable() const { return termination == Termination::kConverged; }
   std::string BriefReport() const;

@@ -17,7 +17,11 @@ class ConfigurationSet {
   void Add(const std::vector<double>& q) { Add(q.data()); }
   /// Appends configuration i of `other` with its precomputed cos/sin (no trig).
   void AddFrom(const ConfigurationSet& other, int i);
-  void Clear() { q_.clear(); cos_q_.clear(); sin_q_.clear(); }
+  void Clear() {
+    q_.clear();
+    cos_q_.clear();
+    sin_q_.clear();
+  }
   void Reserve(int n);
   const double* q(int i) const { return q_.data() + i * num_joints_; }
   const double* cos_q(int i) const { return cos_q_.data() + i * num_joints_; }

@@ -27,18 +27,24 @@ Eigen::Matrix<T, 4, 4> LinkTransform(const T& theta, const T& d, const T& a, con
   using std::cos;
   using std::sin;
   Eigen::Matrix<T, 4, 4> rz = Eigen::Matrix<T, 4, 4>::Identity();
-  rz(0, 0) = cos(theta); rz(0, 1) = -sin(theta);
-  rz(1, 0) = sin(theta); rz(1, 1) = cos(theta);
+  rz(0, 0) = cos(theta);
+  rz(0, 1) = -sin(theta);
+  rz(1, 0) = sin(theta);
+  rz(1, 1) = cos(theta);
   Eigen::Matrix<T, 4, 4> tz = Eigen::Matrix<T, 4, 4>::Identity();
   tz(2, 3) = d;
   Eigen::Matrix<T, 4, 4> tx = Eigen::Matrix<T, 4, 4>::Identity();
   tx(0, 3) = a;
   Eigen::Matrix<T, 4, 4> rx = Eigen::Matrix<T, 4, 4>::Identity();
-  rx(1, 1) = cos(alpha); rx(1, 2) = -sin(alpha);
-  rx(2, 1) = sin(alpha); rx(2, 2) = cos(alpha);
+  rx(1, 1) = cos(alpha);
+  rx(1, 2) = -sin(alpha);
+  rx(2, 1) = sin(alpha);
+  rx(2, 2) = cos(alpha);
   Eigen::Matrix<T, 4, 4> ry = Eigen::Matrix<T, 4, 4>::Identity();
-  ry(0, 0) = cos(beta); ry(0, 2) = sin(beta);
-  ry(2, 0) = -sin(beta); ry(2, 2) = cos(beta);
+  ry(0, 0) = cos(beta);
+  ry(0, 2) = sin(beta);
+  ry(2, 0) = -sin(beta);
+  ry(2, 2) = cos(beta);
   return rz * tz * tx * rx * ry;
 }
 

@@ -9,8 +9,8 @@
 // beam's hit point, n the plane normal):
 //     ∂h/∂θ_i = -n·(z_{i-1} × (p_J - o_{i-1})) / (n·b)      ∂h/∂d_i = -n·z_{i-1} / (n·b)
 //     ∂h/∂a_i = -n·x'_i / (n·b)
-//     ∂h/∂α_i = -n·(x'_i × (p_J - o_i)) / (n·b)            ∂h/∂β_i = -n·(y''_i × (p_J - o_i)) / (n·b)
-//     ∂h/∂u   = -p_J·∂n/∂u / (n·b)                          ∂h/∂f   = -1 / (n·b)
+//     ∂h/∂α_i = -n·(x'_i × (p_J - o_i)) / (n·b)            ∂h/∂β_i = -n·(y''_i × (p_J - o_i)) /
+//     (n·b) ∂h/∂u   = -p_J·∂n/∂u / (n·b)                          ∂h/∂f   = -1 / (n·b)
 // (differentiate h = -(n·p + f)/(n·b) and use n·p + f = -h·n·b: a motion of the tool moves the
 // hit point, held fixed on the beam, and h changes by minus its normal component over n·b).
 // Tests check this against Ceres autodiff through kinematics.h and against central differences.
@@ -26,9 +26,9 @@
 #include "lrcal/kinematics/chain.h"
 #include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/kinematics/forward_kinematics.h"
-#include "lrcal/measurement/plane.h"
-#include "lrcal/measurement/parameter_set.h"
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/plane.h"
 
 namespace lrcal {
 

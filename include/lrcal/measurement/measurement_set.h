@@ -10,8 +10,8 @@ namespace lrcal {
 /// Readings to identify from: one entry per configuration.
 struct MeasurementSet {
   ConfigurationSet configs;
-  std::vector<double> mean_h;      ///< m, mean of the readings at each configuration
-  std::vector<int> repetitions;    ///< number of readings averaged (the residual weight)
+  std::vector<double> mean_h;    ///< m, mean of the readings at each configuration
+  std::vector<int> repetitions;  ///< number of readings averaged (the residual weight)
   int size() const { return configs.size(); }
 };
 

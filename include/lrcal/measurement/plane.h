@@ -58,11 +58,11 @@ struct NormalChart {
 
 /// Why a configuration gives no reading.
 enum class BeamMiss {
-  kNone = 0,         ///< the beam hits the plane: h is a valid reading
-  kParallel,         ///< n·b is (numerically) zero: the beam runs along the plane
-  kBehind,           ///< h ≤ 0: the plane is behind the ranger
-  kOutOfRange,       ///< h outside [min_range, max_range]
-  kGrazing,          ///< incidence angle above the ranger's limit
+  kNone = 0,    ///< the beam hits the plane: h is a valid reading
+  kParallel,    ///< n·b is (numerically) zero: the beam runs along the plane
+  kBehind,      ///< h ≤ 0: the plane is behind the ranger
+  kOutOfRange,  ///< h outside [min_range, max_range]
+  kGrazing,     ///< incidence angle above the ranger's limit
 };
 inline constexpr EnumName<BeamMiss> kBeamMissNames[] = {
     {BeamMiss::kNone, "ok"},

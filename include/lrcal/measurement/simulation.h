@@ -9,17 +9,16 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "lrcal/measurement/measurement_set.h"
-#include "lrcal/measurement/measurement_model.h"
 #include "lrcal/core/random.h"
+#include "lrcal/measurement/measurement_model.h"
+#include "lrcal/measurement/measurement_set.h"
 
 namespace lrcal {
 
 /// The model readings of (link values, plane) at every configuration, and each one's BeamMiss.
-void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
-                   const Plane& plane, const RangerSpec& ranger, const ConfigurationSet& configs,
-                   std::vector<double>* h,
-                   std::vector<BeamMiss>* misses);
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values, const Plane& plane,
+                   const RangerSpec& ranger, const ConfigurationSet& configs,
+                   std::vector<double>* h, std::vector<BeamMiss>* misses);
 
 struct NoiseModel {
   double sigma = 0.2e-3;  ///< m, standard deviation of one reading
@@ -39,8 +38,8 @@ struct NoiseModel {
 /// two designs drawn from one pool see the same noise on the configurations they share.
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const Plane& true_plane, const RangerSpec& ranger,
-                     const ConfigurationSet& configs,
-                     const NoiseModel& noise, const RandomStream& stream, MeasurementSet* data,
+                     const ConfigurationSet& configs, const NoiseModel& noise,
+                     const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr,
                      const std::vector<int>* noise_slots = nullptr);
 

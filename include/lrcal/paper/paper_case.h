@@ -12,12 +12,12 @@
 
 #include <vector>
 
+#include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identification.h"
-#include "lrcal/measurement/simulation.h"
-#include "lrcal/core/text_table.h"
 #include "lrcal/kinematics/pose_errors.h"
+#include "lrcal/measurement/simulation.h"
 
 namespace lrcal {
 
@@ -37,10 +37,10 @@ struct PaperCaseOptions {
 
 struct PaperCase {
   std::string label;
-  SelectionResult selection;            ///< indices into the pool
-  MeasurementSet data;                  ///< simulated mean readings
+  SelectionResult selection;  ///< indices into the pool
+  MeasurementSet data;        ///< simulated mean readings
   IdentificationSummary summary;
-  PoseErrors validation;                ///< identified model vs truth on validation configs
+  PoseErrors validation;  ///< identified model vs truth on validation configs
 };
 
 struct PaperCasesResult {

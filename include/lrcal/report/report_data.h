@@ -11,9 +11,9 @@
 namespace lrcal {
 
 struct ReportData {
-  std::string dir;        ///< RUN_DIR/report
-  long long done = 0;     ///< trials in the snapshot
-  long long expected = 0; ///< trials of the whole study
+  std::string dir;         ///< RUN_DIR/report
+  long long done = 0;      ///< trials in the snapshot
+  long long expected = 0;  ///< trials of the whole study
   bool complete = false;
   bool realisation = false;  ///< realisation.json written (needs the study file)
   std::string note;          ///< why the realisation is missing, if it is

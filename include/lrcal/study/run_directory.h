@@ -62,8 +62,8 @@ class RunDirectory {
   void WriteManifest(const Json& manifest) const;
 
   /// Refuses (InputError naming what changed) if the manifest holds another study or shard.
-  static void CheckCompatible(const Json& manifest, const Json& study, const std::string& study_path,
-                              int shard_index, int shard_count);
+  static void CheckCompatible(const Json& manifest, const Json& study,
+                              const std::string& study_path, int shard_index, int shard_count);
   /// The manifest of a new session: study, build, dependencies, shard, and a session entry
   /// ("running") appended; `*session` gets its index.
   static Json StartSession(Json manifest, const Study& study, int shard_index, int shard_count,

@@ -39,9 +39,9 @@ class StopToken {
 };
 
 struct RunOptions {
-  std::string out_dir;   ///< run directory (created)
-  int threads = 0;       ///< 0: all cores
-  int shard_index = 0;   ///< this process runs trials with trial % shard_count == shard_index
+  std::string out_dir;  ///< run directory (created)
+  int threads = 0;      ///< 0: all cores
+  int shard_index = 0;  ///< this process runs trials with trial % shard_count == shard_index
   int shard_count = 1;
   bool progress = true;  ///< progress on stderr (a bar on a terminal, lines otherwise)
   int batch_size = 512;  ///< records per SQLite transaction (also flushed every second)
@@ -56,27 +56,27 @@ struct RunOptions {
 };
 
 struct RunResult {
-  long long total = 0;          ///< trials of this run (or shard)
-  long long done_before = 0;    ///< already in the store at start
-  long long computed = 0;       ///< computed by this session (this process)
-  bool interrupted = false;     ///< stopped before every trial of the run was recorded
-  bool complete = false;        ///< every trial of the run (or shard) is recorded (rank 0)
-  bool tables_written = false;  ///< set by the caller that writes the tables
-  double seconds = 0;           ///< wall time of the whole call
-  double trial_seconds = 0;     ///< sum of the computed trials' own wall time
-  double prepare_seconds = 0;   ///< wall time preparing the cells (pools, designs, covariance)
-  double run_seconds = 0;       ///< wall time from the first trial to the last record written
-  double tables_seconds = 0;    ///< wall time aggregating and writing the tables (the caller's)
-  long peak_rss_kb_trials = 0;  ///< peak resident memory when the trials were done (kB)
-  long peak_rss_kb = 0;         ///< peak resident memory at the end (kB)
-  long long ranks_computed = 0; ///< trials computed by all ranks of this job
+  long long total = 0;           ///< trials of this run (or shard)
+  long long done_before = 0;     ///< already in the store at start
+  long long computed = 0;        ///< computed by this session (this process)
+  bool interrupted = false;      ///< stopped before every trial of the run was recorded
+  bool complete = false;         ///< every trial of the run (or shard) is recorded (rank 0)
+  bool tables_written = false;   ///< set by the caller that writes the tables
+  double seconds = 0;            ///< wall time of the whole call
+  double trial_seconds = 0;      ///< sum of the computed trials' own wall time
+  double prepare_seconds = 0;    ///< wall time preparing the cells (pools, designs, covariance)
+  double run_seconds = 0;        ///< wall time from the first trial to the last record written
+  double tables_seconds = 0;     ///< wall time aggregating and writing the tables (the caller's)
+  long peak_rss_kb_trials = 0;   ///< peak resident memory when the trials were done (kB)
+  long peak_rss_kb = 0;          ///< peak resident memory at the end (kB)
+  long long ranks_computed = 0;  ///< trials computed by all ranks of this job
 };
 
 /// Runs (or resumes) a study; see the file comment. Throws InputError for a bad study or a busy
 /// or incompatible run directory. With a `collective` of P > 1 ranks (an MPI job) every rank
 /// calls this. `stop` (optional) is the run's stop token; without one the run makes its own.
-RunResult RunStudy(const Study& study, const RunOptions& options,
-                   Collective* collective = nullptr, StopToken* stop = nullptr);
+RunResult RunStudy(const Study& study, const RunOptions& options, Collective* collective = nullptr,
+                   StopToken* stop = nullptr);
 
 /// Installs the SIGINT/SIGTERM handlers: the first signal sets the stop token of the run in
 /// progress (if any), the second exits at once with code 130.

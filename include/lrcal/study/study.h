@@ -20,11 +20,10 @@
 #include "lrcal/core/json.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identification.h"
-#include "lrcal/measurement/plane.h"
 #include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/plane.h"
 
 namespace lrcal {
-
 
 /// The typed settings of one cell (all SI except where a name says otherwise), parsed from the
 /// resolved settings JSON. The defaults live in one place, StudyDefaults(); the initial values
@@ -65,10 +64,10 @@ struct CellSettings {
 };
 
 struct Cell {
-  std::string id;        ///< 16 hex digits: FNV-1a of the canonical settings JSON
-  std::string label;     ///< human label from the axis labels/values ("case 1", "sigma_mm=0.1")
-  int order = 0;         ///< position in the study's canonical order
-  Json settings;         ///< resolved settings (canonical JSON)
+  std::string id;     ///< 16 hex digits: FNV-1a of the canonical settings JSON
+  std::string label;  ///< human label from the axis labels/values ("case 1", "sigma_mm=0.1")
+  int order = 0;      ///< position in the study's canonical order
+  Json settings;      ///< resolved settings (canonical JSON)
   CellSettings typed;
   std::map<std::string, std::string> axis_values;  ///< axis key → value label
 };
@@ -79,8 +78,8 @@ struct Study {
   std::string description;
   std::uint64_t seed = 0;
   int trials = 0;
-  Json base;              ///< resolved base settings (before sweeps)
-  Json sweep;             ///< the sweep section as given (canonical JSON)
+  Json base;   ///< resolved base settings (before sweeps)
+  Json sweep;  ///< the sweep section as given (canonical JSON)
   std::vector<std::string> axis_keys;
   std::vector<Cell> cells;
   /// The whole resolved study (name, seed, trials, base, sweep): what a run directory records.

@@ -26,9 +26,9 @@ struct TrialRecord {
   long long trial = 0;
   TrialStatus status = TrialStatus::kOk;
   int iterations = 0;
-  double residual_rms = 0;  ///< m
-  double sigma_hat = 0;     ///< m, residual-based per-reading σ
-  double sigma_min = 0;     ///< σ_min of the design's G (SI)
+  double residual_rms = 0;     ///< m
+  double sigma_hat = 0;        ///< m, residual-based per-reading σ
+  double sigma_min = 0;        ///< σ_min of the design's G (SI)
   std::vector<double> errors;  ///< estimate − truth per parameter (SI); empty unless ok
   /// Validation of the identified model: rms pos xyz, rms ori xyz, max pos xyz, max ori xyz (SI).
   std::array<double, 12> validation{};
