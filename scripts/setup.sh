@@ -2,7 +2,9 @@
 # lrcal set-up on Debian 12: install what is missing (apt-get), build, then run the main job or
 # the whole test suite.
 #   bash scripts/setup.sh run    # build and run the main job
-#   bash scripts/setup.sh test   # build and run every test (what .ci/run does)
+#   bash scripts/setup.sh test   # build and run every test (what .ci/run does first)
+#   bash scripts/setup.sh build  # build only
+# LRCAL_WERROR=ON (CI) turns warnings into errors.
 set -euo pipefail
 action="${1:-run}"
 case "$action" in run|test|build) ;; *) echo "usage: bash scripts/setup.sh run|test|build" >&2; exit 2;; esac
@@ -12,18 +14,9 @@ packages=(g++ cmake make git pkg-config
   libeigen3-dev libceres-dev libyaml-cpp-dev libsqlite3-dev librandom123-dev nlohmann-json3-dev
   libboost-program-options-dev libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
   python3 python3-pandas python3-numpy python3-matplotlib chromium)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+bash scripts/install_packages.sh "${packages[@]}"
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLRCAL_WERROR="${LRCAL_WERROR:-OFF}"
 cmake --build build -j2
 
 case "$action" in

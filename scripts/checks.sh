@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The code-health checks CI runs after the test suite (README "How it is built"):
+#   format   clang-format on every C++ file (no differences allowed)
+#   layers   no file includes a higher layer (scripts/check_layers.py)
+#   tidy     clang-tidy's function-size and cognitive-complexity limits on src/ (.clang-tidy)
+#   asan     every unit test built with AddressSanitizer + UndefinedBehaviorSanitizer
+#   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
+# Usage: bash scripts/checks.sh [format|layers|tidy|asan|tsan ...]   (default: all, in order)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install_packages.sh clang-format clang-tidy python3
+stages=("$@")
+((${#stages[@]})) || stages=(format layers tidy asan tsan)
+
+stage() { echo "== checks: $1 ($(date -u +%H:%M:%S))"; }
+sanitizer_build() {  # dir, sanitizers, targets...
+  local dir=$1 san=$2; shift 2
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
+    -DLRCAL_SANITIZE="$san" -DLRCAL_BUILD_BENCH=OFF > /dev/null
+  cmake --build "$dir" -j2 --target "$@"
+}
+
+for s in "${stages[@]}"; do
+  case "$s" in
+    format)
+      stage format
+      git ls-files '*.cc' '*.h' | xargs clang-format --dry-run --Werror ;;
+    layers)
+      stage layers
+      python3 scripts/check_layers.py ;;
+    tidy)
+      stage tidy
+      cmake -S . -B build-tidy -DLRCAL_PCH=OFF -DCMAKE_EXPORT_COMPILE_COMMANDS=ON \
+        -DLRCAL_BUILD_TESTS=OFF -DLRCAL_BUILD_BENCH=OFF > /dev/null
+      ls src/*/*.cc | xargs -P2 -n1 clang-tidy -p build-tidy --quiet
+      echo "clang-tidy: $(ls src/*/*.cc | wc -l) files within the limits" ;;
+    asan)
+      stage asan
+      sanitizer_build build-asan address,undefined all
+      export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+      # OpenMPI's own allocations are not freed at exit: leak checks off for the MPI tests only.
+      ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j2 --output-on-failure -E '^Mpi\.'
+      ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-asan -j2 --output-on-failure -R '^Mpi\.' ;;
+    tsan)
+      stage tsan
+      sanitizer_build build-tsan thread lrcal_cli lrcal_study_tests
+      TSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/tsan.supp:halt_on_error=1" \
+        ctest --test-dir build-tsan -j2 --output-on-failure -L study ;;
+    *) echo "unknown stage '$s' (format, layers, tidy, asan, tsan)" >&2; exit 2 ;;
+  esac
+done
+echo "== checks: done ($(date -u +%H:%M:%S))"
