@@ -215,6 +215,7 @@ int SampleCommand(const std::vector<std::string>& args) {
   options.ranger = rig.ranger;
   options.min_jacobian_singular_value = vm["min-singular-value"].as<double>();
   options.require_beam_hit = !vm["validation"].as<bool>();
+  options.Validate("--min-singular-value");
   SamplingReport report;
   const bool validation = vm["validation"].as<bool>();
   ConfigurationSet configs = SampleConfigurations(
@@ -247,7 +248,8 @@ int SimulateCommand(const std::vector<std::string>& args) {
   NoiseModel noise;
   noise.sigma = vm["sigma-mm"].as<double>() * 1e-3;
   noise.repetitions = vm["repetitions"].as<int>();
-  if (!(noise.sigma >= 0)) throw InputError("--sigma-mm", "expected a value >= 0");
+  if (!(std::isfinite(noise.sigma) && noise.sigma >= 0))
+    throw InputError("--sigma-mm", "expected a finite noise >= 0 (mm)");
   if (noise.repetitions < 1) throw InputError("--repetitions", "expected at least 1");
   MeasurementSet data;
   std::vector<BeamMiss> misses;

@@ -29,9 +29,18 @@ BeamMiss BeamOf(const ModelPoint& point, const ConfigurationSet& one, const Rang
 
 }  // namespace
 
+void SamplingOptions::Validate(const std::string& source) const {
+  if (!(std::isfinite(min_jacobian_singular_value) && min_jacobian_singular_value >= 0))
+    throw InputError(source, "min_jacobian_singular_value: expected a finite value >= 0");
+  if (max_attempts_per_configuration < 1)
+    throw InputError(source, "max_attempts_per_configuration: expected at least 1");
+  ranger.Validate(source + " ranger");
+}
+
 ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
                                       const RandomStream& stream, const SamplingOptions& options,
                                       SamplingReport* report) {
+  options.Validate();
   SamplingReport local;
   SamplingReport& rep = report ? *report : local;
   rep = SamplingReport{};

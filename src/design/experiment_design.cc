@@ -374,6 +374,13 @@ Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
   return G;
 }
 
+void SelectionOptions::Validate(const std::string& source) const {
+  if (samples < 1) throw InputError(source, "samples: expected at least 1 random subset");
+  if (restarts < 1) throw InputError(source, "restarts: expected at least 1 start");
+  if (!(exhaustive_limit >= 1))
+    throw InputError(source, "exhaustive_limit: expected at least 1 subset");
+}
+
 namespace {
 
 void CheckSelectionSize(int N, int n, int k) {
@@ -466,6 +473,7 @@ void SelectExchange(const Eigen::MatrixXd& G, int k, const SelectionOptions& opt
 
 SelectionResult SelectConfigurations(const Eigen::MatrixXd& G, int k,
                                      const SelectionOptions& options, const RandomStream& stream) {
+  options.Validate();
   CheckSelectionSize(static_cast<int>(G.rows()), static_cast<int>(G.cols()), k);
   SelectionResult best;
   best.score = -std::numeric_limits<double>::infinity();

@@ -154,10 +154,7 @@ RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
   if (rg["max_incidence_deg"])
     ranger.max_incidence =
         Number(rg["max_incidence_deg"], path, "ranger.max_incidence_deg") * M_PI / 180.0;
-  if (!(ranger.min_range >= 0 && ranger.min_range < ranger.max_range))
-    throw InputError(Where(path, rg, "ranger"), "expected 0 <= min_range < max_range (m)");
-  if (!(ranger.max_incidence > 0 && ranger.max_incidence <= M_PI / 2))
-    throw InputError(Where(path, rg, "ranger.max_incidence_deg"), "expected a value in (0, 90]");
+  ranger.Validate(Where(path, rg, "ranger"));
   return ranger;
 }
 

@@ -60,6 +60,13 @@ void NormalChart::NormalAndJacobian(double u1, double u2, Eigen::Vector3d* n,
   dn_du->col(1) = P * t2;
 }
 
+void RangerSpec::Validate(const std::string& source) const {
+  if (!(min_range >= 0 && min_range < max_range && std::isfinite(max_range)))
+    throw InputError(source, "expected 0 <= min_range < max_range (finite, m)");
+  if (!(max_incidence > 0 && max_incidence <= M_PI / 2))
+    throw InputError(source, "max_incidence: expected an angle in (0, 90] degrees");
+}
+
 BeamMiss ClassifyReading(double h, double n_dot_b, const RangerSpec& ranger) {
   if (!(std::fabs(n_dot_b) > kParallelBeamThreshold) || !std::isfinite(h))
     return BeamMiss::kParallel;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "lrcal/core/error.h"
+
 namespace lrcal {
 
 void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values, const Plane& plane,
@@ -19,12 +21,21 @@ void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values, 
   }
 }
 
+void NoiseModel::Validate(const std::string& source) const {
+  if (!(std::isfinite(sigma) && sigma >= 0))
+    throw InputError(source, "sigma: expected a finite standard deviation >= 0 (m), got " +
+                                 std::to_string(sigma));
+  if (repetitions < 1)
+    throw InputError(source, "repetitions: expected at least 1 reading per configuration");
+}
+
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const Plane& true_plane, const RangerSpec& ranger,
                      const ConfigurationSet& configs, const NoiseModel& noise,
                      const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses, std::vector<double>* raw,
                      const std::vector<int>* noise_slots) {
+  noise.Validate();
   std::vector<double> h;
   std::vector<BeamMiss> local;
   std::vector<BeamMiss>* m = misses ? misses : &local;

@@ -493,8 +493,8 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
                Location(path, line == lines.end() ? 0 : line->second);
   }
   if (cell.label.empty()) cell.label = "base";
-  CheckUnknownKeys(cell.settings, StudyDefaults(), "", KeyLocator{path, &lines, context});
-  cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context});
+  CheckUnknownKeys(cell.settings, StudyDefaults(), "", KeyLocator{path, &lines, context, ""});
+  cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context, ""});
   cell.id = HashHex(cell.settings.dump());
   return cell;
 }
@@ -506,7 +506,7 @@ Study LoadStudy(const std::string& path) {
   yaml::RequireMap(root, path, "");
   LineMap lines;
   const Json given = ToJsonNode(root, "", &lines);
-  const KeyLocator where{path, &lines, ""};
+  const KeyLocator where{path, &lines, "", ""};
   Study study;
   study.path = path;
   ParseHeader(given, path, where, &study);

@@ -34,8 +34,27 @@ long long MissingTrials::Count() const {
 
 namespace {
 
+// What both schedules share: this process's share of the trials and the count handed out so
+// far, under the mutex that also guards each schedule's own cursor.
+class CountingWorkSource : public WorkSource {
+ public:
+  long long claimed() const override {
+    std::lock_guard<std::mutex> g(mutex_);
+    return claimed_;
+  }
+  bool Exhausted() const override {
+    std::lock_guard<std::mutex> g(mutex_);
+    return claimed_ >= share_;
+  }
+  long long share() const override { return share_; }
+
+ protected:
+  mutable std::mutex mutex_;
+  long long share_ = 0, claimed_ = 0;  // claimed_ under mutex_; share_ fixed after construction
+};
+
 // Every P-th missing trial to rank r; max_new_trials limits this process.
-class StaticSchedule : public WorkSource {
+class StaticSchedule : public CountingWorkSource {
  public:
   StaticSchedule(MissingTrials missing, int rank, int ranks, long long max_new)
       : missing_(std::move(missing)), rank_(rank), ranks_(ranks) {
@@ -60,27 +79,16 @@ class StaticSchedule : public WorkSource {
     }
   }
   bool Pump(bool, bool workers_done) override { return workers_done; }
-  long long claimed() const override {
-    std::lock_guard<std::mutex> g(mutex_);
-    return claimed_;
-  }
-  bool Exhausted() const override {
-    std::lock_guard<std::mutex> g(mutex_);
-    return claimed_ >= share_;
-  }
-  long long share() const override { return share_; }
 
  private:
-  mutable std::mutex mutex_;
   MissingTrials missing_;
   int rank_, ranks_;
-  long long share_ = 0, claimed_ = 0;
 };
 
 // Rank 0 hands out chunks of kChunk missing trials, numbered in canonical order; each rank's
 // chunks arrive in increasing order, so its cursor only moves forward. Only the main thread
 // talks to other ranks (Pump); workers wait for chunks under the mutex.
-class DynamicSchedule : public WorkSource {
+class DynamicSchedule : public CountingWorkSource {
  public:
   static constexpr long long kChunk = 64;
   enum : int { kTagRequest = 1, kTagChunk = 2, kTagDone = 3 };
@@ -128,16 +136,6 @@ class DynamicSchedule : public WorkSource {
     return released_ >= collective_->size() - 1;  // rank 0 serves until every rank is released
   }
 
-  long long claimed() const override {
-    std::lock_guard<std::mutex> g(mutex_);
-    return claimed_;
-  }
-  bool Exhausted() const override {
-    std::lock_guard<std::mutex> g(mutex_);
-    return claimed_ >= share_;
-  }
-  long long share() const override { return share_; }
-
  private:
   // Rank 0: answers the other ranks' requests.
   void Serve(bool stopping) {
@@ -177,11 +175,10 @@ class DynamicSchedule : public WorkSource {
     chunk_cv_.notify_all();
   }
 
-  mutable std::mutex mutex_;
   std::condition_variable chunk_cv_;
   MissingTrials missing_;
   Collective* collective_;
-  long long count_ = 0, num_chunks_ = 0, share_ = 0, claimed_ = 0;
+  long long count_ = 0, num_chunks_ = 0;
   std::deque<long long> chunks_;  // chunk ids received, not started
   bool no_more_chunks_ = false;
   long long chunk_left_ = 0;  // trials left in the chunk being handed out

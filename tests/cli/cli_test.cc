@@ -235,7 +235,32 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"DesignUnknownCriterion", "", "design --generate 30 --select 26 --criterion F",
                  "unknown criterion 'F'"},
         BadInput{"DesignPoolAndGenerate", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
-                 "design --pool {} --generate 5 --select 26", "give exactly one"}),
+                 "design --pool {} --generate 5 --select 26", "give exactly one"},
+        // Options validated against their range (one Validate() per options struct).
+        BadInput{"RankToleranceOne", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "identifiability --configs {} --rank-tolerance 1",
+                 "--rank-tolerance: rank tolerance: expected a relative tolerance in [0, 1)"},
+        BadInput{"RankToleranceNegative", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "identifiability --configs {} --rank-tolerance -1",
+                 "expected a relative tolerance in [0, 1)"},
+        BadInput{"RankToleranceNan", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "identifiability --configs {} --rank-tolerance nan",
+                 "expected a relative tolerance in [0, 1)"},
+        BadInput{"SimulateInfiniteSigma", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
+                 "simulate --configs {} --sigma-mm inf --out /tmp/lrcal_never.csv",
+                 "--sigma-mm: expected a finite noise >= 0 (mm)"},
+        BadInput{"SampleNanSingularValue", "", "sample --min-singular-value nan --out /tmp/x.csv",
+                 "--min-singular-value: min_jacobian_singular_value: expected a finite value"},
+        BadInput{"RunNegativeMaxTrials", "", "run quick --max-trials -5 --out /tmp/lrcal_never",
+                 "--max-trials: expected 0 (no limit) or a positive number of trials"},
+        BadInput{"IdentifyUnknownLoss", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,1\n",
+                 "identify --data {} --loss tukey",
+                 "--loss: unknown loss 'tukey'; expected none, "
+                 "huber or cauchy"},
+        BadInput{"IdentifyUnknownSolver", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,1\n",
+                 "identify --data {} --solver gn",
+                 "--solver: unknown solver 'gn'; expected lm or "
+                 "ceres"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return info.param.name; });
 
 }  // namespace

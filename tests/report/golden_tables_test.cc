@@ -14,13 +14,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(GoldenTables, QuickStudyTablesAreByteIdentical) {
   const std::string dir = testing::TempDir("golden_quick");
   std::string out;
@@ -35,7 +28,7 @@ TEST(GoldenTables, QuickStudyTablesAreByteIdentical) {
   for (const auto& entry : fs::directory_iterator(golden)) {
     const fs::path produced = fs::path(dir) / "run" / "tables" / entry.path().filename();
     ASSERT_TRUE(fs::exists(produced)) << produced << " was not written";
-    EXPECT_EQ(ReadAll(produced), ReadAll(entry.path()))
+    EXPECT_EQ(testing::ReadFile(produced.string()), testing::ReadFile(entry.path().string()))
         << entry.path().filename() << " differs from the golden copy; if the change is meant to "
         << "alter the tables, run scripts/update_golden.sh and say why in the commit";
     ++compared;

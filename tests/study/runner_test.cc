@@ -27,18 +27,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Every table file of a run directory, by name.
 std::map<std::string, std::string> Tables(const std::string& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::directory_iterator(fs::path(dir) / "tables"))
-    out[e.path().filename().string()] = ReadFile(e.path());
+    out[e.path().filename().string()] = testing::ReadFile(e.path().string());
   return out;
 }
 
@@ -214,7 +207,7 @@ TEST(MonteCarlo, KilledProcessResumesToTheSameTables) {
       << out;
   RunSmall(study, dir + "/whole", 2);
   EXPECT_EQ(Tables(dir + "/whole"), Tables(killed));
-  const std::string manifest = ReadFile(fs::path(killed) / "manifest.json");
+  const std::string manifest = testing::ReadFile((fs::path(killed) / "manifest.json").string());
   EXPECT_NE(manifest.find("\"running\""), std::string::npos);  // the killed session's entry
   EXPECT_NE(manifest.find("\"completed\""), std::string::npos);
 }
@@ -230,7 +223,7 @@ TEST(MonteCarlo, SigintStopsCleanlyAndResumes) {
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 130);  // interrupted, everything in flight flushed
-  const std::string manifest = ReadFile(fs::path(run) / "manifest.json");
+  const std::string manifest = testing::ReadFile((fs::path(run) / "manifest.json").string());
   EXPECT_NE(manifest.find("\"interrupted\""), std::string::npos);
   std::string out;
   ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + run, &out), 0);

@@ -5,6 +5,8 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace lrcal::testing {
 
@@ -45,6 +47,13 @@ ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned s
 
 ConfigurationSet PaperHittingConfigurations(int count, unsigned seed) {
   return HittingConfigurations(PaperPlane(), count, seed);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
 }
 
 int RunCommand(const std::string& command, std::string* output) {

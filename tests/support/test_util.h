@@ -26,6 +26,8 @@ ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned s
 ConfigurationSet PaperHittingConfigurations(int count, unsigned seed = 1);
 /// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
 int RunCommand(const std::string& command, std::string* output);
+/// The bytes of a file ("" if it cannot be read).
+std::string ReadFile(const std::string& path);
 /// A fresh empty temporary directory for one test.
 std::string TempDir(const std::string& name);
 

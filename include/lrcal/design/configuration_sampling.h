@@ -31,6 +31,8 @@ struct SamplingOptions {
   RangerSpec ranger;
   /// Give up after this many attempts per requested configuration.
   int max_attempts_per_configuration = 10000;
+  /// Throws InputError (where = `source`) naming the field and the range expected.
+  void Validate(const std::string& source = "sampling") const;
 };
 
 struct SamplingReport {

@@ -82,6 +82,8 @@ struct SelectionOptions {
   int samples = 1000;  ///< subsets tried by kSampled
   int restarts = 4;    ///< kExchange: starts = backward-greedy design + (restarts−1) random
   double exhaustive_limit = 5e6;  ///< most subsets kExhaustive will enumerate
+  /// Throws InputError (where = `source`) naming the field and the range expected.
+  void Validate(const std::string& source = "selection") const;
 };
 
 struct SelectionResult {

@@ -77,6 +77,9 @@ struct RangerSpec {
   double min_range = 0.05;        ///< m; shorter readings are rejected
   double max_range = 3.0;         ///< m; longer readings are out of range
   double max_incidence = 1.2217;  ///< rad (70°); angle between the beam and the plane normal
+  /// Throws InputError (where = `source`) unless 0 ≤ min_range < max_range (finite) and the
+  /// incidence limit is in (0, π/2].
+  void Validate(const std::string& source = "ranger") const;
 };
 
 /// Numerically parallel beam: |n·b| at or below this, the beam runs along the plane and h is not

@@ -28,6 +28,8 @@ struct NoiseModel {
   /// the cost no longer grows with R. The Monte-Carlo trials use this; `lrcal simulate` writes
   /// every reading.
   bool draw_mean = false;
+  /// Throws InputError (where = `source`) unless σ is finite and ≥ 0 and R ≥ 1.
+  void Validate(const std::string& source = "noise") const;
 };
 
 /// Noisy readings of the true model. Fills `data` with the configurations that have a reading
