@@ -99,6 +99,8 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) 
   options.solver = ParseName(kSolverNames, vm["solver"].as<std::string>(), "--solver", "solver");
   options.loss = ParseName(kRobustLossNames, vm["loss"].as<std::string>(), "--loss", "loss");
   options.loss_scale = vm["loss-scale-mm"].as<double>() * 1e-3;
+  if (!(std::isfinite(options.loss_scale) && options.loss_scale > 0))
+    throw InputError("--loss-scale-mm", "expected a finite scale > 0 (mm)");
   options.sigma = vm["sigma-mm"].as<double>() * 1e-3;
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
   if (std::string bad = options.Validate(); !bad.empty()) throw InputError("options", bad);
@@ -205,12 +207,15 @@ int SampleCommand(const std::vector<std::string>& args) {
       "out", po::value<std::string>()->required(), "output CSV (q1..qN)");
   po::variables_map vm;
   if (!Parse("sample", "--out C.csv [options]", o, args, &vm)) return 0;
+  CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const Plane& plane = setup.plane;
   const int count = vm["count"].as<int>();
-  if (count < 1) throw InputError("--count", "expected a positive number of configurations");
+  if (count < 1 || count > 1000000)
+    throw InputError("--count",
+                     "expected 1 to 1,000,000 configurations, got " + std::to_string(count));
   SamplingOptions options;
   options.ranger = rig.ranger;
   options.min_jacobian_singular_value = vm["min-singular-value"].as<double>();
@@ -239,6 +244,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
       "out", po::value<std::string>()->required(), "measurement CSV to write");
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
+  CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
@@ -250,7 +256,12 @@ int SimulateCommand(const std::vector<std::string>& args) {
   noise.repetitions = vm["repetitions"].as<int>();
   if (!(std::isfinite(noise.sigma) && noise.sigma >= 0))
     throw InputError("--sigma-mm", "expected a finite noise >= 0 (mm)");
-  if (noise.repetitions < 1) throw InputError("--repetitions", "expected at least 1");
+  if (noise.repetitions < 1 || noise.repetitions > 1000000)
+    throw InputError("--repetitions", "expected 1 to 1,000,000 readings per configuration");
+  if (static_cast<double>(noise.repetitions) * configs.size() > 1e7)
+    throw InputError("--repetitions", "would write " + std::to_string(configs.size()) + " x " +
+                                          std::to_string(noise.repetitions) +
+                                          " readings; at most 10,000,000 lines per file");
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
@@ -291,7 +302,8 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const Plane& plane = setup.plane;
-  const MeasurementSet data = ReadMeasurements(vm["data"].as<std::string>(), robot.num_links());
+  const MeasurementSet data =
+      ReadMeasurements(vm["data"].as<std::string>(), robot.num_links(), &rig.ranger);
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
   const IdentificationOptions options = ResolveIdentificationOptions(vm);
   const IdentificationSummary s = Identify(model, data, options);
@@ -364,6 +376,7 @@ int PaperCommand(const std::vector<std::string>& args) {
   options.case1_selection.method =
       ParseSelectionMethod(vm["case1-selection"].as<std::string>(), "--case1-selection");
   options.case1_selection.samples = vm["samples"].as<int>();
+  options.case1_selection.Validate("--samples");
   const PaperCasesResult r = RunPaperCases(robot, *rig.plane, options);
   const Table params = PaperParameterTable(robot, r);
   const Table validation = PaperValidationTable(r);

@@ -60,7 +60,8 @@ CandidatePool ResolvePool(const po::variables_map& vm, const Setup& setup, std::
   CandidatePool pool{ConfigurationSet(robot.num_links()), {}, ""};
   if (vm.count("generate")) {
     const int n = vm["generate"].as<int>();
-    if (n < 1) throw InputError("--generate", "expected a positive number of candidates");
+    if (n < 1 || n > 100000)
+      throw InputError("--generate", "expected 1 to 100,000 candidates, got " + std::to_string(n));
     SamplingOptions sampling;
     sampling.ranger = setup.rig.ranger;
     pool.configs =
@@ -101,14 +102,22 @@ SelectionOptions ResolveSelection(const po::variables_map& vm) {
   return options;
 }
 
+// A finite, positive option value (an expected error in mm or mrad).
+double PositiveMm(const po::variables_map& vm, const std::string& name) {
+  const double v = vm[name].as<double>();
+  if (!(std::isfinite(v) && v > 0))
+    throw InputError("--" + name, "expected a finite value > 0, got " + std::to_string(v));
+  return v;
+}
+
 // G of the pool at the nominal model, columns scaled as asked.
 Eigen::MatrixXd ScaledJacobian(const po::variables_map& vm, const MeasurementModel& model,
                                const ConfigurationSet& pool, DesignScaling scaling) {
   const ParameterSet& ps = model.parameters();
   Eigen::VectorXd expected(ps.size());
   for (int k = 0; k < ps.size(); ++k)
-    expected[k] = ps.IsAngular(k) ? vm["expected-angle-mrad"].as<double>() * 1e-3
-                                  : vm["expected-length-mm"].as<double>() * 1e-3;
+    expected[k] = ps.IsAngular(k) ? PositiveMm(vm, "expected-angle-mrad") * 1e-3
+                                  : PositiveMm(vm, "expected-length-mm") * 1e-3;
   return ScaleColumns(IdentificationJacobian(model, pool), scaling, expected);
 }
 
@@ -158,6 +167,7 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (!Parse("design", "--pool C.csv|--generate N --select K [options] --out chosen.csv", o, args,
              &vm))
     return 0;
+  if (vm.count("out")) CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const Setup setup = ResolveSetup(vm);
   const long long seed_value = vm["seed"].as<long long>();
   if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
@@ -175,6 +185,9 @@ int DesignCommand(const std::vector<std::string>& args) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const int baseline = vm["baseline"].as<int>();
+  if (baseline < 1 || baseline > 1000000)
+    throw InputError("--baseline",
+                     "expected 1 to 1,000,000 random designs, got " + std::to_string(baseline));
   Table t({"index", "chosen", "random mean", "random p5", "random p95", "percentile of chosen"},
           "Observability of the chosen " + std::to_string(k) + " of " +
               std::to_string(pool.configs.size()) + " against " + std::to_string(baseline) +

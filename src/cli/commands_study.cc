@@ -132,6 +132,9 @@ int RunCommand(const std::vector<std::string>& args) {
   PrintRunSummary(r, options, ranks);
   if (r.tables_written) {
     std::cout << "tables: " << options.out_dir << "/tables/summary.md (also .csv, .json, .tex)\n";
+  } else if (r.interrupted && r.total == 0) {
+    std::cout << "interrupted while the cells were prepared; nothing was written\n";
+    return 130;
   } else if (r.interrupted) {
     std::cout << "interrupted: " << r.done_before + r.computed << "/" << r.total
               << " trials recorded; run the same command again to continue\n";

@@ -77,6 +77,9 @@ int main(int argc, char** argv) {
     } catch (const lrcal::InputError& e) {
       if (!OtherMpiRank()) std::cerr << "lrcal " << name << ": error: " << e.what() << "\n";
       return 2;
+    } catch (const lrcal::StorageError& e) {
+      std::cerr << "lrcal " << name << ": could not write results: " << e.what() << "\n";
+      return 5;
     } catch (const std::exception& e) {
       std::cerr << "lrcal " << name << ": failed: " << e.what() << "\n";
       return 1;

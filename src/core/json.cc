@@ -1,6 +1,7 @@
 #include "lrcal/core/json.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -57,33 +58,63 @@ Json ReadJsonFile(const std::string& path) {
   }
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw std::runtime_error(Errno("create", tmp));
+namespace {
+
+// Writes all of `text` to `fd`; false (errno set) on any failure, including a short write.
+bool WriteAll(int fd, const std::string& text) {
   const char* data = text.data();
   std::size_t left = text.size();
   while (left > 0) {
     const ssize_t n = ::write(fd, data, left);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      const std::string message = Errno("write", tmp);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      throw std::runtime_error(message);
+      if (n == 0) errno = ENOSPC;
+      return false;
     }
     data += n;
     left -= static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+  return true;
+}
+
+// A device or pipe (/dev/stdout, /dev/null, /dev/full): written in place, checked; never
+// replaced by a rename.
+void WriteToSpecialFile(const std::string& path, const std::string& text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) throw StorageError(Errno("open", path));
+  const bool ok = WriteAll(fd, text);
+  const std::string message = ok ? "" : Errno("write", path);
+  if (::close(fd) != 0 && ok) throw StorageError(Errno("write", path));
+  if (!ok) throw StorageError(message);
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::string& text) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    if (S_ISDIR(st.st_mode)) throw StorageError(path + " is a directory, not a file");
+    WriteToSpecialFile(path, text);
+    return;
+  }
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw StorageError(Errno("create", tmp));
+  if (!WriteAll(fd, text) || ::fsync(fd) != 0) {
+    const std::string message = Errno("write", tmp);
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw StorageError(message);
+  }
+  if (::close(fd) != 0) {
     const std::string message = Errno("write", tmp);
     ::unlink(tmp.c_str());
-    throw std::runtime_error(message);
+    throw StorageError(message);
   }
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string message = Errno("rename " + tmp + " to", path);
     ::unlink(tmp.c_str());
-    throw std::runtime_error(message);
+    throw StorageError(message);
   }
 }
 

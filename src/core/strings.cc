@@ -1,32 +1,107 @@
 #include "lrcal/core/strings.h"
 
 #include <cmath>
-#include <regex>
+#include <cstdlib>
 
 namespace lrcal {
 
-bool ParseAngleExpression(const std::string& text, double* value) {
-  static const std::regex kNumber(R"(\s*([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)\s*)");
-  static const std::regex kPi(
-      R"(\s*([-+])?\s*(?:(\d+\.?\d*)\s*\*\s*)?pi\s*(?:/\s*(\d+\.?\d*))?\s*)");
-  std::smatch m;
-  if (std::regex_match(text, m, kNumber)) {
-    *value = std::stod(m[1].str());
-    return std::isfinite(*value);
+namespace {
+
+bool IsDigit(char c) { return c >= '0' && c <= '9'; }
+
+void SkipBlanks(const std::string& s, std::size_t* i) {
+  while (*i < s.size() && (s[*i] == ' ' || s[*i] == '\t')) ++*i;
+}
+
+// An unsigned decimal number at *i: digits[.digits] or .digits, then an optional exponent.
+// Strict: no "inf", "nan" or hexadecimal, unlike strtod. Advances *i past it.
+bool ScanNumber(const std::string& s, std::size_t* i, double* value) {
+  const std::size_t start = *i;
+  std::size_t k = start, digits = 0;
+  while (k < s.size() && IsDigit(s[k])) ++k, ++digits;
+  if (k < s.size() && s[k] == '.') {
+    ++k;
+    while (k < s.size() && IsDigit(s[k])) ++k, ++digits;
   }
-  if (std::regex_match(text, m, kPi)) {
-    double v = M_PI;
-    if (m[2].matched) v *= std::stod(m[2].str());
-    if (m[3].matched) {
-      double den = std::stod(m[3].str());
-      if (den == 0) return false;
-      v /= den;
+  if (digits == 0) return false;
+  if (k < s.size() && (s[k] == 'e' || s[k] == 'E')) {
+    std::size_t e = k + 1;
+    if (e < s.size() && (s[e] == '+' || s[e] == '-')) ++e;
+    if (e < s.size() && IsDigit(s[e])) {
+      while (e < s.size() && IsDigit(s[e])) ++e;
+      k = e;
     }
-    if (m[1].matched && m[1].str() == "-") v = -v;
-    *value = v;
-    return true;
   }
-  return false;
+  *value = std::strtod(s.substr(start, k - start).c_str(), nullptr);
+  *i = k;
+  return std::isfinite(*value);
+}
+
+}  // namespace
+
+bool ParseAngleExpression(const std::string& text, double* value) {
+  // [blanks] [sign] (number | [number '*'] pi ['/' number]) [blanks]
+  std::size_t i = 0;
+  SkipBlanks(text, &i);
+  double sign = 1;
+  if (i < text.size() && (text[i] == '+' || text[i] == '-')) sign = text[i++] == '-' ? -1 : 1;
+  SkipBlanks(text, &i);
+  double factor = 1;
+  const bool has_number = i < text.size() && (IsDigit(text[i]) || text[i] == '.');
+  if (has_number && !ScanNumber(text, &i, &factor)) return false;
+  SkipBlanks(text, &i);
+  bool pi = !has_number;                                  // "pi", "-pi/2"
+  if (has_number && i < text.size() && text[i] == '*') {  // "3*pi/4"
+    ++i;
+    SkipBlanks(text, &i);
+    pi = true;
+  }
+  if (pi) {
+    if (text.compare(i, 2, "pi") != 0) return false;
+    i += 2;
+    SkipBlanks(text, &i);
+    double divisor = 1;
+    if (i < text.size() && text[i] == '/') {
+      ++i;
+      SkipBlanks(text, &i);
+      if (!ScanNumber(text, &i, &divisor) || divisor == 0) return false;
+      SkipBlanks(text, &i);
+    }
+    factor = factor * M_PI / divisor;
+  }
+  if (i != text.size()) return false;
+  *value = sign * factor;
+  return std::isfinite(*value);
+}
+
+bool IsValidUtf8(const std::string& text) {
+  const auto* s = reinterpret_cast<const unsigned char*>(text.data());
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n;) {
+    const unsigned char c = s[i];
+    int extra;
+    unsigned min;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      extra = 1, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      extra = 2, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      extra = 3, min = 0x10000;
+    } else {
+      return false;
+    }
+    unsigned cp = c & (0x3F >> extra);
+    for (int k = 1; k <= extra; ++k) {
+      if (i + k >= n || (s[i + k] & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (s[i + k] & 0x3F);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += extra + 1;
+  }
+  return true;
 }
 
 std::vector<std::string> SplitList(const std::string& text, char separator) {

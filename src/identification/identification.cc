@@ -17,7 +17,8 @@ std::string IdentificationOptions::Validate() const {
   if (!(parameter_tolerance >= 0)) return "parameter_tolerance must be >= 0";
   if (!(function_tolerance >= 0)) return "function_tolerance must be >= 0";
   if (!(sigma >= 0) || !std::isfinite(sigma)) return "sigma must be a finite value >= 0 (m)";
-  if (loss != RobustLoss::kNone && !(loss_scale > 0)) return "loss_scale must be > 0 (m)";
+  if (!(loss_scale > 0) || !std::isfinite(loss_scale))
+    return "loss_scale must be a finite value > 0 (m)";
   if (loss != RobustLoss::kNone && solver != Solver::kCeres)
     return "robust losses need the Ceres solver (solver: ceres)";
   return "";

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -19,27 +20,119 @@ int CsvTable::Column(const std::string& name) const {
   return -1;
 }
 
+double CsvTable::Number(std::size_t row, int column) const {
+  const std::string& cell = rows[row][column];
+  char* end = nullptr;
+  const double value = std::strtod(cell.c_str(), &end);
+  if (cell.empty() || *end != '\0' || !std::isfinite(value))
+    throw InputError(Location(path, lines[row]) + " column '" + header[column] + "'",
+                     "expected a finite number, got '" + cell + "'");
+  return value;
+}
+
 std::string FormatExact(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
 
-CsvTable ReadCsv(const std::string& path) {
-  std::ifstream in(path);
+namespace {
+
+std::string ReadWholeFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path, "is a directory; expected a CSV file");
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Lines split at LF, CRLF or a lone CR; a leading UTF-8 byte-order mark is dropped.
+std::vector<std::string> SplitLines(std::string text) {
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+  std::vector<std::string> lines;
+  std::string line;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n' || c == '\r') {
+      lines.push_back(line);
+      line.clear();
+      if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+    } else {
+      line += c;
+    }
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+// The cells of one line: comma-separated, blanks around unquoted cells trimmed, "..." quoting
+// with "" for a quote inside.
+std::vector<std::string> SplitCells(const std::string& line, const std::string& where) {
+  std::vector<std::string> cells;
+  std::string cell;
+  bool quoted = false, was_quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c != '"')
+        cell += c;
+      else if (i + 1 < line.size() && line[i + 1] == '"')
+        cell += line[++i];
+      else
+        quoted = false;
+    } else if (c == '"' && Trim(cell).empty()) {
+      quoted = was_quoted = true;
+      cell.clear();
+    } else if (c == ',') {
+      cells.push_back(was_quoted ? cell : Trim(cell));
+      cell.clear();
+      was_quoted = false;
+    } else {
+      cell += c;
+    }
+  }
+  if (quoted) throw InputError(where, "a quoted cell is not closed (missing \")");
+  cells.push_back(was_quoted ? cell : Trim(cell));
+  return cells;
+}
+
+void CheckHeader(const CsvTable& t, int line) {
+  for (std::size_t a = 0; a < t.header.size(); ++a)
+    for (std::size_t b = a + 1; b < t.header.size(); ++b)
+      if (t.header[a] == t.header[b] && !t.header[a].empty())
+        throw InputError(Location(t.path, line) + " column '" + t.header[a] + "'",
+                         "repeated: columns " + std::to_string(a + 1) + " and " +
+                             std::to_string(b + 1) + " have the same name");
+}
+
+}  // namespace
+
+CsvTable ReadCsv(const std::string& path) {
+  const std::string text = ReadWholeFile(path);
   CsvTable t;
   t.path = path;
-  std::string line;
-  int number = 0;
+  const std::vector<std::string> lines = SplitLines(text);
   bool have_header = false;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos || line[0] == '#') continue;
-    std::vector<std::string> cells = SplitList(line);
+  for (std::size_t n = 0; n < lines.size(); ++n) {
+    const int number = static_cast<int>(n) + 1;
+    const std::string& line = lines[n];
+    if (line.find('\0') != std::string::npos)
+      throw InputError(Location(path, number), "a NUL byte in the line: not a text CSV file");
+    const std::string trimmed = Trim(line);
+    if (trimmed.empty() || trimmed[0] == '#') continue;
+    std::vector<std::string> cells = SplitCells(line, Location(path, number));
     if (!have_header) {
-      t.header = cells;
+      t.header = std::move(cells);
+      CheckHeader(t, number);
       have_header = true;
       continue;
     }
@@ -48,15 +141,7 @@ CsvTable ReadCsv(const std::string& path) {
                        "expected " + std::to_string(t.header.size()) +
                            " cells (header: " + std::to_string(t.header.size()) +
                            " columns), got " + std::to_string(cells.size()));
-    std::vector<double> row(cells.size());
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      char* end = nullptr;
-      row[c] = std::strtod(cells[c].c_str(), &end);
-      if (cells[c].empty() || *end != '\0' || !std::isfinite(row[c]))
-        throw InputError(Location(path, number) + " column '" + t.header[c] + "'",
-                         "expected a finite number, got '" + cells[c] + "'");
-    }
-    t.rows.push_back(std::move(row));
+    t.rows.push_back(std::move(cells));
     t.lines.push_back(number);
   }
   if (!have_header) throw InputError(path, "empty file: expected a header line q1,...,qN");
@@ -64,6 +149,17 @@ CsvTable ReadCsv(const std::string& path) {
 }
 
 namespace {
+
+// True for "q<k>" with k > num_joints (also when k has more digits than any int).
+bool NamesAnotherJoint(const std::string& name, int num_joints) {
+  if (name.size() < 2 || name[0] != 'q' ||
+      name.find_first_not_of("0123456789", 1) != std::string::npos)
+    return false;
+  const std::string digits = name.substr(name.find_first_not_of('0', 1) == std::string::npos
+                                             ? name.size()
+                                             : name.find_first_not_of('0', 1));
+  return digits.size() > 9 || (!digits.empty() && std::stol(digits) > num_joints);
+}
 
 std::vector<int> JointColumns(const CsvTable& t, int num_joints) {
   std::vector<int> cols;
@@ -75,15 +171,18 @@ std::vector<int> JointColumns(const CsvTable& t, int num_joints) {
                            " joints: expected columns q1..q" + std::to_string(num_joints));
     cols.push_back(c);
   }
-  for (const std::string& name : t.header) {
-    if (name.size() > 1 && name[0] == 'q' &&
-        name.find_first_not_of("0123456789", 1) == std::string::npos &&
-        std::stoi(name.substr(1)) > num_joints)
+  for (const std::string& name : t.header)
+    if (NamesAnotherJoint(name, num_joints))
       throw InputError(Location(t.path, 1) + " column '" + name + "'",
                        "the robot has only " + std::to_string(num_joints) +
                            " joints (wrong robot or wrong file?)");
-  }
   return cols;
+}
+
+std::vector<double> JointValues(const CsvTable& t, std::size_t row, const std::vector<int>& cols) {
+  std::vector<double> q(cols.size());
+  for (std::size_t j = 0; j < cols.size(); ++j) q[j] = t.Number(row, cols[j]);
+  return q;
 }
 
 }  // namespace
@@ -93,15 +192,11 @@ ConfigurationSet ReadConfigurations(const std::string& path, int num_joints) {
   std::vector<int> cols = JointColumns(t, num_joints);
   if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
   ConfigurationSet out(num_joints);
-  std::vector<double> q(num_joints);
-  for (const auto& row : t.rows) {
-    for (int j = 0; j < num_joints; ++j) q[j] = row[cols[j]];
-    out.Add(q);
-  }
+  for (std::size_t r = 0; r < t.rows.size(); ++r) out.Add(JointValues(t, r, cols));
   return out;
 }
 
-MeasurementSet ReadMeasurements(const std::string& path, int num_joints) {
+MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const RangerSpec* ranger) {
   CsvTable t = ReadCsv(path);
   std::vector<int> cols = JointColumns(t, num_joints);
   const int hc = t.Column("h");
@@ -114,12 +209,17 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints) {
   std::vector<double> sums;
   std::vector<int> counts;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    std::vector<double> q(num_joints);
-    for (int j = 0; j < num_joints; ++j) q[j] = t.rows[r][cols[j]];
-    const double h = t.rows[r][hc];
+    const std::vector<double> q = JointValues(t, r, cols);
+    const double h = t.Number(r, hc);
     if (!(h > 0))
       throw InputError(Location(path, t.lines[r]) + " column 'h'",
                        "a reading must be a positive distance in m, got " + FormatExact(h));
+    if (ranger && (h < ranger->min_range || h > ranger->max_range))
+      throw InputError(Location(path, t.lines[r]) + " column 'h'",
+                       FormatExact(h) + " m is outside the ranger's range [" +
+                           FormatExact(ranger->min_range) + ", " + FormatExact(ranger->max_range) +
+                           "] m (the robot file's ranger:); readings are in metres: were they "
+                           "written in mm?");
     auto [it, inserted] = index.emplace(q, static_cast<int>(qs.size()));
     if (inserted) {
       qs.push_back(q);
@@ -139,13 +239,23 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints) {
   return data;
 }
 
-// The file is written whole or not at all: a failed or full disk is an error naming it.
+// The file is written whole or not at all. A path that cannot be a file is bad input (exit 2);
+// a full or failing disk is a StorageError naming the file (exit 5).
 void WriteOutputFile(const std::string& path, const std::string& text) {
-  try {
-    WriteFileAtomically(path, text);
-  } catch (const std::runtime_error& e) {
-    throw InputError(path, std::string("cannot write the output file: ") + e.what());
-  }
+  CheckOutputFile(path, "--out");
+  WriteFileAtomically(path, text);
+}
+
+void CheckOutputFile(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw InputError(option, "expected a file name, got an empty string");
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw InputError(option, "'" + path + "' is a directory; expected a file name");
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec))
+    throw InputError(
+        option, "cannot write '" + path + "': the folder '" + parent.string() + "' does not exist");
 }
 
 void WriteConfigurations(const std::string& path, const ConfigurationSet& configs) {

@@ -1,14 +1,28 @@
 #include "io/yaml_util.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "lrcal/core/strings.h"
 
 namespace lrcal::yaml {
 
+namespace {
+
+// A value quoted in a message: at most 40 characters.
+std::string Abbreviate(const std::string& text) {
+  return text.size() <= 40 ? text : text.substr(0, 37) + "...";
+}
+
+}  // namespace
+
 YAML::Node LoadFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path, "is a directory; expected a YAML file");
   std::ifstream in(path);
   if (!in) throw InputError(path, "cannot open file");
   try {
@@ -18,6 +32,16 @@ YAML::Node LoadFile(const std::string& path) {
   }
 }
 
+std::string Key(const YAML::Node& key, const std::string& file, const std::string& context) {
+  if (!key.IsScalar())
+    throw InputError(Where(file, key, context), "expected a plain key (a name), got a " +
+                                                    std::string(key.IsSequence() ? "list"
+                                                                : key.IsMap()    ? "mapping"
+                                                                                 : "null") +
+                                                    " as a key");
+  return key.Scalar();
+}
+
 void RequireMap(const YAML::Node& node, const std::string& file, const std::string& key) {
   if (!node.IsMap()) throw InputError(Where(file, node, key), "expected a mapping of keys");
 }
@@ -25,8 +49,13 @@ void RequireMap(const YAML::Node& node, const std::string& file, const std::stri
 void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& file,
                const std::string& context) {
   RequireMap(map, file, context);
+  std::map<std::string, int> seen;  // key → line
   for (const auto& kv : map) {
-    std::string key = kv.first.as<std::string>();
+    const std::string key = Key(kv.first, file, context);
+    const int line = kv.first.Mark().line + 1;
+    if (!seen.emplace(key, line).second)
+      throw InputError(Where(file, kv.first, context.empty() ? key : context + "." + key),
+                       "repeated key (first at line " + std::to_string(seen[key]) + ")");
     if (!allowed.count(key)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -44,14 +73,15 @@ double Number(const YAML::Node& node, const std::string& file, const std::string
   double value = 0;
   if (allow_pi) {
     if (ParseAngleExpression(text, &value)) return value;
-    throw InputError(
-        Where(file, node, key),
-        "expected a number or an expression like pi/2, -pi, 3*pi/4; got '" + text + "'");
+    throw InputError(Where(file, node, key),
+                     "expected a finite number or an expression like pi/2, -pi, 3*pi/4; got '" +
+                         Abbreviate(text) + "'");
   }
   char* end = nullptr;
   value = std::strtod(text.c_str(), &end);
   if (text.empty() || *end != '\0' || !std::isfinite(value))
-    throw InputError(Where(file, node, key), "expected a finite number; got '" + text + "'");
+    throw InputError(Where(file, node, key),
+                     "expected a finite number; got '" + Abbreviate(text) + "'");
   return value;
 }
 

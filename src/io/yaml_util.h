@@ -26,6 +26,9 @@ YAML::Node LoadFile(const std::string& path);
 void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& file,
                const std::string& context);
 
+/// A mapping key as text; InputError for a complex key (`? [a, b]`) or a null one.
+std::string Key(const YAML::Node& key, const std::string& file, const std::string& context);
+
 void RequireMap(const YAML::Node& node, const std::string& file, const std::string& key);
 
 /// A number (also "pi/2"-style expressions when `allow_pi`). Throws naming file/line/key.

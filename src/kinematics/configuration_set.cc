@@ -1,5 +1,6 @@
 #include "lrcal/kinematics/configuration_set.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lrcal {
@@ -19,9 +20,10 @@ void ConfigurationSet::AddFrom(const ConfigurationSet& other, int i) {
 }
 
 void ConfigurationSet::Reserve(int n) {
-  q_.reserve(n * num_joints_);
-  cos_q_.reserve(n * num_joints_);
-  sin_q_.reserve(n * num_joints_);
+  const std::size_t values = static_cast<std::size_t>(std::max(n, 0)) * num_joints_;
+  q_.reserve(values);
+  cos_q_.reserve(values);
+  sin_q_.reserve(values);
 }
 
 ConfigurationSet ConfigurationSet::Subset(const std::vector<int>& indices) const {

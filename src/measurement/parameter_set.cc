@@ -100,6 +100,11 @@ ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
     set.f_index = set.size();
     set.names.push_back("plane_f");
   }
+  if (set.size() == 0)
+    throw InputError(source,
+                     "nothing left to estimate: the robot file marks no link value as a "
+                     "parameter, or every parameter is fixed; list parameters in the "
+                     "robot file's links or fix fewer");
   return set;
 }
 

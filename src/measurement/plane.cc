@@ -14,12 +14,21 @@ Plane Plane::FromCoefficients(double nx, double ny, double nz, double f,
   Eigen::Vector3d n(nx, ny, nz);
   if (!n.allFinite() || !std::isfinite(f))
     throw InputError(source, "plane coefficients must be finite numbers");
-  double norm = n.norm();
-  if (norm < 1e-12)
+  // Components so large that |n|² overflows (or so small that it underflows) are scaled first;
+  // ordinary normals are normalised as they are (the same bits as ever).
+  const double largest = n.cwiseAbs().maxCoeff();
+  if (largest > 1e150 || (largest > 0 && largest < 1e-150)) {
+    n /= largest;
+    f /= largest;
+  }
+  const double norm = n.norm();
+  if (!(norm >= 1e-12))
     throw InputError(source, "plane normal (nx, ny, nz) is zero; expected a non-zero vector");
   Plane p;
   p.normal = n / norm;
   p.offset = f / norm;
+  if (!std::isfinite(p.offset))
+    throw InputError(source, "plane offset f is too large for its normal (|f|/|n| overflows)");
   return p;
 }
 

@@ -46,6 +46,35 @@ constexpr const char* kRandomNumbers =
     "configuration is addressed by its index in the candidate pool). Pools and validation "
     "sets are keyed by a hash of the settings they depend on.";
 
+// The keys lrcal relies on; a manifest without them is damaged (or not lrcal's).
+void CheckManifest(const Json& manifest, const std::string& path) {
+  const auto require = [&](const Json& j, const std::string& key, bool (Json::*is)() const,
+                           const char* what) {
+    const auto dot = key.rfind('.');
+    const std::string last = dot == std::string::npos ? key : key.substr(dot + 1);
+    if (!j.is_object() || !j.contains(last) || !(j[last].*is)())
+      throw InputError(path + " key '" + key + "'",
+                       std::string("missing or not ") + what +
+                           ": the manifest is damaged or was not written by lrcal");
+    return j[last];
+  };
+  const Json study = require(manifest, "study", &Json::is_object, "a mapping");
+  require(study, "study.name", &Json::is_string, "a name");
+  require(study, "study.seed", &Json::is_number_unsigned, "a seed");
+  require(study, "study.trials", &Json::is_number_integer, "a number of trials");
+  require(study, "study.base", &Json::is_object, "a mapping");
+  const Json cells = require(study, "study.cells", &Json::is_array, "a list of cells");
+  for (const auto& c : cells)
+    if (!c.is_object() || !c.contains("id") || !c["id"].is_string() || !c.contains("label") ||
+        !c["label"].is_string())
+      throw InputError(path + " key 'study.cells'",
+                       "every cell needs an id and a label: the manifest is damaged");
+  const Json shard = require(manifest, "shard", &Json::is_object, "a mapping");
+  require(shard, "shard.index", &Json::is_number_integer, "a number");
+  require(shard, "shard.count", &Json::is_number_integer, "a number");
+  require(manifest, "sessions", &Json::is_array, "a list");
+}
+
 }  // namespace
 
 std::string UtcNow() {
@@ -91,7 +120,12 @@ std::string RunDirectory::RankStorePath(int rank) const {
 }
 
 void RunDirectory::CreateAndLock() {
-  fs::create_directories(path_);
+  std::error_code ec;
+  if (fs::exists(path_, ec) && !fs::is_directory(path_, ec))
+    throw InputError("--out", "'" + path_ + "' is a file; expected a run directory");
+  fs::create_directories(path_, ec);
+  if (ec)
+    throw InputError("--out", "cannot create the run directory '" + path_ + "': " + ec.message());
   lock_ = std::make_unique<DirectoryLock>(path_);
 }
 
@@ -107,7 +141,9 @@ Json RunDirectory::ReadManifest() const {
     throw InputError(path_,
                      "not an lrcal run directory (expected manifest.json and "
                      "trials.sqlite)");
-  return ReadJsonFile(ManifestPath());
+  const Json manifest = ReadJsonFile(ManifestPath());
+  CheckManifest(manifest, ManifestPath());
+  return manifest;
 }
 
 void RunDirectory::WriteManifest(const Json& manifest) const {
@@ -212,6 +248,22 @@ void ParseShard(const std::string& text, int* index, int* count) {
 
 void MergeRunStores(const std::vector<std::string>& shard_dirs, const std::string& out_dir) {
   if (shard_dirs.empty()) throw InputError("merge", "give the shard run directories to merge");
+  std::error_code ec;
+  for (const std::string& d : shard_dirs)
+    if (fs::equivalent(d, out_dir, ec))
+      throw InputError("--out", "'" + out_dir +
+                                    "' is one of the directories to merge; merge into "
+                                    "a new directory");
+  // A shard still running would give a partial snapshot: refuse until it has stopped.
+  std::vector<std::unique_ptr<RunDirectory>> shards;
+  for (const std::string& d : shard_dirs) {
+    shards.push_back(std::make_unique<RunDirectory>(d));
+    try {
+      shards.back()->Lock();
+    } catch (const InputError& e) {
+      throw InputError(d, std::string("cannot merge it now: ") + e.what());
+    }
+  }
   RunDirectory out(out_dir);
   out.CreateAndLock();
   Json merged;
@@ -243,6 +295,29 @@ void MergeRunStores(const std::vector<std::string>& shard_dirs, const std::strin
   }
   out.WriteManifest(merged);
 }
+
+namespace {
+
+// Whether RUN_DIR/tables/ is there and matches the records (its summary.json says whether every
+// trial was in when it was written).
+std::string TablesStatus(const std::string& run_dir, bool run_complete) {
+  const std::string summary = run_dir + "/tables/summary.json";
+  if (!fs::exists(summary))
+    return run_complete ? "tables: missing; write them with: lrcal aggregate " + run_dir + "\n"
+                        : "tables: not written yet (they are written when every trial is done)\n";
+  bool tables_complete = false;
+  try {
+    tables_complete = ReadJsonFile(summary).value("complete", false);
+  } catch (const InputError&) {
+    return "tables: " + summary + " is damaged; rewrite them with: lrcal aggregate " + run_dir +
+           "\n";
+  }
+  if (tables_complete) return "tables: " + run_dir + "/tables/summary.md (complete)\n";
+  return std::string("tables: written from a partial run") +
+         (run_complete ? "; rewrite them with: lrcal aggregate " + run_dir : "") + "\n";
+}
+
+}  // namespace
 
 std::string RunStatus(const std::string& run_dir) { return GetRunStatus(run_dir).text; }
 
@@ -281,6 +356,7 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
   if (!sessions.empty())
     out << "last session: " << sessions.back().value("start", std::string()) << " → "
         << sessions.back().value("ended", std::string()) << "\n";
+  out << TablesStatus(run_dir, total_done >= total);
   if (total_done < total) {
     out << "to finish: lrcal run " << manifest.value("study_file", std::string("STUDY.yaml"))
         << " --out " << run_dir;

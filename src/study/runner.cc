@@ -175,9 +175,18 @@ class StudyRunner {
   RunResult Run() {
     start_ = Clock::now();
     PrepareCells();
+    if (stop_->stop_requested()) {  // a signal while the cells were prepared: nothing written
+      result_.interrupted = true;
+      result_.seconds = Seconds(start_, Clock::now());
+      return result_;
+    }
     OpenRunDirectory();
     FindMissingTrials();
-    RunTrials();
+    try {
+      RunTrials();
+    } catch (const StorageError& e) {
+      throw StorageError(std::string(e.what()) + "\n" + SafeTrialsNote());
+    }
     FinishSession();
     result_.seconds = Seconds(start_, Clock::now());
     return result_;
@@ -186,9 +195,21 @@ class StudyRunner {
  private:
   bool root() const { return rank_ == 0; }
 
+  // What a user needs after a storage failure: what is safe and how to go on.
+  std::string SafeTrialsNote() const {
+    const long long safe = result_.done_before + result_.computed;
+    return std::to_string(safe) + " of " + std::to_string(result_.total) +
+           " trials are safely recorded in " + store_path_ +
+           " (committed batches are never lost). Free space or fix the disk, then run the same "
+           "command again: the run resumes where it stopped and gives the same tables.";
+  }
+
   // Every rank prepares every cell (the same deterministic result).
   void PrepareCells() {
-    for (const Cell& cell : study_.cells) contexts_.push_back(PrepareCell(study_, cell));
+    for (const Cell& cell : study_.cells) {
+      if (stop_->stop_requested()) return;
+      contexts_.push_back(PrepareCell(study_, cell));
+    }
     result_.prepare_seconds = Seconds(start_, Clock::now());
   }
 

@@ -8,6 +8,7 @@
 #include "io/yaml_util.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
+#include "lrcal/core/strings.h"
 #include "lrcal/io/robot_file.h"
 
 namespace lrcal {
@@ -49,27 +50,16 @@ std::string Join(const std::string& prefix, const std::string& key) {
   return prefix.empty() ? key : prefix + "." + key;
 }
 
-// YAML → JSON, recording the line of every key path.
-Json ToJsonNode(const YAML::Node& node, const std::string& path, LineMap* lines) {
-  if (lines && node.Mark().line >= 0) (*lines)[path] = node.Mark().line + 1;
-  if (node.IsMap()) {
-    Json j = Json::object();
-    for (const auto& kv : node) {
-      const std::string key = kv.first.as<std::string>();
-      if (lines) (*lines)[Join(path, key)] = kv.first.Mark().line + 1;
-      j[key] = ToJsonNode(kv.second, Join(path, key), lines);
-      if (lines) (*lines)[Join(path, key)] = kv.first.Mark().line + 1;
-    }
-    return j;
-  }
-  if (node.IsSequence()) {
-    Json j = Json::array();
-    for (std::size_t i = 0; i < node.size(); ++i)
-      j.push_back(ToJsonNode(node[i], path + "[" + std::to_string(i) + "]", lines));
-    return j;
-  }
-  if (node.IsNull()) return Json();
+// YAML → JSON, recording the line of every key path. `budget` bounds the values converted, so
+// that nested aliases (a "billion laughs" file) are refused instead of expanded for minutes.
+constexpr long kMaxStudyValues = 100000;
+constexpr int kMaxCells = 100000;
+
+Json ToJsonScalar(const YAML::Node& node, const std::string& path, const std::string& file) {
   const std::string s = node.Scalar();
+  if (!IsValidUtf8(s))
+    throw InputError(Location(file, node.Mark().line + 1) + " key '" + path + "'",
+                     "the value is not valid UTF-8 text");
   if (node.Tag() == "!") return s;  // quoted: a string
   if (s == "true" || s == "yes") return true;
   if (s == "false" || s == "no") return false;
@@ -81,6 +71,36 @@ Json ToJsonNode(const YAML::Node& node, const std::string& path, LineMap* lines)
     return v;
   }
   return s;
+}
+
+Json ToJsonNode(const YAML::Node& node, const std::string& path, const std::string& file,
+                LineMap* lines, long* budget) {
+  if (--*budget < 0)
+    throw InputError(file, "the file expands to more than " + std::to_string(kMaxStudyValues) +
+                               " values (nested YAML aliases?): refused");
+  if (node.Mark().line >= 0) (*lines)[path] = node.Mark().line + 1;
+  if (node.IsMap()) {
+    Json j = Json::object();
+    for (const auto& kv : node) {
+      const std::string key = yaml::Key(kv.first, file, path);
+      const std::string sub = Join(path, key);
+      if (j.contains(key))
+        throw InputError(Location(file, kv.first.Mark().line + 1) + " key '" + sub + "'",
+                         "repeated key (first at line " + std::to_string((*lines)[sub]) + ")");
+      (*lines)[sub] = kv.first.Mark().line + 1;
+      j[key] = ToJsonNode(kv.second, sub, file, lines, budget);
+      (*lines)[sub] = kv.first.Mark().line + 1;
+    }
+    return j;
+  }
+  if (node.IsSequence()) {
+    Json j = Json::array();
+    for (std::size_t i = 0; i < node.size(); ++i)
+      j.push_back(ToJsonNode(node[i], path + "[" + std::to_string(i) + "]", file, lines, budget));
+    return j;
+  }
+  if (node.IsNull()) return Json();
+  return ToJsonScalar(node, path, file);
 }
 
 // Where a key path was written: "file:line key 'path'".
@@ -157,11 +177,14 @@ double Num(const Json& s, const std::string& path, const KeyLocator& where) {
   return j.get<double>();
 }
 
-int Int(const Json& s, const std::string& path, const KeyLocator& where, int min) {
+// A whole number in [min, max]: the upper limits keep a typo (1e9 configurations) from
+// running out of memory or time without a word.
+int Int(const Json& s, const std::string& path, const KeyLocator& where, int min,
+        int max = 1000000000) {
   const double v = Num(s, path, where);
-  if (v != std::floor(v) || v < min || v > 1e9)
-    throw InputError(where(path), "expected a whole number >= " + std::to_string(min) + ", got " +
-                                      Json(v).dump());
+  if (v != std::floor(v) || v < min || v > max)
+    throw InputError(where(path), "expected a whole number from " + std::to_string(min) + " to " +
+                                      std::to_string(max) + ", got " + Json(v).dump());
   return static_cast<int>(v);
 }
 
@@ -248,11 +271,11 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
   c->truth_angle_sigma = NonNegative(s, "truth.angle_sigma_mrad", where) * 1e-3;
   c->truth_length_sigma = NonNegative(s, "truth.length_sigma_mm", where) * 1e-3;
   c->sigma = NonNegative(s, "noise.sigma_mm", where) * 1e-3;
-  c->repetitions = Int(s, "noise.repetitions", where, 1);
+  c->repetitions = Int(s, "noise.repetitions", where, 1, 1000000);
 }
 
 void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings* c) {
-  c->pool_size = Int(s, "pool.size", where, 1);
+  c->pool_size = Int(s, "pool.size", where, 1, 100000);
   c->pool_redraw = Bool(s, "pool.redraw", where);
   c->min_singular_value = NonNegative(s, "pool.min_singular_value", where);
   c->select_count = Int(s, "selection.count", where, 1);
@@ -264,11 +287,11 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
       ParseSelectionMethod(Str(s, "selection.method", where), where("selection.method"));
   c->selection.criterion =
       ParseDesignCriterion(Str(s, "selection.criterion", where), where("selection.criterion"));
-  c->selection.samples = Int(s, "selection.samples", where, 1);
-  c->selection.restarts = Int(s, "selection.restarts", where, 1);
+  c->selection.samples = Int(s, "selection.samples", where, 1, 1000000);
+  c->selection.restarts = Int(s, "selection.restarts", where, 1, 1000);
   c->selection_redraw = Bool(s, "selection.redraw", where);
   c->scaling = ParseDesignScaling(Str(s, "selection.scaling", where), where("selection.scaling"));
-  c->validation_size = Int(s, "validation.size", where, 1);
+  c->validation_size = Int(s, "validation.size", where, 1, 100000);
 }
 
 void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c) {
@@ -285,7 +308,7 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
   }
   c->identification.solver = ParseName(kSolverNames, Str(s, "identification.solver", where),
                                        where("identification.solver"), "solver");
-  c->identification.max_iterations = Int(s, "identification.max_iterations", where, 1);
+  c->identification.max_iterations = Int(s, "identification.max_iterations", where, 1, 10000);
   const std::string rank = Str(s, "identification.on_rank_deficient", where);
   if (rank != "fail" && rank != "fix")
     throw InputError(where("identification.on_rank_deficient"),
@@ -377,8 +400,16 @@ void ParseHeader(const Json& given, const std::string& path, const KeyLocator& w
     if (!given.contains(required))
       throw InputError(Location(path, 1) + " key '" + required + "'", "missing (required)");
   study->name = Str(given, "name", where);
-  if (study->name.empty() || study->name.find_first_of("/\\ ") != std::string::npos)
-    throw InputError(where("name"), "expected a non-empty name without spaces or slashes");
+  // The name becomes a folder (output/<name>): only plain names.
+  const bool plain = !study->name.empty() && study->name[0] != '.' &&
+                     study->name.find_first_not_of(
+                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                         "0123456789._-") == std::string::npos;
+  if (!plain)
+    throw InputError(where("name"),
+                     "expected a plain name (letters, digits, '.', '_', '-'; not "
+                     "starting with '.'), got '" +
+                         study->name + "'");
   if (given.contains("description")) study->description = Str(given, "description", where);
   const double seed = Num(given, "seed", where);
   if (seed < 0 || seed != std::floor(seed) || seed > 9e15)
@@ -457,6 +488,12 @@ std::vector<Axis> ParseSweep(const Json& given, const KeyLocator& where, Study* 
     for (const auto& a : axes)
       if (a.values.size() != axes[0].values.size())
         throw InputError(where("sweep.axes"), "zip needs axes of equal length");
+  double cells = 1;
+  for (const auto& a : axes) cells *= *combine == "zip" ? 1 : static_cast<double>(a.values.size());
+  if (cells > kMaxCells)
+    throw InputError(where("sweep.axes"), "the axes give " + Json(cells).dump() +
+                                              " cells; at most " + std::to_string(kMaxCells) +
+                                              " are allowed in one study (split the sweep)");
   return axes;
 }
 
@@ -505,7 +542,8 @@ Study LoadStudy(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);
   yaml::RequireMap(root, path, "");
   LineMap lines;
-  const Json given = ToJsonNode(root, "", &lines);
+  long budget = kMaxStudyValues;
+  const Json given = ToJsonNode(root, "", path, &lines, &budget);
   const KeyLocator where{path, &lines, "", ""};
   Study study;
   study.path = path;

@@ -2,6 +2,7 @@
 
 #include <sqlite3.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -16,11 +17,33 @@ const char* const TrialStore::kMetricColumns[12] = {
 
 namespace {
 
+// SQLite's result codes that mean the storage failed (not the query): a StorageError, which the
+// runner turns into a clean stop that keeps every committed trial.
+bool IsStorageFailure(int rc) {
+  switch (rc & 0xff) {
+    case SQLITE_FULL:
+    case SQLITE_IOERR:
+    case SQLITE_READONLY:
+    case SQLITE_CANTOPEN:
+    case SQLITE_CORRUPT:
+    case SQLITE_NOTADB:
+      return true;
+    default:
+      return false;
+  }
+}
+
+[[noreturn]] void ThrowSqlite(int rc, const std::string& message) {
+  if (IsStorageFailure(rc)) throw StorageError(message);
+  throw std::runtime_error(message);
+}
+
 class Statement {
  public:
   Statement(sqlite3* db, const std::string& sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
-      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db) + " in: " + sql);
+    const int rc = sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt_, nullptr);
+    if (rc != SQLITE_OK)
+      ThrowSqlite(rc, std::string("sqlite: ") + sqlite3_errmsg(db) + " in: " + sql);
   }
   ~Statement() { sqlite3_finalize(stmt_); }
   sqlite3_stmt* get() { return stmt_; }
@@ -28,7 +51,8 @@ class Statement {
     int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
     if (rc == SQLITE_DONE) return false;
-    throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db_));
+    ThrowSqlite(rc, std::string("sqlite (") + sqlite3_db_filename(db_, "main") +
+                        "): " + sqlite3_errmsg(db_));
   }
   void Reset() {
     sqlite3_reset(stmt_);
@@ -68,11 +92,15 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
     std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
-    throw std::runtime_error("cannot open trial store " + path + ": " + msg);
+    throw StorageError("cannot open trial store " + path + ": " + msg);
   }
   sqlite3_busy_timeout(db_, 10000);
   Exec("PRAGMA journal_mode=WAL");
   Exec("PRAGMA synchronous=NORMAL");
+  // Fault injection for tests: a store that holds at most this many pages fails with SQLITE_FULL
+  // exactly as a full disk does.
+  if (const char* pages = std::getenv("LRCAL_TEST_STORE_MAX_PAGES"))
+    Exec("PRAGMA max_page_count=" + std::to_string(std::atol(pages)));
   Exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
   Exec(
       "CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
@@ -99,10 +127,11 @@ TrialStore::~TrialStore() { sqlite3_close(db_); }
 
 void TrialStore::Exec(const std::string& sql) const {
   char* err = nullptr;
-  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+  const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
+  if (rc != SQLITE_OK) {
     std::string msg = err ? err : "unknown error";
     sqlite3_free(err);
-    throw std::runtime_error("sqlite (" + path_ + "): " + msg + " in: " + sql);
+    ThrowSqlite(rc, "sqlite (" + path_ + "): " + msg + " in: " + sql);
   }
 }
 
@@ -200,11 +229,11 @@ void TrialStore::Insert(const std::vector<TrialRecord>& records) {
       sqlite3_bind_double(st.get(), 33, r.seconds);
       st.Step();
     }
+    Exec("COMMIT");  // a full disk usually shows here: the batch is rolled back, nothing half-done
   } catch (...) {
-    Exec("ROLLBACK");
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     throw;
   }
-  Exec("COMMIT");
 }
 
 std::vector<long long> TrialStore::DoneTrials(const std::string& cell_id) const {

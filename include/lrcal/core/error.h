@@ -2,7 +2,8 @@
 //
 // Every bad input is reported as an InputError that names where the problem is (file, line,
 // field) and what was expected, so that the user can act on it without reading the source.
-// The command-line program turns an InputError into exit code 2.
+// The command-line program turns an InputError into exit code 2, and a StorageError (results
+// could not be written: a full disk, an I/O error) into exit code 5.
 #pragma once
 
 #include <stdexcept>
@@ -21,6 +22,13 @@ class InputError : public std::runtime_error {
 
  private:
   std::string where_;
+};
+
+/// Results could not be written or read back: a full disk, an I/O error, a read-only or vanished
+/// folder. What was already committed is intact; the message says where and what to do.
+class StorageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 /// Formats "file:line" (line is 1-based; 0 means unknown and is omitted).

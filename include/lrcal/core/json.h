@@ -18,9 +18,11 @@ std::vector<std::string> DiffJson(const Json& before, const Json& after,
 /// Reads a JSON file. InputError naming the file if it cannot be read or parsed.
 Json ReadJsonFile(const std::string& path);
 
-/// Writes `text` to `path` through a temporary file in the same folder, checked and renamed:
-/// the file is either the old one or the complete new one, never partial. Throws
-/// std::runtime_error naming the file on any failure (the temporary is removed).
+/// Writes `text` to `path` through a temporary file in the same folder, checked, synced and
+/// renamed: the file is either the old one or the complete new one, never partial. A device or
+/// pipe (/dev/stdout, /dev/full) is written in place, checked, never replaced. Throws
+/// StorageError naming the file on any failure (a full disk, a short write, a folder that
+/// cannot be written; the temporary is removed).
 void WriteFileAtomically(const std::string& path, const std::string& text);
 
 }  // namespace lrcal

@@ -11,6 +11,10 @@ namespace lrcal {
 /// an empty item between two separators is kept as "" (callers report it).
 std::vector<std::string> SplitList(const std::string& text, char separator = ',');
 
+/// True if `text` is well-formed UTF-8 (no stray continuation bytes, no overlong forms, no
+/// surrogates, nothing above U+10FFFF).
+bool IsValidUtf8(const std::string& text);
+
 /// Parses a number that may be written with pi: "1.5", "-pi/2", "pi", "3*pi/4".
 /// Returns false if `text` is none of those forms (or the value is not finite).
 bool ParseAngleExpression(const std::string& text, double* value);

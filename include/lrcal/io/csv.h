@@ -2,8 +2,11 @@
 //
 // Configurations: header `q1,...,qN` (rad, or m for prismatic joints), one configuration a row.
 // Measurements: the same columns plus `h` (m), optionally `repetition`; rows with the same q are
-// readings of one configuration, averaged (identification.h). Other columns are ignored only if
-// their names do not look like joints (q<k> with k > N is an error: wrong robot).
+// readings of one configuration, averaged (identification.h). Other columns, of any type, are
+// ignored, unless their names look like joints of another robot (q<k> with k > N: an error).
+// Read as written by spreadsheets and loggers: a UTF-8 byte-order mark, CRLF, LF or CR-only line
+// endings, double-quoted headers and values ("" inside quotes is a quote), blank lines and '#'
+// comment lines. A NUL byte, a repeated column name or a ragged row is an error.
 // Every error names the file, the line and the column, and says what was expected.
 #pragma once
 
@@ -15,21 +18,32 @@
 
 namespace lrcal {
 
+/// A CSV file as text: the header and the cells of every data row.
 struct CsvTable {
   std::string path;
   std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
+  std::vector<std::vector<std::string>> rows;
   std::vector<int> lines;  ///< 1-based line of each row
+  /// Index of a column, or -1.
   int Column(const std::string& name) const;
+  /// Cell (row, column) as a finite number; InputError naming file:line and the column.
+  double Number(std::size_t row, int column) const;
 };
 
-/// Reads a CSV of numbers with a header line; '#' lines and blank lines are skipped.
+/// Reads a CSV file with a header line (see the file comment). InputError naming the file and
+/// line for a folder, an empty file, a NUL byte, repeated column names or a ragged row.
 CsvTable ReadCsv(const std::string& path);
 
 ConfigurationSet ReadConfigurations(const std::string& path, int num_joints);
-MeasurementSet ReadMeasurements(const std::string& path, int num_joints);
+/// Readings grouped by configuration. With a `ranger`, a reading outside its range is an error
+/// naming the line (and suggesting the likely unit mistake: readings are in metres).
+MeasurementSet ReadMeasurements(const std::string& path, int num_joints,
+                                const RangerSpec* ranger = nullptr);
 
-/// Writes `q1..qN` rows with 17 significant digits (exact round trip).
+/// Refuses (InputError naming `option`) an output path that cannot be a file: empty, a folder,
+/// or in a folder that does not exist.
+void CheckOutputFile(const std::string& path, const std::string& option);
+
 /// Writes configurations (header q1..qN) at full precision. The file is written whole or not at
 /// all; any failure (a full disk, a folder that cannot be written) is an InputError naming it.
 void WriteConfigurations(const std::string& path, const ConfigurationSet& configs);
