@@ -39,6 +39,19 @@ bool ScanNumber(const std::string& s, std::size_t* i, double* value) {
 
 }  // namespace
 
+bool ParseDecimal(const std::string& text, double* value) {
+  std::size_t i = 0;
+  SkipBlanks(text, &i);
+  double sign = 1;
+  if (i < text.size() && (text[i] == '+' || text[i] == '-')) sign = text[i++] == '-' ? -1 : 1;
+  double magnitude = 0;
+  if (!ScanNumber(text, &i, &magnitude)) return false;
+  SkipBlanks(text, &i);
+  if (i != text.size()) return false;
+  *value = sign * magnitude;
+  return true;
+}
+
 bool ParseAngleExpression(const std::string& text, double* value) {
   // [blanks] [sign] (number | [number '*'] pi ['/' number]) [blanks]
   std::size_t i = 0;

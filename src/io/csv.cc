@@ -22,9 +22,8 @@ int CsvTable::Column(const std::string& name) const {
 
 double CsvTable::Number(std::size_t row, int column) const {
   const std::string& cell = rows[row][column];
-  char* end = nullptr;
-  const double value = std::strtod(cell.c_str(), &end);
-  if (cell.empty() || *end != '\0' || !std::isfinite(value))
+  double value = 0;
+  if (!ParseDecimal(cell, &value))
     throw InputError(Location(path, lines[row]) + " column '" + header[column] + "'",
                      "expected a finite number, got '" + cell + "'");
   return value;

@@ -77,9 +77,7 @@ double Number(const YAML::Node& node, const std::string& file, const std::string
                      "expected a finite number or an expression like pi/2, -pi, 3*pi/4; got '" +
                          Abbreviate(text) + "'");
   }
-  char* end = nullptr;
-  value = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(value))
+  if (!ParseDecimal(text, &value))
     throw InputError(Where(file, node, key),
                      "expected a finite number; got '" + Abbreviate(text) + "'");
   return value;

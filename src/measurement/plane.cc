@@ -38,9 +38,7 @@ Plane Plane::Parse(const std::string& text, const std::string& source) {
     throw InputError(source, "expected four numbers nx,ny,nz,f; got '" + text + "'");
   double v[4];
   for (int i = 0; i < 4; ++i) {
-    char* end = nullptr;
-    v[i] = std::strtod(parts[i].c_str(), &end);
-    if (parts[i].empty() || *end != '\0')
+    if (!ParseDecimal(parts[i], &v[i]))
       throw InputError(source, "'" + parts[i] + "' is not a number (expected nx,ny,nz,f)");
   }
   return FromCoefficients(v[0], v[1], v[2], v[3], source);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <iostream>
 #include <mutex>
+#include <system_error>
 #include <thread>
 
 #include "lrcal/core/error.h"
@@ -303,7 +304,17 @@ class StudyRunner {
     std::vector<std::thread> pool;
     std::exception_ptr writer_failure;
     try {
-      for (int i = 0; i < threads_; ++i) pool.emplace_back([this, &queue] { Worker(&queue); });
+      for (int i = 0; i < threads_; ++i) {
+        try {
+          pool.emplace_back([this, &queue] { Worker(&queue); });
+        } catch (const std::system_error& e) {
+          // Not every thread could start (a process limit): the others are stopped below.
+          for (int k = i; k < threads_; ++k) queue.WorkerDone();
+          throw InputError("--threads", "could start only " + std::to_string(i) + " of " +
+                                            std::to_string(threads_) + " worker threads (" +
+                                            e.what() + "); run with fewer --threads");
+        }
+      }
       WriterLoop(&queue, &progress);
     } catch (...) {
       // The writer failed (e.g. the disk is full) or a thread could not start: stop the
@@ -396,7 +407,9 @@ class StudyRunner {
 
 void RunOptions::Validate() const {
   if (out_dir.empty()) throw InputError("--out", "expected a run directory, got an empty name");
-  if (threads < 0) throw InputError("--threads", "expected 0 (all cores) or more");
+  if (threads < 0 || threads > 4096)
+    throw InputError("--threads", "expected 0 (all cores) to 4096 worker threads, got " +
+                                      std::to_string(threads));
   if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
     throw InputError("--shard", "expected i/N with 1 <= i <= N");
   if (batch_size < 1) throw InputError("batch_size", "expected at least 1 record per batch");

@@ -1,4 +1,6 @@
 // Atomic, checked file writes and JSON differences.
+#include "lrcal/core/json.h"
+
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -6,7 +8,6 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "lrcal/core/json.h"
 #include "test_util.h"
 
 namespace lrcal {

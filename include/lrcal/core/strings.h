@@ -15,6 +15,10 @@ std::vector<std::string> SplitList(const std::string& text, char separator = ','
 /// surrogates, nothing above U+10FFFF).
 bool IsValidUtf8(const std::string& text);
 
+/// Parses a plain decimal number ("-1.5", "2e-3", surrounding blanks allowed): no "inf", "nan"
+/// or hexadecimal, and the value must be finite. Returns false otherwise.
+bool ParseDecimal(const std::string& text, double* value);
+
 /// Parses a number that may be written with pi: "1.5", "-pi/2", "pi", "3*pi/4".
 /// Returns false if `text` is none of those forms (or the value is not finite).
 bool ParseAngleExpression(const std::string& text, double* value);
