@@ -124,12 +124,26 @@ def build(run_dir):
                  html.escape(json.dumps(run.manifest, indent=2)) + "</pre></details>")
     parts.append(f"<script>{CHECK}</script></body></html>")
     path = os.path.join(run.report_dir, "report.html")
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("\n".join(parts))
-    with open(os.path.join(run.report_dir, "figures.json"), "w", encoding="utf-8") as f:
-        json.dump({"figures": [os.path.basename(p) for p, _ in figures],
-                   "seconds": round(time.time() - t0, 2)}, f, indent=2)
+    write_atomically(path, "\n".join(parts))
+    write_atomically(os.path.join(run.report_dir, "figures.json"),
+                     json.dumps({"figures": [os.path.basename(p) for p, _ in figures],
+                                 "seconds": round(time.time() - t0, 2)}, indent=2))
     return path, figures
+
+
+def write_atomically(path, text):
+    """Writes text to path whole or not at all: a temporary file, flushed, synced, renamed."""
+    tmp = path + ".tmp"
+    try:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except OSError:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
 
 
 def main(argv):
@@ -141,6 +155,9 @@ def main(argv):
     except la.RunDataError as e:
         print(f"report.py: error: {e}", file=sys.stderr)
         return 2
+    except OSError as e:  # a full disk, a folder that cannot be written
+        print(f"report.py: could not write the report: {e}", file=sys.stderr)
+        return 5
     print(f"report.py: {len(figures)} figures, {path}")
     return 0
 

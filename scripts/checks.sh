@@ -5,12 +5,14 @@
 #   tidy     clang-tidy's function-size and cognitive-complexity limits on src/ (.clang-tidy)
 #   asan     every unit test built with AddressSanitizer + UndefinedBehaviorSanitizer
 #   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
-# Usage: bash scripts/checks.sh [format|layers|tidy|asan|tsan ...]   (default: all, in order)
+#   fuzz     libFuzzer on the CSV readers, robot files, study files and the number parser
+#            (ASan + UBSan, about a minute each: scripts/fuzz.sh)
+# Usage: bash scripts/checks.sh [format|layers|tidy|asan|tsan|fuzz ...]  (default: all, in order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_packages.sh clang-format clang-tidy python3
 stages=("$@")
-((${#stages[@]})) || stages=(format layers tidy asan tsan)
+((${#stages[@]})) || stages=(format layers tidy asan tsan fuzz)
 
 stage() { echo "== checks: $1 ($(date -u +%H:%M:%S))"; }
 sanitizer_build() {  # dir, sanitizers, targets...
@@ -46,7 +48,10 @@ for s in "${stages[@]}"; do
       sanitizer_build build-tsan thread lrcal_cli lrcal_study_tests
       TSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/tsan.supp:halt_on_error=1" \
         ctest --test-dir build-tsan -j2 --output-on-failure -L study ;;
-    *) echo "unknown stage '$s' (format, layers, tidy, asan, tsan)" >&2; exit 2 ;;
+    fuzz)
+      stage fuzz
+      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-60}" ;;
+    *) echo "unknown stage '$s' (format, layers, tidy, asan, tsan, fuzz)" >&2; exit 2 ;;
   esac
 done
 echo "== checks: done ($(date -u +%H:%M:%S))"

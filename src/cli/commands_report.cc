@@ -54,7 +54,7 @@ int ReportCommand(const std::vector<std::string>& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (code != 0) {
     std::cerr << "lrcal report: analysis/report.py failed (exit " << code << ")\n";
-    return code == 2 ? 2 : 1;
+    return code == 2 || code == 5 ? code : 1;
   }
   std::cout << "report: " << data.dir << "/report.html (" << data.done << "/" << data.expected
             << " trials" << (data.complete ? "" : ", PARTIAL run") << "; built in "

@@ -186,6 +186,7 @@ class StudyRunner {
     try {
       RunTrials();
     } catch (const StorageError& e) {
+      CloseSessionAfterStorageError();
       throw StorageError(std::string(e.what()) + "\n" + SafeTrialsNote());
     }
     FinishSession();
@@ -195,6 +196,19 @@ class StudyRunner {
 
  private:
   bool root() const { return rank_ == 0; }
+
+  // Best effort: the manifest says how the session ended; if even that cannot be written, the
+  // old manifest stays as it was (atomic writes never leave a partial file).
+  void CloseSessionAfterStorageError() {
+    if (!root()) return;
+    try {
+      Json& session = manifest_["sessions"][session_];
+      session["end"] = UtcNow();
+      session["ended"] = "stopped: results could not be written";
+      dir_.WriteManifest(manifest_);
+    } catch (const std::exception&) {
+    }
+  }
 
   // What a user needs after a storage failure: what is safe and how to go on.
   std::string SafeTrialsNote() const {

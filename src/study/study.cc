@@ -83,6 +83,8 @@ Json ToJsonNode(const YAML::Node& node, const std::string& path, const std::stri
     Json j = Json::object();
     for (const auto& kv : node) {
       const std::string key = yaml::Key(kv.first, file, path);
+      if (!IsValidUtf8(key))
+        throw InputError(Location(file, kv.first.Mark().line + 1), "a key is not valid UTF-8 text");
       const std::string sub = Join(path, key);
       if (j.contains(key))
         throw InputError(Location(file, kv.first.Mark().line + 1) + " key '" + sub + "'",

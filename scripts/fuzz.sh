@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Builds lrcal's fuzz targets with clang's libFuzzer under AddressSanitizer and
+# UndefinedBehaviorSanitizer, and runs each for a bounded time on its checked-in corpus
+# (tests/fuzz/corpus/<target>). Any crash, sanitizer report, or reader answer other than a clear
+# InputError is a finding: the script fails and leaves the input in build-fuzz/findings/.
+#   bash scripts/fuzz.sh [seconds per target, default 60]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-${LRCAL_FUZZ_SECONDS:-60}}"
+bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev \
+  nlohmann-json3-dev
+out=build-fuzz
+mkdir -p "$out/obj" "$out/findings"
+flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
+       -fno-sanitize-recover=undefined -Iinclude -Isrc -I/usr/include/eigen3
+       "-DLRCAL_SOURCE_DIR=\"$PWD\"")
+# The readers and what they need (no Ceres, no SQLite: the fuzzers build in about a minute).
+sources=(core/strings core/json core/hash kinematics/robot_model kinematics/configuration_set
+         measurement/plane measurement/parameter_set io/csv io/robot_file io/yaml_util study/study)
+objects=()
+build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
+  local name=$1 obj="$out/obj/${1//\//_}.o"
+  clang++ "${flags[@]}" -fsanitize=fuzzer-no-link -c "src/$name.cc" -o "$obj"
+}
+for s in "${sources[@]}"; do
+  build_object "$s" &
+  objects+=("$out/obj/${s//\//_}.o")
+  (( $(jobs -r | wc -l) >= 2 )) && wait -n
+done
+wait
+targets=(expression csv robot_file study_file)
+for t in "${targets[@]}"; do
+  clang++ "${flags[@]}" -fsanitize=fuzzer "tests/fuzz/${t}_fuzzer.cc" "${objects[@]}" \
+    -lyaml-cpp -o "$out/${t}_fuzzer"
+done
+echo "fuzz: built ${#targets[@]} targets; running each for ${seconds} s"
+status=0
+run_target() {
+  local t=$1 work="$out/corpus/$1"
+  mkdir -p "$work"
+  "$out/${t}_fuzzer" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
+    -artifact_prefix="$out/findings/${t}-" -print_final_stats=1 "$work" "tests/fuzz/corpus/$t" \
+    > "$out/${t}.log" 2>&1
+}
+pids=()
+for t in "${targets[@]}"; do
+  run_target "$t" &
+  pids+=($!)
+  if (( ${#pids[@]} == 2 )); then
+    for p in "${pids[@]}"; do wait "$p" || status=1; done
+    pids=()
+  fi
+done
+for p in "${pids[@]}"; do wait "$p" || status=1; done
+for t in "${targets[@]}"; do
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$out/${t}.log" | grep -o '[0-9]*$' || echo "?")
+  echo "fuzz: $t: ${runs} inputs in ${seconds} s"
+done
+if ((status)); then
+  echo "fuzz: FINDINGS (inputs in $out/findings/):" >&2
+  ls "$out/findings" >&2
+  for t in "${targets[@]}"; do grep -h -A12 "ERROR\|deadly signal\|runtime error" "$out/${t}.log" >&2 || true; done
+  exit 1
+fi
+echo "fuzz: no findings"
