@@ -33,7 +33,18 @@ double Seconds(Clock::time_point from, Clock::time_point to) {
 std::atomic<StopToken*> g_active_stop{nullptr};
 std::atomic<int> g_signals{0};
 
+// True while a run prepares its cells: nothing is written yet, so a signal may end the process
+// at once (one cell's preparation can take minutes).
+std::atomic<bool> g_preparing{false};
+
 void OnStopSignal(int) {
+  if (g_preparing.load()) {
+    static const char kMessage[] =
+        "lrcal run: interrupted while the cells were prepared; nothing was written\n";
+    if (::write(STDERR_FILENO, kMessage, sizeof kMessage - 1) < 0) {
+    }
+    _exit(130);
+  }
   if (g_signals.fetch_add(1) >= 1) _exit(130);  // second signal: stop now
   if (StopToken* token = g_active_stop.load()) token->RequestStop();
 }
@@ -221,8 +232,14 @@ class StudyRunner {
 
   // Every rank prepares every cell (the same deterministic result).
   void PrepareCells() {
+    // Signals end the process at once while nothing is written (see OnStopSignal); a library
+    // caller's own stop token is checked between cells.
+    struct Preparing {
+      Preparing() { g_preparing.store(true); }
+      ~Preparing() { g_preparing.store(false); }
+    } preparing;
     for (const Cell& cell : study_.cells) {
-      if (stop_->stop_requested()) return;
+      if (stop_->stop_requested()) break;
       contexts_.push_back(PrepareCell(study_, cell));
     }
     result_.prepare_seconds = Seconds(start_, Clock::now());

@@ -67,6 +67,9 @@ TEST(Storage, AFullFileSystemStopsCleanlyAndResumesOnceSpaceIsFreed) {
   EXPECT_EQ(first, 5) << out;
   EXPECT_NE(out.find("could not write results"), std::string::npos) << out;
   if (fs::exists(run + "/manifest.json")) ExpectIntactManifest(run);
+  // Run again on the still-full disk: refused the same way, and nothing already there damaged.
+  EXPECT_EQ(RunCommand(command, &out), 5) << out;
+  if (fs::exists(run + "/manifest.json")) ExpectIntactManifest(run);
   // Free space (a larger file system) and rerun the same command.
   ASSERT_EQ(::mount("tmpfs", mount.c_str(), "tmpfs", MS_REMOUNT, "size=8m"), 0);
   const int second = RunCommand(command, &out);
@@ -92,6 +95,23 @@ TEST(Storage, TablesThatCannotBeWrittenLeaveTheRunIntactAndAggregateRewritesThem
   fs::remove(run + "/tables/summary.json.tmp");
   ASSERT_EQ(RunCommand(LrcalBinary() + " aggregate " + run, &out), 0) << out;
   ExpectGoldenTables(run);
+}
+
+TEST(Storage, MergeAndReportThatCannotWriteAreExitFiveAndKeepTheirInputs) {
+  const std::string dir = testing::TempDir("storage_merge_report");
+  std::string out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " run " + Quick() + " --out " + dir + "/a --quiet", &out), 0)
+      << out;
+  // merge: the merged manifest cannot be written.
+  fs::create_directories(dir + "/m/manifest.json.tmp");
+  ASSERT_EQ(RunCommand(LrcalBinary() + " merge " + dir + "/a --out " + dir + "/m", &out), 5) << out;
+  EXPECT_NE(out.find("manifest.json.tmp"), std::string::npos) << out;
+  ExpectGoldenTables(dir + "/a");  // the input is untouched
+  // report: report.html cannot be written (its temporary name is taken by a folder).
+  fs::create_directories(dir + "/a/report/report.html.tmp");
+  ASSERT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/a", &out), 5) << out;
+  EXPECT_NE(out.find("report.html.tmp"), std::string::npos) << out;
+  ExpectIntactManifest(dir + "/a");
 }
 
 struct WritingCommand {

@@ -7,6 +7,7 @@
 
 #include <random>
 
+#include "lrcal/core/error.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -111,6 +112,23 @@ TEST(NormalChart, RegularAtThePapersPlaneAndEverywhere) {
     chart.NormalAndJacobian(0.3, -0.2, &n, &J);
     EXPECT_NEAR(n.norm(), 1.0, 1e-15);
   }
+}
+
+TEST(Plane, HugeOrTinyCoefficientsNormaliseInsteadOfVanishing) {
+  // |n|² of (1e200, 0, 0) overflows: the normal used to become 0 and every beam "parallel".
+  const Plane big = Plane::FromCoefficients(1e200, 0, 0, -0.5e200);
+  EXPECT_EQ(big.normal, Eigen::Vector3d(1, 0, 0));
+  EXPECT_DOUBLE_EQ(big.offset, -0.5);
+  const Plane tiny = Plane::FromCoefficients(0, 3e-200, 4e-200, 5e-200);
+  EXPECT_NEAR(tiny.normal.y(), 0.6, 1e-15);
+  EXPECT_NEAR(tiny.normal.z(), 0.8, 1e-15);
+  EXPECT_NEAR(tiny.offset, 1.0, 1e-15);
+  // Ordinary planes keep their bits (the paper's plane, normalised as ever).
+  const Plane paper = Plane::FromCoefficients(0, 1, 4.6, -0.69);
+  const Eigen::Vector3d n(0, 1, 4.6);
+  EXPECT_EQ(paper.normal, n / n.norm());
+  EXPECT_THROW(Plane::FromCoefficients(0, 0, 0, 1), InputError);
+  EXPECT_THROW(Plane::FromCoefficients(1e-300, 0, 0, 1e300), InputError);  // |f|/|n| overflows
 }
 
 TEST(ClassifyReading, ReportsEveryMissReason) {
