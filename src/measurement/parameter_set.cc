@@ -56,47 +56,59 @@ int ParameterSet::Find(const std::string& name) const {
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
-ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
-                              const std::vector<std::string>& fixed, const std::string& source) {
-  std::vector<int> fixed_values;
-  bool fix_u[2] = {false, false}, fix_offset = false;
+namespace {
+
+// What `fixed` names: robot link values (indices) and plane terms.
+struct FixedNames {
+  std::vector<int> values;
+  bool u[2] = {false, false};
+  bool offset = false;
+};
+
+FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& fixed,
+                      const std::string& source) {
+  FixedNames out;
   for (const std::string& name : fixed) {
     if (name.empty()) continue;
-    if (name == "plane_u1") {
-      fix_u[0] = true;
-      continue;
-    }
-    if (name == "plane_u2") {
-      fix_u[1] = true;
+    if (name == "plane_u1" || name == "plane_u2") {
+      out.u[name == "plane_u2"] = true;
       continue;
     }
     if (name == "plane_f") {
-      fix_offset = true;
+      out.offset = true;
       continue;
     }
-    int k = robot.FindValue(name);
+    const int k = robot.FindValue(name);
     if (k < 0)
       throw InputError(source, "unknown parameter '" + name +
                                    "'; expected a name like theta1, alpha2, a3, d4, beta6");
     const auto& ids = robot.parameter_indices();
     if (std::find(ids.begin(), ids.end(), k) == ids.end())
       throw InputError(source, "'" + name + "' is fixed on this robot already (not a parameter)");
-    fixed_values.push_back(k);
+    out.values.push_back(k);
   }
+  return out;
+}
+
+}  // namespace
+
+ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
+                              const std::vector<std::string>& fixed, const std::string& source) {
+  const FixedNames f = ParseFixed(robot, fixed, source);
   ParameterSet set;
   set.plane = plane;
   for (int k : robot.parameter_indices()) {
-    if (std::find(fixed_values.begin(), fixed_values.end(), k) != fixed_values.end()) continue;
+    if (std::find(f.values.begin(), f.values.end(), k) != f.values.end()) continue;
     set.robot_values.push_back(k);
     set.names.push_back(robot.ValueName(k));
   }
   for (int c = 0; c < 2; ++c) {
-    if (plane.normal && !fix_u[c]) {
+    if (plane.normal && !f.u[c]) {
       set.u_index[c] = set.size();
       set.names.push_back(c == 0 ? "plane_u1" : "plane_u2");
     }
   }
-  if (plane.offset && !fix_offset) {
+  if (plane.offset && !f.offset) {
     set.f_index = set.size();
     set.names.push_back("plane_f");
   }
