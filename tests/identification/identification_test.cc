@@ -11,6 +11,10 @@
 #include "test_util.h"
 
 namespace lrcal {
+
+// Short, stable test names in ctest: the solver's name (found by argument-dependent lookup).
+void PrintTo(IdentificationOptions::Solver s, std::ostream* os) { *os << NameOf(kSolverNames, s); }
+
 namespace {
 
 using testing::PaperRobot;
