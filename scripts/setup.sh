@@ -21,6 +21,18 @@ cmake --build build -j2
 
 case "$action" in
   run) ./build/lrcal run studies/paper.yaml ;;
-  test) ctest --test-dir build -j2 --output-on-failure ;;
+  test)
+    ctest --test-dir build -j2 --output-on-failure
+    # The installed package: install to a temporary prefix, build the consumer against it, run
+    # it and the installed program (which must find its data there, not in the sources).
+    prefix=$(mktemp -d)
+    trap 'rm -rf "$prefix"' EXIT
+    cmake --install build --prefix "$prefix" > /dev/null
+    cmake -S examples/consumer -B "$prefix/consumer-build" -DCMAKE_PREFIX_PATH="$prefix" > /dev/null
+    cmake --build "$prefix/consumer-build" -j2 > /dev/null
+    "$prefix/consumer-build/lrcal_consumer" "$prefix/share/lrcal/studies/robots/paper.yaml"
+    (cd "$prefix" && "$prefix/bin/lrcal" run quick --out "$prefix/quick" --quiet > /dev/null)
+    cmp "$prefix/quick/tables/summary.md" tests/golden/quick/summary.md
+    echo "setup: installed package, consumer and installed lrcal checked" ;;
   build) ;;
 esac

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "cli_common.h"
+#include "lrcal/core/data_dir.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/report/report_data.h"
 
@@ -22,13 +23,11 @@ std::string Quote(const std::string& s) {
 
 std::string FindReportScript() {
   namespace fs = std::filesystem;
-  for (const fs::path& base : {fs::path("."), fs::path(LRCAL_SOURCE_DIR)}) {
-    const fs::path p = base / "analysis" / "report.py";
-    if (fs::exists(p)) return p.string();
-  }
-  throw InputError("analysis/report.py",
-                   "not found next to the working directory or in the "
-                   "source tree " LRCAL_SOURCE_DIR);
+  if (fs::exists("analysis/report.py")) return "analysis/report.py";
+  if (std::string shipped = FindDataFile("analysis/report.py"); !shipped.empty()) return shipped;
+  throw InputError(
+      "analysis/report.py",
+      "not found in the working directory nor in lrcal's data folder (" + DataDirectory() + ")");
 }
 
 }  // namespace

@@ -4,23 +4,26 @@
 #include <filesystem>
 
 #include "io/yaml_util.h"
+#include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
 
 namespace lrcal {
 
-std::string ResolveRobotPath(const std::string& name_or_path) {
+std::string ResolveRobotPath(const std::string& name_or_path, const std::string& relative_to) {
   namespace fs = std::filesystem;
   const bool looks_like_file =
       name_or_path.size() > 5 && name_or_path.substr(name_or_path.size() - 5) == ".yaml";
+  const fs::path given(name_or_path);
+  if (!relative_to.empty() && given.is_relative() &&
+      (looks_like_file || name_or_path.find('/') != std::string::npos))
+    return (fs::path(relative_to) / given).string();
   if (name_or_path.find('/') != std::string::npos || fs::exists(name_or_path) || looks_like_file)
     return name_or_path;
-  // A short name: look for studies/robots/NAME.yaml next to the working directory, then in the
-  // source tree this binary was built from.
-  for (const fs::path& base : {fs::path("."), fs::path(LRCAL_SOURCE_DIR)}) {
-    fs::path p = base / "studies" / "robots" / (name_or_path + ".yaml");
-    if (fs::exists(p)) return p.string();
-  }
+  // A short name: studies/robots/NAME.yaml in the working directory, then in lrcal's data.
+  const fs::path local = fs::path("studies") / "robots" / (name_or_path + ".yaml");
+  if (fs::exists(local)) return local.string();
+  if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;
   throw InputError("--robot", "'" + name_or_path +
                                   "' is neither a robot file nor a shipped robot name "
                                   "(shipped: studies/robots/*.yaml, e.g. 'paper')");

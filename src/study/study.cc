@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "io/yaml_util.h"
+#include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
 #include "lrcal/core/strings.h"
@@ -16,10 +17,9 @@ namespace lrcal {
 std::string ResolveStudyPath(const std::string& name_or_path) {
   namespace fs = std::filesystem;
   if (fs::exists(name_or_path) || name_or_path.find('/') != std::string::npos) return name_or_path;
-  for (const fs::path& base : {fs::path("."), fs::path(LRCAL_SOURCE_DIR)}) {
-    fs::path p = base / "studies" / (name_or_path + ".yaml");
-    if (fs::exists(p)) return p.string();
-  }
+  const fs::path local = fs::path("studies") / (name_or_path + ".yaml");
+  if (fs::exists(local)) return local.string();
+  if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;
   return name_or_path;  // LoadStudy reports "cannot open file"
 }
 
@@ -372,6 +372,8 @@ std::string ValueLabel(const Json& v) {
 
 }  // namespace
 
+std::string Study::folder() const { return std::filesystem::path(path).parent_path().string(); }
+
 Json Study::ToJson() const {
   Json j;
   j["name"] = name;
@@ -422,13 +424,13 @@ void ParseHeader(const Json& given, const std::string& path, const KeyLocator& w
 
 // The defaults with the file's settings merged in, and the robot file's content hash: a changed
 // robot is a new cell.
-Json ResolveBase(const Json& given, const KeyLocator& where) {
+Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& folder) {
   Json settings = given;
   for (const char* k : {"name", "description", "seed", "trials", "sweep"}) settings.erase(k);
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
   base.merge_patch(settings);
-  const std::string robot_path = ResolveRobotPath(Str(base, "robot", where));
+  const std::string robot_path = ResolveRobotPath(Str(base, "robot", where), folder);
   std::ifstream in(robot_path);
   if (!in || std::filesystem::is_directory(robot_path))
     throw InputError(where("robot"), "cannot open robot file '" + robot_path + "'");
@@ -550,7 +552,7 @@ Study LoadStudy(const std::string& path) {
   Study study;
   study.path = path;
   ParseHeader(given, path, where, &study);
-  study.base = ResolveBase(given, where);
+  study.base = ResolveBase(given, where, study.folder());
   std::string combine;
   const std::vector<Axis> axes = ParseSweep(given, where, &study, &combine);
   std::map<std::string, std::string> seen;

@@ -99,8 +99,8 @@ double DesignSigmaMin(const Eigen::MatrixXd& GtG, int m) {
 // ---------------------------------------------------------------------------------------------
 // The cell's steps.
 
-void LoadRig(const CellSettings& s, CellContext* c) {
-  RobotFile file = LoadRobotFile(ResolveRobotPath(s.robot));
+void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
+  RobotFile file = LoadRobotFile(ResolveRobotPath(s.robot, study.folder()));
   c->robot = std::make_shared<RobotModel>(std::move(file.robot));
   c->ranger = file.ranger;
   if (!s.plane_from_robot) {
@@ -319,7 +319,7 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
   c->seed = study.seed;
   const CellSettings& s = cell.typed;
   try {
-    LoadRig(s, c.get());
+    LoadRig(study, s, c.get());
     BuildParameterSet(s, c.get());
     DrawCellConfigurations(study, s, c.get());
     CheckIdentifiability(s, c.get());

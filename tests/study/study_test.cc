@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
@@ -104,6 +107,38 @@ TEST(StudySchema, CeresSolverRunsInTheTrialsAndAgreesWithLm) {
     }
     EXPECT_FALSE(identical) << "the Ceres cell gave LM's bits: is the solver key ignored?";
   }
+}
+
+// A relative robot path in a study file is taken relative to the study file's folder, whatever
+// the working directory.
+TEST(StudySchema, RelativeRobotPathsResolveAgainstTheStudyFolder) {
+  const std::string dir = testing::TempDir("study_relative_robot");
+  std::filesystem::create_directories(dir + "/rigs");
+  std::filesystem::copy_file(testing::SourcePath("studies/robots/paper.yaml"),
+                             dir + "/rigs/arm.yaml");
+  std::ofstream(dir + "/s.yaml") << "name: s\nseed: 1\ntrials: 2\nrobot: rigs/arm.yaml\n"
+                                    "pool: {size: 40}\nselection: {count: 30}\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  EXPECT_EQ(study.folder(), dir);
+  const auto cell = PrepareCell(study, study.cells[0]);
+  EXPECT_EQ(cell->robot->source, dir + "/rigs/arm.yaml");
+}
+
+TEST(DataDirectory, LrcalDataDirOverridesAndIsChecked) {
+  ::setenv("LRCAL_DATA_DIR", testing::SourcePath("").c_str(), 1);
+  EXPECT_EQ(FindDataFile("studies/robots/paper.yaml"),
+            testing::SourcePath("studies/robots/paper.yaml"));
+  ::setenv("LRCAL_DATA_DIR", "/nonexistent/lrcal", 1);
+  try {
+    DataDirectory();
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("LRCAL_DATA_DIR: '/nonexistent/lrcal' is not an lrcal "
+                                         "data folder"),
+              std::string::npos)
+        << e.what();
+  }
+  ::unsetenv("LRCAL_DATA_DIR");
 }
 
 }  // namespace

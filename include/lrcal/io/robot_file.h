@@ -26,7 +26,9 @@ struct RobotFile {
 RobotFile LoadRobotFile(const std::string& path);
 
 /// Resolves a robot argument: a path to a YAML file, or a short name of a shipped robot
-/// ("paper" → studies/robots/paper.yaml). Throws InputError for an unknown name.
-std::string ResolveRobotPath(const std::string& name_or_path);
+/// ("paper" → studies/robots/paper.yaml in the working directory or in lrcal's data folder,
+/// core/data_dir.h). A relative path is taken relative to `relative_to` when given (a study
+/// file's folder), else to the working directory. Throws InputError for an unknown name.
+std::string ResolveRobotPath(const std::string& name_or_path, const std::string& relative_to = "");
 
 }  // namespace lrcal

@@ -74,6 +74,8 @@ struct Cell {
 
 struct Study {
   std::string path;
+  /// The study file's folder: relative robot paths in the file are taken relative to it.
+  std::string folder() const;
   std::string name;
   std::string description;
   std::uint64_t seed = 0;

@@ -1,0 +1,20 @@
+// Where lrcal's shipped data lives: the robot files and studies (studies/) and the analysis
+// scripts (analysis/). Found relative to the lrcal program, never through a path baked in at build
+// time, so an installed or moved lrcal still finds them:
+//   1. $LRCAL_DATA_DIR, if set (an error if it is not such a folder);
+//   2. <program folder>/../share/lrcal   (installed: P/bin/lrcal → P/share/lrcal);
+//   3. <program folder>/share/lrcal      (the build tree: CMake links it to the sources).
+#pragma once
+
+#include <string>
+
+namespace lrcal {
+
+/// The data folder (see the file comment). Throws InputError if none is found.
+std::string DataDirectory();
+
+/// `relative` (e.g. "studies/robots/paper.yaml") inside the data folder, or "" if there is no
+/// data folder or no such file.
+std::string FindDataFile(const std::string& relative);
+
+}  // namespace lrcal
