@@ -232,7 +232,7 @@ Eigen::Vector3d Vector3(const Json& s, const std::string& path, const std::strin
 
 // plane: 'robot', {normal, offset} or {tilt_deg, azimuth_deg, through}.
 void ParsePlane(const Json& s, const KeyLocator& where, CellSettings* c) {
-  const Json& plane = s["plane"];
+  const Json& plane = At(s, "plane");  // null when given as nothing (a merge deletes it)
   if (plane.is_string()) {
     if (plane != "robot")
       throw InputError(where("plane"),

@@ -316,6 +316,8 @@ const std::vector<BadInput>& Cases() {
        "run s.yaml --out run",
        2,
        {"s.yaml:5", "a key is not valid UTF-8 text"}},
+      {"StudyPlaneGivenAsNothing", {{"s.yaml", "{study}plane:\n"}}, "run s.yaml --out run", 2,
+       {"key 'plane'", "expected 'robot' or a mapping"}},
       {"StudyComplexKey",
        {{"s.yaml", "{study}? [a, b]\n: 1\n"}},
        "run s.yaml --out run",
