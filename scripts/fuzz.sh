@@ -15,7 +15,7 @@ flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
        -fno-sanitize-recover=undefined -Iinclude -Isrc -I/usr/include/eigen3
        "-DLRCAL_SOURCE_DIR=\"$PWD\"")
 # The readers and what they need (no Ceres, no SQLite: the fuzzers build in about a minute).
-sources=(core/strings core/json core/hash kinematics/robot_model kinematics/configuration_set
+sources=(core/strings core/json core/hash core/data_dir kinematics/robot_model kinematics/configuration_set
          measurement/plane measurement/parameter_set io/csv io/robot_file io/yaml_util study/study)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
@@ -35,6 +35,7 @@ for t in "${targets[@]}"; do
 done
 echo "fuzz: built ${#targets[@]} targets; running each for ${seconds} s"
 status=0
+export LRCAL_DATA_DIR="$PWD"  # the studies name the shipped robot "paper"
 run_target() {
   local t=$1 work="$out/corpus/$1"
   mkdir -p "$work"

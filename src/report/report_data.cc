@@ -36,9 +36,10 @@ namespace {
 
 Json ReadReportManifest(const std::string& run_dir) {
   const fs::path dir = run_dir;
-  if (!fs::is_directory(dir)) throw InputError(run_dir, "no such run directory");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(run_dir, "no such run directory");
   const fs::path manifest_path = dir / "manifest.json";
-  if (!fs::exists(manifest_path))
+  if (!fs::exists(manifest_path, ec))
     throw InputError(run_dir, "not an lrcal run directory: manifest.json is missing");
   const Json manifest = ReadJsonFile(manifest_path.string());
   if (!manifest.contains("study") || !manifest["study"].contains("cells") ||

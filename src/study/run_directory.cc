@@ -134,10 +134,14 @@ void RunDirectory::Lock() {
   lock_ = std::make_unique<DirectoryLock>(path_);
 }
 
-bool RunDirectory::HasManifest() const { return fs::exists(ManifestPath()); }
+bool RunDirectory::HasManifest() const {
+  std::error_code ec;
+  return fs::exists(ManifestPath(), ec);
+}
 
 Json RunDirectory::ReadManifest() const {
-  if (!fs::exists(ManifestPath()) || !fs::exists(MainStorePath()))
+  std::error_code ec;
+  if (!fs::exists(ManifestPath(), ec) || !fs::exists(MainStorePath(), ec))
     throw InputError(path_,
                      "not an lrcal run directory (expected manifest.json and "
                      "trials.sqlite)");
@@ -188,8 +192,9 @@ Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_ind
 
 std::vector<std::string> RunDirectory::RankStorePaths() const {
   std::vector<std::string> out;
-  if (!fs::exists(path_)) return out;
-  for (const auto& e : fs::directory_iterator(path_)) {
+  std::error_code ec;
+  if (!fs::is_directory(path_, ec)) return out;
+  for (const auto& e : fs::directory_iterator(path_, ec)) {
     const std::string name = e.path().filename().string();
     if (name.rfind("trials.rank", 0) == 0 && name.size() > 18 &&
         name.compare(name.size() - 7, 7, ".sqlite") == 0)
@@ -201,7 +206,8 @@ std::vector<std::string> RunDirectory::RankStorePaths() const {
 
 std::vector<std::string> RunDirectory::StorePaths() const {
   std::vector<std::string> out;
-  if (fs::exists(MainStorePath())) out.push_back(MainStorePath());
+  std::error_code ec;
+  if (fs::exists(MainStorePath(), ec)) out.push_back(MainStorePath());
   for (const auto& p : RankStorePaths()) out.push_back(p);
   return out;
 }

@@ -14,11 +14,19 @@
 
 namespace lrcal {
 
+namespace {
+// No exception for a name the file system cannot even look up (too long, invalid): not there.
+bool Exists(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::exists(p, ec);
+}
+}  // namespace
+
 std::string ResolveStudyPath(const std::string& name_or_path) {
   namespace fs = std::filesystem;
-  if (fs::exists(name_or_path) || name_or_path.find('/') != std::string::npos) return name_or_path;
+  if (Exists(name_or_path) || name_or_path.find('/') != std::string::npos) return name_or_path;
   const fs::path local = fs::path("studies") / (name_or_path + ".yaml");
-  if (fs::exists(local)) return local.string();
+  if (Exists(local)) return local.string();
   if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;
   return name_or_path;  // LoadStudy reports "cannot open file"
 }
@@ -430,7 +438,12 @@ Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& 
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
   base.merge_patch(settings);
-  const std::string robot_path = ResolveRobotPath(Str(base, "robot", where), folder);
+  std::string robot_path;
+  try {
+    robot_path = ResolveRobotPath(Str(base, "robot", where), folder);
+  } catch (const InputError& e) {
+    throw InputError(where("robot"), e.what());
+  }
   std::ifstream in(robot_path);
   if (!in || std::filesystem::is_directory(robot_path))
     throw InputError(where("robot"), "cannot open robot file '" + robot_path + "'");
