@@ -18,6 +18,11 @@ bool IsDataDirectory(const fs::path& dir) {
 
 }  // namespace
 
+bool PathExists(const std::string& path) {
+  std::error_code ec;
+  return fs::exists(path, ec);
+}
+
 std::string DataDirectory() {
   if (const char* env = std::getenv("LRCAL_DATA_DIR")) {
     if (!IsDataDirectory(env))
@@ -42,8 +47,7 @@ std::string DataDirectory() {
 std::string FindDataFile(const std::string& relative) {
   try {
     const fs::path p = fs::path(DataDirectory()) / relative;
-    std::error_code ec;
-    return fs::exists(p, ec) ? p.string() : "";
+    return PathExists(p.string()) ? p.string() : "";
   } catch (const InputError&) {
     return "";
   }

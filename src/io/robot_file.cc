@@ -10,14 +10,6 @@
 
 namespace lrcal {
 
-namespace {
-// No exception for a name the file system cannot even look up (too long, invalid): not there.
-bool Exists(const std::filesystem::path& p) {
-  std::error_code ec;
-  return std::filesystem::exists(p, ec);
-}
-}  // namespace
-
 std::string ResolveRobotPath(const std::string& name_or_path, const std::string& relative_to) {
   namespace fs = std::filesystem;
   const bool looks_like_file =
@@ -26,11 +18,11 @@ std::string ResolveRobotPath(const std::string& name_or_path, const std::string&
   if (!relative_to.empty() && given.is_relative() &&
       (looks_like_file || name_or_path.find('/') != std::string::npos))
     return (fs::path(relative_to) / given).string();
-  if (name_or_path.find('/') != std::string::npos || Exists(name_or_path) || looks_like_file)
+  if (name_or_path.find('/') != std::string::npos || PathExists(name_or_path) || looks_like_file)
     return name_or_path;
   // A short name: studies/robots/NAME.yaml in the working directory, then in lrcal's data.
   const fs::path local = fs::path("studies") / "robots" / (name_or_path + ".yaml");
-  if (Exists(local)) return local.string();
+  if (PathExists(local)) return local.string();
   if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;
   throw InputError("--robot", "'" + name_or_path +
                                   "' is neither a robot file nor a shipped robot name "

@@ -14,19 +14,11 @@
 
 namespace lrcal {
 
-namespace {
-// No exception for a name the file system cannot even look up (too long, invalid): not there.
-bool Exists(const std::filesystem::path& p) {
-  std::error_code ec;
-  return std::filesystem::exists(p, ec);
-}
-}  // namespace
-
 std::string ResolveStudyPath(const std::string& name_or_path) {
   namespace fs = std::filesystem;
-  if (Exists(name_or_path) || name_or_path.find('/') != std::string::npos) return name_or_path;
+  if (PathExists(name_or_path) || name_or_path.find('/') != std::string::npos) return name_or_path;
   const fs::path local = fs::path("studies") / (name_or_path + ".yaml");
-  if (Exists(local)) return local.string();
+  if (PathExists(local)) return local.string();
   if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;
   return name_or_path;  // LoadStudy reports "cannot open file"
 }

@@ -10,6 +10,10 @@
 
 namespace lrcal {
 
+/// True if `path` exists. A name the file system cannot even look up (too long, invalid) is
+/// simply not there: no exception.
+bool PathExists(const std::string& path);
+
 /// The data folder (see the file comment). Throws InputError if none is found.
 std::string DataDirectory();
 
