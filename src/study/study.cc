@@ -352,7 +352,10 @@ void Apply(Json* settings, const std::string& key, const Json& value) {
 }
 
 bool KeyExists(const Json& defaults, const std::string& key) {
-  if (key == "." || key == "plane" || key.rfind("plane.", 0) == 0) return true;
+  if (key == "." || key == "plane") return true;
+  for (const char* k : {"normal", "offset", "tilt_deg", "azimuth_deg", "through"})
+    if (key == std::string("plane.") + k) return true;
+  if (key.rfind("plane.", 0) == 0) return false;
   const Json* j = &defaults;
   std::string rest = key;
   while (!rest.empty()) {
@@ -531,7 +534,14 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
   cell.settings = base;
   std::string context;
   for (std::size_t a = 0; a < axes.size(); ++a) {
-    Apply(&cell.settings, axes[a].key, axes[a].values[combo[a]]);
+    try {
+      Apply(&cell.settings, axes[a].key, axes[a].values[combo[a]]);
+    } catch (const Json::exception&) {  // e.g. plane.normal on a plane given as 'robot'
+      throw InputError(KeyLocator{path, &lines, "", ""}(axes[a].value_paths[combo[a]]),
+                       "cannot set '" + axes[a].key +
+                           "' here: the setting above it is not a "
+                           "mapping in this cell");
+    }
     cell.label += (a ? ", " : "") + axes[a].labels[combo[a]];
     cell.axis_values[axes[a].key] = axes[a].labels[combo[a]];
     const auto line = lines.find(axes[a].value_paths[combo[a]]);
