@@ -45,7 +45,7 @@ void AddDesignOptions(po::options_description& o) {
       "out", po::value<std::string>(), "write the chosen configurations (CSV)");
 }
 
-struct CandidatePool {
+struct ResolvedPool {
   ConfigurationSet configs;
   SamplingReport report;
   std::string source;
@@ -53,11 +53,11 @@ struct CandidatePool {
 
 // The candidate pool (generated, or read and filtered by the nominal beam), with what was
 // rejected and why.
-CandidatePool ResolvePool(const po::variables_map& vm, const Setup& setup, std::uint64_t seed) {
+ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::uint64_t seed) {
   const RobotModel& robot = setup.rig.robot;
   if (vm.count("pool") == vm.count("generate"))
     throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
-  CandidatePool pool{ConfigurationSet(robot.num_links()), {}, ""};
+  ResolvedPool pool{ConfigurationSet(robot.num_links()), {}, ""};
   if (vm.count("generate")) {
     const int n = vm["generate"].as<int>();
     if (n < 1 || n > 100000)
@@ -71,21 +71,14 @@ CandidatePool ResolvePool(const po::variables_map& vm, const Setup& setup, std::
     return pool;
   }
   const std::string path = vm["pool"].as<std::string>();
-  const ConfigurationSet read = ReadConfigurations(path, robot.num_links());
-  std::vector<double> h;
-  std::vector<BeamMiss> misses;
-  ExactReadings(robot, robot.nominal_values(), setup.plane, setup.rig.ranger, read, &h, &misses);
-  pool.report.requested = pool.report.attempts = read.size();
-  for (int i = 0; i < read.size(); ++i) {
-    if (misses[i] != BeamMiss::kNone) {
-      ++pool.report.rejected[BeamMissName(misses[i])];
+  CandidatePool usable = UsableCandidates(robot, setup.plane, setup.rig.ranger,
+                                          ReadConfigurations(path, robot.num_links()));
+  for (std::size_t i = 0; i < usable.misses.size(); ++i)
+    if (usable.misses[i] != BeamMiss::kNone)
       std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
-                << ") rejected: " << BeamMissName(misses[i]) << "\n";
-      continue;
-    }
-    pool.configs.AddFrom(read, i);
-  }
-  pool.report.accepted = pool.configs.size();
+                << ") rejected: " << BeamMissName(usable.misses[i]) << "\n";
+  pool.configs = std::move(usable.configs);
+  pool.report = usable.report;
   pool.source = path + ": " + pool.report.ToString();
   if (pool.configs.size() == 0) throw InputError("--pool", "no usable candidate configurations");
   return pool;
@@ -113,12 +106,8 @@ double PositiveMm(const po::variables_map& vm, const std::string& name) {
 // G of the pool at the nominal model, columns scaled as asked.
 Eigen::MatrixXd ScaledJacobian(const po::variables_map& vm, const MeasurementModel& model,
                                const ConfigurationSet& pool, DesignScaling scaling) {
-  const ParameterSet& ps = model.parameters();
-  Eigen::VectorXd expected(ps.size());
-  for (int k = 0; k < ps.size(); ++k)
-    expected[k] = ps.IsAngular(k) ? PositiveMm(vm, "expected-angle-mrad") * 1e-3
-                                  : PositiveMm(vm, "expected-length-mm") * 1e-3;
-  return ScaleColumns(IdentificationJacobian(model, pool), scaling, expected);
+  return DesignJacobian(model, pool, scaling, PositiveMm(vm, "expected-angle-mrad") * 1e-3,
+                        PositiveMm(vm, "expected-length-mm") * 1e-3);
 }
 
 Eigen::MatrixXd NormalMatrixOfRows(const Eigen::MatrixXd& G, const std::vector<int>& rows) {
@@ -172,7 +161,7 @@ int DesignCommand(const std::vector<std::string>& args) {
   const long long seed_value = vm["seed"].as<long long>();
   if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
   const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);
-  const CandidatePool pool = ResolvePool(vm, setup, seed);
+  const ResolvedPool pool = ResolvePool(vm, setup, seed);
   MeasurementModel model(setup.rig.robot, setup.plane, ResolveParameterSet(setup.rig.robot, vm));
   const SelectionOptions options = ResolveSelection(vm);
   const DesignScaling scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");

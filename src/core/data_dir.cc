@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
 
 #include "lrcal/core/error.h"
 
@@ -14,6 +15,14 @@ namespace {
 bool IsDataDirectory(const fs::path& dir) {
   std::error_code ec;
   return fs::is_directory(dir / "studies", ec);
+}
+
+std::mutex g_embedded_mutex;
+std::string g_embedded_dir;  // guarded by g_embedded_mutex
+
+std::string EmbeddedDataDirectory() {
+  std::lock_guard<std::mutex> lock(g_embedded_mutex);
+  return g_embedded_dir;
 }
 
 }  // namespace
@@ -32,6 +41,9 @@ std::string DataDirectory() {
     return env;
   }
   std::error_code ec;
+  if (const std::string embedded = EmbeddedDataDirectory();
+      !embedded.empty() && IsDataDirectory(embedded))
+    return fs::weakly_canonical(embedded, ec).string();
   const fs::path program = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     const fs::path bin = program.parent_path();
@@ -42,6 +54,11 @@ std::string DataDirectory() {
                    "cannot find lrcal's data (studies/, analysis/) next to this program; set "
                    "LRCAL_DATA_DIR to the folder that holds them (P/share/lrcal after "
                    "cmake --install --prefix P)");
+}
+
+void SetEmbeddedDataDirectory(const std::string& dir) {
+  std::lock_guard<std::mutex> lock(g_embedded_mutex);
+  g_embedded_dir = dir;
 }
 
 std::string FindDataFile(const std::string& relative) {

@@ -1,6 +1,7 @@
 #include "lrcal/core/strings.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace lrcal {
@@ -135,6 +136,12 @@ std::vector<std::string> SplitList(const std::string& text, char separator) {
   }
   flush();
   return out;
+}
+
+std::string FormatExact(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
 }
 
 }  // namespace lrcal

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "lrcal/core/error.h"
+#include "lrcal/measurement/simulation.h"
 
 namespace lrcal {
 
@@ -91,6 +92,25 @@ ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plan
     out.Add(q);
   }
   rep.accepted = out.size();
+  return out;
+}
+
+CandidatePool UsableCandidates(const RobotModel& robot, const Plane& plane,
+                               const RangerSpec& ranger, const ConfigurationSet& pool) {
+  CandidatePool out;
+  out.configs = ConfigurationSet(pool.num_joints());
+  std::vector<double> h;
+  ExactReadings(robot, robot.nominal_values(), plane, ranger, pool, &h, &out.misses);
+  out.report.requested = out.report.attempts = pool.size();
+  for (int i = 0; i < pool.size(); ++i) {
+    if (out.misses[i] != BeamMiss::kNone) {
+      ++out.report.rejected[BeamMissName(out.misses[i])];
+      continue;
+    }
+    out.configs.AddFrom(pool, i);
+    out.kept.push_back(i);
+  }
+  out.report.accepted = out.configs.size();
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "lrcal/core/error.h"
+#include "lrcal/identification/identifiability.h"
 
 namespace lrcal {
 
@@ -353,6 +354,19 @@ Eigen::VectorXd RankOneUpdatedEigenvalues(const Eigen::VectorXd& lambda, const E
 double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion) {
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A, Eigen::EigenvaluesOnly);
   return ScoreFromEigenvalues(eig.eigenvalues(), m, criterion);
+}
+
+Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, double length) {
+  Eigen::VectorXd expected(parameters.size());
+  for (int k = 0; k < parameters.size(); ++k)
+    expected[k] = parameters.IsAngular(k) ? angle : length;
+  return expected;
+}
+
+Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
+                               DesignScaling scaling, double angle, double length) {
+  return ScaleColumns(IdentificationJacobian(model, pool), scaling,
+                      ExpectedErrors(model.parameters(), angle, length));
 }
 
 Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,

@@ -29,12 +29,6 @@ double CsvTable::Number(std::size_t row, int column) const {
   return value;
 }
 
-std::string FormatExact(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 namespace {
 
 std::string ReadWholeFile(const std::string& path) {
@@ -202,40 +196,16 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const R
   if (hc < 0)
     throw InputError(Location(path, 1) + " column 'h'", "missing: expected the reading h (m)");
   if (t.rows.empty()) throw InputError(path, "no readings (only a header)");
-  // Group readings by identical q, in order of first appearance.
-  std::map<std::vector<double>, int> index;
-  std::vector<std::vector<double>> qs;
-  std::vector<double> sums;
-  std::vector<int> counts;
+  ConfigurationSet q(num_joints);
+  q.Reserve(static_cast<int>(t.rows.size()));
+  std::vector<double> h;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    const std::vector<double> q = JointValues(t, r, cols);
-    const double h = t.Number(r, hc);
-    if (!(h > 0))
-      throw InputError(Location(path, t.lines[r]) + " column 'h'",
-                       "a reading must be a positive distance in m, got " + FormatExact(h));
-    if (ranger && (h < ranger->min_range || h > ranger->max_range))
-      throw InputError(Location(path, t.lines[r]) + " column 'h'",
-                       FormatExact(h) + " m is outside the ranger's range [" +
-                           FormatExact(ranger->min_range) + ", " + FormatExact(ranger->max_range) +
-                           "] m (the robot file's ranger:); readings are in metres: were they "
-                           "written in mm?");
-    auto [it, inserted] = index.emplace(q, static_cast<int>(qs.size()));
-    if (inserted) {
-      qs.push_back(q);
-      sums.push_back(0);
-      counts.push_back(0);
-    }
-    sums[it->second] += h;
-    counts[it->second] += 1;
+    q.Add(JointValues(t, r, cols));
+    h.push_back(t.Number(r, hc));
   }
-  MeasurementSet data;
-  data.configs = ConfigurationSet(num_joints);
-  for (std::size_t i = 0; i < qs.size(); ++i) {
-    data.configs.Add(qs[i]);
-    data.mean_h.push_back(sums[i] / counts[i]);
-    data.repetitions.push_back(counts[i]);
-  }
-  return data;
+  return GroupReadings(q, h, ranger, [&](int r) {
+    return r < 0 ? path : Location(path, t.lines[r]) + " column 'h'";
+  });
 }
 
 // The file is written whole or not at all. A path that cannot be a file is bad input (exit 2);

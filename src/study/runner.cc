@@ -357,9 +357,20 @@ class StudyRunner {
     for (auto& t : pool) t.join();
     result_.run_seconds = Seconds(t_run, Clock::now());
     progress.Report(result_.computed, true);
+    NotifyProgress();
     if (writer_failure) std::rethrow_exception(writer_failure);
     if (auto failure = queue.failure()) std::rethrow_exception(failure);
     result_.peak_rss_kb_trials = PeakRssKb();
+  }
+
+  void NotifyProgress() const {
+    if (!options_.on_progress || !root()) return;
+    RunProgress p;
+    p.total = result_.total;
+    p.computed = result_.computed;
+    p.done = std::min(result_.total, result_.done_before + result_.computed * ranks_);
+    p.seconds = Seconds(start_, Clock::now());
+    options_.on_progress(p);
   }
 
   void WriterLoop(RecordQueue* queue, ProgressReporter* progress) {
@@ -376,6 +387,7 @@ class StudyRunner {
         last_flush = now;
       }
       progress->Tick(result_.computed);
+      NotifyProgress();
       const bool stopping = stop_->stop_requested() || work_->Exhausted();
       if (work_->Pump(stopping, workers_done) && workers_done) break;
     }

@@ -58,13 +58,9 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
 // G of a candidate pool at the nominal model, scaled as the cell's selection says (the paper:
 // SI). Expected-error scaling uses the truth's prior σ (truth.angle_sigma_mrad,
 // truth.length_sigma_mm) for robot parameters and plane terms alike.
-Eigen::MatrixXd DesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
+Eigen::MatrixXd CellDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
   const CellSettings& s = c.cell->typed;
-  const ParameterSet& ps = c.model->parameters();
-  Eigen::VectorXd expected(ps.size());
-  for (int k = 0; k < ps.size(); ++k)
-    expected[k] = ps.IsAngular(k) ? s.truth_angle_sigma : s.truth_length_sigma;
-  return ScaleColumns(IdentificationJacobian(*c.model, pool), s.scaling, expected);
+  return DesignJacobian(*c.model, pool, s.scaling, s.truth_angle_sigma, s.truth_length_sigma);
 }
 
 ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::VectorXd& truth,
@@ -158,7 +154,7 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
 // The selected design, its σ_min and the predicted covariance at the nominal model; the
 // design's Jacobian also gives the first linearisation of every trial, computed once here.
 void SelectCellDesign(const CellSettings& s, CellContext* c) {
-  const Eigen::MatrixXd G = DesignJacobian(*c, c->pool);
+  const Eigen::MatrixXd G = CellDesignJacobian(*c, c->pool);
   if (s.selection_redraw) c->pool_design_G = G;
   c->design = SelectDesign(*c, 0, c->pool, G);
   const int n = c->model->num_parameters();
@@ -213,7 +209,7 @@ bool DesignOfTrial(const CellContext& c, long long trial, const TrialTruth& trut
     } catch (const InputError&) {
       return false;
     }
-    *redrawn = SelectDesign(c, trial, pool, DesignJacobian(c, pool));
+    *redrawn = SelectDesign(c, trial, pool, CellDesignJacobian(c, pool));
   } else {
     *redrawn = SelectDesign(c, trial, c.pool, c.pool_design_G);
   }

@@ -11,6 +11,10 @@
 #include <random>
 
 #include "lrcal/core/error.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/measurement/simulation.h"
+#include "test_util.h"
 
 namespace lrcal {
 namespace {
@@ -221,6 +225,48 @@ TEST(Selection, BadRequestsAreClearErrors) {
   EXPECT_THROW(SelectConfigurations(Eigen::MatrixXd(0, 4), 1, o, stream), InputError);
   o.method = SelectionMethod::kExhaustive;
   EXPECT_THROW(SelectConfigurations(RandomMatrix(101, 25, 1), 50, o, stream), InputError);
+}
+
+TEST(DesignJacobian, ScalesTheIdentificationJacobianAsAsked) {
+  const MeasurementModel model(testing::PaperRobot(), testing::PaperPlane(),
+                               MakeParameterSet(testing::PaperRobot(), PlaneTerms{}));
+  SamplingOptions sampling;
+  const ConfigurationSet pool =
+      SampleConfigurations(testing::PaperRobot(), testing::PaperPlane(), 40,
+                           RandomStream(3, 0, 0, RandomPurpose::kPool), sampling);
+  const Eigen::MatrixXd G = IdentificationJacobian(model, pool);
+  EXPECT_EQ(DesignJacobian(model, pool, DesignScaling::kSI, 2e-3, 5e-3), G);
+  const Eigen::MatrixXd E = DesignJacobian(model, pool, DesignScaling::kExpectedErrors, 2e-3, 5e-3);
+  const ParameterSet& ps = model.parameters();
+  for (int k = 0; k < ps.size(); ++k)
+    EXPECT_EQ(E.col(k), G.col(k) * (ps.IsAngular(k) ? 2e-3 : 5e-3)) << ps.names[k];
+}
+
+TEST(UsableCandidates, KeepsTheConfigurationsWhoseNominalBeamHitsAndSaysWhyOthersDoNot) {
+  const RobotModel& robot = testing::PaperRobot();
+  SamplingOptions anywhere;
+  anywhere.require_beam_hit = false;
+  const ConfigurationSet pool =
+      SampleConfigurations(robot, testing::PaperPlane(), 200,
+                           RandomStream(5, 0, 0, RandomPurpose::kValidation), anywhere);
+  const CandidatePool usable = UsableCandidates(robot, testing::PaperPlane(), RangerSpec{}, pool);
+  std::vector<double> h;
+  std::vector<BeamMiss> misses;
+  ExactReadings(robot, robot.nominal_values(), testing::PaperPlane(), RangerSpec{}, pool, &h,
+                &misses);
+  std::vector<int> expected;
+  for (int i = 0; i < pool.size(); ++i)
+    if (misses[i] == BeamMiss::kNone) expected.push_back(i);
+  ASSERT_GT(expected.size(), 0u);
+  ASSERT_LT(expected.size(), 200u);  // the test needs both kinds
+  EXPECT_EQ(usable.kept, expected);
+  EXPECT_EQ(usable.misses, misses);
+  EXPECT_EQ(usable.configs.size(), static_cast<int>(expected.size()));
+  EXPECT_EQ(usable.configs.q(0)[3], pool.q(expected[0])[3]);
+  EXPECT_EQ(usable.report.accepted, static_cast<int>(expected.size()));
+  int rejected = 0;
+  for (const auto& [why, n] : usable.report.rejected) rejected += n;
+  EXPECT_EQ(rejected, 200 - usable.report.accepted);
 }
 
 }  // namespace

@@ -75,6 +75,36 @@ TEST(MonteCarlo, TablesAreBitIdenticalForOneTwoAndFourThreads) {
   EXPECT_EQ(t1, Tables(dir + "/t4"));
 }
 
+TEST(MonteCarlo, ProgressCallbackSeesTheRunAndCanStopIt) {
+  const std::string dir = testing::TempDir("mc_progress");
+  const std::string study = SmallStudy(dir, 200);
+  RunOptions o;
+  o.out_dir = dir + "/run";
+  o.threads = 2;
+  o.progress = false;
+  o.batch_size = 5;
+  StopToken stop;
+  std::vector<RunProgress> seen;
+  o.on_progress = [&](const RunProgress& p) {
+    seen.push_back(p);
+    if (p.done > 0) stop.RequestStop();  // the first records: stop, as Ctrl-C from Python does
+  };
+  const RunResult r = RunStudyAndWriteTables(LoadStudy(study), o, nullptr, &stop);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_FALSE(r.tables_written);
+  EXPECT_EQ(seen.back().total, 800);
+  EXPECT_EQ(seen.back().done, r.computed);  // the last call reports the final count
+  EXPECT_LT(r.computed, 800);
+  for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i].done, seen[i - 1].done);
+  // The rest of the run, without a callback, gives the uninterrupted tables.
+  o.on_progress = nullptr;
+  StopToken fresh;
+  EXPECT_TRUE(RunStudyAndWriteTables(LoadStudy(study), o, nullptr, &fresh).tables_written);
+  RunSmall(study, dir + "/whole", 2);
+  EXPECT_EQ(Tables(dir + "/run"), Tables(dir + "/whole"));
+}
+
 TEST(MonteCarlo, TablesAreBitIdenticalWhicheverInstructionSetRuns) {
   // A machine without AVX-512 (or a shard on another node) runs the default variant of the hot
   // kernels: the tables must not change.

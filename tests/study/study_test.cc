@@ -141,5 +141,20 @@ TEST(DataDirectory, LrcalDataDirOverridesAndIsChecked) {
   ::unsetenv("LRCAL_DATA_DIR");
 }
 
+TEST(DataDirectory, AnEmbeddingProgramsFolderComesBeforeTheProgramsOwn) {
+  // The test binary's folder has data next to it (build/share/lrcal, which has no x.yaml): the
+  // registered folder is searched first, and $LRCAL_DATA_DIR still comes before it.
+  const std::string dir = testing::TempDir("embedded_data");
+  std::filesystem::create_directories(dir + "/studies/robots");
+  std::ofstream(dir + "/studies/robots/x.yaml") << "x";
+  SetEmbeddedDataDirectory(dir);
+  EXPECT_EQ(FindDataFile("studies/robots/x.yaml"), dir + "/studies/robots/x.yaml");
+  ::setenv("LRCAL_DATA_DIR", testing::SourcePath("").c_str(), 1);
+  EXPECT_EQ(FindDataFile("studies/robots/x.yaml"), "");
+  ::unsetenv("LRCAL_DATA_DIR");
+  SetEmbeddedDataDirectory("");
+  EXPECT_EQ(FindDataFile("studies/robots/x.yaml"), "");
+}
+
 }  // namespace
 }  // namespace lrcal

@@ -2,8 +2,10 @@
 // scripts (analysis/). Found relative to the lrcal program, never through a path baked in at build
 // time, so an installed or moved lrcal still finds them:
 //   1. $LRCAL_DATA_DIR, if set (an error if it is not such a folder);
-//   2. <program folder>/../share/lrcal   (installed: P/bin/lrcal → P/share/lrcal);
-//   3. <program folder>/share/lrcal      (the build tree: CMake links it to the sources).
+//   2. the folder registered by a program that embeds lrcal away from its data (the Python
+//      module registers the one relative to its own installed location);
+//   3. <program folder>/../share/lrcal   (installed: P/bin/lrcal → P/share/lrcal);
+//   4. <program folder>/share/lrcal      (the build tree: CMake links it to the sources).
 #pragma once
 
 #include <string>
@@ -16,6 +18,9 @@ bool PathExists(const std::string& path);
 
 /// The data folder (see the file comment). Throws InputError if none is found.
 std::string DataDirectory();
+
+/// Registers the data folder of a program that embeds lrcal (step 2 above); "" removes it.
+void SetEmbeddedDataDirectory(const std::string& dir);
 
 /// `relative` (e.g. "studies/robots/paper.yaml") inside the data folder, or "" if there is no
 /// data folder or no such file.

@@ -23,4 +23,7 @@ bool ParseDecimal(const std::string& text, double* value);
 /// Returns false if `text` is none of those forms (or the value is not finite).
 bool ParseAngleExpression(const std::string& text, double* value);
 
+/// Formats a double with 17 significant digits (reads back to the same bits).
+std::string FormatExact(double v);
+
 }  // namespace lrcal

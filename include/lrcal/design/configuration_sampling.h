@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lrcal/core/random.h"
 #include "lrcal/measurement/measurement_model.h"
@@ -48,5 +49,17 @@ struct SamplingReport {
 ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
                                       const RandomStream& stream, const SamplingOptions& options,
                                       SamplingReport* report = nullptr);
+
+/// The candidates of a given pool whose nominal beam hits `plane` within `ranger`'s limits (the
+/// others cannot give a reading): the usable configurations, the pool index of each (`kept`,
+/// ascending), every candidate's BeamMiss (`misses`, kNone when kept) and a report by reason.
+struct CandidatePool {
+  ConfigurationSet configs;
+  std::vector<int> kept;
+  std::vector<BeamMiss> misses;
+  SamplingReport report;
+};
+CandidatePool UsableCandidates(const RobotModel& robot, const Plane& plane,
+                               const RangerSpec& ranger, const ConfigurationSet& pool);
 
 }  // namespace lrcal

@@ -28,6 +28,8 @@
 
 #include "lrcal/core/enum_names.h"
 #include "lrcal/core/random.h"
+#include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/measurement_model.h"
 
 namespace lrcal {
 
@@ -100,6 +102,15 @@ double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion
 /// error magnitude (rad or m) for kExpectedErrors. Column norms are those of G itself.
 Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
                              const Eigen::VectorXd& expected = Eigen::VectorXd());
+
+/// Expected error magnitudes of a parameter set's entries: `angle` (rad) for angular ones,
+/// `length` (m) for the others; the column weights of DesignScaling::kExpectedErrors.
+Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, double length);
+
+/// The identification Jacobian of `pool` at the nominal model, columns scaled as `scaling` says
+/// (expected errors `angle` rad and `length` m for kExpectedErrors): what design selects from.
+Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
+                               DesignScaling scaling, double angle, double length);
 
 /// Chooses k rows of G (N×n). Throws InputError for an empty pool, k > N, k < n, or an
 /// exhaustive search beyond exhaustive_limit.

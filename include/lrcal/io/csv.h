@@ -52,7 +52,4 @@ void WriteConfigurations(const std::string& path, const ConfigurationSet& config
 void WriteReadings(const std::string& path, const ConfigurationSet& configs,
                    const std::vector<double>& readings, int repetitions);
 
-/// Formats a double with 17 significant digits.
-std::string FormatExact(double v);
-
 }  // namespace lrcal

@@ -1,9 +1,12 @@
 // Readings of a laser ranger at a set of configurations, as an identification consumes them.
 #pragma once
 
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/plane.h"
 
 namespace lrcal {
 
@@ -14,5 +17,15 @@ struct MeasurementSet {
   std::vector<int> repetitions;  ///< number of readings averaged (the residual weight)
   int size() const { return configs.size(); }
 };
+
+/// Groups individual readings into a MeasurementSet: reading r was taken at joint values
+/// `q.q(r)` (rad or m) and read `h[r]` (m). Readings at identical joint values are one
+/// configuration (in order of first appearance) whose mean_h is their sum divided by their
+/// count, summed in reading order. Throws InputError, located by `where(r)` (e.g. "file.csv:12"),
+/// for a reading that is not a positive distance, or one outside `ranger`'s range if given.
+/// What `lrcal identify` does with a measurement CSV and the Python module with arrays.
+MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
+                             const RangerSpec* ranger,
+                             const std::function<std::string(int)>& where);
 
 }  // namespace lrcal

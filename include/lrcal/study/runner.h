@@ -20,6 +20,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <string>
 
 #include "lrcal/study/collective.h"
@@ -38,6 +39,14 @@ class StopToken {
   static_assert(std::atomic<bool>::is_always_lock_free);
 };
 
+/// Where a run stands, as a progress callback sees it.
+struct RunProgress {
+  long long done = 0;      ///< trials of the run (or shard) recorded so far, this process's view
+  long long total = 0;     ///< trials of the run (or shard)
+  long long computed = 0;  ///< computed by this call so far
+  double seconds = 0;      ///< since the call started
+};
+
 struct RunOptions {
   std::string out_dir;  ///< run directory (created)
   int threads = 0;      ///< 0: all cores
@@ -51,6 +60,10 @@ struct RunOptions {
   /// MPI only: rank 0 hands out chunks of missing trials on request, instead of dealing every
   /// P-th trial to each rank. For sweeps whose cells differ a lot in cost. Same results.
   bool dynamic_schedule = false;
+  /// Called on the thread that called RunStudy about every 0.1 s while the trials run, and once
+  /// when they end (rank 0 only). It must not throw; to stop the run it sets the run's
+  /// StopToken. How the Python module reports progress and honours Ctrl-C.
+  std::function<void(const RunProgress&)> on_progress;
   /// Checks the fields; throws InputError naming the option and the range expected.
   void Validate() const;
 };
