@@ -2,7 +2,7 @@
 """Fails when a file includes a higher layer (README "How it is built").
 
 Layers, from the bottom: core, kinematics, measurement, identification, design, io, paper, study,
-report; src/cli may include any. A file in include/lrcal/<layer>/ or src/<layer>/ may include
+report; src/cli and src/python (the program and the Python module) may include any. A file in include/lrcal/<layer>/ or src/<layer>/ may include
 "lrcal/<lower or same layer>/..." and private headers "<lower or same layer>/..." under src/.
 Prints every violation as file:line and exits 1 if there is one.
 """
@@ -11,7 +11,7 @@ import re
 import sys
 
 LAYERS = ["core", "kinematics", "measurement", "identification", "design", "io", "paper", "study",
-          "report", "cli"]
+          "report", "cli", "python"]
 RANK = {name: i for i, name in enumerate(LAYERS)}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"(?:lrcal/)?([a-z_]+)/[^"]+"')
 

@@ -5,14 +5,15 @@
 #   tidy     clang-tidy's function-size and cognitive-complexity limits on src/ (.clang-tidy)
 #   asan     every unit test built with AddressSanitizer + UndefinedBehaviorSanitizer
 #   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
+#   docs     the API reference (Doxygen) builds without a warning
 #   fuzz     libFuzzer on the CSV readers, robot files, study files and the number parser
 #            (ASan + UBSan, about a minute each: scripts/fuzz.sh)
-# Usage: bash scripts/checks.sh [format|layers|tidy|asan|tsan|fuzz ...]  (default: all, in order)
+# Usage: bash scripts/checks.sh [format|layers|tidy|docs|asan|tsan|fuzz ...]  (default: all, in order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_packages.sh clang-format clang-tidy python3
 stages=("$@")
-((${#stages[@]})) || stages=(format layers tidy asan tsan fuzz)
+((${#stages[@]})) || stages=(format layers tidy docs asan tsan fuzz)
 
 stage() { echo "== checks: $1 ($(date -u +%H:%M:%S))"; }
 sanitizer_build() {  # dir, sanitizers, targets...
@@ -36,6 +37,11 @@ for s in "${stages[@]}"; do
         -DLRCAL_BUILD_TESTS=OFF -DLRCAL_BUILD_BENCH=OFF > /dev/null
       ls src/*/*.cc | xargs -P2 -n1 clang-tidy -p build-tidy --quiet
       echo "clang-tidy: $(ls src/*/*.cc | wc -l) files within the limits" ;;
+    docs)
+      stage docs
+      bash scripts/install_packages.sh doxygen
+      doxygen docs/Doxyfile
+      echo "doxygen: build/docs/html/index.html, no warnings" ;;
     asan)
       stage asan
       sanitizer_build build-asan address,undefined all
@@ -51,7 +57,7 @@ for s in "${stages[@]}"; do
     fuzz)
       stage fuzz
       bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-60}" ;;
-    *) echo "unknown stage '$s' (format, layers, tidy, asan, tsan, fuzz)" >&2; exit 2 ;;
+    *) echo "unknown stage '$s' (format, layers, tidy, docs, asan, tsan, fuzz)" >&2; exit 2 ;;
   esac
 done
 echo "== checks: done ($(date -u +%H:%M:%S))"

@@ -13,7 +13,8 @@ cd "$(dirname "$0")/.."
 packages=(g++ cmake make git pkg-config
   libeigen3-dev libceres-dev libyaml-cpp-dev libsqlite3-dev librandom123-dev nlohmann-json3-dev
   libboost-program-options-dev libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
-  python3 python3-pandas python3-numpy python3-matplotlib chromium)
+  python3 python3-pandas python3-numpy python3-matplotlib chromium
+  pybind11-dev python3-dev python3-pytest)
 bash scripts/install_packages.sh "${packages[@]}"
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLRCAL_WERROR="${LRCAL_WERROR:-OFF}"
@@ -33,6 +34,13 @@ case "$action" in
     "$prefix/consumer-build/lrcal_consumer" "$prefix/share/lrcal/studies/robots/paper.yaml"
     (cd "$prefix" && "$prefix/bin/lrcal" run quick --out "$prefix/quick" --quiet > /dev/null)
     cmp "$prefix/quick/tables/summary.md" tests/golden/quick/summary.md
-    echo "setup: installed package, consumer and installed lrcal checked" ;;
+    # The installed Python module: the documented import, pytest, and the example.
+    site=$(find "$prefix" -path '*/lrcal/_lrcal*.so' -printf '%h\n' | head -1)
+    [ -n "$site" ] || { echo "setup: the Python module was not installed" >&2; exit 1; }
+    export PYTHONPATH="${site%/lrcal}" LRCAL_CLI="$prefix/bin/lrcal" PYTHONDONTWRITEBYTECODE=1
+    (cd "$prefix" && /usr/bin/python3 -c "import lrcal; print('setup: lrcal', lrcal.__version__, 'from', lrcal.__file__)")
+    /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
+    (root=$PWD; cd "$prefix" && /usr/bin/python3 "$root/examples/python/calibrate.py" "$prefix/example" > /dev/null)
+    echo "setup: installed package, consumer, Python module and installed lrcal checked" ;;
   build) ;;
 esac

@@ -79,14 +79,7 @@ void PrintIdentification(const IdentificationSummary& s) {
     if (!s.identifiability.full_rank()) std::cout << s.identifiability.ToString();
     return;
   }
-  Table t({"parameter", "unit", "nominal (SI)", "delta", "std", "std (given sigma)"},
-          "Identified parameters (delta and std in mrad / mm)");
-  for (std::size_t k = 0; k < s.names.size(); ++k) {
-    t.AddRow({s.names[k], IsAngularName(s.names[k]) ? "mrad" : "mm", Fixed(s.nominal[k], 6),
-              Fixed(s.delta[k] * 1e3), Fixed(s.std_residual[k] * 1e3),
-              s.std_given.size() ? Fixed(s.std_given[k] * 1e3) : "—"});
-  }
-  std::cout << t.ToText();
+  std::cout << s.ParameterTable();
   if (!s.fixed.empty()) {
     std::cout << "fixed at nominal because of rank deficiency:";
     for (const auto& f : s.fixed) std::cout << " " << f;

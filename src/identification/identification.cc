@@ -9,6 +9,7 @@
 
 #include "core/cpu_dispatch.h"
 #include "identification/levenberg_marquardt.h"
+#include "lrcal/core/text_table.h"
 
 namespace lrcal {
 
@@ -583,6 +584,18 @@ std::string IdentificationSummary::BriefReport() const {
   return out.str();
 }
 
+std::string IdentificationSummary::ParameterTable() const {
+  if (!IsSolutionUsable()) return "";
+  Table t({"parameter", "unit", "nominal (SI)", "delta", "std", "std (given sigma)"},
+          "Identified parameters (delta and std in mrad / mm)");
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    t.AddRow({names[k], IsAngularName(names[k]) ? "mrad" : "mm", Fixed(nominal[k], 6),
+              Fixed(delta[k] * 1e3), Fixed(std_residual[k] * 1e3),
+              std_given.size() ? Fixed(std_given[k] * 1e3) : "—"});
+  }
+  return t.ToText();
+}
+
 std::string IdentificationSummary::FullReport() const {
   std::ostringstream out;
   out << BriefReport() << "\n" << message << "\n";
@@ -592,7 +605,9 @@ std::string IdentificationSummary::FullReport() const {
     out << "\n";
   }
   if (IsSolutionUsable()) {
-    out << "sigma_hat per reading: " << sigma_hat * 1e3 << " mm\n";
+    out << "sigma_hat per reading: " << sigma_hat * 1e3 << " mm\n" << ParameterTable();
+  } else if (!identifiability.full_rank()) {
+    out << identifiability.ToString();
   }
   return out.str();
 }

@@ -98,8 +98,13 @@ struct IdentificationSummary {
   std::string solver;                     ///< "lrcal-lm" or "ceres"
 
   bool IsSolutionUsable() const { return termination == Termination::kConverged; }
+  /// One line: solver, termination, iterations, sizes, cost, residual RMS.
   std::string BriefReport() const;
+  /// The brief report, the solver's message, σ̂ and the parameter table (or, when the set is
+  /// rank-deficient, the identifiability report).
   std::string FullReport() const;
+  /// The identified parameters as a text table (delta and std in mm / mrad); "" unless usable.
+  std::string ParameterTable() const;
 };
 
 /// The covariance σ²·A⁻¹ of a least-squares estimate from its normal matrix A = GᵀWG (by LDLᵀ);

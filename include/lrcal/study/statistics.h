@@ -32,7 +32,7 @@ Distribution DescribeInPlace(std::vector<double>* values);
 double Percentile(const std::vector<double>& sorted, double p);
 /// The same percentile of values in any order, by selection in O(n) (reorders `values`).
 double Quantile(std::vector<double>* values, double p);
-/// Where x falls among `values` (any order), in percent: 100·(#below + ½#equal)/n.
+/// Where x falls among `values` (any order), in percent: 100·(number below + ½·number equal)/n.
 double PercentileRank(const std::vector<double>& values, double x);
 
 struct ParameterStats {

@@ -1,0 +1,179 @@
+"""lrcal.load_run: a run directory's trials and tables as pandas DataFrames (or numpy arrays).
+
+A run directory (docs/FILE_FORMATS.md) holds manifest.json, trials.sqlite (and, after an
+interrupted MPI job, trials.rank<r>.sqlite) and, once every trial is done, tables/*.csv and
+tables/summary.json. The stores are opened read-only, so a run in progress can be read.
+"""
+import csv
+import glob
+import json
+import os
+import sqlite3
+
+import numpy as np
+
+try:
+    import pandas as _pandas
+except ImportError:  # pandas is optional: numpy structured arrays without it
+    _pandas = None
+
+_METRICS = [f"{stat}_{kind}_{axis}" for stat in ("rms", "max") for kind in ("pos", "ori")
+            for axis in ("x", "y", "z")]
+_TRIAL_COLUMNS = (["cell_id", "trial", "status", "iterations", "residual_rms", "sigma_hat",
+                   "sigma_min"] + [f"val_{m}" for m in _METRICS] + [f"nom_{m}" for m in _METRICS]
+                  + ["seconds"])
+_CELL_JSON = ("settings", "parameter_names", "predicted_std", "fixed_for_rank", "truth_errors")
+
+
+def _error(path, what):
+    from ._lrcal import InputError
+    error = InputError(f"{path}: {what}")
+    error.where = path
+    return error
+
+
+def _records(columns, rows, as_pandas):
+    """A table as a DataFrame, or as a numpy structured array (numbers float64/int64, text
+    object) when pandas is not used."""
+    if as_pandas:
+        return _pandas.DataFrame.from_records(rows, columns=columns)
+    dtypes = []
+    for k, name in enumerate(columns):
+        values = [r[k] for r in rows]
+        if values and all(isinstance(v, bool) for v in values):
+            dtypes.append((name, np.bool_))
+        elif values and all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+            dtypes.append((name, np.int64))
+        elif values and all(isinstance(v, (int, float)) or v is None for v in values):
+            dtypes.append((name, np.float64))
+        else:
+            dtypes.append((name, object))
+    fixed = [tuple(np.nan if (v is None and dt == np.float64) else v
+                   for v, (_, dt) in zip(r, dtypes)) for r in rows]
+    return np.array(fixed, dtype=dtypes)
+
+
+def _read_csv(path, as_pandas):
+    if as_pandas:
+        return _pandas.read_csv(path)
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        header = next(reader)
+        rows = list(reader)
+    converted = []
+    for k in range(len(header)):
+        column = [r[k] for r in rows]
+        for kind in (int, float):
+            try:
+                converted.append([kind(v) for v in column])
+                break
+            except ValueError:
+                continue
+        else:
+            converted.append(column)
+    return _records(header, list(zip(*converted)) if rows else [], False)
+
+
+class Run:
+    """A run directory read back (lrcal.load_run).
+
+    Attributes:
+      path      the run directory
+      manifest  manifest.json as a dict (study, seed, build, sessions)
+      cells     one row per cell: cell_id, ord, label, settings (dict), parameter_names (list),
+                predicted_std (list, SI), design_sigma_min, fixed_for_rank, pool_report,
+                truth_errors (list, SI)
+      trials    one row per recorded trial: cell_id, trial, status, iterations, residual_rms (m),
+                sigma_hat (m), sigma_min, val_{rms,max}_{pos,ori}_{x,y,z} (validation errors of
+                the identified model, m or rad), nom_... (of the nominal model), seconds
+      tables    {name: table} for every tables/<name>.csv (units as the CSV headers say;
+                empty until the run is complete)
+      summary   tables/summary.json as a dict, or None
+    Tables are pandas DataFrames, or numpy structured arrays without pandas.
+    """
+
+    def __init__(self, path, as_pandas):
+        self.path = path
+        self._as_pandas = as_pandas
+        manifest = os.path.join(path, "manifest.json")
+        if not os.path.isfile(manifest):
+            raise _error(path, "not a run directory (no manifest.json); expected the --out "
+                               "folder of lrcal run or lrcal.run_study")
+        with open(manifest, encoding="utf-8") as f:
+            self.manifest = json.load(f)
+        self._stores = [p for p in [os.path.join(path, "trials.sqlite")] +
+                        sorted(glob.glob(os.path.join(path, "trials.rank*.sqlite")))
+                        if os.path.isfile(p)]
+        self._cells = self._read_cells()
+        self.cells = _records(
+            ["cell_id", "ord", "label"] + list(_CELL_JSON) + ["design_sigma_min", "pool_report"],
+            self._cells, as_pandas)
+        self.trials = _records(_TRIAL_COLUMNS, self._read_trials(), as_pandas)
+        tables = os.path.join(path, "tables")
+        self.tables = {os.path.splitext(os.path.basename(p))[0]: _read_csv(p, as_pandas)
+                       for p in sorted(glob.glob(os.path.join(tables, "*.csv")))}
+        summary = os.path.join(tables, "summary.json")
+        self.summary = None
+        if os.path.isfile(summary):
+            with open(summary, encoding="utf-8") as f:
+                self.summary = json.load(f)
+
+    def _connect(self, store):
+        return sqlite3.connect(f"file:{store}?mode=ro", uri=True)
+
+    def _read_cells(self):
+        rows = {}
+        for store in self._stores:
+            with self._connect(store) as db:
+                for r in db.execute(
+                        "SELECT cell_id, ord, label, settings, parameter_names, predicted_std, "
+                        "fixed_for_rank, truth_errors, design_sigma_min, pool_report FROM cells "
+                        "ORDER BY ord"):
+                    decoded = [json.loads(v) if v else None for v in r[3:8]]
+                    rows.setdefault(r[0], (r[0], r[1], r[2], *decoded, r[8], r[9]))
+        return sorted(rows.values(), key=lambda r: r[1])
+
+    def _read_trials(self, with_errors=False):
+        rows = {}
+        columns = ", ".join(_TRIAL_COLUMNS + (["errors"] if with_errors else []))
+        for store in self._stores:
+            with self._connect(store) as db:
+                for r in db.execute(f"SELECT {columns} FROM trials"):
+                    rows.setdefault((r[0], r[1]), r)
+        order = {c[0]: c[1] for c in self._cells}
+        return sorted(rows.values(), key=lambda r: (order.get(r[0], 1 << 30), r[0], r[1]))
+
+    def errors(self, cell):
+        """Parameter errors (estimate - truth, SI) of one cell's successful trials: a table with
+        the column `trial` and one column per parameter (cells' parameter_names). `cell` is a
+        cell_id or a label."""
+        match = [c for c in self._cells if cell in (c[0], c[2])]
+        if not match:
+            known = ", ".join(f"{c[2]} ({c[0]})" for c in self._cells)
+            raise _error(self.path, f"no cell '{cell}'; the cells are: {known}")
+        cell_id, names = match[0][0], match[0][4]
+        rows = []
+        for r in self._read_trials(with_errors=True):
+            if r[0] != cell_id or r[-1] is None:
+                continue
+            values = np.frombuffer(r[-1], dtype="<f8")
+            rows.append((r[1], *values.tolist()))
+        return _records(["trial"] + list(names), rows, self._as_pandas)
+
+    def __repr__(self):
+        return (f"lrcal.Run('{self.path}', {len(self._cells)} cells, {len(self.trials)} trials, "
+                f"tables: {', '.join(self.tables) or 'none yet'})")
+
+
+def load_run(path, as_pandas=None):
+    """Reads a run directory (lrcal run --out DIR, or lrcal.run_study): its manifest, cells,
+    trials, every table of tables/ and summary.json; see lrcal.Run.
+
+    as_pandas: True for pandas DataFrames, False for numpy structured arrays, None (default) for
+    DataFrames if pandas is installed. Raises lrcal.InputError if `path` is not a run directory.
+    """
+    if as_pandas is None:
+        as_pandas = _pandas is not None
+    if as_pandas and _pandas is None:
+        raise ImportError("load_run(as_pandas=True) needs pandas (Debian: python3-pandas)")
+    return Run(os.fspath(path), as_pandas)

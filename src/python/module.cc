@@ -1,0 +1,771 @@
+// The Python module lrcal._lrcal (pybind11): the library's calibration core and the Monte-Carlo
+// runner on numpy arrays. src/python/lrcal/__init__.py re-exports it and adds load_run.
+//
+// Conventions, as in the C++ library: SI units (m, rad), joint arrays N×joints (one row per
+// configuration), the robot file's plane unless `plane` is given. Every InputError of the library
+// becomes lrcal.InputError (a ValueError) with the same message as the command line's, naming
+// the file, line or argument; a StorageError becomes lrcal.StorageError (an OSError). Long
+// computations run with the GIL released.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lrcal/core/data_dir.h"
+#include "lrcal/core/error.h"
+#include "lrcal/core/random.h"
+#include "lrcal/core/strings.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/design/experiment_design.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/measurement_set.h"
+#include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/simulation.h"
+#include "lrcal/report/run_tables.h"
+#include "lrcal/study/run_directory.h"
+#include "lrcal/study/runner.h"
+#include "lrcal/study/study.h"
+
+namespace py = pybind11;
+
+namespace lrcal::python {
+
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// --- errors ---------------------------------------------------------------------------------
+
+PyObject* g_error = nullptr;          // lrcal.Error(Exception)
+PyObject* g_input_error = nullptr;    // lrcal.InputError(Error, ValueError)
+PyObject* g_storage_error = nullptr;  // lrcal.StorageError(Error, OSError)
+
+// Raises `type` with `message`, and the attribute `where` (file:line, key or argument) if known.
+void SetError(PyObject* type, const char* message, const std::string& where) {
+  PyObject* instance = PyObject_CallFunction(type, "s", message);
+  if (!instance) return;  // the call set its own error
+  PyObject* where_str = PyUnicode_FromString(where.c_str());
+  if (where_str) {
+    PyObject_SetAttrString(instance, "where", where_str);
+    Py_DECREF(where_str);
+  }
+  PyErr_SetObject(type, instance);
+  Py_DECREF(instance);
+}
+
+void RegisterErrors(py::module_& m) {
+  g_error =
+      PyErr_NewExceptionWithDoc("lrcal.Error", "Base of lrcal's errors.", PyExc_Exception, nullptr);
+  py::object input_bases = py::make_tuple(py::handle(g_error), py::handle(PyExc_ValueError));
+  g_input_error = PyErr_NewExceptionWithDoc(
+      "lrcal.InputError",
+      "Bad input (a file, a setting, an argument); the message names where and what was expected "
+      "(the command line's exit code 2). Attribute `where`: the file:line, key or argument.",
+      input_bases.ptr(), nullptr);
+  py::object storage_bases = py::make_tuple(py::handle(g_error), py::handle(PyExc_OSError));
+  g_storage_error = PyErr_NewExceptionWithDoc(
+      "lrcal.StorageError",
+      "Results could not be written (a full disk, an I/O error); what was committed is intact "
+      "(the command line's exit code 5).",
+      storage_bases.ptr(), nullptr);
+  m.add_object("Error", py::handle(g_error));
+  m.add_object("InputError", py::handle(g_input_error));
+  m.add_object("StorageError", py::handle(g_storage_error));
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      SetError(g_input_error, e.what(), e.where());
+    } catch (const StorageError& e) {
+      SetError(g_storage_error, e.what(), "");
+    }
+  });
+}
+
+// --- argument conversion --------------------------------------------------------------------
+
+// A joint array: N×joints (or one configuration as a vector of `joints`), finite values.
+ConfigurationSet ToConfigurations(const Array& q, int joints, const char* name) {
+  const py::buffer_info b = q.request();
+  const bool vector = b.ndim == 1 && b.shape[0] == joints;
+  if (!vector && !(b.ndim == 2 && b.shape[1] == joints))
+    throw InputError(name, "expected an array of shape (N, " + std::to_string(joints) +
+                               "): one row of joint values (rad) per configuration");
+  const auto rows = static_cast<int>(vector ? 1 : b.shape[0]);
+  const double* data = static_cast<const double*>(b.ptr);
+  ConfigurationSet configs(joints);
+  configs.Reserve(rows);
+  for (int i = 0; i < rows; ++i) {
+    for (int j = 0; j < joints; ++j)
+      if (!std::isfinite(data[i * joints + j]))
+        throw InputError(name, "row " + std::to_string(i) + ", joint " + std::to_string(j + 1) +
+                                   ": expected a finite joint value, got " +
+                                   FormatExact(data[i * joints + j]));
+    configs.Add(data + static_cast<std::ptrdiff_t>(i) * joints);
+  }
+  return configs;
+}
+
+std::vector<double> ToVector(const Array& a, const char* name) {
+  const py::buffer_info b = a.request();
+  if (b.ndim != 1) throw InputError(name, "expected a one-dimensional array");
+  const double* data = static_cast<const double*>(b.ptr);
+  return std::vector<double>(data, data + b.shape[0]);
+}
+
+// `plane`: None (the robot file's), a Plane, or four numbers nx, ny, nz, f.
+Plane ResolvePlane(const RobotFile& rig, const py::object& plane) {
+  if (plane.is_none()) {
+    if (rig.plane) return *rig.plane;
+    throw InputError("plane", "the robot file '" + rig.path +
+                                  "' has no plane: pass plane=lrcal.Plane((nx, ny, nz), f)");
+  }
+  if (py::isinstance<Plane>(plane)) return plane.cast<Plane>();
+  std::vector<double> c;
+  try {
+    c = plane.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw InputError("plane", "expected None, an lrcal.Plane or four numbers (nx, ny, nz, f)");
+  }
+  if (c.size() != 4)
+    throw InputError("plane",
+                     "expected four numbers (nx, ny, nz, f), got " + std::to_string(c.size()));
+  return Plane::FromCoefficients(c[0], c[1], c[2], c[3], "plane");
+}
+
+// `fix`: a list of names or one comma-separated string.
+std::vector<std::string> ToNames(const py::object& fix) {
+  if (fix.is_none()) return {};
+  if (py::isinstance<py::str>(fix)) return SplitList(fix.cast<std::string>());
+  try {
+    return fix.cast<std::vector<std::string>>();
+  } catch (const py::cast_error&) {
+    throw InputError("fix", "expected a list of parameter names or one comma-separated string");
+  }
+}
+
+ParameterSet ResolveParameters(const RobotModel& robot, const std::string& estimate_plane,
+                               const py::object& fix) {
+  return MakeParameterSet(robot, PlaneTerms::Parse(estimate_plane, "estimate_plane"), ToNames(fix),
+                          "fix");
+}
+
+// The 5N link values of `model`: "nominal", "true", or an array of 5N values (SI).
+Eigen::VectorXd ResolveLinkValues(const RobotModel& robot, const py::object& model) {
+  if (py::isinstance<py::str>(model)) {
+    const std::string which = model.cast<std::string>();
+    if (which == "nominal") return robot.nominal_values();
+    if (which == "true") return robot.true_values();
+    throw InputError("model", "expected 'nominal', 'true' or an array of " +
+                                  std::to_string(robot.num_values()) + " link values, got '" +
+                                  which + "'");
+  }
+  const std::vector<double> v = ToVector(model.cast<Array>(), "model");
+  if (static_cast<int>(v.size()) != robot.num_values())
+    throw InputError("model", "expected " + std::to_string(robot.num_values()) +
+                                  " link values (theta, alpha, a, d, beta per link), got " +
+                                  std::to_string(v.size()));
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), robot.num_values());
+}
+
+std::uint64_t ToSeed(long long seed) {
+  if (seed < 0) throw InputError("seed", "expected a non-negative integer");
+  return static_cast<std::uint64_t>(seed);
+}
+
+py::array_t<double> ToArray(const std::vector<double>& v) {
+  return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
+py::array_t<double> ToArray(const ConfigurationSet& configs) {
+  py::array_t<double> out(
+      {static_cast<py::ssize_t>(configs.size()), static_cast<py::ssize_t>(configs.num_joints())});
+  auto w = out.mutable_unchecked<2>();
+  for (int i = 0; i < configs.size(); ++i)
+    for (int j = 0; j < configs.num_joints(); ++j) w(i, j) = configs.q(i)[j];
+  return out;
+}
+
+// --- results --------------------------------------------------------------------------------
+
+/// Readings as a measurement CSV holds them: one row per single reading.
+struct Readings {
+  py::array_t<double> q;                             ///< M×joints
+  py::array_t<double> h;                             ///< M, m
+  py::array_t<int> configuration;                    ///< M, 0-based index of the configuration read
+  std::vector<std::pair<int, std::string>> skipped;  ///< (configuration, why) without a reading
+};
+
+/// A chosen design.
+struct Design {
+  std::vector<int> indices;  ///< rows of the pool given, ascending
+  double score = 0;
+  long long evaluations = 0;
+  std::string criterion, method, scaling;
+  std::vector<std::pair<int, std::string>> rejected;  ///< pool rows whose beam misses
+};
+
+// --- functions ------------------------------------------------------------------------------
+
+RobotFile LoadRobot(const std::string& name_or_path) {
+  return LoadRobotFile(ResolveRobotPath(name_or_path));
+}
+
+py::array_t<double> ForwardKinematicsPy(const RobotFile& rig, const Array& q,
+                                        const py::object& model) {
+  const RobotModel& robot = rig.robot;
+  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
+  const Eigen::VectorXd values = ResolveLinkValues(robot, model);
+  py::array_t<double> out(
+      {static_cast<py::ssize_t>(configs.size()), py::ssize_t{4}, py::ssize_t{4}});
+  auto w = out.mutable_unchecked<3>();
+  for (int i = 0; i < configs.size(); ++i) {
+    const Pose<double> pose = ForwardKinematics<double>(robot, values.data(), configs.q(i));
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) w(i, r, c) = pose.R_BT(r, c);
+      w(i, r, 3) = pose.p_BT[r];
+      w(i, 3, r) = 0;
+    }
+    w(i, 3, 3) = 1;
+  }
+  return out;
+}
+
+py::object LaserReadingsPy(const RobotFile& rig, const Array& q, const py::object& plane_arg,
+                           const py::object& model, bool return_status) {
+  const RobotModel& robot = rig.robot;
+  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
+  const Plane plane = ResolvePlane(rig, plane_arg);
+  const Eigen::VectorXd values = ResolveLinkValues(robot, model);
+  std::vector<double> h;
+  std::vector<BeamMiss> misses;
+  ExactReadings(robot, values, plane, rig.ranger, configs, &h, &misses);
+  std::vector<std::string> status;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    if (misses[i] != BeamMiss::kNone) h[i] = std::numeric_limits<double>::quiet_NaN();
+    status.emplace_back(BeamMissName(misses[i]));
+  }
+  if (!return_status) return ToArray(h);
+  return py::make_tuple(ToArray(h), py::cast(status));
+}
+
+py::array_t<double> SampleConfigurationsPy(const RobotFile& rig, int count, long long seed,
+                                           const py::object& plane_arg, bool validation,
+                                           double min_singular_value) {
+  if (count < 1 || count > 1000000)
+    throw InputError("count",
+                     "expected 1 to 1,000,000 configurations, got " + std::to_string(count));
+  const Plane plane = ResolvePlane(rig, plane_arg);
+  SamplingOptions options;
+  options.ranger = rig.ranger;
+  options.min_jacobian_singular_value = min_singular_value;
+  options.require_beam_hit = !validation;
+  options.Validate("min_singular_value");
+  ConfigurationSet configs;
+  {
+    py::gil_scoped_release release;
+    configs = SampleConfigurations(
+        rig.robot, plane, count,
+        RandomStream(ToSeed(seed), 0, 0,
+                     validation ? RandomPurpose::kValidation : RandomPurpose::kPool),
+        options);
+  }
+  return ToArray(configs);
+}
+
+Readings SimulatePy(const RobotFile& rig, const Array& q, double sigma, int repetitions,
+                    long long seed, const py::object& plane_arg, const py::object& model) {
+  const RobotModel& robot = rig.robot;
+  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
+  const Plane plane = ResolvePlane(rig, plane_arg);
+  const Eigen::VectorXd values = ResolveLinkValues(robot, model);
+  NoiseModel noise;
+  noise.sigma = sigma;
+  noise.repetitions = repetitions;
+  if (!(std::isfinite(sigma) && sigma >= 0))
+    throw InputError("sigma", "expected a finite noise >= 0 (m)");
+  if (repetitions < 1 || repetitions > 1000000)
+    throw InputError("repetitions", "expected 1 to 1,000,000 readings per configuration");
+  MeasurementSet data;
+  std::vector<BeamMiss> misses;
+  std::vector<double> raw;
+  {
+    py::gil_scoped_release release;
+    SimulateReadings(robot, values, plane, rig.ranger, configs, noise,
+                     RandomStream(ToSeed(seed), 0, 0, RandomPurpose::kNoise), &data, &misses, &raw);
+  }
+  // The kept configurations in order, `repetitions` readings each (as lrcal simulate writes).
+  Readings out;
+  std::vector<int> kept;
+  for (int i = 0; i < configs.size(); ++i) {
+    if (misses[i] == BeamMiss::kNone) {
+      kept.push_back(i);
+    } else {
+      out.skipped.emplace_back(i, BeamMissName(misses[i]));
+    }
+  }
+  const auto m = static_cast<py::ssize_t>(raw.size());
+  const int n = robot.num_links();
+  out.q = py::array_t<double>({m, static_cast<py::ssize_t>(n)});
+  out.h = ToArray(raw);
+  out.configuration = py::array_t<int>(m);
+  auto wq = out.q.mutable_unchecked<2>();
+  auto wc = out.configuration.mutable_unchecked<1>();
+  for (py::ssize_t r = 0; r < m; ++r) {
+    const int i = kept[static_cast<std::size_t>(r / repetitions)];
+    for (int j = 0; j < n; ++j) wq(r, j) = configs.q(i)[j];
+    wc(r) = i;
+  }
+  return out;
+}
+
+IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
+                                 const py::object& plane_arg, const std::string& estimate_plane,
+                                 const py::object& fix, bool auto_fix, const std::string& solver,
+                                 const std::string& loss, double loss_scale, double sigma,
+                                 int max_iterations) {
+  const RobotModel& robot = rig.robot;
+  const ConfigurationSet readings_q = ToConfigurations(q, robot.num_links(), "q");
+  const std::vector<double> readings = ToVector(h, "h");
+  const MeasurementSet data = GroupReadings(readings_q, readings, &rig.ranger, [](int r) {
+    return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]";
+  });
+  const Plane plane = ResolvePlane(rig, plane_arg);
+  const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
+  options.loss = ParseName(kRobustLossNames, loss, "loss", "loss");
+  options.loss_scale = loss_scale;
+  if (!(std::isfinite(loss_scale) && loss_scale > 0))
+    throw InputError("loss_scale", "expected a finite scale > 0 (m)");
+  options.sigma = sigma;
+  options.max_iterations = max_iterations;
+  options.fix_dependent_parameters = auto_fix;
+  if (std::string bad = options.Validate(); !bad.empty()) throw InputError("options", bad);
+  py::gil_scoped_release release;
+  return Identify(model, data, options);
+}
+
+IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
+                                        const py::object& plane_arg,
+                                        const std::string& estimate_plane, const py::object& fix,
+                                        double rank_tolerance) {
+  const RobotModel& robot = rig.robot;
+  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
+  const MeasurementModel model(robot, ResolvePlane(rig, plane_arg),
+                               ResolveParameters(robot, estimate_plane, fix));
+  IdentifiabilityOptions options;
+  options.rank_tolerance = rank_tolerance;
+  options.Validate("rank_tolerance");
+  py::gil_scoped_release release;
+  return AnalyzeIdentifiability(model, configs, nullptr, options);
+}
+
+Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const std::string& criterion,
+                const std::string& method, const std::string& scaling, double expected_angle,
+                double expected_length, int restarts, int samples, long long seed,
+                const py::object& plane_arg, const std::string& estimate_plane,
+                const py::object& fix) {
+  const RobotModel& robot = rig.robot;
+  const Plane plane = ResolvePlane(rig, plane_arg);
+  const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
+  SelectionOptions options;
+  options.criterion = ParseDesignCriterion(criterion, "criterion");
+  options.method = ParseSelectionMethod(method, "method");
+  options.restarts = restarts;
+  options.samples = samples;
+  options.Validate("design");
+  const DesignScaling scale = ParseDesignScaling(scaling, "scaling");
+  for (const auto& [value, name] :
+       {std::pair{expected_angle, "expected_angle"}, std::pair{expected_length, "expected_length"}})
+    if (!(std::isfinite(value) && value > 0))
+      throw InputError(name, "expected a finite value > 0 (rad or m)");
+  const CandidatePool pool = UsableCandidates(robot, plane, rig.ranger,
+                                              ToConfigurations(pool_q, robot.num_links(), "pool"));
+  if (pool.configs.size() == 0)
+    throw InputError("pool", "no usable candidate configurations (every beam misses the plane)");
+  Design out;
+  for (std::size_t i = 0; i < pool.misses.size(); ++i)
+    if (pool.misses[i] != BeamMiss::kNone)
+      out.rejected.emplace_back(static_cast<int>(i), BeamMissName(pool.misses[i]));
+  SelectionResult chosen;
+  {
+    py::gil_scoped_release release;
+    const Eigen::MatrixXd G =
+        DesignJacobian(model, pool.configs, scale, expected_angle, expected_length);
+    chosen = SelectConfigurations(G, k, options,
+                                  RandomStream(ToSeed(seed), 1, 0, RandomPurpose::kSelection));
+  }
+  for (int i : chosen.indices) out.indices.push_back(pool.kept[static_cast<std::size_t>(i)]);
+  out.score = chosen.score;
+  out.evaluations = chosen.evaluations;
+  out.criterion = DesignCriterionName(options.criterion);
+  out.method = SelectionMethodName(options.method);
+  out.scaling = DesignScalingName(scale);
+  return out;
+}
+
+// Runs a study; progress(p) is called about every 0.1 s with a RunProgress. Ctrl-C (or an
+// exception in `progress`) stops the run as the command line's first Ctrl-C does: the trials
+// done are committed, the session is closed as interrupted, and the exception is raised.
+RunResult RunStudyPy(const std::string& study_arg, const std::string& out_dir, int threads,
+                     const py::object& progress, const std::optional<std::string>& shard,
+                     long long max_trials) {
+  const Study study = LoadStudy(ResolveStudyPath(study_arg));
+  RunOptions options;
+  options.out_dir = out_dir;
+  options.threads = threads;
+  if (shard) ParseShard(*shard, &options.shard_index, &options.shard_count);
+  options.max_new_trials = max_trials;
+  options.progress = false;
+  options.Validate();
+  StopToken stop;
+  std::exception_ptr raised;  // a KeyboardInterrupt or the callback's exception
+  options.on_progress = [&](const RunProgress& p) {
+    py::gil_scoped_acquire gil;
+    if (raised) return;
+    try {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      if (!progress.is_none()) progress(p);
+    } catch (...) {
+      raised = std::current_exception();
+      stop.RequestStop();
+    }
+  };
+  RunResult result;
+  {
+    py::gil_scoped_release release;
+    result = RunStudyAndWriteTables(study, options, nullptr, &stop);
+  }
+  if (raised) std::rethrow_exception(raised);
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  return result;
+}
+
+// --- definitions ----------------------------------------------------------------------------
+
+// Python's shortest round-trip form of a number (for repr).
+std::string Num(double v) { return py::repr(py::float_(v)).cast<std::string>(); }
+
+std::string PlaneRepr(const Plane& p) {
+  return "lrcal.Plane(normal=(" + Num(p.normal.x()) + ", " + Num(p.normal.y()) + ", " +
+         Num(p.normal.z()) + "), offset=" + Num(p.offset) + ")";
+}
+
+void DefineRig(py::module_& m) {
+  py::class_<Plane>(m, "Plane", R"doc(
+A plane n·p + f = 0 in the robot's base frame: unit normal n, offset f (m).
+
+Plane(normal, offset): the normal is normalised (and f with it), as in robot files.
+Plane.parse("nx,ny,nz,f") reads the command line's --plane form.)doc")
+      .def(py::init([](const std::vector<double>& normal, double offset) {
+             if (normal.size() != 3)
+               throw InputError("normal", "expected three numbers (nx, ny, nz)");
+             return Plane::FromCoefficients(normal[0], normal[1], normal[2], offset, "plane");
+           }),
+           py::arg("normal"), py::arg("offset"))
+      .def_static(
+          "parse", [](const std::string& text) { return Plane::Parse(text, "plane"); },
+          py::arg("text"), "A plane from 'nx,ny,nz,f' (the --plane form).")
+      .def_property_readonly(
+          "normal", [](const Plane& p) { return Eigen::Vector3d(p.normal); },
+          "Unit normal (3,), base frame.")
+      .def_readonly("offset", &Plane::offset, "f (m): the plane is n·p + f = 0.")
+      .def("signed_distance", &Plane::SignedDistance, py::arg("point"),
+           "n·p + f (m) of a point p (3,) in the base frame.")
+      .def("__repr__", &PlaneRepr);
+
+  py::class_<RangerSpec>(m, "Ranger", "The laser ranger's limits (the robot file's ranger:).")
+      .def_readonly("min_range", &RangerSpec::min_range, "m; shorter readings are rejected")
+      .def_readonly("max_range", &RangerSpec::max_range, "m; longer readings are out of range")
+      .def_readonly("max_incidence", &RangerSpec::max_incidence,
+                    "rad; largest angle between the beam and the plane normal")
+      .def("__repr__", [](const RangerSpec& r) {
+        return "lrcal.Ranger(min_range=" + Num(r.min_range) + ", max_range=" + Num(r.max_range) +
+               ", max_incidence=" + Num(r.max_incidence) + ")";
+      });
+}
+
+void DefineRobot(py::module_& m) {
+  py::class_<RobotFile>(m, "Robot", R"doc(
+A robot file: the arm (D-H links with the twist β, nominal values, simulated true errors, joint
+limits), its measurement plane if the file gives one, and the ranger's limits.
+
+Load one with Robot.load(path_or_name): a YAML robot file, or a shipped name ("paper").
+Link values are ordered theta, alpha, a, d, beta per link (SI: rad and m).)doc")
+      .def_static("load", &LoadRobot, py::arg("path"), R"doc(
+Loads a robot file (YAML) by path, or a shipped robot by name ("paper").
+Raises lrcal.InputError naming the file, line and key of anything wrong.)doc")
+      .def_property_readonly("name", [](const RobotFile& r) { return r.robot.name(); })
+      .def_readonly("path", &RobotFile::path, "Where the file was read from.")
+      .def_property_readonly(
+          "num_joints", [](const RobotFile& r) { return r.robot.num_links(); },
+          "Number of joints (one link each).")
+      .def_property_readonly(
+          "value_names",
+          [](const RobotFile& r) {
+            std::vector<std::string> names;
+            for (int k = 0; k < r.robot.num_values(); ++k) names.push_back(r.robot.ValueName(k));
+            return names;
+          },
+          "Names of the 5N link values (theta1, alpha1, a1, d1, beta1, theta2, ...).")
+      .def_property_readonly(
+          "parameter_names",
+          [](const RobotFile& r) { return MakeParameterSet(r.robot, PlaneTerms{}).names; },
+          "The identifiable link parameters the file declares (identify's default set).")
+      .def_property_readonly(
+          "nominal_values", [](const RobotFile& r) { return r.robot.nominal_values(); },
+          "Nominal link values (5N,), SI.")
+      .def_property_readonly(
+          "true_errors", [](const RobotFile& r) { return r.robot.true_errors(); },
+          "Simulated true errors of the link values (5N,), SI.")
+      .def_property_readonly(
+          "true_values", [](const RobotFile& r) { return r.robot.true_values(); },
+          "nominal_values + true_errors (5N,), SI.")
+      .def_property_readonly(
+          "joint_limits",
+          [](const RobotFile& r) {
+            Eigen::MatrixXd limits(r.robot.num_links(), 2);
+            for (int i = 0; i < r.robot.num_links(); ++i)
+              limits.row(i) << r.robot.links()[i].q_min, r.robot.links()[i].q_max;
+            return limits;
+          },
+          "(N, 2) joint limits q_min, q_max (rad).")
+      .def_readonly("plane", &RobotFile::plane, "The file's plane, or None.")
+      .def_readonly("ranger", &RobotFile::ranger, "The ranger's limits.")
+      .def("__repr__", [](const RobotFile& r) {
+        return "lrcal.Robot('" + r.robot.name() + "', " + std::to_string(r.robot.num_links()) +
+               " joints, from '" + r.path + "')";
+      });
+}
+
+void DefineResults(py::module_& m) {
+  py::class_<Readings>(m, "Readings", R"doc(
+Simulated single readings, one row per reading (as a measurement CSV holds them):
+q (M, joints) rad, h (M,) m, configuration (M,) the 0-based row of the q given,
+skipped: [(row, why)] for configurations whose beam missed (no reading).)doc")
+      .def_readonly("q", &Readings::q)
+      .def_readonly("h", &Readings::h)
+      .def_readonly("configuration", &Readings::configuration)
+      .def_readonly("skipped", &Readings::skipped);
+
+  py::class_<Dependency>(m, "Dependency",
+                         "Moving the parameters along these SI coefficients leaves every reading "
+                         "unchanged to first order.")
+      .def_readonly("terms", &Dependency::terms, "[(name, coefficient)]; the first has 1.")
+      .def("__str__", &Dependency::ToString)
+      .def("__repr__", &Dependency::ToString);
+
+  py::class_<IdentifiabilityReport>(m, "Identifiability", R"doc(
+What a set of configurations can identify: rank of the identification Jacobian G, singular values
+of its unit-norm columns, the parameters with no effect (unidentifiable), the exact dependences,
+and the parameters to fix for a full-rank set (suggested_fixed). str() gives the report.)doc")
+      .def_readonly("names", &IdentifiabilityReport::names)
+      .def_readonly("num_configurations", &IdentifiabilityReport::num_configurations)
+      .def_readonly("rank", &IdentifiabilityReport::rank)
+      .def_readonly("column_norms", &IdentifiabilityReport::column_norms)
+      .def_readonly("singular_values", &IdentifiabilityReport::singular_values)
+      .def_readonly("condition_number", &IdentifiabilityReport::condition_number)
+      .def_readonly("unidentifiable", &IdentifiabilityReport::unidentifiable)
+      .def_readonly("dependencies", &IdentifiabilityReport::dependencies)
+      .def_readonly("suggested_fixed", &IdentifiabilityReport::suggested_fixed)
+      .def_property_readonly("full_rank", &IdentifiabilityReport::full_rank)
+      .def("__str__", &IdentifiabilityReport::ToString);
+
+  py::class_<Design>(m, "Design", R"doc(
+A chosen design: indices (rows of the pool given, ascending), the criterion's score of the chosen
+set, the candidate evaluations spent, and the pool rows rejected because their beam misses.)doc")
+      .def_readonly("indices", &Design::indices)
+      .def_readonly("score", &Design::score)
+      .def_readonly("evaluations", &Design::evaluations)
+      .def_readonly("criterion", &Design::criterion)
+      .def_readonly("method", &Design::method)
+      .def_readonly("scaling", &Design::scaling)
+      .def_readonly("rejected", &Design::rejected)
+      .def("__repr__", [](const Design& d) {
+        return "lrcal.Design(" + std::to_string(d.indices.size()) + " configurations, " +
+               d.criterion + " = " + Num(d.score) + ")";
+      });
+}
+
+void DefineIdentification(py::module_& m) {
+  using S = IdentificationSummary;
+  py::class_<S>(m, "Identification", R"doc(
+The result of lrcal.identify. Arrays are SI (m, rad); index k belongs to names[k].
+  names, nominal, estimate (= nominal + delta), delta
+  std, covariance, correlation: from the residuals (σ̂²·(GᵀWG)⁻¹)
+  std_given, covariance_given: with the σ given (empty unless sigma > 0)
+  sigma_hat (m), residual_rms (m), initial_cost, final_cost (½Σr², m²), iterations,
+  num_configurations, termination ('converged', 'max_iterations', 'rank_deficient',
+  'beam_missed', 'numerical_failure', 'invalid_input'), usable, message, fixed (parameters fixed
+  for rank), identifiability, solver.
+str() gives the full text report; repr() the one-line summary.)doc")
+      .def_readonly("names", &S::names)
+      .def_readonly("nominal", &S::nominal)
+      .def_readonly("estimate", &S::estimate)
+      .def_readonly("delta", &S::delta)
+      .def_readonly("std", &S::std_residual)
+      .def_readonly("std_given", &S::std_given)
+      .def_readonly("covariance", &S::covariance_residual)
+      .def_readonly("covariance_given", &S::covariance_given)
+      .def_readonly("correlation", &S::correlation)
+      .def_readonly("sigma_hat", &S::sigma_hat)
+      .def_readonly("initial_cost", &S::initial_cost)
+      .def_readonly("final_cost", &S::final_cost)
+      .def_readonly("residual_rms", &S::residual_rms)
+      .def_readonly("iterations", &S::iterations)
+      .def_readonly("num_configurations", &S::num_configurations)
+      .def_property_readonly("termination",
+                             [](const S& s) { return std::string(TerminationName(s.termination)); })
+      .def_property_readonly("usable", &S::IsSolutionUsable)
+      .def_readonly("message", &S::message)
+      .def_readonly("fixed", &S::fixed)
+      .def_readonly("identifiability", &S::identifiability)
+      .def_readonly("solver", &S::solver)
+      .def("__str__", &S::FullReport)
+      .def("__repr__", &S::BriefReport);
+}
+
+void DefineRun(py::module_& m) {
+  py::class_<RunProgress>(m, "RunProgress", "Where a run stands (run_study's progress callback).")
+      .def_readonly("done", &RunProgress::done, "trials of the run recorded so far")
+      .def_readonly("total", &RunProgress::total, "trials of the run (or shard)")
+      .def_readonly("computed", &RunProgress::computed, "computed by this call so far")
+      .def_readonly("seconds", &RunProgress::seconds, "since the call started")
+      .def("__repr__", [](const RunProgress& p) {
+        return "lrcal.RunProgress(" + std::to_string(p.done) + "/" + std::to_string(p.total) + ")";
+      });
+  py::class_<RunResult>(m, "RunResult", "What run_study did (as lrcal run prints it).")
+      .def_readonly("total", &RunResult::total, "trials of the run (or shard)")
+      .def_readonly("done_before", &RunResult::done_before, "already recorded at the start")
+      .def_readonly("computed", &RunResult::computed, "computed by this call")
+      .def_readonly("interrupted", &RunResult::interrupted)
+      .def_readonly("complete", &RunResult::complete, "every trial of the run is recorded")
+      .def_readonly("tables_written", &RunResult::tables_written, "OUT/tables/ was written")
+      .def_readonly("seconds", &RunResult::seconds)
+      .def("__repr__", [](const RunResult& r) {
+        return "lrcal.RunResult(" + std::to_string(r.done_before + r.computed) + "/" +
+               std::to_string(r.total) + " trials, " + (r.complete ? "complete" : "incomplete") +
+               ")";
+      });
+}
+
+void DefineKinematics(py::module_& m) {
+  m.def("forward_kinematics", &ForwardKinematicsPy, py::arg("robot"), py::arg("q"),
+        py::arg("model") = "nominal", R"doc(
+Tool poses in the base frame: (N, 4, 4) homogeneous transforms for q (N, joints) in rad.
+model: "nominal", "true" (nominal + the file's true errors) or an array of the 5N link values
+(e.g. a calibrated model). The tool z axis (column 2) is the laser beam.)doc");
+  m.def("laser_readings", &LaserReadingsPy, py::arg("robot"), py::arg("q"),
+        py::arg("plane") = py::none(), py::arg("model") = "nominal",
+        py::arg("return_status") = false, R"doc(
+Exact laser readings h (N,) in m of q (N, joints): the distance along the beam to the plane.
+NaN where the ranger gives no reading (beam parallel, plane behind, out of range, grazing).
+plane: None (the robot file's), an lrcal.Plane or (nx, ny, nz, f). model: as forward_kinematics.
+With return_status=True: (h, status), status a list of 'ok' or the reason per configuration.)doc");
+  m.def("sample_configurations", &SampleConfigurationsPy, py::arg("robot"), py::arg("count"),
+        py::arg("seed") = 1, py::arg("plane") = py::none(), py::arg("validation") = false,
+        py::arg("min_singular_value") = 0.05, R"doc(
+Draws count configurations (count, joints) uniformly within the joint limits whose nominal beam
+hits the plane within the ranger's limits and whose geometric Jacobian's smallest singular value
+is at least min_singular_value; validation=True drops the beam condition (validation poses).
+The same numbers as `lrcal sample --seed SEED [--validation]`.)doc");
+  m.def("simulate", &SimulatePy, py::arg("robot"), py::arg("q"), py::arg("sigma") = 0.2e-3,
+        py::arg("repetitions") = 10, py::arg("seed") = 1, py::arg("plane") = py::none(),
+        py::arg("model") = "true", R"doc(
+Simulated noisy readings of the arm `model` ("true" by default: nominal + the file's true errors)
+at the configurations q (N, joints): `repetitions` readings per configuration with Gaussian noise
+of standard deviation sigma (m). Returns an lrcal.Readings (q, h, configuration, skipped), the
+same numbers as `lrcal simulate --seed SEED`.)doc");
+}
+
+void DefineCalibration(py::module_& m) {
+  m.def("identify", &IdentifyPy, py::arg("robot"), py::arg("q"), py::arg("h"),
+        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+        py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("solver") = "lm",
+        py::arg("loss") = "none", py::arg("loss_scale") = 1e-3, py::arg("sigma") = 0.0,
+        py::arg("max_iterations") = 100, R"doc(
+Identifies the geometric parameters (and plane terms) from laser readings.
+
+q (M, joints) rad and h (M,) m are single readings; readings at identical joint values are
+averaged (weight = their count), exactly as `lrcal identify --data` does with a CSV.
+plane: None (the robot file's), an lrcal.Plane or (nx, ny, nz, f), the nominal plane.
+estimate_plane: "none", "normal", "offset" or "normal,offset" (names plane_u1, plane_u2, plane_f).
+fix: parameter names kept at nominal (a list or "a1,d2"). auto_fix: if the set is rank-deficient,
+fix the suggested parameters and go on (else termination is 'rank_deficient').
+solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (ceres only) with loss_scale m.
+sigma: the known σ of one reading (m) for covariance_given; 0 = unknown.
+Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc");
+  m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
+        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+        py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8, R"doc(
+What the configurations q (N, joints) can identify of the parameter set (estimate_plane, fix as
+in identify), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
+`lrcal identifiability`.)doc");
+  m.def("design", &DesignPy, py::arg("robot"), py::arg("pool"), py::arg("k"),
+        py::arg("criterion") = "E", py::arg("method") = "exchange", py::arg("scaling") = "si",
+        py::arg("expected_angle") = 1e-3, py::arg("expected_length") = 1e-3,
+        py::arg("restarts") = 4, py::arg("samples") = 1000, py::arg("seed") = 1,
+        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+        py::arg("fix") = py::none(), R"doc(
+Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
+identification Jacobian at the nominal model (as `lrcal design --pool`).
+criterion: E (= O3, σ_min), D, A, O1, O2, O4, O5. method: exhaustive, greedy, backward, exchange,
+sampled, random. scaling of G's columns: si (the paper), unit, expected (× expected_angle rad /
+expected_length m). Candidates whose nominal beam misses the plane are left out (Design.rejected).
+Returns an lrcal.Design whose indices are rows of `pool`.)doc");
+}
+
+void DefineStudy(py::module_& m) {
+  m.def("run_study", &RunStudyPy, py::arg("study"), py::arg("out_dir"), py::arg("threads") = 0,
+        py::arg("progress") = py::none(), py::arg("shard") = py::none(), py::arg("max_trials") = 0,
+        R"doc(
+Runs (or resumes) a Monte-Carlo study, as `lrcal run STUDY --out OUT_DIR` does, and writes
+OUT_DIR/tables/ when every trial is recorded. The same numbers, bit for bit, as the command line
+whatever `threads` (0: all cores).
+
+study: a study file or a shipped name ("quick", "paper"). shard: "i/N" to run one shard.
+max_trials: stop after this many new trials (0: no limit); call again to continue.
+progress: None or a callable taking an lrcal.RunProgress, called about every 0.1 s from this
+thread. The trials run with the GIL released, so other Python threads keep running.
+Ctrl-C (KeyboardInterrupt) or an exception raised by `progress` stops the run like the command
+line's first Ctrl-C: finished trials are kept, and the exception is raised; run again to resume.
+Returns an lrcal.RunResult. Read the results with lrcal.load_run(out_dir).)doc");
+}
+
+}  // namespace
+
+}  // namespace lrcal::python
+
+PYBIND11_MODULE(_lrcal, m) {
+  namespace lp = lrcal::python;
+  m.doc() = "lrcal's C++ core (see the package lrcal for the documented interface).";
+  lp::RegisterErrors(m);
+  lp::DefineRig(m);
+  lp::DefineRobot(m);
+  lp::DefineResults(m);
+  lp::DefineIdentification(m);
+  lp::DefineRun(m);
+  lp::DefineKinematics(m);
+  lp::DefineCalibration(m);
+  lp::DefineStudy(m);
+  m.def("set_data_directory", &lrcal::SetEmbeddedDataDirectory, py::arg("path"),
+        "Registers where lrcal's shipped data is (the package does this on import).");
+  m.def(
+      "data_directory", [] { return lrcal::DataDirectory(); },
+      "The folder of lrcal's shipped robots, studies and analysis scripts ($LRCAL_DATA_DIR "
+      "overrides).");
+  m.attr("__version__") = LRCAL_VERSION;
+}

@@ -1,0 +1,138 @@
+"""The calibration core from Python: numpy shapes and dtypes, and the same numbers, bit for bit,
+as the lrcal program (sample, simulate, identify, identifiability, design)."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import lrcal
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array([[float(v) for v in r] for r in rows[1:]])
+
+
+def test_version_and_data_directory():
+    assert lrcal.__version__ == "0.2.0"
+    assert lrcal.data_directory().endswith("share/lrcal")
+
+
+def test_robot_file_is_read_as_the_program_reads_it(paper):
+    assert paper.name == "paper"
+    assert paper.num_joints == 6
+    assert paper.nominal_values.shape == (30,) and paper.nominal_values.dtype == np.float64
+    assert paper.value_names[:5] == ["theta1", "alpha1", "a1", "d1", "beta1"]
+    assert len(paper.parameter_names) == 25
+    np.testing.assert_array_equal(paper.true_values, paper.nominal_values + paper.true_errors)
+    assert paper.joint_limits.shape == (6, 2)
+    assert np.isclose(np.linalg.norm(paper.plane.normal), 1.0, atol=1e-15)
+
+
+def test_forward_kinematics_and_readings_shapes_and_geometry(paper):
+    q = lrcal.sample_configurations(paper, 25, seed=3)
+    assert q.shape == (25, 6) and q.dtype == np.float64
+    T = lrcal.forward_kinematics(paper, q)
+    assert T.shape == (25, 4, 4)
+    np.testing.assert_allclose(T[:, :3, :3] @ T[:, :3, :3].transpose(0, 2, 1),
+                               np.broadcast_to(np.eye(3), (25, 3, 3)), atol=1e-12)
+    h = lrcal.laser_readings(paper, q)
+    assert h.shape == (25,) and h.dtype == np.float64
+    # Independent check: the point p + h·b lies on the plane n·x + f = 0.
+    n, f = paper.plane.normal, paper.plane.offset
+    hit = T[:, :3, 3] + h[:, None] * T[:, :3, 2]
+    np.testing.assert_allclose(hit @ n + f, 0, atol=1e-12)
+    # One configuration as a vector; the true model differs from the nominal one.
+    assert lrcal.forward_kinematics(paper, q[0]).shape == (1, 4, 4)
+    assert not np.array_equal(lrcal.forward_kinematics(paper, q, model="true"), T)
+    np.testing.assert_array_equal(lrcal.forward_kinematics(paper, q, model=paper.nominal_values),
+                                  T)
+
+
+def test_missed_beams_are_nan_with_their_reason(paper):
+    q = lrcal.sample_configurations(paper, 200, seed=5, validation=True)
+    h, status = lrcal.laser_readings(paper, q, return_status=True)
+    missed = np.isnan(h)
+    assert missed.any() and not missed.all()
+    assert [s != "ok" for s in status] == missed.tolist()
+
+
+def test_sample_simulate_identify_match_the_program_bit_for_bit(tmp_path, cli, paper):
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    cli("sample", "--robot", "paper", "--count", 60, "--seed", 7, "--out", configs)
+    cli("simulate", "--robot", "paper", "--configs", configs, "--seed", 7, "--out", data)
+    program = json.loads(cli("identify", "--robot", "paper", "--data", data, "--sigma-mm", 0.2,
+                             "--format", "json").stdout)
+
+    q = lrcal.sample_configurations(paper, 60, seed=7)
+    _, c = read_csv(configs)
+    np.testing.assert_array_equal(q, c)
+    readings = lrcal.simulate(paper, q, sigma=0.2e-3, repetitions=10, seed=7)
+    header, m = read_csv(data)
+    assert readings.q.shape == (600, 6) and readings.h.shape == (600,)
+    np.testing.assert_array_equal(readings.q, m[:, :6])
+    np.testing.assert_array_equal(readings.h, m[:, header.index("h")])
+    np.testing.assert_array_equal(readings.configuration, np.repeat(np.arange(60), 10))
+
+    result = lrcal.identify(paper, readings.q, readings.h, sigma=0.2 * 1e-3)
+    assert result.termination == program["termination"] == "converged"
+    assert result.names == [p["name"] for p in program["parameters"]]
+    np.testing.assert_array_equal(result.estimate, [p["estimate"] for p in program["parameters"]])
+    np.testing.assert_array_equal(result.std, [p["std"] for p in program["parameters"]])
+    np.testing.assert_array_equal(result.covariance, program["covariance"])
+    np.testing.assert_array_equal(result.covariance_given, program["covariance_given_sigma"])
+    np.testing.assert_array_equal(result.correlation, program["correlation"])
+    assert result.iterations == program["iterations"]
+    assert result.sigma_hat == program["sigma_hat"]
+    assert result.covariance.shape == (25, 25) and result.estimate.dtype == np.float64
+    assert result.usable and "converged" in repr(result) and "theta1" in str(result)
+
+
+def test_identification_recovers_the_true_errors_without_noise(paper):
+    q = lrcal.sample_configurations(paper, 60, seed=11)
+    h = lrcal.laser_readings(paper, q, model="true")
+    hit = ~np.isnan(h)  # the true arm's beam may miss where the nominal one hits
+    result = lrcal.identify(paper, q[hit], h[hit])
+    truth = np.array([paper.true_errors[paper.value_names.index(n)] for n in result.names])
+    np.testing.assert_allclose(result.delta, truth, atol=1e-10)
+
+
+def test_identifiability_and_design_match_the_program(tmp_path, cli, paper):
+    pool = tmp_path / "pool.csv"
+    cli("sample", "--robot", "paper", "--count", 101, "--seed", 2, "--out", pool)
+    _, q = read_csv(pool)
+    program = json.loads(cli("identifiability", "--robot", "paper", "--configs", pool,
+                             "--format", "json").stdout)
+    report = lrcal.identifiability(paper, q)
+    assert report.rank == program["rank"] == 25 and report.full_rank
+    np.testing.assert_array_equal(report.singular_values, program["singular_values"])
+    few = lrcal.identifiability(paper, q[:10])
+    assert not few.full_rank and few.suggested_fixed and few.dependencies
+
+    program = json.loads(cli("design", "--robot", "paper", "--pool", pool, "--select", 40,
+                             "--baseline", 1, "--format", "json").stdout)
+    design = lrcal.design(paper, q, 40)
+    assert design.indices == program["selected"]
+    assert design.score == program["score"]
+    assert design.criterion == "E" and design.method == "exchange"
+
+
+def test_design_indices_are_rows_of_the_pool_given(paper):
+    anywhere = lrcal.sample_configurations(paper, 150, seed=9, validation=True)
+    design = lrcal.design(paper, anywhere, 30, method="greedy")
+    rejected = {row for row, _ in design.rejected}
+    assert rejected and not rejected & set(design.indices)
+    h = lrcal.laser_readings(paper, anywhere[design.indices])
+    assert not np.isnan(h).any()
+
+
+def test_docstrings_say_what_the_arguments_are():
+    for function in (lrcal.identify, lrcal.simulate, lrcal.design, lrcal.identifiability,
+                     lrcal.forward_kinematics, lrcal.laser_readings, lrcal.run_study,
+                     lrcal.load_run, lrcal.sample_configurations):
+        assert function.__doc__ and len(function.__doc__) > 200, function.__name__
+    doc = lrcal.identify.__doc__
+    for words in ("identify(robot", "estimate_plane", "(M, joints) rad", "lrcal.InputError"):
+        assert words in doc
