@@ -32,6 +32,11 @@ bool PathExists(const std::string& path) {
   return fs::exists(path, ec);
 }
 
+bool IsDirectory(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
 std::string DataDirectory() {
   if (const char* env = std::getenv("LRCAL_DATA_DIR")) {
     if (!IsDataDirectory(env))

@@ -18,7 +18,8 @@ std::string ResolveRobotPath(const std::string& name_or_path, const std::string&
   if (!relative_to.empty() && given.is_relative() &&
       (looks_like_file || name_or_path.find('/') != std::string::npos))
     return (fs::path(relative_to) / given).string();
-  if (name_or_path.find('/') != std::string::npos || PathExists(name_or_path) || looks_like_file)
+  const bool file_here = PathExists(name_or_path) && !IsDirectory(name_or_path);
+  if (name_or_path.find('/') != std::string::npos || file_here || looks_like_file)
     return name_or_path;
   // A short name: studies/robots/NAME.yaml in the working directory, then in lrcal's data.
   const fs::path local = fs::path("studies") / "robots" / (name_or_path + ".yaml");

@@ -16,7 +16,10 @@ namespace lrcal {
 
 std::string ResolveStudyPath(const std::string& name_or_path) {
   namespace fs = std::filesystem;
-  if (PathExists(name_or_path) || name_or_path.find('/') != std::string::npos) return name_or_path;
+  // A folder of that name (e.g. a run directory made by --out quick) is never a study file: a
+  // short name then still means the shipped study.
+  const bool file_here = PathExists(name_or_path) && !IsDirectory(name_or_path);
+  if (file_here || name_or_path.find('/') != std::string::npos) return name_or_path;
   const fs::path local = fs::path("studies") / (name_or_path + ".yaml");
   if (PathExists(local)) return local.string();
   if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;

@@ -12,6 +12,7 @@
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/io/robot_file.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
 
@@ -154,6 +155,22 @@ TEST(DataDirectory, AnEmbeddingProgramsFolderComesBeforeTheProgramsOwn) {
   ::unsetenv("LRCAL_DATA_DIR");
   SetEmbeddedDataDirectory("");
   EXPECT_EQ(FindDataFile("studies/robots/x.yaml"), "");
+}
+
+TEST(StudyPath, AFolderNamedLikeAShippedStudyDoesNotHideIt) {
+  // `lrcal run quick --out quick`, run again from the same folder: 'quick' is now a run
+  // directory, and still means the shipped study (likewise a robot name).
+  const std::string dir = testing::TempDir("study_path_folder");
+  std::filesystem::create_directories(dir + "/quick");
+  std::filesystem::create_directories(dir + "/paper");
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  const std::string study = ResolveStudyPath("quick");
+  const std::string robot = ResolveRobotPath("paper");
+  std::filesystem::current_path(before);
+  EXPECT_EQ(study, FindDataFile("studies/quick.yaml"));
+  EXPECT_EQ(robot, FindDataFile("studies/robots/paper.yaml"));
+  EXPECT_FALSE(study.empty());
 }
 
 }  // namespace

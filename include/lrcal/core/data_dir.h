@@ -16,6 +16,9 @@ namespace lrcal {
 /// simply not there: no exception.
 bool PathExists(const std::string& path);
 
+/// True if `path` is a directory (false for anything the file system cannot look up).
+bool IsDirectory(const std::string& path);
+
 /// The data folder (see the file comment). Throws InputError if none is found.
 std::string DataDirectory();
 
