@@ -24,8 +24,12 @@ const char* kAxes[3] = {"x", "y", "z"};
 
 std::string MeanRange(const Distribution& d, double scale) {
   if (d.n == 0) return "—";
-  return Fixed(d.mean * scale) + " [" + Fixed(d.p5 * scale) + ", " + Fixed(d.p95 * scale) + "]";
+  return Fixed(d.mean * scale) + " ± " + Fixed(d.mean_se * scale) + " [" + Fixed(d.p5 * scale) +
+         ", " + Fixed(d.p95 * scale) + "]";
 }
+
+// A number of a CSV column that may be unavailable (too few trials): empty then.
+std::string CsvValue(double x, int digits = 6) { return std::isnan(x) ? "" : Fixed(x, digits); }
 
 std::string UnitOf(const std::string& parameter) {
   return IsAngularName(parameter) ? "mrad" : "mm";
@@ -33,8 +37,20 @@ std::string UnitOf(const std::string& parameter) {
 
 Json DistJson(const Distribution& d, double scale) {
   auto v = [&](double x) { return std::isnan(x) ? Json() : Json(x * scale); };
-  return {{"n", d.n},        {"mean", v(d.mean)}, {"std", v(d.std)}, {"p5", v(d.p5)},
-          {"p50", v(d.p50)}, {"p95", v(d.p95)},   {"max", v(d.max)}};
+  auto ci = [&](const QuantileInterval& q) { return Json::array({v(q.low), v(q.high)}); };
+  return {{"n", d.n},
+          {"mean", v(d.mean)},
+          {"mean_se", v(d.mean_se)},
+          {"std", v(d.std)},
+          {"std_se", v(d.std_se)},
+          {"p5", v(d.p5)},
+          {"p5_ci", ci(d.p5_ci)},
+          {"p50", v(d.p50)},
+          {"p50_ci", ci(d.p50_ci)},
+          {"p95", v(d.p95)},
+          {"p95_ci", ci(d.p95_ci)},
+          {"max", v(d.max)},
+          {"max_bounds_p95", d.n ? Json(d.max_bounds_p95) : Json()}};
 }
 
 Json MatrixJson(const Eigen::MatrixXd& m) {
@@ -152,7 +168,8 @@ std::string Header(const Json& study, long long trials, bool complete) {
   if (study.contains("description") && !study["description"].get<std::string>().empty())
     md << study["description"].get<std::string>() << "\n\n";
   md << "Seed " << study.value("seed", 0ULL) << ", " << trials
-     << " trials per cell. Lengths in mm, angles in mrad; 'mean [p5, p95]' over the trials of a "
+     << " trials per cell. Lengths in mm, angles in mrad; 'mean ± SE [p5, p95]' over the trials of "
+        "a "
         "cell.\n";
   if (!complete) md << "\n**Partial run: some cells do not have all their trials yet.**\n";
   return md.str();
@@ -182,10 +199,28 @@ void AddValidationCsvRows(const CellSummary& s, bool identified, int axis, Table
   const auto& dists = identified ? s.validation : s.nominal;
   for (int m = 0; m < 4; ++m) {
     const Distribution& d = dists[3 * m + axis];
-    csv->AddRow({s.cell.id, s.cell.label, identified ? "identified" : "nominal", kMetricNames[m],
-                 kAxes[axis], m % 2 == 0 ? "mm" : "mrad", std::to_string(d.n),
-                 Fixed(d.mean * 1e3, 6), Fixed(d.std * 1e3, 6), Fixed(d.p5 * 1e3, 6),
-                 Fixed(d.p50 * 1e3, 6), Fixed(d.p95 * 1e3, 6), Fixed(d.max * 1e3, 6)});
+    csv->AddRow({s.cell.id,
+                 s.cell.label,
+                 identified ? "identified" : "nominal",
+                 kMetricNames[m],
+                 kAxes[axis],
+                 m % 2 == 0 ? "mm" : "mrad",
+                 std::to_string(d.n),
+                 Fixed(d.mean * 1e3, 6),
+                 Fixed(d.std * 1e3, 6),
+                 Fixed(d.p5 * 1e3, 6),
+                 Fixed(d.p50 * 1e3, 6),
+                 Fixed(d.p95 * 1e3, 6),
+                 Fixed(d.max * 1e3, 6),
+                 CsvValue(d.mean_se * 1e3),
+                 CsvValue(d.std_se * 1e3),
+                 CsvValue(d.p5_ci.low * 1e3),
+                 CsvValue(d.p5_ci.high * 1e3),
+                 CsvValue(d.p50_ci.low * 1e3),
+                 CsvValue(d.p50_ci.high * 1e3),
+                 CsvValue(d.p95_ci.low * 1e3),
+                 CsvValue(d.p95_ci.high * 1e3),
+                 d.n ? Fixed(d.max_bounds_p95, 6) : ""});
   }
 }
 
@@ -241,18 +276,20 @@ std::string PaperLayoutSection(const std::vector<CellSummary>& cells) {
 std::string ParameterSections(const std::vector<CellSummary>& cells, Table* csv, Table* tex) {
   std::ostringstream md;
   md << "\n## Parameter errors (estimate − truth)\n\nBias = mean error ± its Monte-Carlo standard "
-        "error; predicted std = σ·√diag(GᵀWG)⁻¹ at the nominal model; ratio = empirical / "
-        "predicted.\n";
+        "error; empirical std ± its standard error; predicted std = σ·√diag(GᵀWG)⁻¹ at the "
+        "nominal model; ratio = empirical / predicted ± its standard error.\n";
   for (const auto& s : cells) {
-    Table t({"parameter", "unit", "bias ± SE", "empirical std", "predicted std", "ratio"},
+    Table t({"parameter", "unit", "bias ± SE", "empirical std ± SE", "predicted std", "ratio ± SE"},
             "Cell " + s.cell.label + " (" + std::to_string(s.ok) + " trials ok)");
     for (const auto& p : s.parameters) {
       const std::string unit = UnitOf(p.name);
       t.AddRow({p.name, unit, Fixed(p.bias * 1e3) + " ± " + Fixed(p.bias_se * 1e3),
-                Fixed(p.std * 1e3), Fixed(p.predicted_std * 1e3), Fixed(p.ratio, 3)});
+                Fixed(p.std * 1e3) + " ± " + Fixed(p.std_se * 1e3), Fixed(p.predicted_std * 1e3),
+                Fixed(p.ratio, 3) + " ± " + Fixed(p.ratio_se, 3)});
       csv->AddRow({s.cell.id, s.cell.label, p.name, unit, Fixed(p.bias * 1e3, 6),
                    Fixed(p.bias_se * 1e3, 6), Fixed(p.std * 1e3, 6),
-                   Fixed(p.predicted_std * 1e3, 6), Fixed(p.ratio, 6)});
+                   Fixed(p.predicted_std * 1e3, 6), Fixed(p.ratio, 6), CsvValue(p.std_se * 1e3),
+                   CsvValue(p.ratio_se), std::to_string(s.ok)});
       tex->AddRow({s.cell.label, p.name, unit, Fixed(p.bias * 1e3), Fixed(p.bias_se * 1e3),
                    Fixed(p.std * 1e3), Fixed(p.predicted_std * 1e3), Fixed(p.ratio, 3)});
     }
@@ -284,8 +321,10 @@ Json CellJson(const CellSummary& s) {
                       {"bias", p.bias},
                       {"bias_se", p.bias_se},
                       {"std", p.std},
+                      {"std_se", NullIfNan(p.std_se)},
                       {"predicted_std", NullIfNan(p.predicted_std)},
-                      {"ratio", NullIfNan(p.ratio)}});
+                      {"ratio", NullIfNan(p.ratio)},
+                      {"ratio_se", NullIfNan(p.ratio_se)}});
   c["parameters"] = params;
   c["covariance"] = MatrixJson(s.covariance);
   c["correlation"] = MatrixJson(s.correlation);
@@ -331,19 +370,32 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
 
   Table val(
       {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
-  Table val_csv({"cell_id", "cell_label", "model", "metric", "axis", "unit", "n", "mean", "std",
-                 "p5", "p50", "p95", "max"});
+  Table val_csv({"cell_id",     "cell_label",
+                 "model",       "metric",
+                 "axis",        "unit",
+                 "n",           "mean",
+                 "std",         "p5",
+                 "p50",         "p95",
+                 "max",         "mean_se",
+                 "std_se",      "p5_ci_low",
+                 "p5_ci_high",  "p50_ci_low",
+                 "p50_ci_high", "p95_ci_low",
+                 "p95_ci_high", "max_bounds_p95"});
   ValidationTables(result.cells, &val, &val_csv);
   Table par_csv({"cell_id", "cell_label", "parameter", "unit", "bias", "bias_se", "std_empirical",
-                 "std_predicted", "std_ratio"});
+                 "std_predicted", "std_ratio", "std_empirical_se", "std_ratio_se", "n"});
   Table par_tex({"cell", "parameter", "unit", "bias", "SE", "std", "predicted", "ratio"},
                 "Parameter errors (estimate - truth), mm and mrad");
   const Table cells = CellsTable(result.cells);
 
   std::ostringstream md;
   md << Header(study, trials, result.complete) << "\n## Cells\n\n" << cells.ToMarkdown();
-  md << "\n## Validation errors\n\nOver the validation configurations, per base axis: mean "
-        "[p5, p95] over the trials (mm, mrad).\n\n"
+  md << "\n## Validation errors\n\nOver the validation configurations, per base axis: mean ± its "
+        "standard error [p5, p95] over the trials (mm, mrad). validation.csv adds the std ± SE, "
+        "95 % distribution-free confidence intervals of p5, p50 and p95 (from order statistics; "
+        "empty where a cell has too few trials, e.g. below 72 for the upper end of p95), and the "
+        "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
+        "(Wilks: at least 95 % from N = 59).\n\n"
      << val.ToMarkdown();
   md << PaperLayoutSection(result.cells) << ParameterSections(result.cells, &par_csv, &par_tex);
   if (any_paper)
