@@ -55,8 +55,14 @@ std::unique_ptr<Collective> MpiWorldIfLaunched() {
 }
 
 void PrintRunSummary(const RunResult& r, const RunOptions& options, int ranks) {
+  if (r.ranks_computed == 0 && r.done_before >= r.total) {
+    std::cerr << "lrcal run: nothing to compute: all " << r.total
+              << " trials of this run were already recorded\n";
+    return;
+  }
   std::cerr << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)
-            << " s (" << r.done_before << " already done, " << r.total << " in this run";
+            << " s (of " << r.total << " in this run; " << r.done_before
+            << " were already recorded";
   if (r.computed > 0)
     std::cerr << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial"
               << (ranks > 1 ? " on rank 0" : "");
@@ -65,14 +71,19 @@ void PrintRunSummary(const RunResult& r, const RunOptions& options, int ranks) {
   const int threads = options.threads > 0
                           ? options.threads
                           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // The runner's overhead is only measurable when the trials take a while: on a run of a few
+  // milliseconds thread start-up dominates and a percentage would mislead.
+  const std::string overhead =
+      r.run_seconds >= 1.0
+          ? "runner overhead " + Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1) +
+                " % over the trials' own time"
+          : "too short to measure the runner's overhead";
   std::cerr << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
             << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
-            << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string())
-            << "; runner overhead "
-            << Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1)
-            << " % over the trials' own time), tables " << Fixed(r.tables_seconds, 3)
-            << " s; peak memory " << r.peak_rss_kb_trials / 1024 << " MiB after the trials, "
-            << r.peak_rss_kb / 1024 << " MiB with the tables\n";
+            << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string()) << "; "
+            << overhead << "), tables " << Fixed(r.tables_seconds, 3) << " s; peak memory "
+            << r.peak_rss_kb_trials / 1024 << " MiB after the trials, " << r.peak_rss_kb / 1024
+            << " MiB with the tables\n";
 }
 
 // Shards of one study: which array tasks to resubmit, or how to merge.
@@ -128,10 +139,14 @@ int RunCommand(const std::vector<std::string>& args) {
               << study.trials << " trials → " << options.out_dir
               << (ranks > 1 ? " (" + std::to_string(ranks) + " MPI ranks)" : std::string()) << "\n";
   const RunResult r = RunStudyAndWriteTables(study, options, world.get());
-  if (rank != 0) return r.interrupted ? 130 : 0;
+  if (rank != 0) return r.interrupted && !r.reached_max_trials ? 130 : 0;
   PrintRunSummary(r, options, ranks);
   if (r.tables_written) {
     std::cout << "tables: " << options.out_dir << "/tables/summary.md (also .csv, .json, .tex)\n";
+  } else if (r.reached_max_trials) {
+    std::cout << "stopped after " << r.ranks_computed
+              << " new trials (--max-trials): " << r.done_before + r.ranks_computed << "/"
+              << r.total << " trials recorded; run the same command again to continue\n";
   } else if (r.interrupted && r.total == 0) {
     std::cout << "interrupted while the cells were prepared; nothing was written\n";
     return 130;
@@ -194,8 +209,8 @@ int PlanCommand(const std::vector<std::string>& args) {
               << "\n";
   } else {
     std::cout << t.ToText() << "total: " << study.cells.size() << " cells, " << study.total_trials()
-              << " trials, about " << Fixed(total_seconds, 0) << " s on " << threads
-              << " threads\n";
+              << " trials, about " << Fixed(total_seconds, total_seconds < 10 ? 1 : 0) << " s on "
+              << threads << " threads\n";
   }
   return 0;
 }
@@ -227,10 +242,22 @@ int MergeCommand(const std::vector<std::string>& args) {
   pos.add("dirs", -1);
   po::variables_map vm;
   if (!Parse("merge", "DIR... --out DIR", o, args, &vm, &pos)) return 0;
-  MergeRuns(vm["dirs"].as<std::vector<std::string>>(), vm["out"].as<std::string>());
-  std::cout << RunStatus(vm["out"].as<std::string>());
-  std::cout << "tables: " << vm["out"].as<std::string>() << "/tables/summary.md\n";
-  return 0;
+  const auto& dirs = vm["dirs"].as<std::vector<std::string>>();
+  const std::string out = vm["out"].as<std::string>();
+  const bool complete = MergeRuns(dirs, out);
+  if (complete) {
+    std::cout << RunStatus(out) << "tables: " << out << "/tables/summary.md\n";
+    return 0;
+  }
+  // Not every trial is in the shards: say which shards to finish, write no tables.
+  const RunStatusInfo merged = GetRunStatus(out);
+  std::cout << merged.text.substr(0, merged.text.find("last session"));
+  std::vector<RunStatusInfo> infos;
+  for (const auto& d : dirs) infos.push_back(GetRunStatus(d));
+  PrintShardAdvice(dirs, infos);
+  std::cout << "tables not written: the shards do not hold every trial yet; finish them and run "
+               "lrcal merge again\n";
+  return 1;
 }
 
 int AggregateCommand(const std::vector<std::string>& args) {

@@ -46,9 +46,11 @@ RunResult RunStudyAndWriteTables(const Study& study, const RunOptions& options,
   return result;
 }
 
-void MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& out_dir) {
+bool MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& out_dir) {
   MergeRunStores(shard_dirs, out_dir);
+  if (!GetRunStatus(out_dir).complete) return false;
   WriteRunTables(out_dir);
+  return true;
 }
 
 }  // namespace lrcal

@@ -181,8 +181,16 @@ Table CellsTable(const std::vector<CellSummary>& cells) {
     std::string failed;
     for (const auto& [reason, n] : s.failed)
       failed += (failed.empty() ? "" : ", ") + reason + " " + std::to_string(n);
+    const Json settings = Json::parse(s.cell.settings);
+    const bool redrawn = settings.value("/selection/redraw"_json_pointer, false) ||
+                         settings.value("/pool/redraw"_json_pointer, false);
+    const std::string sigma_min =
+        redrawn && s.design_sigma_min.n > 0
+            ? Fixed(s.design_sigma_min.mean, 5) + " [" + Fixed(s.design_sigma_min.p5, 5) + ", " +
+                  Fixed(s.design_sigma_min.p95, 5) + "] (redrawn per trial)"
+            : Fixed(s.cell.design_sigma_min, 5);
     t.AddRow({s.cell.label, s.cell.id, std::to_string(s.trials), std::to_string(s.ok),
-              failed.empty() ? "0" : failed, Fixed(s.cell.design_sigma_min, 5)});
+              failed.empty() ? "0" : failed, sigma_min});
   }
   return t;
 }
@@ -313,6 +321,7 @@ Json CellJson(const CellSummary& s) {
   c["ok"] = s.ok;
   c["failed"] = s.failed;
   c["design_sigma_min"] = s.cell.design_sigma_min;
+  c["design_sigma_min_trials"] = DistJson(s.design_sigma_min, 1.0);
   c["fixed_for_rank"] = s.cell.fixed_for_rank;
   c["settings"] = Json::parse(s.cell.settings);
   Json params = Json::array();

@@ -393,6 +393,12 @@ class StudyRunner {
     }
   }
 
+  // The run stopped at --max-trials (this process's limit), not at a signal, before the end.
+  bool ReachedMaxTrials() const {
+    return !result_.complete && !stop_->stop_requested() && options_.max_new_trials > 0 &&
+           result_.computed >= options_.max_new_trials;
+  }
+
   // Rank 0 folds the rank stores into the main store and closes the session in the manifest.
   void FinishSession() {
     result_.ranks_computed = collective_->SumAll(result_.computed);
@@ -408,10 +414,13 @@ class StudyRunner {
             ++done_now;
       result_.complete = done_now >= result_.total;
       result_.interrupted = stop_->stop_requested() || !result_.complete;
+      result_.reached_max_trials = ReachedMaxTrials();
       Json& session = manifest_["sessions"][session_];
       session["end"] = UtcNow();
       session["trials_computed"] = result_.ranks_computed;
-      session["ended"] = result_.interrupted ? "interrupted" : "completed";
+      session["ended"] = result_.reached_max_trials ? "max_trials"
+                         : result_.interrupted      ? "interrupted"
+                                                    : "completed";
       session["seconds"] = {{"prepare", result_.prepare_seconds},
                             {"trials", result_.run_seconds},
                             {"sum_of_trial_times", result_.trial_seconds}};
@@ -424,6 +433,7 @@ class StudyRunner {
       // token and, under the static schedule, whether it finished its share.
       result_.interrupted =
           stop_->stop_requested() || (!dynamic_ && result_.computed < work_->share());
+      result_.reached_max_trials = result_.interrupted && ReachedMaxTrials();
     }
     collective_->Barrier();  // rank 0 has merged: the run directory is consistent
   }

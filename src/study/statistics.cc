@@ -159,7 +159,7 @@ namespace {
 struct CellValues {
   Eigen::MatrixXd errors;  ///< row = ok trial in canonical order, column-major
   std::array<std::vector<double>, 12> validation, nominal;
-  std::vector<double> iterations, sigma_hat;
+  std::vector<double> iterations, sigma_hat, sigma_min;
 };
 
 CellValues ReadCellValues(const TrialStore& store, const StoredCell& cell, CellSummary* s) {
@@ -186,6 +186,7 @@ CellValues ReadCellValues(const TrialStore& store, const StoredCell& cell, CellS
     for (int k = 0; k < 12; ++k) v.validation[k].push_back(r.validation[k]);
     v.iterations.push_back(r.iterations);
     v.sigma_hat.push_back(r.sigma_hat);
+    v.sigma_min.push_back(r.sigma_min);
   });
   v.errors.conservativeResize(s->ok, n);
   return v;
@@ -238,6 +239,7 @@ CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
   }
   s.iterations = DescribeInPlace(&v.iterations);
   s.sigma_hat = DescribeInPlace(&v.sigma_hat);
+  s.design_sigma_min = DescribeInPlace(&v.sigma_min);
   // The paper's placement needs the raw errors of paper cells; keep only those.
   if (Json::parse(cell.settings).value("paper_case", 0) > 0)
     for (int k = 0; k < v.errors.cols(); ++k)

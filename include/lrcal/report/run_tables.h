@@ -22,7 +22,9 @@ StudyTablesResult WriteRunTables(const std::string& run_dir);
 RunResult RunStudyAndWriteTables(const Study& study, const RunOptions& options,
                                  Collective* collective = nullptr, StopToken* stop = nullptr);
 
-/// Combines shard run directories into `out_dir` (records, manifest) and writes the tables.
-void MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& out_dir);
+/// Combines shard run directories into `out_dir` (records, manifest) and, when every trial of
+/// the study is there, writes the tables; returns whether it did (a partial merge writes none:
+/// finish the shards and merge again).
+bool MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& out_dir);
 
 }  // namespace lrcal

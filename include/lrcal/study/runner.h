@@ -69,10 +69,12 @@ struct RunOptions {
 };
 
 struct RunResult {
-  long long total = 0;           ///< trials of this run (or shard)
-  long long done_before = 0;     ///< already in the store at start
-  long long computed = 0;        ///< computed by this session (this process)
-  bool interrupted = false;      ///< stopped before every trial of the run was recorded
+  long long total = 0;        ///< trials of this run (or shard)
+  long long done_before = 0;  ///< already in the store at start
+  long long computed = 0;     ///< computed by this session (this process)
+  bool interrupted = false;   ///< stopped before every trial of the run was recorded
+  /// Stopped because max_new_trials were computed (not by a signal): a slice, not an interruption.
+  bool reached_max_trials = false;
   bool complete = false;         ///< every trial of the run (or shard) is recorded (rank 0)
   bool tables_written = false;   ///< set by the caller that writes the tables
   double seconds = 0;            ///< wall time of the whole call

@@ -81,6 +81,9 @@ struct CellSummary {
   std::array<std::vector<double>, 12> validation_values;
   std::vector<std::vector<double>> error_values;
   Distribution iterations, sigma_hat;
+  /// σ_min of each ok trial's design: one value for a fixed design, a distribution when the
+  /// pool or the selection is redrawn per trial.
+  Distribution design_sigma_min;
 };
 
 /// Summarises one cell from the store.

@@ -1,0 +1,87 @@
+// What lrcal run, merge and plan tell the user about a run: slices by --max-trials are not
+// interruptions, a finished run says there is nothing to do, a partial merge writes no tables,
+// and redrawn designs show their σ_min over the trials.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+using testing::LrcalBinary;
+using testing::RunCommand;
+namespace fs = std::filesystem;
+
+int Lrcal(const std::string& args, std::string* out) {
+  return RunCommand(LrcalBinary() + " " + args, out);
+}
+
+std::string LastSessionEnd(const std::string& run_dir) {
+  const auto manifest = nlohmann::json::parse(testing::ReadFile(run_dir + "/manifest.json"));
+  return manifest["sessions"].back()["ended"].get<std::string>();
+}
+
+TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
+  const std::string dir = testing::TempDir("max_trials_slice");
+  std::string out;
+  ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet --max-trials 50", &out), 0) << out;
+  EXPECT_NE(out.find("stopped after 50 new trials (--max-trials): 50/200 trials recorded"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(out.find("interrupted"), std::string::npos) << out;
+  EXPECT_EQ(LastSessionEnd(dir + "/run"), "max_trials");
+  ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
+  EXPECT_NE(out.find("150 trials computed"), std::string::npos) << out;
+  EXPECT_NE(out.find("50 were already recorded"), std::string::npos) << out;
+  EXPECT_EQ(LastSessionEnd(dir + "/run"), "completed");
+  // Once more: nothing to do, said so (not "0 trials computed").
+  ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
+  EXPECT_NE(out.find("nothing to compute: all 200 trials of this run were already recorded"),
+            std::string::npos)
+      << out;
+  // A short run does not print a meaningless overhead percentage.
+  ASSERT_EQ(Lrcal("run quick --out " + dir + "/small --quiet --threads 2", &out), 0) << out;
+  EXPECT_NE(out.find("too short to measure the runner's overhead"), std::string::npos) << out;
+}
+
+TEST(RunBookkeeping, MergingIncompleteShardsWritesNoTablesAndSaysWhatToFinish) {
+  const std::string dir = testing::TempDir("merge_incomplete");
+  std::string out;
+  ASSERT_EQ(Lrcal("run quick --shard 1/2 --out " + dir + "/s1 --quiet", &out), 0) << out;
+  ASSERT_EQ(Lrcal("run quick --shard 2/2 --out " + dir + "/s2 --quiet --max-trials 30", &out), 0)
+      << out;
+  ASSERT_EQ(Lrcal("merge " + dir + "/s1 " + dir + "/s2 --out " + dir + "/m", &out), 1) << out;
+  EXPECT_NE(out.find("tables not written"), std::string::npos) << out;
+  EXPECT_NE(out.find("unfinished or missing shards: 2"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir + "/m/tables"));
+  ASSERT_EQ(Lrcal("run quick --shard 2/2 --out " + dir + "/s2 --quiet", &out), 0) << out;
+  ASSERT_EQ(Lrcal("merge " + dir + "/s1 " + dir + "/s2 --out " + dir + "/m", &out), 0) << out;
+  EXPECT_EQ(testing::ReadFile(dir + "/m/tables/summary.md"),
+            testing::ReadFile(testing::SourcePath("tests/golden/quick/summary.md")));
+}
+
+TEST(RunBookkeeping, PlanOfAShortStudySaysItsSecondsWithADecimal) {
+  std::string out;
+  ASSERT_EQ(Lrcal("plan quick", &out), 0) << out;
+  EXPECT_NE(out.find("trials, about 0."), std::string::npos) << out;
+  EXPECT_EQ(out.find("about 0 s"), std::string::npos) << out;
+}
+
+TEST(RunBookkeeping, RedrawnDesignsShowSigmaMinOverTheTrials) {
+  const std::string dir = testing::TempDir("redraw_sigma_min");
+  std::ofstream(dir + "/s.yaml") << "name: redraw\nseed: 4\ntrials: 20\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 40, redraw: true}\nselection: {count: 30}\n"
+                                    "validation: {size: 5}\n";
+  std::string out;
+  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
+  const std::string cells = testing::ReadFile(dir + "/run/tables/cells.csv");
+  EXPECT_NE(cells.find("(redrawn per trial)"), std::string::npos) << cells;
+}
+
+}  // namespace
+}  // namespace lrcal
