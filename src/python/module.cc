@@ -652,6 +652,8 @@ void DefineRun(py::module_& m) {
       .def_readonly("done_before", &RunResult::done_before, "already recorded at the start")
       .def_readonly("computed", &RunResult::computed, "computed by this call")
       .def_readonly("interrupted", &RunResult::interrupted)
+      .def_readonly("reached_max_trials", &RunResult::reached_max_trials,
+                    "stopped because max_trials were computed (call again to continue)")
       .def_readonly("complete", &RunResult::complete, "every trial of the run is recorded")
       .def_readonly("tables_written", &RunResult::tables_written, "OUT/tables/ was written")
       .def_readonly("seconds", &RunResult::seconds)

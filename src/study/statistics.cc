@@ -221,6 +221,11 @@ void SummarizeParameters(const StoredCell& cell, Eigen::MatrixXd* errors, CellSu
     p.ratio = p.std / p.predicted_std;
     p.std_se = StdStandardError(errors->col(k).data(), static_cast<std::size_t>(m), 0, p.std);
     p.ratio_se = p.std_se / p.predicted_std;
+    p.predicted_std_truth = k < static_cast<int>(cell.predicted_std_truth.size())
+                                ? cell.predicted_std_truth[k]
+                                : std::nan("");
+    p.ratio_truth = p.std / p.predicted_std_truth;
+    p.ratio_truth_se = p.std_se / p.predicted_std_truth;
     s->parameters.push_back(p);
   }
 }

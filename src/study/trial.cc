@@ -188,6 +188,12 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
     ExactReadings(*c->robot, truth, c->plane, c->ranger, c->pool, &c->pool_true_h,
                   &c->pool_true_miss);
   c->validation_true_poses = ToolPoses(*c->robot, truth, c->validation);
+  if (!c->rank_deficient && !s.selection_redraw && !s.pool_redraw) {
+    const Eigen::MatrixXd Gt =
+        IdentificationJacobian(*c->model, c->design.configs, c->fixed_truth.delta.data());
+    c->predicted_std_truth =
+        ParameterCovariance(s.repetitions * (Gt.transpose() * Gt), s.sigma).diagonal().cwiseSqrt();
+  }
   c->nominal_validation =
       ComparePoses(*c->robot, truth, c->robot->nominal_values(), c->validation).stats;
 }

@@ -71,7 +71,10 @@ struct CellContext {
   std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
   ConfigurationSet validation;                      ///< shared by every trial of the cell
   Eigen::VectorXd predicted_std;  ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
-  TrialTruth fixed_truth;         ///< when the truth is fixed (robot file × scale)
+  /// The same with G at the true parameters: the Cramér–Rao bound of the simulated experiment
+  /// (fixed truth and design; empty otherwise).
+  Eigen::VectorXd predicted_std_truth;
+  TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;
 };

@@ -73,7 +73,21 @@ class Statement {
 
 constexpr const char* kCellColumns =
     "cell_id, ord, label, settings, parameter_names, predicted_std, design_sigma_min, "
-    "fixed_for_rank, pool_report, truth_errors";
+    "fixed_for_rank, pool_report, truth_errors, predicted_std_truth";
+
+// Standard deviations as JSON, NaN (a parameter without a prediction) as null, and back.
+std::string StdJson(const std::vector<double>& sd) {
+  nlohmann::json j = nlohmann::json::array();
+  for (double v : sd) j.push_back(std::isnan(v) ? nlohmann::json() : nlohmann::json(v));
+  return j.dump();
+}
+
+std::vector<double> StdFromJson(const std::string& text) {
+  std::vector<double> sd;
+  for (const auto& v : nlohmann::json::parse(text))
+    sd.push_back(v.is_null() ? std::nan("") : v.get<double>());
+  return sd;
+}
 
 std::string TrialColumns() {
   std::string cols = "cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min";
@@ -105,15 +119,19 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
   Exec(
       "CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
       "settings TEXT, parameter_names TEXT, predicted_std TEXT, design_sigma_min REAL, "
-      "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT)");
-  // Stores written before lrcal recorded the truth: add the column (the tables then leave out
-  // what needs the truth rather than re-reading a robot file that may have changed).
-  bool has_truth = false;
+      "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT, predicted_std_truth TEXT)");
+  // Stores written before lrcal recorded the truth or its prediction: add the columns (the tables
+  // then leave out what needs them rather than re-reading a robot file that may have changed).
+  bool has_truth = false, has_truth_prediction = false;
   {
     Statement info(db_, "PRAGMA table_info(cells)");
-    while (info.Step()) has_truth |= info.ColumnText(1) == "truth_errors";
+    while (info.Step()) {
+      has_truth |= info.ColumnText(1) == "truth_errors";
+      has_truth_prediction |= info.ColumnText(1) == "predicted_std_truth";
+    }
   }
   if (!has_truth) Exec("ALTER TABLE cells ADD COLUMN truth_errors TEXT");
+  if (!has_truth_prediction) Exec("ALTER TABLE cells ADD COLUMN predicted_std_truth TEXT");
   std::string trials =
       "CREATE TABLE IF NOT EXISTS trials(cell_id TEXT NOT NULL, trial INTEGER NOT NULL, "
       "status TEXT NOT NULL, iterations INTEGER, residual_rms REAL, sigma_hat REAL, sigma_min REAL";
@@ -149,21 +167,20 @@ StoredCell ToStoredCell(const CellContext& c) {
   if (!c.cell->typed.truth_random)
     s.truth_errors.assign(c.fixed_truth.errors.data(),
                           c.fixed_truth.errors.data() + c.fixed_truth.errors.size());
+  s.predicted_std_truth.assign(c.predicted_std_truth.data(),
+                               c.predicted_std_truth.data() + c.predicted_std_truth.size());
   return s;
 }
 
 void TrialStore::PutCell(const StoredCell& cell) {
   Statement st(db_, "INSERT OR REPLACE INTO cells(" + std::string(kCellColumns) +
-                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   st.Text(1, cell.id);
   sqlite3_bind_int(st.get(), 2, cell.order);
   st.Text(3, cell.label);
   st.Text(4, cell.settings);
   st.Text(5, nlohmann::json(cell.parameter_names).dump());
-  nlohmann::json sd = nlohmann::json::array();
-  for (double v : cell.predicted_std)
-    sd.push_back(std::isnan(v) ? nlohmann::json() : nlohmann::json(v));
-  st.Text(6, sd.dump());
+  st.Text(6, StdJson(cell.predicted_std));
   sqlite3_bind_double(st.get(), 7, cell.design_sigma_min);
   st.Text(8, nlohmann::json(cell.fixed_for_rank).dump());
   st.Text(9, cell.pool_report);
@@ -171,6 +188,10 @@ void TrialStore::PutCell(const StoredCell& cell) {
     sqlite3_bind_null(st.get(), 10);
   else
     st.Text(10, nlohmann::json(cell.truth_errors).dump());
+  if (cell.predicted_std_truth.empty())
+    sqlite3_bind_null(st.get(), 11);
+  else
+    st.Text(11, StdJson(cell.predicted_std_truth));
   st.Step();
 }
 
@@ -184,13 +205,14 @@ std::vector<StoredCell> TrialStore::Cells() const {
     c.label = st.ColumnText(2);
     c.settings = st.ColumnText(3);
     c.parameter_names = nlohmann::json::parse(st.ColumnText(4)).get<std::vector<std::string>>();
-    for (const auto& v : nlohmann::json::parse(st.ColumnText(5)))
-      c.predicted_std.push_back(v.is_null() ? std::nan("") : v.get<double>());
+    c.predicted_std = StdFromJson(st.ColumnText(5));
     c.design_sigma_min = sqlite3_column_double(st.get(), 6);
     c.fixed_for_rank = nlohmann::json::parse(st.ColumnText(7)).get<std::vector<std::string>>();
     c.pool_report = st.ColumnText(8);
     if (sqlite3_column_type(st.get(), 9) != SQLITE_NULL)
       c.truth_errors = nlohmann::json::parse(st.ColumnText(9)).get<std::vector<double>>();
+    if (sqlite3_column_type(st.get(), 10) != SQLITE_NULL)
+      c.predicted_std_truth = StdFromJson(st.ColumnText(10));
     out.push_back(c);
   }
   return out;

@@ -64,6 +64,9 @@ def test_run_study_gives_the_programs_tables_and_trials(tmp_path, cli):
 
 
 def test_load_run_without_pandas_gives_numpy_structured_arrays(tmp_path):
+    part = lrcal.run_study("quick", str(tmp_path / "r"), threads=1, max_trials=50)
+    assert part.reached_max_trials and not part.complete and part.computed == 50
+    assert not lrcal.load_run(tmp_path / "r").tables
     lrcal.run_study("quick", str(tmp_path / "r"), threads=1)
     run = lrcal.load_run(tmp_path / "r", as_pandas=False)
     assert isinstance(run.trials, np.ndarray) and run.trials.dtype.names[:3] == (

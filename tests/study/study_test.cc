@@ -12,7 +12,10 @@
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/identification.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/study/trial_store.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
 
@@ -171,6 +174,40 @@ TEST(StudyPath, AFolderNamedLikeAShippedStudyDoesNotHideIt) {
   EXPECT_EQ(study, FindDataFile("studies/quick.yaml"));
   EXPECT_EQ(robot, FindDataFile("studies/robots/paper.yaml"));
   EXPECT_FALSE(study.empty());
+}
+
+TEST(CellPrediction, AtTheTruthIsTheNominalFormulaForAnArmWhoseNominalIsTheTruth) {
+  // Independent path: an arm whose nominal link values are the true ones, evaluated at e = 0,
+  // has the Jacobian of the original arm at e = truth.
+  const std::string dir = testing::TempDir("prediction_truth");
+  std::ofstream(dir + "/s.yaml") << "name: p\nseed: 2\ntrials: 5\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 40}\nselection: {count: 30}\n"
+                                    "validation: {size: 5}\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  const auto cell = PrepareCell(study, study.cells[0]);
+  const RobotModel& robot = *cell->robot;
+  std::vector<Link> links = robot.links();
+  for (int i = 0; i < robot.num_links(); ++i)
+    for (int v = 0; v < kValuesPerLink; ++v)
+      links[i].nominal[v] = robot.true_values()[kValuesPerLink * i + v];
+  const RobotModel at_truth("truth", links, Eigen::VectorXd::Zero(robot.num_values()));
+  const MeasurementModel model(at_truth, cell->plane, cell->model->parameters());
+  const Eigen::MatrixXd G = IdentificationJacobian(model, cell->design.configs);
+  const CellSettings& s = cell->cell->typed;
+  const Eigen::VectorXd expected =
+      ParameterCovariance(s.repetitions * (G.transpose() * G), s.sigma).diagonal().cwiseSqrt();
+  ASSERT_EQ(cell->predicted_std_truth.size(), expected.size());
+  for (Eigen::Index k = 0; k < expected.size(); ++k)
+    EXPECT_NEAR(cell->predicted_std_truth[k] / expected[k], 1.0, 1e-9) << k;
+  // It differs from the prediction at the nominal model (mrad-size true errors), and the store
+  // keeps it.
+  EXPECT_GT((cell->predicted_std_truth - cell->predicted_std).cwiseAbs().maxCoeff(), 0.0);
+  TrialStore store(dir + "/store.sqlite");
+  store.PutCell(ToStoredCell(*cell));
+  EXPECT_EQ(store.Cells()[0].predicted_std_truth,
+            std::vector<double>(cell->predicted_std_truth.data(),
+                                cell->predicted_std_truth.data() + expected.size()));
 }
 
 }  // namespace

@@ -66,6 +66,10 @@ struct ParameterStats {
   /// Standard errors of std (as Distribution::std_se) and of ratio (std_se / predicted_std: the
   /// prediction is exact).
   double std_se = 0, ratio_se = 0;
+  /// The prediction at the true parameters (the Cramér–Rao bound of the simulated experiment),
+  /// and the empirical std's ratio to it with its SE; NaN when the cell has none (random truth
+  /// or redrawn designs).
+  double predicted_std_truth = 0, ratio_truth = 0, ratio_truth_se = 0;
 };
 
 struct CellSummary {

@@ -2,7 +2,8 @@
 //
 // Tables (queryable from Python/pandas; analysis/ reads them):
 //   cells(cell_id, ord, label, settings JSON, parameter_names JSON, predicted_std JSON (SI),
-//         design_sigma_min, fixed_for_rank JSON, pool_report, truth_errors JSON (SI, 5N))
+//         design_sigma_min, fixed_for_rank JSON, pool_report, truth_errors JSON (SI, 5N),
+//         predicted_std_truth JSON (SI))
 //   trials(cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min,
 //          val_{rms,max}_{pos,ori}_{x,y,z}, nom_{...}, errors BLOB, seconds)
 //     errors: the parameter errors (estimate − truth, SI) as little-endian float64, in the order
@@ -35,7 +36,10 @@ struct StoredCell {
   int order = 0;
   std::string settings;  ///< JSON
   std::vector<std::string> parameter_names;
-  std::vector<double> predicted_std;  ///< SI
+  std::vector<double> predicted_std;  ///< SI, G at the nominal model
+  /// SI, G at the true parameters (the Cramér–Rao bound of the simulated experiment); empty
+  /// unless the truth and the design are fixed.
+  std::vector<double> predicted_std_truth;
   double design_sigma_min = 0;
   std::vector<std::string> fixed_for_rank;
   std::string pool_report;

@@ -22,7 +22,8 @@ _METRICS = [f"{stat}_{kind}_{axis}" for stat in ("rms", "max") for kind in ("pos
 _TRIAL_COLUMNS = (["cell_id", "trial", "status", "iterations", "residual_rms", "sigma_hat",
                    "sigma_min"] + [f"val_{m}" for m in _METRICS] + [f"nom_{m}" for m in _METRICS]
                   + ["seconds"])
-_CELL_JSON = ("settings", "parameter_names", "predicted_std", "fixed_for_rank", "truth_errors")
+_CELL_JSON = ("settings", "parameter_names", "predicted_std", "fixed_for_rank", "truth_errors",
+              "predicted_std_truth")
 
 
 def _error(path, what):
@@ -125,12 +126,15 @@ class Run:
         rows = {}
         for store in self._stores:
             with self._connect(store) as db:
+                present = {c[1] for c in db.execute("PRAGMA table_info(cells)")}
+                # Columns a store written by an older lrcal lacks are read as NULL.
+                json_columns = [c if c in present else f"NULL AS {c}" for c in _CELL_JSON]
                 for r in db.execute(
-                        "SELECT cell_id, ord, label, settings, parameter_names, predicted_std, "
-                        "fixed_for_rank, truth_errors, design_sigma_min, pool_report FROM cells "
-                        "ORDER BY ord"):
-                    decoded = [json.loads(v) if v else None for v in r[3:8]]
-                    rows.setdefault(r[0], (r[0], r[1], r[2], *decoded, r[8], r[9]))
+                        f"SELECT cell_id, ord, label, {', '.join(json_columns)}, "
+                        "design_sigma_min, pool_report FROM cells ORDER BY ord"):
+                    n = len(_CELL_JSON)
+                    decoded = [json.loads(v) if v else None for v in r[3:3 + n]]
+                    rows.setdefault(r[0], (r[0], r[1], r[2], *decoded, r[3 + n], r[4 + n]))
         return sorted(rows.values(), key=lambda r: r[1])
 
     def _read_trials(self, with_errors=False):
