@@ -69,5 +69,6 @@ int PlanCommand(const std::vector<std::string>& args);
 int StatusCommand(const std::vector<std::string>& args);
 int MergeCommand(const std::vector<std::string>& args);
 int AggregateCommand(const std::vector<std::string>& args);
+int TrialCommand(const std::vector<std::string>& args);
 
 }  // namespace lrcal::cli

@@ -16,6 +16,8 @@ const std::vector<Command>& Commands() {
       {"plan", "dry run: cells, trials and an estimated run time of a study", PlanCommand},
       {"status", "done / remaining trials per cell of a run directory", StatusCommand},
       {"merge", "combine shard run directories into one run", MergeCommand},
+      {"trial", "replay one recorded trial in detail and check it against its record",
+       TrialCommand},
       {"aggregate", "rewrite the tables of a run directory from its trial store", AggregateCommand},
       {"report", "figures (PNG, SVG) and a self-contained report.html of a run, partial or not",
        ReportCommand},

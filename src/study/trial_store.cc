@@ -282,6 +282,30 @@ TrialStatus StatusFromName(const std::string& s) {
 }
 }  // namespace
 
+namespace {
+
+// One row of SELECT TrialColumns() into a record (the cell id is the caller's).
+void ReadTrialRow(Statement& st, TrialRecord* r) {
+  r->trial = sqlite3_column_int64(st.get(), 1);
+  r->status = StatusFromName(st.ColumnText(2));
+  r->iterations = sqlite3_column_int(st.get(), 3);
+  r->residual_rms = sqlite3_column_double(st.get(), 4);
+  r->sigma_hat = sqlite3_column_double(st.get(), 5);
+  r->sigma_min = sqlite3_column_double(st.get(), 6);
+  for (int k = 0; k < 12; ++k) {
+    r->validation[k] = sqlite3_column_type(st.get(), 7 + k) == SQLITE_NULL
+                           ? std::nan("")
+                           : sqlite3_column_double(st.get(), 7 + k);
+    r->nominal[k] = sqlite3_column_double(st.get(), 19 + k);
+  }
+  const int bytes = sqlite3_column_bytes(st.get(), 31);
+  r->errors.resize(bytes / sizeof(double));
+  if (bytes) std::memcpy(r->errors.data(), sqlite3_column_blob(st.get(), 31), bytes);
+  r->seconds = sqlite3_column_double(st.get(), 32);
+}
+
+}  // namespace
+
 void TrialStore::ForEachTrial(const std::string& cell_id,
                               const std::function<void(const TrialRecord&)>& visit) const {
   Statement st(db_, "SELECT " + TrialColumns() + " FROM trials WHERE cell_id = ? ORDER BY trial");
@@ -289,24 +313,20 @@ void TrialStore::ForEachTrial(const std::string& cell_id,
   TrialRecord r;
   r.cell_id = cell_id;  // every row has it: no per-row string
   while (st.Step()) {
-    r.trial = sqlite3_column_int64(st.get(), 1);
-    r.status = StatusFromName(st.ColumnText(2));
-    r.iterations = sqlite3_column_int(st.get(), 3);
-    r.residual_rms = sqlite3_column_double(st.get(), 4);
-    r.sigma_hat = sqlite3_column_double(st.get(), 5);
-    r.sigma_min = sqlite3_column_double(st.get(), 6);
-    for (int k = 0; k < 12; ++k) {
-      r.validation[k] = sqlite3_column_type(st.get(), 7 + k) == SQLITE_NULL
-                            ? std::nan("")
-                            : sqlite3_column_double(st.get(), 7 + k);
-      r.nominal[k] = sqlite3_column_double(st.get(), 19 + k);
-    }
-    const int bytes = sqlite3_column_bytes(st.get(), 31);
-    r.errors.resize(bytes / sizeof(double));
-    if (bytes) std::memcpy(r.errors.data(), sqlite3_column_blob(st.get(), 31), bytes);
-    r.seconds = sqlite3_column_double(st.get(), 32);
+    ReadTrialRow(st, &r);
     visit(r);
   }
+}
+
+std::optional<TrialRecord> TrialStore::GetTrial(const std::string& cell_id, long long trial) const {
+  Statement st(db_, "SELECT " + TrialColumns() + " FROM trials WHERE cell_id = ? AND trial = ?");
+  st.Text(1, cell_id);
+  sqlite3_bind_int64(st.get(), 2, trial);
+  if (!st.Step()) return std::nullopt;
+  TrialRecord r;
+  r.cell_id = cell_id;
+  ReadTrialRow(st, &r);
+  return r;
 }
 
 void TrialStore::MergeFrom(const std::string& other_path) {

@@ -65,6 +65,8 @@ class TrialStore {
   /// Trial indices stored for a cell, ascending.
   std::vector<long long> DoneTrials(const std::string& cell_id) const;
   long long CountTrials(const std::string& cell_id) const;
+  /// The record of (cell, trial), if stored.
+  std::optional<TrialRecord> GetTrial(const std::string& cell_id, long long trial) const;
   /// Every record of a cell in trial order (the canonical order for aggregation).
   void ForEachTrial(const std::string& cell_id,
                     const std::function<void(const TrialRecord&)>& visit) const;

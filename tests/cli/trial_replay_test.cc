@@ -1,0 +1,85 @@
+// lrcal trial: a recorded trial is recomputed bit for bit; a tampered record, an unknown cell or
+// trial, and a study file changed since the run are reported.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+using testing::LrcalBinary;
+using testing::RunCommand;
+
+int Lrcal(const std::string& args, std::string* out) {
+  return RunCommand(LrcalBinary() + " " + args, out);
+}
+
+class TrialReplayTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::TempDir("trial_replay");
+    study_ = dir_ + "/s.yaml";
+    WriteStudy(7);
+    std::string out;
+    ASSERT_EQ(Lrcal("run " + study_ + " --out " + dir_ + "/run --quiet", &out), 0) << out;
+  }
+  void WriteStudy(int seed) const {
+    std::ofstream(study_)
+        << "name: replay\nseed: " << seed
+        << "\ntrials: 30\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
+        << "\npool: {size: 40}\nselection: {count: 30}\nvalidation: {size: 5}\n"
+           "sweep:\n  axes:\n    - key: noise.sigma_mm\n      values: [0.1, 0.3]\n";
+  }
+  std::string dir_, study_;
+};
+
+TEST_F(TrialReplayTest, RecomputesARecordedTrialBitForBit) {
+  std::string out;
+  ASSERT_EQ(
+      Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.3' --trial 12 --format json", &out), 0)
+      << out;
+  const auto j = nlohmann::json::parse(out);
+  EXPECT_TRUE(j["stored"].get<bool>());
+  EXPECT_TRUE(j["identical"].get<bool>());
+  EXPECT_EQ(j["configurations"].size(), 30u);
+  EXPECT_EQ(j["record"]["errors"].size(), j["parameters"].size());
+  ASSERT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 0", &out), 0) << out;
+  EXPECT_NE(out.find("identical to the stored record, bit for bit"), std::string::npos) << out;
+}
+
+TEST_F(TrialReplayTest, ATamperedRecordIsReportedWithTheFieldsThatDiffer) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir_ + "/run/trials.sqlite").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "UPDATE trials SET iterations = iterations + 1, val_rms_pos_y = 1 "
+                         "WHERE trial = 4",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  std::string out;
+  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 4", &out), 1) << out;
+  EXPECT_NE(out.find("DIFFERS from the stored record in: iterations val_rms_pos_y"),
+            std::string::npos)
+      << out;
+}
+
+TEST_F(TrialReplayTest, BadRequestsAndAChangedStudyAreClearErrors) {
+  std::string out;
+  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell nope --trial 1", &out), 2) << out;
+  EXPECT_NE(out.find("--cell: no cell 'nope' in the run; cells: noise.sigma_mm=0.1"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 30", &out), 2) << out;
+  EXPECT_NE(out.find("--trial: expected 0 to 29, got 30"), std::string::npos) << out;
+  EXPECT_EQ(Lrcal("trial " + dir_ + " --cell x --trial 1", &out), 2) << out;  // not a run
+  WriteStudy(8);
+  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 1", &out), 2) << out;
+  EXPECT_NE(out.find("has changed since the run"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace lrcal
