@@ -16,7 +16,8 @@ flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
        "-DLRCAL_SOURCE_DIR=\"$PWD\"")
 # The readers and what they need (no Ceres, no SQLite: the fuzzers build in about a minute).
 sources=(core/strings core/json core/hash core/data_dir kinematics/robot_model kinematics/configuration_set
-         measurement/plane measurement/parameter_set measurement/measurement_set io/csv io/robot_file io/yaml_util study/study)
+         measurement/plane measurement/parameter_set measurement/measurement_set io/csv io/robot_file io/yaml_util study/study
+         study/stop_when)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
   local name=$1 obj="$out/obj/${1//\//_}.o"

@@ -129,8 +129,11 @@ std::vector<StoredCell> CellsInOrder(const TrialStore& store, const Json& study)
 // Cells are summarised in parallel (each thread with its own read-only connection) and kept in
 // canonical order; each cell's values are released once its placement rows are made, so memory
 // is a few cells' worth.
+// Under a stop_when rule a cell is summarised up to its stopping point, decided from its records
+// in canonical order (stopping.h): the same trials whatever computed them.
 void SummarizeCells(const TrialStore& store, const std::vector<StoredCell>& cells,
-                    std::vector<CellSummary>* summaries, std::vector<Rows>* placements) {
+                    const StopWhen& rule, long long max_trials, std::vector<CellSummary>* summaries,
+                    std::vector<Rows>* placements) {
   summaries->resize(cells.size());
   placements->resize(cells.size());
   std::atomic<std::size_t> next{0};
@@ -141,7 +144,15 @@ void SummarizeCells(const TrialStore& store, const std::vector<StoredCell>& cell
       TrialStore local(store.path());
       for (std::size_t i; (i = next.fetch_add(1)) < cells.size();) {
         CellSummary& s = (*summaries)[i];
-        s = SummarizeCell(local, cells[i]);
+        if (rule.enabled()) {
+          const CellStopping stop = EvaluateStopping({&local}, cells[i].id, rule, max_trials);
+          s = SummarizeCell(local, cells[i], stop.trials_used());
+          s.stop = {true, stop.decided(), stop.precise(), stop.trials_used(), stop.precision()};
+        } else {
+          s = SummarizeCell(local, cells[i], max_trials);
+          s.stop.decided = s.trials >= max_trials;
+          s.stop.trials_used = max_trials;
+        }
         (*placements)[i] = PlaceCell(s);
         for (auto& v : s.validation_values) std::vector<double>().swap(v);
         std::vector<std::vector<double>>().swap(s.error_values);
@@ -162,21 +173,55 @@ void SummarizeCells(const TrialStore& store, const std::vector<StoredCell>& cell
 // ---------------------------------------------------------------------------------------------
 // The tables.
 
-std::string Header(const Json& study, long long trials, bool complete) {
+// "1.23 %", or "—" when a precision cannot be stated yet.
+std::string Percent(double x) { return std::isfinite(x) ? Fixed(100 * x, 2) + " %" : "—"; }
+
+std::string Header(const Json& study, long long trials, const StopWhen& rule, bool complete) {
   std::ostringstream md;
   md << "# Study `" << study.value("name", std::string("?")) << "` — Monte-Carlo summary\n\n";
   if (study.contains("description") && !study["description"].get<std::string>().empty())
     md << study["description"].get<std::string>() << "\n\n";
-  md << "Seed " << study.value("seed", 0ULL) << ", " << trials
-     << " trials per cell. Lengths in mm, angles in mrad; 'mean ± SE [p5, p95]' over the trials of "
-        "a "
-        "cell.\n";
+  md << "Seed " << study.value("seed", 0ULL) << ", ";
+  if (rule.enabled()) {
+    md << "up to " << trials << " trials per cell in blocks of " << rule.block
+       << ", each cell stopped at the first block where ";
+    if (rule.relative_se > 0)
+      md << "every validation mean had a relative standard error ≤ " << Percent(rule.relative_se);
+    if (rule.relative_se > 0 && rule.p95_relative_halfwidth > 0) md << " and ";
+    if (rule.p95_relative_halfwidth > 0)
+      md << "every validation p95 had a 95 % confidence half-width ≤ "
+         << Percent(rule.p95_relative_halfwidth) << " of it";
+    md << " (see the cells table for the trials used)";
+  } else {
+    md << trials << " trials per cell";
+  }
+  md << ". Lengths in mm, angles in mrad; 'mean ± SE [p5, p95]' over the trials of a cell.\n";
   if (!complete) md << "\n**Partial run: some cells do not have all their trials yet.**\n";
   return md.str();
 }
 
-Table CellsTable(const std::vector<CellSummary>& cells) {
-  Table t({"cell", "id", "trials", "ok", "failed", "sigma_min(G) of the design"});
+// Under stop_when: where each cell stopped and the precision it reached (worst metric).
+std::vector<std::string> StopColumns(const CellSummary& s) {
+  const CellStop& stop = s.stop;
+  std::string when;
+  if (!stop.decided)
+    when = "not yet (running)";
+  else if (stop.precise)
+    when = "precision reached at " + std::to_string(stop.trials_used);
+  else
+    when = "maximum " + std::to_string(stop.trials_used) + " (precision not reached)";
+  return {when, Percent(stop.precision.relative_se),
+          Percent(stop.precision.p95_relative_halfwidth)};
+}
+
+Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
+  std::vector<std::string> columns = {"cell", "id",     "trials",
+                                      "ok",   "failed", "sigma_min(G) of the design"};
+  if (rule.enabled())
+    for (const char* c :
+         {"stopped", "worst relative SE of a mean", "worst p95 relative half-width"})
+      columns.push_back(c);
+  Table t(columns);
   for (const auto& s : cells) {
     std::string failed;
     for (const auto& [reason, n] : s.failed)
@@ -189,8 +234,15 @@ Table CellsTable(const std::vector<CellSummary>& cells) {
             ? Fixed(s.design_sigma_min.mean, 5) + " [" + Fixed(s.design_sigma_min.p5, 5) + ", " +
                   Fixed(s.design_sigma_min.p95, 5) + "] (redrawn per trial)"
             : Fixed(s.cell.design_sigma_min, 5);
-    t.AddRow({s.cell.label, s.cell.id, std::to_string(s.trials), std::to_string(s.ok),
-              failed.empty() ? "0" : failed, sigma_min});
+    std::vector<std::string> row = {s.cell.label,
+                                    s.cell.id,
+                                    std::to_string(s.trials),
+                                    std::to_string(s.ok),
+                                    failed.empty() ? "0" : failed,
+                                    sigma_min};
+    if (rule.enabled())
+      for (auto& c : StopColumns(s)) row.push_back(std::move(c));
+    t.AddRow(row);
   }
   return t;
 }
@@ -331,6 +383,16 @@ Json CellJson(const CellSummary& s) {
   c["design_sigma_min"] = s.cell.design_sigma_min;
   c["design_sigma_min_trials"] = DistJson(s.design_sigma_min, 1.0);
   c["fixed_for_rank"] = s.cell.fixed_for_rank;
+  if (s.stop.rule) {
+    const auto finite = [](double x) { return std::isfinite(x) ? Json(x) : Json(); };
+    c["stop"] = {{"decided", s.stop.decided},
+                 {"reason", !s.stop.decided  ? "running"
+                            : s.stop.precise ? "precision"
+                                             : "maximum"},
+                 {"trials_used", s.stop.trials_used},
+                 {"relative_se", finite(s.stop.precision.relative_se)},
+                 {"p95_relative_halfwidth", finite(s.stop.precision.p95_relative_halfwidth)}};
+  }
   c["settings"] = Json::parse(s.cell.settings);
   Json params = Json::array();
   for (const auto& p : s.parameters)
@@ -378,10 +440,12 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   fs::create_directories(dir);
   StudyTablesResult result;
   const long long trials = study.value("trials", 0LL);
+  const StopWhen rule =
+      StopWhen::FromJson(study.value("stop_when", Json()), "manifest study.stop_when");
   std::vector<Rows> placements;
-  SummarizeCells(store, CellsInOrder(store, study), &result.cells, &placements);
+  SummarizeCells(store, CellsInOrder(store, study), rule, trials, &result.cells, &placements);
   for (const auto& s : result.cells)
-    if (s.trials < trials) result.complete = false;
+    if (!s.stop.decided || s.trials < s.stop.trials_used) result.complete = false;
   Table place({"case", "quantity", "axis/parameter", "unit", "paper", "lrcal p5", "lrcal p50",
                "lrcal p95", "percentile of paper"});
   for (const auto& rows : placements)
@@ -407,10 +471,10 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
                  "std_predicted_truth", "std_ratio_truth", "std_ratio_truth_se"});
   Table par_tex({"cell", "parameter", "unit", "bias", "SE", "std", "predicted", "ratio"},
                 "Parameter errors (estimate - truth), mm and mrad");
-  const Table cells = CellsTable(result.cells);
+  const Table cells = CellsTable(result.cells, rule);
 
   std::ostringstream md;
-  md << Header(study, trials, result.complete) << "\n## Cells\n\n" << cells.ToMarkdown();
+  md << Header(study, trials, rule, result.complete) << "\n## Cells\n\n" << cells.ToMarkdown();
   md << "\n## Validation errors\n\nOver the validation configurations, per base axis: mean ± its "
         "standard error [p5, p95] over the trials (mm, mrad). validation.csv adds the std ± SE, "
         "95 % distribution-free confidence intervals of p5, p50 and p95 (from order statistics; "

@@ -15,6 +15,7 @@
 
 #include "lrcal/build_info.h"
 #include "lrcal/core/error.h"
+#include "lrcal/study/stopping.h"
 
 namespace lrcal {
 
@@ -323,6 +324,47 @@ std::string TablesStatus(const std::string& run_dir, bool run_complete) {
          (run_complete ? "; rewrite them with: lrcal aggregate " + run_dir : "") + "\n";
 }
 
+// One cell's line of `lrcal status` and its counts toward the total.
+struct CellProgress {
+  long long done = 0, total = 0;
+  bool stopped_early = false;
+  std::string text;
+};
+
+CellProgress FixedCellProgress(const std::set<long long>& done, long long trials, int shard_index,
+                               int shard_count) {
+  CellProgress p;
+  for (long long t = shard_index; t < trials; t += shard_count) ++p.total;
+  p.done = static_cast<long long>(done.size());
+  p.text = std::to_string(p.done) + "/" + std::to_string(p.total) +
+           (p.done >= p.total ? " done" : " remaining " + std::to_string(p.total - p.done));
+  return p;
+}
+
+// Under stop_when: the cell's own stopping point, decided from its recorded trials.
+CellProgress AdaptiveCellProgress(const std::vector<const TrialStore*>& stores,
+                                  const std::string& id, const StopWhen& rule, long long trials,
+                                  const std::set<long long>& done) {
+  const CellStopping stop = EvaluateStopping(stores, id, rule, trials);
+  const long long used = stop.trials_used();
+  CellProgress p;
+  const std::string of = "/" + std::to_string(trials);
+  if (!stop.decided()) {
+    p.done = static_cast<long long>(std::distance(done.begin(), done.lower_bound(used)));
+    p.total = trials;
+    p.text = std::to_string(p.done) + of + " (at most; the next decision at " +
+             std::to_string(stop.next_boundary()) + ")";
+    return p;
+  }
+  p.done = p.total = used;
+  p.stopped_early = stop.precise() && used < trials;
+  p.text = std::to_string(used) + of +
+           (p.stopped_early  ? " done: stopped early, precision reached"
+            : stop.precise() ? " done: precision reached at the maximum"
+                             : " done: the maximum, precision not reached");
+  return p;
+}
+
 }  // namespace
 
 std::string RunStatus(const std::string& run_dir) { return GetRunStatus(run_dir).text; }
@@ -342,22 +384,31 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
   if (sc > 1) out << " (shard " << si << "/" << sc << ")";
   out << "\n";
   long long total_done = 0, total = 0;
+  const StopWhen rule = StopWhen::FromJson(manifest["study"].value("stop_when", Json()),
+                                           dir.ManifestPath() + " key 'study.stop_when'");
+  const bool adaptive = rule.enabled() && sc == 1;
+  std::vector<const TrialStore*> store_list;
+  for (const auto& st : stores) store_list.push_back(st.get());
+  int stopped_early = 0;
   for (const auto& c : manifest["study"]["cells"]) {
     const std::string id = c["id"];
-    long long expected = 0;
-    for (long long t = 0; t < trials; ++t)
-      if (t % sc == si - 1) ++expected;
     std::set<long long> union_done;
     for (const auto& st : stores)
       for (long long t : st->DoneTrials(id)) union_done.insert(t);
-    const long long done = static_cast<long long>(union_done.size());
-    total_done += done;
-    total += expected;
-    out << "  " << c["label"].get<std::string>() << " (" << id << "): " << done << "/" << expected
-        << (done >= expected ? " done" : " remaining " + std::to_string(expected - done)) << "\n";
+    out << "  " << c["label"].get<std::string>() << " (" << id << "): ";
+    const CellProgress p = adaptive ? AdaptiveCellProgress(store_list, id, rule, trials, union_done)
+                                    : FixedCellProgress(union_done, trials, si - 1, sc);
+    total_done += p.done;
+    total += p.total;
+    stopped_early += p.stopped_early;
+    out << p.text << "\n";
   }
-  out << "total: " << total_done << "/" << total << (total_done >= total ? " — complete" : "")
-      << "\n";
+  out << "total: " << total_done << "/" << total << (total_done >= total ? " — complete" : "");
+  if (adaptive) out << " (stop_when: " << stopped_early << " cells stopped early)";
+  out << "\n";
+  if (rule.enabled() && sc > 1)
+    out << "stop_when: a shard cannot see the other shards' trials, so it runs up to the "
+           "maximum; lrcal merge applies the rule\n";
   const auto& sessions = manifest["sessions"];
   if (!sessions.empty())
     out << "last session: " << sessions.back().value("start", std::string()) << " → "

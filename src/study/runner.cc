@@ -15,6 +15,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/study/run_directory.h"
+#include "lrcal/study/stopping.h"
 #include "lrcal/study/trial_store.h"
 #include "lrcal/study/work_source.h"
 #include "study/trial_pipeline.h"
@@ -138,6 +139,12 @@ class ProgressReporter {
     Report(computed, false);
     last_ = now;
   }
+  // An adaptive run learns its total as cells stop; `note` says how many did.
+  void SetTotal(long long total, long long expected_total, std::string note) {
+    total_ = total;
+    expected_total_ = expected_total;
+    note_ = std::move(note);
+  }
   void Report(long long computed, bool final) const {
     if (!enabled_) return;
     const double elapsed = Seconds(start_, Clock::now());
@@ -149,14 +156,14 @@ class ProgressReporter {
     if (tty_) {
       const int width = 30;
       const int filled = total_ ? static_cast<int>(width * shown / total_) : width;
-      std::snprintf(line, sizeof line, "\r[%s%s] %lld/%lld trials  %.0f/s  ETA %s ",
+      std::snprintf(line, sizeof line, "\r[%s%s] %lld/%lld trials  %.0f/s  ETA %s%s ",
                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-                    shown, total_, rate, Duration(eta).c_str());
+                    shown, total_, rate, Duration(eta).c_str(), note_.c_str());
       std::cerr << line << (final ? "\n" : "") << std::flush;
     } else {
-      std::snprintf(line, sizeof line, "lrcal run: %lld/%lld trials, %.0f/s, ETA %s%s", shown,
+      std::snprintf(line, sizeof line, "lrcal run: %lld/%lld trials, %.0f/s, ETA %s%s%s", shown,
                     total_, rate, Duration(eta).c_str(),
-                    ranks_ > 1 ? " (estimated from rank 0)" : "");
+                    ranks_ > 1 ? " (estimated from rank 0)" : "", note_.c_str());
       std::cerr << line << "\n";
     }
   }
@@ -167,6 +174,7 @@ class ProgressReporter {
   long long total_, done_before_, expected_total_;
   Clock::time_point start_, last_;
   double line_every_ = 10.0;
+  std::string note_;
 };
 
 class StudyRunner {
@@ -289,11 +297,19 @@ class StudyRunner {
         ++result_.total;
         if (cell[t]) ++result_.done_before;
       }
-    MissingTrials missing(&done_, study_.trials, options_.shard_index, options_.shard_count);
+    // stop_when needs every trial of a block to decide; a shard sees only its share, so shards
+    // run to the maximum and the merge applies the rule (same tables).
+    adaptive_ = study_.stop_when.enabled() && options_.shard_count == 1;
     dynamic_ = options_.dynamic_schedule && ranks_ > 1;
-    work_ = dynamic_
-                ? MakeDynamicSchedule(std::move(missing), collective_, options_.max_new_trials)
-                : MakeStaticSchedule(std::move(missing), rank_, ranks_, options_.max_new_trials);
+    if (!adaptive_)
+      work_ = MakeWorkSource(
+          MissingTrials(&done_, study_.trials, options_.shard_index, options_.shard_count),
+          options_.max_new_trials);
+  }
+
+  std::unique_ptr<WorkSource> MakeWorkSource(MissingTrials missing, long long max_new) {
+    return dynamic_ ? MakeDynamicSchedule(std::move(missing), collective_, max_new)
+                    : MakeStaticSchedule(std::move(missing), rank_, ranks_, max_new);
   }
 
   // One worker thread: claims trials, computes them, hands the records to the writer.
@@ -325,13 +341,108 @@ class StudyRunner {
     batch->clear();
   }
 
-  // Workers compute; this thread writes batches, reports progress and pumps the schedule.
+  // Workers compute; this thread writes batches, reports progress and pumps the schedule. With
+  // stop_when the trials run in rounds (one block of every cell still running), each followed by
+  // the decisions.
   void RunTrials() {
     const auto t_run = Clock::now();
-    RecordQueue queue(threads_, static_cast<std::size_t>(options_.batch_size));
-    const long long expected = result_.done_before + work_->share() * ranks_;
+    const long long expected =
+        result_.done_before +
+        (adaptive_ ? result_.total - result_.done_before : work_->share() * ranks_);
     ProgressReporter progress(options_.progress && root(), ranks_, result_.total,
                               result_.done_before, expected, start_);
+    if (adaptive_) {
+      RunRounds(&progress);
+    } else {
+      RunRound(&progress);
+    }
+    result_.run_seconds = Seconds(t_run, Clock::now());
+    progress.Report(result_.computed, true);
+    NotifyProgress();
+    result_.peak_rss_kb_trials = PeakRssKb();
+  }
+
+  // The adaptive loop: a round computes [next, next boundary) of every undecided cell; then
+  // rank 0 feeds those trials, in canonical order, from every store to the cells' stopping
+  // rules and tells every rank what it decided. Stops with the run (signal, --max-trials) or
+  // when every cell is decided.
+  void RunRounds(ProgressReporter* progress) {
+    const int num_cells = static_cast<int>(contexts_.size());
+    if (root()) stopping_.assign(num_cells, CellStopping(study_.stop_when, study_.trials));
+    std::vector<TrialRange> ranges(num_cells, TrialRange{0, study_.stop_when.block});
+    while (true) {
+      bool any = false;
+      for (const auto& [first, end] : ranges) any |= end > first;
+      if (!any) {
+        all_decided_ = true;
+        break;
+      }
+      long long max_new = 0;
+      if (options_.max_new_trials > 0) {
+        max_new = options_.max_new_trials - result_.computed;
+        if (max_new <= 0) break;
+      }
+      work_ = MakeWorkSource(MissingTrials(&done_, study_.trials, 0, 1, ranges), max_new);
+      RunRound(progress);
+      const bool stopping =
+          stop_->stop_requested() ||
+          (options_.max_new_trials > 0 && result_.computed >= options_.max_new_trials);
+      if (collective_->SumAll(stopping ? 1 : 0) > 0) break;  // every rank leaves together
+      ranges = Decide(progress);
+    }
+  }
+
+  // Rank 0 reads the round's trials (its store, or every rank's once they are committed) and
+  // feeds the stopping rules; every rank gets the next round's ranges.
+  std::vector<TrialRange> Decide(ProgressReporter* progress) {
+    collective_->Barrier();  // every rank has committed its round
+    std::string decisions;
+    if (root()) {
+      std::vector<std::unique_ptr<TrialStore>> others;
+      std::vector<const TrialStore*> stores = {store_.get()};
+      if (ranks_ > 1) {
+        stores.clear();
+        for (const std::string& path : dir_.StorePaths()) {
+          others.push_back(std::make_unique<TrialStore>(path));
+          stores.push_back(others.back().get());
+        }
+      }
+      Json ranges = Json::array();
+      long long total = 0;
+      int stopped_early = 0, decided = 0;
+      for (std::size_t c = 0; c < stopping_.size(); ++c) {
+        CellStopping& state = stopping_[c];
+        if (!state.decided() &&
+            !FeedStopping(stores, contexts_[c]->cell->id, state.next_boundary(), &state))
+          throw std::logic_error("stop_when: a round ended with trials of cell " +
+                                 contexts_[c]->cell->id + " unrecorded");
+        if (state.decided()) {
+          ranges.push_back({0, 0});
+          ++decided;
+          stopped_early += state.trials_used() < study_.trials;
+        } else {
+          ranges.push_back({state.next(), state.next_boundary()});
+        }
+        total += state.trials_used();
+      }
+      result_.total = total;
+      const std::string note = "  " + std::to_string(decided) + "/" +
+                               std::to_string(stopping_.size()) + " cells done (" +
+                               std::to_string(stopped_early) + " stopped early)";
+      progress->SetTotal(total, total, note);
+      decisions = Json({{"ranges", ranges}, {"total", total}}).dump();
+    }
+    const Json j = Json::parse(collective_->Broadcast(decisions));
+    result_.total = j["total"].get<long long>();
+    std::vector<TrialRange> next;
+    for (const auto& r : j["ranges"])
+      next.emplace_back(r[0].get<long long>(), r[1].get<long long>());
+    return next;
+  }
+
+  // One pass of the workers over work_: they compute, this thread writes.
+  void RunRound(ProgressReporter* progress) {
+    RecordQueue queue(threads_, static_cast<std::size_t>(options_.batch_size));
     std::vector<std::thread> pool;
     std::exception_ptr writer_failure;
     try {
@@ -346,7 +457,7 @@ class StudyRunner {
                                             e.what() + "); run with fewer --threads");
         }
       }
-      WriterLoop(&queue, &progress);
+      WriterLoop(&queue, progress);
     } catch (...) {
       // The writer failed (e.g. the disk is full) or a thread could not start: stop the
       // workers, join them, and report; committed records stay.
@@ -355,12 +466,8 @@ class StudyRunner {
       work_->Pump(true, false);
     }
     for (auto& t : pool) t.join();
-    result_.run_seconds = Seconds(t_run, Clock::now());
-    progress.Report(result_.computed, true);
-    NotifyProgress();
     if (writer_failure) std::rethrow_exception(writer_failure);
     if (auto failure = queue.failure()) std::rethrow_exception(failure);
-    result_.peak_rss_kb_trials = PeakRssKb();
   }
 
   void NotifyProgress() const {
@@ -412,7 +519,7 @@ class StudyRunner {
         for (long long t : main_store.DoneTrials(cell.id))
           if (t >= 0 && t < study_.trials && t % options_.shard_count == options_.shard_index)
             ++done_now;
-      result_.complete = done_now >= result_.total;
+      result_.complete = adaptive_ ? all_decided_ : done_now >= result_.total;
       result_.interrupted = stop_->stop_requested() || !result_.complete;
       result_.reached_max_trials = ReachedMaxTrials();
       Json& session = manifest_["sessions"][session_];
@@ -432,7 +539,8 @@ class StudyRunner {
       // Completeness is rank 0's to judge (from the merged store); this rank knows its stop
       // token and, under the static schedule, whether it finished its share.
       result_.interrupted =
-          stop_->stop_requested() || (!dynamic_ && result_.computed < work_->share());
+          stop_->stop_requested() ||
+          (adaptive_ ? !all_decided_ : !dynamic_ && result_.computed < work_->share());
       result_.reached_max_trials = result_.interrupted && ReachedMaxTrials();
     }
     collective_->Barrier();  // rank 0 has merged: the run directory is consistent
@@ -454,6 +562,10 @@ class StudyRunner {
   DoneSet done_;
   bool dynamic_ = false;
   std::unique_ptr<WorkSource> work_;
+  // stop_when (single process or MPI, not shards): the rules' state (rank 0) and whether every
+  // cell is decided.
+  bool adaptive_ = false, all_decided_ = false;
+  std::vector<CellStopping> stopping_;
 };
 
 }  // namespace

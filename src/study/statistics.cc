@@ -162,10 +162,11 @@ struct CellValues {
   std::vector<double> iterations, sigma_hat, sigma_min;
 };
 
-CellValues ReadCellValues(const TrialStore& store, const StoredCell& cell, CellSummary* s) {
+CellValues ReadCellValues(const TrialStore& store, const StoredCell& cell, long long end,
+                          CellSummary* s) {
   const int n = static_cast<int>(cell.parameter_names.size());
   CellValues v;
-  const std::size_t expected = static_cast<std::size_t>(store.CountTrials(cell.id));
+  const std::size_t expected = static_cast<std::size_t>(std::min(end, store.CountTrials(cell.id)));
   v.errors.resize(static_cast<Eigen::Index>(expected), n);
   for (int k = 0; k < 12; ++k) {
     v.validation[k].reserve(expected);
@@ -173,21 +174,24 @@ CellValues ReadCellValues(const TrialStore& store, const StoredCell& cell, CellS
   }
   v.iterations.reserve(expected);
   v.sigma_hat.reserve(expected);
-  store.ForEachTrial(cell.id, [&](const TrialRecord& r) {
-    ++s->trials;
-    for (int k = 0; k < 12; ++k) v.nominal[k].push_back(r.nominal[k]);
-    if (r.status != TrialStatus::kOk) {
-      ++s->failed[TrialStatusName(r.status)];
-      return;
-    }
-    ++s->ok;
-    for (int k = 0; k < n && k < static_cast<int>(r.errors.size()); ++k)
-      v.errors(s->ok - 1, k) = r.errors[k];
-    for (int k = 0; k < 12; ++k) v.validation[k].push_back(r.validation[k]);
-    v.iterations.push_back(r.iterations);
-    v.sigma_hat.push_back(r.sigma_hat);
-    v.sigma_min.push_back(r.sigma_min);
-  });
+  store.ForEachTrial(
+      cell.id,
+      [&](const TrialRecord& r) {
+        ++s->trials;
+        for (int k = 0; k < 12; ++k) v.nominal[k].push_back(r.nominal[k]);
+        if (r.status != TrialStatus::kOk) {
+          ++s->failed[TrialStatusName(r.status)];
+          return;
+        }
+        ++s->ok;
+        for (int k = 0; k < n && k < static_cast<int>(r.errors.size()); ++k)
+          v.errors(s->ok - 1, k) = r.errors[k];
+        for (int k = 0; k < 12; ++k) v.validation[k].push_back(r.validation[k]);
+        v.iterations.push_back(r.iterations);
+        v.sigma_hat.push_back(r.sigma_hat);
+        v.sigma_min.push_back(r.sigma_min);
+      },
+      0, end);
   v.errors.conservativeResize(s->ok, n);
   return v;
 }
@@ -232,10 +236,10 @@ void SummarizeParameters(const StoredCell& cell, Eigen::MatrixXd* errors, CellSu
 
 }  // namespace
 
-CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell) {
+CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell, long long end) {
   CellSummary s;
   s.cell = cell;
-  CellValues v = ReadCellValues(store, cell, &s);
+  CellValues v = ReadCellValues(store, cell, end, &s);
   for (int k = 0; k < 12; ++k) {
     s.validation[k] = DescribeInPlace(&v.validation[k]);
     s.nominal[k] = DescribeInPlace(&v.nominal[k]);

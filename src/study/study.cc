@@ -386,6 +386,7 @@ Json Study::ToJson() const {
   j["description"] = description;
   j["seed"] = seed;
   j["trials"] = trials;
+  if (stop_when.enabled()) j["stop_when"] = stop_when.ToJson();
   j["base"] = base;
   j["sweep"] = sweep;
   Json cs = Json::array();
@@ -403,11 +404,47 @@ struct Axis {
   std::vector<std::string> value_paths;  // for line lookup
 };
 
-// name, description, seed, trials.
+// stop_when: {block, relative_se, p95_relative_halfwidth, trials}. `trials` there is another
+// place for the study's maximum (the top-level `trials`); given twice, the two must agree.
+void ParseStopWhen(const Json& given, const KeyLocator& where, Study* study) {
+  if (!given.contains("stop_when")) return;
+  Json rule = given["stop_when"];
+  if (!rule.is_object())
+    throw InputError(where("stop_when"),
+                     "expected a mapping {block, relative_se, p95_relative_halfwidth, trials}, "
+                     "got " +
+                         (rule.is_null() ? std::string("nothing") : rule.dump()));
+  OnlyKeys(rule, "stop_when", {"block", "relative_se", "p95_relative_halfwidth", "trials"},
+           "block, relative_se, p95_relative_halfwidth, trials", where);
+  if (rule.contains("trials")) {
+    const int max = Int(given, "stop_when.trials", where, 1);
+    if (given.contains("trials") && max != Int(given, "trials", where, 1))
+      throw InputError(where("stop_when.trials"), "differs from the study's trials (" +
+                                                      given["trials"].dump() +
+                                                      "); give the maximum once");
+    study->trials = max;
+    rule.erase("trials");
+  }
+  try {
+    study->stop_when = StopWhen::FromJson(rule, "stop_when");
+  } catch (const InputError& e) {
+    // Name the file and line of the key at fault.
+    const std::string what = e.what();
+    throw InputError(where(e.where()), what.substr(e.where().size() + 2));
+  }
+  if (study->stop_when.block > study->trials)
+    throw InputError(where("stop_when.block"), "expected at most the study's trials (" +
+                                                   std::to_string(study->trials) + "), got " +
+                                                   std::to_string(study->stop_when.block));
+}
+
+// name, description, seed, trials, stop_when.
 void ParseHeader(const Json& given, const std::string& path, const KeyLocator& where,
                  Study* study) {
+  const bool trials_in_rule = given.contains("stop_when") && given["stop_when"].is_object() &&
+                              given["stop_when"].contains("trials");
   for (const char* required : {"name", "seed", "trials"})
-    if (!given.contains(required))
+    if (!given.contains(required) && !(trials_in_rule && std::string(required) == "trials"))
       throw InputError(Location(path, 1) + " key '" + required + "'", "missing (required)");
   study->name = Str(given, "name", where);
   // The name becomes a folder (output/<name>): only plain names.
@@ -425,14 +462,16 @@ void ParseHeader(const Json& given, const std::string& path, const KeyLocator& w
   if (seed < 0 || seed != std::floor(seed) || seed > 9e15)
     throw InputError(where("seed"), "expected a whole number >= 0");
   study->seed = static_cast<std::uint64_t>(seed);
-  study->trials = Int(given, "trials", where, 1);
+  if (given.contains("trials")) study->trials = Int(given, "trials", where, 1);
+  ParseStopWhen(given, where, study);
 }
 
 // The defaults with the file's settings merged in, and the robot file's content hash: a changed
 // robot is a new cell.
 Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& folder) {
   Json settings = given;
-  for (const char* k : {"name", "description", "seed", "trials", "sweep"}) settings.erase(k);
+  for (const char* k : {"name", "description", "seed", "trials", "stop_when", "sweep"})
+    settings.erase(k);
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
   base.merge_patch(settings);

@@ -307,9 +307,14 @@ void ReadTrialRow(Statement& st, TrialRecord* r) {
 }  // namespace
 
 void TrialStore::ForEachTrial(const std::string& cell_id,
-                              const std::function<void(const TrialRecord&)>& visit) const {
-  Statement st(db_, "SELECT " + TrialColumns() + " FROM trials WHERE cell_id = ? ORDER BY trial");
+                              const std::function<void(const TrialRecord&)>& visit, long long first,
+                              long long end) const {
+  Statement st(db_,
+               "SELECT " + TrialColumns() +
+                   " FROM trials WHERE cell_id = ? AND trial >= ? AND trial < ? ORDER BY trial");
   st.Text(1, cell_id);
+  sqlite3_bind_int64(st.get(), 2, first);
+  sqlite3_bind_int64(st.get(), 3, end);
   TrialRecord r;
   r.cell_id = cell_id;  // every row has it: no per-row string
   while (st.Step()) {

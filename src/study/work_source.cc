@@ -5,21 +5,31 @@
 namespace lrcal {
 
 MissingTrials::MissingTrials(const DoneSet* done, long long trials, int shard_index,
-                             int shard_count)
+                             int shard_count, std::vector<TrialRange> ranges)
     : done_(done),
-      trials_(trials),
-      space_(static_cast<long long>(done->size()) * trials),
+      ranges_(std::move(ranges)),
       shard_index_(shard_index),
-      shard_count_(shard_count) {}
+      shard_count_(shard_count) {
+  if (ranges_.empty()) ranges_.assign(done->size(), TrialRange{0, trials});
+  for (auto& [first, end] : ranges_) {
+    first = std::clamp<long long>(first, 0, trials);
+    end = std::clamp<long long>(end, first, trials);
+  }
+}
 
 bool MissingTrials::Next(TrialId* id) {
-  while (cursor_ < space_) {
-    const int c = static_cast<int>(cursor_ / trials_);
-    const long long t = cursor_ % trials_;
-    ++cursor_;
-    if (t % shard_count_ != shard_index_ || (*done_)[c][t]) continue;
+  while (cell_ < ranges_.size()) {
+    const auto [first, end] = ranges_[cell_];
+    t_ = std::max(t_, first);
+    if (t_ >= end) {
+      ++cell_;
+      t_ = 0;
+      continue;
+    }
+    const long long t = t_++;
+    if (t % shard_count_ != shard_index_ || (*done_)[cell_][t]) continue;
     ++seen_;
-    *id = {c, t};
+    *id = {static_cast<int>(cell_), t};
     return true;
   }
   return false;
@@ -27,8 +37,9 @@ bool MissingTrials::Next(TrialId* id) {
 
 long long MissingTrials::Count() const {
   long long n = 0;
-  for (const auto& cell : *done_)
-    for (long long t = shard_index_; t < trials_; t += shard_count_) n += !cell[t];
+  for (std::size_t c = 0; c < ranges_.size(); ++c)
+    for (long long t = ranges_[c].first; t < ranges_[c].second; ++t)
+      n += t % shard_count_ == shard_index_ && !(*done_)[c][t];
   return n;
 }
 

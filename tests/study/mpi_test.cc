@@ -87,6 +87,23 @@ TEST(Mpi, DynamicScheduleGivesTheSameTables) {
   ExpectRanksMatchSingleProcess(dir, Study(dir, 150), "--schedule dynamic");
 }
 
+TEST(Mpi, StopWhenStopsTheCellsAtTheSameTrialsAsASingleProcess) {
+  if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
+  const std::string dir = testing::TempDir("mpi_stop_when");
+  const std::string study = dir + "/adaptive.yaml";
+  std::ofstream(study)
+      << "name: adaptive\nseed: 5\ntrials: 3000\n"
+         "stop_when: {block: 100, relative_se: 0.04, p95_relative_halfwidth: 0.3}\n"
+         "robot: "
+      << testing::SourcePath("studies/robots/paper.yaml")
+      << "\npool: {size: 60}\nvalidation: {size: 10}\n"
+         "sweep:\n  axes:\n    - key: selection.count\n      values: [30, 59]\n";
+  ExpectRanksMatchSingleProcess(dir, study, "");
+  ExpectRanksMatchSingleProcess(dir + "/dynamic", study, "--schedule dynamic");
+  const std::string summary = Tables(dir + "/np2").at("summary.json");
+  EXPECT_NE(summary.find("\"reason\": \"precision\""), std::string::npos);
+}
+
 TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
   if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
   const std::string dir = testing::TempDir("mpi_kill");

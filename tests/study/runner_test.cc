@@ -401,6 +401,18 @@ INSTANTIATE_TEST_SUITE_P(
                  "'noise.sigma' is not a study setting"},
         BadStudy{"UnknownMethod", "selection: {method: best}\n", "unknown selection method 'best'"},
         BadStudy{"UnknownScaling", "selection: {scaling: log}\n", "unknown scaling 'log'"},
+        BadStudy{"StopWhenBlockOfOne", "stop_when: {block: 1, relative_se: 0.01}\n",
+                 "bad.yaml:5 key 'stop_when.block': expected a whole number of trials per block"},
+        BadStudy{"StopWhenWithoutCriterion", "stop_when: {block: 2}\n",
+                 "bad.yaml:5 key 'stop_when': expected at least one criterion"},
+        BadStudy{"StopWhenNegativeSe", "stop_when: {block: 2, relative_se: -0.1}\n",
+                 "key 'stop_when.relative_se': expected a number > 0"},
+        BadStudy{"StopWhenUnknownKey", "stop_when: {block: 2, relative_sd: 0.1}\n",
+                 "key 'stop_when.relative_sd': unknown key; expected block, relative_se"},
+        BadStudy{"StopWhenBlockAboveTrials", "stop_when: {block: 10, relative_se: 0.1}\n",
+                 "key 'stop_when.block': expected at most the study's trials (5)"},
+        BadStudy{"StopWhenOtherMaximum", "stop_when: {block: 2, relative_se: 0.1, trials: 9}\n",
+                 "key 'stop_when.trials': differs from the study's trials (5)"},
         BadStudy{
             "ZipOfUnequalAxes",
             "sweep:\n  combine: zip\n  axes:\n    - {key: noise.sigma_mm, values: [0.1, 0.2]}\n"

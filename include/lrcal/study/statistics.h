@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "lrcal/study/stopping.h"
 #include "lrcal/study/trial_store.h"
 
 namespace lrcal {
@@ -72,9 +73,20 @@ struct ParameterStats {
   double predicted_std_truth = 0, ratio_truth = 0, ratio_truth_se = 0;
 };
 
+/// How a cell's trial count came about under a stop_when rule (stopping.h).
+struct CellStop {
+  bool rule = false;          ///< the study has a stop_when rule
+  bool decided = false;       ///< the stopping point is known (every trial before it recorded)
+  bool precise = false;       ///< the criteria held there (else the cell reached the maximum)
+  long long trials_used = 0;  ///< the stopping point (the maximum until decided)
+  StopPrecision precision;    ///< at the last boundary evaluated
+};
+
 struct CellSummary {
   StoredCell cell;
+  /// Trials summarised (trials 0 … trials−1 when complete) and those that identified.
   long long trials = 0, ok = 0;
+  CellStop stop;
   std::map<std::string, long long> failed;  ///< status → count
   std::vector<ParameterStats> parameters;
   Eigen::MatrixXd covariance, correlation;  ///< empirical, SI
@@ -90,7 +102,9 @@ struct CellSummary {
   Distribution design_sigma_min;
 };
 
-/// Summarises one cell from the store.
-CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell);
+/// Summarises one cell from the store: its trials with index < `end` (a stop_when cell's
+/// stopping point; every recorded trial by default).
+CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell,
+                          long long end = std::numeric_limits<long long>::max());
 
 }  // namespace lrcal

@@ -22,6 +22,7 @@
 #include "lrcal/identification/identification.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
+#include "lrcal/study/stopping.h"
 
 namespace lrcal {
 
@@ -79,12 +80,16 @@ struct Study {
   std::string name;
   std::string description;
   std::uint64_t seed = 0;
+  /// Trials per cell; with stop_when, the maximum.
   int trials = 0;
+  /// Adaptive stopping (stopping.h); off unless the study file has `stop_when`.
+  StopWhen stop_when;
   Json base;   ///< resolved base settings (before sweeps)
   Json sweep;  ///< the sweep section as given (canonical JSON)
   std::vector<std::string> axis_keys;
   std::vector<Cell> cells;
-  /// The whole resolved study (name, seed, trials, base, sweep): what a run directory records.
+  /// The whole resolved study (name, seed, trials, stop_when if on, base, sweep): what a run
+  /// directory records.
   Json ToJson() const;
   long long total_trials() const { return static_cast<long long>(trials) * cells.size(); }
 };

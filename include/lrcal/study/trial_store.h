@@ -15,6 +15,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -67,9 +68,11 @@ class TrialStore {
   long long CountTrials(const std::string& cell_id) const;
   /// The record of (cell, trial), if stored.
   std::optional<TrialRecord> GetTrial(const std::string& cell_id, long long trial) const;
-  /// Every record of a cell in trial order (the canonical order for aggregation).
+  /// Every record of a cell with first <= trial < end, in trial order (the canonical order for
+  /// aggregation).
   void ForEachTrial(const std::string& cell_id,
-                    const std::function<void(const TrialRecord&)>& visit) const;
+                    const std::function<void(const TrialRecord&)>& visit, long long first = 0,
+                    long long end = std::numeric_limits<long long>::max()) const;
   /// Copies every cell and trial of another store (INSERT OR IGNORE).
   void MergeFrom(const std::string& other_path);
   void SetMeta(const std::string& key, const std::string& value);

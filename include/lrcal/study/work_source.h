@@ -23,10 +23,16 @@ namespace lrcal {
 /// (cell index in the study, trial index).
 using TrialId = std::pair<int, long long>;
 
+/// Trials [first, end) of one cell.
+using TrialRange = std::pair<long long, long long>;
+
 /// The missing trials of this shard in canonical order, with a forward-only cursor.
 class MissingTrials {
  public:
-  MissingTrials(const DoneSet* done, long long trials, int shard_index, int shard_count);
+  /// Within `ranges` (one per cell; every trial [0, trials) of every cell when empty): an
+  /// adaptive run's round is one block of each cell still running.
+  MissingTrials(const DoneSet* done, long long trials, int shard_index, int shard_count,
+                std::vector<TrialRange> ranges = {});
   /// The next missing trial; false at the end.
   bool Next(TrialId* id);
   /// Missing trials passed so far.
@@ -36,7 +42,9 @@ class MissingTrials {
 
  private:
   const DoneSet* done_;
-  long long trials_, space_, cursor_ = 0, seen_ = 0;
+  std::vector<TrialRange> ranges_;
+  std::size_t cell_ = 0;
+  long long t_ = 0, seen_ = 0;
   int shard_index_, shard_count_;
 };
 
