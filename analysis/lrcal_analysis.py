@@ -1,6 +1,7 @@
 """Figures of an lrcal run, from what `lrcal run` and `lrcal report` wrote (never recomputing the
-science): RUN_DIR/manifest.json and RUN_DIR/report/{tables/*, trials.snapshot.sqlite,
-realisation.json, status.json}. Units as in the tables: mm and mrad.
+science): RUN_DIR/manifest.json and RUN_DIR/report/{tables/*, trials.snapshot.sqlite (removed by
+`lrcal report` once the figures are drawn), realisation.json, status.json}. Units as in the
+tables: mm and mrad, named on every axis.
 
 Uses Debian's python3-pandas, python3-numpy and python3-matplotlib.
 """
@@ -13,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 import pandas as pd  # noqa: E402
 
 AXES = ("x", "y", "z")
@@ -72,18 +74,38 @@ class Run:
             raise RunDataError(f"{path}: not a readable CSV ({e})") from e
 
     def trial_metrics(self):
-        """One row per ok trial: cell_id, trial and the identified model's validation metrics."""
+        """One row per ok trial the tables use: cell_id, trial and the identified model's
+        validation metrics (under stop_when, only the trials before each cell's stopping
+        point)."""
         columns = ", ".join(f"val_{m}_{a}" for m, _ in METRICS for a in AXES)
         with sqlite3.connect(f"file:{self.snapshot}?mode=ro", uri=True) as db:
-            return pd.read_sql_query(
+            data = pd.read_sql_query(
                 f"SELECT cell_id, trial, {columns} FROM trials WHERE status = 'ok' "
                 "ORDER BY cell_id, trial", db)
+        used = {c["id"]: c["stop"]["trials_used"] for c in self.cells if "stop" in c}
+        if used:
+            limit = data["cell_id"].map(used).fillna(np.inf)
+            data = data[data["trial"] < limit]
+        return data
 
     def shown_cells(self, limit=MAX_CELLS_PER_FIGURE):
         """Paper cells first, then the others, at most `limit`."""
         paper = [c for c in self.cells if c["settings"].get("paper_case", 0)]
         rest = [c for c in self.cells if not c["settings"].get("paper_case", 0)]
         return (paper + rest)[:limit]
+
+    def left_out_note(self, shown):
+        """What a figure showing `shown` cells says about the others ("" when it shows all)."""
+        if len(shown) >= len(self.cells):
+            return ""
+        return (f" Only the first {len(shown)} of the {len(self.cells)} cells are drawn "
+                "(paper cells first); the tables have every cell.")
+
+    def parameter_unit(self, cell_id, name):
+        """mm or mrad for a parameter, from parameters.csv."""
+        rows = self.parameters[(self.parameters["cell_id"] == cell_id) &
+                               (self.parameters["parameter"] == name)]
+        return str(rows["unit"].iloc[0]) if len(rows) else ("mrad" if name[:1] in "θαβ" else "mm")
 
     def paper_value(self, cell, metric, axis):
         """The paper's published value for a paper cell, from paper_placement.csv (or None)."""
@@ -114,20 +136,26 @@ def realisation_figures(run, out_dir):
     if not cells:
         return []
     out = []
-    fig, axes = plt.subplots(len(cells), 1, figsize=(9, 2.6 * len(cells)), squeeze=False)
-    for ax, c in zip(axes[:, 0], cells):
+    # Nominal and identified on their own axes: the identified errors are ~100 times smaller and
+    # would be invisible on the nominal model's scale.
+    fig, axes = plt.subplots(len(cells), 2, figsize=(12, 2.6 * len(cells)), squeeze=False)
+    for row, c in zip(axes, cells):
         n = np.arange(1, len(c["distance_error_nominal"]) + 1)
-        ax.bar(n - 0.2, c["distance_error_nominal"], width=0.4, color="0.6", label="nominal model")
-        ax.bar(n + 0.2, c["distance_error_identified"], width=0.4, color="C0", label="identified")
-        ax.axhline(0, color="k", lw=0.5)
-        ax.set_title(f"{c['label']}: distance error per measurement configuration (trial 0)")
-        ax.set_xlabel("measurement configuration")
-        ax.set_ylabel("h measured − h model (mm)")
-        ax.legend(loc="upper right", fontsize=8)
+        for ax, key, color, name in ((row[0], "distance_error_nominal", "0.5", "nominal model"),
+                                     (row[1], "distance_error_identified", "C0", "identified model")):
+            ax.bar(n, c[key], width=0.8, color=color)
+            ax.axhline(0, color="k", lw=0.5)
+            ax.set_title(f"{c['label']}: {name} (trial 0)", fontsize=9)
+            ax.set_xlabel("measurement configuration")
+            ax.set_ylabel("h measured − h model (mm)")
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     fig.tight_layout()
     out.append((_save(fig, out_dir, "realisation_distance_errors"),
-                "Distance errors in the measurement configurations, nominal and identified model "
-                "(one realisation, as the paper's first figure)."))
+                "Distance errors in the measurement configurations, nominal model (left) and "
+                "identified model (right, on its own scale: about a hundred times smaller), one "
+                "realisation, as the paper's first figure." +
+                (f" The first {len(cells)} cells with a realisation are drawn."
+                 if len(run.realisation["cells"]) > len(cells) else "")))
 
     fig, axes = plt.subplots(2, 2, figsize=(11, 7))
     for row, (key, title) in enumerate((("measurement", "measurement"), ("validation", "validation"))):
@@ -147,6 +175,7 @@ def realisation_figures(run, out_dir):
             ax.set_yscale("log")
             ax.set_title(f"{what} error, {title} configurations")
             ax.set_xlabel(f"{title} configuration")
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.set_ylabel(f"|error| ({unit})")
             ax.legend(fontsize=7)
     fig.tight_layout()
@@ -163,9 +192,11 @@ def distribution_figure(run, out_dir):
     if data.empty:
         return []
     cells = run.shown_cells()
+    shown_paper = set()
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5))
     for ax, (metric, title) in zip(axes.flat, METRICS):
         boxes, positions, colors = [], [], []
+        any_paper = False
         ticks, ticklabels = [], []
         for i, cell in enumerate(cells):
             rows = data[data["cell_id"] == cell["id"]]
@@ -176,7 +207,9 @@ def distribution_figure(run, out_dir):
                 paper = run.paper_value(cell, metric, axis)
                 if paper is not None:
                     ax.plot(i * 4 + j, paper, "D", color="red", ms=5,
-                            label="paper" if (i == 0 and j == 0) or not ax.get_legend_handles_labels()[1] else None)
+                            label=None if any_paper else "paper")
+                    any_paper = True
+                    shown_paper.add(True)
             ticks.append(i * 4 + 1)
             ticklabels.append(cell["label"])
         bp = ax.boxplot(boxes, positions=positions, widths=0.8, showfliers=False, patch_artist=True)
@@ -191,13 +224,13 @@ def distribution_figure(run, out_dir):
         labels = list(AXES)
         h, l = ax.get_legend_handles_labels()
         ax.legend(handles + h, labels + l, fontsize=7, loc="upper right")
-    fig.suptitle("Validation errors over the Monte-Carlo trials (boxes: p25–p75, whiskers 1.5 IQR; "
-                 "red: the paper's published value)", fontsize=10)
+    fig.suptitle("Validation errors over the Monte-Carlo trials (boxes: p25–p75, whiskers 1.5 IQR"
+                 + ("; red: the paper's published value)" if shown_paper else ")"), fontsize=10)
     fig.tight_layout()
     return [(_save(fig, out_dir, "distributions_validation"),
              "Distributions of the validation RMS and max errors per base axis over the trials of "
-             "each cell" + (" (first %d cells)" % len(cells) if len(run.cells) > len(cells) else "")
-             + ". Red diamonds: the paper's published values.")]
+             "each cell." + (" Red diamonds: the paper's published values." if shown_paper else "")
+             + run.left_out_note(cells))]
 
 
 def _axis_values(run, cell, axis_index, key, n_axes):
@@ -240,67 +273,99 @@ def sensitivity_figures(run, out_dir):
         df = pd.DataFrame(rows)
         numeric = bool(df["numeric"].all())
         categories = list(dict.fromkeys(df["x"]))
+        # "." sweeps whole settings: name the axis by its labels, not by the key.
+        name = key if key != "." else "the swept settings (" + ", ".join(map(str, categories)) + ")"
         fig, axs = plt.subplots(1, 2, figsize=(12, 4.2))
+        groups = df["group"].nunique()
         for ax, (metric, title) in zip(axs, (("rms_pos", "RMS position error (mm)"),
                                              ("rms_ori", "RMS orientation error (mrad)"))):
             for g, (group, sub) in enumerate(df[df["metric"] == metric].groupby("group", sort=False)):
-                xs = sub["x"].to_numpy(dtype=float) if numeric else \
-                    np.array([categories.index(v) for v in sub["x"]], dtype=float)
-                order = np.argsort(xs)
-                ax.plot(xs[order], sub["mean"].to_numpy()[order], "o-", color=f"C{g % 10}",
-                        label=group or "mean")
-                ax.fill_between(xs[order], sub["p5"].to_numpy()[order], sub["p95"].to_numpy()[order],
-                                color=f"C{g % 10}", alpha=0.15)
+                color = f"C{g % 10}"
+                mean, p5, p95 = (sub[c].to_numpy() for c in ("mean", "p5", "p95"))
+                if numeric:
+                    xs = sub["x"].to_numpy(dtype=float)
+                    order = np.argsort(xs)
+                    ax.plot(xs[order], mean[order], "o-", color=color, label=group or "mean")
+                    ax.fill_between(xs[order], p5[order], p95[order], color=color, alpha=0.15)
+                else:
+                    # Categories: points with their p5–p95 range, no line between them (the
+                    # order of categories means nothing); groups side by side.
+                    xs = np.array([categories.index(v) for v in sub["x"]], dtype=float)
+                    xs += (g - (groups - 1) / 2) * 0.12
+                    ax.errorbar(xs, mean, yerr=[mean - p5, p95 - mean], fmt="o", color=color,
+                                capsize=3, label=group or "mean, p5–p95")
             if numeric:
                 values = df["x"].astype(float)
                 if values.min() > 0 and values.max() / values.min() > 20:
                     ax.set_xscale("log")
+                if all(float(v).is_integer() for v in values):
+                    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             else:
                 ax.set_xticks(range(len(categories)))
-                ax.set_xticklabels(categories, rotation=30, ha="right", fontsize=8)
+                ax.set_xticklabels(categories, rotation=30 if len(categories) > 4 else 0,
+                                   ha="right" if len(categories) > 4 else "center", fontsize=8)
+                ax.set_xlim(-0.5, len(categories) - 0.5)
             ax.set_yscale("log")
-            ax.set_xlabel(key)
+            ax.set_xlabel(key if key != "." else "swept settings")
             ax.set_ylabel(title)
             ax.grid(alpha=0.3)
-            if df["group"].nunique() > 1:
+            if groups > 1 or not numeric:
                 ax.legend(fontsize=7)
-        fig.suptitle(f"Sensitivity to {key}: mean over trials with the p5–p95 band "
+        band = "p5–p95 band" if numeric else "p5–p95 range"
+        fig.suptitle(f"Sensitivity to {name}: mean over trials with the {band} "
                      "(averaged over the x, y, z axes)", fontsize=10)
         fig.tight_layout()
         safe = "".join(ch if ch.isalnum() else "_" for ch in key).strip("_") or "settings"
         out.append((_save(fig, out_dir, f"sensitivity_{safe}"),
-                    f"Validation accuracy against the swept setting '{key}'."))
+                    f"Validation accuracy against {name}" +
+                    ("." if numeric else ", drawn as categories.")))
     return out
 
 
 def parameter_figures(run, out_dir, limit=4):
     """Empirical against predicted std per parameter, the bias with its Monte-Carlo error bar, and
-    the correlation matrix, for the first cells."""
+    the correlation matrix, for the first cells; lengths (mm) and angles (mrad) on their own
+    axes."""
     out = []
-    for k, cell in enumerate(run.shown_cells(limit)):
+    shown = run.shown_cells(limit)
+    note = run.left_out_note(shown)
+    for k, cell in enumerate(shown):
         params = pd.DataFrame(cell["parameters"])
         if params.empty or params["std"].isna().all():
             continue
-        names = params["name"].tolist()
-        x = np.arange(len(names))
-        fig, axs = plt.subplots(2, 1, figsize=(12, 6.5), sharex=True)
-        axs[0].bar(x - 0.2, params["std"] * 1e3, width=0.4, label="empirical std")
-        axs[0].bar(x + 0.2, params["predicted_std"].astype(float) * 1e3, width=0.4,
-                   label="predicted σ·√diag(GᵀWG)⁻¹")
-        axs[0].set_ylabel("std (mm or mrad)")
-        axs[0].legend(fontsize=8)
-        axs[1].errorbar(x, params["bias"] * 1e3, yerr=2 * params["bias_se"] * 1e3, fmt="o", ms=3,
-                        capsize=2, label="bias ± 2 SE")
-        axs[1].axhline(0, color="k", lw=0.5)
-        axs[1].set_ylabel("bias (mm or mrad)")
-        axs[1].legend(fontsize=8)
-        axs[1].set_xticks(x)
-        axs[1].set_xticklabels(names, rotation=60, fontsize=8)
+        params["unit"] = [run.parameter_unit(cell["id"], n) for n in params["name"]]
+        units = [u for u in ("mm", "mrad") if (params["unit"] == u).any()]
+        fig, axs = plt.subplots(2, len(units), figsize=(13, 6.5), squeeze=False,
+                                gridspec_kw={"width_ratios": [max(1, (params["unit"] == u).sum())
+                                                              for u in units]})
+        for col, unit in enumerate(units):
+            sub = params[params["unit"] == unit]
+            x = np.arange(len(sub))
+            top, bottom = axs[0, col], axs[1, col]
+            top.bar(x - 0.2, sub["std"] * 1e3, width=0.4, label="empirical std")
+            top.bar(x + 0.2, sub["predicted_std"].astype(float) * 1e3, width=0.4,
+                    label="predicted σ·√diag(GᵀWG)⁻¹")
+            top.set_ylabel(f"std ({unit})")
+            top.set_title("lengths" if unit == "mm" else "angles", fontsize=9)
+            top.legend(fontsize=7)
+            bottom.errorbar(x, sub["bias"] * 1e3, yerr=2 * sub["bias_se"] * 1e3, fmt="o", ms=3,
+                            capsize=2, label="bias ± 2 SE")
+            bottom.axhline(0, color="k", lw=0.5)
+            bottom.set_ylabel(f"bias ({unit})")
+            bottom.legend(fontsize=7)
+            for ax in (top, bottom):
+                ax.set_xticks(x)
+                ax.set_xlim(-0.6, len(sub) - 0.4)
+            top.set_xticklabels([])
+            bottom.set_xticklabels(sub["name"].tolist(), rotation=60, fontsize=8)
         fig.suptitle(f"Parameter errors, cell {cell['label']} ({cell['ok']} trials)", fontsize=10)
         fig.tight_layout()
         out.append((_save(fig, out_dir, f"parameters_{k}"),
                     f"Cell {cell['label']}: empirical against predicted standard deviation of each "
-                    "parameter's error, and its bias with ±2 Monte-Carlo standard errors."))
+                    "parameter's error, and its bias with ±2 Monte-Carlo standard errors; lengths "
+                    "in mm, angles in mrad." + note))
+        names = params["name"].tolist()
+        x = np.arange(len(names))
         corr = np.array([[np.nan if v is None else v for v in row] for row in cell["correlation"]],
                         dtype=float)
         fig, ax = plt.subplots(figsize=(7.5, 6.5))
@@ -309,12 +374,58 @@ def parameter_figures(run, out_dir, limit=4):
         ax.set_yticks(x)
         ax.set_xticklabels(names, rotation=90, fontsize=7)
         ax.set_yticklabels(names, fontsize=7)
-        fig.colorbar(im, ax=ax, shrink=0.8, label="correlation")
+        fig.colorbar(im, ax=ax, shrink=0.8, label="correlation (no unit)")
         ax.set_title(f"Empirical correlation of the parameter errors, {cell['label']}", fontsize=10)
         fig.tight_layout()
         out.append((_save(fig, out_dir, f"correlation_{k}"),
                     f"Cell {cell['label']}: correlation matrix of the parameter errors over the "
-                    "trials."))
+                    "trials." + note))
+    return out
+
+
+def histogram_figures(run, out_dir, limit=4):
+    """Per cell: a histogram of each validation metric of the identified model over the trials,
+    with the mean, the p95 and the p95's 95 % confidence interval from the tables."""
+    data = run.trial_metrics()
+    if data.empty:
+        return []
+    out = []
+    shown = run.shown_cells(limit)
+    note = run.left_out_note(shown)
+    val = run.validation[run.validation["model"] == "identified"]
+    for k, cell in enumerate(shown):
+        rows = data[data["cell_id"] == cell["id"]]
+        if rows.empty:
+            continue
+        fig, axes = plt.subplots(4, 3, figsize=(12, 10))
+        for m, (metric, title) in enumerate(METRICS):
+            unit = "mm" if metric.endswith("pos") else "mrad"
+            for a, axis in enumerate(AXES):
+                ax = axes[m, a]
+                values = rows[f"val_{metric}_{axis}"].to_numpy() * 1e3
+                ax.hist(values, bins=min(60, max(10, len(values) // 20)), color=f"C{a}", alpha=0.6)
+                t = val[(val["cell_id"] == cell["id"]) & (val["metric"] == metric) &
+                        (val["axis"] == axis)]
+                if len(t):
+                    t = t.iloc[0]
+                    ax.axvline(t["mean"], color="k", lw=1, label="mean")
+                    ax.axvline(t["p95"], color="C3", lw=1, label="p95")
+                    if pd.notna(t["p95_ci_low"]) and pd.notna(t["p95_ci_high"]):
+                        ax.axvspan(t["p95_ci_low"], t["p95_ci_high"], color="C3", alpha=0.2,
+                                   label="p95 95 % CI")
+                ax.set_xlabel(f"{title.split(' (')[0]}, {axis} ({unit})", fontsize=8)
+                ax.set_ylabel("trials", fontsize=8)
+                ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+                ax.tick_params(labelsize=7)
+                if m == 0 and a == 0:
+                    ax.legend(fontsize=7)
+        fig.suptitle(f"Validation errors of the identified model, cell {cell['label']} "
+                     f"({len(rows)} trials ok)", fontsize=10)
+        fig.tight_layout()
+        out.append((_save(fig, out_dir, f"histograms_{k}"),
+                    f"Cell {cell['label']}: histograms of the validation metrics over the trials, "
+                    "with the mean, the p95 and the p95's distribution-free 95 % confidence "
+                    "interval (shaded) from validation.csv." + note))
     return out
 
 
@@ -323,6 +434,7 @@ def all_figures(run, out_dir):
     figures = []
     figures += realisation_figures(run, out_dir)
     figures += distribution_figure(run, out_dir)
+    figures += histogram_figures(run, out_dir)
     figures += sensitivity_figures(run, out_dir)
     figures += parameter_figures(run, out_dir)
     return figures

@@ -127,6 +127,7 @@ def build(run_dir):
     write_atomically(path, "\n".join(parts))
     write_atomically(os.path.join(run.report_dir, "figures.json"),
                      json.dumps({"figures": [os.path.basename(p) for p, _ in figures],
+                                 "captions": [c for _, c in figures],
                                  "seconds": round(time.time() - t0, 2)}, indent=2))
     return path, figures
 

@@ -49,6 +49,7 @@ int ReportCommand(const std::vector<std::string>& args) {
   if (const char* p = std::getenv("LRCAL_PYTHON")) python = p;
   const int status = std::system((Quote(python) + " " + Quote(script) + " " + Quote(dir)).c_str());
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  RemoveReportSnapshot(data);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (code != 0) {

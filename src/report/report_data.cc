@@ -59,13 +59,14 @@ void SnapshotAndTables(const std::string& run_dir, const Json& manifest, ReportD
   if (stores.empty())
     throw InputError(run_dir, "no trial store (trials.sqlite): the run has not started");
   for (const std::string& path : stores) snap.MergeFrom(path);
-  const long long trials = manifest["study"]["trials"];
-  for (const auto& c : manifest["study"]["cells"]) {
-    data->done += snap.CountTrials(c["id"].get<std::string>());
-    data->expected += trials;
+  // Done and expected as the tables count them: up to each cell's stopping point under
+  // stop_when, the maximum until it is decided.
+  const StudyTablesResult tables = WriteStudyTables(snap, manifest["study"], data->dir);
+  for (const CellSummary& s : tables.cells) {
+    data->done += s.trials;
+    data->expected += s.stop.trials_used;
   }
-  data->complete = data->done >= data->expected;
-  WriteStudyTables(snap, manifest["study"], data->dir);
+  data->complete = tables.complete;
 }
 
 Json PoseErrorsJson(const PoseErrors& nominal, const PoseErrors& identified) {
@@ -117,6 +118,12 @@ Json Realisation(const Json& manifest) {
 }
 
 }  // namespace
+
+void RemoveReportSnapshot(const ReportData& data) {
+  std::error_code ec;
+  const std::string snapshot = (fs::path(data.dir) / "trials.snapshot.sqlite").string();
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) fs::remove(snapshot + suffix, ec);
+}
 
 ReportData PrepareReportData(const std::string& run_dir) {
   const Json manifest = ReadReportManifest(run_dir);

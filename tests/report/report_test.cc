@@ -49,8 +49,17 @@ TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
   ASSERT_TRUE(fs::exists(report / "report.html")) << out;
   const Json figures = Json::parse(Read(report / "figures.json"));
   const std::vector<std::string> names = figures["figures"];
-  // One-realisation (2), distributions, sensitivity, parameters and correlation per cell (2 × 2).
-  EXPECT_EQ(names.size(), 8u) << figures.dump();
+  // One-realisation (2), distributions, sensitivity, and per cell histograms, parameters and
+  // correlation (2 × 3).
+  EXPECT_EQ(names.size(), 10u) << figures.dump();
+  // The snapshot of the store is gone once the figures are drawn.
+  EXPECT_FALSE(fs::exists(report / "trials.snapshot.sqlite"));
+  const std::string captions = figures["captions"].dump();
+  EXPECT_NE(captions.find("Red diamonds"), std::string::npos);  // paper cells: paper values
+  EXPECT_NE(captions.find("the swept settings (case 1, case 2), drawn as categories"),
+            std::string::npos)
+      << captions;
+  EXPECT_EQ(captions.find("Only the first"), std::string::npos);  // every cell is drawn
   for (const auto& png : names) {
     EXPECT_GT(fs::file_size(report / "figures" / png), 10000u) << png;
     EXPECT_TRUE(fs::exists(report / "figures" / (png.substr(0, png.size() - 4) + ".svg"))) << png;
@@ -81,6 +90,26 @@ TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
                        &out),
             0);
   EXPECT_GT(fs::file_size(shot), 20000u);
+}
+
+TEST(Report, FiguresSayWhatTheyLeaveOutAndMarkPaperValuesOnlyWhereThereAreAny) {
+  const std::string dir = testing::TempDir("report_sweep");
+  const std::string study = dir + "/sweep.yaml";
+  std::ofstream(study) << "name: sweep\nseed: 3\ntrials: 30\nrobot: "
+                       << testing::SourcePath("studies/robots/paper.yaml")
+                       << "\npool: {size: 60}\nvalidation: {size: 10}\n"
+                          "sweep:\n  axes:\n    - key: noise.repetitions\n"
+                          "      values: [1, 2, 3, 4, 5]\n";
+  std::string out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " run " + study + " --out " + dir + "/run --quiet", &out), 0)
+      << out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/run", &out), 0) << out;
+  const Json figures = Json::parse(Read(fs::path(dir) / "run/report/figures.json"));
+  const std::string captions = figures["captions"].dump();
+  EXPECT_EQ(captions.find("Red diamonds"), std::string::npos) << captions;
+  EXPECT_NE(captions.find("Only the first 4 of the 5 cells"), std::string::npos) << captions;
+  EXPECT_NE(captions.find("Validation accuracy against noise.repetitions."), std::string::npos)
+      << captions;
 }
 
 TEST(Report, PartialRunIsReportedAsPartial) {
