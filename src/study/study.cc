@@ -146,8 +146,12 @@ void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string
   if (!given.is_object() || !defaults.is_object()) return;
   for (auto it = given.begin(); it != given.end(); ++it) {
     const std::string p = Join(path, it.key());
-    // plane: checked by the typed parser; the robot file's hash is lrcal's own.
+    // plane: checked by the typed parser; the robot file's hash is lrcal's own. pool.file and
+    // validation.file (with lrcal's hash of them) are optional keys without a default.
     if (path.empty() && (it.key() == "plane" || it.key() == "robot_file_fnv1a")) continue;
+    if ((path == "pool" || path == "validation") &&
+        (it.key() == "file" || it.key() == "file_fnv1a"))
+      continue;
     if (!defaults.contains(it.key()))
       throw InputError(where(p), "unknown key; expected one of: " + KeyList(defaults));
     const Json& d = defaults[it.key()];
@@ -283,8 +287,17 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
   c->pool_size = Int(s, "pool.size", where, 1, 100000);
   c->pool_redraw = Bool(s, "pool.redraw", where);
   c->min_singular_value = NonNegative(s, "pool.min_singular_value", where);
+  if (!At(s, "pool.file").is_null()) {
+    c->pool_file = Str(s, "pool.file", where);
+    if (c->pool_redraw)
+      throw InputError(where("pool.redraw"),
+                       "a pool read from a file (pool.file) cannot be redrawn per trial; drop "
+                       "pool.redraw or pool.file");
+  }
+  if (!At(s, "validation.file").is_null()) c->validation_file = Str(s, "validation.file", where);
   c->select_count = Int(s, "selection.count", where, 1);
-  if (c->select_count > c->pool_size)
+  // A pool from a file is checked against the count when it is read (PrepareCell).
+  if (c->pool_file.empty() && c->select_count > c->pool_size)
     throw InputError(where("selection.count"), "cannot select " + std::to_string(c->select_count) +
                                                    " configurations from a pool of " +
                                                    std::to_string(c->pool_size) + " (pool.size)");
@@ -379,6 +392,12 @@ std::string ValueLabel(const Json& v) {
 }  // namespace
 
 std::string Study::folder() const { return std::filesystem::path(path).parent_path().string(); }
+
+std::string ResolveStudyFile(const std::string& file, const std::string& folder) {
+  const std::filesystem::path p(file);
+  if (p.is_absolute() || folder.empty()) return file;
+  return (std::filesystem::path(folder) / p).string();
+}
 
 Json Study::ToJson() const {
   Json j;
@@ -570,6 +589,27 @@ std::vector<std::vector<int>> Combinations(const std::vector<Axis>& axes,
   }
 }
 
+// pool.file and validation.file: their content's hash goes into the settings (a changed file
+// is a new cell), next to the path as written.
+void HashConfigurationFiles(Json* settings, const KeyLocator& where, const std::string& folder) {
+  for (const char* section : {"pool", "validation"}) {
+    if (!settings->contains(section) || !(*settings)[section].is_object()) continue;
+    Json& sec = (*settings)[section];
+    sec.erase("file_fnv1a");  // lrcal's own key, never the user's
+    if (!sec.contains("file")) continue;
+    const std::string key = std::string(section) + ".file";
+    if (!sec["file"].is_string() || sec["file"].get<std::string>().empty())
+      throw InputError(where(key), "expected the path of a CSV file of configurations (q1..qN)");
+    const std::string file = ResolveStudyFile(sec["file"].get<std::string>(), folder);
+    std::ifstream in(file, std::ios::binary);
+    if (!in || std::filesystem::is_directory(file))
+      throw InputError(where(key), "cannot open the configuration file '" + file + "'");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    sec["file_fnv1a"] = HashHex(ss.str());
+  }
+}
+
 Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector<int>& combo,
               const std::string& path, const LineMap& lines) {
   Cell cell;
@@ -591,6 +631,8 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
                Location(path, line == lines.end() ? 0 : line->second);
   }
   if (cell.label.empty()) cell.label = "base";
+  HashConfigurationFiles(&cell.settings, KeyLocator{path, &lines, context, ""},
+                         std::filesystem::path(path).parent_path().string());
   CheckUnknownKeys(cell.settings, StudyDefaults(), "", KeyLocator{path, &lines, context, ""});
   cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context, ""});
   cell.id = HashHex(cell.settings.dump());

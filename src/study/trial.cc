@@ -3,6 +3,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
+#include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/simulation.h"
 #include "study/trial_pipeline.h"
@@ -80,7 +81,7 @@ ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::
 TrialDesign SelectDesign(const CellContext& c, long long trial, const ConfigurationSet& pool,
                          const Eigen::MatrixXd& pool_G) {
   const CellSettings& s = c.cell->typed;
-  const RandomStream stream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
+  const RandomStream stream(c.selection_seed, c.pool_stream, static_cast<std::uint64_t>(trial),
                             RandomPurpose::kSelection);
   TrialDesign d;
   d.slots = SelectConfigurations(pool_G, s.select_count, s.selection, stream).indices;
@@ -117,15 +118,71 @@ void BuildParameterSet(const CellSettings& s, CellContext* c) {
                                             " parameters: need at least as many");
 }
 
+// A study's configuration file (pool.file, validation.file), read for the cell's robot.
+ConfigurationSet ReadStudyConfigurations(const Study& study, const std::string& file,
+                                         const std::string& key, const RobotModel& robot) {
+  try {
+    return ReadConfigurations(ResolveStudyFile(file, study.folder()), robot.num_links());
+  } catch (const InputError& e) {
+    throw InputError(key, e.what());
+  }
+}
+
+// The candidates of a pool file whose beam hits the plane (nominal model, and the fixed truth
+// when there is one); the others are reported like a drawn pool's rejections.
+ConfigurationSet UsablePoolFromFile(const Study& study, const CellSettings& s, CellContext* c) {
+  const ConfigurationSet given =
+      ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot);
+  CandidatePool usable = UsableCandidates(*c->robot, c->plane, c->ranger, given);
+  if (!s.truth_random) {  // the true beam must hit too
+    std::vector<double> h;
+    std::vector<BeamMiss> misses;
+    ExactReadings(*c->robot, c->fixed_truth.values, c->plane, c->ranger, usable.configs, &h,
+                  &misses);
+    ConfigurationSet kept(usable.configs.num_joints());
+    for (int i = 0; i < usable.configs.size(); ++i) {
+      if (misses[i] == BeamMiss::kNone) {
+        kept.AddFrom(usable.configs, i);
+      } else {
+        ++usable.report.rejected[std::string("true model: ") + BeamMissName(misses[i])];
+      }
+    }
+    usable.configs = kept;
+  }
+  c->pool_report = usable.report;
+  c->pool_report.requested = static_cast<int>(given.size());
+  c->pool_report.accepted = static_cast<int>(usable.configs.size());
+  c->pool_report.attempts = static_cast<int>(given.size());
+  if (static_cast<int>(usable.configs.size()) < s.select_count)
+    throw InputError("pool.file",
+                     "'" + s.pool_file + "' has " + std::to_string(given.size()) +
+                         " configurations, " + std::to_string(usable.configs.size()) +
+                         " of them usable (" + c->pool_report.ToString() +
+                         "): fewer than selection.count = " + std::to_string(s.select_count));
+  return usable.configs;
+}
+
 void DrawCellConfigurations(const Study& study, const CellSettings& s, CellContext* c) {
   c->pool_stream =
       StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "plane", "pool", "truth"});
   c->validation_stream =
       StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "validation", "pool"});
+  // With the pool from a file, the selection's random draws (sampled, exchange, random) do not
+  // depend on the seed: with the validation set from a file too, another seed changes only the
+  // noise (and a drawn truth).
+  c->selection_seed = s.pool_file.empty() ? study.seed : 0;
   // The pool must give readings on the nominal model and, for a fixed truth, on the true one.
   if (!s.truth_random) c->fixed_truth = DrawTruth(*c, 0);
-  c->pool = SamplePool(*c, 0, s.truth_random ? c->robot->nominal_values() : c->fixed_truth.values,
-                       &c->pool_report);
+  if (!s.pool_file.empty()) {
+    c->pool = UsablePoolFromFile(study, s, c);
+  } else {
+    c->pool = SamplePool(*c, 0, s.truth_random ? c->robot->nominal_values() : c->fixed_truth.values,
+                         &c->pool_report);
+  }
+  if (!s.validation_file.empty()) {
+    c->validation = ReadStudyConfigurations(study, s.validation_file, "validation.file", *c->robot);
+    return;
+  }
   SamplingOptions vo;
   vo.ranger = c->ranger;
   vo.min_jacobian_singular_value = s.min_singular_value;

@@ -51,6 +51,9 @@ struct TrialDesign {
 struct CellContext {
   const Cell* cell = nullptr;
   std::uint64_t seed = 0;
+  /// The seed of the selection's random draws: the study's, or 0 when the pool comes from a
+  /// file (the design then does not change with the seed).
+  std::uint64_t selection_seed = 0;
   std::shared_ptr<const RobotModel> robot;
   Plane plane;
   RangerSpec ranger;                        ///< the robot file's ranger limits

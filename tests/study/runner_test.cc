@@ -16,6 +16,10 @@
 #include <thread>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/random.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/io/csv.h"
+#include "lrcal/io/robot_file.h"
 #include "lrcal/report/run_tables.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/statistics.h"
@@ -358,6 +362,55 @@ TEST(MonteCarlo, SelectionRedrawnPerTrialVariesTheDesign) {
   }
 }
 
+// pool.file / validation.file: the user's configurations, hashed into the cell id; with both
+// from files, another seed changes only the noise (the design, even a randomised selection, and
+// the validation set stay).
+TEST(MonteCarlo, PoolAndValidationFromFilesChangeOnlyTheNoiseWithTheSeed) {
+  const std::string dir = testing::TempDir("mc_files");
+  const RobotFile robot = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
+  SamplingOptions o;
+  o.ranger = robot.ranger;
+  WriteConfigurations(dir + "/pool.csv",
+                      SampleConfigurations(robot.robot, *robot.plane, 70,
+                                           RandomStream(4, 0, 0, RandomPurpose::kPool), o));
+  o.require_beam_hit = false;
+  WriteConfigurations(dir + "/val.csv",
+                      SampleConfigurations(robot.robot, *robot.plane, 12,
+                                           RandomStream(9, 0, 0, RandomPurpose::kValidation), o));
+  const auto study = [&](int seed, bool files) {
+    const std::string path = dir + "/s" + std::to_string(seed) + (files ? "f" : "d") + ".yaml";
+    std::ofstream(path) << "name: files\nseed: " << seed << "\ntrials: 20\nrobot: "
+                        << testing::SourcePath("studies/robots/paper.yaml") << "\n"
+                        << (files ? "pool: {file: pool.csv}\nvalidation: {file: val.csv}\n"
+                                  : "pool: {size: 70}\nvalidation: {size: 12}\n")
+                        << "selection: {count: 40, method: sampled, samples: 30}\n";
+    return path;
+  };
+  const auto cell_of = [&](const std::string& run) {
+    TrialStore store(run + "/trials.sqlite");
+    return SummarizeCell(store, store.Cells().at(0));
+  };
+  for (bool files : {true, false}) {
+    const std::string tag = files ? "f" : "d";
+    RunSmall(study(1, files), dir + "/r1" + tag, 2);
+    RunSmall(study(2, files), dir + "/r2" + tag, 2);
+    const CellSummary a = cell_of(dir + "/r1" + tag), b = cell_of(dir + "/r2" + tag);
+    EXPECT_EQ(a.cell.id, b.cell.id);                        // the seed is not a setting
+    EXPECT_NE(a.validation[0].mean, b.validation[0].mean);  // other noise
+    if (files) {
+      EXPECT_EQ(a.cell.design_sigma_min, b.cell.design_sigma_min);
+      EXPECT_EQ(a.nominal[0].mean, b.nominal[0].mean);  // the same validation set
+    } else {  // drawn: the seed changes the pool, the design and the validation set too
+      EXPECT_NE(a.cell.design_sigma_min, b.cell.design_sigma_min);
+      EXPECT_NE(a.nominal[0].mean, b.nominal[0].mean);
+    }
+  }
+  // The file's content is part of the cell id.
+  const std::string before = cell_of(dir + "/r1f").cell.id;
+  std::ofstream(dir + "/pool.csv", std::ios::app) << "0.1,0.2,0.3,0.4,0.5,0.6\n";
+  EXPECT_NE(LoadStudy(study(1, true)).cells.at(0).id, before);
+}
+
 struct BadStudy {
   std::string name, text, expected;
 };
@@ -413,6 +466,11 @@ INSTANTIATE_TEST_SUITE_P(
                  "key 'stop_when.block': expected at most the study's trials (5)"},
         BadStudy{"StopWhenOtherMaximum", "stop_when: {block: 2, relative_se: 0.1, trials: 9}\n",
                  "key 'stop_when.trials': differs from the study's trials (5)"},
+        BadStudy{"PoolFileMissing", "pool: {file: nowhere.csv}\n",
+                 "bad.yaml:5 key 'pool.file': cannot open the configuration file"},
+        BadStudy{"PoolFileRedrawn", "pool: {file: bad.yaml, redraw: true}\n",
+                 "key 'pool.redraw': a pool read from a file (pool.file) cannot be redrawn"},
+        BadStudy{"ValidationFileNotCsv", "validation: {file: bad.yaml}\n", "validation.file: "},
         BadStudy{
             "ZipOfUnequalAxes",
             "sweep:\n  combine: zip\n  axes:\n    - {key: noise.sigma_mm, values: [0.1, 0.2]}\n"

@@ -43,6 +43,10 @@ struct CellSettings {
   int repetitions = 0;  ///< readings averaged per configuration
   // Candidate pool.
   int pool_size = 0;
+  /// pool.file: the candidates from a CSV of configurations (q1..qN, rad), as written in the
+  /// study (relative to its folder); empty when the pool is drawn. The file's hash is part of
+  /// the settings (pool.file_fnv1a), hence of the cell id.
+  std::string pool_file;
   bool pool_redraw = false;  ///< new pool every trial (else one pool per cell, shared by trials)
   double min_singular_value = 0;
   // Selection.
@@ -54,6 +58,8 @@ struct CellSettings {
   bool selection_redraw = false;
   // Validation.
   int validation_size = 0;
+  /// validation.file: the validation configurations from a CSV (as pool_file); empty: drawn.
+  std::string validation_file;
   // Identification.
   PlaneTerms plane_terms;
   std::vector<std::string> fixed;
@@ -100,6 +106,10 @@ const Json& StudyDefaults();
 
 /// Loads, validates and expands a study file. Throws InputError.
 Study LoadStudy(const std::string& path);
+
+/// A file named in a study (pool.file, validation.file): relative paths are taken relative to
+/// the study file's folder.
+std::string ResolveStudyFile(const std::string& file, const std::string& folder);
 
 /// Resolves a study argument: a path, or a shipped name ("quick" → studies/quick.yaml).
 std::string ResolveStudyPath(const std::string& name_or_path);
