@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -68,50 +69,64 @@ bool SameDistribution(const Distribution& a, const Distribution& b) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The paper's published numbers in our distributions (paper cells only). Placement needs a
-// cell's sorted values; it runs as each cell is summarised, after which the values are released.
+// The paper's published numbers in our distributions (paper cells only): the values are placed
+// while a cell is summarised (SummaryProbes), so no cell's values are ever held in memory.
 
-void PlaceValidation(const CellSummary& s, int paper_case, Rows* rows) {
-  const std::string label = "case " + std::to_string(paper_case);
-  for (int m = 0; m < 4; ++m)
-    for (int a = 0; a < 3; ++a) {
-      const int k = 3 * m + a;
-      const double paper = kPaperValidation[paper_case][a][m];
-      rows->push_back({label, std::string("validation ") + kMetricNames[m], kAxes[a],
-                       m % 2 == 0 ? "mm" : "mrad", Fixed(paper), Fixed(s.validation[k].p5 * 1e3),
-                       Fixed(s.validation[k].p50 * 1e3), Fixed(s.validation[k].p95 * 1e3),
-                       Fixed(PercentileRank(s.validation_values[k], paper * 1e-3), 2)});
-    }
+int PaperCaseOf(const StoredCell& cell) {
+  const int paper_case = Json::parse(cell.settings).value("paper_case", 0);
+  return paper_case >= 1 && paper_case <= 2 ? paper_case : 0;
 }
 
 // Identified parameters: published error = published Δ − the cell's recorded true Δ (the robot
-// file's errors × truth.scale, stored with the cell: no robot file is read after the run).
-void PlaceIdentified(const CellSummary& s, int paper_case, Rows* rows) {
-  const std::vector<double>& truth = s.cell.truth_errors;
+// file's errors × truth.scale, stored with the cell: no robot file is read after the run). NaN
+// where the paper has no value.
+double PublishedError(const StoredCell& cell, int paper_case, const std::string& name) {
+  const std::vector<double>& truth = cell.truth_errors;
   const int num_links = static_cast<int>(truth.size()) / kValuesPerLink;
-  if (num_links != 6) return;
-  const std::string label = "case " + std::to_string(paper_case);
-  for (std::size_t k = 0; k < s.parameters.size(); ++k) {
-    const std::string& name = s.parameters[k].name;
-    const int index = LinkValueIndex(name, num_links);
-    if (index < 0) continue;
-    const double published =
-        kPaperIdentified[paper_case - 1][index / kValuesPerLink][index % kValuesPerLink];
-    if (std::isnan(published)) continue;
-    const double err = published * 1e-3 - truth[index];
-    std::vector<double> values = s.error_values[k];
-    rows->push_back({label, "identified error", name, UnitOf(name), Fixed(err * 1e3),
-                     Fixed(Quantile(&values, 5) * 1e3), Fixed(Quantile(&values, 50) * 1e3),
-                     Fixed(Quantile(&values, 95) * 1e3), Fixed(PercentileRank(values, err), 2)});
-  }
+  const int index = num_links == 6 ? LinkValueIndex(name, num_links) : -1;
+  if (index < 0) return std::nan("");
+  const double published =
+      kPaperIdentified[paper_case - 1][index / kValuesPerLink][index % kValuesPerLink];
+  return published * 1e-3 - truth[index];
+}
+
+// The probes of a paper cell (nullopt for other cells).
+std::optional<SummaryProbes> PaperProbes(const StoredCell& cell) {
+  const int paper_case = PaperCaseOf(cell);
+  if (!paper_case) return std::nullopt;
+  SummaryProbes probes;
+  for (int m = 0; m < 4; ++m)
+    for (int a = 0; a < 3; ++a)
+      probes.validation[3 * m + a] = kPaperValidation[paper_case][a][m] * 1e-3;
+  for (const std::string& name : cell.parameter_names)
+    probes.errors.push_back(PublishedError(cell, paper_case, name));
+  probes.error_quantiles = true;
+  return probes;
 }
 
 Rows PlaceCell(const CellSummary& s) {
   Rows rows;
-  const int paper_case = Json::parse(s.cell.settings).value("paper_case", 0);
-  if (paper_case < 1 || paper_case > 2) return rows;
-  PlaceValidation(s, paper_case, &rows);
-  PlaceIdentified(s, paper_case, &rows);
+  const int paper_case = PaperCaseOf(s.cell);
+  if (!paper_case) return rows;
+  const std::string label = "case " + std::to_string(paper_case);
+  for (int m = 0; m < 4; ++m)
+    for (int a = 0; a < 3; ++a) {
+      const int k = 3 * m + a;
+      rows.push_back({label, std::string("validation ") + kMetricNames[m], kAxes[a],
+                      m % 2 == 0 ? "mm" : "mrad", Fixed(kPaperValidation[paper_case][a][m]),
+                      Fixed(s.validation[k].p5 * 1e3), Fixed(s.validation[k].p50 * 1e3),
+                      Fixed(s.validation[k].p95 * 1e3), Fixed(s.validation_probe_rank[k], 2)});
+    }
+  if (s.cell.truth_errors.size() != 6 * kValuesPerLink) return rows;
+  for (std::size_t k = 0; k < s.parameters.size() && k < s.error_quantiles.size(); ++k) {
+    const std::string& name = s.parameters[k].name;
+    const double err = PublishedError(s.cell, paper_case, name);
+    if (std::isnan(err)) continue;
+    const auto& q = s.error_quantiles[k];
+    rows.push_back({label, "identified error", name, UnitOf(name), Fixed(err * 1e3),
+                    Fixed(q[0] * 1e3), Fixed(q[1] * 1e3), Fixed(q[2] * 1e3),
+                    Fixed(s.error_probe_rank[k], 2)});
+  }
   return rows;
 }
 
@@ -142,20 +157,21 @@ void SummarizeCells(const TrialStore& store, const std::vector<StoredCell>& cell
   auto summarize = [&] {
     try {
       TrialStore local(store.path());
+      local.MapForReading();
       for (std::size_t i; (i = next.fetch_add(1)) < cells.size();) {
         CellSummary& s = (*summaries)[i];
+        const std::optional<SummaryProbes> probes = PaperProbes(cells[i]);
+        const SummaryProbes* p = probes ? &*probes : nullptr;
         if (rule.enabled()) {
           const CellStopping stop = EvaluateStopping({&local}, cells[i].id, rule, max_trials);
-          s = SummarizeCell(local, cells[i], stop.trials_used());
+          s = SummarizeCell(local, cells[i], stop.trials_used(), p);
           s.stop = {true, stop.decided(), stop.precise(), stop.trials_used(), stop.precision()};
         } else {
-          s = SummarizeCell(local, cells[i], max_trials);
+          s = SummarizeCell(local, cells[i], max_trials, p);
           s.stop.decided = s.trials >= max_trials;
           s.stop.trials_used = max_trials;
         }
         (*placements)[i] = PlaceCell(s);
-        for (auto& v : s.validation_values) std::vector<double>().swap(v);
-        std::vector<std::vector<double>>().swap(s.error_values);
       }
     } catch (...) {
       std::lock_guard<std::mutex> g(failure_mutex);

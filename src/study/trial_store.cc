@@ -334,6 +334,10 @@ std::optional<TrialRecord> TrialStore::GetTrial(const std::string& cell_id, long
   return r;
 }
 
+void TrialStore::MapForReading() {
+  Exec("PRAGMA mmap_size=33554432");
+}  // 32 MiB: small stores whole
+
 void TrialStore::MergeFrom(const std::string& other_path) {
   { TrialStore upgraded(other_path); }  // opening brings an older store's schema up to date
   Statement attach(db_, "ATTACH DATABASE ? AS other");

@@ -92,19 +92,37 @@ struct CellSummary {
   Eigen::MatrixXd covariance, correlation;  ///< empirical, SI
   std::array<Distribution, 12> validation;  ///< identified model, SI (layout: trial.h)
   std::array<Distribution, 12> nominal;     ///< nominal model, SI
-  /// Sorted values, kept for percentile ranks (paper placement): validation metrics and the
-  /// parameter errors. The caller may release them once used (memory is then one cell's worth).
-  std::array<std::vector<double>, 12> validation_values;
-  std::vector<std::vector<double>> error_values;
+  /// Percentile ranks (PercentileRank) of the probes asked for (SummaryProbes): per validation
+  /// metric and per parameter error; NaN where no probe was given.
+  std::array<double, 12> validation_probe_rank{};
+  std::vector<double> error_probe_rank;
+  /// p5, p50, p95 of each parameter's error (SI), when SummaryProbes::error_quantiles.
+  std::vector<std::array<double, 3>> error_quantiles;
   Distribution iterations, sigma_hat;
   /// σ_min of each ok trial's design: one value for a fixed design, a distribution when the
   /// pool or the selection is redrawn per trial.
   Distribution design_sigma_min;
 };
 
+/// Values to place among a cell's trials while it is summarised (the paper's published numbers):
+/// NaN (or a short vector) where there is none.
+struct SummaryProbes {
+  std::array<double, 12> validation;  ///< SI, per validation metric of the identified model
+  std::vector<double> errors;         ///< SI, per parameter error
+  bool error_quantiles = false;       ///< also the p5, p50, p95 of every parameter error
+  SummaryProbes() { validation.fill(std::numeric_limits<double>::quiet_NaN()); }
+};
+
 /// Summarises one cell from the store: its trials with index < `end` (a stop_when cell's
 /// stopping point; every recorded trial by default).
+///
+/// Memory does not grow with the trial count: the store is read in a few passes in canonical
+/// order (sums, then the centred moments and the covariance lanes, then the order statistics by
+/// radix selection: histograms of the values' leading bits bracket each wanted rank, and only
+/// the few values inside a bracket are kept). The numbers are the same bits as sorting every
+/// value in memory (Describe; tested).
 CellSummary SummarizeCell(const TrialStore& store, const StoredCell& cell,
-                          long long end = std::numeric_limits<long long>::max());
+                          long long end = std::numeric_limits<long long>::max(),
+                          const SummaryProbes* probes = nullptr);
 
 }  // namespace lrcal
