@@ -222,7 +222,8 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->model, c->design.configs);
   if (!c->rank_deficient && design_report.full_rank()) {
-    c->predicted_std = ParameterCovariance(s.repetitions * GtG, s.sigma).diagonal().cwiseSqrt();
+    c->predicted_covariance = ParameterCovariance(s.repetitions * GtG, s.sigma);
+    c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
   } else {
     if (!c->rank_deficient) c->rank_message = design_report.ToString();
     c->rank_deficient = true;
@@ -253,6 +254,68 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
   }
   c->nominal_validation =
       ComparePoses(*c->robot, truth, c->robot->nominal_values(), c->validation).stats;
+}
+
+// The linearised validation errors: the Jacobian (6M × n, rows per configuration j: position
+// 3j..3j+2, then orientation 3M+3j..) of the validation pose errors with respect to the
+// parameters, by central differences at the nominal model.
+Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
+  const int n = c.model->num_parameters(), m = c.validation.size();
+  const std::vector<Pose<double>> poses =
+      ToolPoses(*c.robot, c.robot->nominal_values(), c.validation);
+  Eigen::MatrixXd J(6 * m, n);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+  constexpr double kStep = 1e-6;  // m or rad: truncation O(step²), rounding O(1e-16/step)
+  for (int k = 0; k < n; ++k) {
+    e[k] = kStep;
+    const PoseErrors plus =
+        ComparePoses(*c.robot, poses, c.model->LinkValues(e.data()), c.validation);
+    e[k] = -kStep;
+    const PoseErrors minus =
+        ComparePoses(*c.robot, poses, c.model->LinkValues(e.data()), c.validation);
+    e[k] = 0;
+    for (int j = 0; j < m; ++j)
+      for (int a = 0; a < 3; ++a) {
+        J(3 * j + a, k) = (plus.position(a, j) - minus.position(a, j)) / (2 * kStep);
+        J(3 * m + 3 * j + a, k) = (plus.orientation(a, j) - minus.orientation(a, j)) / (2 * kStep);
+      }
+  }
+  return J;
+}
+
+// The first-order prediction of the validation metrics' means, the planner's estimate: the
+// covariance predicted at the nominal model propagated to the validation poses through their
+// Jacobian (linear in the parameter errors), then each metric's mean over 4000 Gaussian draws
+// of those linear errors (the RMS and max of correlated errors have no closed form). Draws are
+// addressed by the validation set's stream, so the prediction is a function of the settings.
+void PredictValidation(CellContext* c) {
+  c->predicted_validation.fill(std::nan(""));
+  const Eigen::MatrixXd& C = c->predicted_covariance;
+  if (c->rank_deficient || C.size() == 0 || !C.allFinite()) return;
+  const int n = c->model->num_parameters(), m = c->validation.size();
+  if (m == 0) return;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(C);
+  const Eigen::MatrixXd L =
+      eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  constexpr int kDraws = 4000;
+  Eigen::MatrixXd Z(n, kDraws);
+  const RandomStream stream(0, c->validation_stream, 0, RandomPurpose::kPrediction);
+  stream.Normals(0, n * kDraws, Z.data());
+  const Eigen::MatrixXd E = ValidationPoseJacobian(*c) * (L * Z);  // 6M × draws
+  std::array<double, 12> sum{};
+  for (int d = 0; d < kDraws; ++d)
+    for (int part = 0; part < 2; ++part)  // position, orientation
+      for (int a = 0; a < 3; ++a) {
+        double ss = 0, max = 0;
+        for (int j = 0; j < m; ++j) {
+          const double x = E(3 * m * part + 3 * j + a, d);
+          ss += x * x;
+          max = std::max(max, std::fabs(x));
+        }
+        sum[3 * part + a] += std::sqrt(ss / m);  // rms pos xyz, rms ori xyz
+        sum[6 + 3 * part + a] += max;            // max pos xyz, max ori xyz
+      }
+  for (int k = 0; k < 12; ++k) c->predicted_validation[k] = sum[k] / kDraws;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -385,6 +448,7 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
     c->parameter_names = c->model->parameters().names;
     SelectCellDesign(s, c.get());
     CacheTruth(s, c.get());
+    PredictValidation(c.get());
   } catch (const InputError& e) {
     throw InputError(study.path + " cell '" + cell.label + "' (" + cell.id + ")", e.what());
   }

@@ -20,6 +20,8 @@
 // Private to src/: the runner, `lrcal report` and `lrcal plan` use it; tests and benchmarks too.
 #pragma once
 
+#include <Eigen/Eigenvalues>
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -77,6 +79,11 @@ struct CellContext {
   /// The same with G at the true parameters: the Cramér–Rao bound of the simulated experiment
   /// (fixed truth and design; empty otherwise).
   Eigen::VectorXd predicted_std_truth;
+  /// σ²·(GᵀWG)⁻¹ of the cell's design at the nominal model (SI; empty if rank deficient).
+  Eigen::MatrixXd predicted_covariance;
+  /// First-order prediction of the mean of each validation metric of the identified model
+  /// (layout of TrialRecord::validation, SI); NaN where the covariance cannot be predicted.
+  std::array<double, 12> predicted_validation{};
   TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;

@@ -2,6 +2,7 @@
 
 #include <sqlite3.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -73,7 +74,7 @@ class Statement {
 
 constexpr const char* kCellColumns =
     "cell_id, ord, label, settings, parameter_names, predicted_std, design_sigma_min, "
-    "fixed_for_rank, pool_report, truth_errors, predicted_std_truth";
+    "fixed_for_rank, pool_report, truth_errors, predicted_std_truth, predicted_validation";
 
 // Standard deviations as JSON, NaN (a parameter without a prediction) as null, and back.
 std::string StdJson(const std::vector<double>& sd) {
@@ -119,19 +120,22 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
   Exec(
       "CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
       "settings TEXT, parameter_names TEXT, predicted_std TEXT, design_sigma_min REAL, "
-      "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT, predicted_std_truth TEXT)");
+      "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT, predicted_std_truth TEXT, "
+      "predicted_validation TEXT)");
   // Stores written before lrcal recorded the truth or its prediction: add the columns (the tables
   // then leave out what needs them rather than re-reading a robot file that may have changed).
-  bool has_truth = false, has_truth_prediction = false;
+  bool has_truth = false, has_truth_prediction = false, has_validation_prediction = false;
   {
     Statement info(db_, "PRAGMA table_info(cells)");
     while (info.Step()) {
       has_truth |= info.ColumnText(1) == "truth_errors";
       has_truth_prediction |= info.ColumnText(1) == "predicted_std_truth";
+      has_validation_prediction |= info.ColumnText(1) == "predicted_validation";
     }
   }
   if (!has_truth) Exec("ALTER TABLE cells ADD COLUMN truth_errors TEXT");
   if (!has_truth_prediction) Exec("ALTER TABLE cells ADD COLUMN predicted_std_truth TEXT");
+  if (!has_validation_prediction) Exec("ALTER TABLE cells ADD COLUMN predicted_validation TEXT");
   std::string trials =
       "CREATE TABLE IF NOT EXISTS trials(cell_id TEXT NOT NULL, trial INTEGER NOT NULL, "
       "status TEXT NOT NULL, iterations INTEGER, residual_rms REAL, sigma_hat REAL, sigma_min REAL";
@@ -169,12 +173,14 @@ StoredCell ToStoredCell(const CellContext& c) {
                           c.fixed_truth.errors.data() + c.fixed_truth.errors.size());
   s.predicted_std_truth.assign(c.predicted_std_truth.data(),
                                c.predicted_std_truth.data() + c.predicted_std_truth.size());
+  if (!std::isnan(c.predicted_validation[0]))
+    s.predicted_validation.assign(c.predicted_validation.begin(), c.predicted_validation.end());
   return s;
 }
 
 void TrialStore::PutCell(const StoredCell& cell) {
   Statement st(db_, "INSERT OR REPLACE INTO cells(" + std::string(kCellColumns) +
-                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   st.Text(1, cell.id);
   sqlite3_bind_int(st.get(), 2, cell.order);
   st.Text(3, cell.label);
@@ -192,6 +198,10 @@ void TrialStore::PutCell(const StoredCell& cell) {
     sqlite3_bind_null(st.get(), 11);
   else
     st.Text(11, StdJson(cell.predicted_std_truth));
+  if (cell.predicted_validation.empty())
+    sqlite3_bind_null(st.get(), 12);
+  else
+    st.Text(12, StdJson(cell.predicted_validation));
   st.Step();
 }
 
@@ -213,6 +223,8 @@ std::vector<StoredCell> TrialStore::Cells() const {
       c.truth_errors = nlohmann::json::parse(st.ColumnText(9)).get<std::vector<double>>();
     if (sqlite3_column_type(st.get(), 10) != SQLITE_NULL)
       c.predicted_std_truth = StdFromJson(st.ColumnText(10));
+    if (sqlite3_column_type(st.get(), 11) != SQLITE_NULL)
+      c.predicted_validation = StdFromJson(st.ColumnText(11));
     out.push_back(c);
   }
   return out;

@@ -25,6 +25,7 @@ enum class RandomPurpose : std::uint32_t {
   kValidation = 3,  ///< validation configurations
   kTruth = 4,       ///< per-trial parameter errors
   kSelection = 5,   ///< random selection / exchange restarts
+  kPrediction = 6,  ///< draws of the linearised prediction of the validation metrics
 };
 
 class RandomStream {

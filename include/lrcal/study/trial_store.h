@@ -3,7 +3,7 @@
 // Tables (queryable from Python/pandas; analysis/ reads them):
 //   cells(cell_id, ord, label, settings JSON, parameter_names JSON, predicted_std JSON (SI),
 //         design_sigma_min, fixed_for_rank JSON, pool_report, truth_errors JSON (SI, 5N),
-//         predicted_std_truth JSON (SI))
+//         predicted_std_truth JSON (SI), predicted_validation JSON (SI, 12 metrics))
 //   trials(cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min,
 //          val_{rms,max}_{pos,ori}_{x,y,z}, nom_{...}, errors BLOB, seconds)
 //     errors: the parameter errors (estimate − truth, SI) as little-endian float64, in the order
@@ -41,6 +41,10 @@ struct StoredCell {
   /// SI, G at the true parameters (the Cramér–Rao bound of the simulated experiment); empty
   /// unless the truth and the design are fixed.
   std::vector<double> predicted_std_truth;
+  /// The first-order prediction of each validation metric's mean (identified model, the 12 of
+  /// TrialRecord::validation, SI): the nominal-model covariance propagated to the validation
+  /// poses. Empty when it cannot be predicted (rank deficient) or for older stores.
+  std::vector<double> predicted_validation;
   double design_sigma_min = 0;
   std::vector<std::string> fixed_for_rank;
   std::string pool_report;
