@@ -6,6 +6,7 @@
 #include "cli_common.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
+#include "lrcal/design/design_certificate.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/io/csv.h"
@@ -184,6 +185,9 @@ int DesignCommand(const std::vector<std::string>& args) {
               "; E = sigma_min, D = log det, A = -trace inv)");
   Json indices;
   CompareWithRandomDesigns(G, chosen, k, baseline, seed, &t, &indices);
+  const DesignCertificate certificate = CertifyDesign(G, chosen.indices, options.criterion);
+  const std::string statement =
+      certificate.ToString(options.criterion, k, static_cast<int>(pool.configs.size()));
   if (vm.count("out"))
     WriteConfigurations(vm["out"].as<std::string>(), pool.configs.Subset(chosen.indices));
 
@@ -201,6 +205,14 @@ int DesignCommand(const std::vector<std::string>& args) {
     j["evaluations"] = chosen.evaluations;
     j["seconds"] = seconds;
     j["indices"] = indices;
+    j["certificate"] = {{"available", certificate.available},
+                        {"statement", statement},
+                        {"iterations", certificate.iterations}};
+    if (certificate.available) {
+      j["certificate"]["bound"] = certificate.bound;
+      j["certificate"]["achieved"] = certificate.achieved;
+      j["certificate"]["efficiency"] = certificate.efficiency;
+    }
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -211,7 +223,7 @@ int DesignCommand(const std::vector<std::string>& args) {
             << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
             << "chosen (0-based pool indices):";
   for (int i : chosen.indices) std::cout << " " << i;
-  std::cout << "\n\n" << t.ToText();
+  std::cout << "\ncertificate: " << statement << "\n\n" << t.ToText();
   if (vm.count("out")) std::cout << "wrote " << vm["out"].as<std::string>() << "\n";
   return 0;
 }

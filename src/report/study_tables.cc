@@ -230,9 +230,17 @@ std::vector<std::string> StopColumns(const CellSummary& s) {
           Percent(stop.precision.p95_relative_halfwidth)};
 }
 
+// The certified share of the best possible criterion value the cell's design reaches.
+std::string DesignEfficiency(const CellSummary& s) {
+  if (std::isnan(s.cell.design_efficiency)) return "—";
+  const std::string criterion =
+      Json::parse(s.cell.settings).value("/selection/criterion"_json_pointer, std::string("E"));
+  return Fixed(100 * s.cell.design_efficiency, 1) + " % of the " + criterion + " bound";
+}
+
 Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
-  std::vector<std::string> columns = {"cell", "id",     "trials",
-                                      "ok",   "failed", "sigma_min(G) of the design"};
+  std::vector<std::string> columns = {
+      "cell", "id", "trials", "ok", "failed", "sigma_min(G) of the design", "design efficiency"};
   if (rule.enabled())
     for (const char* c :
          {"stopped", "worst relative SE of a mean", "worst p95 relative half-width"})
@@ -255,7 +263,8 @@ Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
                                     std::to_string(s.trials),
                                     std::to_string(s.ok),
                                     failed.empty() ? "0" : failed,
-                                    sigma_min};
+                                    sigma_min,
+                                    DesignEfficiency(s)};
     if (rule.enabled())
       for (auto& c : StopColumns(s)) row.push_back(std::move(c));
     t.AddRow(row);
@@ -432,6 +441,7 @@ Json CellJson(const CellSummary& s) {
   c["failed"] = s.failed;
   c["design_sigma_min"] = s.cell.design_sigma_min;
   c["design_sigma_min_trials"] = DistJson(s.design_sigma_min, 1.0);
+  c["design_efficiency"] = NullIfNan(s.cell.design_efficiency);
   c["fixed_for_rank"] = s.cell.fixed_for_rank;
   if (s.stop.rule) {
     const auto finite = [](double x) { return std::isfinite(x) ? Json(x) : Json(); };

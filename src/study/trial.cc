@@ -3,6 +3,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
+#include "lrcal/design/design_certificate.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/simulation.h"
@@ -214,6 +215,13 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
   const Eigen::MatrixXd G = CellDesignJacobian(*c, c->pool);
   if (s.selection_redraw) c->pool_design_G = G;
   c->design = SelectDesign(*c, 0, c->pool, G);
+  c->design_efficiency = std::nan("");
+  if (!s.selection_redraw && !s.pool_redraw) {
+    // 300 relaxation steps: the bound within ~0.05 % of 1500 steps' on the paper's arm, ~20 ms.
+    const DesignCertificate certificate =
+        CertifyDesign(G, c->design.slots, s.selection.criterion, 300);
+    if (certificate.available) c->design_efficiency = certificate.efficiency;
+  }
   const int n = c->model->num_parameters();
   const Eigen::MatrixXd Gd = IdentificationJacobian(*c->model, c->design.configs);
   const Eigen::MatrixXd GtG = Gd.transpose() * Gd;

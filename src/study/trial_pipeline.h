@@ -79,6 +79,10 @@ struct CellContext {
   /// The same with G at the true parameters: the Cramér–Rao bound of the simulated experiment
   /// (fixed truth and design; empty otherwise).
   Eigen::VectorXd predicted_std_truth;
+  /// The design's certified efficiency (design_certificate.h: share of the relaxation's upper
+  /// bound on the criterion that the chosen design reaches); NaN when the criterion has no
+  /// certificate or the design is redrawn per trial.
+  double design_efficiency = 0;
   /// σ²·(GᵀWG)⁻¹ of the cell's design at the nominal model (SI; empty if rank deficient).
   Eigen::MatrixXd predicted_covariance;
   /// First-order prediction of the mean of each validation metric of the identified model

@@ -74,7 +74,8 @@ class Statement {
 
 constexpr const char* kCellColumns =
     "cell_id, ord, label, settings, parameter_names, predicted_std, design_sigma_min, "
-    "fixed_for_rank, pool_report, truth_errors, predicted_std_truth, predicted_validation";
+    "fixed_for_rank, pool_report, truth_errors, predicted_std_truth, predicted_validation, "
+    "design_efficiency";
 
 // Standard deviations as JSON, NaN (a parameter without a prediction) as null, and back.
 std::string StdJson(const std::vector<double>& sd) {
@@ -121,21 +122,24 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
       "CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
       "settings TEXT, parameter_names TEXT, predicted_std TEXT, design_sigma_min REAL, "
       "fixed_for_rank TEXT, pool_report TEXT, truth_errors TEXT, predicted_std_truth TEXT, "
-      "predicted_validation TEXT)");
+      "predicted_validation TEXT, design_efficiency REAL)");
   // Stores written before lrcal recorded the truth or its prediction: add the columns (the tables
   // then leave out what needs them rather than re-reading a robot file that may have changed).
-  bool has_truth = false, has_truth_prediction = false, has_validation_prediction = false;
+  bool has_truth = false, has_truth_prediction = false, has_validation_prediction = false,
+       has_efficiency = false;
   {
     Statement info(db_, "PRAGMA table_info(cells)");
     while (info.Step()) {
       has_truth |= info.ColumnText(1) == "truth_errors";
       has_truth_prediction |= info.ColumnText(1) == "predicted_std_truth";
       has_validation_prediction |= info.ColumnText(1) == "predicted_validation";
+      has_efficiency |= info.ColumnText(1) == "design_efficiency";
     }
   }
   if (!has_truth) Exec("ALTER TABLE cells ADD COLUMN truth_errors TEXT");
   if (!has_truth_prediction) Exec("ALTER TABLE cells ADD COLUMN predicted_std_truth TEXT");
   if (!has_validation_prediction) Exec("ALTER TABLE cells ADD COLUMN predicted_validation TEXT");
+  if (!has_efficiency) Exec("ALTER TABLE cells ADD COLUMN design_efficiency REAL");
   std::string trials =
       "CREATE TABLE IF NOT EXISTS trials(cell_id TEXT NOT NULL, trial INTEGER NOT NULL, "
       "status TEXT NOT NULL, iterations INTEGER, residual_rms REAL, sigma_hat REAL, sigma_min REAL";
@@ -175,12 +179,13 @@ StoredCell ToStoredCell(const CellContext& c) {
                                c.predicted_std_truth.data() + c.predicted_std_truth.size());
   if (!std::isnan(c.predicted_validation[0]))
     s.predicted_validation.assign(c.predicted_validation.begin(), c.predicted_validation.end());
+  s.design_efficiency = c.design_efficiency;
   return s;
 }
 
 void TrialStore::PutCell(const StoredCell& cell) {
   Statement st(db_, "INSERT OR REPLACE INTO cells(" + std::string(kCellColumns) +
-                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                        ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   st.Text(1, cell.id);
   sqlite3_bind_int(st.get(), 2, cell.order);
   st.Text(3, cell.label);
@@ -202,6 +207,10 @@ void TrialStore::PutCell(const StoredCell& cell) {
     sqlite3_bind_null(st.get(), 12);
   else
     st.Text(12, StdJson(cell.predicted_validation));
+  if (std::isnan(cell.design_efficiency))
+    sqlite3_bind_null(st.get(), 13);
+  else
+    sqlite3_bind_double(st.get(), 13, cell.design_efficiency);
   st.Step();
 }
 
@@ -225,6 +234,8 @@ std::vector<StoredCell> TrialStore::Cells() const {
       c.predicted_std_truth = StdFromJson(st.ColumnText(10));
     if (sqlite3_column_type(st.get(), 11) != SQLITE_NULL)
       c.predicted_validation = StdFromJson(st.ColumnText(11));
+    if (sqlite3_column_type(st.get(), 12) != SQLITE_NULL)
+      c.design_efficiency = sqlite3_column_double(st.get(), 12);
     out.push_back(c);
   }
   return out;

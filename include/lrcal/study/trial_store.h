@@ -3,7 +3,8 @@
 // Tables (queryable from Python/pandas; analysis/ reads them):
 //   cells(cell_id, ord, label, settings JSON, parameter_names JSON, predicted_std JSON (SI),
 //         design_sigma_min, fixed_for_rank JSON, pool_report, truth_errors JSON (SI, 5N),
-//         predicted_std_truth JSON (SI), predicted_validation JSON (SI, 12 metrics))
+//         predicted_std_truth JSON (SI), predicted_validation JSON (SI, 12 metrics),
+//         design_efficiency)
 //   trials(cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min,
 //          val_{rms,max}_{pos,ori}_{x,y,z}, nom_{...}, errors BLOB, seconds)
 //     errors: the parameter errors (estimate − truth, SI) as little-endian float64, in the order
@@ -45,6 +46,8 @@ struct StoredCell {
   /// TrialRecord::validation, SI): the nominal-model covariance propagated to the validation
   /// poses. Empty when it cannot be predicted (rank deficient) or for older stores.
   std::vector<double> predicted_validation;
+  /// The design's certified efficiency (design_certificate.h), NaN when there is none.
+  double design_efficiency = std::numeric_limits<double>::quiet_NaN();
   double design_sigma_min = 0;
   std::vector<std::string> fixed_for_rank;
   std::string pool_report;
