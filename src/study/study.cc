@@ -303,8 +303,11 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
                                                    std::to_string(c->pool_size) + " (pool.size)");
   c->selection.method =
       ParseSelectionMethod(Str(s, "selection.method", where), where("selection.method"));
-  c->selection.criterion =
-      ParseDesignCriterion(Str(s, "selection.criterion", where), where("selection.criterion"));
+  const std::string criterion = Str(s, "selection.criterion", where);
+  c->task_criterion = criterion == "I";
+  c->selection.criterion = c->task_criterion
+                               ? DesignCriterion::kA
+                               : ParseDesignCriterion(criterion, where("selection.criterion"));
   c->selection.samples = Int(s, "selection.samples", where, 1, 1000000);
   c->selection.restarts = Int(s, "selection.restarts", where, 1, 1000);
   c->selection_redraw = Bool(s, "selection.redraw", where);

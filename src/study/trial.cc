@@ -209,10 +209,29 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   if (!s.truth_random) c->fixed_truth.delta = DrawTruth(*c, 0).delta;
 }
 
+Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
+
+// The task criterion's selection matrix (selection.criterion: I): the pool's G (SI) times L⁻ᵀ,
+// W = LLᵀ = Σ_j J_jᵀJ_j over the validation configurations' position Jacobians, so that A on it
+// is tr(W (GᵀG)⁻¹): the predicted mean-square validation position error, up to σ²/M. W is
+// singular for parameters that do not move the tool (plane terms): a ridge of 1e-9·tr W/n keeps
+// it invertible (those columns then weigh nothing).
+Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
+  const int n = c.model->num_parameters(), m = c.validation.size();
+  const Eigen::MatrixXd J = ValidationPoseJacobian(c).topRows(3 * m);
+  Eigen::MatrixXd W = J.transpose() * J;
+  W.diagonal().array() += 1e-9 * W.trace() / n + 1e-300;
+  const Eigen::LLT<Eigen::MatrixXd> llt(W);
+  const Eigen::MatrixXd G = DesignJacobian(*c.model, pool, DesignScaling::kSI, 0, 0);
+  // G·L⁻ᵀ = (L⁻¹·Gᵀ)ᵀ
+  return llt.matrixL().solve(G.transpose()).transpose();
+}
+
 // The selected design, its σ_min and the predicted covariance at the nominal model; the
 // design's Jacobian also gives the first linearisation of every trial, computed once here.
 void SelectCellDesign(const CellSettings& s, CellContext* c) {
-  const Eigen::MatrixXd G = CellDesignJacobian(*c, c->pool);
+  const Eigen::MatrixXd G =
+      s.task_criterion ? TaskDesignJacobian(*c, c->pool) : CellDesignJacobian(*c, c->pool);
   if (s.selection_redraw) c->pool_design_G = G;
   c->design = SelectDesign(*c, 0, c->pool, G);
   c->design_efficiency = std::nan("");
@@ -343,7 +362,9 @@ bool DesignOfTrial(const CellContext& c, long long trial, const TrialTruth& trut
     } catch (const InputError&) {
       return false;
     }
-    *redrawn = SelectDesign(c, trial, pool, CellDesignJacobian(c, pool));
+    *redrawn = SelectDesign(
+        c, trial, pool,
+        c.cell->typed.task_criterion ? TaskDesignJacobian(c, pool) : CellDesignJacobian(c, pool));
   } else {
     *redrawn = SelectDesign(c, trial, c.pool, c.pool_design_G);
   }

@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <fstream>
+#include <list>
 #include <random>
 
 #include "lrcal/report/run_tables.h"
@@ -73,6 +74,50 @@ TEST(ValidationPrediction, PredictsTheMonteCarloMeansOfAStudy) {
   }
   const std::string csv = testing::ReadFile(dir + "/run/tables/validation.csv");
   EXPECT_NE(csv.find(",mean_predicted\n"), std::string::npos);
+}
+
+// selection.criterion: I minimises the predicted mean-square validation position error: its
+// design has a smaller tr(W·(GᵀG)⁻¹) than the A design's, and a smaller predicted RMS position
+// error, on the same pool.
+TEST(TaskCriterion, ItsDesignPredictsALowerValidationPositionErrorThanA) {
+  const std::string dir = testing::TempDir("task_criterion");
+  std::list<Study> studies;  // a CellContext points into its study
+  const auto cell = [&](const std::string& criterion) {
+    const std::string path = dir + "/" + criterion + ".yaml";
+    std::ofstream(path) << "name: task\nseed: 3\ntrials: 1\nrobot: "
+                        << testing::SourcePath("studies/robots/paper.yaml")
+                        << "\npool: {size: 60}\nvalidation: {size: 15}\n"
+                           "selection: {count: 30, method: exchange, criterion: "
+                        << criterion << "}\n";
+    studies.push_back(LoadStudy(path));
+    return PrepareCell(studies.back(), studies.back().cells[0]);
+  };
+  const auto a = cell("A"), task = cell("I");
+  // The predicted mean square of the validation position errors, Σ over configurations and axes.
+  const auto mean_square = [](const CellContext& c) {
+    const int m = c.validation.size();
+    Eigen::MatrixXd J(3 * m, c.model->num_parameters());
+    const std::vector<Pose<double>> poses =
+        ToolPoses(*c.robot, c.robot->nominal_values(), c.validation);
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(c.model->num_parameters());
+    for (int k = 0; k < e.size(); ++k) {  // forward differences: an independent Jacobian
+      e[k] = 1e-7;
+      const PoseErrors p =
+          ComparePoses(*c.robot, poses, c.model->LinkValues(e.data()), c.validation);
+      e[k] = 0;
+      for (int j = 0; j < m; ++j)
+        for (int x = 0; x < 3; ++x) J(3 * j + x, k) = p.position(x, j) / 1e-7;
+    }
+    return (J * c.predicted_covariance * J.transpose()).trace();
+  };
+  EXPECT_LT(mean_square(*task), mean_square(*a));
+  double rms_task = 0, rms_a = 0;
+  for (int x = 0; x < 3; ++x) {
+    rms_task += task->predicted_validation[x];
+    rms_a += a->predicted_validation[x];
+  }
+  EXPECT_LT(rms_task, rms_a);
+  EXPECT_EQ(task->cell->settings["selection"]["criterion"], "I");
 }
 
 }  // namespace

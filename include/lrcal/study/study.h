@@ -53,6 +53,11 @@ struct CellSettings {
   int select_count = 0;
   SelectionOptions selection;
   DesignScaling scaling = DesignScaling::kSI;  ///< column scaling of G before selection
+  /// selection.criterion: I, the task criterion: minimise the predicted mean-square position
+  /// error over the validation configurations, tr(W·(GᵀG)⁻¹) with W = Σ_j J_jᵀJ_j of the
+  /// validation poses' position Jacobians (I-optimality for pose accuracy). Selected as
+  /// A-optimality on G·L⁻ᵀ, W = LLᵀ; `selection.criterion` is then kA.
+  bool task_criterion = false;
   /// Select anew in every trial (from the cell's pool): a random or sampled design then varies
   /// from trial to trial, which is the honest baseline for "how much does the design buy".
   bool selection_redraw = false;
