@@ -66,6 +66,7 @@ int RunCommand(const std::vector<std::string>& args);
 int DesignCommand(const std::vector<std::string>& args);
 int ReportCommand(const std::vector<std::string>& args);
 int PlanCommand(const std::vector<std::string>& args);
+int PlanAccuracyCommand(const std::vector<std::string>& args);
 int StatusCommand(const std::vector<std::string>& args);
 int MergeCommand(const std::vector<std::string>& args);
 int AggregateCommand(const std::vector<std::string>& args);

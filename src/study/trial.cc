@@ -310,27 +310,19 @@ Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
   return J;
 }
 
-// The first-order prediction of the validation metrics' means, the planner's estimate: the
-// covariance predicted at the nominal model propagated to the validation poses through their
-// Jacobian (linear in the parameter errors), then each metric's mean over 4000 Gaussian draws
-// of those linear errors (the RMS and max of correlated errors have no closed form). Draws are
-// addressed by the validation set's stream, so the prediction is a function of the settings.
-void PredictValidation(CellContext* c) {
-  c->predicted_validation.fill(std::nan(""));
-  const Eigen::MatrixXd& C = c->predicted_covariance;
-  if (c->rank_deficient || C.size() == 0 || !C.allFinite()) return;
-  const int n = c->model->num_parameters(), m = c->validation.size();
-  if (m == 0) return;
+Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
+  const Eigen::MatrixXd& C = c.predicted_covariance;
+  const int n = c.model->num_parameters(), m = c.validation.size();
+  Eigen::MatrixXd out = Eigen::MatrixXd::Constant(draws, 12, std::nan(""));
+  if (c.rank_deficient || C.size() == 0 || !C.allFinite() || m == 0) return out;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(C);
   const Eigen::MatrixXd L =
       eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
-  constexpr int kDraws = 4000;
-  Eigen::MatrixXd Z(n, kDraws);
-  const RandomStream stream(0, c->validation_stream, 0, RandomPurpose::kPrediction);
-  stream.Normals(0, n * kDraws, Z.data());
-  const Eigen::MatrixXd E = ValidationPoseJacobian(*c) * (L * Z);  // 6M × draws
-  std::array<double, 12> sum{};
-  for (int d = 0; d < kDraws; ++d)
+  Eigen::MatrixXd Z(n, draws);
+  const RandomStream stream(0, c.validation_stream, 0, RandomPurpose::kPrediction);
+  stream.Normals(0, n * draws, Z.data());
+  const Eigen::MatrixXd E = ValidationPoseJacobian(c) * (L * Z);  // 6M × draws
+  for (int d = 0; d < draws; ++d)
     for (int part = 0; part < 2; ++part)  // position, orientation
       for (int a = 0; a < 3; ++a) {
         double ss = 0, max = 0;
@@ -339,9 +331,23 @@ void PredictValidation(CellContext* c) {
           ss += x * x;
           max = std::max(max, std::fabs(x));
         }
-        sum[3 * part + a] += std::sqrt(ss / m);  // rms pos xyz, rms ori xyz
-        sum[6 + 3 * part + a] += max;            // max pos xyz, max ori xyz
+        out(d, 3 * part + a) = std::sqrt(ss / m);  // rms pos xyz, rms ori xyz
+        out(d, 6 + 3 * part + a) = max;            // max pos xyz, max ori xyz
       }
+  return out;
+}
+
+// The first-order prediction of the validation metrics' means, the planner's estimate: the
+// covariance predicted at the nominal model propagated to the validation poses through their
+// Jacobian (linear in the parameter errors), then each metric's mean over 4000 Gaussian draws
+// of those linear errors (the RMS and max of correlated errors have no closed form). Draws are
+// addressed by the validation set's stream, so the prediction is a function of the settings.
+void PredictValidation(CellContext* c) {
+  constexpr int kDraws = 4000;
+  const Eigen::MatrixXd draws = LinearisedDraws(*c, kDraws);
+  std::array<double, 12> sum{};
+  for (int d = 0; d < kDraws; ++d)  // in draw order (a fixed summation order: fixed bits)
+    for (int k = 0; k < 12; ++k) sum[k] += draws(d, k);
   for (int k = 0; k < 12; ++k) c->predicted_validation[k] = sum[k] / kDraws;
 }
 
@@ -527,6 +533,10 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
           .stats);
   if (details) FillDetails(c, truth, identified, *ws, details);
   return finish(TrialStatus::kOk);
+}
+
+Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws) {
+  return LinearisedDraws(c, draws);
 }
 
 }  // namespace lrcal

@@ -42,6 +42,13 @@ struct TrialTruth {
   Eigen::VectorXd delta;   ///< the errors in the estimate layout (robot deltas; plane terms 0)
 };
 
+/// The validation metrics (draws × 12, layout of TrialRecord::validation, SI) of `draws`
+/// Gaussian parameter-error draws from the cell's predicted covariance pushed through the
+/// validation poses' Jacobian (first order): what the prediction of the means averages, and the
+/// planner's distribution of any validation statistic. NaN when there is no prediction.
+struct CellContext;
+Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws);
+
 /// A design: configurations and their slots in the pool (which address the noise).
 struct TrialDesign {
   ConfigurationSet configs;
