@@ -56,15 +56,7 @@ std::string SmallStudy(const std::string& dir, int trials, const std::string& ex
 
 RunResult RunSmall(const std::string& study_path, const std::string& out, int threads,
                    int shard_index = 0, int shard_count = 1, long long max_new = 0) {
-  RunOptions o;
-  o.out_dir = out;
-  o.threads = threads;
-  o.shard_index = shard_index;
-  o.shard_count = shard_count;
-  o.progress = false;
-  o.max_new_trials = max_new;
-  o.batch_size = 7;  // several transactions even in small runs
-  return RunStudyAndWriteTables(LoadStudy(study_path), o);
+  return testing::RunStudyFile(study_path, out, threads, shard_index, shard_count, max_new);
 }
 
 TEST(MonteCarlo, TablesAreBitIdenticalForOneTwoAndFourThreads) {
@@ -367,16 +359,7 @@ TEST(MonteCarlo, SelectionRedrawnPerTrialVariesTheDesign) {
 // the validation set stay).
 TEST(MonteCarlo, PoolAndValidationFromFilesChangeOnlyTheNoiseWithTheSeed) {
   const std::string dir = testing::TempDir("mc_files");
-  const RobotFile robot = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
-  SamplingOptions o;
-  o.ranger = robot.ranger;
-  WriteConfigurations(dir + "/pool.csv",
-                      SampleConfigurations(robot.robot, *robot.plane, 70,
-                                           RandomStream(4, 0, 0, RandomPurpose::kPool), o));
-  o.require_beam_hit = false;
-  WriteConfigurations(dir + "/val.csv",
-                      SampleConfigurations(robot.robot, *robot.plane, 12,
-                                           RandomStream(9, 0, 0, RandomPurpose::kValidation), o));
+  testing::WritePaperConfigurationFiles(dir, 70, 12, 4, 9);
   const auto study = [&](int seed, bool files) {
     const std::string path = dir + "/s" + std::to_string(seed) + (files ? "f" : "d") + ".yaml";
     std::ofstream(path) << "name: files\nseed: " << seed << "\ntrials: 20\nrobot: "

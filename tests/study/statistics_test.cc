@@ -99,16 +99,7 @@ TEST(Statistics, P95IntervalsOfFortySeedsCoverTheReferenceP95AsOftenAsPromised) 
   // p95 with probability >= 95 %. The truth is the p95 of a 20,000-trial reference run (another
   // seed); 33 to 40 of 40 is the binomial range.
   const std::string dir = testing::TempDir("coverage");
-  const RobotFile robot = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
-  SamplingOptions o;
-  o.ranger = robot.ranger;
-  WriteConfigurations(dir + "/pool.csv",
-                      SampleConfigurations(robot.robot, *robot.plane, 40,
-                                           RandomStream(5, 0, 0, RandomPurpose::kPool), o));
-  o.require_beam_hit = false;
-  WriteConfigurations(dir + "/val.csv",
-                      SampleConfigurations(robot.robot, *robot.plane, 10,
-                                           RandomStream(6, 0, 0, RandomPurpose::kValidation), o));
+  testing::WritePaperConfigurationFiles(dir, 40, 10, 5, 6);
   const auto run = [&](int seed, int trials) {
     const std::string study = dir + "/s" + std::to_string(seed) + ".yaml";
     std::ofstream(study) << "name: coverage\nseed: " << seed << "\ntrials: " << trials

@@ -166,15 +166,7 @@ std::string AdaptiveStudy(const std::string& dir, const std::string& rule, int t
 
 RunResult RunAdaptive(const std::string& study, const std::string& out, int threads,
                       int shard_index = 0, int shard_count = 1, long long max_new = 0) {
-  RunOptions o;
-  o.out_dir = out;
-  o.threads = threads;
-  o.shard_index = shard_index;
-  o.shard_count = shard_count;
-  o.progress = false;
-  o.max_new_trials = max_new;
-  o.batch_size = 13;
-  return RunStudyAndWriteTables(LoadStudy(study), o);
+  return testing::RunStudyFile(study, out, threads, shard_index, shard_count, max_new, 13);
 }
 
 std::map<std::string, std::string> Tables(const std::string& dir) {

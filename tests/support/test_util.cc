@@ -8,6 +8,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "lrcal/core/random.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/io/csv.h"
+#include "lrcal/report/run_tables.h"
+
 namespace lrcal::testing {
 
 std::string SourcePath(const std::string& relative) {
@@ -72,6 +77,34 @@ std::string TempDir(const std::string& name) {
   fs::remove_all(p);
   fs::create_directories(p);
   return p.string();
+}
+
+void WritePaperConfigurationFiles(const std::string& dir, int pool, int validation,
+                                  std::uint64_t pool_seed, std::uint64_t validation_seed) {
+  const RobotFile& rig = PaperRig();
+  SamplingOptions o;
+  o.ranger = rig.ranger;
+  WriteConfigurations(dir + "/pool.csv",
+                      SampleConfigurations(rig.robot, *rig.plane, pool,
+                                           RandomStream(pool_seed, 0, 0, RandomPurpose::kPool), o));
+  o.require_beam_hit = false;
+  WriteConfigurations(
+      dir + "/val.csv",
+      SampleConfigurations(rig.robot, *rig.plane, validation,
+                           RandomStream(validation_seed, 0, 0, RandomPurpose::kValidation), o));
+}
+
+RunResult RunStudyFile(const std::string& study, const std::string& out, int threads,
+                       int shard_index, int shard_count, long long max_new, int batch_size) {
+  RunOptions o;
+  o.out_dir = out;
+  o.threads = threads;
+  o.shard_index = shard_index;
+  o.shard_count = shard_count;
+  o.progress = false;
+  o.max_new_trials = max_new;
+  o.batch_size = batch_size;
+  return RunStudyAndWriteTables(LoadStudy(study), o);
 }
 
 }  // namespace lrcal::testing

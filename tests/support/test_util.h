@@ -7,6 +7,7 @@
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/measurement_model.h"
+#include "lrcal/study/runner.h"
 
 namespace lrcal::testing {
 
@@ -24,6 +25,16 @@ const Plane& PaperPlane();
 ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed = 1);
 /// The same for the paper's own plane.
 ConfigurationSet PaperHittingConfigurations(int count, unsigned seed = 1);
+/// Writes a candidate pool (`pool` configurations whose beam hits the paper's plane) and a
+/// validation set (`validation` configurations anywhere) of the paper's arm to DIR/pool.csv and
+/// DIR/val.csv, drawn with the given seeds: a user's own configuration files for a study.
+void WritePaperConfigurationFiles(const std::string& dir, int pool, int validation,
+                                  std::uint64_t pool_seed, std::uint64_t validation_seed);
+/// Runs (or resumes) the study file at `study` into `out` quietly and writes its tables, with
+/// small batches (several transactions even in small runs).
+RunResult RunStudyFile(const std::string& study, const std::string& out, int threads,
+                       int shard_index = 0, int shard_count = 1, long long max_new = 0,
+                       int batch_size = 7);
 /// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
 int RunCommand(const std::string& command, std::string* output);
 /// The bytes of a file ("" if it cannot be read).
