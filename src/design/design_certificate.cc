@@ -94,7 +94,7 @@ Step StepA(const Eigen::MatrixXd& G, const Eigen::MatrixXd& M, int k) {
 
 // The relaxation's best bound in the criterion's own units (E: λ_min, not yet σ).
 double RelaxationBound(const Eigen::MatrixXd& G, int k, DesignCriterion criterion, int iterations,
-                       int* used) {
+                       int* used, Eigen::VectorXd* weights = nullptr) {
   const int N = static_cast<int>(G.rows());
   Eigen::VectorXd w = Eigen::VectorXd::Constant(N, static_cast<double>(k) / N);
   double best = kInf;
@@ -111,6 +111,7 @@ double RelaxationBound(const Eigen::MatrixXd& G, int k, DesignCriterion criterio
     w = ProjectCappedSimplex(w + (0.5 / std::sqrt(t + 1.0)) * s.gradient / scale, k);
   }
   *used = t;
+  if (weights) *weights = w;
   return best;
 }
 
@@ -123,6 +124,21 @@ double DesignUpperBound(const Eigen::MatrixXd& G, int k, DesignCriterion criteri
   const double bound = RelaxationBound(G, k, criterion, iterations, &used);
   if (!std::isfinite(bound)) return kNan;
   return criterion == DesignCriterion::kE ? std::sqrt(std::max(bound, 0.0)) : bound;
+}
+
+std::vector<int> RelaxedDesign(const Eigen::MatrixXd& G, int k, DesignCriterion criterion,
+                               int iterations) {
+  if (!Certifiable(criterion) || k < G.cols() || k > G.rows()) return {};
+  int used = 0;
+  Eigen::VectorXd w;
+  RelaxationBound(G, k, criterion, iterations, &used, &w);
+  if (w.size() != G.rows()) return {};
+  std::vector<int> order(static_cast<std::size_t>(G.rows()));
+  for (int i = 0; i < G.rows(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return w[a] > w[b]; });
+  order.resize(static_cast<std::size_t>(k));
+  std::sort(order.begin(), order.end());
+  return order;
 }
 
 DesignCertificate CertifyDesign(const Eigen::MatrixXd& G, const std::vector<int>& chosen,

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "lrcal/core/error.h"
+#include "lrcal/design/design_certificate.h"
 #include "lrcal/identification/identifiability.h"
 
 namespace lrcal {
@@ -463,15 +464,26 @@ void SelectExhaustive(const Eigen::MatrixXd& G, int k, const SelectionOptions& o
   }
 }
 
-// Exchange from several starts (the backward-greedy design, then random designs); the best end
-// wins.
+// Exchange from several starts (the backward-greedy design, then random designs, then the
+// greedy forward design and the relaxation's rounded solution); the best end wins, so the
+// result is at least as good as greedy (forward or backward) followed by swaps.
 void SelectExchange(const Eigen::MatrixXd& G, int k, const SelectionOptions& options,
                     const RandomStream& stream, SelectionResult* best) {
   const int N = static_cast<int>(G.rows());
+  const int random_starts = std::max(1, options.restarts);
   best->start_score = -std::numeric_limits<double>::infinity();
-  for (int r = 0; r < std::max(1, options.restarts); ++r) {
-    std::vector<int> start = r == 0 ? Backward(G, k, options.criterion, &best->evaluations)
-                                    : RandomSubset(N, k, stream, static_cast<std::uint64_t>(r) * N);
+  for (int r = 0; r < random_starts + 2; ++r) {
+    std::vector<int> start;
+    if (r == 0) {
+      start = Backward(G, k, options.criterion, &best->evaluations);
+    } else if (r < random_starts) {
+      start = RandomSubset(N, k, stream, static_cast<std::uint64_t>(r) * N);
+    } else if (r == random_starts) {
+      start = Forward(G, k, options.criterion, &best->evaluations);
+    } else {
+      start = RelaxedDesign(G, k, options.criterion);
+      if (start.empty()) continue;  // no relaxation for this criterion
+    }
     best->start_score =
         std::max(best->start_score, CriterionScore(NormalMatrixOf(G, start), k, options.criterion));
     std::vector<int> end = Exchange(G, start, options.criterion, &best->evaluations);

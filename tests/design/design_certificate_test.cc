@@ -97,5 +97,35 @@ TEST(DesignCertificate, PaperArmDesignsAndTheLimitsOfTheCertificate) {
             << ", 1500: " << DesignUpperBound(G, 50, DesignCriterion::kE, 1500) << "\n";
 }
 
+// Exchange starts from backward and forward greedy designs and the relaxation's rounding: it is
+// never worse than either greedy design, for E, D and A, near the number of parameters too.
+TEST(DesignCertificate, ExchangeIsAtLeastAsGoodAsGreedyEverywhere) {
+  const RobotFile rig = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
+  SamplingOptions so;
+  so.ranger = rig.ranger;
+  so.min_jacobian_singular_value = 0.05;
+  const ConfigurationSet pool = SampleConfigurations(
+      rig.robot, *rig.plane, 101, RandomStream(11, 7, 0, RandomPurpose::kPool), so);
+  const MeasurementModel model(rig.robot, *rig.plane,
+                               MakeParameterSet(rig.robot, PlaneTerms{}, {}, "fix"));
+  const Eigen::MatrixXd G = DesignJacobian(model, pool, DesignScaling::kSI, 1e-3, 1e-3);
+  const RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
+  for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA})
+    for (int k : {26, 30, 40, 50}) {
+      SCOPED_TRACE(std::string(DesignCriterionName(c)) + " k " + std::to_string(k));
+      SelectionOptions o;
+      o.criterion = c;
+      o.method = SelectionMethod::kExchange;
+      const double exchange = SelectConfigurations(G, k, o, stream).score;
+      o.method = SelectionMethod::kGreedy;
+      const double forward = SelectConfigurations(G, k, o, stream).score;
+      o.method = SelectionMethod::kBackward;
+      const double backward = SelectConfigurations(G, k, o, stream).score;
+      EXPECT_GE(exchange, forward);
+      EXPECT_GE(exchange, backward);
+      EXPECT_LE(exchange, DesignUpperBound(G, k, c) * (1 + 1e-12) + 1e-12);
+    }
+}
+
 }  // namespace
 }  // namespace lrcal

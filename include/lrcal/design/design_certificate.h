@@ -47,4 +47,9 @@ DesignCertificate CertifyDesign(const Eigen::MatrixXd& G, const std::vector<int>
 double DesignUpperBound(const Eigen::MatrixXd& G, int k, DesignCriterion criterion,
                         int iterations = 1500);
 
+/// The relaxation's solution rounded to a design: the k candidates with the largest weights
+/// (ascending indices); empty when the criterion has no relaxation. A start for exchange.
+std::vector<int> RelaxedDesign(const Eigen::MatrixXd& G, int k, DesignCriterion criterion,
+                               int iterations = 300);
+
 }  // namespace lrcal

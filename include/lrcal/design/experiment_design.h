@@ -82,7 +82,9 @@ struct SelectionOptions {
   DesignCriterion criterion = DesignCriterion::kE;
   SelectionMethod method = SelectionMethod::kBackward;
   int samples = 1000;  ///< subsets tried by kSampled
-  int restarts = 4;    ///< kExchange: starts = backward-greedy design + (restarts−1) random
+  /// kExchange: starts = backward-greedy design + (restarts−1) random, then the forward-greedy
+  /// design and the relaxation's rounded solution (design_certificate.h): the best end wins.
+  int restarts = 4;
   double exhaustive_limit = 5e6;  ///< most subsets kExhaustive will enumerate
   /// Throws InputError (where = `source`) naming the field and the range expected.
   void Validate(const std::string& source = "selection") const;
