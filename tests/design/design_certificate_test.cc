@@ -98,7 +98,8 @@ TEST(DesignCertificate, PaperArmDesignsAndTheLimitsOfTheCertificate) {
 }
 
 // Exchange starts from backward and forward greedy designs and the relaxation's rounding: it is
-// never worse than either greedy design, for E, D and A, near the number of parameters too.
+// never worse than either greedy design, for E, D and A, near the number of parameters too
+// (k = 26 of 25 parameters) and in between.
 TEST(DesignCertificate, ExchangeIsAtLeastAsGoodAsGreedyEverywhere) {
   const RobotFile rig = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
   SamplingOptions so;
@@ -111,7 +112,7 @@ TEST(DesignCertificate, ExchangeIsAtLeastAsGoodAsGreedyEverywhere) {
   const Eigen::MatrixXd G = DesignJacobian(model, pool, DesignScaling::kSI, 1e-3, 1e-3);
   const RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
   for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA})
-    for (int k : {26, 30, 40, 50}) {
+    for (int k : {26, 40}) {
       SCOPED_TRACE(std::string(DesignCriterionName(c)) + " k " + std::to_string(k));
       SelectionOptions o;
       o.criterion = c;
@@ -123,7 +124,7 @@ TEST(DesignCertificate, ExchangeIsAtLeastAsGoodAsGreedyEverywhere) {
       const double backward = SelectConfigurations(G, k, o, stream).score;
       EXPECT_GE(exchange, forward);
       EXPECT_GE(exchange, backward);
-      EXPECT_LE(exchange, DesignUpperBound(G, k, c) * (1 + 1e-12) + 1e-12);
+      EXPECT_LE(exchange, DesignUpperBound(G, k, c, 300) * (1 + 1e-12) + 1e-12);
     }
 }
 

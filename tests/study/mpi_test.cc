@@ -92,8 +92,8 @@ TEST(Mpi, StopWhenStopsTheCellsAtTheSameTrialsAsASingleProcess) {
   const std::string dir = testing::TempDir("mpi_stop_when");
   const std::string study = dir + "/adaptive.yaml";
   std::ofstream(study)
-      << "name: adaptive\nseed: 5\ntrials: 3000\n"
-         "stop_when: {block: 100, relative_se: 0.04, p95_relative_halfwidth: 0.3}\n"
+      << "name: adaptive\nseed: 5\ntrials: 1500\n"
+         "stop_when: {block: 50, relative_se: 0.06, p95_relative_halfwidth: 0.35}\n"
          "robot: "
       << testing::SourcePath("studies/robots/paper.yaml")
       << "\npool: {size: 60}\nvalidation: {size: 10}\n"

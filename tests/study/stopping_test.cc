@@ -178,25 +178,25 @@ std::map<std::string, std::string> Tables(const std::string& dir) {
 
 TEST(StopWhen, StopsEveryCellWithThePrecisionStatedBitIdenticalAcrossThreadsShardsAndRestarts) {
   const std::string dir = testing::TempDir("stop_when_runs");
-  const double relative_se = 0.03, halfwidth = 0.25;
+  const double relative_se = 0.05, halfwidth = 0.3;
   const std::string study =
-      AdaptiveStudy(dir, "{block: 100, relative_se: 0.03, p95_relative_halfwidth: 0.25}");
+      AdaptiveStudy(dir, "{block: 50, relative_se: 0.05, p95_relative_halfwidth: 0.3}", 1000);
   const RunResult one = RunAdaptive(study, dir + "/t1", 1);
   ASSERT_TRUE(one.complete);
   ASSERT_TRUE(one.tables_written);
-  EXPECT_LT(one.computed, 4 * 2000) << "no cell stopped early";
+  EXPECT_LT(one.computed, 4 * 1000) << "no cell stopped early";
   EXPECT_EQ(one.computed, one.total);
   RunAdaptive(study, dir + "/t2", 2);
   for (int i = 0; i < 2; ++i) RunAdaptive(study, dir + "/shard" + std::to_string(i), 2, i, 2);
   ASSERT_TRUE(MergeRuns({dir + "/shard0", dir + "/shard1"}, dir + "/merged"));
-  // Restarts: slices of 170 new trials (not a multiple of the block) until complete.
+  // Restarts: slices of 330 new trials (not a multiple of the block) until complete.
   RunResult slice;
   int slices = 0;
   do {
-    slice = RunAdaptive(study, dir + "/sliced", 2, 0, 1, 170);
+    slice = RunAdaptive(study, dir + "/sliced", 2, 0, 1, 330);
     ASSERT_LT(++slices, 100);
   } while (!slice.complete);
-  EXPECT_GT(slices, 3);
+  EXPECT_GT(slices, 2);
 
   const auto reference = Tables(dir + "/t1");
   EXPECT_EQ(reference, Tables(dir + "/t2"));
@@ -214,8 +214,8 @@ TEST(StopWhen, StopsEveryCellWithThePrecisionStatedBitIdenticalAcrossThreadsShar
     EXPECT_EQ(stop["reason"], "precision");
     const long long used = stop["trials_used"];
     EXPECT_EQ(c["trials"].get<long long>(), used);
-    EXPECT_EQ(used % 100, 0);
-    EXPECT_LT(used, 2000);
+    EXPECT_EQ(used % 50, 0);
+    EXPECT_LT(used, 1000);
     EXPECT_LE(stop["relative_se"].get<double>(), relative_se);
     EXPECT_LE(stop["p95_relative_halfwidth"].get<double>(), halfwidth);
     for (const auto& [metric, d] : c["validation"].items()) {
@@ -228,12 +228,12 @@ TEST(StopWhen, StopsEveryCellWithThePrecisionStatedBitIdenticalAcrossThreadsShar
     StoredCell cell;
     for (const auto& s : store.Cells())
       if (s.id == c["id"]) cell = s;
-    const CellSummary before = SummarizeCell(store, cell, used - 100);
+    const CellSummary before = SummarizeCell(store, cell, used - 50);
     bool failed = false;
     for (const auto& d : before.validation)
       failed |= d.mean_se / d.mean > relative_se ||
                 (d.p95_ci.high - d.p95_ci.low) / 2 / d.p95 > halfwidth || std::isnan(d.p95_ci.high);
-    EXPECT_TRUE(failed) << "the rule held at " << used - 100;
+    EXPECT_TRUE(failed) << "the rule held at " << used - 50;
   }
 
   std::string out;
