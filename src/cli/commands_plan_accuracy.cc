@@ -184,8 +184,8 @@ std::string WriteStudy(const Study& base, const std::string& path, const std::st
 
 // The Monte-Carlo figure of each cell of a run: the quantile of the worst axis with its
 // distribution-free interval.
-void Confirm(const std::string& run_dir, const Target& t, double confidence,
-             std::vector<Campaign>* campaigns) {
+void MonteCarloFigures(const std::string& run_dir, const Target& t, double confidence,
+                       std::vector<Campaign>* campaigns) {
   TrialStore store(run_dir + "/trials.sqlite");
   const std::vector<StoredCell> cells = store.Cells();
   for (std::size_t i = 0; i < cells.size() && i < campaigns->size(); ++i) {
@@ -316,7 +316,7 @@ class Planner {
     ro.progress = false;
     const RunResult run = RunStudyAndWriteTables(LoadStudy(study_path_), ro);
     if (!run.complete) throw StorageError("the confirmation run did not finish: " + run_dir_);
-    lrcal::cli::Confirm(run_dir_, in_.target, in_.confidence, &confirm_);
+    MonteCarloFigures(run_dir_, in_.target, in_.confidence, &confirm_);
   }
 
   void PrintJson() const {

@@ -68,14 +68,22 @@ Step StepE(const Eigen::MatrixXd& G, const Eigen::MatrixXd& M, int k, int t) {
   return s;
 }
 
+// M⁻¹ by Cholesky, with log det M; false when M is not positive definite.
+bool SpdInverse(const Eigen::MatrixXd& M, Eigen::MatrixXd* inverse, double* logdet) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(M);
+  if (llt.info() != Eigen::Success) return false;
+  *inverse = llt.solve(Eigen::MatrixXd::Identity(M.rows(), M.cols()));
+  *logdet = 2 * llt.matrixLLT().diagonal().array().log().sum();
+  return true;
+}
+
 // D: log det M, ∇ᵢ = gᵢᵀM⁻¹gᵢ, Σ wᵢ∇ᵢ = n.
 Step StepD(const Eigen::MatrixXd& G, const Eigen::MatrixXd& M, int k) {
   Step s;
-  const Eigen::LLT<Eigen::MatrixXd> llt(M);
-  if (llt.info() != Eigen::Success) return s;
-  const Eigen::MatrixXd Minv = llt.solve(Eigen::MatrixXd::Identity(M.rows(), M.cols()));
+  Eigen::MatrixXd Minv;
+  double logdet = 0;
+  if (!SpdInverse(M, &Minv, &logdet)) return s;
   s.gradient = ((G * Minv).array() * G.array()).rowwise().sum().matrix();
-  const double logdet = 2 * llt.matrixLLT().diagonal().array().log().sum();
   s.bound = logdet + TopKSum(s.gradient, k) - static_cast<double>(M.rows());
   return s;
 }
@@ -83,9 +91,9 @@ Step StepD(const Eigen::MatrixXd& G, const Eigen::MatrixXd& M, int k) {
 // A: −tr M⁻¹, ∇ᵢ = gᵢᵀM⁻²gᵢ, Σ wᵢ∇ᵢ = tr M⁻¹.
 Step StepA(const Eigen::MatrixXd& G, const Eigen::MatrixXd& M, int k) {
   Step s;
-  const Eigen::LLT<Eigen::MatrixXd> llt(M);
-  if (llt.info() != Eigen::Success) return s;
-  const Eigen::MatrixXd Minv = llt.solve(Eigen::MatrixXd::Identity(M.rows(), M.cols()));
+  Eigen::MatrixXd Minv;
+  double logdet = 0;
+  if (!SpdInverse(M, &Minv, &logdet)) return s;
   s.gradient = ((G * (Minv * Minv)).array() * G.array()).rowwise().sum().matrix();
   const double trace = Minv.trace();
   s.bound = -trace + TopKSum(s.gradient, k) - trace;

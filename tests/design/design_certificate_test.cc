@@ -61,16 +61,22 @@ TEST(DesignCertificate, BoundIsNeverBelowTheExhaustiveOptimumAndIsTight) {
   }
 }
 
-TEST(DesignCertificate, PaperArmDesignsAndTheLimitsOfTheCertificate) {
-  const RobotFile rig = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
+// The SI design Jacobian of a 101-candidate pool of the paper's arm (its plane, E sampling
+// options as in studies), drawn with `seed`.
+Eigen::MatrixXd PaperArmPoolJacobian(std::uint64_t seed) {
+  const RobotFile& rig = testing::PaperRig();
   SamplingOptions so;
   so.ranger = rig.ranger;
   so.min_jacobian_singular_value = 0.05;
   const ConfigurationSet pool = SampleConfigurations(
-      rig.robot, *rig.plane, 101, RandomStream(2026, 7, 0, RandomPurpose::kPool), so);
+      rig.robot, *rig.plane, 101, RandomStream(seed, 7, 0, RandomPurpose::kPool), so);
   const MeasurementModel model(rig.robot, *rig.plane,
                                MakeParameterSet(rig.robot, PlaneTerms{}, {}, "fix"));
-  const Eigen::MatrixXd G = DesignJacobian(model, pool, DesignScaling::kSI, 1e-3, 1e-3);
+  return DesignJacobian(model, pool, DesignScaling::kSI, 1e-3, 1e-3);
+}
+
+TEST(DesignCertificate, PaperArmDesignsAndTheLimitsOfTheCertificate) {
+  const Eigen::MatrixXd G = PaperArmPoolJacobian(2026);
   SelectionOptions o;  // backward elimination, E: the paper's case 1
   const SelectionResult r =
       SelectConfigurations(G, 50, o, RandomStream(1, 0, 0, RandomPurpose::kSelection));
@@ -101,15 +107,7 @@ TEST(DesignCertificate, PaperArmDesignsAndTheLimitsOfTheCertificate) {
 // never worse than either greedy design, for E, D and A, near the number of parameters too
 // (k = 26 of 25 parameters) and in between.
 TEST(DesignCertificate, ExchangeIsAtLeastAsGoodAsGreedyEverywhere) {
-  const RobotFile rig = LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"));
-  SamplingOptions so;
-  so.ranger = rig.ranger;
-  so.min_jacobian_singular_value = 0.05;
-  const ConfigurationSet pool = SampleConfigurations(
-      rig.robot, *rig.plane, 101, RandomStream(11, 7, 0, RandomPurpose::kPool), so);
-  const MeasurementModel model(rig.robot, *rig.plane,
-                               MakeParameterSet(rig.robot, PlaneTerms{}, {}, "fix"));
-  const Eigen::MatrixXd G = DesignJacobian(model, pool, DesignScaling::kSI, 1e-3, 1e-3);
+  const Eigen::MatrixXd G = PaperArmPoolJacobian(11);
   const RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
   for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA})
     for (int k : {26, 40}) {
