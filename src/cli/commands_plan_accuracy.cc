@@ -24,6 +24,7 @@
 
 #include "cli_common.h"
 #include "lrcal/core/data_dir.h"
+#include "lrcal/core/json.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
@@ -151,9 +152,11 @@ std::string WriteStudy(const Study& base, const std::string& path, const std::st
   Json settings = Json::parse(base.base.dump());
   settings.erase("robot_file_fnv1a");
   settings["robot"] = fs::absolute(ResolveRobotPath(base.base["robot"], base.folder())).string();
-  settings["pool"] = {{"file", fs::absolute(pool_file).string()},
+  // The configuration files are beside the study file, named relative to it: the plan's
+  // folder can be moved or copied to another machine.
+  settings["pool"] = {{"file", fs::path(pool_file).filename().string()},
                       {"min_singular_value", base.base["pool"]["min_singular_value"]}};
-  settings["validation"] = {{"file", fs::absolute(validation_file).string()}};
+  settings["validation"] = {{"file", fs::path(validation_file).filename().string()}};
   Json counts = Json::array(), reps = Json::array(), labels = Json::array();
   for (const Campaign& c : campaigns) {
     counts.push_back(c.configurations);
@@ -173,12 +176,10 @@ std::string WriteStudy(const Study& base, const std::string& path, const std::st
                        {{{"key", "selection.count"}, {"values", counts}},
                         {{"key", "noise.repetitions"}, {"values", reps}}}}};
   }
-  std::ofstream out(path);
-  out << "# Written by lrcal plan-accuracy (JSON is YAML). Run it with another seed to check the\n"
-         "# campaign: lrcal run "
-      << path << "\n"
-      << study.dump(2) << "\n";
-  if (!out) throw StorageError("cannot write " + path);
+  WriteFileAtomically(path,
+                      "# Written by lrcal plan-accuracy (JSON is YAML). Run it with another seed "
+                      "to check the\n# campaign: lrcal run " +
+                          path + "\n" + study.dump(2) + "\n");
   return path;
 }
 

@@ -488,6 +488,22 @@ void ParseHeader(const Json& given, const std::string& path, const KeyLocator& w
   ParseStopWhen(given, where, study);
 }
 
+// The robot file's content hash, per cell (a sweep may name another robot file).
+void HashRobotFile(Json* settings, const KeyLocator& where, const std::string& folder) {
+  std::string robot_path;
+  try {
+    robot_path = ResolveRobotPath(Str(*settings, "robot", where), folder);
+  } catch (const InputError& e) {
+    throw InputError(where("robot"), e.what());
+  }
+  std::ifstream in(robot_path);
+  if (!in || std::filesystem::is_directory(robot_path))
+    throw InputError(where("robot"), "cannot open robot file '" + robot_path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  (*settings)["robot_file_fnv1a"] = HashHex(ss.str());
+}
+
 // The defaults with the file's settings merged in, and the robot file's content hash: a changed
 // robot is a new cell.
 Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& folder) {
@@ -497,18 +513,7 @@ Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& 
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
   base.merge_patch(settings);
-  std::string robot_path;
-  try {
-    robot_path = ResolveRobotPath(Str(base, "robot", where), folder);
-  } catch (const InputError& e) {
-    throw InputError(where("robot"), e.what());
-  }
-  std::ifstream in(robot_path);
-  if (!in || std::filesystem::is_directory(robot_path))
-    throw InputError(where("robot"), "cannot open robot file '" + robot_path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  base["robot_file_fnv1a"] = HashHex(ss.str());
+  HashRobotFile(&base, where, folder);
   ParseCell(base, where);  // the base itself must be valid
   return base;
 }
@@ -634,15 +639,29 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
                Location(path, line == lines.end() ? 0 : line->second);
   }
   if (cell.label.empty()) cell.label = "base";
-  HashConfigurationFiles(&cell.settings, KeyLocator{path, &lines, context, ""},
-                         std::filesystem::path(path).parent_path().string());
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  HashRobotFile(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
+  HashConfigurationFiles(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
   CheckUnknownKeys(cell.settings, StudyDefaults(), "", KeyLocator{path, &lines, context, ""});
   cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context, ""});
-  cell.id = HashHex(cell.settings.dump());
+  cell.id = HashHex(CellIdentity(cell.settings).dump());
   return cell;
 }
 
 }  // namespace
+
+Json CellIdentity(const Json& settings) {
+  Json id = settings;
+  for (const char* section : {"pool", "validation"})
+    if (id.contains(section) && id[section].is_object()) id[section].erase("file");
+  if (id.contains("robot") && id["robot"].is_string()) {
+    const std::string robot = id["robot"].get<std::string>();
+    const bool is_path = robot.find('/') != std::string::npos ||
+                         (robot.size() > 5 && robot.substr(robot.size() - 5) == ".yaml");
+    if (is_path) id["robot"] = "file";
+  }
+  return id;
+}
 
 Study LoadStudy(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);

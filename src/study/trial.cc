@@ -29,8 +29,9 @@ namespace {
 
 // Stream id of a draw family: a hash of the settings it depends on.
 std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> keys) {
+  const Json identity = CellIdentity(settings);
   Json part;
-  for (const char* k : keys) part[k] = settings[k];
+  for (const char* k : keys) part[k] = identity[k];
   return Fnv1a(part.dump());
 }
 

@@ -128,6 +128,51 @@ TEST(StudySchema, RelativeRobotPathsResolveAgainstTheStudyFolder) {
   EXPECT_EQ(cell->robot->source, dir + "/rigs/arm.yaml");
 }
 
+// A cell's identity (id, pool, validation set, prediction draws) counts files by content: the
+// same study in two folders, its robot and configuration files named by relative or absolute
+// paths, is the same cells with the same numbers; a changed file is another cell.
+TEST(StudySchema, CellsAreTheSameWhereverTheStudyAndItsFilesAre) {
+  const std::string paper = testing::SourcePath("studies/robots/paper.yaml");
+  const auto write = [&](const std::string& dir, const std::string& robot) {
+    std::filesystem::create_directories(dir + "/rigs");
+    std::filesystem::copy_file(paper, dir + "/rigs/arm.yaml",
+                               std::filesystem::copy_options::overwrite_existing);
+    testing::WritePaperConfigurationFiles(dir + "/rigs", 60, 12, 3, 4);
+    std::ofstream(dir + "/s.yaml") << "name: s\nseed: 1\ntrials: 2\nrobot: " << robot
+                                   << "\npool: {file: rigs/pool.csv}\n"
+                                      "validation: {file: rigs/val.csv}\n"
+                                      "selection: {count: 30}\n";
+    return LoadStudy(dir + "/s.yaml");
+  };
+  const std::string a = testing::TempDir("identity_a"), b = testing::TempDir("identity_b/x");
+  const Study sa = write(a, "rigs/arm.yaml");
+  const Study sb = write(b, b + "/rigs/arm.yaml");
+  ASSERT_EQ(sa.cells[0].id, sb.cells[0].id);
+  const auto ca = PrepareCell(sa, sa.cells[0]), cb = PrepareCell(sb, sb.cells[0]);
+  EXPECT_EQ(ca->validation_stream, cb->validation_stream);
+  for (int k = 0; k < 12; ++k) EXPECT_EQ(ca->predicted_validation[k], cb->predicted_validation[k]);
+  // Another validation file is another cell.
+  testing::WritePaperConfigurationFiles(b + "/rigs", 60, 12, 3, 5);
+  EXPECT_NE(LoadStudy(b + "/s.yaml").cells[0].id, sa.cells[0].id);
+  // A sweep over two robot files: each cell hashes its own file.
+  std::string text;
+  {
+    std::ifstream in(paper);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  std::ofstream(a + "/rigs/arm2.yaml") << text << "\n# another file\n";
+  std::ofstream(a + "/sweep.yaml")
+      << "name: s\nseed: 1\ntrials: 2\nrobot: rigs/arm.yaml\npool: {size: 40}\n"
+         "selection: {count: 30}\nsweep:\n  axes:\n    - {key: robot, values: [rigs/arm.yaml, "
+         "rigs/arm2.yaml]}\n";
+  const Study sweep = LoadStudy(a + "/sweep.yaml");
+  ASSERT_EQ(sweep.cells.size(), 2u);
+  EXPECT_NE(sweep.cells[0].settings["robot_file_fnv1a"],
+            sweep.cells[1].settings["robot_file_fnv1a"]);
+}
+
 TEST(DataDirectory, LrcalDataDirOverridesAndIsChecked) {
   ::setenv("LRCAL_DATA_DIR", testing::SourcePath("").c_str(), 1);
   EXPECT_EQ(FindDataFile("studies/robots/paper.yaml"),

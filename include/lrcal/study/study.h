@@ -76,7 +76,7 @@ struct CellSettings {
 };
 
 struct Cell {
-  std::string id;     ///< 16 hex digits: FNV-1a of the canonical settings JSON
+  std::string id;     ///< 16 hex digits: FNV-1a of CellIdentity(settings) as canonical JSON
   std::string label;  ///< human label from the axis labels/values ("case 1", "sigma_mm=0.1")
   int order = 0;      ///< position in the study's canonical order
   Json settings;      ///< resolved settings (canonical JSON)
@@ -111,6 +111,13 @@ const Json& StudyDefaults();
 
 /// Loads, validates and expands a study file. Throws InputError.
 Study LoadStudy(const std::string& path);
+
+/// The part of a cell's resolved settings that identifies it: its id and its random streams
+/// (pool, validation set, prediction draws) are functions of this. Files count by content, not
+/// by where they are: pool.file and validation.file are left out (their *.file_fnv1a stay), and
+/// a robot given as a file path becomes "file" (its robot_file_fnv1a stays); a shipped robot
+/// name stays as written. So a study gives the same numbers wherever it and its files are.
+Json CellIdentity(const Json& settings);
 
 /// A file named in a study (pool.file, validation.file): relative paths are taken relative to
 /// the study file's folder.
