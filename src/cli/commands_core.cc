@@ -68,6 +68,7 @@ Json IdentificationJson(const IdentificationSummary& s) {
   j["sigma_hat"] = s.sigma_hat;
   j["n_configurations"] = s.num_configurations;
   j["solver"] = s.solver;
+  j["loss"] = s.loss;
   if (!s.identifiability.full_rank()) j["identifiability"] = IdentifiabilityJson(s.identifiability);
   return j;
 }
@@ -285,8 +286,10 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "if the set is rank-deficient, fix the suggested parameters and go on")(
       "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
       "loss", po::value<std::string>()->default_value("none"),
-      "robust loss: none, huber, cauchy (needs --solver ceres)")(
-      "loss-scale-mm", po::value<double>()->default_value(1.0), "robust loss scale (mm)")(
+      "robust loss: none, huber, cauchy (either solver)")(
+      "loss-scale-mm", po::value<double>()->default_value(1.0),
+      "robust loss scale (mm) on each configuration's residual sqrt(R)*(mean h - h); "
+      "e.g. 1.345 sigma for Huber, 2.385 sigma for Cauchy (95 % efficiency)")(
       "sigma-mm", po::value<double>()->default_value(0.0),
       "known noise of one reading (mm) for the given-sigma covariance");
   po::variables_map vm;

@@ -15,13 +15,12 @@ namespace lrcal {
 
 std::string IdentificationOptions::Validate() const {
   if (max_iterations < 1) return "max_iterations must be at least 1";
+  if (max_robust_iterations < 1) return "max_robust_iterations must be at least 1";
   if (!(parameter_tolerance >= 0)) return "parameter_tolerance must be >= 0";
   if (!(function_tolerance >= 0)) return "function_tolerance must be >= 0";
   if (!(sigma >= 0) || !std::isfinite(sigma)) return "sigma must be a finite value >= 0 (m)";
   if (!(loss_scale > 0) || !std::isfinite(loss_scale))
     return "loss_scale must be a finite value > 0 (m)";
-  if (loss != RobustLoss::kNone && solver != Solver::kCeres)
-    return "robust losses need the Ceres solver (solver: ceres)";
   return "";
 }
 
@@ -175,11 +174,10 @@ void LevenbergMarquardt::FormNormalEquations() {
 // functions it needs that state passed around, and its bit-for-bit results are pinned by the
 // golden tables and the Ceres agreement tests.
 // NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
-LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& model,
-                                                     const ConfigurationSet& configs,
-                                                     const double* mean_h, const double* weights,
-                                                     const IdentificationOptions& options,
-                                                     Eigen::VectorXd* e, const Nominal* nominal) {
+LevenbergMarquardt::Result LevenbergMarquardt::SolveLeastSquares(
+    const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
+    const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
+    const Nominal* nominal) {
   Result result;
   const int n = model.num_parameters(), m = configs.size();
   e->setZero(n);
@@ -304,6 +302,147 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
   return result;
 }
 
+LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& model,
+                                                     const ConfigurationSet& configs,
+                                                     const double* mean_h, const double* weights,
+                                                     const IdentificationOptions& options,
+                                                     Eigen::VectorXd* e, const Nominal* nominal) {
+  Result result = SolveLeastSquares(model, configs, mean_h, weights, options, e, nominal);
+  if (options.loss == RobustLoss::kNone || result.termination != Termination::kConverged)
+    return result;
+  RefineRobust(model, mean_h, options, e, &result);
+  return result;
+}
+
+double LevenbergMarquardt::RobustCost(const IdentificationOptions& options,
+                                      const Eigen::VectorXd& r, RobustWeights* weights) {
+  const double a = options.loss_scale, a2 = a * a;
+  if (weights) {
+    weights->rho1.resize(r.size());
+    weights->curvature.resize(r.size());
+  }
+  double cost = 0;
+  for (Eigen::Index i = 0; i < r.size(); ++i) {
+    const double s = r[i] * r[i];
+    double rho, rho1, rho2;
+    if (options.loss == RobustLoss::kHuber) {  // ceres::HuberLoss
+      const bool inlier = s <= a2;
+      const double root = std::sqrt(s);
+      rho = inlier ? s : 2 * a * root - a2;
+      rho1 = inlier ? 1.0 : a / root;
+      rho2 = inlier ? 0.0 : -0.5 * rho1 / s;
+    } else {  // ceres::CauchyLoss
+      const double sum = 1 + s / a2;
+      rho = a2 * std::log(sum);
+      rho1 = 1 / sum;
+      rho2 = -rho1 * rho1 / a2;
+    }
+    cost += 0.5 * rho;
+    if (weights) {
+      weights->rho1[i] = rho1;
+      // d²/dr² of ½ρ(r²) is ρ' + 2sρ''; negative (a falling tail) is clipped to 0.
+      weights->curvature[i] = std::max(0.0, rho1 + 2 * s * rho2);
+    }
+  }
+  return cost;
+}
+
+// Levenberg–Marquardt on F(e) = ½·Σρ(r_i²). The model's Hessian is Jᵀ·diag(ρ' + 2sρ'')·J with
+// the curvature clipped at 0 (exact for Huber, whose cost is piecewise quadratic: convergence in
+// a few steps once the inliers are settled, where reweighting alone crawls, L1-like, at small
+// scales); the damping is scaled by the reweighted matrix Jᵀ·diag(ρ')·J, which stays regular
+// when few residuals are inliers. The gradient is exact, so the minimum is Ceres' (which
+// reweights). Stops on a small step or cost decrease like the least-squares loop; a step that
+// cannot lower the cost when undamped means the minimum is reached to rounding.
+void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const double* mean_h,
+                                      const IdentificationOptions& options, Eigen::VectorXd* e,
+                                      Result* result) {
+  RobustWeights w, w_trial;
+  Eigen::VectorXd step;
+  Eigen::MatrixXd A_reweighted, J_weighted;
+  Eigen::Matrix<bool, Eigen::Dynamic, 1> settled_regions;
+  double cost = Linearize(model, mean_h, *e, &r_, &J_);
+  if (!std::isfinite(cost)) {
+    result->termination = Termination::kBeamMissed;
+    return;
+  }
+  cost = RobustCost(options, r_, &w);
+  const auto form = [&] {
+    g_.noalias() = J_.transpose() * w.rho1.cwiseProduct(r_);
+    J_weighted = J_;
+    J_weighted.array().colwise() *= w.rho1.cwiseSqrt().array();
+    NormalMatrix(J_weighted, &A_reweighted);
+    scale_ = A_reweighted.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    J_weighted = J_;
+    J_weighted.array().colwise() *= w.curvature.cwiseSqrt().array();
+    NormalMatrix(J_weighted, &A_);
+  };
+  form();
+  constexpr double kCostResolution = 1e-10;
+  double lambda = 0, previous_step = std::numeric_limits<double>::infinity();
+  result->termination = Termination::kMaxIterations;
+  for (int iter = 1; iter <= options.max_robust_iterations; ++iter) {
+    ++result->iterations;
+    rhs_ = scale_.cwiseProduct(g_);
+    bool solved = false;
+    // The Newton model once the residuals' regions (curvature > 0 or not) have settled, and it
+    // is regular; until then the reweighted one, which always descends.
+    const bool settled = (w.curvature.array() > 0).matrix() == settled_regions;
+    for (const Eigen::MatrixXd* M : {settled ? &A_ : &A_reweighted, &A_reweighted}) {
+      As_.noalias() = scale_.asDiagonal() * (*M) * scale_.asDiagonal();
+      As_.diagonal().array() += lambda;
+      if ((solved = CholeskySolve(As_, rhs_, &L_, &step, 1e-13))) break;
+    }
+    if (!solved) {
+      result->termination = Termination::kNumericalFailure;
+      break;
+    }
+    step = scale_.cwiseProduct(step);
+    e_trial_ = *e + step;
+    const double tolerance =
+        options.parameter_tolerance * (e->norm() + options.parameter_tolerance);
+    const double step_norm = step.norm();
+    const bool small_step = step_norm <= tolerance;
+    // The error left after this step, from the observed contraction (as in least squares).
+    const double contraction = step_norm / previous_step;
+    const bool last_step =
+        std::isfinite(previous_step) && contraction < 0.5 && contraction * step_norm <= tolerance;
+    // Near the minimum the cost resolves only ~1e-12 relative: a step predicted to gain less
+    // than that is at the minimum to rounding, whatever the evaluated cost says.
+    const bool at_resolution = lambda == 0 && 0.5 * step.dot(g_) <= kCostResolution * cost;
+    double trial_cost = Linearize(model, mean_h, e_trial_, &r_trial_, &J_trial_);
+    if (std::isfinite(trial_cost)) trial_cost = RobustCost(options, r_trial_, &w_trial);
+    if (std::isfinite(trial_cost) && trial_cost <= cost) {
+      const bool small_decrease = cost - trial_cost <= options.function_tolerance * cost;
+      e->swap(e_trial_);
+      J_.swap(J_trial_);
+      r_.swap(r_trial_);
+      settled_regions = (w.curvature.array() > 0).matrix();
+      std::swap(w, w_trial);
+      cost = trial_cost;
+      form();
+      previous_step = step_norm;
+      lambda = lambda < 1e-10 ? 0 : lambda / 10;
+      if (small_step || last_step || small_decrease || at_resolution) {
+        result->termination = Termination::kConverged;
+        break;
+      }
+    } else if ((small_step || at_resolution) && lambda == 0) {  // at the minimum to rounding
+      result->termination = Termination::kConverged;
+      break;
+    } else {
+      lambda = lambda == 0 ? 1e-6 : lambda * 10;
+      if (lambda > 1e12) {
+        result->termination = Termination::kNumericalFailure;
+        break;
+      }
+    }
+  }
+  result->final_cost = cost;
+  // The least-squares normal matrix at the robust estimate (what the covariance reads).
+  if (std::isfinite(Linearize(model, mean_h, *e, &r_, &J_))) FormNormalEquations();
+}
+
 namespace {
 
 // Configuration i's residual √R·(h̄ − h) and (if `row`) its Jacobian row −√R·∂h/∂e; false if the
@@ -416,6 +555,8 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
   // every residual of a few mm would count as an outlier at a sub-mm scale, and the non-convex
   // Cauchy loss would hardly move). One block per configuration, each with its own loss on its
   // weighted residual √R·(h̄ − h): Ceres applies a loss to the squared norm of a whole block.
+  ceres::Solver::Options robust_options = so;
+  robust_options.max_num_iterations = options.max_robust_iterations;
   ceres::Problem robust;
   for (int i = 0; i < data.size(); ++i) {
     ceres::LossFunction* loss =
@@ -425,7 +566,7 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
     robust.AddResidualBlock(new OneConfigurationCost(model, data, i), loss, e->data());
   }
   ceres::Solver::Summary robust_summary;
-  ceres::Solve(so, &robust, &robust_summary);
+  ceres::Solve(robust_options, &robust, &robust_summary);
   *iterations += static_cast<int>(robust_summary.iterations.size()) - 1;
   *message = "least squares: " + summary.message + "; robust refinement: " + robust_summary.message;
   return CeresTermination(robust_summary);
@@ -530,6 +671,12 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
                                const IdentificationOptions& options) {
   IdentificationSummary s;
   s.solver = options.solver == IdentificationOptions::Solver::kCeres ? "ceres" : "lrcal-lm";
+  if (options.loss != RobustLoss::kNone) {
+    std::ostringstream loss;
+    loss << NameOf(kRobustLossNames, options.loss) << " loss, scale " << options.loss_scale * 1e3
+         << " mm";
+    s.loss = loss.str();
+  }
   s.num_configurations = data.size();
   if (std::string problem = options.Validate(); !problem.empty()) {
     s.message = "invalid options: " + problem;
@@ -577,10 +724,10 @@ Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double
 
 std::string IdentificationSummary::BriefReport() const {
   std::ostringstream out;
-  out << "lrcal identification (" << solver << "): " << TerminationName(termination) << ", "
-      << iterations << " iterations, " << names.size() << " parameters, " << num_configurations
-      << " configurations, cost " << initial_cost << " -> " << final_cost << " m^2, residual RMS "
-      << residual_rms * 1e3 << " mm";
+  out << "lrcal identification (" << solver << ", " << loss << "): " << TerminationName(termination)
+      << ", " << iterations << " iterations, " << names.size() << " parameters, "
+      << num_configurations << " configurations, cost " << initial_cost << " -> " << final_cost
+      << " m^2, residual RMS " << residual_rms * 1e3 << " mm";
   return out.str();
 }
 

@@ -44,12 +44,31 @@ class LevenbergMarquardt {
   /// have configs.size() entries (weights = repetitions). `nominal`, if given, must be the model
   /// at e = 0 on these configurations. On return `normal_matrix()` holds GᵀWG at the last
   /// linearisation point (within one final step of e).
+  ///
+  /// With a robust loss (options.loss) the least-squares estimate is then refined to the minimum
+  /// of ½·Σ ρ(r_i²), r_i the weighted residual, ρ Ceres' HuberLoss / CauchyLoss of scale
+  /// options.loss_scale: the same cost, started from the same point, as the Ceres path (tested to
+  /// agree to 1e-8). normal_matrix() is then the least-squares GᵀWG at the robust estimate.
   Result Solve(const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
                const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
                const Nominal* nominal = nullptr);
   const Eigen::MatrixXd& normal_matrix() const { return A_; }
 
  private:
+  Result SolveLeastSquares(const MeasurementModel& model, const ConfigurationSet& configs,
+                           const double* mean_h, const double* weights,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           const Nominal* nominal);
+  // The robust refinement from *e to the minimum of ½·Σρ(r_i²); adds its iterations.
+  void RefineRobust(const MeasurementModel& model, const double* mean_h,
+                    const IdentificationOptions& options, Eigen::VectorXd* e, Result* result);
+  struct RobustWeights {
+    Eigen::VectorXd rho1;       // ρ'(r_i²): the gradient's weights
+    Eigen::VectorXd curvature;  // max(0, ρ' + 2sρ''): the model Hessian's weights
+  };
+  // ½·Σρ(r_i²) of weighted residuals r, and (if `weights`) the per-residual weights.
+  static double RobustCost(const IdentificationOptions& options, const Eigen::VectorXd& r,
+                           RobustWeights* weights);
   using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   // Weighted residuals √w·(h̄ − h) and Jacobian √w·G at e into (r, J); returns the cost, NaN if a
   // beam runs parallel to the plane.

@@ -707,7 +707,7 @@ plane: None (the robot file's), an lrcal.Plane or (nx, ny, nz, f), the nominal p
 estimate_plane: "none", "normal", "offset" or "normal,offset" (names plane_u1, plane_u2, plane_f).
 fix: parameter names kept at nominal (a list or "a1,d2"). auto_fix: if the set is rank-deficient,
 fix the suggested parameters and go on (else termination is 'rank_deficient').
-solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (ceres only) with loss_scale m.
+solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (either solver) with loss_scale m.
 sigma: the known σ of one reading (m) for covariance_given; 0 = unknown.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc");
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),

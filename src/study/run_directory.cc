@@ -16,6 +16,7 @@
 #include "lrcal/build_info.h"
 #include "lrcal/core/error.h"
 #include "lrcal/study/stopping.h"
+#include "lrcal/study/study.h"
 
 namespace lrcal {
 
@@ -89,7 +90,7 @@ Json StudyFingerprint(const Json& study) {
   return {{"name", study["name"]},
           {"seed", study["seed"]},
           {"trials", study["trials"]},
-          {"base", study["base"]}};
+          {"base", CellIdentity(study["base"])}};
 }
 
 DirectoryLock::DirectoryLock(const std::string& dir) {

@@ -39,7 +39,8 @@ const Json& StudyDefaults() {
                   "scaling": "si", "restarts": 4, "redraw": false},
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
-                       "max_iterations": 100, "on_rank_deficient": "fail"},
+                       "max_iterations": 100, "on_rank_deficient": "fail",
+                       "loss": "none", "loss_scale": 1.345},
     "paper_case": 0
   })");
   return d;
@@ -335,6 +336,19 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
     throw InputError(where("identification.on_rank_deficient"),
                      "expected fail or fix, got '" + rank + "'");
   c->fix_dependent = rank == "fix";
+  c->identification.loss = ParseName(kRobustLossNames, Str(s, "identification.loss", where),
+                                     where("identification.loss"), "loss");
+  const double scale = Num(s, "identification.loss_scale", where);
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw InputError(where("identification.loss_scale"),
+                     "expected a scale > 0 in units of the reading's standard deviation "
+                     "(Huber 1.345, Cauchy 2.385 for 95 % efficiency)");
+  if (c->identification.loss != RobustLoss::kNone && !(c->sigma > 0))
+    throw InputError(where("identification.loss"),
+                     "a robust loss needs noise.sigma_mm > 0: its scale is in units of σ");
+  // The scale applies to each configuration's weighted residual √R·(h̄ − h), whose standard
+  // deviation is that of one reading.
+  c->identification.loss_scale = c->sigma > 0 ? scale * c->sigma : 1e-3;
 }
 
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
@@ -652,6 +666,15 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
 
 Json CellIdentity(const Json& settings) {
   Json id = settings;
+  // Keys added after studies were run are left out at their neutral values, so that the cells
+  // (and run directories) of earlier studies keep their names.
+  if (id.contains("identification") && id["identification"].is_object()) {
+    Json& ident = id["identification"];
+    if (ident.value("loss", Json("none")) == "none") {
+      ident.erase("loss");
+      ident.erase("loss_scale");
+    }
+  }
   for (const char* section : {"pool", "validation"})
     if (id.contains(section) && id[section].is_object()) id[section].erase("file");
   if (id.contains("robot") && id["robot"].is_string()) {

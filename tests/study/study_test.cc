@@ -173,6 +173,39 @@ TEST(StudySchema, CellsAreTheSameWhereverTheStudyAndItsFilesAre) {
             sweep.cells[1].settings["robot_file_fnv1a"]);
 }
 
+// identification.loss: the scale is in units of one reading's σ; a study that does not use a
+// loss keeps the cell names it had before the key existed (loss: none makes loss_scale moot).
+TEST(StudySchema, RobustLossScaleIsInSigmaAndLeavesOldCellsAlone) {
+  const std::string dir = testing::TempDir("study_loss");
+  const auto load = [&](const std::string& identification) {
+    std::ofstream(dir + "/s.yaml") << "name: s\nseed: 1\ntrials: 2\nnoise: {sigma_mm: 0.2}\n"
+                                      "identification: "
+                                   << identification << "\n";
+    return LoadStudy(dir + "/s.yaml");
+  };
+  const Study plain = load("{}");
+  const Study moot = load("{loss: none, loss_scale: 3}");
+  const Study huber = load("{loss: huber}");
+  EXPECT_EQ(plain.cells[0].id, moot.cells[0].id);
+  EXPECT_NE(plain.cells[0].id, huber.cells[0].id);
+  EXPECT_EQ(huber.cells[0].typed.identification.loss, RobustLoss::kHuber);
+  EXPECT_DOUBLE_EQ(huber.cells[0].typed.identification.loss_scale, 1.345 * 0.2e-3);
+  EXPECT_NE(load("{loss: cauchy, loss_scale: 2}").cells[0].id,
+            load("{loss: cauchy, loss_scale: 3}").cells[0].id);
+  std::ofstream(dir + "/bad.yaml") << "name: s\nseed: 1\ntrials: 2\nnoise: {sigma_mm: 0}\n"
+                                      "identification: {loss: huber}\n";
+  try {
+    LoadStudy(dir + "/bad.yaml");
+    ADD_FAILURE() << "a loss without noise was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("identification.loss"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sigma_mm"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir + "/bad.yaml") << "name: s\nseed: 1\ntrials: 2\n"
+                                      "identification: {loss: huber, loss_scale: -1}\n";
+  EXPECT_THROW(LoadStudy(dir + "/bad.yaml"), InputError);
+}
+
 TEST(DataDirectory, LrcalDataDirOverridesAndIsChecked) {
   ::setenv("LRCAL_DATA_DIR", testing::SourcePath("").c_str(), 1);
   EXPECT_EQ(FindDataFile("studies/robots/paper.yaml"),

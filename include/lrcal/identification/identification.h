@@ -7,7 +7,10 @@
 //    equations accumulated in one pass, no allocation per iteration once the workspace is warm.
 //    The Monte-Carlo hot path.
 //  - kCeres: Ceres' Levenberg–Marquardt on the same analytic cost (one residual block for all
-//    configurations). The reference path; it also offers robust losses (Huber, Cauchy).
+//    configurations). The reference path.
+// With a robust loss (Huber, Cauchy: Ceres' definitions, on each configuration's weighted
+// residual) both solve least squares first and then refine from that estimate to the minimum of
+// ½·Σρ(r_i²); they agree to 1e-8.
 // A rank-deficient parameter set is detected before solving (identifiability.h) and reported as
 // Termination::kRankDeficient with the dependencies, unless the options say to fix the suggested
 // parameters and go on.
@@ -30,13 +33,17 @@ inline constexpr EnumName<RobustLoss> kRobustLossNames[] = {
 
 struct IdentificationOptions {
   enum class Solver { kLevenbergMarquardt, kCeres };  ///< names: kSolverNames
-  /// lrcal's own LM is the fast default; kCeres is the reference and the only one with losses.
+  /// lrcal's own LM is the fast default; kCeres is the reference. Both take the robust losses.
   Solver solver = Solver::kLevenbergMarquardt;
   RobustLoss loss = RobustLoss::kNone;
   /// Scale of the robust loss (m), applied to each configuration's weighted residual
   /// √R·(h̄ − h): residuals beyond it are down-weighted.
   double loss_scale = 1e-3;
   int max_iterations = 100;
+  /// Iterations of the robust refinement (after least squares). Its own budget: at loss scales
+  /// far below the noise nearly every residual is in the loss' tail and the refinement
+  /// converges only linearly (Ceres' too), e.g. ~200 iterations at 0.005 σ.
+  int max_robust_iterations = 1000;
   /// Stop when the step is below parameter_tolerance·(‖e‖ + parameter_tolerance). Ceres'
   /// defaults stop measurably short of the minimum on this problem (DESIGN.md); 1e-12 reaches
   /// it to rounding.
@@ -96,9 +103,12 @@ struct IdentificationSummary {
   std::vector<std::string> fixed;         ///< parameters fixed because of rank deficiency
   IdentifiabilityReport identifiability;  ///< of the parameter set at the nominal model
   std::string solver;                     ///< "lrcal-lm" or "ceres"
+  /// The cost minimised, in words: "least squares", or "huber loss, scale 0.269 mm" (the
+  /// scale on each configuration's weighted residual √R·(h̄ − h)).
+  std::string loss = "least squares";
 
   bool IsSolutionUsable() const { return termination == Termination::kConverged; }
-  /// One line: solver, termination, iterations, sizes, cost, residual RMS.
+  /// One line: solver, loss, termination, iterations, sizes, cost, residual RMS.
   std::string BriefReport() const;
   /// The brief report, the solver's message, σ̂ and the parameter table (or, when the set is
   /// rank-deficient, the identifiability report).
