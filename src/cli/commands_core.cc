@@ -234,6 +234,14 @@ int SimulateCommand(const std::vector<std::string>& args) {
   o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
       "sigma-mm", po::value<double>()->default_value(0.2), "noise of one reading (mm)")(
       "repetitions", po::value<int>()->default_value(10), "readings per configuration")(
+      "encoder-sigma-mrad", po::value<double>()->default_value(0.0),
+      "joint-encoder noise, each joint, each reading (mrad); the CSV records the joint "
+      "angles without it")("form-sigma-mm", po::value<double>()->default_value(0.0),
+                           "plane flatness deviation at each configuration's hit point (mm)")(
+      "outlier-fraction", po::value<double>()->default_value(0.0),
+      "share of readings with a gross error")("outlier-sigma-mm",
+                                              po::value<double>()->default_value(5.0),
+                                              "standard deviation of a gross error (mm)")(
       "seed", po::value<long long>()->default_value(1), "random seed")(
       "out", po::value<std::string>()->required(), "measurement CSV to write");
   po::variables_map vm;
@@ -250,6 +258,19 @@ int SimulateCommand(const std::vector<std::string>& args) {
   noise.repetitions = vm["repetitions"].as<int>();
   if (!(std::isfinite(noise.sigma) && noise.sigma >= 0))
     throw InputError("--sigma-mm", "expected a finite noise >= 0 (mm)");
+  const auto non_negative = [&](const char* option, double scale, const char* unit) {
+    const double v = vm[option].as<double>();
+    if (!(std::isfinite(v) && v >= 0))
+      throw InputError(std::string("--") + option,
+                       std::string("expected a finite value >= 0 (") + unit + ")");
+    return v * scale;
+  };
+  noise.encoder_sigma = non_negative("encoder-sigma-mrad", 1e-3, "mrad");
+  noise.form_sigma = non_negative("form-sigma-mm", 1e-3, "mm");
+  noise.outlier_sigma = non_negative("outlier-sigma-mm", 1e-3, "mm");
+  noise.outlier_fraction = non_negative("outlier-fraction", 1.0, "a fraction");
+  if (noise.outlier_fraction > 1)
+    throw InputError("--outlier-fraction", "expected a fraction of readings in [0, 1]");
   if (noise.repetitions < 1 || noise.repetitions > 1000000)
     throw InputError("--repetitions", "expected 1 to 1,000,000 readings per configuration");
   if (static_cast<double>(noise.repetitions) * configs.size() > 1e7)

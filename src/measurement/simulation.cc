@@ -27,7 +27,75 @@ void NoiseModel::Validate(const std::string& source) const {
                                  std::to_string(sigma));
   if (repetitions < 1)
     throw InputError(source, "repetitions: expected at least 1 reading per configuration");
+  const auto check = [&](double v, const char* what) {
+    if (!(std::isfinite(v) && v >= 0))
+      throw InputError(
+          source, std::string(what) + ": expected a finite value >= 0, got " + std::to_string(v));
+  };
+  check(encoder_sigma, "encoder_sigma");
+  check(form_sigma, "form_sigma");
+  check(outlier_sigma, "outlier_sigma");
+  if (!(outlier_fraction >= 0 && outlier_fraction <= 1))
+    throw InputError(source, "outlier_fraction: expected a fraction in [0, 1], got " +
+                                 std::to_string(outlier_fraction));
 }
+
+namespace {
+
+// The exact readings under encoder noise and form error: per configuration (draw_mean, at the
+// mean joint error) or per reading. Misses are those of the recorded configuration.
+void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                       const Plane& plane, const ConfigurationSet& configs, const NoiseModel& noise,
+                       const RandomStream& stream, const std::vector<int>* noise_slots,
+                       std::vector<double>* out) {
+  const int R = noise.repetitions, per = noise.draw_mean ? 1 : R, nj = configs.num_joints();
+  const RandomStream encoder = stream.WithPurpose(RandomPurpose::kEncoder);
+  const RandomStream form = stream.WithPurpose(RandomPurpose::kPlaneForm);
+  const double sigma_q = noise.draw_mean ? noise.encoder_sigma / std::sqrt(static_cast<double>(R))
+                                         : noise.encoder_sigma;
+  ConfigurationSet disturbed(nj);
+  disturbed.Reserve(configs.size() * per);
+  std::vector<double> q(nj);
+  for (int i = 0; i < configs.size(); ++i) {
+    const std::uint64_t slot = noise_slots ? (*noise_slots)[i] : i;
+    for (int r = 0; r < per; ++r) {
+      for (int j = 0; j < nj; ++j)
+        q[j] = configs.q(i)[j] +
+               (sigma_q > 0 ? sigma_q * encoder.Normal((slot * R + r) * nj + j) : 0.0);
+      disturbed.Add(q.data());
+    }
+  }
+  ModelPoint point;
+  PrepareModelPoint(robot, link_values.data(), plane, &point);
+  out->resize(disturbed.size());
+  for (int k = 0; k < disturbed.size(); ++k) {
+    const std::uint64_t slot = noise_slots ? (*noise_slots)[k / per] : k / per;
+    Plane local = plane;
+    if (noise.form_sigma > 0) local.offset += noise.form_sigma * form.Normal(slot);
+    double nb;
+    (*out)[k] = BeamReading(ToolPose(point, disturbed, k), local, &nb);
+  }
+}
+
+// The gross errors' contribution to reading r of slot (raw), or to the mean of R (draw_mean).
+double OutlierError(const NoiseModel& noise, const RandomStream& outliers, std::uint64_t slot,
+                    int r) {
+  const int R = noise.repetitions;
+  if (!noise.draw_mean) {
+    const std::uint64_t k = slot * R + r;
+    return outliers.Uniform(2 * k) <= noise.outlier_fraction
+               ? noise.outlier_sigma * outliers.Normal(2 * k + 1)
+               : 0.0;
+  }
+  int count = 0;
+  for (int rr = 0; rr < R; ++rr)
+    count += outliers.Uniform(2 * (slot * R + rr)) <= noise.outlier_fraction;
+  return count ? std::sqrt(static_cast<double>(count)) * noise.outlier_sigma *
+                     outliers.Normal(2 * slot * R + 1) / R
+               : 0.0;
+}
+
+}  // namespace
 
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const Plane& true_plane, const RangerSpec& ranger,
@@ -40,12 +108,20 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   std::vector<BeamMiss> local;
   std::vector<BeamMiss>* m = misses ? misses : &local;
   ExactReadings(robot, true_link_values, true_plane, ranger, configs, &h, m);
-  return AddNoise(h, *m, configs, noise, stream, data, raw, noise_slots);
+  if (!noise.DisturbsGeometry())
+    return AddNoise(h, *m, configs, noise, stream, data, raw, noise_slots);
+  std::vector<double> disturbed;
+  DisturbedReadings(robot, true_link_values, true_plane, configs, noise, stream, noise_slots,
+                    &disturbed);
+  if (noise.draw_mean)
+    return AddNoise(disturbed, *m, configs, noise, stream, data, raw, noise_slots);
+  return AddNoise(h, *m, configs, noise, stream, data, raw, noise_slots, &disturbed);
 }
 
 int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
              const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
-             MeasurementSet* data, std::vector<double>* raw, const std::vector<int>* noise_slots) {
+             MeasurementSet* data, std::vector<double>* raw, const std::vector<int>* noise_slots,
+             const std::vector<double>* per_reading) {
   // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial).
   if (data->configs.num_joints() != configs.num_joints())
     data->configs = ConfigurationSet(configs.num_joints());
@@ -57,6 +133,8 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
   const double sigma_mean = noise.sigma / std::sqrt(static_cast<double>(R));
   std::vector<double> z(noise.draw_mean ? 1 : R);
   if (raw) raw->clear();
+  const bool outliers = noise.outlier_fraction > 0;
+  const RandomStream outlier_stream = stream.WithPurpose(RandomPurpose::kOutlier);
   int missed = 0;
   for (int i = 0; i < configs.size(); ++i) {
     const std::uint64_t slot = noise_slots ? (*noise_slots)[i] : i;
@@ -67,11 +145,13 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
     double mean;
     if (noise.draw_mean) {
       mean = h[i] + sigma_mean * stream.Normal(slot);
+      if (outliers) mean += OutlierError(noise, outlier_stream, slot, 0);
     } else {
       stream.Normals(slot * R, R, z.data());
       double sum = 0;
       for (int r = 0; r < R; ++r) {
-        const double reading = h[i] + noise.sigma * z[r];
+        double reading = (per_reading ? (*per_reading)[i * R + r] : h[i]) + noise.sigma * z[r];
+        if (outliers) reading += OutlierError(noise, outlier_stream, slot, r);
         sum += reading;
         if (raw) raw->push_back(reading);
       }

@@ -33,7 +33,8 @@ const Json& StudyDefaults() {
     "robot": "paper",
     "plane": "robot",
     "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0},
-    "noise": {"sigma_mm": 0.2, "repetitions": 10},
+    "noise": {"sigma_mm": 0.2, "repetitions": 10, "encoder_sigma_mrad": 0.0, "form_sigma_mm": 0.0,
+              "outlier_fraction": 0.0, "outlier_sigma_mm": 5.0},
     "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
     "selection": {"count": 50, "method": "backward", "criterion": "E", "samples": 1000,
                   "scaling": "si", "restarts": 4, "redraw": false},
@@ -282,6 +283,13 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
   c->truth_length_sigma = NonNegative(s, "truth.length_sigma_mm", where) * 1e-3;
   c->sigma = NonNegative(s, "noise.sigma_mm", where) * 1e-3;
   c->repetitions = Int(s, "noise.repetitions", where, 1, 1000000);
+  c->encoder_sigma = NonNegative(s, "noise.encoder_sigma_mrad", where) * 1e-3;
+  c->form_sigma = NonNegative(s, "noise.form_sigma_mm", where) * 1e-3;
+  c->outlier_fraction = NonNegative(s, "noise.outlier_fraction", where);
+  if (c->outlier_fraction > 1)
+    throw InputError(where("noise.outlier_fraction"),
+                     "expected the fraction of readings with a gross error, in [0, 1]");
+  c->outlier_sigma = NonNegative(s, "noise.outlier_sigma_mm", where) * 1e-3;
 }
 
 void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings* c) {
@@ -668,6 +676,15 @@ Json CellIdentity(const Json& settings) {
   Json id = settings;
   // Keys added after studies were run are left out at their neutral values, so that the cells
   // (and run directories) of earlier studies keep their names.
+  if (id.contains("noise") && id["noise"].is_object()) {
+    Json& noise = id["noise"];
+    for (const char* k : {"encoder_sigma_mrad", "form_sigma_mm"})
+      if (noise.contains(k) && noise[k] == 0) noise.erase(k);
+    if (noise.value("outlier_fraction", Json(0)) == 0) {
+      noise.erase("outlier_fraction");
+      noise.erase("outlier_sigma_mm");
+    }
+  }
   if (id.contains("identification") && id["identification"].is_object()) {
     Json& ident = id["identification"];
     if (ident.value("loss", Json("none")) == "none") {

@@ -386,9 +386,13 @@ bool DesignOfTrial(const CellContext& c, long long trial, const TrialTruth& trut
 int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTruth& truth,
                           const TrialDesign& design, TrialWorkspace* ws) {
   const CellSettings& s = c.cell->typed;
-  const NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
+  NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
+  noise.encoder_sigma = s.encoder_sigma;
+  noise.form_sigma = s.form_sigma;
+  noise.outlier_fraction = s.outlier_fraction;
+  noise.outlier_sigma = s.outlier_sigma;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
-  if (s.truth_random || s.pool_redraw)
+  if (s.truth_random || s.pool_redraw || noise.DisturbsGeometry())
     return SimulateReadings(*c.robot, truth.values, c.plane, c.ranger, design.configs, noise,
                             stream, &ws->data, nullptr, nullptr, &design.slots);
   if (!s.selection_redraw)

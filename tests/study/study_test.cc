@@ -76,7 +76,8 @@ std::string LoadError(const std::string& name, const std::string& body) {
 TEST(StudySchema, SectionsGivenAsNothingOrScalarsAreErrorsNamingTheKey) {
   const std::string empty = LoadError("null_section", "noise:\npool: {size: 60}\n");
   EXPECT_NE(empty.find("s.yaml:5 key 'noise'"), std::string::npos) << empty;
-  EXPECT_NE(empty.find("expected a mapping with keys repetitions, sigma_mm, got nothing"),
+  EXPECT_NE(empty.find("expected a mapping with keys encoder_sigma_mrad, form_sigma_mm, "
+                       "outlier_fraction, outlier_sigma_mm, repetitions, sigma_mm, got nothing"),
             std::string::npos)
       << empty;
   const std::string scalar = LoadError("scalar_section", "selection: 5\n");

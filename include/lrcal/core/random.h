@@ -26,6 +26,9 @@ enum class RandomPurpose : std::uint32_t {
   kTruth = 4,       ///< per-trial parameter errors
   kSelection = 5,   ///< random selection / exchange restarts
   kPrediction = 6,  ///< draws of the linearised prediction of the validation metrics
+  kEncoder = 7,     ///< joint-encoder errors: index = (configuration·R + repetition)·joints + j
+  kPlaneForm = 8,   ///< plane flatness deviation at a configuration's hit point: index = slot
+  kOutlier = 9,     ///< gross errors: 2·(configuration·R + repetition) (+1 for the size)
 };
 
 class RandomStream {
@@ -45,6 +48,10 @@ class RandomStream {
   double Normal(std::uint64_t index) const;
   /// Fills out[0..count) with the standard normals at indices first .. first+count-1.
   void Normals(std::uint64_t first, int count, double* out) const;
+  /// The same (seed, stream, trial) for another purpose: a sibling family of draws.
+  RandomStream WithPurpose(RandomPurpose purpose) const {
+    return RandomStream(seed_, stream_, trial_, purpose);
+  }
 
  private:
   std::uint64_t seed_, stream_, trial_, purpose_;

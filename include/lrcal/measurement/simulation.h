@@ -4,6 +4,20 @@
 // index i·R + r of the noise stream (random.h); the measurand of a configuration is the mean of
 // its R readings (slide 'Measurement Noise'). A configuration whose true beam misses the plane
 // (laser_plane.h) has no reading: it is reported, never filled with a NaN.
+//
+// Beyond the paper, a real rig's disturbances (each off by default, each from its own family of
+// draws, so that turning one on leaves the others' numbers unchanged):
+//  - joint-encoder noise: reading r is taken at the true joint angles q_i + δq_r, δq_r ~ N(0,
+//    σ_q² I) per joint, while the data records q_i (identification treats q as exact:
+//    errors in variables). With draw_mean the mean of R readings is taken at q_i + δq̄,
+//    δq̄ ~ N(0, σ_q²/R·I): the same distribution to first order in δq (the curvature term is
+//    ~ L·σ_q², below 1e-8 m for σ_q ≤ 0.1 mrad);
+//  - plane form error: the plane at configuration i's hit point is displaced along its normal
+//    by ε_i ~ N(0, σ_form²), the same for all R readings there (a flatness deviation does not
+//    average out): the reading changes by −ε_i/(n·b);
+//  - outliers: each reading independently, with probability p, carries a gross error
+//    ~ N(0, σ_out²). With draw_mean the K ~ Binomial(R, p) gross errors of a mean add
+//    √K·σ_out·z/R — the same distribution.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,7 +42,14 @@ struct NoiseModel {
   /// the cost no longer grows with R. The Monte-Carlo trials use this; `lrcal simulate` writes
   /// every reading.
   bool draw_mean = false;
-  /// Throws InputError (where = `source`) unless σ is finite and ≥ 0 and R ≥ 1.
+  double encoder_sigma = 0;     ///< rad, each joint, each reading
+  double form_sigma = 0;        ///< m, flatness deviation at each configuration's hit point
+  double outlier_fraction = 0;  ///< probability that a reading carries a gross error
+  double outlier_sigma = 5e-3;  ///< m, standard deviation of a gross error
+  /// Encoder noise or form error: the readings need the kinematics, not only exact readings.
+  bool DisturbsGeometry() const { return encoder_sigma > 0 || form_sigma > 0; }
+  /// Throws InputError (where = `source`) unless σ is finite and ≥ 0, R ≥ 1, the disturbance
+  /// σs are finite and ≥ 0 and the outlier fraction is in [0, 1].
   void Validate(const std::string& source = "noise") const;
 };
 
@@ -46,10 +67,13 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
                      const std::vector<int>* noise_slots = nullptr);
 
 /// The noisy part of SimulateReadings, from exact readings already computed (e.g. once per
-/// Monte-Carlo cell when the truth and the design are fixed). Same results as SimulateReadings.
+/// Monte-Carlo cell when the truth and the design are fixed). Same results as SimulateReadings
+/// when the noise does not disturb the geometry (!noise.DisturbsGeometry()); `per_reading`
+/// (configs.size()·R values, if given) replaces exact_h for the raw readings.
 int AddNoise(const std::vector<double>& exact_h, const std::vector<BeamMiss>& misses,
              const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
              MeasurementSet* data, std::vector<double>* raw = nullptr,
-             const std::vector<int>* noise_slots = nullptr);
+             const std::vector<int>* noise_slots = nullptr,
+             const std::vector<double>* per_reading = nullptr);
 
 }  // namespace lrcal

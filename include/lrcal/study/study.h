@@ -41,6 +41,11 @@ struct CellSettings {
   // Noise.
   double sigma = 0;     ///< m, one reading
   int repetitions = 0;  ///< readings averaged per configuration
+  // A real rig's disturbances (simulation.h): off at 0.
+  double encoder_sigma = 0;     ///< rad, joint-encoder noise per joint and reading
+  double form_sigma = 0;        ///< m, plane flatness deviation per configuration
+  double outlier_fraction = 0;  ///< share of readings with a gross error
+  double outlier_sigma = 0;     ///< m, σ of a gross error
   // Candidate pool.
   int pool_size = 0;
   /// pool.file: the candidates from a CSV of configurations (q1..qN, rad), as written in the
