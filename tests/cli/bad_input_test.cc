@@ -522,8 +522,9 @@ const std::vector<BadInput>& Cases() {
        2,
        {"s.yaml:4", "noise.outlier_fraction", "[0, 1]"}},
       {"StudyLossWithoutNoise",
-       {{"s.yaml", "name: s\nseed: 1\ntrials: 2\nnoise: {sigma_mm: 0}\n"
-                   "identification: {loss: cauchy}\n"}},
+       {{"s.yaml",
+         "name: s\nseed: 1\ntrials: 2\nnoise: {sigma_mm: 0}\n"
+         "identification: {loss: cauchy}\n"}},
        "run s.yaml --out r",
        2,
        {"identification.loss", "noise.sigma_mm > 0"}},
