@@ -53,7 +53,10 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
     terms = PlaneTerms::Parse(vm["estimate-plane"].as<std::string>(), "--estimate-plane");
   std::vector<std::string> fixed;
   if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
-  return MakeParameterSet(robot, terms, fixed, "--fix");
+  RangerTerms ranger;
+  if (vm.count("estimate-ranger"))
+    ranger = RangerTerms::Parse(vm["estimate-ranger"].as<std::string>(), "--estimate-ranger");
+  return MakeParameterSet(robot, terms, fixed, "--fix", ranger);
 }
 
 Format ResolveFormat(const po::variables_map& vm) {

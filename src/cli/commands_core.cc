@@ -152,6 +152,8 @@ int KinematicsCommand(const std::vector<std::string>& args) {
                   "configurations CSV (q1..qN, rad)")(
       "model", po::value<std::string>()->default_value("nominal"), "nominal or true")(
       "jacobian", po::bool_switch(), "also print the identification Jacobian row")(
+      "estimate-ranger", po::value<std::string>()->default_value("none"),
+      "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
       "plane terms in the Jacobian: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters left out of the Jacobian, comma-separated");
@@ -254,6 +256,8 @@ int SimulateCommand(const std::vector<std::string>& args) {
   const ConfigurationSet configs =
       ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
   NoiseModel noise;
+  noise.ranger_offset = rig.ranger_offset;  // the robot file's true ranger errors
+  noise.ranger_scale = rig.ranger_scale;
   noise.sigma = vm["sigma-mm"].as<double>() * 1e-3;
   noise.repetitions = vm["repetitions"].as<int>();
   if (!(std::isfinite(noise.sigma) && noise.sigma >= 0))
@@ -300,6 +304,8 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   AddCommonOptions(o);
   o.add_options()("data", po::value<std::string>()->required(),
                   "measurement CSV (q1..qN, h in m; rows with equal q are averaged)")(
+      "estimate-ranger", po::value<std::string>()->default_value("none"),
+      "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
       "plane terms to estimate: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters to keep at nominal, comma-separated")(
@@ -348,6 +354,8 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identifiability options");
   AddCommonOptions(o);
   o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
+      "estimate-ranger", po::value<std::string>()->default_value("none"),
+      "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
       "plane terms in the set: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters to leave out, comma-separated")(

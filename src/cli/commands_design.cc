@@ -41,6 +41,8 @@ void AddDesignOptions(po::options_description& o) {
       "exchange: starts (backward design + random)")(
       "samples", po::value<int>()->default_value(1000), "sampled: random subsets tried")(
       "baseline", po::value<int>()->default_value(1000), "random designs for the baseline")(
+      "estimate-ranger", po::value<std::string>()->default_value("none"),
+      "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
       "fix", po::value<std::string>(), "parameters left out, comma-separated")(
       "out", po::value<std::string>(), "write the chosen configurations (CSV)");

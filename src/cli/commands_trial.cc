@@ -59,10 +59,10 @@ void PrintReplay(const TrialReplay& t) {
             << t.recomputed.iterations << " iterations, residual RMS "
             << Fixed(t.recomputed.residual_rms * 1e3, 6) << " mm, design sigma_min "
             << Fixed(t.recomputed.sigma_min, 6) << "\n";
-  Table e({"parameter", "unit", "estimate - truth"}, "Parameter errors (mm, mrad)");
+  Table e({"parameter", "unit", "estimate - truth"}, "Parameter errors (mm, mrad, ppm)");
   for (std::size_t k = 0; k < t.recomputed.errors.size() && k < t.parameter_names.size(); ++k)
-    e.AddRow({t.parameter_names[k], IsAngularName(t.parameter_names[k]) ? "mrad" : "mm",
-              Fixed(t.recomputed.errors[k] * 1e3, 6)});
+    e.AddRow({t.parameter_names[k], DisplayUnitOf(t.parameter_names[k]).unit,
+              Fixed(t.recomputed.errors[k] * DisplayUnitOf(t.parameter_names[k]).factor, 6)});
   std::cout << e.ToText();
   Table v({"metric", "x", "y", "z"}, "Validation errors of the identified model (mm, mrad)");
   for (int m = 0; m < 4; ++m)

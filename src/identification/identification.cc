@@ -640,7 +640,7 @@ void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet&
   s.initial_cost = cost_at(zero.data(), nullptr);
   s.final_cost = cost_at(e.data(), &s.residual_rms);
   s.delta = e;
-  s.nominal.resize(n);
+  s.nominal.setZero(n);  // plane chart u and ranger terms are 0 at nominal
   const ParameterSet& ps = model->parameters();
   for (int k = 0; k < ps.num_robot(); ++k)
     s.nominal[k] = model->robot().nominal_values()[ps.robot_values[k]];
@@ -734,11 +734,12 @@ std::string IdentificationSummary::BriefReport() const {
 std::string IdentificationSummary::ParameterTable() const {
   if (!IsSolutionUsable()) return "";
   Table t({"parameter", "unit", "nominal (SI)", "delta", "std", "std (given sigma)"},
-          "Identified parameters (delta and std in mrad / mm)");
+          "Identified parameters (delta and std in the unit shown: mrad, mm, ppm)");
   for (std::size_t k = 0; k < names.size(); ++k) {
-    t.AddRow({names[k], IsAngularName(names[k]) ? "mrad" : "mm", Fixed(nominal[k], 6),
-              Fixed(delta[k] * 1e3), Fixed(std_residual[k] * 1e3),
-              std_given.size() ? Fixed(std_given[k] * 1e3) : "—"});
+    const DisplayUnit u = DisplayUnitOf(names[k]);
+    t.AddRow({names[k], u.unit, Fixed(nominal[k], 6), Fixed(delta[k] * u.factor),
+              Fixed(std_residual[k] * u.factor),
+              std_given.size() ? Fixed(std_given[k] * u.factor) : "—"});
   }
   return t.ToText();
 }

@@ -106,7 +106,8 @@ Eigen::VectorXd ParseTrueErrors(const YAML::Node& root, const std::string& path,
   Eigen::VectorXd errors = Eigen::VectorXd::Zero(kValuesPerLink * links.size());
   const YAML::Node te = root["true_errors"];
   if (!te) return errors;
-  CheckKeys(te, {"angle_unit", "length_unit", "links"}, path, "true_errors");
+  CheckKeys(te, {"angle_unit", "length_unit", "links", "ranger_offset_mm", "ranger_scale_ppm"},
+            path, "true_errors");
   const double as = AngleScale(
       te["angle_unit"] ? String(te["angle_unit"], path, "true_errors.angle_unit") : "rad",
       Where(path, te["angle_unit"], "true_errors.angle_unit"));
@@ -164,6 +165,23 @@ RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
 
 }  // namespace
 
+// true_errors.ranger_offset_mm / ranger_scale_ppm: the true ranger's errors (SI out).
+void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFile* file) {
+  using namespace yaml;
+  const YAML::Node te = root["true_errors"];
+  if (!te) return;
+  if (te["ranger_offset_mm"])
+    file->ranger_offset =
+        Number(te["ranger_offset_mm"], path, "true_errors.ranger_offset_mm") * 1e-3;
+  if (te["ranger_scale_ppm"]) {
+    file->ranger_scale =
+        Number(te["ranger_scale_ppm"], path, "true_errors.ranger_scale_ppm") * 1e-6;
+    if (!(std::fabs(file->ranger_scale) < 0.5))
+      throw InputError(Where(path, te["ranger_scale_ppm"], "true_errors.ranger_scale_ppm"),
+                       "expected a scale error in ppm, below 500,000 in magnitude");
+  }
+}
+
 RobotFile LoadRobotFile(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);
   yaml::CheckKeys(root, {"name", "description", "links", "true_errors", "plane", "ranger"}, path,
@@ -173,6 +191,7 @@ RobotFile LoadRobotFile(const std::string& path) {
   RobotFile file{RobotModel(name, links, ParseTrueErrors(root, path, links), path),
                  ParsePlane(root, path), ParseRanger(root, path), path};
   file.robot.source = path;
+  ParseRangerErrors(root, path, &file);
   return file;
 }
 

@@ -242,16 +242,21 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
   const KernelArgs args{m_,         &point,        &model.parameters(), q_.data(),       cq_.data(),
                         sq_.data(), state_.data(), frames_.data(),      scratch_.data(), h,
                         J};
+  bool ok;
   switch (isa) {
 #if defined(__x86_64__)
     case Isa::kAvx512:
-      return KernelAvx512(args);
+      ok = KernelAvx512(args);
+      break;
     case Isa::kAvx2:
-      return KernelAvx2(args);
+      ok = KernelAvx2(args);
+      break;
 #endif
     default:
-      return KernelDefault(args);
+      ok = KernelDefault(args);
   }
+  model.ApplyRanger(point, m_, h, J);
+  return ok;
 }
 
 }  // namespace lrcal

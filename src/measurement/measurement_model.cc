@@ -10,6 +10,8 @@ void PrepareModelPoint(const RobotModel& robot, const double* v, const Plane& pl
                        ModelPoint* point) {
   PrepareChainPoint(robot, v, point);
   point->plane = plane;
+  point->ranger_offset = 0;
+  point->ranger_scale = 0;
 }
 
 MeasurementModel::MeasurementModel(const RobotModel& robot, const Plane& nominal_plane,
@@ -50,6 +52,28 @@ void MeasurementModel::Prepare(const double* e, ModelPoint* point) const {
   }
   if (parameters_.f_index >= 0) plane.offset += e[parameters_.f_index];
   PrepareModelPoint(*robot_, v, plane, point);
+  if (parameters_.ranger_offset_index >= 0)
+    point->ranger_offset = e[parameters_.ranger_offset_index];
+  if (parameters_.ranger_scale_index >= 0) point->ranger_scale = e[parameters_.ranger_scale_index];
+}
+
+void MeasurementModel::ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const {
+  const int io = parameters_.ranger_offset_index, is = parameters_.ranger_scale_index;
+  const double o = point.ranger_offset, s = point.ranger_scale;
+  if (io < 0 && is < 0 && o == 0 && s == 0) return;
+  if (J) {
+    for (int k = 0; k < num_parameters(); ++k) {
+      double* col = J + static_cast<std::size_t>(k) * m;
+      if (k == io) {
+        for (int i = 0; i < m; ++i) col[i] = 1.0;
+      } else if (k == is) {
+        for (int i = 0; i < m; ++i) col[i] = h[i];
+      } else if (s != 0) {
+        for (int i = 0; i < m; ++i) col[i] *= 1 + s;
+      }
+    }
+  }
+  for (int i = 0; i < m; ++i) h[i] = (1 + s) * h[i] + o;
 }
 
 double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i,
@@ -60,7 +84,10 @@ double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSe
   const Eigen::Vector3d b = pose.R_BT.col(2);
   double nb;
   *h = BeamReading(pose, point.plane, &nb);
-  if (!row) return nb;
+  if (!row) {
+    ApplyRanger(point, 1, h, nullptr);
+    return nb;
+  }
   const Eigen::Vector3d p_hit = pose.p_BT + (*h) * b;
   const double inv = -1.0 / nb;
   int col = 0;
@@ -92,6 +119,8 @@ double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSe
     if (parameters_.u_index[c] >= 0)
       row[parameters_.u_index[c]] = inv * p_hit.dot(point.dn_du.col(c));
   if (parameters_.f_index >= 0) row[parameters_.f_index] = inv;
+  // One configuration: a 1×n row is a column-major matrix with leading dimension 1.
+  ApplyRanger(point, 1, h, row);
   return nb;
 }
 

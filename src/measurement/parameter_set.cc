@@ -30,6 +30,33 @@ std::string PlaneTerms::ToString() const {
   return "none";
 }
 
+RangerTerms RangerTerms::Parse(const std::string& text, const std::string& source) {
+  RangerTerms t;
+  if (text == "none" || text.empty()) return t;
+  for (const std::string& s : SplitList(text)) {
+    if (s == "offset")
+      t.offset = true;
+    else if (s == "scale")
+      t.scale = true;
+    else
+      throw InputError(
+          source, "unknown ranger term '" + s + "'; expected none, offset, scale or offset,scale");
+  }
+  return t;
+}
+
+std::string RangerTerms::ToString() const {
+  if (offset && scale) return "offset,scale";
+  if (offset) return "offset";
+  if (scale) return "scale";
+  return "none";
+}
+
+DisplayUnit DisplayUnitOf(const std::string& name) {
+  if (name == "ranger_scale") return {"ppm", 1e6};
+  return IsAngularName(name) ? DisplayUnit{"mrad", 1e3} : DisplayUnit{"mm", 1e3};
+}
+
 ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
                                const std::vector<std::string>& names) {
   // Everything `in` already leaves out stays out.
@@ -40,7 +67,9 @@ ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
   if (in.plane.normal && in.u_index[0] < 0) fixed.push_back("plane_u1");
   if (in.plane.normal && in.u_index[1] < 0) fixed.push_back("plane_u2");
   if (in.plane.offset && in.f_index < 0) fixed.push_back("plane_f");
-  return MakeParameterSet(robot, in.plane, fixed);
+  if (in.ranger.offset && in.ranger_offset_index < 0) fixed.push_back("ranger_offset");
+  if (in.ranger.scale && in.ranger_scale_index < 0) fixed.push_back("ranger_scale");
+  return MakeParameterSet(robot, in.plane, fixed, "--fix", in.ranger);
 }
 
 bool IsAngularName(const std::string& name) {
@@ -63,6 +92,7 @@ struct FixedNames {
   std::vector<int> values;
   bool u[2] = {false, false};
   bool offset = false;
+  bool ranger_offset = false, ranger_scale = false;
 };
 
 FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& fixed,
@@ -76,6 +106,10 @@ FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& f
     }
     if (name == "plane_f") {
       out.offset = true;
+      continue;
+    }
+    if (name == "ranger_offset" || name == "ranger_scale") {
+      (name == "ranger_offset" ? out.ranger_offset : out.ranger_scale) = true;
       continue;
     }
     const int k = robot.FindValue(name);
@@ -93,7 +127,8 @@ FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& f
 }  // namespace
 
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
-                              const std::vector<std::string>& fixed, const std::string& source) {
+                              const std::vector<std::string>& fixed, const std::string& source,
+                              RangerTerms ranger) {
   const FixedNames f = ParseFixed(robot, fixed, source);
   ParameterSet set;
   set.plane = plane;
@@ -111,6 +146,15 @@ ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
   if (plane.offset && !f.offset) {
     set.f_index = set.size();
     set.names.push_back("plane_f");
+  }
+  set.ranger = ranger;
+  if (ranger.offset && !f.ranger_offset) {
+    set.ranger_offset_index = set.size();
+    set.names.push_back("ranger_offset");
+  }
+  if (ranger.scale && !f.ranger_scale) {
+    set.ranger_scale_index = set.size();
+    set.names.push_back("ranger_scale");
   }
   if (set.size() == 0)
     throw InputError(source,

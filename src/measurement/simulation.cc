@@ -35,6 +35,8 @@ void NoiseModel::Validate(const std::string& source) const {
   check(encoder_sigma, "encoder_sigma");
   check(form_sigma, "form_sigma");
   check(outlier_sigma, "outlier_sigma");
+  if (!std::isfinite(ranger_offset) || !(std::fabs(ranger_scale) < 0.5))
+    throw InputError(source, "the ranger's errors: expected a finite offset and |scale| < 0.5");
   if (!(outlier_fraction >= 0 && outlier_fraction <= 1))
     throw InputError(source, "outlier_fraction: expected a fraction in [0, 1], got " +
                                  std::to_string(outlier_fraction));
@@ -143,14 +145,16 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
       continue;
     }
     double mean;
+    const double ranger_scale = 1 + noise.ranger_scale;
     if (noise.draw_mean) {
-      mean = h[i] + sigma_mean * stream.Normal(slot);
+      mean = ranger_scale * h[i] + noise.ranger_offset + sigma_mean * stream.Normal(slot);
       if (outliers) mean += OutlierError(noise, outlier_stream, slot, 0);
     } else {
       stream.Normals(slot * R, R, z.data());
       double sum = 0;
       for (int r = 0; r < R; ++r) {
-        double reading = (per_reading ? (*per_reading)[i * R + r] : h[i]) + noise.sigma * z[r];
+        double reading = ranger_scale * (per_reading ? (*per_reading)[i * R + r] : h[i]) +
+                         noise.ranger_offset + noise.sigma * z[r];
         if (outliers) reading += OutlierError(noise, outlier_stream, slot, r);
         sum += reading;
         if (raw) raw->push_back(reading);

@@ -32,9 +32,7 @@ std::string MeanRange(const Distribution& d, double scale) {
 // A number of a CSV column that may be unavailable (too few trials): empty then.
 std::string CsvValue(double x, int digits = 6) { return std::isnan(x) ? "" : Fixed(x, digits); }
 
-std::string UnitOf(const std::string& parameter) {
-  return IsAngularName(parameter) ? "mrad" : "mm";
-}
+std::string UnitOf(const std::string& parameter) { return DisplayUnitOf(parameter).unit; }
 
 Json DistJson(const Distribution& d, double scale) {
   auto v = [&](double x) { return std::isnan(x) ? Json() : Json(x * scale); };
@@ -404,21 +402,20 @@ std::string ParameterSections(const std::vector<CellSummary>& cells, Table* csv,
             "Cell " + s.cell.label + " (" + std::to_string(s.ok) + " trials ok)");
     for (const auto& p : s.parameters) {
       const std::string unit = UnitOf(p.name);
-      t.AddRow({p.name, unit, Fixed(p.bias * 1e3) + " ± " + Fixed(p.bias_se * 1e3),
-                Fixed(p.std * 1e3) + " ± " + Fixed(p.std_se * 1e3), Fixed(p.predicted_std * 1e3),
-                Fixed(p.ratio, 3) + " ± " + Fixed(p.ratio_se, 3),
-                Fixed(p.predicted_std_truth * 1e3),
+      const double f = DisplayUnitOf(p.name).factor;
+      t.AddRow({p.name, unit, Fixed(p.bias * f) + " ± " + Fixed(p.bias_se * f),
+                Fixed(p.std * f) + " ± " + Fixed(p.std_se * f), Fixed(p.predicted_std * f),
+                Fixed(p.ratio, 3) + " ± " + Fixed(p.ratio_se, 3), Fixed(p.predicted_std_truth * f),
                 std::isnan(p.ratio_truth)
                     ? std::string("—")
                     : Fixed(p.ratio_truth, 3) + " ± " + Fixed(p.ratio_truth_se, 3)});
-      csv->AddRow({s.cell.id, s.cell.label, p.name, unit, Fixed(p.bias * 1e3, 6),
-                   Fixed(p.bias_se * 1e3, 6), Fixed(p.std * 1e3, 6),
-                   Fixed(p.predicted_std * 1e3, 6), Fixed(p.ratio, 6), CsvValue(p.std_se * 1e3),
-                   CsvValue(p.ratio_se), std::to_string(s.ok),
-                   CsvValue(p.predicted_std_truth * 1e3), CsvValue(p.ratio_truth),
-                   CsvValue(p.ratio_truth_se)});
-      tex->AddRow({s.cell.label, p.name, unit, Fixed(p.bias * 1e3), Fixed(p.bias_se * 1e3),
-                   Fixed(p.std * 1e3), Fixed(p.predicted_std * 1e3), Fixed(p.ratio, 3)});
+      csv->AddRow({s.cell.id, s.cell.label, p.name, unit, Fixed(p.bias * f, 6),
+                   Fixed(p.bias_se * f, 6), Fixed(p.std * f, 6), Fixed(p.predicted_std * f, 6),
+                   Fixed(p.ratio, 6), CsvValue(p.std_se * f), CsvValue(p.ratio_se),
+                   std::to_string(s.ok), CsvValue(p.predicted_std_truth * f),
+                   CsvValue(p.ratio_truth), CsvValue(p.ratio_truth_se)});
+      tex->AddRow({s.cell.label, p.name, unit, Fixed(p.bias * f), Fixed(p.bias_se * f),
+                   Fixed(p.std * f), Fixed(p.predicted_std * f), Fixed(p.ratio, 3)});
     }
     if (!s.cell.fixed_for_rank.empty()) {
       std::string f;

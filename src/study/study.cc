@@ -41,7 +41,7 @@ const Json& StudyDefaults() {
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
                        "max_iterations": 100, "on_rank_deficient": "fail",
-                       "loss": "none", "loss_scale": 1.345},
+                       "loss": "none", "loss_scale": 1.345, "estimate_ranger": "none"},
     "paper_case": 0
   })");
   return d;
@@ -344,6 +344,8 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
     throw InputError(where("identification.on_rank_deficient"),
                      "expected fail or fix, got '" + rank + "'");
   c->fix_dependent = rank == "fix";
+  c->ranger_terms = RangerTerms::Parse(Str(s, "identification.estimate_ranger", where),
+                                       where("identification.estimate_ranger"));
   c->identification.loss = ParseName(kRobustLossNames, Str(s, "identification.loss", where),
                                      where("identification.loss"), "loss");
   const double scale = Num(s, "identification.loss_scale", where);
@@ -687,6 +689,7 @@ Json CellIdentity(const Json& settings) {
   }
   if (id.contains("identification") && id["identification"].is_object()) {
     Json& ident = id["identification"];
+    if (ident.value("estimate_ranger", Json("none")) == "none") ident.erase("estimate_ranger");
     if (ident.value("loss", Json("none")) == "none") {
       ident.erase("loss");
       ident.erase("loss_scale");

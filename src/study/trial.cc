@@ -55,6 +55,8 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
   const ParameterSet& ps = c.model->parameters();
   truth.delta.setZero(ps.size());
   for (int k = 0; k < ps.num_robot(); ++k) truth.delta[k] = truth.errors[ps.robot_values[k]];
+  if (ps.ranger_offset_index >= 0) truth.delta[ps.ranger_offset_index] = c.ranger_offset;
+  if (ps.ranger_scale_index >= 0) truth.delta[ps.ranger_scale_index] = c.ranger_scale;
   return truth;
 }
 
@@ -102,6 +104,9 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   RobotFile file = LoadRobotFile(ResolveRobotPath(s.robot, study.folder()));
   c->robot = std::make_shared<RobotModel>(std::move(file.robot));
   c->ranger = file.ranger;
+  const double scale = s.truth_random ? 1.0 : s.truth_scale;
+  c->ranger_offset = file.ranger_offset * scale;
+  c->ranger_scale = file.ranger_scale * scale;
   if (!s.plane_from_robot) {
     c->plane = s.plane;
   } else if (file.plane) {
@@ -112,7 +117,8 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
 }
 
 void BuildParameterSet(const CellSettings& s, CellContext* c) {
-  ParameterSet ps = MakeParameterSet(*c->robot, s.plane_terms, s.fixed, "identification.fix");
+  ParameterSet ps =
+      MakeParameterSet(*c->robot, s.plane_terms, s.fixed, "identification.fix", s.ranger_terms);
   c->model = std::make_unique<MeasurementModel>(*c->robot, c->plane, ps);
   if (s.select_count < ps.size())
     throw InputError("selection.count", "selecting " + std::to_string(s.select_count) +
@@ -391,6 +397,8 @@ int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTrut
   noise.form_sigma = s.form_sigma;
   noise.outlier_fraction = s.outlier_fraction;
   noise.outlier_sigma = s.outlier_sigma;
+  noise.ranger_offset = c.ranger_offset;
+  noise.ranger_scale = c.ranger_scale;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
   if (s.truth_random || s.pool_redraw || noise.DisturbsGeometry())
     return SimulateReadings(*c.robot, truth.values, c.plane, c.ranger, design.configs, noise,
@@ -461,6 +469,9 @@ void FillDetails(const CellContext& c, const TrialTruth& truth, const Eigen::Vec
   ExactReadings(*c.robot, nominal, c.plane, c.ranger, configs, &h_nominal, &unused);
   ExactReadings(*c.robot, identified, c.model->PlaneAt(ws.e.data()), c.ranger, configs,
                 &h_identified, &unused);
+  ModelPoint point;  // the identified ranger terms, if any
+  c.model->Prepare(ws.e.data(), &point);
+  c.model->ApplyRanger(point, static_cast<int>(h_identified.size()), h_identified.data(), nullptr);
   details->distance_error_nominal.clear();
   details->distance_error_identified.clear();
   for (int i = 0; i < ws.data.size(); ++i) {

@@ -65,7 +65,10 @@ struct CellContext {
   std::uint64_t selection_seed = 0;
   std::shared_ptr<const RobotModel> robot;
   Plane plane;
-  RangerSpec ranger;                        ///< the robot file's ranger limits
+  RangerSpec ranger;  ///< the robot file's ranger limits
+  /// The true ranger's errors (robot file × truth.scale for a robot_file truth): it reads
+  /// (1 + ranger_scale)·h + ranger_offset (m).
+  double ranger_offset = 0, ranger_scale = 0;
   std::unique_ptr<MeasurementModel> model;  ///< the (possibly reduced) parameter set
   std::vector<std::string> fixed_for_rank;  ///< parameters fixed because of rank deficiency
   bool rank_deficient = false;              ///< and not fixed: every trial fails

@@ -119,6 +119,32 @@ TEST_F(CliTest, IdentifiabilityFindsThePapersHorizontalPlaneRemark) {
   EXPECT_TRUE(j["dependencies"].empty());
 }
 
+// --estimate-ranger offset,scale against one known plane: the analysis names the ranger offset
+// with d6 (both translate along the beam) and the scale with the arm's lengths (a uniform
+// scaling about the point where the plane meets the base z axis keeps every reading's ratio).
+TEST_F(CliTest, IdentifiabilityNamesTheRangerDependences) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 3 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("identifiability --configs " + Path("c.csv") +
+                    " --estimate-ranger offset,scale --format json",
+                &out),
+            0)
+      << out;
+  const Json j = Json::parse(out);
+  EXPECT_EQ(j["n_params"], 27);
+  EXPECT_EQ(j["rank"], 25);
+  ASSERT_EQ(j["dependencies"].size(), 2u);
+  const Json& offset = j["dependencies"][0];
+  ASSERT_EQ(offset.size(), 2u);
+  EXPECT_EQ(offset[0]["name"], "ranger_offset");
+  EXPECT_EQ(offset[1]["name"], "d6");
+  EXPECT_NEAR(offset[1]["coefficient"].get<double>(), 1.0, 1e-9);
+  EXPECT_EQ(j["dependencies"][1][0]["name"], "ranger_scale");
+  EXPECT_EQ(j["suggested_fixed"], Json::array({"ranger_offset", "ranger_scale"}));
+  EXPECT_NE(Run("identifiability --configs " + Path("c.csv") + " --estimate-ranger zero", &out), 0);
+  EXPECT_NE(out.find("--estimate-ranger: unknown ranger term 'zero'"), std::string::npos) << out;
+}
+
 TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   std::string out;
   ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;

@@ -305,6 +305,54 @@ TEST(Identification, RobustFitsConvergeOnCleanData) {
     EXPECT_NEAR(s.delta[k], robot.true_errors()[model.parameters().robot_values[k]], 1e-9);
 }
 
+// The ranger reads (1 + s)·h + o. Its offset is a translation along the beam, which d6 also is
+// on this arm (the beam runs along z5 at nominal); its scale is confounded with the arm's lengths
+// against one plane. The identifiability analysis finds both on its own; with d6 and a2 known
+// (their true errors zero here) noise-free readings give back o, s and every other parameter.
+TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
+  const RobotModel& robot = PaperRobot();
+  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 9);
+  for (const char* term : {"offset", "scale"}) {
+    MeasurementModel model(
+        robot, testing::PaperPlane(),
+        MakeParameterSet(robot, PlaneTerms{}, {}, "--fix", RangerTerms::Parse(term)));
+    const IdentifiabilityReport r = AnalyzeIdentifiability(model, configs);
+    EXPECT_EQ(r.rank, 25) << term;
+    ASSERT_EQ(r.suggested_fixed.size(), 1u) << term;
+    EXPECT_EQ(r.suggested_fixed[0], std::string("ranger_") + term);
+    const std::string text = r.ToString();
+    EXPECT_NE(text.find("d6"), std::string::npos) << text;
+    if (std::string(term) == "scale") EXPECT_NE(text.find("a2"), std::string::npos) << text;
+  }
+  Eigen::VectorXd truth = robot.true_values();
+  truth[robot.FindValue("d6")] = robot.nominal_values()[robot.FindValue("d6")];
+  truth[robot.FindValue("a2")] = robot.nominal_values()[robot.FindValue("a2")];
+  NoiseModel exact{0.0, 1, true};
+  exact.ranger_offset = 0.4e-3;
+  exact.ranger_scale = 250e-6;
+  MeasurementSet data;
+  SimulateReadings(robot, truth, testing::PaperPlane(), testing::PaperRig().ranger, configs, exact,
+                   RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+  MeasurementModel model(
+      robot, testing::PaperPlane(),
+      MakeParameterSet(robot, PlaneTerms{}, {"d6", "a2"}, "--fix", RangerTerms{true, true}));
+  for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
+                      IdentificationOptions::Solver::kCeres}) {
+    IdentificationOptions o;
+    o.solver = solver;
+    const IdentificationSummary s = Identify(model, data, o);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
+    const ParameterSet& ps = model.parameters();
+    for (int k = 0; k < ps.num_robot(); ++k)
+      EXPECT_NEAR(s.delta[k],
+                  truth[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]], 1e-9)
+          << ps.names[k];
+    EXPECT_NEAR(s.delta[ps.ranger_offset_index], 0.4e-3, 1e-9);
+    EXPECT_NEAR(s.delta[ps.ranger_scale_index], 250e-6, 1e-9);
+    EXPECT_NE(s.ParameterTable().find("ppm"), std::string::npos);
+  }
+}
+
 TEST(Identification, OptionsValidationNamesTheField) {
   IdentificationOptions o;
   o.max_iterations = 0;

@@ -46,6 +46,12 @@ TEST(BatchEvaluator, MatchesPerConfigurationEvaluationForEveryPlaneTerm) {
                            PlaneTerms{false, true}, PlaneTerms{true, true}}) {
     MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, terms));
     ExpectSame(model, configs);
+    for (RangerTerms ranger :
+         {RangerTerms{true, false}, RangerTerms{false, true}, RangerTerms{true, true}}) {
+      MeasurementModel with_ranger(robot, testing::PaperPlane(),
+                                   MakeParameterSet(robot, terms, {}, "--fix", ranger));
+      ExpectSame(with_ranger, configs);
+    }
   }
 }
 

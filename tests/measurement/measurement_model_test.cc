@@ -18,16 +18,17 @@ constexpr double kAutodiffTolerance = 1e-11;
 // Central differences with step 1e-6 have truncation error O(step²·h''') ≈ 1e-12 and rounding
 // error O(eps·h/step) ≈ 1e-10.
 constexpr double kFiniteDifferenceTolerance = 1e-8;
-constexpr int kMaxParams = 28;
+constexpr int kMaxParams = 30;
 using Jet = ceres::Jet<double, kMaxParams>;
 
 struct Case {
   PlaneTerms terms;
   std::vector<std::string> fixed;
+  RangerTerms ranger = {};
 };
 // Short, stable test names in ctest (not the struct's bytes).
 void PrintTo(const Case& c, std::ostream* os) {
-  *os << c.terms.ToString();
+  *os << c.terms.ToString() << " ranger " << c.ranger.ToString();
   for (const auto& f : c.fixed) *os << " -" << f;
 }
 
@@ -35,8 +36,9 @@ class JacobianTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(JacobianTest, AnalyticMatchesAutodiffAndCentralDifferences) {
   const RobotModel& robot = testing::PaperRobot();
-  MeasurementModel model(robot, testing::PaperPlane(),
-                         MakeParameterSet(robot, GetParam().terms, GetParam().fixed));
+  MeasurementModel model(
+      robot, testing::PaperPlane(),
+      MakeParameterSet(robot, GetParam().terms, GetParam().fixed, "--fix", GetParam().ranger));
   const int n = model.num_parameters();
   ASSERT_LE(n, kMaxParams);
   ConfigurationSet configs = testing::PaperHittingConfigurations(30, 3);
@@ -81,19 +83,23 @@ TEST_P(JacobianTest, AnalyticMatchesAutodiffAndCentralDifferences) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(PlaneTerms, JacobianTest,
-                         ::testing::Values(Case{PlaneTerms{false, false}, {}},
-                                           Case{PlaneTerms{true, false}, {}},
-                                           Case{PlaneTerms{false, true}, {}},
-                                           Case{PlaneTerms{true, true}, {}},
-                                           Case{PlaneTerms{true, true}, {"plane_u1", "d1"}}),
-                         [](const ::testing::TestParamInfo<Case>& info) {
-                           std::string name = info.param.terms.normal ? "Normal" : "";
-                           name += info.param.terms.offset ? "Offset" : "";
-                           if (name.empty()) name = "PlaneKnown";
-                           if (!info.param.fixed.empty()) name += "SomeFixed";
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    PlaneTerms, JacobianTest,
+    ::testing::Values(Case{PlaneTerms{false, false}, {}}, Case{PlaneTerms{true, false}, {}},
+                      Case{PlaneTerms{false, true}, {}}, Case{PlaneTerms{true, true}, {}},
+                      Case{PlaneTerms{true, true}, {"plane_u1", "d1"}},
+                      Case{PlaneTerms{false, false}, {}, RangerTerms{true, false}},
+                      Case{PlaneTerms{false, false}, {}, RangerTerms{false, true}},
+                      Case{PlaneTerms{true, true}, {}, RangerTerms{true, true}}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      std::string name = info.param.terms.normal ? "Normal" : "";
+      name += info.param.terms.offset ? "Offset" : "";
+      if (name.empty()) name = "PlaneKnown";
+      if (!info.param.fixed.empty()) name += "SomeFixed";
+      if (info.param.ranger.offset) name += "RangerOffset";
+      if (info.param.ranger.scale) name += "RangerScale";
+      return name;
+    });
 
 TEST(NormalChart, RegularAtThePapersPlaneAndEverywhere) {
   // The paper's plane has n_x = 0; the chart's Jacobian must still have full rank 2 there and

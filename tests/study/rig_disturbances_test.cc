@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "lrcal/io/robot_file.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
@@ -63,6 +64,43 @@ TEST(RigDisturbances, EncoderNoiseAndFormErrorCostAccuracy) {
   for (int k : {1, 2})
     EXPECT_GT(cells[k].first - 3 * cells[k].second, cells[0].first + 3 * cells[0].second)
         << "cell " << k << ": " << cells[k].first << " against " << cells[0].first;
+}
+
+// A ranger with a zero offset (robot file true_errors) and identification.estimate_ranger: the
+// offset is a translation along the beam like d6 (o and d6 both +t leave every reading as it
+// is), so with d6 fixed at nominal the estimated offset is o − 0.85 mm (d6's true error) and
+// otherwise unbiased. The file's scale error is read (and 0 here: unestimated, it would bias).
+TEST(RigDisturbances, RangerErrorsFromTheRobotFileAreEstimated) {
+  const std::string dir = testing::TempDir("rig_ranger");
+  std::string robot = testing::ReadFile(testing::SourcePath("studies/robots/paper.yaml"));
+  const std::string anchor = "  length_unit: mm\n";
+  robot.replace(robot.find(anchor), anchor.size(),
+                anchor + "  ranger_offset_mm: 0.3\n  ranger_scale_ppm: 0\n");
+  std::ofstream(dir + "/ranger.yaml") << robot;
+  std::ofstream(dir + "/s.yaml")
+      << "name: ranger\nseed: 3\ntrials: 300\nrobot: ranger.yaml\npool: {size: 80}\n"
+         "selection: {count: 60}\nvalidation: {size: 10}\n"
+         "identification: {estimate_ranger: offset, fix: [d6]}\n";
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
+  TrialStore store(dir + "/run/trials.sqlite");
+  const CellSummary s = SummarizeCell(store, store.Cells().at(0));
+  ASSERT_GT(s.ok, 290);
+  bool found = false;
+  for (const ParameterStats& p : s.parameters) {
+    if (p.name != "ranger_offset") continue;
+    found = true;
+    // Bias against the true offset: minus d6's error, within 4 standard errors.
+    EXPECT_NEAR(p.bias, -0.85e-3, 4 * p.bias_se) << p.bias << " ± " << p.bias_se;
+  }
+  EXPECT_TRUE(found);
+  const std::string csv = testing::ReadFile(dir + "/run/tables/parameters.csv");
+  EXPECT_NE(csv.find("ranger_offset,mm"), std::string::npos);
+  // The robot file's ranger errors, in SI.
+  robot.replace(robot.find("ranger_scale_ppm: 0"), 19, "ranger_scale_ppm: 150");
+  std::ofstream(dir + "/ranger2.yaml") << robot;
+  const RobotFile file = LoadRobotFile(dir + "/ranger2.yaml");
+  EXPECT_DOUBLE_EQ(file.ranger_offset, 0.3e-3);
+  EXPECT_DOUBLE_EQ(file.ranger_scale, 150e-6);
 }
 
 }  // namespace

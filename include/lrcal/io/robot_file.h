@@ -20,6 +20,10 @@ struct RobotFile {
   std::optional<Plane> plane;  ///< the plane of the file's measurement set-up, if it gives one
   RangerSpec ranger;           ///< the ranger's limits (defaults unless the file gives them)
   std::string path;            ///< where it was read from
+  /// The true ranger's errors (true_errors.ranger_offset_mm, ranger_scale_ppm): it reads
+  /// (1 + ranger_scale)·h + ranger_offset (m) for a true distance h. For simulation.
+  double ranger_offset = 0;
+  double ranger_scale = 0;
 };
 
 /// Reads a robot YAML file. Throws InputError naming the file, line and key on any problem.

@@ -37,9 +37,13 @@ namespace lrcal {
 struct ModelPoint : ChainPoint {
   Plane plane;
   Eigen::Matrix<double, 3, 2> dn_du = Eigen::Matrix<double, 3, 2>::Zero();
+  /// The ranger at this estimate: it reads (1 + ranger_scale)·h + ranger_offset (m) for a
+  /// geometric distance h. Zero unless the parameter set estimates them.
+  double ranger_offset = 0;
+  double ranger_scale = 0;
 };
 
-/// Prepares a ModelPoint from explicit link values (5N, SI) and a plane.
+/// Prepares a ModelPoint from explicit link values (5N, SI) and a plane (a perfect ranger).
 void PrepareModelPoint(const RobotModel& robot, const double* link_values, const Plane& plane,
                        ModelPoint* point);
 
@@ -61,7 +65,9 @@ class MeasurementModel {
 
   /// Reading h (m) for configuration i at `point`, and (if jacobian_row is not null) the
   /// num_parameters() entries of ∂h/∂e. Returns n·b (the cosine of the beam's incidence, signed)
-  /// so callers can classify the reading; h is finite unless n·b == 0.
+  /// so callers can classify the reading; h is finite unless n·b == 0. With ranger terms the
+  /// reading is r = (1 + s)·h_geo + o: the geometric columns are scaled by (1 + s),
+  /// ∂r/∂o = 1 and ∂r/∂s = h_geo.
   double Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i, double* h,
                   double* jacobian_row) const;
 
@@ -79,8 +85,16 @@ class MeasurementModel {
       n = chart_.Normal<T>(u[0] >= 0 ? e[u[0]] : T(0), u[1] >= 0 ? e[u[1]] : T(0));
     }
     if (parameters_.f_index >= 0) f += e[parameters_.f_index];
-    return LaserDistance<T>(pose.p_BT, pose.R_BT.col(2), n, f);
+    const T h = LaserDistance<T>(pose.p_BT, pose.R_BT.col(2), n, f);
+    const T o = parameters_.ranger_offset_index >= 0 ? e[parameters_.ranger_offset_index] : T(0);
+    const T s = parameters_.ranger_scale_index >= 0 ? e[parameters_.ranger_scale_index] : T(0);
+    return (T(1) + s) * h + o;
   }
+
+  /// Applies the ranger terms of `point` to geometric readings h[0..m) and, if J is not null,
+  /// to their Jacobian (column-major, leading dimension m): see Evaluate. A no-op for a
+  /// perfect ranger that is not estimated (the paper's model keeps its bits).
+  void ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const;
 
  private:
   const RobotModel* robot_;

@@ -2,9 +2,12 @@
 // optionally, the plane's normal (two chart coordinates, laser_plane.h) and offset f.
 //
 // The estimate vector e is laid out as
-//   [Δ(robot link values, robot file order) | u1, u2 (if the normal) | Δf (if the offset)]
-// in SI units (rad, m; u is dimensionless ≈ rad). Its names are the link value names
-// ("theta1", ...), then "plane_u1", "plane_u2", "plane_f".
+//   [Δ(robot link values, robot file order) | u1, u2 (if the normal) | Δf (if the offset)
+//    | ranger offset o | ranger scale s]
+// in SI units (rad, m; u and s are dimensionless, u ≈ rad). Its names are the link value names
+// ("theta1", ...), then "plane_u1", "plane_u2", "plane_f", "ranger_offset", "ranger_scale".
+// The ranger reads (1 + s)·h + o for a geometric distance h (measurement_model.h); nominally
+// o = s = 0.
 #pragma once
 
 #include <string>
@@ -23,6 +26,16 @@ struct PlaneTerms {
   std::string ToString() const;
 };
 
+/// Which ranger terms are estimated: the zero offset o (m) and the scale error s.
+struct RangerTerms {
+  bool offset = false;
+  bool scale = false;
+  /// Parses "none", "offset", "scale", "offset,scale". Throws InputError.
+  static RangerTerms Parse(const std::string& text,
+                           const std::string& source = "--estimate-ranger");
+  std::string ToString() const;
+};
+
 struct ParameterSet {
   std::vector<int> robot_values;  ///< indices into the robot's 5N link values
   PlaneTerms plane;
@@ -36,6 +49,10 @@ struct ParameterSet {
   /// Index of Δf in e, or -1 when the offset is not estimated.
   int f_index = -1;
   bool EstimatesNormal() const { return u_index[0] >= 0 || u_index[1] >= 0; }
+  RangerTerms ranger;
+  /// Indices in e of the ranger's offset o and scale s, or -1 when not estimated.
+  int ranger_offset_index = -1;
+  int ranger_scale_index = -1;
   /// True for the entries measured in rad (angles, chart coordinates); false for metres.
   bool IsAngular(int k) const;
   /// Index of a name, or -1.
@@ -46,14 +63,23 @@ struct ParameterSet {
 /// Throws InputError (where = `source`) for an unknown or non-parameter name in `fixed`.
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed = {},
-                              const std::string& source = "--fix");
+                              const std::string& source = "--fix", RangerTerms ranger = {});
 
 /// `in` without the parameters `names` (robot parameters or plane terms): what remains when
 /// an identifiability analysis says to fix them. Throws InputError for an unknown name.
 ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
                                const std::vector<std::string>& names);
 
-/// True for names of quantities in rad (theta*, alpha*, beta*, plane_u*); false for metres.
+/// True for names of quantities in rad (theta*, alpha*, beta*, plane_u*); false for metres
+/// (and for the dimensionless ranger_scale: see DisplayUnitOf).
 bool IsAngularName(const std::string& name);
+
+/// How a quantity is shown to users: "mrad" (×1e3 from rad), "mm" (×1e3 from m) or, for the
+/// ranger's scale error, "ppm" (×1e6).
+struct DisplayUnit {
+  const char* unit;
+  double factor;
+};
+DisplayUnit DisplayUnitOf(const std::string& name);
 
 }  // namespace lrcal

@@ -46,6 +46,10 @@ struct NoiseModel {
   double form_sigma = 0;        ///< m, flatness deviation at each configuration's hit point
   double outlier_fraction = 0;  ///< probability that a reading carries a gross error
   double outlier_sigma = 5e-3;  ///< m, standard deviation of a gross error
+  /// The true ranger's errors: it reads (1 + ranger_scale)·h + ranger_offset (m) for a true
+  /// geometric distance h, before the random errors above.
+  double ranger_offset = 0;
+  double ranger_scale = 0;
   /// Encoder noise or form error: the readings need the kinematics, not only exact readings.
   bool DisturbsGeometry() const { return encoder_sigma > 0 || form_sigma > 0; }
   /// Throws InputError (where = `source`) unless σ is finite and ≥ 0, R ≥ 1, the disturbance

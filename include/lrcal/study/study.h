@@ -72,6 +72,7 @@ struct CellSettings {
   std::string validation_file;
   // Identification.
   PlaneTerms plane_terms;
+  RangerTerms ranger_terms;  ///< identification.estimate_ranger
   std::vector<std::string> fixed;
   bool fix_dependent = false;  ///< on rank deficiency: fix the suggested parameters (else fail)
   IdentificationOptions identification;
