@@ -360,22 +360,31 @@ void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const doubl
   RobustWeights w, w_trial;
   Eigen::VectorXd step;
   Eigen::MatrixXd A_reweighted, J_weighted;
-  Eigen::Matrix<bool, Eigen::Dynamic, 1> settled_regions;
+  bool newton_failed = false, used_newton = false;
   double cost = Linearize(model, mean_h, *e, &r_, &J_);
   if (!std::isfinite(cost)) {
     result->termination = Termination::kBeamMissed;
     return;
   }
   cost = RobustCost(options, r_, &w);
+  bool reweighted_formed = false;
   const auto form = [&] {
     g_.noalias() = J_.transpose() * w.rho1.cwiseProduct(r_);
-    J_weighted = J_;
-    J_weighted.array().colwise() *= w.rho1.cwiseSqrt().array();
-    NormalMatrix(J_weighted, &A_reweighted);
-    scale_ = A_reweighted.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    scale_ = (J_.array().square().colwise() * w.rho1.array()).colwise().sum().transpose();
+    scale_ = scale_.cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
     J_weighted = J_;
     J_weighted.array().colwise() *= w.curvature.cwiseSqrt().array();
     NormalMatrix(J_weighted, &A_);
+    reweighted_formed = false;
+  };
+  const auto reweighted = [&]() -> const Eigen::MatrixXd& {  // formed when first needed
+    if (!reweighted_formed) {
+      J_weighted = J_;
+      J_weighted.array().colwise() *= w.rho1.cwiseSqrt().array();
+      NormalMatrix(J_weighted, &A_reweighted);
+      reweighted_formed = true;
+    }
+    return A_reweighted;
   };
   form();
   constexpr double kCostResolution = 1e-10;
@@ -385,17 +394,14 @@ void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const doubl
     ++result->iterations;
     rhs_ = scale_.cwiseProduct(g_);
     bool solved = false;
-    // The Newton model once the residuals' regions (curvature > 0 or not) have settled, and it
-    // is regular; until then the reweighted one, which always descends.
-    const bool settled = (w.curvature.array() > 0).matrix() == settled_regions;
-    for (const Eigen::MatrixXd* M : {settled ? &A_ : &A_reweighted, &A_reweighted}) {
-      As_.noalias() = scale_.asDiagonal() * (*M) * scale_.asDiagonal();
+    // The Newton model first; the reweighted one (which always descends) when the Newton model
+    // is singular (too few inliers) or its last step at this damping was rejected.
+    for (int attempt = newton_failed ? 1 : 0; attempt < 2 && !solved; ++attempt) {
+      used_newton = attempt == 0;
+      As_.noalias() =
+          scale_.asDiagonal() * (attempt == 0 ? A_ : reweighted()) * scale_.asDiagonal();
       As_.diagonal().array() += lambda;
-      if ((solved = CholeskySolve(As_, rhs_, &L_, &step, 1e-13))) break;
-    }
-    if (!solved) {
-      result->termination = Termination::kNumericalFailure;
-      break;
+      solved = CholeskySolve(As_, rhs_, &L_, &step, 1e-13);
     }
     step = scale_.cwiseProduct(step);
     e_trial_ = *e + step;
@@ -410,6 +416,23 @@ void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const doubl
     // Near the minimum the cost resolves only ~1e-12 relative: a step predicted to gain less
     // than that is at the minimum to rounding, whatever the evaluated cost says.
     const bool at_resolution = lambda == 0 && 0.5 * step.dot(g_) <= kCostResolution * cost;
+    if ((small_step || last_step || at_resolution) && lambda == 0) {
+      // The final step: checked on residuals alone, without a Jacobian.
+      double final_cost = Cost(model, mean_h, e_trial_);
+      if (std::isfinite(final_cost)) {
+        r_trial_ = sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, r_.size()) - h_);
+        final_cost = RobustCost(options, r_trial_, nullptr);
+      }
+      const bool accepted = std::isfinite(final_cost) && (final_cost <= cost || at_resolution);
+      if (accepted) {
+        e->swap(e_trial_);
+        cost = final_cost;
+      }
+      if (accepted || small_step) {  // else a predicted last step that failed: go on
+        result->termination = Termination::kConverged;
+        break;
+      }
+    }
     double trial_cost = Linearize(model, mean_h, e_trial_, &r_trial_, &J_trial_);
     if (std::isfinite(trial_cost)) trial_cost = RobustCost(options, r_trial_, &w_trial);
     if (std::isfinite(trial_cost) && trial_cost <= cost) {
@@ -417,8 +440,8 @@ void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const doubl
       e->swap(e_trial_);
       J_.swap(J_trial_);
       r_.swap(r_trial_);
-      settled_regions = (w.curvature.array() > 0).matrix();
       std::swap(w, w_trial);
+      newton_failed = false;
       cost = trial_cost;
       form();
       previous_step = step_norm;
@@ -427,10 +450,10 @@ void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const doubl
         result->termination = Termination::kConverged;
         break;
       }
-    } else if ((small_step || at_resolution) && lambda == 0) {  // at the minimum to rounding
-      result->termination = Termination::kConverged;
-      break;
+    } else if (used_newton) {
+      newton_failed = true;  // the same damping with the reweighted model next
     } else {
+      newton_failed = false;
       lambda = lambda == 0 ? 1e-6 : lambda * 10;
       if (lambda > 1e12) {
         result->termination = Termination::kNumericalFailure;
@@ -439,8 +462,6 @@ void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const doubl
     }
   }
   result->final_cost = cost;
-  // The least-squares normal matrix at the robust estimate (what the covariance reads).
-  if (std::isfinite(Linearize(model, mean_h, *e, &r_, &J_))) FormNormalEquations();
 }
 
 namespace {

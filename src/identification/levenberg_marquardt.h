@@ -42,17 +42,15 @@ class LevenbergMarquardt {
   };
   /// Solves for e (resized to model.num_parameters(), started at 0). `mean_h` and `weights`
   /// have configs.size() entries (weights = repetitions). `nominal`, if given, must be the model
-  /// at e = 0 on these configurations. On return `normal_matrix()` holds GᵀWG at the last
-  /// linearisation point (within one final step of e).
+  /// at e = 0 on these configurations.
   ///
   /// With a robust loss (options.loss) the least-squares estimate is then refined to the minimum
   /// of ½·Σ ρ(r_i²), r_i the weighted residual, ρ Ceres' HuberLoss / CauchyLoss of scale
   /// options.loss_scale: the same cost, started from the same point, as the Ceres path (tested to
-  /// agree to 1e-8). normal_matrix() is then the least-squares GᵀWG at the robust estimate.
+  /// agree to 1e-8).
   Result Solve(const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
                const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
                const Nominal* nominal = nullptr);
-  const Eigen::MatrixXd& normal_matrix() const { return A_; }
 
  private:
   Result SolveLeastSquares(const MeasurementModel& model, const ConfigurationSet& configs,
