@@ -32,7 +32,8 @@ const Json& StudyDefaults() {
   static const Json d = Json::parse(R"({
     "robot": "paper",
     "plane": "robot",
-    "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0},
+    "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0,
+              "ranger_offset_mm": "robot_file", "ranger_scale_ppm": "robot_file"},
     "noise": {"sigma_mm": 0.2, "repetitions": 10, "encoder_sigma_mrad": 0.0, "form_sigma_mm": 0.0,
               "outlier_fraction": 0.0, "outlier_sigma_mm": 5.0},
     "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
@@ -281,6 +282,20 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
   c->truth_scale = NonNegative(s, "truth.scale", where);
   c->truth_angle_sigma = NonNegative(s, "truth.angle_sigma_mrad", where) * 1e-3;
   c->truth_length_sigma = NonNegative(s, "truth.length_sigma_mm", where) * 1e-3;
+  for (const char* key : {"truth.ranger_offset_mm", "truth.ranger_scale_ppm"}) {
+    const Json& v = At(s, key);
+    if (v == "robot_file") continue;
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      throw InputError(where(key), "expected a number, or robot_file (the robot file's value)");
+    const double x = v.get<double>();
+    if (std::string(key) == "truth.ranger_offset_mm") {
+      c->ranger_offset = x * 1e-3;
+    } else {
+      if (!(std::fabs(x) < 5e5))
+        throw InputError(where(key), "expected a scale error in ppm, below 500,000 in magnitude");
+      c->ranger_scale = x * 1e-6;
+    }
+  }
   c->sigma = NonNegative(s, "noise.sigma_mm", where) * 1e-3;
   c->repetitions = Int(s, "noise.repetitions", where, 1, 1000000);
   c->encoder_sigma = NonNegative(s, "noise.encoder_sigma_mrad", where) * 1e-3;
@@ -678,6 +693,9 @@ Json CellIdentity(const Json& settings) {
   Json id = settings;
   // Keys added after studies were run are left out at their neutral values, so that the cells
   // (and run directories) of earlier studies keep their names.
+  if (id.contains("truth") && id["truth"].is_object())
+    for (const char* k : {"ranger_offset_mm", "ranger_scale_ppm"})
+      if (id["truth"].value(k, Json("robot_file")) == "robot_file") id["truth"].erase(k);
   if (id.contains("noise") && id["noise"].is_object()) {
     Json& noise = id["noise"];
     for (const char* k : {"encoder_sigma_mrad", "form_sigma_mm"})

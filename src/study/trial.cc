@@ -29,7 +29,11 @@ namespace {
 
 // Stream id of a draw family: a hash of the settings it depends on.
 std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> keys) {
-  const Json identity = CellIdentity(settings);
+  Json identity = CellIdentity(settings);
+  // The ranger's errors do not change which beams hit the plane: cells that differ only in
+  // them share their pools and validation sets.
+  if (identity.contains("truth") && identity["truth"].is_object())
+    for (const char* k : {"ranger_offset_mm", "ranger_scale_ppm"}) identity["truth"].erase(k);
   Json part;
   for (const char* k : keys) part[k] = identity[k];
   return Fnv1a(part.dump());
@@ -105,8 +109,8 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   c->robot = std::make_shared<RobotModel>(std::move(file.robot));
   c->ranger = file.ranger;
   const double scale = s.truth_random ? 1.0 : s.truth_scale;
-  c->ranger_offset = file.ranger_offset * scale;
-  c->ranger_scale = file.ranger_scale * scale;
+  c->ranger_offset = s.ranger_offset ? *s.ranger_offset : file.ranger_offset * scale;
+  c->ranger_scale = s.ranger_scale ? *s.ranger_scale : file.ranger_scale * scale;
   if (!s.plane_from_robot) {
     c->plane = s.plane;
   } else if (file.plane) {

@@ -5,11 +5,13 @@
 
 #include <fstream>
 
+#include "lrcal/core/error.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
+#include "study/trial_pipeline.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -101,6 +103,30 @@ TEST(RigDisturbances, RangerErrorsFromTheRobotFileAreEstimated) {
   const RobotFile file = LoadRobotFile(dir + "/ranger2.yaml");
   EXPECT_DOUBLE_EQ(file.ranger_offset, 0.3e-3);
   EXPECT_DOUBLE_EQ(file.ranger_scale, 150e-6);
+}
+
+// truth.ranger_offset_mm / ranger_scale_ppm override the robot file's ranger errors as sweep
+// values; cells that differ only in them share their pool, design and validation set (the errors
+// do not change which beams hit), so their numbers differ by the ranger alone.
+TEST(RigDisturbances, RangerTruthAsASweepAxisKeepsTheDesign) {
+  const std::string dir = testing::TempDir("rig_ranger_axis");
+  std::ofstream(dir + "/s.yaml") << "name: s\nseed: 2\ntrials: 2\npool: {size: 60}\n"
+                                    "selection: {count: 40}\nvalidation: {size: 10}\nsweep:\n"
+                                    "  axes:\n    - {key: truth.ranger_offset_mm, values: "
+                                    "[robot_file, 0.5]}\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  ASSERT_EQ(study.cells.size(), 2u);
+  const auto a = PrepareCell(study, study.cells[0]), b = PrepareCell(study, study.cells[1]);
+  EXPECT_EQ(a->ranger_offset, 0.0);
+  EXPECT_DOUBLE_EQ(b->ranger_offset, 0.5e-3);
+  ASSERT_EQ(a->design.configs.size(), b->design.configs.size());
+  for (int i = 0; i < a->design.configs.size(); ++i)
+    for (int j = 0; j < 6; ++j) EXPECT_EQ(a->design.configs.q(i)[j], b->design.configs.q(i)[j]);
+  for (int i = 0; i < a->validation.size(); ++i)
+    EXPECT_EQ(a->validation.q(i)[0], b->validation.q(i)[0]);
+  std::ofstream(dir + "/bad.yaml") << "name: s\nseed: 2\ntrials: 2\n"
+                                      "truth: {ranger_scale_ppm: lots}\n";
+  EXPECT_THROW(LoadStudy(dir + "/bad.yaml"), InputError);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct CellSettings {
   double truth_scale = 0;
   double truth_angle_sigma = 0;   ///< rad, per-parameter σ of drawn angle errors
   double truth_length_sigma = 0;  ///< m, per-parameter σ of drawn length errors
+  /// truth.ranger_offset_mm / ranger_scale_ppm: the true ranger's errors (m, dimensionless);
+  /// empty: the robot file's (× truth.scale for a robot_file truth).
+  std::optional<double> ranger_offset, ranger_scale;
   // Noise.
   double sigma = 0;     ///< m, one reading
   int repetitions = 0;  ///< readings averaged per configuration
