@@ -353,7 +353,9 @@ double LevenbergMarquardt::RobustCost(const IdentificationOptions& options,
 // scales); the damping is scaled by the reweighted matrix Jᵀ·diag(ρ')·J, which stays regular
 // when few residuals are inliers. The gradient is exact, so the minimum is Ceres' (which
 // reweights). Stops on a small step or cost decrease like the least-squares loop; a step that
-// cannot lower the cost when undamped means the minimum is reached to rounding.
+// cannot lower the cost when undamped means the minimum is reached to rounding. Kept whole like
+// the least-squares loop: its two models, damping and stopping rules share their state.
+// NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
 void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const double* mean_h,
                                       const IdentificationOptions& options, Eigen::VectorXd* e,
                                       Result* result) {

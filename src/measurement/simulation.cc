@@ -97,6 +97,24 @@ double OutlierError(const NoiseModel& noise, const RandomStream& outliers, std::
                : 0.0;
 }
 
+// The mean of R single readings of a configuration (each appended to `raw`): the exact
+// reading (per reading when `per_reading`, else `exact`) through the ranger, noise, outliers.
+double MeanOfReadings(const NoiseModel& noise, const RandomStream& stream,
+                      const RandomStream& outliers, std::uint64_t slot, const double* per_reading,
+                      double exact, std::vector<double>* z, std::vector<double>* raw) {
+  const int R = noise.repetitions;
+  stream.Normals(slot * R, R, z->data());
+  double sum = 0;
+  for (int r = 0; r < R; ++r) {
+    double reading = (1 + noise.ranger_scale) * (per_reading ? per_reading[r] : exact) +
+                     noise.ranger_offset + noise.sigma * (*z)[r];
+    if (noise.outlier_fraction > 0) reading += OutlierError(noise, outliers, slot, r);
+    sum += reading;
+    if (raw) raw->push_back(reading);
+  }
+  return sum / R;
+}
+
 }  // namespace
 
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
@@ -145,21 +163,13 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
       continue;
     }
     double mean;
-    const double ranger_scale = 1 + noise.ranger_scale;
     if (noise.draw_mean) {
-      mean = ranger_scale * h[i] + noise.ranger_offset + sigma_mean * stream.Normal(slot);
+      mean =
+          (1 + noise.ranger_scale) * h[i] + noise.ranger_offset + sigma_mean * stream.Normal(slot);
       if (outliers) mean += OutlierError(noise, outlier_stream, slot, 0);
     } else {
-      stream.Normals(slot * R, R, z.data());
-      double sum = 0;
-      for (int r = 0; r < R; ++r) {
-        double reading = ranger_scale * (per_reading ? (*per_reading)[i * R + r] : h[i]) +
-                         noise.ranger_offset + noise.sigma * z[r];
-        if (outliers) reading += OutlierError(noise, outlier_stream, slot, r);
-        sum += reading;
-        if (raw) raw->push_back(reading);
-      }
-      mean = sum / R;
+      mean = MeanOfReadings(noise, stream, outlier_stream, slot,
+                            per_reading ? &(*per_reading)[i * R] : nullptr, h[i], &z, raw);
     }
     data->configs.AddFrom(configs, i);
     data->mean_h.push_back(mean);

@@ -689,38 +689,51 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
 
 }  // namespace
 
+namespace {
+
+// Keys added after studies were run: left out of a cell's identity at their neutral value
+// (with the companion key that matters only when they are not), so that the cells and run
+// directories of earlier studies keep their names.
+struct NeutralKey {
+  const char* section;
+  const char* key;
+  Json neutral;
+  const char* companion;
+};
+
+void DropNeutralKeys(Json* id) {
+  static const NeutralKey kNeutral[] = {{"truth", "ranger_offset_mm", "robot_file", nullptr},
+                                        {"truth", "ranger_scale_ppm", "robot_file", nullptr},
+                                        {"noise", "encoder_sigma_mrad", 0, nullptr},
+                                        {"noise", "form_sigma_mm", 0, nullptr},
+                                        {"noise", "outlier_fraction", 0, "outlier_sigma_mm"},
+                                        {"identification", "estimate_ranger", "none", nullptr},
+                                        {"identification", "loss", "none", "loss_scale"}};
+  for (const NeutralKey& k : kNeutral) {
+    const auto section = id->find(k.section);
+    if (section == id->end() || !section->is_object()) continue;
+    const auto value = section->find(k.key);
+    if (value == section->end() || *value != k.neutral) continue;
+    section->erase(k.key);
+    if (k.companion) section->erase(k.companion);
+  }
+}
+
+bool IsRobotFilePath(const std::string& robot) {
+  return robot.find('/') != std::string::npos ||
+         (robot.size() > 5 && robot.substr(robot.size() - 5) == ".yaml");
+}
+
+}  // namespace
+
 Json CellIdentity(const Json& settings) {
   Json id = settings;
-  // Keys added after studies were run are left out at their neutral values, so that the cells
-  // (and run directories) of earlier studies keep their names.
-  if (id.contains("truth") && id["truth"].is_object())
-    for (const char* k : {"ranger_offset_mm", "ranger_scale_ppm"})
-      if (id["truth"].value(k, Json("robot_file")) == "robot_file") id["truth"].erase(k);
-  if (id.contains("noise") && id["noise"].is_object()) {
-    Json& noise = id["noise"];
-    for (const char* k : {"encoder_sigma_mrad", "form_sigma_mm"})
-      if (noise.contains(k) && noise[k] == 0) noise.erase(k);
-    if (noise.value("outlier_fraction", Json(0)) == 0) {
-      noise.erase("outlier_fraction");
-      noise.erase("outlier_sigma_mm");
-    }
-  }
-  if (id.contains("identification") && id["identification"].is_object()) {
-    Json& ident = id["identification"];
-    if (ident.value("estimate_ranger", Json("none")) == "none") ident.erase("estimate_ranger");
-    if (ident.value("loss", Json("none")) == "none") {
-      ident.erase("loss");
-      ident.erase("loss_scale");
-    }
-  }
+  DropNeutralKeys(&id);
   for (const char* section : {"pool", "validation"})
     if (id.contains(section) && id[section].is_object()) id[section].erase("file");
-  if (id.contains("robot") && id["robot"].is_string()) {
-    const std::string robot = id["robot"].get<std::string>();
-    const bool is_path = robot.find('/') != std::string::npos ||
-                         (robot.size() > 5 && robot.substr(robot.size() - 5) == ".yaml");
-    if (is_path) id["robot"] = "file";
-  }
+  if (id.contains("robot") && id["robot"].is_string() &&
+      IsRobotFilePath(id["robot"].get<std::string>()))
+    id["robot"] = "file";
   return id;
 }
 
