@@ -65,7 +65,22 @@ Json IdentificationJson(const IdentificationSummary& s) {
   j["usable"] = s.IsSolutionUsable();
   j["message"] = s.message;
   j["residual_rms"] = s.residual_rms;
-  j["sigma_hat"] = s.sigma_hat;
+  const auto number = [](double x) { return std::isnan(x) ? Json() : Json(x); };
+  j["sigma_hat"] = number(s.sigma_hat);
+  if (s.IsSolutionUsable()) {
+    Json fit = {{"dof", s.fit.dof}, {"standardized_residuals", s.fit.standardized}};
+    Json suspects = Json::array();
+    for (int i : s.fit.suspects) suspects.push_back(i + 1);
+    fit["suspects"] = suspects;  // 1-based configurations
+    if (s.fit.sigma_given) {
+      fit["chi2"] = s.fit.chi2;
+      fit["p_value"] = number(s.fit.p_value);
+      fit["consistent"] = s.fit.consistent;
+    } else {
+      fit["chi2"] = fit["p_value"] = fit["consistent"] = nullptr;  // no σ given: no test
+    }
+    j["fit"] = fit;
+  }
   j["n_configurations"] = s.num_configurations;
   j["solver"] = s.solver;
   j["loss"] = s.loss;
@@ -80,7 +95,11 @@ void PrintIdentification(const IdentificationSummary& s) {
     if (!s.identifiability.full_rank()) std::cout << s.identifiability.ToString();
     return;
   }
-  std::cout << s.ParameterTable();
+  std::cout << "sigma_hat per reading: "
+            << (std::isnan(s.sigma_hat) ? std::string("undefined")
+                                        : Fixed(s.sigma_hat * 1e3, 4) + " mm")
+            << "\n"
+            << s.fit.Explain() << s.ParameterTable();
   if (!s.fixed.empty()) {
     std::cout << "fixed at nominal because of rank deficiency:";
     for (const auto& f : s.fixed) std::cout << " " << f;
@@ -330,6 +349,8 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
   const IdentificationOptions options = ResolveIdentificationOptions(vm);
   const IdentificationSummary s = Identify(model, data, options);
+  if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
+    throw InputError(vm["data"].as<std::string>(), s.message);
 
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << IdentificationJson(s).dump(2) << "\n";
@@ -346,6 +367,11 @@ int IdentifyCommand(const std::vector<std::string>& args) {
           return l;
         }() << ") or pass --auto-fix\n";
     return 3;
+  }
+  if (s.IsSolutionUsable() && !s.fit.consistent) {
+    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
+              << " < 0.001); see the fit line above\n";
+    return 4;
   }
   return s.IsSolutionUsable() ? 0 : 1;
 }

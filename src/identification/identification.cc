@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
+#include <boost/math/special_functions/gamma.hpp>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -637,6 +638,33 @@ const MeasurementModel* CheckIdentifiable(const MeasurementModel& model_in,
   return nullptr;
 }
 
+// The χ² test against the stated σ and the standardised residuals (FitCheck).
+void CheckFit(const MeasurementModel& model, const MeasurementSet& data, const Eigen::VectorXd& e,
+              const IdentificationOptions& options, IdentificationSummary* s) {
+  FitCheck& fit = s->fit;
+  const int m = data.size(), n = model.num_parameters();
+  fit.dof = m - n;
+  fit.sigma_given = options.sigma > 0;
+  if (fit.sigma_given) {
+    fit.chi2 = 2 * s->final_cost / (options.sigma * options.sigma);
+    if (fit.dof > 0)
+      fit.p_value = boost::math::gamma_q(0.5 * fit.dof, 0.5 * fit.chi2);  // χ² upper tail
+    fit.consistent = !(fit.p_value < 1e-3);
+  }
+  const double scale = fit.sigma_given ? options.sigma : s->sigma_hat;
+  if (!(scale > 0)) return;
+  ModelPoint point;
+  model.Prepare(e.data(), &point);
+  for (int i = 0; i < m; ++i) {
+    double h;
+    model.Evaluate(point, data.configs, i, &h, nullptr);
+    const double z =
+        std::sqrt(static_cast<double>(data.repetitions[i])) * (data.mean_h[i] - h) / scale;
+    fit.standardized.push_back(z);
+    if (std::fabs(z) > 4) fit.suspects.push_back(i);
+  }
+}
+
 // Costs, residuals and covariance at the estimate e (same formulas for both solvers).
 void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet& data,
                         const std::vector<double>& weights, const Eigen::VectorXd& e,
@@ -677,7 +705,8 @@ void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet&
       G.transpose() *
       Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(weights.data(), m)).asDiagonal() * G;
   const Eigen::MatrixXd Ainv = ParameterCovariance(A, 1.0);
-  s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : 0.0;
+  s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : std::nan("");
+  CheckFit(*model, data, e, options, &s);
   s.covariance_residual = s.sigma_hat * s.sigma_hat * Ainv;
   s.std_residual = s.covariance_residual.diagonal().cwiseSqrt();
   if (options.sigma > 0) {
@@ -711,18 +740,21 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
     return s;
   }
 
+  // Too few configurations is its own diagnosis, before any talk of dependences (which every
+  // parameter beyond the m-th would otherwise be listed as).
+  if (data.size() < model_in.num_parameters()) {
+    s.names = model_in.parameters().names;
+    s.message = std::to_string(model_in.num_parameters()) +
+                " parameters need at least as many configurations (distinct joint "
+                "configurations with a reading); " +
+                std::to_string(data.size()) + " given";
+    return s;
+  }
   std::unique_ptr<MeasurementModel> reduced;
   const MeasurementModel* model = CheckIdentifiable(model_in, data, options, &reduced, &s);
   if (!model) return s;
 
-  const int n = model->num_parameters();
-  const int m = data.size();
   s.names = model->parameters().names;
-  if (m < n) {
-    s.message = "fewer configurations (" + std::to_string(m) + ") than parameters (" +
-                std::to_string(n) + ")";
-    return s;
-  }
   std::vector<double> weights(data.repetitions.begin(), data.repetitions.end());
   Eigen::VectorXd e;
   LevenbergMarquardt lm;
@@ -745,6 +777,34 @@ Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double
   return sigma * sigma * normal_matrix.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
 }
 
+std::string FitCheck::Explain() const {
+  std::ostringstream out;
+  if (sigma_given) {
+    out << "fit: chi2 = " << chi2 << " on " << dof << " degrees of freedom";
+    if (dof <= 0) {
+      out << " (as many configurations as parameters: no test)";
+    } else if (consistent) {
+      out << ", p = " << p_value << ": consistent with the stated noise";
+    } else {
+      out << ", p = " << p_value << ": INCONSISTENT with the stated noise: the residuals are "
+          << std::sqrt(chi2 / dof)
+          << " times what sigma predicts. Likely causes: sigma too small for these readings; an "
+             "error the model does not have (readings on a second plane, the ranger's offset or "
+             "scale, noisy joint encoders, a fixed parameter that is not at its nominal value); "
+             "wrong units (readings in mm, joint angles in degrees); outlying readings";
+      if (!suspects.empty()) out << " (see the suspects below)";
+    }
+    out << "\n";
+  }
+  if (!suspects.empty()) {
+    out << "suspect readings (|residual| > 4 " << (sigma_given ? "sigma" : "sigma_hat")
+        << "), configuration (1-based) and standardised residual:";
+    for (int i : suspects) out << " " << i + 1 << " (" << standardized[i] << ")";
+    out << "\n";
+  }
+  return out.str();
+}
+
 std::string IdentificationSummary::BriefReport() const {
   std::ostringstream out;
   out << "lrcal identification (" << solver << ", " << loss << "): " << TerminationName(termination)
@@ -761,10 +821,15 @@ std::string IdentificationSummary::ParameterTable() const {
   for (std::size_t k = 0; k < names.size(); ++k) {
     const DisplayUnit u = DisplayUnitOf(names[k]);
     t.AddRow({names[k], u.unit, Fixed(nominal[k], 6), Fixed(delta[k] * u.factor),
-              Fixed(std_residual[k] * u.factor),
+              std::isnan(std_residual[k]) ? "undefined" : Fixed(std_residual[k] * u.factor),
               std_given.size() ? Fixed(std_given[k] * u.factor) : "—"});
   }
-  return t.ToText();
+  std::string text = t.ToText();
+  if (std::isnan(sigma_hat))
+    text +=
+        "std: undefined (as many configurations as parameters: no residual to estimate the "
+        "noise from; give --sigma-mm for the given-sigma column)\n";
+  return text;
 }
 
 std::string IdentificationSummary::FullReport() const {
@@ -776,7 +841,10 @@ std::string IdentificationSummary::FullReport() const {
     out << "\n";
   }
   if (IsSolutionUsable()) {
-    out << "sigma_hat per reading: " << sigma_hat * 1e3 << " mm\n" << ParameterTable();
+    out << "sigma_hat per reading: "
+        << (std::isnan(sigma_hat) ? std::string("undefined") : Fixed(sigma_hat * 1e3, 4) + " mm")
+        << "\n"
+        << fit.Explain() << ParameterTable();
   } else if (!identifiability.full_rank()) {
     out << identifiability.ToString();
   }

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "lrcal/kinematics/robot_model.h"
 #include "test_util.h"
@@ -158,6 +159,51 @@ TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
       0)
       << out;
   EXPECT_EQ(Json::parse(out)["fixed_for_rank"].size(), 1u);
+}
+
+// identify with --sigma-mm: a consistent fit passes; a stated σ of a fifth of the real one is
+// exit 4 with the verdict in words; too few configurations are exit 2 naming the file.
+TEST_F(CliTest, IdentifyChecksTheFitAgainstTheStatedNoise) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0);
+  ASSERT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.2 --format json", &out), 0)
+      << out;
+  const Json fit = Json::parse(out)["fit"];
+  EXPECT_EQ(fit["dof"], 35);
+  EXPECT_TRUE(fit["consistent"].get<bool>());
+  EXPECT_GT(fit["p_value"].get<double>(), 1e-3);
+  EXPECT_EQ(fit["standardized_residuals"].size(), 60u);
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.04", &out), 4);
+  EXPECT_NE(out.find("INCONSISTENT with the stated noise"), std::string::npos) << out;
+  EXPECT_NE(out.find("wrong units"), std::string::npos) << out;
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.04 --format json", &out), 4);
+  EXPECT_FALSE(Json::parse(out.substr(0, out.rfind('}') + 1))["fit"]["consistent"].get<bool>());
+  // Without σ: no test, σ̂ and the standardised residuals.
+  ASSERT_EQ(Run("identify --data " + Path("m.csv") + " --format json", &out), 0) << out;
+  EXPECT_TRUE(Json::parse(out)["fit"]["chi2"].is_null());
+  // Ten configurations for 25 parameters.
+  std::string ten;
+  {
+    std::ifstream in(Path("m.csv"));
+    std::string line;
+    std::getline(in, line);
+    ten = line + "\n";  // the header as simulate writes it
+    std::set<std::string> seen;
+    while (std::getline(in, line) && seen.size() < 10) {
+      std::size_t end = 0;
+      for (int c = 0; c < 6; ++c) end = line.find(',', end) + 1;
+      seen.insert(line.substr(0, end));  // the joint values q1..q6
+      ten += line + "\n";
+    }
+  }
+  Write("few.csv", ten);
+  EXPECT_EQ(Run("identify --data " + Path("few.csv"), &out), 2);
+  EXPECT_NE(out.find("few.csv"), std::string::npos) << out;
+  EXPECT_NE(out.find("25 parameters need at least as many configurations"), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("10 given"), std::string::npos) << out;
+  EXPECT_EQ(out.find("dependence"), std::string::npos) << out;
 }
 
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {

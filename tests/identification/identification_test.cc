@@ -322,7 +322,9 @@ TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
     EXPECT_EQ(r.suggested_fixed[0], std::string("ranger_") + term);
     const std::string text = r.ToString();
     EXPECT_NE(text.find("d6"), std::string::npos) << text;
-    if (std::string(term) == "scale") EXPECT_NE(text.find("a2"), std::string::npos) << text;
+    if (std::string(term) == "scale") {
+      EXPECT_NE(text.find("a2"), std::string::npos) << text;
+    }
   }
   Eigen::VectorXd truth = robot.true_values();
   truth[robot.FindValue("d6")] = robot.nominal_values()[robot.FindValue("d6")];
@@ -351,6 +353,94 @@ TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
     EXPECT_NEAR(s.delta[ps.ranger_scale_index], 250e-6, 1e-9);
     EXPECT_NE(s.ParameterTable().find("ppm"), std::string::npos);
   }
+}
+
+// The χ² fit test: the statistic is Σ R_i·r_i²/σ², its p-value the closed-form upper tail for an
+// even number of degrees of freedom, Q(k, x) = e^(−x)·Σ_{j<k} x^j/j! with k = dof/2, x = χ²/2;
+// over 200 seeds with the true σ the fit is flagged about as often as the level says (0.1 %)
+// and the p-values are uniform; with a third of the true σ stated it is flagged every time.
+TEST(Identification, FitCheckAgainstTheStatedNoise) {
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  // 62 configurations whose nominal beam hits, 61 of which the true beam does: dof 36 (even).
+  const ConfigurationSet configs = testing::PaperHittingConfigurations(62, 14);
+  int flagged = 0, flagged_inflated = 0;
+  double p_sum = 0;
+  const int seeds = 200;
+  for (int seed = 0; seed < seeds; ++seed) {
+    MeasurementSet data;
+    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                     configs, NoiseModel{0.2e-3, 10, true},
+                     RandomStream(seed, 0, 0, RandomPurpose::kNoise), &data);
+    IdentificationOptions o;
+    o.sigma = 0.2e-3;
+    const IdentificationSummary s = Identify(model, data, o);
+    ASSERT_TRUE(s.IsSolutionUsable());
+    ASSERT_EQ(s.fit.dof, 36);
+    if (seed == 0) {
+      ModelPoint point;
+      model.Prepare(s.delta.data(), &point);
+      double chi2 = 0;
+      for (int i = 0; i < data.size(); ++i) {
+        double h;
+        model.Evaluate(point, data.configs, i, &h, nullptr);
+        chi2 += data.repetitions[i] * std::pow(data.mean_h[i] - h, 2) / (o.sigma * o.sigma);
+      }
+      EXPECT_NEAR(s.fit.chi2, chi2, 1e-9 * chi2);
+      double term = std::exp(-chi2 / 2), q = 0;
+      for (int j = 0; j < 18; ++j) {
+        q += term;
+        term *= (chi2 / 2) / (j + 1);
+      }
+      EXPECT_NEAR(s.fit.p_value, q, 1e-12);
+    }
+    flagged += !s.fit.consistent;
+    p_sum += s.fit.p_value;
+    o.sigma = 0.2e-3 / 3;  // a third of the true noise stated: P(missed) ~ 1e-7
+    const IdentificationSummary bad = Identify(model, data, o);
+    flagged_inflated += !bad.fit.consistent;
+    if (seed == 0) {
+      EXPECT_NE(bad.fit.Explain().find("INCONSISTENT"), std::string::npos);
+    }
+  }
+  EXPECT_LE(flagged, 2);                  // expected 0.2 of 200
+  EXPECT_NEAR(p_sum / seeds, 0.5, 0.07);  // uniform p-values: SE of the mean 0.02
+  EXPECT_EQ(flagged_inflated, seeds);
+}
+
+// One reading 3 mm off stands out as a suspect; with as many configurations as parameters the
+// residual-based std is undefined (NaN), never 0; with fewer the diagnosis says so.
+TEST(Identification, SuspectsAndTooFewConfigurations) {
+  const RobotModel& robot = PaperRobot();
+  MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  MeasurementSet data;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   testing::PaperHittingConfigurations(60, 15), NoiseModel{0.2e-3, 10, true},
+                   RandomStream(4, 0, 0, RandomPurpose::kNoise), &data);
+  data.mean_h[17] += 3e-3;
+  IdentificationOptions o;
+  const IdentificationSummary s = Identify(model, data, o);
+  ASSERT_TRUE(s.IsSolutionUsable());
+  EXPECT_EQ(s.fit.suspects, std::vector<int>{17});
+  EXPECT_NE(s.fit.Explain().find("18 ("), std::string::npos) << s.fit.Explain();
+  MeasurementSet exact;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   testing::PaperHittingConfigurations(25, 15), NoiseModel{0.2e-3, 10, true},
+                   RandomStream(4, 0, 0, RandomPurpose::kNoise), &exact);
+  const IdentificationSummary square = Identify(model, exact, o);
+  ASSERT_TRUE(square.IsSolutionUsable()) << square.FullReport();
+  EXPECT_TRUE(std::isnan(square.sigma_hat));
+  EXPECT_TRUE(std::isnan(square.std_residual[0]));
+  EXPECT_NE(square.ParameterTable().find("undefined"), std::string::npos);
+  MeasurementSet few;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   testing::PaperHittingConfigurations(10, 15), NoiseModel{0.2e-3, 10, true},
+                   RandomStream(4, 0, 0, RandomPurpose::kNoise), &few);
+  const IdentificationSummary too_few = Identify(model, few, o);
+  EXPECT_EQ(too_few.termination, Termination::kInvalidInput);
+  EXPECT_NE(too_few.message.find("25 parameters need at least"), std::string::npos);
+  EXPECT_NE(too_few.message.find("10 given"), std::string::npos);
+  EXPECT_TRUE(too_few.identifiability.dependencies.empty());
 }
 
 TEST(Identification, OptionsValidationNamesTheField) {

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,26 @@ inline constexpr EnumName<Termination> kTerminationNames[] = {
     {Termination::kInvalidInput, "invalid_input"}};
 inline const char* TerminationName(Termination t) { return NameOf(kTerminationNames, t); }
 
+/// How well the estimate fits the readings: the χ² test against a stated noise, and the
+/// configurations whose residuals stand out.
+struct FitCheck {
+  /// The reading noise σ was given (IdentificationOptions::sigma): chi2, p_value, consistent
+  /// test against it. Otherwise residuals are standardised by σ̂ and there is no test.
+  bool sigma_given = false;
+  /// χ² = Σ R_i·(h̄_i − h_i)²/σ² (the mean of R readings has variance σ²/R); NaN without σ.
+  double chi2 = std::numeric_limits<double>::quiet_NaN();
+  int dof = 0;  ///< configurations − parameters
+  /// P(χ²_dof ≥ chi2): below 0.001 the fit is inconsistent with σ. NaN without σ or dof.
+  double p_value = std::numeric_limits<double>::quiet_NaN();
+  bool consistent = true;  ///< p_value ≥ 0.001 (true when there is no test)
+  /// √R_i·(h̄_i − h_i)/s per configuration, s = σ if given, else σ̂ (empty when neither is).
+  std::vector<double> standardized;
+  /// Configurations (0-based, data order) with |standardized| > 4: readings to check.
+  std::vector<int> suspects;
+  /// The verdict in words, with the likely causes when the fit is inconsistent.
+  std::string Explain() const;
+};
+
 struct IdentificationSummary {
   std::vector<std::string> names;  ///< estimated quantities (parameter_set.h)
   Eigen::VectorXd nominal;   ///< their nominal values (link values; 0 for u; f0 for plane_f), SI
@@ -92,10 +113,13 @@ struct IdentificationSummary {
   Eigen::MatrixXd covariance_residual;  ///< σ̂²·(GᵀWG)⁻¹, σ̂² = Σ r²/(m − n)
   Eigen::MatrixXd covariance_given;     ///< σ²·(GᵀWG)⁻¹ with the given per-reading σ
   Eigen::MatrixXd correlation;          ///< from covariance_residual
-  double sigma_hat = 0;                 ///< m, residual-based per-reading σ estimate
-  double initial_cost = 0;              ///< ½Σr² at the nominal model (m²)
-  double final_cost = 0;                ///< ½Σr² at the estimate (m²)
-  double residual_rms = 0;              ///< m, RMS of h̄_i − h(e, q_i) over configurations
+  /// m, residual-based per-reading σ estimate; NaN when there are no more configurations than
+  /// parameters (no residual degrees of freedom: the residual-based covariance is undefined)
+  double sigma_hat = 0;
+  FitCheck fit;
+  double initial_cost = 0;  ///< ½Σr² at the nominal model (m²)
+  double final_cost = 0;    ///< ½Σr² at the estimate (m²)
+  double residual_rms = 0;  ///< m, RMS of h̄_i − h(e, q_i) over configurations
   int iterations = 0;
   int num_configurations = 0;
   Termination termination = Termination::kInvalidInput;
