@@ -1,14 +1,18 @@
 // The calibration-core subcommands: kinematics, sample, simulate, identify, identifiability,
 // paper.
 #include <cmath>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 
 #include "cli_common.h"
+#include "lrcal/build_info.h"
+#include "lrcal/core/hash.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/paper/paper_case.h"
 
@@ -318,6 +322,40 @@ int SimulateCommand(const std::vector<std::string>& args) {
   return 0;
 }
 
+// identify --write-robot: the calibrated model (the parameter set Identify solved for, reduced
+// if it fixed parameters for rank deficiency) as a robot file with its record.
+void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
+                          const RobotFile& rig, const MeasurementModel& model,
+                          const IdentificationSummary& s, const IdentificationOptions& options) {
+  const MeasurementModel solved(model.robot(), model.nominal_plane(),
+                                WithoutParameters(model.robot(), model.parameters(), s.fixed));
+  CalibrationRecord r;
+  r.data_file = data_file;
+  std::ifstream in(data_file, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  r.data_fnv1a = HashHex(bytes.str());
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  r.date = date;
+  r.lrcal = std::string(LRCAL_VERSION) + " (" + LRCAL_GIT_COMMIT + ")";
+  const bool given = options.sigma > 0;
+  r.sigma = given ? options.sigma : s.sigma_hat;
+  r.sigma_source = given ? "given (--sigma-mm)" : "residual (sigma_hat)";
+  r.parameters = s.names;
+  r.estimate = s.estimate;
+  if (given)
+    r.covariance = s.covariance_given;
+  else if (!std::isnan(s.sigma_hat))
+    r.covariance = s.covariance_residual;
+  WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
+                           solved.PlaneAt(s.delta.data()), r);
+  std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
+}
+
 int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddCommonOptions(o);
@@ -337,7 +375,10 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "robust loss scale (mm) on each configuration's residual sqrt(R)*(mean h - h); "
       "e.g. 1.345 sigma for Huber, 2.385 sigma for Cauchy (95 % efficiency)")(
       "sigma-mm", po::value<double>()->default_value(0.0),
-      "known noise of one reading (mm) for the given-sigma covariance");
+      "known noise of one reading (mm) for the given-sigma covariance")(
+      "write-robot", po::value<std::string>(),
+      "write the calibrated model as a robot file (estimates as nominal values, with their "
+      "covariance and the data's provenance); every command takes it as --robot");
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -368,6 +409,9 @@ int IdentifyCommand(const std::vector<std::string>& args) {
         }() << ") or pass --auto-fix\n";
     return 3;
   }
+  if (vm.count("write-robot") && s.IsSolutionUsable())
+    WriteCalibratedRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig,
+                         model, s, options);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
               << " < 0.001); see the fit line above\n";

@@ -1,11 +1,13 @@
 #include "lrcal/io/robot_file.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "io/yaml_util.h"
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/core/json.h"
 #include "lrcal/core/strings.h"
 
 namespace lrcal {
@@ -184,8 +186,12 @@ void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFil
 
 RobotFile LoadRobotFile(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);
-  yaml::CheckKeys(root, {"name", "description", "links", "true_errors", "plane", "ranger"}, path,
-                  "");
+  yaml::CheckKeys(root,
+                  {"name", "description", "links", "true_errors", "plane", "ranger", "calibration"},
+                  path, "");
+  if (root["calibration"] && !root["calibration"].IsMap())
+    throw InputError(yaml::Where(path, root["calibration"], "calibration"),
+                     "expected a mapping (the record lrcal identify --write-robot writes)");
   const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
   const std::vector<Link> links = ParseLinks(root, path);
   RobotFile file{RobotModel(name, links, ParseTrueErrors(root, path, links), path),
@@ -193,6 +199,79 @@ RobotFile LoadRobotFile(const std::string& path) {
   file.robot.source = path;
   ParseRangerErrors(root, path, &file);
   return file;
+}
+
+namespace {
+
+std::string Num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+std::string Quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string LinkLine(const Link& link, const double* values) {
+  std::string line = "  - {";
+  if (link.joint == JointType::kPrismatic) line += "joint: prismatic, ";
+  for (int v = 0; v < kValuesPerLink; ++v)
+    line += std::string(LinkValueName(v)) + ": " + Num(values[v]) + ", ";
+  line += "parameters: [";
+  bool first = true;
+  for (int v = 0; v < kValuesPerLink; ++v)
+    if (link.is_parameter[v]) {
+      line += std::string(first ? "" : ", ") + LinkValueName(v);
+      first = false;
+    }
+  return line + "], q_min: " + Num(link.q_min) + ", q_max: " + Num(link.q_max) + "}\n";
+}
+
+std::string RecordText(const CalibrationRecord& r) {
+  std::string t = "calibration:\n";
+  t += "  data: " + Quoted(r.data_file) + "\n  data_fnv1a: " + Quoted(r.data_fnv1a) +
+       "\n  date: " + Quoted(r.date) + "\n  lrcal: " + Quoted(r.lrcal) + "\n";
+  t += "  sigma: " + Num(r.sigma) + "  # m, one reading; " + r.sigma_source + "\n";
+  t += "  parameters: [";
+  for (std::size_t k = 0; k < r.parameters.size(); ++k) t += (k ? ", " : "") + r.parameters[k];
+  t += "]\n  estimate: [";  // SI
+  for (Eigen::Index k = 0; k < r.estimate.size(); ++k) t += (k ? ", " : "") + Num(r.estimate[k]);
+  t += "]\n  covariance:";
+  if (r.covariance.size() == 0) return t + " null  # undefined: no residual degrees of freedom\n";
+  t += "  # SI, in the order of parameters\n";
+  for (Eigen::Index i = 0; i < r.covariance.rows(); ++i) {
+    t += "    - [";
+    for (Eigen::Index j = 0; j < r.covariance.cols(); ++j)
+      t += (j ? ", " : "") + Num(r.covariance(i, j));
+    t += "]\n";
+  }
+  return t;
+}
+
+}  // namespace
+
+void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
+                              const Eigen::VectorXd& link_values, const Plane& plane,
+                              const CalibrationRecord& record) {
+  const RobotModel& robot = rig.robot;
+  std::string t = "# A calibrated robot: written by lrcal identify --write-robot from " +
+                  record.data_file + ".\n# Nominal values are the estimates (SI: rad, m); the " +
+                  "record below says from what.\nname: " + Quoted(robot.name() + " (calibrated)") +
+                  "\nlinks:\n";
+  for (int i = 0; i < robot.num_links(); ++i)
+    t += LinkLine(robot.links()[i], link_values.data() + kValuesPerLink * i);
+  t += "plane: {normal: [" + Num(plane.normal.x()) + ", " + Num(plane.normal.y()) + ", " +
+       Num(plane.normal.z()) + "], offset: " + Num(plane.offset) + "}\n";
+  t += "ranger: {min_range: " + Num(rig.ranger.min_range) +
+       ", max_range: " + Num(rig.ranger.max_range) +
+       ", max_incidence_deg: " + Num(rig.ranger.max_incidence * 180.0 / M_PI) + "}\n";
+  WriteFileAtomically(path, t + RecordText(record));
 }
 
 }  // namespace lrcal

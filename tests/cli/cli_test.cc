@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "test_util.h"
 
@@ -204,6 +205,47 @@ TEST_F(CliTest, IdentifyChecksTheFitAgainstTheStatedNoise) {
       << out;
   EXPECT_NE(out.find("10 given"), std::string::npos) << out;
   EXPECT_EQ(out.find("dependence"), std::string::npos) << out;
+}
+
+// identify --write-robot: the calibrated model as a robot file whose nominal values are the
+// estimates to the last bit, with the record; every command takes it, and identifying again from
+// it on the same readings finds nothing left to correct.
+TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 6 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0);
+  ASSERT_EQ(Run("identify --data " + Path("m.csv") +
+                    " --sigma-mm 0.2 --estimate-plane offset --auto-fix " +
+                    "--format json --write-robot " + Path("cal.yaml"),
+                &out),
+            0)
+      << out;
+  const Json j = Json::parse(out.substr(0, out.rfind('}') + 1));
+  const RobotFile cal = LoadRobotFile(Path("cal.yaml"));
+  for (const Json& p : j["parameters"]) {
+    const std::string name = p["name"];
+    if (name == "plane_f") {
+      EXPECT_EQ(cal.plane->offset, p["estimate"].get<double>());
+      continue;
+    }
+    const int k = cal.robot.FindValue(name);
+    ASSERT_GE(k, 0) << name;
+    EXPECT_EQ(cal.robot.nominal_values()[k], p["estimate"].get<double>()) << name;
+    EXPECT_EQ(cal.robot.true_errors()[k], 0.0);
+  }
+  const std::string text = testing::ReadFile(Path("cal.yaml"));
+  EXPECT_NE(text.find("data_fnv1a"), std::string::npos);
+  EXPECT_NE(text.find("sigma: 0.00020000000000000001  # m, one reading; given"), std::string::npos)
+      << text;
+  ASSERT_EQ(Run("kinematics --robot " + Path("cal.yaml") + " --configs " + Path("c.csv"), &out), 0)
+      << out;
+  ASSERT_EQ(Run("identify --robot " + Path("cal.yaml") + " --data " + Path("m.csv") +
+                    " --estimate-plane offset --auto-fix --format json",
+                &out),
+            0)
+      << out;
+  for (const Json& p : Json::parse(out)["parameters"])
+    EXPECT_NEAR(p["delta"].get<double>(), 0.0, 1e-9) << p["name"];
 }
 
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {

@@ -6,8 +6,10 @@
 // into the two.
 #pragma once
 
+#include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/plane.h"
@@ -27,7 +29,30 @@ struct RobotFile {
 };
 
 /// Reads a robot YAML file. Throws InputError naming the file, line and key on any problem.
+/// A `calibration:` mapping (written by WriteCalibratedRobotFile) is a record for people and is
+/// not read into the model.
 RobotFile LoadRobotFile(const std::string& path);
+
+/// Where a calibrated model came from, written into its robot file's `calibration:` section.
+struct CalibrationRecord {
+  std::string data_file;                ///< the measurement CSV, as given
+  std::string data_fnv1a;               ///< FNV-1a of its bytes
+  std::string date;                     ///< UTC, ISO 8601
+  std::string lrcal;                    ///< lrcal's version
+  double sigma = 0;                     ///< m, σ of one reading the covariance assumes
+  std::string sigma_source;             ///< "given" (--sigma-mm) or "residual" (σ̂)
+  std::vector<std::string> parameters;  ///< the estimated quantities
+  Eigen::VectorXd estimate;             ///< their values, SI
+  Eigen::MatrixXd covariance;           ///< their covariance, SI (empty if undefined)
+};
+
+/// Writes a robot file for the calibrated model: `rig`'s links with `link_values` (5N, SI) as
+/// their nominal values and no true errors, `plane` as its plane, `rig`'s ranger limits, and the
+/// record. Numbers are written with 17 significant digits, so reading the file back gives the
+/// same doubles. Written atomically (a temporary file renamed); throws StorageError.
+void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
+                              const Eigen::VectorXd& link_values, const Plane& plane,
+                              const CalibrationRecord& record);
 
 /// Resolves a robot argument: a path to a YAML file, or a short name of a shipped robot
 /// ("paper" → studies/robots/paper.yaml in the working directory or in lrcal's data folder,
