@@ -11,6 +11,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/parameter_set.h"
 
@@ -71,5 +72,11 @@ int StatusCommand(const std::vector<std::string>& args);
 int MergeCommand(const std::vector<std::string>& args);
 int AggregateCommand(const std::vector<std::string>& args);
 int TrialCommand(const std::vector<std::string>& args);
+int AccuracyCommand(const std::vector<std::string>& args);
+/// Predicted accuracy at poses (identification/pose_accuracy.h) as JSON {poses: [{q,
+/// position_std, orientation_std, position_radius_95}], rms_position, p95_position_radius_95,
+/// worst (1-based)} and as a text table.
+Json PoseAccuracyJson(const std::vector<PoseAccuracy>& poses, const ConfigurationSet& configs);
+std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses);
 
 }  // namespace lrcal::cli

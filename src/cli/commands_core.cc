@@ -356,6 +356,23 @@ void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
 }
 
+// identify --predict-at: the fit's covariance (given σ, else residual-based) at the poses.
+void PredictAt(const std::string& file, const MeasurementModel& model,
+               const IdentificationSummary& s, const IdentificationOptions& options, Json* json,
+               std::string* text) {
+  const ConfigurationSet poses = ReadConfigurations(file, model.robot().num_links());
+  const Eigen::MatrixXd& C = options.sigma > 0 ? s.covariance_given : s.covariance_residual;
+  if (!C.allFinite())
+    throw InputError("--predict-at",
+                     "the covariance is undefined (as many configurations as parameters); "
+                     "give --sigma-mm");
+  const MeasurementModel solved(model.robot(), model.nominal_plane(),
+                                WithoutParameters(model.robot(), model.parameters(), s.fixed));
+  const std::vector<PoseAccuracy> predicted = PredictPoseAccuracy(solved, s.delta.data(), C, poses);
+  *json = PoseAccuracyJson(predicted, poses);
+  *text = PoseAccuracyText(predicted);
+}
+
 int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddCommonOptions(o);
@@ -376,6 +393,9 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "e.g. 1.345 sigma for Huber, 2.385 sigma for Cauchy (95 % efficiency)")(
       "sigma-mm", po::value<double>()->default_value(0.0),
       "known noise of one reading (mm) for the given-sigma covariance")(
+      "predict-at", po::value<std::string>(),
+      "poses (a configurations CSV) to predict the calibrated arm's accuracy at, from the "
+      "estimate's covariance (given sigma if --sigma-mm, else residual-based)")(
       "write-robot", po::value<std::string>(),
       "write the calibrated model as a robot file (estimates as nominal values, with their "
       "covariance and the data's provenance); every command takes it as --robot");
@@ -393,10 +413,17 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
     throw InputError(vm["data"].as<std::string>(), s.message);
 
+  Json accuracy;
+  std::string accuracy_text;
+  if (vm.count("predict-at") && s.IsSolutionUsable())
+    PredictAt(vm["predict-at"].as<std::string>(), model, s, options, &accuracy, &accuracy_text);
   if (ResolveFormat(vm) == Format::kJson) {
-    std::cout << IdentificationJson(s).dump(2) << "\n";
+    Json j = IdentificationJson(s);
+    if (!accuracy.is_null()) j["accuracy"] = accuracy;
+    std::cout << j.dump(2) << "\n";
   } else {
     PrintIdentification(s);
+    std::cout << accuracy_text;
   }
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "

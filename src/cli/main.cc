@@ -38,6 +38,8 @@ const std::vector<Command>& Commands() {
        IdentifyCommand},
       {"identifiability", "rank, singular values and dependencies of a parameter set",
        IdentifiabilityCommand},
+      {"accuracy", "predicted pose accuracy of a calibrated robot file at given poses",
+       AccuracyCommand},
   };
   return commands;
 }

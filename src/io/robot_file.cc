@@ -167,6 +167,42 @@ RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
 
 }  // namespace
 
+// calibration: the record of identify --write-robot (parameters, estimate, covariance, sigma).
+CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path) {
+  using namespace yaml;
+  CheckKeys(
+      c, {"data", "data_fnv1a", "date", "lrcal", "sigma", "parameters", "estimate", "covariance"},
+      path, "calibration");
+  CalibrationRecord r;
+  if (c["data"]) r.data_file = String(c["data"], path, "calibration.data");
+  if (c["sigma"]) r.sigma = Number(c["sigma"], path, "calibration.sigma");
+  if (c["parameters"]) r.parameters = StringList(c["parameters"], path, "calibration.parameters");
+  const std::vector<double> estimate = c["estimate"]
+                                           ? NumberList(c["estimate"], path, "calibration.estimate")
+                                           : std::vector<double>{};
+  r.estimate = Eigen::Map<const Eigen::VectorXd>(estimate.data(), estimate.size());
+  const std::size_t n = r.parameters.size();
+  if (estimate.size() != n)
+    throw InputError(Where(path, c, "calibration.estimate"),
+                     "expected one value per name in calibration.parameters");
+  const YAML::Node cov = c["covariance"];
+  if (cov && !cov.IsNull()) {
+    if (!cov.IsSequence() || cov.size() != n)
+      throw InputError(Where(path, cov, "calibration.covariance"),
+                       "expected " + std::to_string(n) + " rows of " + std::to_string(n));
+    r.covariance.resize(n, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::vector<double> row =
+          NumberList(cov[i], path, "calibration.covariance[" + std::to_string(i) + "]");
+      if (row.size() != n)
+        throw InputError(Where(path, cov[i], "calibration.covariance[" + std::to_string(i) + "]"),
+                         "expected " + std::to_string(n) + " numbers");
+      for (std::size_t k = 0; k < n; ++k) r.covariance(i, k) = row[k];
+    }
+  }
+  return r;
+}
+
 // true_errors.ranger_offset_mm / ranger_scale_ppm: the true ranger's errors (SI out).
 void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFile* file) {
   using namespace yaml;
@@ -194,10 +230,14 @@ RobotFile LoadRobotFile(const std::string& path) {
                      "expected a mapping (the record lrcal identify --write-robot writes)");
   const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
   const std::vector<Link> links = ParseLinks(root, path);
-  RobotFile file{RobotModel(name, links, ParseTrueErrors(root, path, links), path),
-                 ParsePlane(root, path), ParseRanger(root, path), path};
+  RobotFile file;
+  file.robot = RobotModel(name, links, ParseTrueErrors(root, path, links), path);
+  file.plane = ParsePlane(root, path);
+  file.ranger = ParseRanger(root, path);
+  file.path = path;
   file.robot.source = path;
   ParseRangerErrors(root, path, &file);
+  if (root["calibration"]) file.calibration = ParseCalibration(root["calibration"], path);
   return file;
 }
 

@@ -248,6 +248,42 @@ TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
     EXPECT_NEAR(p["delta"].get<double>(), 0.0, 1e-9) << p["name"];
 }
 
+// identify --predict-at and lrcal accuracy on the written robot file give the same predicted
+// accuracy at the same poses; a robot file without a record is exit 2 saying how to get one.
+TEST_F(CliTest, AccuracyAtPosesFromTheFitAndFromTheCalibratedFile) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 8 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("sample --count 4 --seed 9 --out " + Path("poses.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0);
+  ASSERT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.2 --predict-at " +
+                    Path("poses.csv") + " --write-robot " + Path("cal.yaml") + " --format json",
+                &out),
+            0)
+      << out;
+  const Json fit = Json::parse(out.substr(0, out.rfind('}') + 1))["accuracy"];
+  ASSERT_EQ(fit["poses"].size(), 4u);
+  ASSERT_EQ(Run("accuracy --robot " + Path("cal.yaml") + " --configs " + Path("poses.csv") +
+                    " --format json",
+                &out),
+            0)
+      << out;
+  const Json file = Json::parse(out);
+  for (int j = 0; j < 4; ++j)
+    for (const char* key : {"position_std", "orientation_std"})
+      for (int a = 0; a < 3; ++a) {
+        const double x = fit["poses"][j][key][a], y = file["poses"][j][key][a];
+        EXPECT_NEAR(x, y, 1e-6 * x) << key << " pose " << j;
+      }
+  EXPECT_NEAR(fit["rms_position"].get<double>(), file["rms_position"].get<double>(),
+              1e-6 * file["rms_position"].get<double>());
+  EXPECT_GT(file["poses"][0]["position_radius_95"].get<double>(), 0);
+  ASSERT_EQ(Run("accuracy --robot " + Path("cal.yaml") + " --configs " + Path("poses.csv"), &out),
+            0);
+  EXPECT_NE(out.find("Predicted accuracy of the calibrated arm"), std::string::npos) << out;
+  EXPECT_EQ(Run("accuracy --robot paper --configs " + Path("poses.csv"), &out), 2);
+  EXPECT_NE(out.find("--write-robot"), std::string::npos) << out;
+}
+
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
   std::string out;
   ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E "

@@ -16,23 +16,6 @@
 
 namespace lrcal {
 
-/// What a robot file holds.
-struct RobotFile {
-  RobotModel robot;
-  std::optional<Plane> plane;  ///< the plane of the file's measurement set-up, if it gives one
-  RangerSpec ranger;           ///< the ranger's limits (defaults unless the file gives them)
-  std::string path;            ///< where it was read from
-  /// The true ranger's errors (true_errors.ranger_offset_mm, ranger_scale_ppm): it reads
-  /// (1 + ranger_scale)·h + ranger_offset (m) for a true distance h. For simulation.
-  double ranger_offset = 0;
-  double ranger_scale = 0;
-};
-
-/// Reads a robot YAML file. Throws InputError naming the file, line and key on any problem.
-/// A `calibration:` mapping (written by WriteCalibratedRobotFile) is a record for people and is
-/// not read into the model.
-RobotFile LoadRobotFile(const std::string& path);
-
 /// Where a calibrated model came from, written into its robot file's `calibration:` section.
 struct CalibrationRecord {
   std::string data_file;                ///< the measurement CSV, as given
@@ -45,6 +28,26 @@ struct CalibrationRecord {
   Eigen::VectorXd estimate;             ///< their values, SI
   Eigen::MatrixXd covariance;           ///< their covariance, SI (empty if undefined)
 };
+
+/// What a robot file holds.
+struct RobotFile {
+  RobotModel robot;
+  std::optional<Plane> plane;  ///< the plane of the file's measurement set-up, if it gives one
+  RangerSpec ranger;           ///< the ranger's limits (defaults unless the file gives them)
+  std::string path;            ///< where it was read from
+  /// The true ranger's errors (true_errors.ranger_offset_mm, ranger_scale_ppm): it reads
+  /// (1 + ranger_scale)·h + ranger_offset (m) for a true distance h. For simulation.
+  double ranger_offset = 0;
+  double ranger_scale = 0;
+  /// The record of a calibrated robot file (identify --write-robot), if it has one: what
+  /// `lrcal accuracy` propagates to poses.
+  std::optional<CalibrationRecord> calibration;
+};
+
+/// Reads a robot YAML file. Throws InputError naming the file, line and key on any problem.
+/// A `calibration:` mapping (written by WriteCalibratedRobotFile) is read into `calibration`,
+/// not into the model.
+RobotFile LoadRobotFile(const std::string& path);
 
 /// Writes a robot file for the calibrated model: `rig`'s links with `link_values` (5N, SI) as
 /// their nominal values and no true errors, `plane` as its plane, `rig`'s ranger limits, and the

@@ -1,0 +1,94 @@
+#include "lrcal/identification/pose_accuracy.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "lrcal/core/error.h"
+#include "lrcal/core/random.h"
+#include "lrcal/kinematics/pose_errors.h"
+
+namespace lrcal {
+
+Eigen::MatrixXd PoseJacobian(const MeasurementModel& model, const double* e,
+                             const ConfigurationSet& configs) {
+  const int n = model.num_parameters(), m = configs.size();
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(e, n);
+  const std::vector<Pose<double>> poses =
+      ToolPoses(model.robot(), model.LinkValues(x.data()), configs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6 * m, n);
+  constexpr double kStep = 1e-6;  // m or rad: truncation O(step²), rounding O(1e-16/step)
+  for (int k = 0; k < n; ++k) {
+    const double x0 = x[k];
+    x[k] = x0 + kStep;
+    const PoseErrors plus = ComparePoses(model.robot(), poses, model.LinkValues(x.data()), configs);
+    x[k] = x0 - kStep;
+    const PoseErrors minus =
+        ComparePoses(model.robot(), poses, model.LinkValues(x.data()), configs);
+    x[k] = x0;
+    // ComparePoses gives reference − model: the pose moves by minus that.
+    for (int j = 0; j < m; ++j)
+      for (int a = 0; a < 3; ++a) {
+        J(6 * j + a, k) = -(plus.position(a, j) - minus.position(a, j)) / (2 * kStep);
+        J(6 * j + 3 + a, k) = -(plus.orientation(a, j) - minus.orientation(a, j)) / (2 * kStep);
+      }
+  }
+  return J;
+}
+
+namespace {
+
+// The 0.95 quantile of |x|, x ~ N(0, Σ) in 3-D: |x|² = Σ λ_i z_i², from fixed draws.
+double Radius95(const Eigen::Matrix3d& sigma, const Eigen::MatrixXd& z) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(sigma, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);
+  std::vector<double> r2(z.cols());
+  for (Eigen::Index d = 0; d < z.cols(); ++d) r2[d] = lambda.dot(z.col(d).cwiseAbs2());
+  const std::size_t k = static_cast<std::size_t>(0.95 * r2.size());
+  std::nth_element(r2.begin(), r2.begin() + k, r2.end());
+  return std::sqrt(r2[k]);
+}
+
+}  // namespace
+
+std::vector<PoseAccuracy> PredictPoseAccuracy(const MeasurementModel& model, const double* e,
+                                              const Eigen::MatrixXd& covariance,
+                                              const ConfigurationSet& configs) {
+  const int n = model.num_parameters();
+  if (covariance.rows() != n || covariance.cols() != n)
+    throw InputError("covariance", "expected " + std::to_string(n) + " x " + std::to_string(n) +
+                                       " (one row and column per estimated parameter)");
+  const Eigen::MatrixXd J = PoseJacobian(model, e, configs);
+  constexpr int kDraws = 20000;
+  Eigen::MatrixXd z(3, kDraws);
+  RandomStream(0, 0, 0, RandomPurpose::kPrediction).Normals(0, 3 * kDraws, z.data());
+  std::vector<PoseAccuracy> out(configs.size());
+  for (int j = 0; j < configs.size(); ++j) {
+    const Eigen::MatrixXd Jj = J.middleRows(6 * j, 6);
+    const Eigen::Matrix<double, 6, 6> S = Jj * covariance * Jj.transpose();
+    out[j].position_std = S.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+    out[j].orientation_std = S.diagonal().tail<3>().cwiseMax(0.0).cwiseSqrt();
+    out[j].position_radius_95 = Radius95(S.topLeftCorner<3, 3>(), z);
+  }
+  return out;
+}
+
+PoseAccuracySummary SummarizePoseAccuracy(const std::vector<PoseAccuracy>& poses) {
+  PoseAccuracySummary s;
+  if (poses.empty()) return s;
+  double sum = 0;
+  std::vector<double> radii;
+  for (std::size_t j = 0; j < poses.size(); ++j) {
+    sum += poses[j].position_std.squaredNorm();
+    radii.push_back(poses[j].position_radius_95);
+    if (s.worst < 0 || poses[j].position_radius_95 > poses[s.worst].position_radius_95)
+      s.worst = static_cast<int>(j);
+  }
+  s.rms_position = std::sqrt(sum / poses.size());
+  std::sort(radii.begin(), radii.end());
+  s.p95_radius_95 = radii[std::min(radii.size() - 1,
+                                   static_cast<std::size_t>(std::ceil(0.95 * radii.size())) - 1)];
+  return s;
+}
+
+}  // namespace lrcal
