@@ -199,13 +199,24 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const R
   ConfigurationSet q(num_joints);
   q.Reserve(static_cast<int>(t.rows.size()));
   std::vector<double> h;
+  // An optional `configuration` column labels the readings of one pose (any text).
+  const int cc = t.Column("configuration");
+  std::vector<std::string> labels;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     q.Add(JointValues(t, r, cols));
     h.push_back(t.Number(r, hc));
+    if (cc >= 0) {
+      if (t.rows[r][cc].empty())
+        throw InputError(Location(path, t.lines[r]) + " column 'configuration'",
+                         "empty: expected the label of the configuration this reading was taken "
+                         "at");
+      labels.push_back(t.rows[r][cc]);
+    }
   }
-  return GroupReadings(q, h, ranger, [&](int r) {
-    return r < 0 ? path : Location(path, t.lines[r]) + " column 'h'";
-  });
+  return GroupReadings(
+      q, h, ranger,
+      [&](int r) { return r < 0 ? path : Location(path, t.lines[r]) + " column 'h'"; },
+      cc >= 0 ? &labels : nullptr);
 }
 
 // The file is written whole or not at all. A path that cannot be a file is bad input (exit 2);

@@ -7,15 +7,52 @@
 
 namespace lrcal {
 
+namespace {
+
+// The joint values of each labelled configuration: its first reading's if all its readings
+// agree, else their mean (summed in reading order).
+void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& group,
+                         const std::vector<int>& first, MeasurementSet* data) {
+  const int n = q.num_joints(), m = static_cast<int>(first.size());
+  std::vector<double> sum(static_cast<std::size_t>(m) * n, 0.0);
+  std::vector<int> count(m, 0);
+  std::vector<bool> differ(m, false);
+  for (int r = 0; r < q.size(); ++r) {
+    const int g = group[r];
+    ++count[g];
+    for (int j = 0; j < n; ++j) {
+      sum[static_cast<std::size_t>(g) * n + j] += q.q(r)[j];
+      differ[g] = differ[g] || q.q(r)[j] != q.q(first[g])[j];
+    }
+  }
+  data->configs = ConfigurationSet(n);
+  data->configs.Reserve(m);
+  std::vector<double> mean(n);
+  for (int g = 0; g < m; ++g) {
+    if (!differ[g]) {
+      data->configs.AddFrom(q, first[g]);
+      continue;
+    }
+    for (int j = 0; j < n; ++j) mean[j] = sum[static_cast<std::size_t>(g) * n + j] / count[g];
+    data->configs.Add(mean.data());
+  }
+}
+
+}  // namespace
+
 MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
-                             const RangerSpec* ranger,
-                             const std::function<std::string(int)>& where) {
+                             const RangerSpec* ranger, const std::function<std::string(int)>& where,
+                             const std::vector<std::string>* labels) {
   if (static_cast<std::size_t>(q.size()) != h.size())
     throw InputError(where(-1), std::to_string(q.size()) + " joint rows but " +
                                     std::to_string(h.size()) + " readings; expected one each");
   const int n = q.num_joints();
+  if (labels && labels->size() != h.size())
+    throw InputError(where(-1), "expected one configuration label per reading");
   std::map<std::vector<double>, int> index;
+  std::map<std::string, int> label_index;
   std::vector<int> first;  // the reading that opened each configuration
+  std::vector<int> group;  // each reading's configuration
   std::vector<double> sums;
   std::vector<int> counts;
   for (int r = 0; r < q.size(); ++r) {
@@ -28,21 +65,31 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
                                      FormatExact(ranger->max_range) +
                                      "] m (the robot file's ranger:); readings are in metres: "
                                      "were they written in mm?");
-    auto [it, inserted] =
-        index.emplace(std::vector<double>(q.q(r), q.q(r) + n), static_cast<int>(first.size()));
-    if (inserted) {
+    const int next = static_cast<int>(first.size());
+    int id;
+    if (labels) {
+      id = label_index.emplace((*labels)[r], next).first->second;
+    } else {
+      id = index.emplace(std::vector<double>(q.q(r), q.q(r) + n), next).first->second;
+    }
+    if (id == next) {
       first.push_back(r);
       sums.push_back(0);
       counts.push_back(0);
     }
-    sums[it->second] += h[r];
-    counts[it->second] += 1;
+    group.push_back(id);
+    sums[id] += h[r];
+    counts[id] += 1;
   }
   MeasurementSet data;
-  data.configs = ConfigurationSet(n);
-  data.configs.Reserve(static_cast<int>(first.size()));
+  if (labels) {
+    LabelledJointValues(q, group, first, &data);
+  } else {
+    data.configs = ConfigurationSet(n);
+    data.configs.Reserve(static_cast<int>(first.size()));
+    for (std::size_t i = 0; i < first.size(); ++i) data.configs.AddFrom(q, first[i]);
+  }
   for (std::size_t i = 0; i < first.size(); ++i) {
-    data.configs.AddFrom(q, first[i]);
     data.mean_h.push_back(sums[i] / counts[i]);
     data.repetitions.push_back(counts[i]);
   }

@@ -27,6 +27,28 @@ TEST(GroupReadings, AveragesIdenticalJointValuesInOrderOfFirstAppearance) {
   EXPECT_EQ(data.mean_h[1], 2.0);
 }
 
+// With labels (a `configuration` column) readings group by label: jittering joint values of
+// one pose are one configuration at their mean; identical ones keep their bits.
+TEST(GroupReadings, LabelsGroupJitteringJointValues) {
+  ConfigurationSet q(2);
+  q.Add({0.1, 0.2});
+  q.Add({0.3, 0.4});
+  q.Add({0.1000002, 0.2});
+  q.Add({0.1, 0.2000004});
+  q.Add({0.3, 0.4});
+  const std::vector<double> h = {1.0, 2.0, 1.1, 1.3, 2.2};
+  const std::vector<std::string> labels = {"p1", "p2", "p1", "p1", "p2"};
+  const MeasurementSet data = GroupReadings(q, h, nullptr, Where, &labels);
+  ASSERT_EQ(data.size(), 2);
+  EXPECT_EQ(data.repetitions, (std::vector<int>{3, 2}));
+  EXPECT_DOUBLE_EQ(data.configs.q(0)[0], (0.1 + 0.1000002 + 0.1) / 3);
+  EXPECT_DOUBLE_EQ(data.configs.q(0)[1], (0.2 + 0.2 + 0.2000004) / 3);
+  EXPECT_EQ(data.configs.q(1)[0], 0.3);  // all agree: the recorded value itself
+  EXPECT_EQ(data.mean_h[0], ((1.0 + 1.1) + 1.3) / 3);
+  // Without labels the jittering readings are three configurations.
+  EXPECT_EQ(GroupReadings(q, h, nullptr, Where).size(), 4);
+}
+
 TEST(GroupReadings, RefusesNonPositiveOutOfRangeAndMismatchedReadings) {
   ConfigurationSet q(1);
   q.Add({0.0});

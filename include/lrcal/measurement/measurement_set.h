@@ -24,8 +24,13 @@ struct MeasurementSet {
 /// count, summed in reading order. Throws InputError, located by `where(r)` (e.g. "file.csv:12"),
 /// for a reading that is not a positive distance, or one outside `ranger`'s range if given.
 /// What `lrcal identify` does with a measurement CSV and the Python module with arrays.
+///
+/// With `labels` (one per reading: a measurement file's `configuration` column), readings are
+/// grouped by label instead: a configuration is the readings that share a label, whatever
+/// their recorded joint values (encoders that jitter between readings of one pose); its joint
+/// values are those of its first reading if all agree, else their mean.
 MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
-                             const RangerSpec* ranger,
-                             const std::function<std::string(int)>& where);
+                             const RangerSpec* ranger, const std::function<std::string(int)>& where,
+                             const std::vector<std::string>* labels = nullptr);
 
 }  // namespace lrcal
