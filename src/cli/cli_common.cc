@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include "lrcal/io/csv.h"
+
 namespace lrcal::cli {
 
 bool Parse(const std::string& command, const std::string& usage, po::options_description& options,
@@ -57,6 +59,39 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
   if (vm.count("estimate-ranger"))
     ranger = RangerTerms::Parse(vm["estimate-ranger"].as<std::string>(), "--estimate-ranger");
   return MakeParameterSet(robot, terms, fixed, "--fix", ranger);
+}
+
+namespace {
+
+void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
+                      const std::string& path) {
+  for (int i = 0; i < configs.size(); ++i)
+    for (int j = 0; j < configs.num_joints(); ++j) {
+      const Link& link = robot.links()[j];
+      const double q = configs.q(i)[j];
+      if (q >= link.q_min - 1e-9 && q <= link.q_max + 1e-9) continue;
+      const bool prismatic = link.joint == JointType::kPrismatic;
+      throw InputError(
+          path + " configuration " + std::to_string(i + 1) + " column 'q" + std::to_string(j + 1) +
+              "'",
+          FormatExact(q) + " is outside the joint's range [" + FormatExact(link.q_min) + ", " +
+              FormatExact(link.q_max) + "] (the robot file's q_min, q_max); joint values are in " +
+              (prismatic ? "m: were they written in mm?" : "rad: were they written in degrees?"));
+    }
+}
+
+}  // namespace
+
+ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot) {
+  ConfigurationSet configs = ReadConfigurations(path, robot.num_links());
+  CheckJointRanges(configs, robot, path);
+  return configs;
+}
+
+MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig) {
+  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger);
+  CheckJointRanges(data.configs, rig.robot, path);
+  return data;
 }
 
 Format ResolveFormat(const po::variables_map& vm) {

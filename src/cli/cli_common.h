@@ -13,6 +13,7 @@
 #include "lrcal/core/strings.h"
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal::cli {
@@ -47,6 +48,13 @@ struct Setup {
 Setup ResolveSetup(const po::variables_map& vm);
 /// --estimate-plane and --fix.
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm);
+
+/// A configurations CSV (io/csv.h) for `robot`, with every joint value checked against the
+/// robot's joint range (q_min, q_max): beyond it is exit 2 naming the file, the configuration
+/// and the joint, and suggesting the likely unit mistake (degrees for rad, mm for m).
+ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot);
+/// A measurement CSV for `rig` (its ranger's range, its robot's joint ranges checked).
+MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig);
 
 enum class Format { kText, kJson };
 Format ResolveFormat(const po::variables_map& vm);

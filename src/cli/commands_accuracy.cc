@@ -111,7 +111,7 @@ int AccuracyCommand(const std::vector<std::string>& args) {
     for (int b = 0; b < n; ++b) C(a, b) = r.covariance(at[a], at[b]);
   const MeasurementModel model(rig.robot, setup.plane, ps);
   const ConfigurationSet configs =
-      ReadConfigurations(vm["configs"].as<std::string>(), rig.robot.num_links());
+      ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot);
   const std::vector<double> zero(n, 0.0);  // the file's nominal values are the estimates
   const std::vector<PoseAccuracy> poses = PredictPoseAccuracy(model, zero.data(), C, configs);
   if (ResolveFormat(vm) == Format::kJson) {

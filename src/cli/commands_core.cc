@@ -189,8 +189,7 @@ int KinematicsCommand(const std::vector<std::string>& args) {
   const std::string which = vm["model"].as<std::string>();
   if (which != "nominal" && which != "true")
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
-  const ConfigurationSet configs =
-      ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
+  const ConfigurationSet configs = ReadRobotConfigurations(vm["configs"].as<std::string>(), robot);
   const Eigen::VectorXd values = which == "true" ? robot.true_values() : robot.nominal_values();
   ParameterSet ps = ResolveParameterSet(robot, vm);
   // The Jacobian is taken at the chosen model: its robot deltas relative to nominal.
@@ -276,8 +275,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const Plane& plane = setup.plane;
-  const ConfigurationSet configs =
-      ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
+  const ConfigurationSet configs = ReadRobotConfigurations(vm["configs"].as<std::string>(), robot);
   NoiseModel noise;
   noise.ranger_offset = rig.ranger_offset;  // the robot file's true ranger errors
   noise.ranger_scale = rig.ranger_scale;
@@ -360,7 +358,7 @@ void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
 void PredictAt(const std::string& file, const MeasurementModel& model,
                const IdentificationSummary& s, const IdentificationOptions& options, Json* json,
                std::string* text) {
-  const ConfigurationSet poses = ReadConfigurations(file, model.robot().num_links());
+  const ConfigurationSet poses = ReadRobotConfigurations(file, model.robot());
   const Eigen::MatrixXd& C = options.sigma > 0 ? s.covariance_given : s.covariance_residual;
   if (!C.allFinite())
     throw InputError("--predict-at",
@@ -405,8 +403,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const Plane& plane = setup.plane;
-  const MeasurementSet data =
-      ReadMeasurements(vm["data"].as<std::string>(), robot.num_links(), &rig.ranger);
+  const MeasurementSet data = ReadRobotMeasurements(vm["data"].as<std::string>(), rig);
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
   const IdentificationOptions options = ResolveIdentificationOptions(vm);
   const IdentificationSummary s = Identify(model, data, options);
@@ -464,8 +461,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const Plane& plane = setup.plane;
-  const ConfigurationSet configs =
-      ReadConfigurations(vm["configs"].as<std::string>(), robot.num_links());
+  const ConfigurationSet configs = ReadRobotConfigurations(vm["configs"].as<std::string>(), robot);
   MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
   IdentifiabilityOptions options;
   options.rank_tolerance = vm["rank-tolerance"].as<double>();

@@ -74,8 +74,8 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
     return pool;
   }
   const std::string path = vm["pool"].as<std::string>();
-  CandidatePool usable = UsableCandidates(robot, setup.plane, setup.rig.ranger,
-                                          ReadConfigurations(path, robot.num_links()));
+  CandidatePool usable =
+      UsableCandidates(robot, setup.plane, setup.rig.ranger, ReadRobotConfigurations(path, robot));
   for (std::size_t i = 0; i < usable.misses.size(); ++i)
     if (usable.misses[i] != BeamMiss::kNone)
       std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2

@@ -244,7 +244,8 @@ TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
                 &out),
             0)
       << out;
-  for (const Json& p : Json::parse(out)["parameters"])
+  const Json again = Json::parse(out);  // kept alive: a range-for over a temporary's member
+  for (const Json& p : again["parameters"])
     EXPECT_NEAR(p["delta"].get<double>(), 0.0, 1e-9) << p["name"];
 }
 
