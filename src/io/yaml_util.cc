@@ -43,7 +43,8 @@ std::string Key(const YAML::Node& key, const std::string& file, const std::strin
 }
 
 void RequireMap(const YAML::Node& node, const std::string& file, const std::string& key) {
-  if (!node.IsMap()) throw InputError(Where(file, node, key), "expected a mapping of keys");
+  if (!node.IsDefined() || !node.IsMap())
+    throw InputError(Where(file, node, key), "expected a mapping of keys");
 }
 
 void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& file,
@@ -106,6 +107,9 @@ bool Bool(const YAML::Node& node, const std::string& file, const std::string& ke
 
 std::vector<double> NumberList(const YAML::Node& node, const std::string& file,
                                const std::string& key, bool allow_pi) {
+  // A missing key is an invalid node, whose IsSequence() throws YAML::InvalidNode.
+  if (!node.IsDefined() || node.IsNull())
+    throw InputError(Where(file, node, key), "missing: expected a list of numbers");
   if (!node.IsSequence()) throw InputError(Where(file, node, key), "expected a list of numbers");
   std::vector<double> out;
   for (std::size_t i = 0; i < node.size(); ++i)
@@ -115,6 +119,8 @@ std::vector<double> NumberList(const YAML::Node& node, const std::string& file,
 
 std::vector<std::string> StringList(const YAML::Node& node, const std::string& file,
                                     const std::string& key) {
+  if (!node.IsDefined() || node.IsNull())
+    throw InputError(Where(file, node, key), "missing: expected a list of names");
   if (node.IsScalar()) return {node.Scalar()};
   if (!node.IsSequence()) throw InputError(Where(file, node, key), "expected a list of names");
   std::vector<std::string> out;

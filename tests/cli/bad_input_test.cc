@@ -171,6 +171,13 @@ const std::vector<BadInput>& Cases() {
        "kinematics --configs c.csv --format json",
        0,
        {"0.1"}},
+      {"RobotPlaneWithoutNormal",  // found by the robot_file fuzzer: used to abort
+       {{"r.yaml",
+         "name: two\nlinks:\n  - {theta: 0, alpha: 0, a: 0.5, d: 0, parameters: [d]}\n"
+         "plane: {offset: -1}\n"}},
+       "kinematics --robot r.yaml --configs c.csv",
+       2,
+       {"r.yaml", "plane.normal", "missing"}},
       {"CsvJointsInDegrees",
        {{"c.csv", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n90,0,45,0,0,0\n"}},
        "kinematics --configs c.csv",
