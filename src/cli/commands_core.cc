@@ -320,13 +320,25 @@ int SimulateCommand(const std::vector<std::string>& args) {
   return 0;
 }
 
+// The model Identify solved: `model`'s parameter set without the parameters it fixed for rank
+// deficiency (s.delta is laid out for it).
+MeasurementModel SolvedModel(const MeasurementModel& model, const IdentificationSummary& s) {
+  return MeasurementModel(model.robot(), model.nominal_plane(),
+                          WithoutParameters(model.robot(), model.parameters(), s.fixed));
+}
+
+// The estimate's covariance: with the given σ when --sigma-mm was given, else residual-based.
+const Eigen::MatrixXd& FitCovariance(const IdentificationSummary& s,
+                                     const IdentificationOptions& options) {
+  return options.sigma > 0 ? s.covariance_given : s.covariance_residual;
+}
+
 // identify --write-robot: the calibrated model (the parameter set Identify solved for, reduced
 // if it fixed parameters for rank deficiency) as a robot file with its record.
 void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
                           const RobotFile& rig, const MeasurementModel& model,
                           const IdentificationSummary& s, const IdentificationOptions& options) {
-  const MeasurementModel solved(model.robot(), model.nominal_plane(),
-                                WithoutParameters(model.robot(), model.parameters(), s.fixed));
+  const MeasurementModel solved = SolvedModel(model, s);
   CalibrationRecord r;
   r.data_file = data_file;
   std::ifstream in(data_file, std::ios::binary);
@@ -345,10 +357,7 @@ void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
   r.sigma_source = given ? "given (--sigma-mm)" : "residual (sigma_hat)";
   r.parameters = s.names;
   r.estimate = s.estimate;
-  if (given)
-    r.covariance = s.covariance_given;
-  else if (!std::isnan(s.sigma_hat))
-    r.covariance = s.covariance_residual;
+  if (given || !std::isnan(s.sigma_hat)) r.covariance = FitCovariance(s, options);
   WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
                            solved.PlaneAt(s.delta.data()), r);
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
@@ -359,14 +368,13 @@ void PredictAt(const std::string& file, const MeasurementModel& model,
                const IdentificationSummary& s, const IdentificationOptions& options, Json* json,
                std::string* text) {
   const ConfigurationSet poses = ReadRobotConfigurations(file, model.robot());
-  const Eigen::MatrixXd& C = options.sigma > 0 ? s.covariance_given : s.covariance_residual;
+  const Eigen::MatrixXd& C = FitCovariance(s, options);
   if (!C.allFinite())
     throw InputError("--predict-at",
                      "the covariance is undefined (as many configurations as parameters); "
                      "give --sigma-mm");
-  const MeasurementModel solved(model.robot(), model.nominal_plane(),
-                                WithoutParameters(model.robot(), model.parameters(), s.fixed));
-  const std::vector<PoseAccuracy> predicted = PredictPoseAccuracy(solved, s.delta.data(), C, poses);
+  const std::vector<PoseAccuracy> predicted =
+      PredictPoseAccuracy(SolvedModel(model, s), s.delta.data(), C, poses);
   *json = PoseAccuracyJson(predicted, poses);
   *text = PoseAccuracyText(predicted);
 }
