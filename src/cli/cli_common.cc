@@ -27,8 +27,9 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 void AddCommonOptions(po::options_description& options) {
   options.add_options()("robot", po::value<std::string>()->default_value("paper"),
                         "robot file (YAML) or shipped robot name")(
-      "plane", po::value<std::string>(),
-      "plane nx,ny,nz,f in the base frame (normalised); default: the robot file's plane")(
+      "plane", po::value<std::vector<std::string>>()->composing(),
+      "plane nx,ny,nz,f in the base frame (normalised); repeat for several planes (a CSV's "
+      "plane column numbers them from 1 in this order); default: the robot file's plane(s)")(
       "format", po::value<std::string>()->default_value("text"), "output: text or json");
 }
 
@@ -36,20 +37,28 @@ RobotFile LoadRobot(const std::string& name_or_path) {
   return LoadRobotFile(ResolveRobotPath(name_or_path));
 }
 
-Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm) {
-  if (vm.count("plane")) return Plane::Parse(vm["plane"].as<std::string>(), "--plane");
-  if (rig.plane) return *rig.plane;
+PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm) {
+  if (vm.count("plane")) {
+    const auto& texts = vm["plane"].as<std::vector<std::string>>();
+    std::vector<Plane> planes;
+    for (std::size_t k = 0; k < texts.size(); ++k)
+      planes.push_back(Plane::Parse(
+          texts[k], texts.size() == 1 ? "--plane" : "--plane (" + std::to_string(k + 1) + ")"));
+    return PlaneSet(std::move(planes), {}, "--plane");
+  }
+  if (rig.planes) return *rig.planes;
   throw InputError("--plane",
                    "the robot file '" + rig.path + "' has no plane: give --plane nx,ny,nz,f");
 }
 
 Setup ResolveSetup(const po::variables_map& vm) {
-  Setup setup{LoadRobot(vm["robot"].as<std::string>()), Plane{}};
-  setup.plane = ResolvePlane(setup.rig, vm);
+  Setup setup{LoadRobot(vm["robot"].as<std::string>()), PlaneSet{}};
+  setup.planes = ResolvePlanes(setup.rig, vm);
   return setup;
 }
 
-ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm) {
+ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
+                                 int num_planes) {
   PlaneTerms terms;
   if (vm.count("estimate-plane"))
     terms = PlaneTerms::Parse(vm["estimate-plane"].as<std::string>(), "--estimate-plane");
@@ -58,7 +67,8 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
   RangerTerms ranger;
   if (vm.count("estimate-ranger"))
     ranger = RangerTerms::Parse(vm["estimate-ranger"].as<std::string>(), "--estimate-ranger");
-  return MakeParameterSet(robot, terms, fixed, "--fix", ranger);
+  return MakeParameterSet(robot, std::vector<PlaneTerms>(num_planes, terms), fixed, "--fix",
+                          ranger);
 }
 
 namespace {
@@ -82,14 +92,16 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
 
 }  // namespace
 
-ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot) {
-  ConfigurationSet configs = ReadConfigurations(path, robot.num_links());
+ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
+                                         const PlaneSet* planes) {
+  ConfigurationSet configs = ReadConfigurations(path, robot.num_links(), planes);
   CheckJointRanges(configs, robot, path);
   return configs;
 }
 
-MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig) {
-  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger);
+MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
+                                     const PlaneSet* planes) {
+  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger, planes);
   CheckJointRanges(data.configs, rig.robot, path);
   return data;
 }

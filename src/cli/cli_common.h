@@ -37,24 +37,30 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 
 /// --robot: a path or a shipped name ("paper").
 RobotFile LoadRobot(const std::string& name_or_path);
-/// --plane if given, else the robot file's plane; InputError if neither.
-Plane ResolvePlane(const RobotFile& rig, const po::variables_map& vm);
+/// --plane (repeated: several planes, in order) if given, else the robot file's plane(s);
+/// InputError if neither.
+PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm);
 
-/// What every science command starts from: the robot file (--robot) and the plane (--plane).
+/// What every science command starts from: the robot file (--robot) and the planes (--plane).
 struct Setup {
   RobotFile rig;
-  Plane plane;
+  PlaneSet planes;
 };
 Setup ResolveSetup(const po::variables_map& vm);
-/// --estimate-plane and --fix.
-ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm);
+/// --estimate-plane (for every plane), --estimate-ranger and --fix, for `num_planes` planes.
+ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
+                                 int num_planes = 1);
 
 /// A configurations CSV (io/csv.h) for `robot`, with every joint value checked against the
 /// robot's joint range (q_min, q_max): beyond it is exit 2 naming the file, the configuration
-/// and the joint, and suggesting the likely unit mistake (degrees for rad, mm for m).
-ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot);
-/// A measurement CSV for `rig` (its ranger's range, its robot's joint ranges checked).
-MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig);
+/// and the joint, and suggesting the likely unit mistake (degrees for rad, mm for m). Its
+/// optional `plane` column is resolved against `planes`.
+ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
+                                         const PlaneSet* planes = nullptr);
+/// A measurement CSV for `rig` (its ranger's range, its robot's joint ranges checked; its
+/// `plane` column resolved against `planes`).
+MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
+                                     const PlaneSet* planes = nullptr);
 
 enum class Format { kText, kJson };
 Format ResolveFormat(const po::variables_map& vm);

@@ -1,4 +1,5 @@
 // lrcal accuracy, and identify --predict-at: the calibrated arm's predicted accuracy at poses.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -18,30 +19,27 @@ Json Vec3(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()});
 // The parameter set a calibration record names: plane and ranger terms from their names, robot
 // parameters not named are fixed. Its order is MakeParameterSet's; `order` maps it to the
 // record's.
-ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord& r,
+ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord& r, int num_planes,
                                 const std::string& source) {
-  PlaneTerms plane;
-  RangerTerms ranger;
-  for (const std::string& name : r.parameters) {
-    if (name == "plane_u1" || name == "plane_u2") plane.normal = true;
-    if (name == "plane_f") plane.offset = true;
-    if (name == "ranger_offset") ranger.offset = true;
-    if (name == "ranger_scale") ranger.scale = true;
-  }
+  const auto named = [&](const std::string& name) {
+    return std::find(r.parameters.begin(), r.parameters.end(), name) != r.parameters.end();
+  };
+  std::vector<PlaneTerms> planes(num_planes);
   std::vector<std::string> fixed;
-  for (int k : robot.parameter_indices()) {
-    const std::string name = robot.ValueName(k);
-    bool named = false;
-    for (const std::string& p : r.parameters) named = named || p == name;
-    if (!named) fixed.push_back(name);
+  for (int p = 0; p < num_planes; ++p) {
+    const std::string u1 = PlaneTermName(p, num_planes, "u1"),
+                      u2 = PlaneTermName(p, num_planes, "u2");
+    planes[p].normal = named(u1) || named(u2);
+    planes[p].offset = named(PlaneTermName(p, num_planes, "f"));
+    if (planes[p].normal && !named(u1)) fixed.push_back(u1);
+    if (planes[p].normal && !named(u2)) fixed.push_back(u2);
   }
-  if (plane.normal)
-    for (const char* u : {"plane_u1", "plane_u2"}) {
-      bool named = false;
-      for (const std::string& p : r.parameters) named = named || p == u;
-      if (!named) fixed.push_back(u);
-    }
-  return MakeParameterSet(robot, plane, fixed, source, ranger);
+  RangerTerms ranger;
+  ranger.offset = named("ranger_offset");
+  ranger.scale = named("ranger_scale");
+  for (int k : robot.parameter_indices())
+    if (!named(robot.ValueName(k))) fixed.push_back(robot.ValueName(k));
+  return MakeParameterSet(robot, planes, fixed, source, ranger);
 }
 
 }  // namespace
@@ -93,7 +91,8 @@ int AccuracyCommand(const std::vector<std::string>& args) {
                                     "with lrcal identify --write-robot (give --sigma-mm, or "
                                     "more configurations than parameters)");
   const CalibrationRecord& r = *rig.calibration;
-  const ParameterSet ps = RecordParameterSet(rig.robot, r, rig.path + " calibration.parameters");
+  const ParameterSet ps =
+      RecordParameterSet(rig.robot, r, setup.planes.size(), rig.path + " calibration.parameters");
   // The record's covariance in the parameter set's order.
   const int n = ps.size();
   if (n != static_cast<int>(r.parameters.size()))
@@ -109,9 +108,9 @@ int AccuracyCommand(const std::vector<std::string>& args) {
   Eigen::MatrixXd C(n, n);
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) C(a, b) = r.covariance(at[a], at[b]);
-  const MeasurementModel model(rig.robot, setup.plane, ps);
+  const MeasurementModel model(rig.robot, setup.planes, ps);
   const ConfigurationSet configs =
-      ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot);
+      ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot, &setup.planes);
   const std::vector<double> zero(n, 0.0);  // the file's nominal values are the estimates
   const std::vector<PoseAccuracy> poses = PredictPoseAccuracy(model, zero.data(), C, configs);
   if (ResolveFormat(vm) == Format::kJson) {

@@ -185,15 +185,16 @@ int KinematicsCommand(const std::vector<std::string>& args) {
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane& plane = setup.plane;
+  const PlaneSet& planes = setup.planes;
   const std::string which = vm["model"].as<std::string>();
   if (which != "nominal" && which != "true")
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
-  const ConfigurationSet configs = ReadRobotConfigurations(vm["configs"].as<std::string>(), robot);
+  const ConfigurationSet configs =
+      ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   const Eigen::VectorXd values = which == "true" ? robot.true_values() : robot.nominal_values();
-  ParameterSet ps = ResolveParameterSet(robot, vm);
+  ParameterSet ps = ResolveParameterSet(robot, vm, planes.size());
   // The Jacobian is taken at the chosen model: its robot deltas relative to nominal.
-  MeasurementModel model(robot, plane, ps);
+  MeasurementModel model(robot, planes, ps);
   std::vector<double> e(ps.size(), 0.0);
   for (int k = 0; k < ps.num_robot(); ++k)
     e[k] = values[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]];
@@ -217,7 +218,8 @@ int KinematicsCommand(const std::vector<std::string>& args) {
 int SampleCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal sample options");
   AddCommonOptions(o);
-  o.add_options()("count", po::value<int>()->default_value(101), "configurations to draw")(
+  o.add_options()("count", po::value<int>()->default_value(101),
+                  "configurations to draw (per plane when several planes are given)")(
       "seed", po::value<long long>()->default_value(1), "random seed")(
       "validation", po::bool_switch(), "validation set: anywhere in the workspace, no beam needed")(
       "min-singular-value", po::value<double>()->default_value(0.05),
@@ -229,7 +231,7 @@ int SampleCommand(const std::vector<std::string>& args) {
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane& plane = setup.plane;
+  const PlaneSet& planes = setup.planes;
   const int count = vm["count"].as<int>();
   if (count < 1 || count > 1000000)
     throw InputError("--count",
@@ -242,7 +244,7 @@ int SampleCommand(const std::vector<std::string>& args) {
   SamplingReport report;
   const bool validation = vm["validation"].as<bool>();
   ConfigurationSet configs = SampleConfigurations(
-      robot, plane, count,
+      robot, planes, std::vector<int>(planes.size(), count),
       RandomStream(ParseSeed(vm), 0, 0,
                    validation ? RandomPurpose::kValidation : RandomPurpose::kPool),
       options, &report);
@@ -274,8 +276,9 @@ int SimulateCommand(const std::vector<std::string>& args) {
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane& plane = setup.plane;
-  const ConfigurationSet configs = ReadRobotConfigurations(vm["configs"].as<std::string>(), robot);
+  const PlaneSet& planes = setup.planes;
+  const ConfigurationSet configs =
+      ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   NoiseModel noise;
   noise.ranger_offset = rig.ranger_offset;  // the robot file's true ranger errors
   noise.ranger_scale = rig.ranger_scale;
@@ -305,9 +308,9 @@ int SimulateCommand(const std::vector<std::string>& args) {
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
-  const int missed = SimulateReadings(robot, robot.true_values(), plane, rig.ranger, configs, noise,
-                                      RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise),
-                                      &data, &misses, &raw);
+  const int missed = SimulateReadings(
+      robot, robot.true_values(), planes, rig.ranger, configs, noise,
+      RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data, &misses, &raw);
   const std::string path = vm["out"].as<std::string>();
   WriteReadings(path, data.configs, raw, noise.repetitions);
   for (int i = 0; i < configs.size(); ++i)
@@ -323,7 +326,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
 // The model Identify solved: `model`'s parameter set without the parameters it fixed for rank
 // deficiency (s.delta is laid out for it).
 MeasurementModel SolvedModel(const MeasurementModel& model, const IdentificationSummary& s) {
-  return MeasurementModel(model.robot(), model.nominal_plane(),
+  return MeasurementModel(model.robot(), model.nominal_planes(),
                           WithoutParameters(model.robot(), model.parameters(), s.fixed));
 }
 
@@ -359,7 +362,7 @@ void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
   r.estimate = s.estimate;
   if (given || !std::isnan(s.sigma_hat)) r.covariance = FitCovariance(s, options);
   WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
-                           solved.PlaneAt(s.delta.data()), r);
+                           solved.PlanesAt(s.delta.data()), r);
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
 }
 
@@ -367,7 +370,8 @@ void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
 void PredictAt(const std::string& file, const MeasurementModel& model,
                const IdentificationSummary& s, const IdentificationOptions& options, Json* json,
                std::string* text) {
-  const ConfigurationSet poses = ReadRobotConfigurations(file, model.robot());
+  const ConfigurationSet poses =
+      ReadRobotConfigurations(file, model.robot(), &model.nominal_planes());
   const Eigen::MatrixXd& C = FitCovariance(s, options);
   if (!C.allFinite())
     throw InputError("--predict-at",
@@ -410,9 +414,9 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane& plane = setup.plane;
-  const MeasurementSet data = ReadRobotMeasurements(vm["data"].as<std::string>(), rig);
-  MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
+  const PlaneSet& planes = setup.planes;
+  const MeasurementSet data = ReadRobotMeasurements(vm["data"].as<std::string>(), rig, &planes);
+  MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   const IdentificationOptions options = ResolveIdentificationOptions(vm);
   const IdentificationSummary s = Identify(model, data, options);
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
@@ -468,9 +472,10 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
-  const Plane& plane = setup.plane;
-  const ConfigurationSet configs = ReadRobotConfigurations(vm["configs"].as<std::string>(), robot);
-  MeasurementModel model(robot, plane, ResolveParameterSet(robot, vm));
+  const PlaneSet& planes = setup.planes;
+  const ConfigurationSet configs =
+      ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
+  MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   IdentifiabilityOptions options;
   options.rank_tolerance = vm["rank-tolerance"].as<double>();
   options.Validate("--rank-tolerance");
@@ -495,7 +500,9 @@ int PaperCommand(const std::vector<std::string>& args) {
   if (!Parse("paper", "[--seed K] [options]", o, args, &vm)) return 0;
   const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
   const RobotModel& robot = rig.robot;
-  if (!rig.plane) throw InputError("--robot", "the robot file '" + rig.path + "' has no plane");
+  if (!rig.planes || rig.planes->size() != 1)
+    throw InputError("--robot", "the robot file '" + rig.path +
+                                    "' has no plane (the paper's study uses one plane)");
   PaperCaseOptions options;
   options.sampling.ranger = rig.ranger;
   options.seed = ParseSeed(vm);
@@ -503,7 +510,7 @@ int PaperCommand(const std::vector<std::string>& args) {
       ParseSelectionMethod(vm["case1-selection"].as<std::string>(), "--case1-selection");
   options.case1_selection.samples = vm["samples"].as<int>();
   options.case1_selection.Validate("--samples");
-  const PaperCasesResult r = RunPaperCases(robot, *rig.plane, options);
+  const PaperCasesResult r = RunPaperCases(robot, (*rig.planes)[0], options);
   const Table params = PaperParameterTable(robot, r);
   const Table validation = PaperValidationTable(r);
   if (ResolveFormat(vm) == Format::kJson) {

@@ -67,15 +67,15 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
       throw InputError("--generate", "expected 1 to 100,000 candidates, got " + std::to_string(n));
     SamplingOptions sampling;
     sampling.ranger = setup.rig.ranger;
-    pool.configs =
-        SampleConfigurations(robot, setup.plane, n, RandomStream(seed, 0, 0, RandomPurpose::kPool),
-                             sampling, &pool.report);
+    pool.configs = SampleConfigurations(
+        robot, setup.planes, std::vector<int>(setup.planes.size(), n),
+        RandomStream(seed, 0, 0, RandomPurpose::kPool), sampling, &pool.report);
     pool.source = "generated: " + pool.report.ToString();
     return pool;
   }
   const std::string path = vm["pool"].as<std::string>();
-  CandidatePool usable =
-      UsableCandidates(robot, setup.plane, setup.rig.ranger, ReadRobotConfigurations(path, robot));
+  CandidatePool usable = UsableCandidates(robot, setup.planes, setup.rig.ranger,
+                                          ReadRobotConfigurations(path, robot, &setup.planes));
   for (std::size_t i = 0; i < usable.misses.size(); ++i)
     if (usable.misses[i] != BeamMiss::kNone)
       std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
@@ -165,7 +165,8 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (seed_value < 0) throw InputError("--seed", "expected a non-negative integer");
   const std::uint64_t seed = static_cast<std::uint64_t>(seed_value);
   const ResolvedPool pool = ResolvePool(vm, setup, seed);
-  MeasurementModel model(setup.rig.robot, setup.plane, ResolveParameterSet(setup.rig.robot, vm));
+  MeasurementModel model(setup.rig.robot, setup.planes,
+                         ResolveParameterSet(setup.rig.robot, vm, setup.planes.size()));
   const SelectionOptions options = ResolveSelection(vm);
   const DesignScaling scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
   const Eigen::MatrixXd G = ScaledJacobian(vm, model, pool.configs, scaling);

@@ -24,8 +24,36 @@ namespace {
 BeamMiss BeamOf(const ModelPoint& point, const ConfigurationSet& one, const RangerSpec& ranger) {
   const Pose<double> pose = ToolPose(point, one, 0);
   double nb;
-  const double h = BeamReading(pose, point.plane, &nb);
+  const double h = BeamReading(pose, point.planes[one.plane(0)], &nb);
   return ClassifyReading(h, nb, ranger);
+}
+
+// The error when the attempt budget for plane p ran out with `accepted` of `wanted` drawn.
+InputError SamplingExhausted(const PlaneSet& planes, int p, int accepted, int wanted,
+                             long long attempts, const SamplingReport& rep) {
+  return InputError("configuration sampling",
+                    "could only accept " + std::to_string(accepted) + " of " +
+                        std::to_string(wanted) + " configurations" +
+                        (planes.size() > 1 ? " on " + planes.Label(p) : std::string()) + " in " +
+                        std::to_string(attempts) + " attempts (" + rep.ToString() +
+                        "); check the plane, the ranger's range and the joint limits");
+}
+
+// Why a drawn configuration (one row, tagged with its plane) is rejected: "" when it is usable.
+// `truth` is null when the true rig is not checked.
+std::string RejectionOf(const RobotModel& robot, const ModelPoint& nominal, const ModelPoint* truth,
+                        const ConfigurationSet& one, const SamplingOptions& options) {
+  if (options.require_beam_hit) {
+    BeamMiss miss = BeamOf(nominal, one, options.ranger);
+    if (miss == BeamMiss::kNone && truth) miss = BeamOf(*truth, one, options.ranger);
+    if (miss != BeamMiss::kNone) return BeamMissName(miss);
+  }
+  if (options.min_jacobian_singular_value > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(
+        GeometricJacobian(robot, robot.nominal_values(), one.q(0)));
+    if (svd.singularValues().minCoeff() < options.min_jacobian_singular_value) return "singular";
+  }
+  return "";
 }
 
 }  // namespace
@@ -41,66 +69,68 @@ void SamplingOptions::Validate(const std::string& source) const {
 ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
                                       const RandomStream& stream, const SamplingOptions& options,
                                       SamplingReport* report) {
+  return SampleConfigurations(robot, PlaneSet(plane), std::vector<int>{count}, stream, options,
+                              report);
+}
+
+ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& planes,
+                                      const std::vector<int>& counts, const RandomStream& stream,
+                                      const SamplingOptions& options, SamplingReport* report) {
   options.Validate();
+  if (static_cast<int>(counts.size()) != planes.size())
+    throw InputError("configuration sampling", "expected one count per plane");
   SamplingReport local;
   SamplingReport& rep = report ? *report : local;
   rep = SamplingReport{};
-  rep.requested = count;
+  for (int c : counts) rep.requested += c;
   const int N = robot.num_links();
   ModelPoint nominal, truth;
-  PrepareModelPoint(robot, robot.nominal_values().data(), plane, &nominal);
+  PrepareModelPoint(robot, robot.nominal_values().data(), planes, &nominal);
   const bool check_truth = options.true_link_values.has_value();
-  if (check_truth)
-    PrepareModelPoint(robot, options.true_link_values->data(),
-                      options.true_plane ? *options.true_plane : plane, &truth);
+  if (check_truth) {
+    const PlaneSet& true_planes = options.true_planes ? *options.true_planes : planes;
+    if (true_planes.size() != planes.size())
+      throw InputError("configuration sampling", "expected one true plane per plane");
+    PrepareModelPoint(robot, options.true_link_values->data(), true_planes, &truth);
+  }
   ConfigurationSet out(N);
-  out.Reserve(count);
-  const long long budget =
-      static_cast<long long>(options.max_attempts_per_configuration) * std::max(count, 1);
+  out.Reserve(rep.requested);
   std::vector<double> q(N);
-  for (long long a = 0; out.size() < count; ++a) {
-    if (a >= budget) {
-      throw InputError("configuration sampling",
-                       "could only accept " + std::to_string(out.size()) + " of " +
-                           std::to_string(count) + " configurations in " + std::to_string(a) +
-                           " attempts (" + rep.ToString() +
-                           "); check the plane, the ranger's range and the joint limits");
-    }
-    ++rep.attempts;
-    for (int j = 0; j < N; ++j) {
-      const Link& link = robot.links()[j];
-      q[j] = link.q_min + (link.q_max - link.q_min) * stream.Uniform(a * N + j);
-    }
-    ConfigurationSet one(N);
-    one.Add(q);
-    if (options.require_beam_hit) {
-      BeamMiss miss = BeamOf(nominal, one, options.ranger);
-      if (miss == BeamMiss::kNone && check_truth) miss = BeamOf(truth, one, options.ranger);
-      if (miss != BeamMiss::kNone) {
-        ++rep.rejected[BeamMissName(miss)];
+  long long a = 0;  // attempts so far, over all planes: draw a·N + j is joint j of attempt a
+  for (int p = 0; p < planes.size(); ++p) {
+    const int target = out.size() + counts[p];
+    const long long budget =
+        a + static_cast<long long>(options.max_attempts_per_configuration) * std::max(counts[p], 1);
+    for (; out.size() < target; ++a) {
+      if (a >= budget) {
+        throw SamplingExhausted(planes, p, out.size() - (target - counts[p]), counts[p], a, rep);
+      }
+      ++rep.attempts;
+      for (int j = 0; j < N; ++j) {
+        const Link& link = robot.links()[j];
+        q[j] = link.q_min + (link.q_max - link.q_min) * stream.Uniform(a * N + j);
+      }
+      ConfigurationSet one(N);
+      one.Add(q, p);
+      const std::string rejection =
+          RejectionOf(robot, nominal, check_truth ? &truth : nullptr, one, options);
+      if (!rejection.empty()) {
+        ++rep.rejected[rejection];
         continue;
       }
+      out.Add(q, p);
     }
-    if (options.min_jacobian_singular_value > 0) {
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(
-          GeometricJacobian(robot, robot.nominal_values(), q.data()));
-      if (svd.singularValues().minCoeff() < options.min_jacobian_singular_value) {
-        ++rep.rejected["singular"];
-        continue;
-      }
-    }
-    out.Add(q);
   }
   rep.accepted = out.size();
   return out;
 }
 
-CandidatePool UsableCandidates(const RobotModel& robot, const Plane& plane,
+CandidatePool UsableCandidates(const RobotModel& robot, const PlaneSet& planes,
                                const RangerSpec& ranger, const ConfigurationSet& pool) {
   CandidatePool out;
   out.configs = ConfigurationSet(pool.num_joints());
   std::vector<double> h;
-  ExactReadings(robot, robot.nominal_values(), plane, ranger, pool, &h, &out.misses);
+  ExactReadings(robot, robot.nominal_values(), planes, ranger, pool, &h, &out.misses);
   out.report.requested = out.report.attempts = pool.size();
   for (int i = 0; i < pool.size(); ++i) {
     if (out.misses[i] != BeamMiss::kNone) {

@@ -626,7 +626,7 @@ const MeasurementModel* CheckIdentifiable(const MeasurementModel& model_in,
   }
   s.fixed = s.identifiability.suggested_fixed;
   *reduced = std::make_unique<MeasurementModel>(
-      model_in.robot(), model_in.nominal_plane(),
+      model_in.robot(), model_in.nominal_planes(),
       WithoutParameters(model_in.robot(), model_in.parameters(), s.fixed));
   model = reduced->get();
   s.identifiability =
@@ -695,9 +695,9 @@ void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet&
   const ParameterSet& ps = model->parameters();
   for (int k = 0; k < ps.num_robot(); ++k)
     s.nominal[k] = model->robot().nominal_values()[ps.robot_values[k]];
-  for (int c = 0; c < 2; ++c)
-    if (ps.u_index[c] >= 0) s.nominal[ps.u_index[c]] = 0;
-  if (ps.f_index >= 0) s.nominal[ps.f_index] = model->nominal_plane().offset;
+  for (int p = 0; p < ps.num_planes(); ++p)
+    if (ps.plane_columns[p].f >= 0)
+      s.nominal[ps.plane_columns[p].f] = model->nominal_planes()[p].offset;
   s.estimate = s.nominal + s.delta;
 
   Eigen::MatrixXd G = IdentificationJacobian(*model, data.configs, e.data());
@@ -737,6 +737,12 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
   if (static_cast<int>(data.mean_h.size()) != data.size() ||
       static_cast<int>(data.repetitions.size()) != data.size()) {
     s.message = "measurement set is inconsistent (configurations, readings, repetitions)";
+    return s;
+  }
+  if (data.configs.num_planes_referenced() > model_in.num_planes()) {
+    s.message = "a configuration is aimed at plane " +
+                std::to_string(data.configs.num_planes_referenced()) + " but the model has " +
+                std::to_string(model_in.num_planes()) + " plane(s)";
     return s;
   }
 

@@ -178,24 +178,68 @@ std::vector<double> JointValues(const CsvTable& t, std::size_t row, const std::v
   return q;
 }
 
-}  // namespace
+// The error for row r's `plane` entry `ref`, which names none of `planes` (null: one plane).
+InputError UnknownPlane(const CsvTable& t, std::size_t r, const std::string& ref,
+                        const PlaneSet* planes) {
+  const int np = planes ? planes->size() : 1;
+  std::string known;
+  for (int k = 0; k < np; ++k)
+    known += (k ? ", " : "") + std::to_string(k + 1) +
+             (planes && !planes->name(k).empty() ? " (" + planes->name(k) + ")" : "");
+  return InputError(Location(t.path, t.lines[r]) + " column 'plane'",
+                    "'" + ref + "' is not one of the " + std::to_string(np) +
+                        " plane(s) given: expected " + known +
+                        (np == 1 ? "; give the set-up's planes (robot file planes: or "
+                                   "repeated --plane)"
+                                 : ""));
+}
 
-ConfigurationSet ReadConfigurations(const std::string& path, int num_joints) {
-  CsvTable t = ReadCsv(path);
-  std::vector<int> cols = JointColumns(t, num_joints);
-  if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
-  ConfigurationSet out(num_joints);
-  for (std::size_t r = 0; r < t.rows.size(); ++r) out.Add(JointValues(t, r, cols));
+// The plane of each row: the `plane` column (a 1-based index or a plane's name) resolved
+// against `planes`, or 0 for every row without the column. A column naming a plane not given,
+// or several planes given and no column, is an error.
+std::vector<int> PlaneColumn(const CsvTable& t, const PlaneSet* planes) {
+  const int pc = t.Column("plane");
+  const int np = planes ? planes->size() : 1;
+  if (pc < 0) {
+    if (np > 1)
+      throw InputError(Location(t.path, 1) + " column 'plane'",
+                       "missing: " + std::to_string(np) +
+                           " planes are given, so each row must say which one it is on "
+                           "(a 1-based index or a plane's name)");
+    return std::vector<int>(t.rows.size(), 0);
+  }
+  std::vector<int> out;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    const std::string& ref = t.rows[r][pc];
+    const int p = planes ? planes->Find(ref) : (ref == "1" ? 0 : -1);
+    if (p < 0) throw UnknownPlane(t, r, ref, planes);
+    out.push_back(p);
+  }
   return out;
 }
 
-MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const RangerSpec* ranger) {
+}  // namespace
+
+ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
+                                    const PlaneSet* planes) {
+  CsvTable t = ReadCsv(path);
+  std::vector<int> cols = JointColumns(t, num_joints);
+  if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
+  const std::vector<int> plane = PlaneColumn(t, planes);
+  ConfigurationSet out(num_joints);
+  for (std::size_t r = 0; r < t.rows.size(); ++r) out.Add(JointValues(t, r, cols), plane[r]);
+  return out;
+}
+
+MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const RangerSpec* ranger,
+                                const PlaneSet* planes) {
   CsvTable t = ReadCsv(path);
   std::vector<int> cols = JointColumns(t, num_joints);
   const int hc = t.Column("h");
   if (hc < 0)
     throw InputError(Location(path, 1) + " column 'h'", "missing: expected the reading h (m)");
   if (t.rows.empty()) throw InputError(path, "no readings (only a header)");
+  const std::vector<int> plane = PlaneColumn(t, planes);
   ConfigurationSet q(num_joints);
   q.Reserve(static_cast<int>(t.rows.size()));
   std::vector<double> h;
@@ -203,7 +247,7 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const R
   const int cc = t.Column("configuration");
   std::vector<std::string> labels;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    q.Add(JointValues(t, r, cols));
+    q.Add(JointValues(t, r, cols), plane[r]);
     h.push_back(t.Number(r, hc));
     if (cc >= 0) {
       if (t.rows[r][cc].empty())
@@ -240,11 +284,13 @@ void CheckOutputFile(const std::string& path, const std::string& option) {
 
 void WriteConfigurations(const std::string& path, const ConfigurationSet& configs) {
   std::ostringstream out;
+  const bool planes = configs.num_planes_referenced() > 1;
   for (int j = 0; j < configs.num_joints(); ++j) out << (j ? "," : "") << "q" << j + 1;
-  out << "\n";
+  out << (planes ? ",plane\n" : "\n");
   for (int i = 0; i < configs.size(); ++i) {
     for (int j = 0; j < configs.num_joints(); ++j)
       out << (j ? "," : "") << FormatExact(configs.q(i)[j]);
+    if (planes) out << "," << configs.plane(i) + 1;
     out << "\n";
   }
   WriteOutputFile(path, out.str());
@@ -254,10 +300,12 @@ void WriteReadings(const std::string& path, const ConfigurationSet& configs,
                    const std::vector<double>& readings, int repetitions) {
   std::ostringstream out;
   for (int j = 0; j < configs.num_joints(); ++j) out << "q" << j + 1 << ",";
-  out << "h,repetition\n";
+  const bool planes = configs.num_planes_referenced() > 1;
+  out << (planes ? "plane,h,repetition\n" : "h,repetition\n");
   for (int i = 0, k = 0; i < configs.size(); ++i)
     for (int r = 0; r < repetitions; ++r, ++k) {
       for (int j = 0; j < configs.num_joints(); ++j) out << FormatExact(configs.q(i)[j]) << ",";
+      if (planes) out << configs.plane(i) + 1 << ",";
       out << FormatExact(readings[k]) << "," << r + 1 << "\n";
     }
   WriteOutputFile(path, out.str());

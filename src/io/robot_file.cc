@@ -138,16 +138,43 @@ Eigen::VectorXd ParseTrueErrors(const YAML::Node& root, const std::string& path,
   return errors;
 }
 
-std::optional<Plane> ParsePlane(const YAML::Node& root, const std::string& path) {
+Plane ParseOnePlane(const YAML::Node& pl, const std::string& path, const std::string& key,
+                    bool named) {
   using namespace yaml;
-  const YAML::Node pl = root["plane"];
-  if (!pl) return std::nullopt;
-  CheckKeys(pl, {"normal", "offset"}, path, "plane");
-  const std::vector<double> n = NumberList(pl["normal"], path, "plane.normal");
+  if (named)
+    CheckKeys(pl, {"normal", "offset", "name"}, path, key);
+  else
+    CheckKeys(pl, {"normal", "offset"}, path, key);
+  const std::vector<double> n = NumberList(pl["normal"], path, key + ".normal");
   if (n.size() != 3)
-    throw InputError(Where(path, pl["normal"], "plane.normal"), "expected 3 numbers");
-  const double f = Number(pl["offset"], path, "plane.offset");
-  return Plane::FromCoefficients(n[0], n[1], n[2], f, Where(path, pl, "plane"));
+    throw InputError(Where(path, pl["normal"], key + ".normal"), "expected 3 numbers");
+  const double f = Number(pl["offset"], path, key + ".offset");
+  return Plane::FromCoefficients(n[0], n[1], n[2], f, Where(path, pl, key));
+}
+
+// plane: {normal, offset} (one plane), or planes: a list of {normal, offset, name}.
+std::optional<PlaneSet> ParsePlanes(const YAML::Node& root, const std::string& path) {
+  using namespace yaml;
+  const YAML::Node one = root["plane"];
+  const YAML::Node list = root["planes"];
+  if (one && list)
+    throw InputError(Where(path, list, "planes"),
+                     "give either plane: (one plane) or planes: (a list), not both");
+  if (one) return PlaneSet(ParseOnePlane(one, path, "plane", false));
+  if (!list) return std::nullopt;
+  if (!list.IsSequence() || list.size() == 0)
+    throw InputError(Where(path, list, "planes"),
+                     "expected a list of planes, each {normal: [nx, ny, nz], offset: f, name: n}");
+  std::vector<Plane> planes;
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string key = "planes[" + std::to_string(k) + "]";
+    if (!list[k].IsMap())
+      throw InputError(Where(path, list[k], key), "expected a mapping {normal, offset, name}");
+    planes.push_back(ParseOnePlane(list[k], path, key, true));
+    names.push_back(list[k]["name"] ? String(list[k]["name"], path, key + ".name") : "");
+  }
+  return PlaneSet(std::move(planes), std::move(names), Where(path, list, "planes"));
 }
 
 RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
@@ -222,9 +249,10 @@ void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFil
 
 RobotFile LoadRobotFile(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);
-  yaml::CheckKeys(root,
-                  {"name", "description", "links", "true_errors", "plane", "ranger", "calibration"},
-                  path, "");
+  yaml::CheckKeys(
+      root,
+      {"name", "description", "links", "true_errors", "plane", "planes", "ranger", "calibration"},
+      path, "");
   if (root["calibration"] && !root["calibration"].IsMap())
     throw InputError(yaml::Where(path, root["calibration"], "calibration"),
                      "expected a mapping (the record lrcal identify --write-robot writes)");
@@ -232,7 +260,7 @@ RobotFile LoadRobotFile(const std::string& path) {
   const std::vector<Link> links = ParseLinks(root, path);
   RobotFile file;
   file.robot = RobotModel(name, links, ParseTrueErrors(root, path, links), path);
-  file.plane = ParsePlane(root, path);
+  file.planes = ParsePlanes(root, path);
   file.ranger = ParseRanger(root, path);
   file.path = path;
   file.robot.source = path;
@@ -297,7 +325,7 @@ std::string RecordText(const CalibrationRecord& r) {
 }  // namespace
 
 void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
-                              const Eigen::VectorXd& link_values, const Plane& plane,
+                              const Eigen::VectorXd& link_values, const PlaneSet& planes,
                               const CalibrationRecord& record) {
   const RobotModel& robot = rig.robot;
   std::string t = "# A calibrated robot: written by lrcal identify --write-robot from " +
@@ -306,8 +334,18 @@ void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
                   "\nlinks:\n";
   for (int i = 0; i < robot.num_links(); ++i)
     t += LinkLine(robot.links()[i], link_values.data() + kValuesPerLink * i);
-  t += "plane: {normal: [" + Num(plane.normal.x()) + ", " + Num(plane.normal.y()) + ", " +
-       Num(plane.normal.z()) + "], offset: " + Num(plane.offset) + "}\n";
+  const auto plane_text = [](const Plane& plane) {
+    return "{normal: [" + Num(plane.normal.x()) + ", " + Num(plane.normal.y()) + ", " +
+           Num(plane.normal.z()) + "], offset: " + Num(plane.offset);
+  };
+  if (planes.size() == 1) {
+    t += "plane: " + plane_text(planes[0]) + "}\n";
+  } else {
+    t += "planes:\n";
+    for (int p = 0; p < planes.size(); ++p)
+      t += "  - " + plane_text(planes[p]) +
+           (planes.name(p).empty() ? "" : ", name: " + Quoted(planes.name(p))) + "}\n";
+  }
   t += "ranger: {min_range: " + Num(rig.ranger.min_range) +
        ", max_range: " + Num(rig.ranger.max_range) +
        ", max_incidence_deg: " + Num(rig.ranger.max_incidence * 180.0 / M_PI) + "}\n";

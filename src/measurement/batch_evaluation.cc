@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "core/cpu_dispatch.h"
 
@@ -27,9 +29,15 @@ void BatchEvaluator::SetConfigurations(const ConfigurationSet& configs) {
       sq_[j * m_ + i] = configs.sin_q(i)[j];
     }
   }
+  plane_.clear();
+  num_planes_referenced_ = configs.num_planes_referenced();
+  if (num_planes_referenced_ > 1) {
+    plane_.resize(m_);
+    for (int i = 0; i < m_; ++i) plane_[i] = configs.plane(i);
+  }
   state_.resize(12 * static_cast<std::size_t>(m_));
   frames_.resize(static_cast<std::size_t>(kFrameArrays) * joints_ * m_);
-  scratch_.resize(8 * static_cast<std::size_t>(m_));
+  scratch_.resize(12 * static_cast<std::size_t>(m_));
 }
 
 namespace {
@@ -41,6 +49,7 @@ struct KernelArgs {
   const double* q;
   const double* cq;
   const double* sq;
+  const int* plane;  // per configuration; null when all are aimed at plane 0
   double* state;
   double* frames;
   double* scratch;
@@ -51,7 +60,8 @@ struct KernelArgs {
 // The vectorised kernel: structure-of-arrays loops over all configurations, inlined into one
 // variant per instruction set (cpu_dispatch.h). Kept in one function on purpose: the compiler
 // vectorises and inlines it whole, and the variants must give the same bits.
-template <bool kJacobian>
+// Several planes: each configuration's plane normal and offset are gathered into arrays.
+template <bool kJacobian, bool kSeveralPlanes>
 // NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
 [[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
   const int m = args.m;
@@ -151,18 +161,38 @@ template <bool kJacobian>
     }
   }
 
-  // Readings: h = -(n·p + f)/(n·b); keep -1/(n·b) and the hit point for the Jacobian.
-  const double n0 = point.plane.normal.x(), n1 = point.plane.normal.y(),
-               n2 = point.plane.normal.z(), fo = point.plane.offset;
+  // Readings: h = -(n·p + f)/(n·b); keep -1/(n·b) and the hit point for the Jacobian. With one
+  // plane its normal n and offset are scalars; with several, arrays over the configurations.
   double* __restrict inv = args.scratch;
   double* __restrict ph0 = inv + m;
   double* __restrict ph1 = ph0 + m;
   double* __restrict ph2 = ph1 + m;
   double* __restrict nbs = ph2 + m;
+  double* __restrict pn0 = nbs + m;
+  double* __restrict pn1 = pn0 + m;
+  double* __restrict pn2 = pn1 + m;
+  double* __restrict pf = pn2 + m;
+  const Plane& plane0 = point.planes[0];
+  const double s0 = plane0.normal.x(), s1 = plane0.normal.y(), s2 = plane0.normal.z(),
+               sf = plane0.offset;
+  if constexpr (kSeveralPlanes) {
+    for (int i = 0; i < m; ++i) {
+      const Plane& p = point.planes[args.plane[i]];
+      pn0[i] = p.normal.x();
+      pn1[i] = p.normal.y();
+      pn2[i] = p.normal.z();
+      pf[i] = p.offset;
+    }
+  }
+  // n at configuration i: the one plane's, or configuration i's plane's.
+  const auto n0 = [&](int i) { return kSeveralPlanes ? pn0[i] : s0; };
+  const auto n1 = [&](int i) { return kSeveralPlanes ? pn1[i] : s1; };
+  const auto n2 = [&](int i) { return kSeveralPlanes ? pn2[i] : s2; };
+  const auto fo = [&](int i) { return kSeveralPlanes ? pf[i] : sf; };
 #pragma GCC ivdep
   for (int i = 0; i < m; ++i) {
-    const double nb = n0 * z0[i] + n1 * z1[i] + n2 * z2[i];
-    const double hi = -(n0 * o0[i] + n1 * o1[i] + n2 * o2[i] + fo) / nb;
+    const double nb = n0(i) * z0[i] + n1(i) * z1[i] + n2(i) * z2[i];
+    const double hi = -(n0(i) * o0[i] + n1(i) * o1[i] + n2(i) * o2[i] + fo(i)) / nb;
     nbs[i] = nb;
     h[i] = hi;
     inv[i] = -1.0 / nb;
@@ -186,7 +216,7 @@ template <bool kJacobian>
       const double* __restrict a1 = a0 + m;
       const double* __restrict a2 = a1 + m;
 #pragma GCC ivdep
-      for (int i = 0; i < m; ++i) col[i] = (n0 * a0[i] + n1 * a1[i] + n2 * a2[i]) * inv[i];
+      for (int i = 0; i < m; ++i) col[i] = (n0(i) * a0[i] + n1(i) * a1[i] + n2(i) * a2[i]) * inv[i];
       continue;
     }
     // θ: axis z_prev through o_prev; α: x_common through o; β: y_twist through o.
@@ -200,33 +230,50 @@ template <bool kJacobian>
     for (int i = 0; i < m; ++i) {
       const double r0 = ph0[i] - c0[i], r1 = ph1[i] - c1[i], r2 = ph2[i] - c2[i];
       // (r × n)·axis
-      const double g =
-          (r1 * n2 - r2 * n1) * a0[i] + (r2 * n0 - r0 * n2) * a1[i] + (r0 * n1 - r1 * n0) * a2[i];
+      const double g = (r1 * n2(i) - r2 * n1(i)) * a0[i] + (r2 * n0(i) - r0 * n2(i)) * a1[i] +
+                       (r0 * n1(i) - r1 * n0(i)) * a2[i];
       col[i] = g * inv[i];
     }
   }
-  for (int c = 0; c < 2; ++c) {
-    if (ps.u_index[c] < 0) continue;
-    double* __restrict col = J + static_cast<std::size_t>(ps.u_index[c]) * m;
-    const double d0 = point.dn_du(0, c), d1 = point.dn_du(1, c), d2 = point.dn_du(2, c);
+  for (int p = 0; p < ps.num_planes(); ++p) {
+    const PlaneColumns& pc = ps.plane_columns[p];
+    // 1 on the configurations aimed at plane p, 0 elsewhere (all are aimed at plane 0 in the
+    // single-plane kernel).
+    const double all_own = p == 0 ? 1.0 : 0.0;
+    const auto own = [&](int i) {
+      return kSeveralPlanes ? (args.plane[i] == p ? 1.0 : 0.0) : all_own;
+    };
+    for (int c = 0; c < 2; ++c) {
+      if (pc.u[c] < 0) continue;
+      double* __restrict col = J + static_cast<std::size_t>(pc.u[c]) * m;
+      const double d0 = point.dn_du[p](0, c), d1 = point.dn_du[p](1, c), d2 = point.dn_du[p](2, c);
 #pragma GCC ivdep
-    for (int i = 0; i < m; ++i) col[i] = (ph0[i] * d0 + ph1[i] * d1 + ph2[i] * d2) * inv[i];
-  }
-  if (ps.f_index >= 0) {
-    double* __restrict col = J + static_cast<std::size_t>(ps.f_index) * m;
+      for (int i = 0; i < m; ++i)
+        col[i] = own(i) * ((ph0[i] * d0 + ph1[i] * d1 + ph2[i] * d2) * inv[i]);
+    }
+    if (pc.f >= 0) {
+      double* __restrict col = J + static_cast<std::size_t>(pc.f) * m;
 #pragma GCC ivdep
-    for (int i = 0; i < m; ++i) col[i] = inv[i];
+      for (int i = 0; i < m; ++i) col[i] = own(i) * inv[i];
+    }
   }
   return parallel == 0;
 }
 
-bool KernelDefault(const KernelArgs& a) { return a.J ? KernelBody<true>(a) : KernelBody<false>(a); }
+template <bool kJacobian>
+[[gnu::always_inline]] inline bool KernelPlanes(const KernelArgs& a) {
+  return a.plane ? KernelBody<kJacobian, true>(a) : KernelBody<kJacobian, false>(a);
+}
+
+bool KernelDefault(const KernelArgs& a) {
+  return a.J ? KernelPlanes<true>(a) : KernelPlanes<false>(a);
+}
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) bool KernelAvx2(const KernelArgs& a) {
-  return a.J ? KernelBody<true>(a) : KernelBody<false>(a);
+  return a.J ? KernelPlanes<true>(a) : KernelPlanes<false>(a);
 }
 __attribute__((target("avx512f"))) bool KernelAvx512(const KernelArgs& a) {
-  return a.J ? KernelBody<true>(a) : KernelBody<false>(a);
+  return a.J ? KernelPlanes<true>(a) : KernelPlanes<false>(a);
 }
 #endif
 
@@ -239,8 +286,21 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
 
 bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
                               double* J, Isa isa) {
-  const KernelArgs args{m_,         &point,        &model.parameters(), q_.data(),       cq_.data(),
-                        sq_.data(), state_.data(), frames_.data(),      scratch_.data(), h,
+  if (num_planes_referenced_ > model.num_planes())
+    throw std::invalid_argument("BatchEvaluator: a configuration is aimed at plane " +
+                                std::to_string(num_planes_referenced_) + " of " +
+                                std::to_string(model.num_planes()));
+  const KernelArgs args{m_,
+                        &point,
+                        &model.parameters(),
+                        q_.data(),
+                        cq_.data(),
+                        sq_.data(),
+                        plane_.empty() ? nullptr : plane_.data(),
+                        state_.data(),
+                        frames_.data(),
+                        scratch_.data(),
+                        h,
                         J};
   bool ok;
   switch (isa) {

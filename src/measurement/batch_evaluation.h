@@ -30,8 +30,11 @@ class BatchEvaluator {
                 Isa isa);
 
  private:
-  int m_ = 0, joints_ = 0;
+  int m_ = 0, joints_ = 0, num_planes_referenced_ = 0;
   std::vector<double> q_, cq_, sq_;  // [joint·m + i]
+  // Each configuration's plane; empty when every configuration is aimed at plane 0 (the
+  // single-plane kernel, which keeps the plane's normal in registers).
+  std::vector<int> plane_;
   // Chain state and per-link frames: [(link·kFrameArrays + k)·m + i].
   std::vector<double> state_, frames_, scratch_;
 };

@@ -6,20 +6,27 @@
 
 namespace lrcal {
 
-void PrepareModelPoint(const RobotModel& robot, const double* v, const Plane& plane,
+void PrepareModelPoint(const RobotModel& robot, const double* v, const PlaneSet& planes,
                        ModelPoint* point) {
   PrepareChainPoint(robot, v, point);
-  point->plane = plane;
+  point->num_planes = planes.size();
+  for (int p = 0; p < planes.size(); ++p) {
+    point->planes[p] = planes[p];
+    point->dn_du[p].setZero();
+  }
   point->ranger_offset = 0;
   point->ranger_scale = 0;
 }
 
-MeasurementModel::MeasurementModel(const RobotModel& robot, const Plane& nominal_plane,
+MeasurementModel::MeasurementModel(const RobotModel& robot, const PlaneSet& nominal_planes,
                                    ParameterSet parameters)
-    : robot_(&robot),
-      nominal_plane_(nominal_plane),
-      parameters_(std::move(parameters)),
-      chart_(nominal_plane.normal) {}
+    : robot_(&robot), nominal_planes_(nominal_planes), parameters_(std::move(parameters)) {
+  if (parameters_.num_planes() != nominal_planes_.size())
+    throw InputError("parameters",
+                     "the parameter set has terms for " + std::to_string(parameters_.num_planes()) +
+                         " plane(s) but the set-up has " + std::to_string(nominal_planes_.size()));
+  for (const Plane& p : nominal_planes_) charts_.emplace_back(p.normal);
+}
 
 Eigen::VectorXd MeasurementModel::LinkValues(const double* e) const {
   Eigen::VectorXd v = robot_->nominal_values();
@@ -27,16 +34,22 @@ Eigen::VectorXd MeasurementModel::LinkValues(const double* e) const {
   return v;
 }
 
-Plane MeasurementModel::PlaneAt(const double* e) const {
-  Plane p = nominal_plane_;
-  if (parameters_.EstimatesNormal()) {
-    const int* u = parameters_.u_index;
+Plane MeasurementModel::PlaneAt(const double* e, int p) const {
+  Plane plane = nominal_planes_[p];
+  const PlaneColumns& c = parameters_.plane_columns[p];
+  if (c.EstimatesNormal()) {
     Eigen::Matrix<double, 3, 2> unused;
-    chart_.NormalAndJacobian(u[0] >= 0 ? e[u[0]] : 0.0, u[1] >= 0 ? e[u[1]] : 0.0, &p.normal,
-                             &unused);
+    charts_[p].NormalAndJacobian(c.u[0] >= 0 ? e[c.u[0]] : 0.0, c.u[1] >= 0 ? e[c.u[1]] : 0.0,
+                                 &plane.normal, &unused);
   }
-  if (parameters_.f_index >= 0) p.offset += e[parameters_.f_index];
-  return p;
+  if (c.f >= 0) plane.offset += e[c.f];
+  return plane;
+}
+
+PlaneSet MeasurementModel::PlanesAt(const double* e) const {
+  PlaneSet out = nominal_planes_;
+  for (int p = 0; p < num_planes(); ++p) out[p] = PlaneAt(e, p);
+  return out;
 }
 
 void MeasurementModel::Prepare(const double* e, ModelPoint* point) const {
@@ -44,17 +57,22 @@ void MeasurementModel::Prepare(const double* e, ModelPoint* point) const {
   const Eigen::VectorXd& nominal = robot_->nominal_values();
   for (int k = 0; k < robot_->num_values(); ++k) v[k] = nominal[k];
   for (int k = 0; k < parameters_.num_robot(); ++k) v[parameters_.robot_values[k]] += e[k];
-  Plane plane = nominal_plane_;
-  if (parameters_.EstimatesNormal()) {
-    const int* u = parameters_.u_index;
-    chart_.NormalAndJacobian(u[0] >= 0 ? e[u[0]] : 0.0, u[1] >= 0 ? e[u[1]] : 0.0, &plane.normal,
-                             &point->dn_du);
+  PrepareChainPoint(*robot_, v, point);
+  point->num_planes = num_planes();
+  for (int p = 0; p < num_planes(); ++p) {
+    Plane& plane = point->planes[p];
+    plane = nominal_planes_[p];
+    point->dn_du[p].setZero();
+    const PlaneColumns& c = parameters_.plane_columns[p];
+    if (c.EstimatesNormal())
+      charts_[p].NormalAndJacobian(c.u[0] >= 0 ? e[c.u[0]] : 0.0, c.u[1] >= 0 ? e[c.u[1]] : 0.0,
+                                   &plane.normal, &point->dn_du[p]);
+    if (c.f >= 0) plane.offset += e[c.f];
   }
-  if (parameters_.f_index >= 0) plane.offset += e[parameters_.f_index];
-  PrepareModelPoint(*robot_, v, plane, point);
-  if (parameters_.ranger_offset_index >= 0)
-    point->ranger_offset = e[parameters_.ranger_offset_index];
-  if (parameters_.ranger_scale_index >= 0) point->ranger_scale = e[parameters_.ranger_scale_index];
+  point->ranger_offset =
+      parameters_.ranger_offset_index >= 0 ? e[parameters_.ranger_offset_index] : 0.0;
+  point->ranger_scale =
+      parameters_.ranger_scale_index >= 0 ? e[parameters_.ranger_scale_index] : 0.0;
 }
 
 void MeasurementModel::ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const {
@@ -80,10 +98,11 @@ double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSe
                                   double* h, double* row) const {
   ChainFrames frames;
   const Pose<double> pose = ToolPose(point, configs, i, row ? &frames : nullptr);
-  const Eigen::Vector3d& n = point.plane.normal;
+  const int plane = configs.plane(i);
+  const Eigen::Vector3d& n = point.planes[plane].normal;
   const Eigen::Vector3d b = pose.R_BT.col(2);
   double nb;
-  *h = BeamReading(pose, point.plane, &nb);
+  *h = BeamReading(pose, point.planes[plane], &nb);
   if (!row) {
     ApplyRanger(point, 1, h, nullptr);
     return nb;
@@ -115,10 +134,13 @@ double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSe
     }
     row[col] = g * inv;
   }
-  for (int c = 0; c < 2; ++c)
-    if (parameters_.u_index[c] >= 0)
-      row[parameters_.u_index[c]] = inv * p_hit.dot(point.dn_du.col(c));
-  if (parameters_.f_index >= 0) row[parameters_.f_index] = inv;
+  for (int p = 0; p < parameters_.num_planes(); ++p) {
+    const PlaneColumns& c = parameters_.plane_columns[p];
+    const bool own = p == plane;
+    for (int k = 0; k < 2; ++k)
+      if (c.u[k] >= 0) row[c.u[k]] = own ? inv * p_hit.dot(point.dn_du[p].col(k)) : 0.0;
+    if (c.f >= 0) row[c.f] = own ? inv : 0.0;
+  }
   // One configuration: a 1×n row is a column-major matrix with leading dimension 1.
   ApplyRanger(point, 1, h, row);
   return nb;

@@ -34,7 +34,7 @@ void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& grou
       continue;
     }
     for (int j = 0; j < n; ++j) mean[j] = sum[static_cast<std::size_t>(g) * n + j] / count[g];
-    data->configs.Add(mean.data());
+    data->configs.Add(mean.data(), q.plane(first[g]));
   }
 }
 
@@ -70,8 +70,15 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
     if (labels) {
       id = label_index.emplace((*labels)[r], next).first->second;
     } else {
-      id = index.emplace(std::vector<double>(q.q(r), q.q(r) + n), next).first->second;
+      std::vector<double> key(q.q(r), q.q(r) + n);
+      key.push_back(q.plane(r));  // one pose read on two planes would be two configurations
+      id = index.emplace(std::move(key), next).first->second;
     }
+    if (id != next && q.plane(r) != q.plane(first[id]))
+      throw InputError(where(r), "this reading is on plane " + std::to_string(q.plane(r) + 1) +
+                                     " but earlier readings of its configuration are on plane " +
+                                     std::to_string(q.plane(first[id]) + 1) +
+                                     "; one configuration's readings are on one plane");
     if (id == next) {
       first.push_back(r);
       sums.push_back(0);

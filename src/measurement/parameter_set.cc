@@ -4,6 +4,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/measurement/plane.h"
 
 namespace lrcal {
 
@@ -57,6 +58,16 @@ DisplayUnit DisplayUnitOf(const std::string& name) {
   return IsAngularName(name) ? DisplayUnit{"mrad", 1e3} : DisplayUnit{"mm", 1e3};
 }
 
+std::string PlaneTermName(int p, int num_planes, const std::string& term) {
+  return num_planes == 1 ? "plane_" + term : "plane" + std::to_string(p + 1) + "_" + term;
+}
+
+bool ParameterSet::EstimatesPlanes() const {
+  for (const PlaneColumns& c : plane_columns)
+    if (c.EstimatesNormal() || c.f >= 0) return true;
+  return false;
+}
+
 ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
                                const std::vector<std::string>& names) {
   // Everything `in` already leaves out stays out.
@@ -64,18 +75,43 @@ ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
   for (int k : robot.parameter_indices())
     if (std::find(in.robot_values.begin(), in.robot_values.end(), k) == in.robot_values.end())
       fixed.push_back(robot.ValueName(k));
-  if (in.plane.normal && in.u_index[0] < 0) fixed.push_back("plane_u1");
-  if (in.plane.normal && in.u_index[1] < 0) fixed.push_back("plane_u2");
-  if (in.plane.offset && in.f_index < 0) fixed.push_back("plane_f");
+  const int np = in.num_planes();
+  for (int p = 0; p < np; ++p) {
+    const PlaneTerms& t = in.plane_terms[p];
+    const PlaneColumns& c = in.plane_columns[p];
+    if (t.normal && c.u[0] < 0) fixed.push_back(PlaneTermName(p, np, "u1"));
+    if (t.normal && c.u[1] < 0) fixed.push_back(PlaneTermName(p, np, "u2"));
+    if (t.offset && c.f < 0) fixed.push_back(PlaneTermName(p, np, "f"));
+  }
   if (in.ranger.offset && in.ranger_offset_index < 0) fixed.push_back("ranger_offset");
   if (in.ranger.scale && in.ranger_scale_index < 0) fixed.push_back("ranger_scale");
-  return MakeParameterSet(robot, in.plane, fixed, "--fix", in.ranger);
+  return MakeParameterSet(robot, in.plane_terms, fixed, "--fix", in.ranger);
 }
 
+namespace {
+
+// "plane_u1" → (0, "u1") with one plane; "plane2_f" → (1, "f"); else false.
+bool ParsePlaneTermName(const std::string& name, int* plane, std::string* term) {
+  if (name.rfind("plane", 0) != 0) return false;
+  std::size_t k = 5;
+  int number = 0;
+  while (k < name.size() && name[k] >= '0' && name[k] <= '9' && number <= kMaxPlanes)
+    number = 10 * number + (name[k++] - '0');
+  if (k >= name.size() || name[k] != '_') return false;
+  *term = name.substr(k + 1);
+  if (*term != "u1" && *term != "u2" && *term != "f") return false;
+  *plane = k == 5 ? -1 : number - 1;  // -1: the unnumbered single-plane form
+  return k == 5 || number >= 1;
+}
+
+}  // namespace
+
 bool IsAngularName(const std::string& name) {
-  for (const char* prefix : {"theta", "alpha", "beta", "plane_u"})
+  for (const char* prefix : {"theta", "alpha", "beta"})
     if (name.rfind(prefix, 0) == 0) return true;
-  return false;
+  int plane;
+  std::string term;
+  return ParsePlaneTermName(name, &plane, &term) && term != "f";
 }
 
 bool ParameterSet::IsAngular(int k) const { return IsAngularName(names[k]); }
@@ -89,23 +125,31 @@ namespace {
 
 // What `fixed` names: robot link values (indices) and plane terms.
 struct FixedNames {
+  struct PlaneFixed {
+    bool u[2] = {false, false};
+    bool offset = false;
+  };
   std::vector<int> values;
-  bool u[2] = {false, false};
-  bool offset = false;
+  std::vector<PlaneFixed> planes;
   bool ranger_offset = false, ranger_scale = false;
 };
 
 FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& fixed,
-                      const std::string& source) {
+                      int num_planes, const std::string& source) {
   FixedNames out;
+  out.planes.resize(num_planes);
   for (const std::string& name : fixed) {
     if (name.empty()) continue;
-    if (name == "plane_u1" || name == "plane_u2") {
-      out.u[name == "plane_u2"] = true;
-      continue;
-    }
-    if (name == "plane_f") {
-      out.offset = true;
+    int p;
+    std::string term;
+    if (ParsePlaneTermName(name, &p, &term)) {
+      if ((p < 0) != (num_planes == 1) || p >= num_planes)
+        throw InputError(source, "unknown plane term '" + name + "': with " +
+                                     std::to_string(num_planes) + " plane(s) the names are " +
+                                     PlaneTermName(0, num_planes, "u1") + " ... " +
+                                     PlaneTermName(num_planes - 1, num_planes, "f"));
+      FixedNames::PlaneFixed& f = out.planes[std::max(p, 0)];
+      (term == "f" ? f.offset : f.u[term == "u2"]) = true;
       continue;
     }
     if (name == "ranger_offset" || name == "ranger_scale") {
@@ -129,23 +173,37 @@ FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& f
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed, const std::string& source,
                               RangerTerms ranger) {
-  const FixedNames f = ParseFixed(robot, fixed, source);
+  return MakeParameterSet(robot, std::vector<PlaneTerms>{plane}, fixed, source, ranger);
+}
+
+ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTerms>& planes,
+                              const std::vector<std::string>& fixed, const std::string& source,
+                              RangerTerms ranger) {
+  const int np = static_cast<int>(planes.size());
+  if (np < 1 || np > kMaxPlanes)
+    throw InputError(source, "expected 1 to " + std::to_string(kMaxPlanes) + " planes, got " +
+                                 std::to_string(np));
+  const FixedNames f = ParseFixed(robot, fixed, np, source);
   ParameterSet set;
-  set.plane = plane;
+  set.plane_terms = planes;
+  set.plane_columns.assign(np, PlaneColumns{});
   for (int k : robot.parameter_indices()) {
     if (std::find(f.values.begin(), f.values.end(), k) != f.values.end()) continue;
     set.robot_values.push_back(k);
     set.names.push_back(robot.ValueName(k));
   }
-  for (int c = 0; c < 2; ++c) {
-    if (plane.normal && !f.u[c]) {
-      set.u_index[c] = set.size();
-      set.names.push_back(c == 0 ? "plane_u1" : "plane_u2");
+  for (int p = 0; p < np; ++p) {
+    PlaneColumns& columns = set.plane_columns[p];
+    for (int c = 0; c < 2; ++c) {
+      if (planes[p].normal && !f.planes[p].u[c]) {
+        columns.u[c] = set.size();
+        set.names.push_back(PlaneTermName(p, np, c == 0 ? "u1" : "u2"));
+      }
     }
-  }
-  if (plane.offset && !f.offset) {
-    set.f_index = set.size();
-    set.names.push_back("plane_f");
+    if (planes[p].offset && !f.planes[p].offset) {
+      columns.f = set.size();
+      set.names.push_back(PlaneTermName(p, np, "f"));
+    }
   }
   set.ranger = ranger;
   if (ranger.offset && !f.ranger_offset) {

@@ -44,6 +44,43 @@ Plane Plane::Parse(const std::string& text, const std::string& source) {
   return FromCoefficients(v[0], v[1], v[2], v[3], source);
 }
 
+PlaneSet::PlaneSet(std::vector<Plane> planes, std::vector<std::string> names,
+                   const std::string& source)
+    : planes_(std::move(planes)), names_(std::move(names)) {
+  if (planes_.empty()) throw InputError(source, "expected at least one plane");
+  if (size() > kMaxPlanes)
+    throw InputError(source, "expected at most " + std::to_string(kMaxPlanes) + " planes, got " +
+                                 std::to_string(size()));
+  if (names_.empty()) names_.assign(planes_.size(), "");
+  if (names_.size() != planes_.size()) throw InputError(source, "expected one name per plane");
+  for (int p = 0; p < size(); ++p) {
+    if (names_[p].empty()) continue;
+    bool digits = true;
+    for (char c : names_[p]) digits = digits && c >= '0' && c <= '9';
+    if (digits)
+      throw InputError(source, "plane name '" + names_[p] +
+                                   "' is a number; a name must not read as a plane's index");
+    for (int k = 0; k < p; ++k)
+      if (names_[k] == names_[p])
+        throw InputError(source, "two planes are named '" + names_[p] + "'");
+  }
+}
+
+std::string PlaneSet::Label(int p) const {
+  return names_[p].empty() ? "plane " + std::to_string(p + 1) : names_[p];
+}
+
+int PlaneSet::Find(const std::string& ref) const {
+  for (int p = 0; p < size(); ++p)
+    if (!names_[p].empty() && names_[p] == ref) return p;
+  int number = 0;
+  for (char c : ref) {
+    if (c < '0' || c > '9' || number > kMaxPlanes) return -1;
+    number = 10 * number + (c - '0');
+  }
+  return !ref.empty() && number >= 1 && number <= size() ? number - 1 : -1;
+}
+
 void TangentBasis(const Eigen::Vector3d& n0, Eigen::Vector3d* t1, Eigen::Vector3d* t2) {
   int axis = 0;
   for (int k = 1; k < 3; ++k)

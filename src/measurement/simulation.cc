@@ -6,19 +6,29 @@
 
 namespace lrcal {
 
-void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values, const Plane& plane,
-                   const RangerSpec& ranger, const ConfigurationSet& configs,
-                   std::vector<double>* h, std::vector<BeamMiss>* misses) {
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                   const PlaneSet& planes, const RangerSpec& ranger,
+                   const ConfigurationSet& configs, std::vector<double>* h,
+                   std::vector<BeamMiss>* misses) {
+  CheckPlanesReferenced(configs, planes);
   ModelPoint point;
-  PrepareModelPoint(robot, link_values.data(), plane, &point);
+  PrepareModelPoint(robot, link_values.data(), planes, &point);
   h->resize(configs.size());
   if (misses) misses->resize(configs.size());
   for (int i = 0; i < configs.size(); ++i) {
     const Pose<double> pose = ToolPose(point, configs, i);
     double nb;
-    (*h)[i] = BeamReading(pose, plane, &nb);
+    (*h)[i] = BeamReading(pose, planes[configs.plane(i)], &nb);
     if (misses) (*misses)[i] = ClassifyReading((*h)[i], nb, ranger);
   }
+}
+
+void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& planes) {
+  if (configs.num_planes_referenced() > planes.size())
+    throw InputError("planes", "a configuration is aimed at plane " +
+                                   std::to_string(configs.num_planes_referenced()) +
+                                   " but the set-up has " + std::to_string(planes.size()) +
+                                   " plane(s)");
 }
 
 void NoiseModel::Validate(const std::string& source) const {
@@ -47,9 +57,9 @@ namespace {
 // The exact readings under encoder noise and form error: per configuration (draw_mean, at the
 // mean joint error) or per reading. Misses are those of the recorded configuration.
 void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
-                       const Plane& plane, const ConfigurationSet& configs, const NoiseModel& noise,
-                       const RandomStream& stream, const std::vector<int>* noise_slots,
-                       std::vector<double>* out) {
+                       const PlaneSet& planes, const ConfigurationSet& configs,
+                       const NoiseModel& noise, const RandomStream& stream,
+                       const std::vector<int>* noise_slots, std::vector<double>* out) {
   const int R = noise.repetitions, per = noise.draw_mean ? 1 : R, nj = configs.num_joints();
   const RandomStream encoder = stream.WithPurpose(RandomPurpose::kEncoder);
   const RandomStream form = stream.WithPurpose(RandomPurpose::kPlaneForm);
@@ -64,15 +74,15 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
       for (int j = 0; j < nj; ++j)
         q[j] = configs.q(i)[j] +
                (sigma_q > 0 ? sigma_q * encoder.Normal((slot * R + r) * nj + j) : 0.0);
-      disturbed.Add(q.data());
+      disturbed.Add(q.data(), configs.plane(i));
     }
   }
   ModelPoint point;
-  PrepareModelPoint(robot, link_values.data(), plane, &point);
+  PrepareModelPoint(robot, link_values.data(), planes, &point);
   out->resize(disturbed.size());
   for (int k = 0; k < disturbed.size(); ++k) {
     const std::uint64_t slot = noise_slots ? (*noise_slots)[k / per] : k / per;
-    Plane local = plane;
+    Plane local = planes[disturbed.plane(k)];
     if (noise.form_sigma > 0) local.offset += noise.form_sigma * form.Normal(slot);
     double nb;
     (*out)[k] = BeamReading(ToolPose(point, disturbed, k), local, &nb);
@@ -118,7 +128,7 @@ double MeanOfReadings(const NoiseModel& noise, const RandomStream& stream,
 }  // namespace
 
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
-                     const Plane& true_plane, const RangerSpec& ranger,
+                     const PlaneSet& true_planes, const RangerSpec& ranger,
                      const ConfigurationSet& configs, const NoiseModel& noise,
                      const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses, std::vector<double>* raw,
@@ -127,11 +137,11 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   std::vector<double> h;
   std::vector<BeamMiss> local;
   std::vector<BeamMiss>* m = misses ? misses : &local;
-  ExactReadings(robot, true_link_values, true_plane, ranger, configs, &h, m);
+  ExactReadings(robot, true_link_values, true_planes, ranger, configs, &h, m);
   if (!noise.DisturbsGeometry())
     return AddNoise(h, *m, configs, noise, stream, data, raw, noise_slots);
   std::vector<double> disturbed;
-  DisturbedReadings(robot, true_link_values, true_plane, configs, noise, stream, noise_slots,
+  DisturbedReadings(robot, true_link_values, true_planes, configs, noise, stream, noise_slots,
                     &disturbed);
   if (noise.draw_mean)
     return AddNoise(disturbed, *m, configs, noise, stream, data, raw, noise_slots);

@@ -40,7 +40,7 @@ PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
   const Eigen::VectorXd truth = robot.true_values();
   SamplingOptions pool_options = options.sampling;
   pool_options.true_link_values = truth;  // the simulated readings must exist
-  pool_options.true_plane = plane;
+  pool_options.true_planes = PlaneSet(plane);
   result.pool = SampleConfigurations(robot, plane, options.pool_size,
                                      RandomStream(options.seed, 0, 0, RandomPurpose::kPool),
                                      pool_options, &result.pool_report);

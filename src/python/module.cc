@@ -128,7 +128,11 @@ std::vector<double> ToVector(const Array& a, const char* name) {
 // `plane`: None (the robot file's), a Plane, or four numbers nx, ny, nz, f.
 Plane ResolvePlane(const RobotFile& rig, const py::object& plane) {
   if (plane.is_none()) {
-    if (rig.plane) return *rig.plane;
+    if (rig.planes && rig.planes->size() == 1) return (*rig.planes)[0];
+    if (rig.planes)
+      throw InputError("plane", "the robot file '" + rig.path +
+                                    "' has several planes; the Python module calibrates against "
+                                    "one: pass plane=lrcal.Plane((nx, ny, nz), f)");
     throw InputError("plane", "the robot file '" + rig.path +
                                   "' has no plane: pass plane=lrcal.Plane((nx, ny, nz), f)");
   }
@@ -543,7 +547,21 @@ Raises lrcal.InputError naming the file, line and key of anything wrong.)doc")
             return limits;
           },
           "(N, 2) joint limits q_min, q_max (rad).")
-      .def_readonly("plane", &RobotFile::plane, "The file's plane, or None.")
+      .def_property_readonly(
+          "plane",
+          [](const RobotFile& r) -> std::optional<Plane> {
+            if (r.planes && r.planes->size() == 1) return (*r.planes)[0];
+            return std::nullopt;
+          },
+          "The file's plane, or None (no plane, or several: see planes).")
+      .def_property_readonly(
+          "planes",
+          [](const RobotFile& r) {
+            std::vector<Plane> out;
+            if (r.planes) out.assign(r.planes->begin(), r.planes->end());
+            return out;
+          },
+          "The file's planes (a list, empty if it gives none).")
       .def_readonly("ranger", &RobotFile::ranger, "The ranger's limits.")
       .def("__repr__", [](const RobotFile& r) {
         return "lrcal.Robot('" + r.robot.name() + "', " + std::to_string(r.robot.num_links()) +

@@ -53,6 +53,7 @@ namespace {
 using LineMap = std::map<std::string, int>;
 
 std::string Join(const std::string& prefix, const std::string& key) {
+  if (key.empty()) return prefix;
   return prefix.empty() ? key : prefix + "." + key;
 }
 
@@ -224,7 +225,7 @@ void OnlyKeys(const Json& map, const std::string& path, std::initializer_list<co
   for (auto it = map.begin(); it != map.end(); ++it) {
     bool ok = false;
     for (const char* a : allowed) ok |= it.key() == a;
-    if (!ok) throw InputError(where(path + "." + it.key()), "unknown key; expected " + expected);
+    if (!ok) throw InputError(where(Join(path, it.key())), "unknown key; expected " + expected);
   }
 }
 
@@ -240,38 +241,75 @@ Eigen::Vector3d Vector3(const Json& s, const std::string& path, const std::strin
   return out;
 }
 
-// plane: 'robot', {normal, offset} or {tilt_deg, azimuth_deg, through}.
+// One plane: {normal, offset} or {tilt_deg, azimuth_deg, through}, the mapping `m` at the key
+// path where.prefix ("plane", or "plane[k]" in a list, which may also give name, share and
+// estimate).
+Plane ParsePlaneMapping(const Json& m, const KeyLocator& where, bool in_list) {
+  const char* const extra = in_list ? ", name, share, estimate" : "";
+  if (m.contains("normal")) {
+    if (in_list)
+      OnlyKeys(m, "", {"normal", "offset", "name", "share", "estimate"},
+               std::string("normal, offset") + extra, where);
+    else
+      OnlyKeys(m, "", {"normal", "offset"}, "normal, offset", where);
+    const Eigen::Vector3d n = Vector3(m, "normal", "three numbers [nx, ny, nz]", where);
+    return Plane::FromCoefficients(n.x(), n.y(), n.z(), Num(m, "offset", where), where(""));
+  }
+  const std::string expected = std::string("normal/offset or tilt_deg/azimuth_deg/through") + extra;
+  if (in_list)
+    OnlyKeys(m, "", {"tilt_deg", "azimuth_deg", "through", "name", "share", "estimate"}, expected,
+             where);
+  else
+    OnlyKeys(m, "", {"tilt_deg", "azimuth_deg", "through"}, expected, where);
+  const double tilt = Num(m, "tilt_deg", where) * M_PI / 180;
+  const double az = m.contains("azimuth_deg") ? Num(m, "azimuth_deg", where) * M_PI / 180 : 0.0;
+  if (tilt < 0 || tilt > M_PI)
+    throw InputError(where("tilt_deg"), "expected an angle in [0, 180] degrees");
+  const Eigen::Vector3d through = m.contains("through")
+                                      ? Vector3(m, "through", "a point [x, y, z] in m", where)
+                                      : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d n(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az),
+                          std::cos(tilt));
+  return Plane::FromCoefficients(n.x(), n.y(), n.z(), -n.dot(through), where(""));
+}
+
+// plane: 'robot', one plane mapping, or a list of them (several planes: each may add name,
+// share — its part of the pool and validation draws, default equal — and estimate — its plane
+// terms, default identification.estimate_plane).
 void ParsePlane(const Json& s, const KeyLocator& where, CellSettings* c) {
   const Json& plane = At(s, "plane");  // null when given as nothing (a merge deletes it)
   if (plane.is_string()) {
     if (plane != "robot")
       throw InputError(where("plane"),
-                       "expected 'robot', {normal: [nx, ny, nz], offset: f} or "
-                       "{tilt_deg: t, azimuth_deg: a, through: [x, y, z]}");
+                       "expected 'robot', {normal: [nx, ny, nz], offset: f}, "
+                       "{tilt_deg: t, azimuth_deg: a, through: [x, y, z]} or a list of these");
     return;
   }
-  if (!plane.is_object()) throw InputError(where("plane"), "expected 'robot' or a mapping");
   c->plane_from_robot = false;
-  if (plane.contains("normal")) {
-    OnlyKeys(plane, "plane", {"normal", "offset"}, "normal, offset", where);
-    const Eigen::Vector3d n = Vector3(s, "plane.normal", "three numbers [nx, ny, nz]", where);
-    c->plane =
-        Plane::FromCoefficients(n.x(), n.y(), n.z(), Num(s, "plane.offset", where), where("plane"));
+  KeyLocator at = where;
+  if (plane.is_object()) {
+    at.prefix = Join(where.prefix, "plane");
+    c->planes = PlaneSet(ParsePlaneMapping(plane, at, false));
     return;
   }
-  OnlyKeys(plane, "plane", {"tilt_deg", "azimuth_deg", "through"},
-           "normal/offset or tilt_deg/azimuth_deg/through", where);
-  const double tilt = Num(s, "plane.tilt_deg", where) * M_PI / 180;
-  const double az =
-      plane.contains("azimuth_deg") ? Num(s, "plane.azimuth_deg", where) * M_PI / 180 : 0.0;
-  if (tilt < 0 || tilt > M_PI)
-    throw InputError(where("plane.tilt_deg"), "expected an angle in [0, 180] degrees");
-  const Eigen::Vector3d through = plane.contains("through")
-                                      ? Vector3(s, "plane.through", "a point [x, y, z] in m", where)
-                                      : Eigen::Vector3d::Zero();
-  const Eigen::Vector3d n(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az),
-                          std::cos(tilt));
-  c->plane = Plane::FromCoefficients(n.x(), n.y(), n.z(), -n.dot(through), where("plane"));
+  if (!plane.is_array() || plane.empty())
+    throw InputError(where("plane"), "expected 'robot', a plane mapping or a list of them");
+  std::vector<Plane> planes;
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < plane.size(); ++k) {
+    at.prefix = Join(where.prefix, "plane") + "[" + std::to_string(k) + "]";
+    const Json& m = plane[k];
+    if (!m.is_object()) throw InputError(at(""), "expected a plane mapping");
+    planes.push_back(ParsePlaneMapping(m, at, true));
+    names.push_back(m.contains("name") ? Str(m, "name", at) : "");
+    const double share = m.contains("share") ? Num(m, "share", at) : 1.0;
+    if (!(share > 0 && std::isfinite(share)))
+      throw InputError(at("share"), "expected a positive share of the configurations");
+    c->plane_shares.push_back(share);
+    c->plane_estimate.push_back(m.contains("estimate") ? Str(m, "estimate", at) : "");
+    if (m.contains("estimate")) PlaneTerms::Parse(c->plane_estimate.back(), at("estimate"));
+  }
+  c->planes = PlaneSet(std::move(planes), std::move(names), where("plane"));
 }
 
 void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c) {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -72,6 +73,28 @@ Eigen::MatrixXd CellDesignJacobian(const CellContext& c, const ConfigurationSet&
   return DesignJacobian(*c.model, pool, s.scaling, s.truth_angle_sigma, s.truth_length_sigma);
 }
 
+// `total` configurations split over the planes by their shares (largest remainders, ties to the
+// earlier plane), so that every plane gets its part and the parts add up to `total`.
+std::vector<int> PerPlaneCounts(const CellSettings& s, const PlaneSet& planes, int total) {
+  const int np = planes.size();
+  std::vector<double> share(np, 1.0);
+  if (static_cast<int>(s.plane_shares.size()) == np) share = s.plane_shares;
+  double sum = 0;
+  for (double w : share) sum += w;
+  std::vector<int> counts(np);
+  std::vector<std::pair<double, int>> remainders;
+  int given = 0;
+  for (int p = 0; p < np; ++p) {
+    const double exact = total * share[p] / sum;
+    counts[p] = static_cast<int>(std::floor(exact));
+    given += counts[p];
+    remainders.emplace_back(-(exact - counts[p]), p);
+  }
+  std::stable_sort(remainders.begin(), remainders.end());
+  for (int k = 0; given < total; ++k, ++given) ++counts[remainders[k % np].second];
+  return counts;
+}
+
 ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::VectorXd& truth,
                             SamplingReport* report) {
   const CellSettings& s = c.cell->typed;
@@ -79,10 +102,11 @@ ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::
   o.ranger = c.ranger;
   o.min_jacobian_singular_value = s.min_singular_value;
   o.true_link_values = truth;
-  o.true_plane = c.plane;
+  o.true_planes = c.planes;
   const RandomStream stream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
                             RandomPurpose::kPool);
-  return SampleConfigurations(*c.robot, c.plane, s.pool_size, stream, o, report);
+  return SampleConfigurations(*c.robot, c.planes, PerPlaneCounts(s, c.planes, s.pool_size), stream,
+                              o, report);
 }
 
 // Selects the design of trial `trial` (0 for the cell's own) from a pool and its scaled G.
@@ -112,18 +136,21 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   c->ranger_offset = s.ranger_offset ? *s.ranger_offset : file.ranger_offset * scale;
   c->ranger_scale = s.ranger_scale ? *s.ranger_scale : file.ranger_scale * scale;
   if (!s.plane_from_robot) {
-    c->plane = s.plane;
-  } else if (file.plane) {
-    c->plane = *file.plane;
+    c->planes = s.planes;
+  } else if (file.planes) {
+    c->planes = *file.planes;
   } else {
     throw InputError("plane", "the robot file has no plane; give plane: in the study");
   }
 }
 
 void BuildParameterSet(const CellSettings& s, CellContext* c) {
+  std::vector<PlaneTerms> terms(c->planes.size(), s.plane_terms);
+  for (std::size_t p = 0; p < s.plane_estimate.size() && p < terms.size(); ++p)
+    if (!s.plane_estimate[p].empty()) terms[p] = PlaneTerms::Parse(s.plane_estimate[p], "plane");
   ParameterSet ps =
-      MakeParameterSet(*c->robot, s.plane_terms, s.fixed, "identification.fix", s.ranger_terms);
-  c->model = std::make_unique<MeasurementModel>(*c->robot, c->plane, ps);
+      MakeParameterSet(*c->robot, terms, s.fixed, "identification.fix", s.ranger_terms);
+  c->model = std::make_unique<MeasurementModel>(*c->robot, c->planes, ps);
   if (s.select_count < ps.size())
     throw InputError("selection.count", "selecting " + std::to_string(s.select_count) +
                                             " configurations for " + std::to_string(ps.size()) +
@@ -145,11 +172,11 @@ ConfigurationSet ReadStudyConfigurations(const Study& study, const std::string& 
 ConfigurationSet UsablePoolFromFile(const Study& study, const CellSettings& s, CellContext* c) {
   const ConfigurationSet given =
       ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot);
-  CandidatePool usable = UsableCandidates(*c->robot, c->plane, c->ranger, given);
+  CandidatePool usable = UsableCandidates(*c->robot, c->planes, c->ranger, given);
   if (!s.truth_random) {  // the true beam must hit too
     std::vector<double> h;
     std::vector<BeamMiss> misses;
-    ExactReadings(*c->robot, c->fixed_truth.values, c->plane, c->ranger, usable.configs, &h,
+    ExactReadings(*c->robot, c->fixed_truth.values, c->planes, c->ranger, usable.configs, &h,
                   &misses);
     ConfigurationSet kept(usable.configs.num_joints());
     for (int i = 0; i < usable.configs.size(); ++i) {
@@ -200,7 +227,7 @@ void DrawCellConfigurations(const Study& study, const CellSettings& s, CellConte
   vo.min_jacobian_singular_value = s.min_singular_value;
   vo.require_beam_hit = false;  // validation judges poses over the whole workspace
   c->validation = SampleConfigurations(
-      *c->robot, c->plane, s.validation_size,
+      *c->robot, c->planes, PerPlaneCounts(s, c->planes, s.validation_size),
       RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), vo);
 }
 
@@ -215,7 +242,7 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   }
   c->fixed_for_rank = rep.suggested_fixed;
   c->model = std::make_unique<MeasurementModel>(
-      *c->robot, c->plane,
+      *c->robot, c->planes,
       WithoutParameters(*c->robot, c->model->parameters(), rep.suggested_fixed));
   if (!s.truth_random) c->fixed_truth.delta = DrawTruth(*c, 0).delta;
 }
@@ -268,7 +295,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
     c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
   }
   std::vector<BeamMiss> unused;
-  ExactReadings(*c->robot, c->robot->nominal_values(), c->plane, c->ranger, c->design.configs,
+  ExactReadings(*c->robot, c->robot->nominal_values(), c->planes, c->ranger, c->design.configs,
                 &c->design_nominal.h, &unused);
   c->design_nominal.G = Gd;
   c->design_nominal.Factorize();
@@ -278,10 +305,10 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
 void CacheTruth(const CellSettings& s, CellContext* c) {
   if (s.truth_random) return;
   const Eigen::VectorXd& truth = c->fixed_truth.values;
-  ExactReadings(*c->robot, truth, c->plane, c->ranger, c->design.configs, &c->design_true_h,
+  ExactReadings(*c->robot, truth, c->planes, c->ranger, c->design.configs, &c->design_true_h,
                 &c->design_true_miss);
   if (s.selection_redraw)
-    ExactReadings(*c->robot, truth, c->plane, c->ranger, c->pool, &c->pool_true_h,
+    ExactReadings(*c->robot, truth, c->planes, c->ranger, c->pool, &c->pool_true_h,
                   &c->pool_true_miss);
   c->validation_true_poses = ToolPoses(*c->robot, truth, c->validation);
   if (!c->rank_deficient && !s.selection_redraw && !s.pool_redraw) {
@@ -405,7 +432,7 @@ int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTrut
   noise.ranger_scale = c.ranger_scale;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
   if (s.truth_random || s.pool_redraw || noise.DisturbsGeometry())
-    return SimulateReadings(*c.robot, truth.values, c.plane, c.ranger, design.configs, noise,
+    return SimulateReadings(*c.robot, truth.values, c.planes, c.ranger, design.configs, noise,
                             stream, &ws->data, nullptr, nullptr, &design.slots);
   if (!s.selection_redraw)
     return AddNoise(c.design_true_h, c.design_true_miss, design.configs, noise, stream, &ws->data,
@@ -470,8 +497,8 @@ void FillDetails(const CellContext& c, const TrialTruth& truth, const Eigen::Vec
   const ConfigurationSet& configs = ws.data.configs;
   std::vector<double> h_nominal, h_identified;
   std::vector<BeamMiss> unused;
-  ExactReadings(*c.robot, nominal, c.plane, c.ranger, configs, &h_nominal, &unused);
-  ExactReadings(*c.robot, identified, c.model->PlaneAt(ws.e.data()), c.ranger, configs,
+  ExactReadings(*c.robot, nominal, c.planes, c.ranger, configs, &h_nominal, &unused);
+  ExactReadings(*c.robot, identified, c.model->PlanesAt(ws.e.data()), c.ranger, configs,
                 &h_identified, &unused);
   ModelPoint point;  // the identified ranger terms, if any
   c.model->Prepare(ws.e.data(), &point);

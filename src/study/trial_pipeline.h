@@ -64,7 +64,7 @@ struct CellContext {
   /// file (the design then does not change with the seed).
   std::uint64_t selection_seed = 0;
   std::shared_ptr<const RobotModel> robot;
-  Plane plane;
+  PlaneSet planes;
   RangerSpec ranger;  ///< the robot file's ranger limits
   /// The true ranger's errors (robot file × truth.scale for a robot_file truth): it reads
   /// (1 + ranger_scale)·h + ranger_offset (m).

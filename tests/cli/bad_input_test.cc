@@ -343,7 +343,7 @@ const std::vector<BadInput>& Cases() {
        {{"s.yaml", "{study}plane:\n"}},
        "run s.yaml --out run",
        2,
-       {"key 'plane'", "expected 'robot' or a mapping"}},
+       {"key 'plane'", "expected 'robot', a plane mapping or a list of them"}},
       {"StudySweepBelowAPlaneName",
        {{"s.yaml", "{study}sweep:\n  axes:\n    - {key: plane.selection, values: [1]}\n"}},
        "run s.yaml --out run",

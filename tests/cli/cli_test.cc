@@ -225,7 +225,7 @@ TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
   for (const Json& p : j["parameters"]) {
     const std::string name = p["name"];
     if (name == "plane_f") {
-      EXPECT_EQ(cal.plane->offset, p["estimate"].get<double>());
+      EXPECT_EQ((*cal.planes)[0].offset, p["estimate"].get<double>());
       continue;
     }
     const int k = cal.robot.FindValue(name);

@@ -69,8 +69,8 @@ Eigen::MatrixXd PaperArmPoolJacobian(std::uint64_t seed) {
   so.ranger = rig.ranger;
   so.min_jacobian_singular_value = 0.05;
   const ConfigurationSet pool = SampleConfigurations(
-      rig.robot, *rig.plane, 101, RandomStream(seed, 7, 0, RandomPurpose::kPool), so);
-  const MeasurementModel model(rig.robot, *rig.plane,
+      rig.robot, (*rig.planes)[0], 101, RandomStream(seed, 7, 0, RandomPurpose::kPool), so);
+  const MeasurementModel model(rig.robot, (*rig.planes)[0],
                                MakeParameterSet(rig.robot, PlaneTerms{}, {}, "fix"));
   return DesignJacobian(model, pool, DesignScaling::kSI, 1e-3, 1e-3);
 }

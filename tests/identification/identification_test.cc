@@ -64,9 +64,9 @@ TEST_P(RecoveryTest, RecoversRobotAndPlaneWhenPlaneEstimated) {
   ASSERT_EQ(model.num_parameters(), 26);
   // True plane: the nominal one tilted by chart coordinates (0.004, -0.003), offset +2 mm.
   std::vector<double> e_true(model.num_parameters(), 0.0);
-  e_true[model.parameters().u_index[0]] = 0.004;
-  e_true[model.parameters().u_index[1]] = -0.003;
-  e_true[model.parameters().f_index] = 0.002;
+  e_true[model.parameters().plane_columns[0].u[0]] = 0.004;
+  e_true[model.parameters().plane_columns[0].u[1]] = -0.003;
+  e_true[model.parameters().plane_columns[0].f] = 0.002;
   const Plane true_plane = model.PlaneAt(e_true.data());
   MeasurementSet data = Exact(robot, truth, true_plane, testing::PaperHittingConfigurations(100));
   IdentificationOptions options;
@@ -78,9 +78,9 @@ TEST_P(RecoveryTest, RecoversRobotAndPlaneWhenPlaneEstimated) {
     EXPECT_NEAR(s.delta[k], truth[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]],
                 kRecoveryTolerance)
         << s.names[k];
-  EXPECT_NEAR(s.delta[ps.u_index[0]], 0.004, kRecoveryTolerance);
-  EXPECT_NEAR(s.delta[ps.u_index[1]], -0.003, kRecoveryTolerance);
-  EXPECT_NEAR(s.delta[ps.f_index], 0.002, kRecoveryTolerance);
+  EXPECT_NEAR(s.delta[ps.plane_columns[0].u[0]], 0.004, kRecoveryTolerance);
+  EXPECT_NEAR(s.delta[ps.plane_columns[0].u[1]], -0.003, kRecoveryTolerance);
+  EXPECT_NEAR(s.delta[ps.plane_columns[0].f], 0.002, kRecoveryTolerance);
 }
 
 TEST_P(RecoveryTest, RankDeficientSetIsReportedNotConverged) {

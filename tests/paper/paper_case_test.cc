@@ -29,7 +29,7 @@ TEST(PaperCases, BothCasesIdentifyTheTruthAndBeatTheNominalArm) {
   const RobotFile& rig = testing::PaperRig();
   PaperCaseOptions options;
   options.sampling.ranger = rig.ranger;
-  const PaperCasesResult r = RunPaperCases(rig.robot, *rig.plane, options);
+  const PaperCasesResult r = RunPaperCases(rig.robot, (*rig.planes)[0], options);
   EXPECT_EQ(r.pool.size(), 101);
   EXPECT_EQ(r.validation.size(), 20);
   ASSERT_EQ(r.cases.size(), 2u);

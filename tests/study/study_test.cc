@@ -271,7 +271,7 @@ TEST(CellPrediction, AtTheTruthIsTheNominalFormulaForAnArmWhoseNominalIsTheTruth
     for (int v = 0; v < kValuesPerLink; ++v)
       links[i].nominal[v] = robot.true_values()[kValuesPerLink * i + v];
   const RobotModel at_truth("truth", links, Eigen::VectorXd::Zero(robot.num_values()));
-  const MeasurementModel model(at_truth, cell->plane, cell->model->parameters());
+  const MeasurementModel model(at_truth, cell->planes, cell->model->parameters());
   const Eigen::MatrixXd G = IdentificationJacobian(model, cell->design.configs);
   const CellSettings& s = cell->cell->typed;
   const Eigen::VectorXd expected =

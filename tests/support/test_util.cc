@@ -28,7 +28,7 @@ const RobotFile& PaperRig() {
 
 const RobotModel& PaperRobot() { return PaperRig().robot; }
 
-const Plane& PaperPlane() { return *PaperRig().plane; }
+const Plane& PaperPlane() { return (*PaperRig().planes)[0]; }
 
 ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed) {
   const RobotModel& robot = PaperRobot();
@@ -85,12 +85,12 @@ void WritePaperConfigurationFiles(const std::string& dir, int pool, int validati
   SamplingOptions o;
   o.ranger = rig.ranger;
   WriteConfigurations(dir + "/pool.csv",
-                      SampleConfigurations(rig.robot, *rig.plane, pool,
+                      SampleConfigurations(rig.robot, (*rig.planes)[0], pool,
                                            RandomStream(pool_seed, 0, 0, RandomPurpose::kPool), o));
   o.require_beam_hit = false;
   WriteConfigurations(
       dir + "/val.csv",
-      SampleConfigurations(rig.robot, *rig.plane, validation,
+      SampleConfigurations(rig.robot, (*rig.planes)[0], validation,
                            RandomStream(validation_seed, 0, 0, RandomPurpose::kValidation), o));
 }
 

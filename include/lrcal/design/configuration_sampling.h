@@ -27,7 +27,7 @@ struct SamplingOptions {
   bool require_beam_hit = true;
   /// Also require the *true* model's beam to hit (simulation), if given.
   std::optional<Eigen::VectorXd> true_link_values;
-  std::optional<Plane> true_plane;
+  std::optional<PlaneSet> true_planes;
   /// The ranger whose limits a reading must meet (the robot file's `ranger:` section).
   RangerSpec ranger;
   /// Give up after this many attempts per requested configuration.
@@ -50,7 +50,15 @@ ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plan
                                       const RandomStream& stream, const SamplingOptions& options,
                                       SamplingReport* report = nullptr);
 
-/// The candidates of a given pool whose nominal beam hits `plane` within `ranger`'s limits (the
+/// Several planes: counts[p] configurations aimed at plane p (tagged p, configuration_set.h),
+/// plane 0's first. Attempts are numbered on across the planes, so plane 0's configurations are
+/// those of the one-plane call with the same stream.
+ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& planes,
+                                      const std::vector<int>& counts, const RandomStream& stream,
+                                      const SamplingOptions& options,
+                                      SamplingReport* report = nullptr);
+
+/// The candidates of a given pool whose nominal beam hits its plane within `ranger`'s limits (the
 /// others cannot give a reading): the usable configurations, the pool index of each (`kept`,
 /// ascending), every candidate's BeamMiss (`misses`, kNone when kept) and a report by reason.
 struct CandidatePool {
@@ -59,7 +67,7 @@ struct CandidatePool {
   std::vector<BeamMiss> misses;
   SamplingReport report;
 };
-CandidatePool UsableCandidates(const RobotModel& robot, const Plane& plane,
+CandidatePool UsableCandidates(const RobotModel& robot, const PlaneSet& planes,
                                const RangerSpec& ranger, const ConfigurationSet& pool);
 
 }  // namespace lrcal

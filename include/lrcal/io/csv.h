@@ -34,11 +34,18 @@ struct CsvTable {
 /// line for a folder, an empty file, a NUL byte, repeated column names or a ragged row.
 CsvTable ReadCsv(const std::string& path);
 
-ConfigurationSet ReadConfigurations(const std::string& path, int num_joints);
-/// Readings grouped by configuration. With a `ranger`, a reading outside its range is an error
-/// naming the line (and suggesting the likely unit mistake: readings are in metres).
+/// Configurations q1..qN. An optional `plane` column says which plane each row's beam is aimed at
+/// (a 1-based index or a plane's name), resolved against `planes` (the set-up's; null: one
+/// unnamed plane). A plane that was not given is an error naming the line; several planes given
+/// and no column is an error too: a file is never read against the wrong planes silently.
+ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
+                                    const PlaneSet* planes = nullptr);
+/// Readings grouped by configuration (and plane, as ReadConfigurations). With a `ranger`, a
+/// reading outside its range is an error naming the line (and suggesting the likely unit
+/// mistake: readings are in metres).
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints,
-                                const RangerSpec* ranger = nullptr);
+                                const RangerSpec* ranger = nullptr,
+                                const PlaneSet* planes = nullptr);
 
 /// Refuses (InputError naming `option`) an output path that cannot be a file: empty, a folder,
 /// or in a folder that does not exist.

@@ -32,9 +32,10 @@ struct CalibrationRecord {
 /// What a robot file holds.
 struct RobotFile {
   RobotModel robot;
-  std::optional<Plane> plane;  ///< the plane of the file's measurement set-up, if it gives one
-  RangerSpec ranger;           ///< the ranger's limits (defaults unless the file gives them)
-  std::string path;            ///< where it was read from
+  /// The planes of the file's measurement set-up (plane: one, planes: a list), if it gives them.
+  std::optional<PlaneSet> planes;
+  RangerSpec ranger;  ///< the ranger's limits (defaults unless the file gives them)
+  std::string path;   ///< where it was read from
   /// The true ranger's errors (true_errors.ranger_offset_mm, ranger_scale_ppm): it reads
   /// (1 + ranger_scale)·h + ranger_offset (m) for a true distance h. For simulation.
   double ranger_offset = 0;
@@ -50,11 +51,11 @@ struct RobotFile {
 RobotFile LoadRobotFile(const std::string& path);
 
 /// Writes a robot file for the calibrated model: `rig`'s links with `link_values` (5N, SI) as
-/// their nominal values and no true errors, `plane` as its plane, `rig`'s ranger limits, and the
+/// their nominal values and no true errors, `planes` as its planes, `rig`'s ranger limits, and the
 /// record. Numbers are written with 17 significant digits, so reading the file back gives the
 /// same doubles. Written atomically (a temporary file renamed); throws StorageError.
 void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
-                              const Eigen::VectorXd& link_values, const Plane& plane,
+                              const Eigen::VectorXd& link_values, const PlaneSet& planes,
                               const CalibrationRecord& record);
 
 /// Resolves a robot argument: a path to a YAML file, or a short name of a shipped robot

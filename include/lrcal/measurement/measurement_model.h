@@ -32,59 +32,66 @@
 
 namespace lrcal {
 
-/// A robot + plane evaluated at one estimate: the chain's per-link trig (chain.h), the plane and
-/// the chart's derivative, ready for many configurations.
+/// A robot + planes evaluated at one estimate: the chain's per-link trig (chain.h), each plane
+/// and its chart's derivative, ready for many configurations.
 struct ModelPoint : ChainPoint {
-  Plane plane;
-  Eigen::Matrix<double, 3, 2> dn_du = Eigen::Matrix<double, 3, 2>::Zero();
+  int num_planes = 1;
+  Plane planes[kMaxPlanes];
+  Eigen::Matrix<double, 3, 2> dn_du[kMaxPlanes];
   /// The ranger at this estimate: it reads (1 + ranger_scale)·h + ranger_offset (m) for a
   /// geometric distance h. Zero unless the parameter set estimates them.
   double ranger_offset = 0;
   double ranger_scale = 0;
 };
 
-/// Prepares a ModelPoint from explicit link values (5N, SI) and a plane (a perfect ranger).
-void PrepareModelPoint(const RobotModel& robot, const double* link_values, const Plane& plane,
+/// Prepares a ModelPoint from explicit link values (5N, SI) and planes (a perfect ranger).
+void PrepareModelPoint(const RobotModel& robot, const double* link_values, const PlaneSet& planes,
                        ModelPoint* point);
 
 class MeasurementModel {
  public:
-  MeasurementModel(const RobotModel& robot, const Plane& nominal_plane, ParameterSet parameters);
+  /// `parameters` must have one entry of plane terms per plane (MakeParameterSet).
+  MeasurementModel(const RobotModel& robot, const PlaneSet& nominal_planes,
+                   ParameterSet parameters);
 
   const RobotModel& robot() const { return *robot_; }
-  const Plane& nominal_plane() const { return nominal_plane_; }
+  const PlaneSet& nominal_planes() const { return nominal_planes_; }
   const ParameterSet& parameters() const { return parameters_; }
   int num_parameters() const { return parameters_.size(); }
+  int num_planes() const { return nominal_planes_.size(); }
 
   /// Link values (5N) at estimate e: nominal + Δ on the estimated entries.
   Eigen::VectorXd LinkValues(const double* e) const;
-  /// Plane at estimate e.
-  Plane PlaneAt(const double* e) const;
+  /// Plane p at estimate e.
+  Plane PlaneAt(const double* e, int p = 0) const;
+  /// Every plane at estimate e (names kept).
+  PlaneSet PlanesAt(const double* e) const;
   /// Prepares `point` at estimate e (size num_parameters()).
   void Prepare(const double* e, ModelPoint* point) const;
 
-  /// Reading h (m) for configuration i at `point`, and (if jacobian_row is not null) the
-  /// num_parameters() entries of ∂h/∂e. Returns n·b (the cosine of the beam's incidence, signed)
-  /// so callers can classify the reading; h is finite unless n·b == 0. With ranger terms the
-  /// reading is r = (1 + s)·h_geo + o: the geometric columns are scaled by (1 + s),
-  /// ∂r/∂o = 1 and ∂r/∂s = h_geo.
+  /// Reading h (m) for configuration i (on its plane, configs.plane(i)) at `point`, and (if
+  /// jacobian_row is not null) the num_parameters() entries of ∂h/∂e: the columns of other
+  /// planes' terms are zero. Returns n·b (the cosine of the beam's incidence, signed) so callers
+  /// can classify the reading; h is finite unless n·b == 0. With ranger terms the reading is
+  /// r = (1 + s)·h_geo + o: the geometric columns are scaled by (1 + s), ∂r/∂o = 1 and
+  /// ∂r/∂s = h_geo.
   double Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i, double* h,
                   double* jacobian_row) const;
 
-  /// Templated reading for autodiff (tests): e has num_parameters() entries.
+  /// Templated reading for autodiff (tests): e has num_parameters() entries; the beam is aimed
+  /// at plane `plane`.
   template <typename T>
-  T Distance(const T* e, const double* q) const {
+  T Distance(const T* e, const double* q, int plane = 0) const {
     std::vector<T> values(robot_->num_values());
     for (int k = 0; k < robot_->num_values(); ++k) values[k] = T(robot_->nominal_values()[k]);
     for (int k = 0; k < parameters_.num_robot(); ++k) values[parameters_.robot_values[k]] += e[k];
     Pose<T> pose = ForwardKinematics<T>(*robot_, values.data(), q);
-    Eigen::Matrix<T, 3, 1> n = nominal_plane_.normal.cast<T>();
-    T f = T(nominal_plane_.offset);
-    if (parameters_.EstimatesNormal()) {
-      const int* u = parameters_.u_index;
-      n = chart_.Normal<T>(u[0] >= 0 ? e[u[0]] : T(0), u[1] >= 0 ? e[u[1]] : T(0));
-    }
-    if (parameters_.f_index >= 0) f += e[parameters_.f_index];
+    Eigen::Matrix<T, 3, 1> n = nominal_planes_[plane].normal.cast<T>();
+    T f = T(nominal_planes_[plane].offset);
+    const PlaneColumns& c = parameters_.plane_columns[plane];
+    if (c.EstimatesNormal())
+      n = charts_[plane].Normal<T>(c.u[0] >= 0 ? e[c.u[0]] : T(0), c.u[1] >= 0 ? e[c.u[1]] : T(0));
+    if (c.f >= 0) f += e[c.f];
     const T h = LaserDistance<T>(pose.p_BT, pose.R_BT.col(2), n, f);
     const T o = parameters_.ranger_offset_index >= 0 ? e[parameters_.ranger_offset_index] : T(0);
     const T s = parameters_.ranger_scale_index >= 0 ? e[parameters_.ranger_scale_index] : T(0);
@@ -98,9 +105,9 @@ class MeasurementModel {
 
  private:
   const RobotModel* robot_;
-  Plane nominal_plane_;
+  PlaneSet nominal_planes_;
   ParameterSet parameters_;
-  NormalChart chart_;
+  std::vector<NormalChart> charts_;
 };
 
 }  // namespace lrcal

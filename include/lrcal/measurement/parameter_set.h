@@ -1,11 +1,14 @@
 // Which quantities an identification estimates: a subset of the robot's geometric parameters and,
-// optionally, the plane's normal (two chart coordinates, laser_plane.h) and offset f.
+// optionally, each plane's normal (two chart coordinates, plane.h) and offset f.
 //
 // The estimate vector e is laid out as
-//   [Δ(robot link values, robot file order) | u1, u2 (if the normal) | Δf (if the offset)
+//   [Δ(robot link values, robot file order)
+//    | for each plane p: u1, u2 (if its normal) | Δf (if its offset)
 //    | ranger offset o | ranger scale s]
 // in SI units (rad, m; u and s are dimensionless, u ≈ rad). Its names are the link value names
-// ("theta1", ...), then "plane_u1", "plane_u2", "plane_f", "ranger_offset", "ranger_scale".
+// ("theta1", ...), then the plane terms, then "ranger_offset", "ranger_scale". With one plane
+// the plane terms are "plane_u1", "plane_u2", "plane_f"; with several they are numbered from 1:
+// "plane1_u1", "plane1_u2", "plane1_f", "plane2_u1", ... (PlaneTermName).
 // The ranger reads (1 + s)·h + o for a geometric distance h (measurement_model.h); nominally
 // o = s = 0.
 #pragma once
@@ -36,19 +39,33 @@ struct RangerTerms {
   std::string ToString() const;
 };
 
+/// Where one plane's terms are in e.
+struct PlaneColumns {
+  /// Index in e of chart coordinate u1 (c = 0) or u2 (c = 1), or -1 when it is not estimated.
+  /// Each can be fixed on its own (e.g. `--fix plane_u1`), the other staying free.
+  int u[2] = {-1, -1};
+  /// Index of Δf in e, or -1 when the offset is not estimated.
+  int f = -1;
+  bool EstimatesNormal() const { return u[0] >= 0 || u[1] >= 0; }
+};
+
+/// The name of plane p's term `term` ("u1", "u2" or "f") among `num_planes` planes: "plane_u1"
+/// with one plane, "plane2_u1" (p = 1) with several.
+std::string PlaneTermName(int p, int num_planes, const std::string& term);
+
 struct ParameterSet {
   std::vector<int> robot_values;  ///< indices into the robot's 5N link values
-  PlaneTerms plane;
+  /// The terms asked for, one entry per plane of the set-up (its size is the number of planes).
+  std::vector<PlaneTerms> plane_terms{PlaneTerms{}};
+  /// Where each plane's estimated terms are in e (one entry per plane).
+  std::vector<PlaneColumns> plane_columns{PlaneColumns{}};
   std::vector<std::string> names;  ///< one per entry of e
 
   int size() const { return static_cast<int>(names.size()); }
   int num_robot() const { return static_cast<int>(robot_values.size()); }
-  /// Index in e of chart coordinate u1 (c = 0) or u2 (c = 1), or -1 when it is not estimated.
-  /// Each can be fixed on its own (e.g. `--fix plane_u1`), the other staying free.
-  int u_index[2] = {-1, -1};
-  /// Index of Δf in e, or -1 when the offset is not estimated.
-  int f_index = -1;
-  bool EstimatesNormal() const { return u_index[0] >= 0 || u_index[1] >= 0; }
+  int num_planes() const { return static_cast<int>(plane_columns.size()); }
+  /// True if any plane term is estimated.
+  bool EstimatesPlanes() const;
   RangerTerms ranger;
   /// Indices in e of the ranger's offset o and scale s, or -1 when not estimated.
   int ranger_offset_index = -1;
@@ -59,10 +76,15 @@ struct ParameterSet {
   int Find(const std::string& name) const;
 };
 
-/// All of the robot's geometric parameters except `fixed`, plus the chosen plane terms.
-/// Throws InputError (where = `source`) for an unknown or non-parameter name in `fixed`.
+/// All of the robot's geometric parameters except `fixed`, plus the chosen plane terms (one
+/// plane). Throws InputError (where = `source`) for an unknown or non-parameter name in `fixed`.
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed = {},
+                              const std::string& source = "--fix", RangerTerms ranger = {});
+
+/// The same with several planes: `planes` has one entry per plane (1 ≤ size ≤ kMaxPlanes).
+ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTerms>& planes,
+                              const std::vector<std::string>& fixed,
                               const std::string& source = "--fix", RangerTerms ranger = {});
 
 /// `in` without the parameters `names` (robot parameters or plane terms): what remains when
@@ -70,7 +92,7 @@ ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
 ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
                                const std::vector<std::string>& names);
 
-/// True for names of quantities in rad (theta*, alpha*, beta*, plane_u*); false for metres
+/// True for names of quantities in rad (theta*, alpha*, beta*, plane*_u*); false for metres
 /// (and for the dimensionless ranger_scale: see DisplayUnitOf).
 bool IsAngularName(const std::string& name);
 

@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <string>
+#include <vector>
 
 #include "lrcal/core/enum_names.h"
 #include "lrcal/kinematics/forward_kinematics.h"
@@ -35,6 +36,40 @@ struct Plane {
   static Plane Parse(const std::string& text, const std::string& source = "--plane");
   /// Signed distance n·p + f (m) of a point from the plane.
   double SignedDistance(const Eigen::Vector3d& p) const { return normal.dot(p) + offset; }
+};
+
+/// Most planes one set-up may have (a cube's faces and two more). Bounded so that a prepared
+/// model point (measurement_model.h) stays a fixed-size, allocation-free value.
+inline constexpr int kMaxPlanes = 8;
+
+/// The planes of a set-up: the paper's one, or several (Zhuang, Motaghedi and Roth 1999: one plane
+/// leaves directions unobservable; three are equivalent to point measurement). A configuration
+/// set tags each configuration with the index of its plane (configuration_set.h). Implicitly
+/// built from one Plane, so single-plane code reads as before.
+class PlaneSet {
+ public:
+  PlaneSet() = default;
+  PlaneSet(const Plane& plane)
+      : planes_{plane}, names_{""} {}  // NOLINT(google-explicit-constructor)
+  /// Throws InputError (where = `source`) for no plane, more than kMaxPlanes or a repeated name;
+  /// `names` may be empty (no names) or one per plane ("" for an unnamed one).
+  PlaneSet(std::vector<Plane> planes, std::vector<std::string> names,
+           const std::string& source = "planes");
+  int size() const { return static_cast<int>(planes_.size()); }
+  const Plane& operator[](int p) const { return planes_[p]; }
+  Plane& operator[](int p) { return planes_[p]; }
+  std::vector<Plane>::const_iterator begin() const { return planes_.begin(); }
+  std::vector<Plane>::const_iterator end() const { return planes_.end(); }
+  /// The name of plane p, or "" if it has none.
+  const std::string& name(int p) const { return names_[p]; }
+  /// How users refer to plane p: its name, else its 1-based number ("plane 2").
+  std::string Label(int p) const;
+  /// The index of a plane given as a 1-based number or a name, or -1.
+  int Find(const std::string& ref) const;
+
+ private:
+  std::vector<Plane> planes_;
+  std::vector<std::string> names_;
 };
 
 /// Orthonormal tangent basis (t1, t2) at unit vector n0, deterministic: t1 is the coordinate axis

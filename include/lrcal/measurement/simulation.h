@@ -29,10 +29,15 @@
 
 namespace lrcal {
 
-/// The model readings of (link values, plane) at every configuration, and each one's BeamMiss.
-void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values, const Plane& plane,
-                   const RangerSpec& ranger, const ConfigurationSet& configs,
-                   std::vector<double>* h, std::vector<BeamMiss>* misses);
+/// The model readings of (link values, planes) at every configuration (on its own plane,
+/// configs.plane(i)), and each one's BeamMiss.
+void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
+                   const PlaneSet& planes, const RangerSpec& ranger,
+                   const ConfigurationSet& configs, std::vector<double>* h,
+                   std::vector<BeamMiss>* misses);
+
+/// Throws InputError unless every configuration's plane index is one of `planes`.
+void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& planes);
 
 struct NoiseModel {
   double sigma = 0.2e-3;  ///< m, standard deviation of one reading
@@ -64,7 +69,7 @@ struct NoiseModel {
 /// (e.g. its index in the candidate pool: draws slot·R + r) instead of its position i, so that
 /// two designs drawn from one pool see the same noise on the configurations they share.
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
-                     const Plane& true_plane, const RangerSpec& ranger,
+                     const PlaneSet& true_planes, const RangerSpec& ranger,
                      const ConfigurationSet& configs, const NoiseModel& noise,
                      const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr,

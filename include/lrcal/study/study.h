@@ -33,7 +33,11 @@ namespace lrcal {
 struct CellSettings {
   std::string robot;             ///< robot file path or shipped name
   bool plane_from_robot = true;  ///< plane: robot
-  Plane plane;                   ///< when !plane_from_robot
+  PlaneSet planes;               ///< when !plane_from_robot: one plane or several
+  /// Several planes: each one's share of the pool and validation draws (empty: equal shares).
+  std::vector<double> plane_shares;
+  /// Several planes: each one's estimated terms ("" = identification.estimate_plane).
+  std::vector<std::string> plane_estimate;
   // Truth: the robot file's errors × scale, or errors drawn per trial.
   bool truth_random = false;
   double truth_scale = 0;
