@@ -55,6 +55,41 @@ TEST(BatchEvaluator, MatchesPerConfigurationEvaluationForEveryPlaneTerm) {
   }
 }
 
+// Several planes: rows on different planes in one batch (the kernel's per-row plane path), with
+// each plane's terms estimated or not, and with only one of three planes referenced (the
+// one-plane path with another plane's columns present).
+TEST(BatchEvaluator, MatchesPerConfigurationEvaluationWithSeveralPlanes) {
+  const RobotModel& robot = testing::PaperRobot();
+  const PlaneSet planes({testing::PaperPlane(), Plane::FromCoefficients(1, 0, 0, 0.9),
+                         Plane::FromCoefficients(0, 1, 0, 0.9)},
+                        {});
+  ConfigurationSet mixed(6), second_only(6);
+  for (int k = 0; k < 13; ++k)
+    for (int p = 0; p < 3; ++p) {
+      const ConfigurationSet c = testing::HittingConfigurations(planes[p], 13, 2 + p);
+      mixed.Add(c.q(k), p);
+      if (p == 1) second_only.Add(c.q(k), 1);
+    }
+  const std::vector<PlaneTerms> all(3, PlaneTerms{true, true});
+  const std::vector<PlaneTerms> some{PlaneTerms{true, false}, PlaneTerms{},
+                                     PlaneTerms{false, true}};
+  for (const auto& terms : {all, some}) {
+    MeasurementModel model(robot, planes,
+                           MakeParameterSet(robot, terms, {}, "--fix", RangerTerms{true, true}));
+    ExpectSame(model, mixed);
+    ExpectSame(model, second_only);
+  }
+  // A row on a plane the model lacks is refused, not read out of bounds.
+  MeasurementModel one(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  BatchEvaluator batch;
+  batch.SetConfigurations(mixed);
+  ModelPoint point;
+  std::vector<double> e(one.num_parameters(), 0.0);
+  one.Prepare(e.data(), &point);
+  std::vector<double> h(mixed.size());
+  EXPECT_THROW(batch.Evaluate(one, point, h.data(), nullptr), std::invalid_argument);
+}
+
 TEST(BatchEvaluator, MatchesWithAPrismaticJoint) {
   std::vector<Link> links(3);
   links[0].nominal = {0.1, -1.2, 0.3, 0.5, 0.0};

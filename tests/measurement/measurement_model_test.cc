@@ -101,6 +101,71 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// Three planes, every plane term and both ranger terms estimated (36 parameters): each row's
+// Jacobian has its own plane's columns and zeros in the other planes' columns, and matches
+// autodiff and central differences. Rows alternate between planes.
+TEST(JacobianSeveralPlanes, AnalyticMatchesAutodiffAndCentralDifferences) {
+  const RobotModel& robot = testing::PaperRobot();
+  const PlaneSet planes({testing::PaperPlane(), Plane::FromCoefficients(1, 0, 0, 0.9),
+                         Plane::FromCoefficients(0, 1, 0, 0.9)},
+                        {});
+  MeasurementModel model(robot, planes,
+                         MakeParameterSet(robot, std::vector<PlaneTerms>(3, PlaneTerms{true, true}),
+                                          {}, "--fix", RangerTerms{true, true}));
+  constexpr int kParams = 36;
+  using BigJet = ceres::Jet<double, kParams>;
+  ASSERT_EQ(model.num_parameters(), kParams);
+  ConfigurationSet configs(6);
+  for (int k = 0; k < 8; ++k)
+    for (int p = 0; p < 3; ++p)
+      configs.Add(testing::HittingConfigurations(planes[p], 8, 5 + p).q(k), p);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> ue(-0.01, 0.01);
+  std::vector<double> e(kParams);
+  for (double& v : e) v = ue(rng);
+  ModelPoint point;
+  model.Prepare(e.data(), &point);
+  const ParameterSet& ps = model.parameters();
+  for (int i = 0; i < configs.size(); ++i) {
+    const int plane = configs.plane(i);
+    double h = 0;
+    std::vector<double> row(kParams);
+    model.Evaluate(point, configs, i, &h, row.data());
+    EXPECT_NEAR(h, model.Distance<double>(e.data(), configs.q(i), plane), 1e-12);
+    std::vector<BigJet> ej(kParams);
+    for (int k = 0; k < kParams; ++k) ej[k] = BigJet(e[k], k);
+    const BigJet hj = model.Distance<BigJet>(ej.data(), configs.q(i), plane);
+    for (int k = 0; k < kParams; ++k) {
+      EXPECT_NEAR(row[k], hj.v[k], kAutodiffTolerance)
+          << "d h / d " << ps.names[k] << " at configuration " << i;
+      std::vector<double> ep = e, em = e;
+      ep[k] += 1e-6;
+      em[k] -= 1e-6;
+      const double fd = (model.Distance<double>(ep.data(), configs.q(i), plane) -
+                         model.Distance<double>(em.data(), configs.q(i), plane)) /
+                        2e-6;
+      EXPECT_NEAR(row[k], fd, kFiniteDifferenceTolerance) << "d h / d " << ps.names[k];
+    }
+    for (int p = 0; p < 3; ++p) {
+      const PlaneColumns& c = ps.plane_columns[p];
+      for (int k : {c.u[0], c.u[1], c.f}) {
+        if (p == plane) {
+          EXPECT_NE(row[k], 0.0) << ps.names[k] << " at configuration " << i;
+        } else {
+          EXPECT_EQ(row[k], 0.0) << ps.names[k] << " at configuration " << i;
+        }
+      }
+    }
+  }
+}
+
+// A measurement model needs one set of plane terms per plane.
+TEST(JacobianSeveralPlanes, PlaneTermsMustMatchThePlanes) {
+  const RobotModel& robot = testing::PaperRobot();
+  const PlaneSet planes({testing::PaperPlane(), Plane::FromCoefficients(1, 0, 0, 0.9)}, {});
+  EXPECT_ANY_THROW(MeasurementModel(robot, planes, MakeParameterSet(robot, PlaneTerms{})));
+}
+
 TEST(NormalChart, RegularAtThePapersPlaneAndEverywhere) {
   // The paper's plane has n_x = 0; the chart's Jacobian must still have full rank 2 there and
   // at the coordinate axes, and n(u) must be a unit vector.
