@@ -10,6 +10,7 @@
 #include "lrcal/core/hash.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
+#include "lrcal/design/identifiability_remedies.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
@@ -43,6 +44,27 @@ Json IdentifiabilityJson(const IdentifiabilityReport& r) {
   }
   j["dependencies"] = deps;
   j["suggested_fixed"] = r.suggested_fixed;
+  return j;
+}
+
+// What each remedy recovers; `cheapest_fix` has one entry per lost direction (null: none found).
+Json RemediesJson(const RemedyReport& r) {
+  Json j;
+  j["lost"] = r.lost;
+  Json list = Json::array();
+  for (const auto& m : r.remedies) {
+    Json e{{"kind", RemedyKindName(m.kind)}, {"action", m.action}, {"recovers", m.recovers}};
+    if (!m.parameter.empty()) e["parameter"] = m.parameter;
+    if (m.kind == Remedy::Kind::kAddPlane || m.kind == Remedy::Kind::kAddKnownDistance)
+      e["plane"] = {{"normal", {m.plane.normal[0], m.plane.normal[1], m.plane.normal[2]}},
+                    {"offset", m.plane.offset}};
+    list.push_back(e);
+  }
+  j["remedies"] = list;
+  Json cheapest = Json::array();
+  for (int c : r.cheapest) cheapest.push_back(c >= 0 ? Json(r.remedies[c].action) : Json());
+  j["cheapest_fix"] = cheapest;
+  j["unreachable"] = r.unreachable;
   return j;
 }
 
@@ -480,10 +502,17 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   options.rank_tolerance = vm["rank-tolerance"].as<double>();
   options.Validate("--rank-tolerance");
   const IdentifiabilityReport r = AnalyzeIdentifiability(model, configs, nullptr, options);
+  RemedyOptions remedy_options;
+  remedy_options.ranger = rig.ranger;
+  remedy_options.identifiability = options;
+  const RemedyReport remedies = FindRemedies(model, configs, r, remedy_options);
   if (ResolveFormat(vm) == Format::kJson) {
-    std::cout << IdentifiabilityJson(r).dump(2) << "\n";
+    Json j = IdentifiabilityJson(r);
+    if (!r.full_rank()) j["remedies"] = RemediesJson(remedies);
+    std::cout << j.dump(2) << "\n";
   } else {
     std::cout << r.ToString();
+    if (!r.full_rank()) std::cout << "how to recover what is lost:\n" << remedies.ToString();
   }
   return 0;
 }

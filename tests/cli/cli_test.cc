@@ -147,6 +147,105 @@ TEST_F(CliTest, IdentifiabilityNamesTheRangerDependences) {
   EXPECT_NE(out.find("--estimate-ranger: unknown ranger term 'zero'"), std::string::npos) << out;
 }
 
+// Issue 12's acceptance: three planes with normals and offsets estimated give 34 parameters,
+// rank 32, the two lost combinations (the planes' common spin with θ1, a shift along z0 with
+// d1) and the cheapest fix of each; with the planes known and the ranger's terms estimated,
+// the ranger offset / d6 dependence.
+TEST_F(CliTest, IdentifiabilityOnThreePlanesNamesTheLostCombinations) {
+  const std::string planes = " --plane 0,0,1,0.3 --plane 1,0,0,0.9 --plane 0,1,0,0.9";
+  std::string out;
+  ASSERT_EQ(Run("sample --count 40 --seed 5 --out " + Path("c.csv") + planes, &out), 0) << out;
+  const std::string csv = testing::ReadFile(Path("c.csv"));
+  ASSERT_EQ(csv.substr(0, csv.find('\n')), "q1,q2,q3,q4,q5,q6,plane");
+  ASSERT_EQ(Run("identifiability --configs " + Path("c.csv") + planes +
+                    " --estimate-plane normal,offset --format json",
+                &out),
+            0)
+      << out;
+  Json j = Json::parse(out);
+  EXPECT_EQ(j["n_params"], 34);
+  EXPECT_EQ(j["n_configurations"], 120);
+  EXPECT_EQ(j["rank"], 32);
+  ASSERT_EQ(j["dependencies"].size(), 2u);
+  std::set<std::string> members;
+  for (const auto& d : j["dependencies"])
+    for (const auto& t : d) members.insert(t["name"].get<std::string>());
+  for (const char* name : {"theta1", "d1", "plane1_f"}) EXPECT_TRUE(members.count(name)) << name;
+  ASSERT_EQ(j["remedies"]["lost"].size(), 2u);
+  ASSERT_EQ(j["remedies"]["cheapest_fix"].size(), 2u);
+  for (const auto& fix : j["remedies"]["cheapest_fix"])
+    EXPECT_EQ(fix.get<std::string>().rfind("fix ", 0), 0u) << fix;
+  // The text output says the same in words.
+  ASSERT_EQ(
+      Run("identifiability --configs " + Path("c.csv") + planes + " --estimate-plane normal,offset",
+          &out),
+      0);
+  EXPECT_NE(out.find("cheapest fix: fix"), std::string::npos) << out;
+  EXPECT_NE(out.find("add a known distance"), std::string::npos) << out;
+
+  ASSERT_EQ(Run("identifiability --configs " + Path("c.csv") + planes +
+                    " --estimate-ranger offset,scale --format json",
+                &out),
+            0)
+      << out;
+  j = Json::parse(out);
+  EXPECT_EQ(j["n_params"], 27);
+  EXPECT_EQ(j["rank"], 26);  // against three known planes the scale is seen, the offset not
+  ASSERT_EQ(j["dependencies"].size(), 1u);
+  std::set<std::string> pair;
+  for (const auto& t : j["dependencies"][0]) pair.insert(t["name"].get<std::string>());
+  EXPECT_EQ(pair, (std::set<std::string>{"d6", "ranger_offset"}));
+}
+
+// A robot file may list planes; sample → simulate → identify on them comes back to the truth
+// within 5 predicted standard deviations, and the planes' names work in a CSV's plane column.
+TEST_F(CliTest, RobotFileWithPlanesRoundTrip) {
+  std::string robot = testing::ReadFile(testing::SourcePath("studies/robots/paper.yaml"));
+  const std::size_t at = robot.find("plane: {");
+  ASSERT_NE(at, std::string::npos);
+  robot.replace(at, robot.find('\n', at) - at,
+                "planes:\n  - {normal: [0, 1, 4.6], offset: -0.69, name: table}\n"
+                "  - {normal: [1, 0, 0], offset: 0.9, name: wall}");
+  Write("rig.yaml", robot);
+  std::string out;
+  ASSERT_EQ(
+      Run("sample --robot " + Path("rig.yaml") + " --count 40 --seed 2 --out " + Path("c.csv"),
+          &out),
+      0)
+      << out;
+  ASSERT_EQ(Run("simulate --robot " + Path("rig.yaml") + " --configs " + Path("c.csv") +
+                    " --sigma-mm 0.05 --repetitions 3 --seed 4 --out " + Path("m.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identify --robot " + Path("rig.yaml") + " --data " + Path("m.csv") +
+                    " --sigma-mm 0.05 --format json",
+                &out),
+            0)
+      << out;
+  const Json j = Json::parse(out);
+  EXPECT_EQ(j["rank"], 25);
+  const RobotModel& paper = testing::PaperRobot();
+  for (const auto& p : j["parameters"]) {
+    const double truth = paper.true_errors()[paper.FindValue(p["name"])];
+    EXPECT_LT(std::fabs(p["delta"].get<double>() - truth), 5 * p["std_given_sigma"].get<double>())
+        << p["name"];
+  }
+  // A configuration file naming the planes.
+  Write("named.csv", "q1,q2,q3,q4,q5,q6,plane\n0,-0.7,0,0,0,0,table\n0,-0.7,0,0,0,0,wall\n");
+  EXPECT_EQ(Run("kinematics --robot " + Path("rig.yaml") + " --configs " + Path("named.csv") +
+                    " --format json",
+                &out),
+            0)
+      << out;
+  Write("bad.csv", "q1,q2,q3,q4,q5,q6,plane\n0,-0.7,0,0,0,0,ceiling\n");
+  EXPECT_EQ(Run("kinematics --robot " + Path("rig.yaml") + " --configs " + Path("bad.csv"), &out),
+            2);
+  EXPECT_NE(out.find("'ceiling' is not one of the 2 plane(s) given: expected 1 (table), 2 (wall)"),
+            std::string::npos)
+      << out;
+}
+
 TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   std::string out;
   ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
@@ -408,6 +507,21 @@ INSTANTIATE_TEST_SUITE_P(
                  "identify --data {} --loss tukey",
                  "--loss: unknown loss 'tukey'; expected none, "
                  "huber or cauchy"},
+        // Several planes: a plane column is resolved against the planes given, never ignored.
+        BadInput{"PlaneColumnNamesAnAbsentPlane",
+                 "q1,q2,q3,q4,q5,q6,plane\n0,0,0,0,0,0,1\n0,0,0,0,0,0,3\n",
+                 "kinematics --configs {} --plane 0,0,1,0.3 --plane 1,0,0,0.9",
+                 "bad.csv:3 column 'plane': '3' is not one of the 2 plane(s) given: expected 1, 2"},
+        BadInput{"PlaneColumnAgainstOnePlane", "q1,q2,q3,q4,q5,q6,plane\n0,0,0,0,0,0,2\n",
+                 "identifiability --configs {}",
+                 "bad.csv:2 column 'plane': '2' is not one of the 1 plane(s) given"},
+        BadInput{"NoPlaneColumnWithTwoPlanes", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,1\n",
+                 "identify --data {} --plane 0,0,1,0.3 --plane 1,0,0,0.9",
+                 "bad.csv:1 column 'plane': missing: 2 planes are given"},
+        BadInput{"UnknownPlaneTermName", "q1,q2,q3,q4,q5,q6,plane\n0,0,0,0,0,0,1\n",
+                 "identifiability --configs {} --plane 0,0,1,0.3 --plane 1,0,0,0.9 "
+                 "--estimate-plane offset --fix plane_f",
+                 "--fix: unknown plane term 'plane_f': with 2 plane(s) the names are plane1_u1"},
         BadInput{"IdentifyUnknownSolver", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,1\n",
                  "identify --data {} --solver gn",
                  "--solver: unknown solver 'gn'; expected lm or "
