@@ -231,6 +231,15 @@ ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
   return out;
 }
 
+ConfigurationSet ReadPoses(const std::string& path, int num_joints) {
+  CsvTable t = ReadCsv(path);
+  std::vector<int> cols = JointColumns(t, num_joints);
+  if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
+  ConfigurationSet out(num_joints);
+  for (std::size_t r = 0; r < t.rows.size(); ++r) out.Add(JointValues(t, r, cols));
+  return out;
+}
+
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const RangerSpec* ranger,
                                 const PlaneSet* planes) {
   CsvTable t = ReadCsv(path);

@@ -158,10 +158,15 @@ void BuildParameterSet(const CellSettings& s, CellContext* c) {
 }
 
 // A study's configuration file (pool.file, validation.file), read for the cell's robot.
+// `planes`: the cell's planes, against which a pool's plane column is resolved; null for a
+// validation file (poses: a plane column is not read).
 ConfigurationSet ReadStudyConfigurations(const Study& study, const std::string& file,
-                                         const std::string& key, const RobotModel& robot) {
+                                         const std::string& key, const RobotModel& robot,
+                                         const PlaneSet* planes) {
   try {
-    return ReadConfigurations(ResolveStudyFile(file, study.folder()), robot.num_links());
+    const std::string path = ResolveStudyFile(file, study.folder());
+    return planes ? ReadConfigurations(path, robot.num_links(), planes)
+                  : ReadPoses(path, robot.num_links());
   } catch (const InputError& e) {
     throw InputError(key, e.what());
   }
@@ -171,7 +176,7 @@ ConfigurationSet ReadStudyConfigurations(const Study& study, const std::string& 
 // when there is one); the others are reported like a drawn pool's rejections.
 ConfigurationSet UsablePoolFromFile(const Study& study, const CellSettings& s, CellContext* c) {
   const ConfigurationSet given =
-      ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot);
+      ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, &c->planes);
   CandidatePool usable = UsableCandidates(*c->robot, c->planes, c->ranger, given);
   if (!s.truth_random) {  // the true beam must hit too
     std::vector<double> h;
@@ -219,7 +224,8 @@ void DrawCellConfigurations(const Study& study, const CellSettings& s, CellConte
                          &c->pool_report);
   }
   if (!s.validation_file.empty()) {
-    c->validation = ReadStudyConfigurations(study, s.validation_file, "validation.file", *c->robot);
+    c->validation =
+        ReadStudyConfigurations(study, s.validation_file, "validation.file", *c->robot, nullptr);
     return;
   }
   SamplingOptions vo;

@@ -40,6 +40,9 @@ CsvTable ReadCsv(const std::string& path);
 /// and no column is an error too: a file is never read against the wrong planes silently.
 ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
                                     const PlaneSet* planes = nullptr);
+/// Arm configurations only (validation poses, which need no reading): a `plane` column, if
+/// any, is not read and every row is tagged plane 0.
+ConfigurationSet ReadPoses(const std::string& path, int num_joints);
 /// Readings grouped by configuration (and plane, as ReadConfigurations). With a `ranger`, a
 /// reading outside its range is an error naming the line (and suggesting the likely unit
 /// mistake: readings are in metres).
