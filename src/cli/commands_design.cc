@@ -25,7 +25,8 @@ constexpr DesignCriterion kAllCriteria[] = {
 void AddDesignOptions(po::options_description& o) {
   AddCommonOptions(o);
   o.add_options()("pool", po::value<std::string>(), "candidate configurations CSV (q1..qN)")(
-      "generate", po::value<int>(), "or: generate this many candidates (beam hits, non-singular)")(
+      "generate", po::value<int>(),
+      "or: generate this many candidates (per plane; beam hits, non-singular)")(
       "seed", po::value<long long>()->default_value(1),
       "seed for --generate, random starts, baseline")("select", po::value<int>()->required(),
                                                       "configurations to choose (k)")(
@@ -193,6 +194,9 @@ int DesignCommand(const std::vector<std::string>& args) {
       certificate.ToString(options.criterion, k, static_cast<int>(pool.configs.size()));
   if (vm.count("out"))
     WriteConfigurations(vm["out"].as<std::string>(), pool.configs.Subset(chosen.indices));
+  const PlaneSet& planes = setup.planes;
+  std::vector<int> per_plane(planes.size(), 0);  // the chosen (configuration, plane) rows
+  for (int i : chosen.indices) ++per_plane[pool.configs.plane(i)];
 
   if (ResolveFormat(vm) == Format::kJson) {
     Json j;
@@ -204,6 +208,7 @@ int DesignCommand(const std::vector<std::string>& args) {
     j["criterion"] = DesignCriterionName(options.criterion);
     j["scaling"] = DesignScalingName(scaling);
     j["selected"] = chosen.indices;
+    j["selected_per_plane"] = per_plane;
     j["score"] = chosen.score;
     j["evaluations"] = chosen.evaluations;
     j["seconds"] = seconds;
@@ -226,6 +231,11 @@ int DesignCommand(const std::vector<std::string>& args) {
             << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
             << "chosen (0-based pool indices):";
   for (int i : chosen.indices) std::cout << " " << i;
+  if (planes.size() > 1) {
+    std::cout << "\nchosen per plane:";
+    for (int p = 0; p < planes.size(); ++p)
+      std::cout << (p ? ", " : " ") << planes.Label(p) << ": " << per_plane[p];
+  }
   std::cout << "\ncertificate: " << statement << "\n\n" << t.ToText();
   if (vm.count("out")) std::cout << "wrote " << vm["out"].as<std::string>() << "\n";
   return 0;

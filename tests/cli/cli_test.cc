@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
@@ -195,6 +196,41 @@ TEST_F(CliTest, IdentifiabilityOnThreePlanesNamesTheLostCombinations) {
   std::set<std::string> pair;
   for (const auto& t : j["dependencies"][0]) pair.insert(t["name"].get<std::string>());
   EXPECT_EQ(pair, (std::set<std::string>{"d6", "ranger_offset"}));
+}
+
+// Design on a pool spanning three planes chooses (configuration, plane) rows: the chosen file
+// keeps each row's plane, and the counts per plane add up to k.
+TEST_F(CliTest, DesignChoosesConfigurationPlanePairs) {
+  const std::string planes = " --plane 0,0,1,0.3 --plane 1,0,0,0.9 --plane 0,1,0,0.9";
+  std::string out;
+  ASSERT_EQ(Run("sample --count 30 --seed 4 --out " + Path("pool.csv") + planes, &out), 0) << out;
+  ASSERT_EQ(Run("design --pool " + Path("pool.csv") + planes +
+                    " --select 40 --method backward --baseline 10 --format json --out " +
+                    Path("chosen.csv"),
+                &out),
+            0)
+      << out;
+  const Json j = Json::parse(out);
+  const std::vector<int> per_plane = j["selected_per_plane"];
+  ASSERT_EQ(per_plane.size(), 3u);
+  EXPECT_EQ(per_plane[0] + per_plane[1] + per_plane[2], 40);
+  // Row i of the chosen file is pool row selected[i], plane column included.
+  const auto lines = [&](const std::string& file) {
+    std::vector<std::string> rows;
+    std::istringstream in(testing::ReadFile(Path(file)));
+    for (std::string line; std::getline(in, line);) rows.push_back(line);
+    return rows;
+  };
+  const std::vector<std::string> pool_rows = lines("pool.csv"), chosen_rows = lines("chosen.csv");
+  ASSERT_EQ(chosen_rows.size(), 41u);
+  EXPECT_EQ(chosen_rows[0], "q1,q2,q3,q4,q5,q6,plane");
+  std::vector<int> counted(3, 0);
+  for (int i = 0; i < 40; ++i) {
+    const int row = j["selected"][i].get<int>() + 1;
+    EXPECT_EQ(chosen_rows[i + 1], pool_rows[row]) << i;
+    ++counted[std::stoi(chosen_rows[i + 1].substr(chosen_rows[i + 1].rfind(',') + 1)) - 1];
+  }
+  EXPECT_EQ(counted, per_plane);
 }
 
 // A robot file may list planes; sample → simulate → identify on them comes back to the truth
