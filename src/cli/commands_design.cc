@@ -151,6 +151,27 @@ void CompareWithRandomDesigns(const Eigen::MatrixXd& G, const SelectionResult& c
   }
 }
 
+Json CertificateJson(const DesignCertificate& certificate, const std::string& statement) {
+  Json j = {{"available", certificate.available},
+            {"statement", statement},
+            {"iterations", certificate.iterations}};
+  if (certificate.available) {
+    j["bound"] = certificate.bound;
+    j["achieved"] = certificate.achieved;
+    j["efficiency"] = certificate.efficiency;
+  }
+  return j;
+}
+
+// "chosen per plane: plane 1: 19, wall: 6\n" with several planes, else "".
+std::string PerPlaneText(const PlaneSet& planes, const std::vector<int>& per_plane) {
+  if (planes.size() < 2) return "";
+  std::string out = "chosen per plane:";
+  for (int p = 0; p < planes.size(); ++p)
+    out += (p ? ", " : " ") + planes.Label(p) + ": " + std::to_string(per_plane[p]);
+  return out + "\n";
+}
+
 }  // namespace
 
 int DesignCommand(const std::vector<std::string>& args) {
@@ -213,14 +234,7 @@ int DesignCommand(const std::vector<std::string>& args) {
     j["evaluations"] = chosen.evaluations;
     j["seconds"] = seconds;
     j["indices"] = indices;
-    j["certificate"] = {{"available", certificate.available},
-                        {"statement", statement},
-                        {"iterations", certificate.iterations}};
-    if (certificate.available) {
-      j["certificate"]["bound"] = certificate.bound;
-      j["certificate"]["achieved"] = certificate.achieved;
-      j["certificate"]["efficiency"] = certificate.efficiency;
-    }
+    j["certificate"] = CertificateJson(certificate, statement);
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -231,12 +245,9 @@ int DesignCommand(const std::vector<std::string>& args) {
             << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
             << "chosen (0-based pool indices):";
   for (int i : chosen.indices) std::cout << " " << i;
-  if (planes.size() > 1) {
-    std::cout << "\nchosen per plane:";
-    for (int p = 0; p < planes.size(); ++p)
-      std::cout << (p ? ", " : " ") << planes.Label(p) << ": " << per_plane[p];
-  }
-  std::cout << "\ncertificate: " << statement << "\n\n" << t.ToText();
+  std::cout << "\n"
+            << PerPlaneText(planes, per_plane) << "certificate: " << statement << "\n\n"
+            << t.ToText();
   if (vm.count("out")) std::cout << "wrote " << vm["out"].as<std::string>() << "\n";
   return 0;
 }
