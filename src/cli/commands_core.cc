@@ -3,6 +3,7 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "cli_common.h"
@@ -11,6 +12,7 @@
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/identifiability_remedies.h"
+#include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
@@ -388,6 +390,34 @@ void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
 }
 
+// identify --holdout: configurations 1-based, like the fit's suspects.
+Json CrossValidationJson(const CrossValidation& cv) {
+  Json predictions = Json::array();
+  for (const auto& p : cv.predictions)
+    predictions.push_back({{"configuration", p.configuration + 1},
+                           {"fold", p.fold},
+                           {"error", p.error},
+                           {"predicted_std", p.predicted_std},
+                           {"z", p.z}});
+  Json failed = Json::array();
+  for (const auto& [fold, why] : cv.failed_folds)
+    failed.push_back({{"fold", fold}, {"reason", why}});
+  Json beyond = Json::array();
+  for (int i : cv.beyond_4) beyond.push_back(i + 1);
+  const bool any = !cv.predictions.empty();
+  return {{"folds", cv.folds},
+          {"assignment", "configuration i (0-based) in fold i mod K"},
+          {"predictions", predictions},
+          {"failed_folds", failed},
+          {"rms_error", any ? Json(cv.rms_error) : Json()},
+          {"rms_predicted", any ? Json(cv.rms_predicted) : Json()},
+          {"ratio", any ? Json(cv.rms_error / cv.rms_predicted) : Json()},
+          {"mean_z2", any ? Json(cv.mean_z2) : Json()},
+          {"mean_z2_tolerance", any ? Json(cv.mean_z2_tolerance) : Json()},
+          {"consistent", any ? Json(cv.consistent()) : Json()},
+          {"beyond_4", beyond}};
+}
+
 // identify --predict-at: the fit's covariance (given σ, else residual-based) at the poses.
 void PredictAt(const std::string& file, const MeasurementModel& model,
                const IdentificationSummary& s, const IdentificationOptions& options, Json* json,
@@ -403,6 +433,28 @@ void PredictAt(const std::string& file, const MeasurementModel& model,
       PredictPoseAccuracy(SolvedModel(model, s), s.delta.data(), C, poses);
   *json = PoseAccuracyJson(predicted, poses);
   *text = PoseAccuracyText(predicted);
+}
+
+// identify's output: the fit, and what --predict-at and --holdout add, as text or JSON.
+void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& model,
+                          const MeasurementSet& data, const IdentificationSummary& s,
+                          const IdentificationOptions& options) {
+  Json accuracy;
+  std::string accuracy_text;
+  if (vm.count("predict-at") && s.IsSolutionUsable())
+    PredictAt(vm["predict-at"].as<std::string>(), model, s, options, &accuracy, &accuracy_text);
+  std::optional<CrossValidation> cv;
+  if (vm.count("holdout") && s.IsSolutionUsable())
+    cv = CrossValidate(model, data, vm["holdout"].as<int>(), options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentificationJson(s);
+    if (!accuracy.is_null()) j["accuracy"] = accuracy;
+    if (cv) j["holdout"] = CrossValidationJson(*cv);
+    std::cout << j.dump(2) << "\n";
+  } else {
+    PrintIdentification(s);
+    std::cout << accuracy_text << (cv ? cv->ToString() : "");
+  }
 }
 
 int IdentifyCommand(const std::vector<std::string>& args) {
@@ -430,7 +482,10 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "estimate's covariance (given sigma if --sigma-mm, else residual-based)")(
       "write-robot", po::value<std::string>(),
       "write the calibrated model as a robot file (estimates as nominal values, with their "
-      "covariance and the data's provenance); every command takes it as --robot");
+      "covariance and the data's provenance); every command takes it as --robot")(
+      "holdout", po::value<int>(),
+      "K-fold cross-validation over the configurations (configuration i in fold i mod K): "
+      "held-out readings against the fit's own prediction of their error");
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -444,18 +499,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
     throw InputError(vm["data"].as<std::string>(), s.message);
 
-  Json accuracy;
-  std::string accuracy_text;
-  if (vm.count("predict-at") && s.IsSolutionUsable())
-    PredictAt(vm["predict-at"].as<std::string>(), model, s, options, &accuracy, &accuracy_text);
-  if (ResolveFormat(vm) == Format::kJson) {
-    Json j = IdentificationJson(s);
-    if (!accuracy.is_null()) j["accuracy"] = accuracy;
-    std::cout << j.dump(2) << "\n";
-  } else {
-    PrintIdentification(s);
-    std::cout << accuracy_text;
-  }
+  PrintIdentifyResults(vm, model, data, s, options);
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "
                  "configurations; fix the suggested parameters (--fix "

@@ -282,6 +282,35 @@ TEST_F(CliTest, RobotFileWithPlanesRoundTrip) {
       << out;
 }
 
+// identify --holdout K: with the true sigma the held-out readings are predicted as the fit
+// says; with half of it they are not (and the fit check exits 4); K out of range exits 2.
+TEST_F(CliTest, IdentifyHoldoutChecksPredictionsOfHeldOutReadings) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 3 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") +
+                    " --sigma-mm 0.2 --repetitions 3 --seed 9 --out " + Path("m.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(
+      Run("identify --data " + Path("m.csv") + " --sigma-mm 0.2 --holdout 5 --format json", &out),
+      0)
+      << out;
+  Json j = Json::parse(out)["holdout"];
+  EXPECT_EQ(j["folds"], 5);
+  ASSERT_EQ(j["predictions"].size(), 60u);
+  EXPECT_EQ(j["predictions"][0]["configuration"], 1);
+  EXPECT_EQ(j["predictions"][7]["fold"], 2);
+  EXPECT_TRUE(j["consistent"].get<bool>()) << j.dump(2);
+  EXPECT_NEAR(j["ratio"].get<double>(), 1.0, 0.3);
+  EXPECT_TRUE(j["failed_folds"].empty());
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.1 --holdout 5", &out), 4);
+  EXPECT_NE(out.find("held-out readings are predicted WORSE than the fit says"), std::string::npos)
+      << out;
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --holdout 61", &out), 2);
+  EXPECT_NE(out.find("--holdout: expected 2 to 60 folds"), std::string::npos) << out;
+}
+
 TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   std::string out;
   ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
