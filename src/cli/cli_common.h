@@ -92,5 +92,13 @@ int AccuracyCommand(const std::vector<std::string>& args);
 /// worst (1-based)} and as a text table.
 Json PoseAccuracyJson(const std::vector<PoseAccuracy>& poses, const ConfigurationSet& configs);
 std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses);
+/// Runs lrcal's Python script `relative` ("analysis/report.py": from the working directory, else
+/// lrcal's data folder) on `argument` with Debian's /usr/bin/python3 (where python3-pandas and
+/// python3-matplotlib are; LRCAL_PYTHON overrides). Returns the script's exit code (1 if it did
+/// not exit normally). Throws InputError when the script is not found.
+int RunAnalysisScript(const std::string& relative, const std::string& argument);
+/// `count` poses drawn uniformly over the robot's joint ranges (non-singular arm, no reading
+/// needed), from `seed`: the workspace over which accuracy is stated (--workspace).
+ConfigurationSet WorkspacePoses(const RobotModel& robot, int count, long long seed);
 
 }  // namespace lrcal::cli

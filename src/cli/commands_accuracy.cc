@@ -7,6 +7,7 @@
 #include "cli_common.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/design/configuration_sampling.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 
@@ -76,13 +77,31 @@ std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses) {
          Fixed(s.p95_radius_95 * 1e3) + " mm; worst pose " + std::to_string(s.worst + 1) + "\n";
 }
 
+ConfigurationSet WorkspacePoses(const RobotModel& robot, int count, long long seed) {
+  if (count < 1 || count > 100000)
+    throw InputError("--workspace", "expected 1 to 100,000 poses, got " + std::to_string(count));
+  if (seed < 0) throw InputError("--seed", "expected a non-negative integer");
+  SamplingOptions o;
+  o.require_beam_hit = false;
+  return SampleConfigurations(
+      robot, Plane{}, count,
+      RandomStream(static_cast<std::uint64_t>(seed), 0, 0, RandomPurpose::kValidation), o);
+}
+
 int AccuracyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal accuracy options");
   AddCommonOptions(o);
-  o.add_options()("configs", po::value<std::string>()->required(),
-                  "poses to predict at: a configurations CSV (q1..qN, rad)");
+  o.add_options()("configs", po::value<std::string>(),
+                  "poses to predict at: a configurations CSV (q1..qN, rad)")(
+      "workspace", po::value<int>(),
+      "or: this many poses drawn over the robot's joint ranges (non-singular arm)")(
+      "seed", po::value<long long>()->default_value(1), "seed of the --workspace draw");
   po::variables_map vm;
-  if (!Parse("accuracy", "--robot CAL.yaml --configs P.csv [options]", o, args, &vm)) return 0;
+  if (!Parse("accuracy", "--robot CAL.yaml --configs P.csv|--workspace N [options]", o, args, &vm))
+    return 0;
+  if (vm.count("configs") == vm.count("workspace"))
+    throw InputError("--configs/--workspace",
+                     "give exactly one: a poses CSV or a number of poses to draw");
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   if (!rig.calibration || rig.calibration->covariance.size() == 0)
@@ -110,17 +129,24 @@ int AccuracyCommand(const std::vector<std::string>& args) {
     for (int b = 0; b < n; ++b) C(a, b) = r.covariance(at[a], at[b]);
   const MeasurementModel model(rig.robot, setup.planes, ps);
   const ConfigurationSet configs =
-      ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot, &setup.planes);
+      vm.count("configs")
+          ? ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot, &setup.planes)
+          : WorkspacePoses(rig.robot, vm["workspace"].as<int>(), vm["seed"].as<long long>());
   const std::vector<double> zero(n, 0.0);  // the file's nominal values are the estimates
   const std::vector<PoseAccuracy> poses = PredictPoseAccuracy(model, zero.data(), C, configs);
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = PoseAccuracyJson(poses, configs);
     j["sigma"] = r.sigma;
+    if (vm.count("workspace"))
+      j["workspace"] = {{"poses", configs.size()}, {"seed", vm["seed"].as<long long>()}};
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "covariance of " << rig.path << " (sigma " << Fixed(r.sigma * 1e3, 4)
-              << " mm per reading)\n"
-              << PoseAccuracyText(poses);
+              << " mm per reading)\n";
+    if (vm.count("workspace"))
+      std::cout << configs.size() << " poses drawn over the joint ranges (seed "
+                << vm["seed"].as<long long>() << ")\n";
+    std::cout << PoseAccuracyText(poses);
   }
   return 0;
 }
