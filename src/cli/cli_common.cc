@@ -1,5 +1,12 @@
 #include "cli_common.h"
 
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "lrcal/core/data_dir.h"
 #include "lrcal/io/csv.h"
 
 namespace lrcal::cli {
@@ -127,6 +134,31 @@ Json ToJson(const Eigen::MatrixXd& m) {
     j.push_back(row);
   }
   return j;
+}
+
+namespace {
+
+std::string ShellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+int RunAnalysisScript(const std::string& relative, const std::string& argument) {
+  std::string script = std::filesystem::exists(relative) ? relative : FindDataFile(relative);
+  if (script.empty())
+    throw InputError(relative, "not found in the working directory nor in lrcal's data folder (" +
+                                   DataDirectory() + ")");
+  // Debian's interpreter, where python3-pandas and python3-matplotlib are installed (a python3
+  // earlier on PATH, e.g. from pyenv, may not have them); LRCAL_PYTHON overrides.
+  std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  if (const char* p = std::getenv("LRCAL_PYTHON")) python = p;
+  std::cout.flush();
+  const int status = std::system(
+      (ShellQuote(python) + " " + ShellQuote(script) + " " + ShellQuote(argument)).c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
 
 }  // namespace lrcal::cli

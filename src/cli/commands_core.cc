@@ -2,6 +2,7 @@
 // paper.
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include "cli_common.h"
 #include "lrcal/build_info.h"
 #include "lrcal/core/hash.h"
+#include "lrcal/core/json.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/identifiability_remedies.h"
@@ -457,6 +459,43 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
   }
 }
 
+// identify --report DIR: everything the page shows, as calibration.json (SI), the calibrated robot
+// file, then report.html from analysis/calibration_report.py. Cross-validation uses --holdout K,
+// else 5 folds; the accuracy map 500 poses over the joint ranges (seed 1).
+void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
+                            const RobotFile& rig, const MeasurementModel& model,
+                            const MeasurementSet& data, const IdentificationSummary& s,
+                            const IdentificationOptions& options) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError("--report", "cannot create the folder '" + dir + "': " + ec.message());
+  Json j = IdentificationJson(s);
+  j["data"] = {{"file", vm["data"].as<std::string>()}, {"configurations", data.size()}};
+  j["robot"] = rig.path;
+  j["sigma_given"] = options.sigma > 0 ? Json(options.sigma) : Json();
+  j["identifiability"] = IdentifiabilityJson(s.identifiability);
+  if (s.IsSolutionUsable()) {
+    const int folds = vm.count("holdout") ? vm["holdout"].as<int>() : std::min(5, data.size());
+    if (folds >= 2) j["holdout"] = CrossValidationJson(CrossValidate(model, data, folds, options));
+    const Eigen::MatrixXd& C = FitCovariance(s, options);
+    if (C.allFinite()) {
+      const ConfigurationSet poses = WorkspacePoses(model.robot(), 500, 1);
+      j["workspace_accuracy"] = PoseAccuracyJson(
+          PredictPoseAccuracy(SolvedModel(model, s), s.delta.data(), C, poses), poses);
+    }
+    WriteCalibratedRobot(dir + "/calibrated.yaml", vm["data"].as<std::string>(), rig, model, s,
+                         options);
+    j["calibrated_robot"] = "calibrated.yaml";
+  }
+  WriteFileAtomically(dir + "/calibration.json", j.dump(2));
+  const int code = RunAnalysisScript("analysis/calibration_report.py", dir);
+  if (code != 0)
+    throw StorageError(dir + "/report.html: analysis/calibration_report.py failed (exit " +
+                       std::to_string(code) +
+                       "); calibration.json and the calibrated robot file are written");
+  std::cerr << "lrcal identify: calibration report written to " << dir << "/report.html\n";
+}
+
 int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddCommonOptions(o);
@@ -485,7 +524,11 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "covariance and the data's provenance); every command takes it as --robot")(
       "holdout", po::value<int>(),
       "K-fold cross-validation over the configurations (configuration i in fold i mod K): "
-      "held-out readings against the fit's own prediction of their error");
+      "held-out readings against the fit's own prediction of their error")(
+      "report", po::value<std::string>(),
+      "write a calibration report into this folder: report.html (fit check, residuals, "
+      "parameters, correlation, identifiability, cross-validation, accuracy over the "
+      "workspace), calibration.json and the calibrated robot file");
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -514,6 +557,8 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (vm.count("write-robot") && s.IsSolutionUsable())
     WriteCalibratedRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig,
                          model, s, options);
+  if (vm.count("report"))
+    WriteCalibrationReport(vm["report"].as<std::string>(), vm, rig, model, data, s, options);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
               << " < 0.001); see the fit line above\n";

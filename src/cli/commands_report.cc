@@ -1,7 +1,5 @@
 // lrcal report RUN_DIR: tables and a one-realisation file from the run's records (C++), then the
 // figures and report.html (analysis/report.py, which only reads what lrcal wrote).
-#include <sys/wait.h>
-
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -13,25 +11,6 @@
 
 namespace lrcal::cli {
 
-namespace {
-
-std::string Quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string FindReportScript() {
-  namespace fs = std::filesystem;
-  if (fs::exists("analysis/report.py")) return "analysis/report.py";
-  if (std::string shipped = FindDataFile("analysis/report.py"); !shipped.empty()) return shipped;
-  throw InputError(
-      "analysis/report.py",
-      "not found in the working directory nor in lrcal's data folder (" + DataDirectory() + ")");
-}
-
-}  // namespace
-
 int ReportCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal report options");
   o.add_options()("dir", po::value<std::string>()->required(), "run directory");
@@ -42,13 +21,7 @@ int ReportCommand(const std::vector<std::string>& args) {
   const std::string dir = vm["dir"].as<std::string>();
   const auto t0 = std::chrono::steady_clock::now();
   const ReportData data = PrepareReportData(dir);
-  const std::string script = FindReportScript();
-  // Debian's interpreter, where python3-pandas and python3-matplotlib are installed (a python3
-  // earlier on PATH, e.g. from pyenv, may not have them); LRCAL_PYTHON overrides.
-  std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  if (const char* p = std::getenv("LRCAL_PYTHON")) python = p;
-  const int status = std::system((Quote(python) + " " + Quote(script) + " " + Quote(dir)).c_str());
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  const int code = RunAnalysisScript("analysis/report.py", dir);
   RemoveReportSnapshot(data);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

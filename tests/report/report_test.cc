@@ -148,5 +148,92 @@ TEST(Report, MissingOrMalformedRunDirectoriesAreClearErrors) {
   EXPECT_NE(out.find("summary.json: missing"), std::string::npos) << out;
 }
 
+// identify --report DIR (issue 13 item 9): from a measured CSV to a page with the fit check,
+// parameters, identifiability, cross-validation and the accuracy map, its five figures decoded
+// in headless Chromium, the calibrated robot file beside it usable by `lrcal accuracy`, and the
+// same numbers in calibration.json as identify's own JSON.
+TEST(Report, CalibrationReportRendersInHeadlessChromium) {
+  const std::string dir = testing::TempDir("report_calibration");
+  std::string out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " sample --count 60 --seed 3 --out " + dir + "/c.csv", &out),
+            0)
+      << out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " simulate --configs " + dir +
+                           "/c.csv --sigma-mm 0.2 --repetitions 3 --seed 9 --out " + dir + "/m.csv",
+                       &out),
+            0)
+      << out;
+  const std::string identify =
+      LrcalBinary() + " identify --data " + dir + "/m.csv --sigma-mm 0.2 --holdout 4";
+  ASSERT_EQ(RunCommand(identify + " --report " + dir + "/cal", &out), 0) << out;
+  const fs::path cal = fs::path(dir) / "cal";
+  for (const char* f : {"report.html", "calibration.json", "calibrated.yaml", "figures.json"})
+    EXPECT_TRUE(fs::exists(cal / f)) << f;
+  const Json figures = Json::parse(Read(cal / "figures.json"));
+  const std::vector<std::string> names = figures["figures"];
+  EXPECT_EQ(names, (std::vector<std::string>{"residuals.png", "parameters.png", "correlation.png",
+                                             "holdout.png", "accuracy.png"}));
+  const Json j = Json::parse(Read(cal / "calibration.json"));
+  EXPECT_EQ(j["holdout"]["folds"], 4);
+  EXPECT_EQ(j["workspace_accuracy"]["poses"].size(), 500u);
+  EXPECT_EQ(j["identifiability"]["rank"], 25);
+  ASSERT_EQ(RunCommand(identify + " --format json", &out), 0) << out;
+  const Json plain = Json::parse(out);
+  EXPECT_EQ(plain["parameters"], j["parameters"]);
+  EXPECT_EQ(plain["holdout"], j["holdout"]);
+  const std::string html = Read(cal / "report.html");
+  for (const char* section :
+       {"Fit check", "Parameters", "Identifiability", "Cross-validation",
+        "Accuracy over the workspace", "Calibrated files", "consistent with the stated noise"})
+    EXPECT_NE(html.find(section), std::string::npos) << section;
+  // The map's poses, predicted again from the written file: the same accuracy.
+  {
+    std::ofstream poses(dir + "/poses.csv");
+    poses.precision(17);
+    poses << "q1,q2,q3,q4,q5,q6\n";
+    for (const auto& pose : j["workspace_accuracy"]["poses"]) {
+      for (int k = 0; k < 6; ++k) poses << (k ? "," : "") << pose["q"][k].get<double>();
+      poses << "\n";
+    }
+  }
+  ASSERT_EQ(RunCommand(LrcalBinary() + " accuracy --robot " + (cal / "calibrated.yaml").string() +
+                           " --configs " + dir + "/poses.csv --format json",
+                       &out),
+            0)
+      << out;
+  EXPECT_NEAR(Json::parse(out)["rms_position"].get<double>(),
+              j["workspace_accuracy"]["rms_position"].get<double>(),
+              1e-9 * j["workspace_accuracy"]["rms_position"].get<double>());
+
+  if (RunCommand("command -v chromium", &out) != 0) GTEST_SKIP() << "chromium is not installed";
+  ASSERT_EQ(RunCommand(Chromium(dir + "/chromium-profile") +
+                           "--enable-logging=stderr --v=0 --virtual-time-budget=10000 "
+                           "--dump-dom file://" +
+                           (cal / "report.html").string() + " 2>" + dir + "/console.log",
+                       &out),
+            0);
+  EXPECT_NE(out.find("<title>lrcal report: 5/5 figures</title>"), std::string::npos);
+  const std::string console = Read(dir + "/console.log");
+  EXPECT_EQ(console.find("CONSOLE"), std::string::npos) << "console messages:\n" << console;
+}
+
+// A report folder that cannot be created is a clear error (exit 2), after nothing was lost.
+TEST(Report, CalibrationReportIntoAFileIsAClearError) {
+  const std::string dir = testing::TempDir("report_calibration_bad");
+  std::string out;
+  ASSERT_EQ(RunCommand(LrcalBinary() + " sample --count 40 --seed 3 --out " + dir + "/c.csv", &out),
+            0);
+  ASSERT_EQ(RunCommand(LrcalBinary() + " simulate --configs " + dir +
+                           "/c.csv --sigma-mm 0.2 --seed 9 --out " + dir + "/m.csv",
+                       &out),
+            0);
+  std::ofstream(dir + "/afile") << "x";
+  EXPECT_EQ(RunCommand(
+                LrcalBinary() + " identify --data " + dir + "/m.csv --report " + dir + "/afile/cal",
+                &out),
+            2);
+  EXPECT_NE(out.find("--report: cannot create the folder"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace lrcal

@@ -1,0 +1,295 @@
+#!/usr/bin/env python3
+"""Writes DIR/report.html for `lrcal identify ... --report DIR`: a self-contained page (figures
+embedded as PNG, also written as PNG and SVG in DIR/figures/) from what identify wrote in
+DIR/calibration.json (SI units; the page shows mm and mrad and says so). It never recomputes the
+calibration: every number comes from the JSON.
+
+    /usr/bin/python3 analysis/calibration_report.py DIR
+
+Sections: the fit check, residuals per configuration, the parameters with their change and
+uncertainty, the correlation map, identifiability, cross-validation, the predicted accuracy over
+the workspace and the calibrated files. Exit code 2 (with a message naming the file) for a
+missing or malformed calibration.json, 5 when the page cannot be written.
+"""
+import base64
+import html
+import json
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report import CHECK, STYLE, write_atomically  # noqa: E402
+
+
+class CalibrationDataError(Exception):
+    """calibration.json is missing or lacks what the page needs."""
+
+
+ANGULAR = ("theta", "alpha", "beta")
+
+
+def is_angular(name):
+    return name.startswith(ANGULAR) or (name.startswith("plane") and "_u" in name)
+
+
+def display(name, value):
+    """(value in the table's unit, unit): mm for lengths, mrad for angles, ppm for the scale."""
+    if name == "ranger_scale":
+        return value * 1e6, "ppm"
+    return value * 1e3, ("mrad" if is_angular(name) else "mm")
+
+
+def load(folder):
+    path = os.path.join(folder, "calibration.json")
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, ValueError) as e:
+        raise CalibrationDataError(f"{path}: expected the JSON that lrcal identify --report "
+                                   f"writes ({e})")
+    for key in ("parameters", "termination", "n_configurations"):
+        if key not in data:
+            raise CalibrationDataError(f"{path}: missing key '{key}'")
+    return data
+
+
+def save(fig, fig_dir, name, caption, out):
+    os.makedirs(fig_dir, exist_ok=True)
+    png = os.path.join(fig_dir, name + ".png")
+    fig.savefig(png, dpi=110, bbox_inches="tight")
+    fig.savefig(os.path.join(fig_dir, name + ".svg"), bbox_inches="tight")
+    plt.close(fig)
+    out.append((png, caption))
+
+
+def residual_figure(data, fig_dir, out):
+    z = data.get("fit", {}).get("standardized_residuals") or []
+    if not z:
+        return
+    given = data.get("sigma_given") is not None
+    fig, ax = plt.subplots(figsize=(10, 3.2))
+    x = np.arange(1, len(z) + 1)
+    ax.bar(x, z, color=["#c0392b" if abs(v) > 4 else "#4a7ab5" for v in z])
+    for level in (-4, 4):
+        ax.axhline(level, color="#c0392b", lw=0.8, ls="--")
+    ax.set_xlabel("configuration (1-based, data order)")
+    ax.set_ylabel("standardized residual")
+    save(fig, fig_dir, "residuals",
+         "Standardized residual of each configuration's mean reading (residual over "
+         + ("the given σ/√R" if given else "σ̂/√R") + "); beyond ±4 (red) are suspects.", out)
+
+
+def parameter_figure(data, fig_dir, out):
+    params = data["parameters"]
+    if not params:
+        return
+    rows = []
+    for p in params:
+        std = p["std_given_sigma"] if p.get("std_given_sigma") is not None else p.get("std")
+        value, unit = display(p["name"], p["delta"])
+        err = display(p["name"], std)[0] if std is not None else 0.0
+        rows.append((p["name"], value, err, unit))
+    units = sorted({r[3] for r in rows})
+    fig, axes = plt.subplots(len(units), 1, figsize=(10, 2.8 * len(units)), squeeze=False)
+    for ax, unit in zip(axes[:, 0], units):
+        sel = [r for r in rows if r[3] == unit]
+        x = np.arange(len(sel))
+        ax.errorbar(x, [r[1] for r in sel], yerr=[2 * r[2] for r in sel], fmt="o", capsize=3)
+        ax.axhline(0, color="#888", lw=0.8)
+        ax.set_xticks(x)
+        ax.set_xticklabels([r[0] for r in sel], rotation=60, fontsize=8)
+        ax.set_ylabel(f"change ({unit})")
+    save(fig, fig_dir, "parameters",
+         "Identified change of each parameter from its nominal value, with ±2 standard "
+         "deviations (given σ when stated, else residual-based); mm, mrad, ppm.", out)
+
+
+def correlation_figure(data, fig_dir, out):
+    corr = data.get("correlation")
+    if not corr:
+        return
+    names = [p["name"] for p in data["parameters"]]
+    fig, ax = plt.subplots(figsize=(7.5, 6.5))
+    im = ax.imshow(np.array(corr), vmin=-1, vmax=1, cmap="RdBu_r")
+    ax.set_xticks(range(len(names)))
+    ax.set_yticks(range(len(names)))
+    ax.set_xticklabels(names, rotation=90, fontsize=7)
+    ax.set_yticklabels(names, fontsize=7)
+    fig.colorbar(im, ax=ax, label="correlation")
+    save(fig, fig_dir, "correlation", "Correlation of the identified parameters.", out)
+
+
+def holdout_figure(data, fig_dir, out):
+    h = data.get("holdout")
+    if not h or not h.get("predictions"):
+        return
+    preds = h["predictions"]
+    fig, ax = plt.subplots(figsize=(10, 3.2))
+    ax.scatter([p["configuration"] for p in preds], [p["z"] for p in preds], s=12,
+               c=[p["fold"] for p in preds], cmap="tab10")
+    for level in (-4, 4):
+        ax.axhline(level, color="#c0392b", lw=0.8, ls="--")
+    ax.set_xlabel("held-out configuration (1-based; colour: fold)")
+    ax.set_ylabel("error / predicted std")
+    save(fig, fig_dir, "holdout",
+         f"Cross-validation, {h['folds']} folds: each configuration's held-out error over the "
+         "fit's own prediction of its standard deviation (about N(0, 1) when the model and σ are "
+         "right).", out)
+
+
+def accuracy_figure(data, fig_dir, out):
+    acc = data.get("workspace_accuracy")
+    if not acc or not acc.get("poses"):
+        return
+    radius = np.array([p["position_radius_95"] for p in acc["poses"]]) * 1e3
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    ax.hist(radius, bins=30, color="#4a7ab5")
+    ax.axvline(acc["p95_position_radius_95"] * 1e3, color="#c0392b", lw=1,
+               label="95th percentile")
+    ax.set_xlabel("radius holding the position error with 95 % probability (mm)")
+    ax.set_ylabel("poses")
+    ax.legend()
+    save(fig, fig_dir, "accuracy",
+         f"Predicted accuracy of the calibrated arm at {len(radius)} poses drawn over the joint "
+         "ranges (first-order propagation of the parameter covariance).", out)
+
+
+def fit_text(data):
+    fit = data.get("fit") or {}
+    parts = [f"Termination: <b>{html.escape(data['termination'])}</b> "
+             f"({html.escape(data.get('solver', ''))}, {html.escape(data.get('loss', ''))}), "
+             f"{data['n_configurations']} configurations, {len(data['parameters'])} parameters, "
+             f"residual RMS {data.get('residual_rms', 0) * 1e3:.4f} mm."]
+    if data.get("message"):
+        parts.append(html.escape(data["message"]))
+    if fit.get("chi2") is not None:
+        verdict = ("consistent with the stated noise" if fit.get("consistent")
+                   else "<b>INCONSISTENT with the stated noise</b>: σ too small, an unmodelled "
+                   "error (a second plane, a ranger offset or scale), wrong units or outliers")
+        parts.append(f"χ² = {fit['chi2']:.2f} on {fit['dof']} degrees of freedom, "
+                     f"p = {fit['p_value']:.3g}: {verdict}.")
+    elif data.get("sigma_hat") is not None:
+        parts.append(f"No σ given: σ̂ per reading {data['sigma_hat'] * 1e3:.4f} mm.")
+    if fit.get("suspects"):
+        parts.append("Suspect configurations (beyond 4 σ): "
+                     + ", ".join(str(i) for i in fit["suspects"]) + ".")
+    return "<p>" + "</p><p>".join(parts) + "</p>"
+
+
+def parameter_table(data):
+    rows = ["<table><tr><th>parameter</th><th>unit</th><th>nominal</th><th>change</th>"
+            "<th>std</th><th>estimate</th></tr>"]
+    for p in data["parameters"]:
+        std = p["std_given_sigma"] if p.get("std_given_sigma") is not None else p.get("std")
+        nominal, unit = display(p["name"], p["nominal"])
+        if p["name"] == "ranger_scale":
+            nominal = p["nominal"] * 1e6
+        rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in (
+            html.escape(p["name"]), unit, f"{nominal:.4f}", f"{display(p['name'], p['delta'])[0]:.4f}",
+            "undefined" if std is None else f"{display(p['name'], std)[0]:.4f}",
+            f"{display(p['name'], p['estimate'])[0]:.4f}")) + "</tr>")
+    rows.append("</table>")
+    return "".join(rows)
+
+
+def identifiability_text(data):
+    ident = data.get("identifiability") or {}
+    text = (f"<p>Rank {ident.get('rank', '?')} of {ident.get('n_params', '?')} parameters "
+            f"at the nominal model.")
+    if data.get("fixed_for_rank"):
+        text += " Fixed for rank deficiency: " + ", ".join(data["fixed_for_rank"]) + "."
+    for dep in ident.get("dependencies", []):
+        text += "<br>Dependence: " + html.escape(" ".join(
+            f"{t['coefficient']:+.4g}·{t['name']}" for t in dep))
+    return text + "</p>"
+
+
+def holdout_text(data):
+    h = data.get("holdout")
+    if not h:
+        return "<p>Not run (fewer than two configurations per fold).</p>"
+    if not h.get("predictions"):
+        return ("<p>No fold could be fitted without its configurations: "
+                + html.escape("; ".join(f["reason"] for f in h.get("failed_folds", []))) + "</p>")
+    verdict = ("held-out readings are predicted as well as the fit says" if h["consistent"]
+               else "<b>held-out readings are predicted worse than the fit says</b>")
+    return (f"<p>{h['folds']} folds (configuration i in fold i mod K): held-out error RMS "
+            f"{h['rms_error'] * 1e3:.4f} mm, predicted {h['rms_predicted'] * 1e3:.4f} mm "
+            f"(ratio {h['ratio']:.3f}); mean z² {h['mean_z2']:.3f} (1 ± "
+            f"{h['mean_z2_tolerance']:.3f} expected): {verdict}.</p>")
+
+
+def accuracy_text(data):
+    acc = data.get("workspace_accuracy")
+    if not acc:
+        return "<p>Not available: the covariance is undefined (give --sigma-mm).</p>"
+    return (f"<p>Over {len(acc['poses'])} poses drawn over the joint ranges: RMS position error "
+            f"{acc['rms_position'] * 1e3:.4f} mm; 95th percentile of the 95 % radius "
+            f"{acc['p95_position_radius_95'] * 1e3:.4f} mm; worst pose {acc['worst']}.</p>")
+
+
+def build(folder):
+    data = load(folder)
+    fig_dir = os.path.join(folder, "figures")
+    figures = []
+    for make in (residual_figure, parameter_figure, correlation_figure, holdout_figure,
+                 accuracy_figure):
+        make(data, fig_dir, figures)
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
+             "<title>lrcal calibration report</title>", f"<style>{STYLE}</style></head><body>",
+             "<h1>Calibration report</h1>",
+             f"<p>Robot <code>{html.escape(str(data.get('robot', '?')))}</code>, data "
+             f"<code>{html.escape(str(data.get('data', {}).get('file', '?')))}</code>. Lengths "
+             "in mm, angles in mrad; calibration.json has every number in SI.</p>",
+             "<h2>Fit check</h2>", fit_text(data), "<h2>Parameters</h2>", parameter_table(data),
+             "<h2>Identifiability</h2>", identifiability_text(data),
+             "<h2>Cross-validation</h2>", holdout_text(data),
+             "<h2>Accuracy over the workspace</h2>", accuracy_text(data), "<h2>Figures</h2>"]
+    for png, caption in figures:
+        with open(png, "rb") as f:
+            encoded = base64.b64encode(f.read()).decode("ascii")
+        svg = os.path.relpath(png[:-4] + ".svg", folder)
+        parts.append(f"<figure><img class='figure' alt='{html.escape(caption)}' "
+                     f"src='data:image/png;base64,{encoded}'><figcaption>{html.escape(caption)} "
+                     f"(<a href='{html.escape(svg)}'>SVG</a>)</figcaption></figure>")
+    parts.append("<h2>Calibrated files</h2>")
+    if data.get("calibrated_robot"):
+        name = html.escape(data["calibrated_robot"])
+        parts.append(f"<p><a href='{name}'>{name}</a>: the calibrated robot file (every lrcal "
+                     "command takes it as --robot); <a href='calibration.json'>calibration.json"
+                     "</a>: everything on this page in SI.</p>")
+    else:
+        parts.append("<p>None: the fit is not usable.</p>")
+    parts.append(f"<script>{CHECK}</script></body></html>")
+    path = os.path.join(folder, "report.html")
+    write_atomically(path, "\n".join(parts))
+    write_atomically(os.path.join(folder, "figures.json"),
+                     json.dumps({"figures": [os.path.basename(p) for p, _ in figures],
+                                 "captions": [c for _, c in figures]}, indent=2))
+    return path, figures
+
+
+def main(argv):
+    if len(argv) != 2:
+        print("usage: calibration_report.py DIR", file=sys.stderr)
+        return 2
+    try:
+        path, figures = build(argv[1])
+    except CalibrationDataError as e:
+        print(f"calibration_report.py: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"calibration_report.py: could not write the report: {e}", file=sys.stderr)
+        return 5
+    print(f"calibration_report.py: {len(figures)} figures, {path}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
