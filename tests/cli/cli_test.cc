@@ -7,8 +7,12 @@
 #include <set>
 #include <sstream>
 
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/measurement_model.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -231,6 +235,51 @@ TEST_F(CliTest, DesignChoosesConfigurationPlanePairs) {
     ++counted[std::stoi(chosen_rows[i + 1].substr(chosen_rows[i + 1].rfind(',') + 1)) - 1];
   }
   EXPECT_EQ(counted, per_plane);
+}
+
+// design --criterion I: the predicted RMS position error at the user's poses, as JSON reports
+// it, against tr(W (GᵀG)⁻¹) computed here from the pool's and the poses' Jacobians; the I design
+// predicts better at those poses than the E design on the same pool.
+TEST_F(CliTest, DesignTaskCriterionMinimisesThePredictedErrorAtThePoses) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 101 --seed 3 --out " + Path("pool.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("sample --validation --count 50 --seed 8 --out " + Path("poses.csv"), &out), 0)
+      << out;
+  const RobotModel& robot = testing::PaperRobot();
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  const ConfigurationSet pool = ReadConfigurations(Path("pool.csv"), 6);
+  const ConfigurationSet poses = ReadConfigurations(Path("poses.csv"), 6);
+  const Eigen::MatrixXd G = IdentificationJacobian(model, pool);
+  const std::vector<double> zero(25, 0.0);
+  const Eigen::MatrixXd J6 = PoseJacobian(model, zero.data(), poses);
+  const auto predicted_rms = [&](const Json& selected) {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(25, 25);
+    for (const auto& i : selected) A += G.row(i.get<int>()).transpose() * G.row(i.get<int>());
+    const Eigen::MatrixXd C = A.inverse();
+    double sum = 0;
+    for (int j = 0; j < poses.size(); ++j)
+      sum += (J6.middleRows(6 * j, 3) * C * J6.middleRows(6 * j, 3).transpose()).trace();
+    return std::sqrt(sum / poses.size());
+  };
+  const std::string design = "design --pool " + Path("pool.csv") + " --select 30 --baseline 10 " +
+                             "--format json --criterion ";
+  ASSERT_EQ(Run(design + "I --poses " + Path("poses.csv"), &out), 0) << out;
+  const Json task = Json::parse(out);
+  EXPECT_EQ(task["criterion"], "I");
+  EXPECT_EQ(task["task"]["poses"], 50);
+  const double rms_i = predicted_rms(task["selected"]);
+  EXPECT_NEAR(task["task"]["rms_position_per_unit_sigma"].get<double>(), rms_i, 1e-9 * rms_i);
+  ASSERT_EQ(Run(design + "E", &out), 0) << out;
+  const double rms_e = predicted_rms(Json::parse(out)["selected"]);
+  EXPECT_LT(rms_i, rms_e);
+  // Without --poses, poses over the joint ranges are used and said so.
+  ASSERT_EQ(
+      Run("design --pool " + Path("pool.csv") + " --select 30 --baseline 10 --criterion I", &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("criterion I (predicted RMS position error at 200 workspace poses"),
+            std::string::npos)
+      << out;
 }
 
 // A robot file may list planes; sample → simulate → identify on them comes back to the truth
