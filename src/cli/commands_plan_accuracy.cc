@@ -148,7 +148,8 @@ struct Campaign {
 // changes only the noise.
 std::string WriteStudy(const Study& base, const std::string& path, const std::string& name,
                        int trials, std::uint64_t seed, const std::vector<Campaign>& campaigns,
-                       const std::string& pool_file, const std::string& validation_file) {
+                       const std::string& pool_file, const std::string& validation_file,
+                       double stop_precision = 0) {
   Json settings = Json::parse(base.base.dump());
   settings.erase("robot_file_fnv1a");
   settings["robot"] = fs::absolute(ResolveRobotPath(base.base["robot"], base.folder())).string();
@@ -167,6 +168,13 @@ std::string WriteStudy(const Study& base, const std::string& path, const std::st
   study["description"] = "Campaigns from lrcal plan-accuracy on " + base.path;
   study["seed"] = seed;
   study["trials"] = trials;
+  // --stop-precision F: the statistics issue's adaptive stopping, trials being the maximum: a
+  // campaign stops once every validation mean's SE is within F/2 of it and every validation
+  // p95's 95 % interval half-width within F of it (decided every 1000 trials, or trials/10).
+  if (stop_precision > 0)
+    study["stop_when"] = {{"block", std::max(1, std::min(1000, trials / 10))},
+                          {"relative_se", stop_precision / 2},
+                          {"p95_relative_halfwidth", stop_precision}};
   if (campaigns.size() == 1) {
     study["selection"]["count"] = campaigns[0].configurations;
     study["noise"]["repetitions"] = campaigns[0].repetitions;
@@ -214,6 +222,7 @@ struct PlanInputs {
   Target target;
   double confidence = 0.95, per_configuration = 0, per_reading = 0;
   int trials = 0, threads = 0;
+  double stop_precision = 0;  // 0: every campaign runs `trials`
   std::vector<int> repetitions;
   std::string configurations;  // as given, or empty
   std::string out_dir;
@@ -230,6 +239,10 @@ PlanInputs ReadInputs(const po::variables_map& vm, const Study& study) {
   in.trials = vm["trials"].as<int>();
   if (in.trials < 100 || in.trials > 10000000)
     throw InputError("--trials", "expected 100 to 10,000,000 trials per campaign");
+  in.stop_precision = vm["stop-precision"].as<double>();
+  if (!(in.stop_precision >= 0 && in.stop_precision < 1))
+    throw InputError("--stop-precision",
+                     "expected 0 (run every trial) or a relative precision in (0, 1), e.g. 0.05");
   in.repetitions = ParseRange(vm["repetitions"].as<std::string>(), "--repetitions", 1);
   if (vm.count("configurations")) in.configurations = vm["configurations"].as<std::string>();
   in.out_dir = vm.count("out") ? vm["out"].as<std::string>() : "output/" + study.name + "-plan";
@@ -310,7 +323,7 @@ class Planner {
     }
     study_path_ = in_.out_dir + "/campaigns.yaml";
     WriteStudy(study_, study_path_, study_.name + "-campaigns", in_.trials, in_.seed, confirm_,
-               pool_file_, validation_file_);
+               pool_file_, validation_file_, in_.stop_precision);
     RunOptions ro;
     ro.out_dir = run_dir_ = in_.out_dir + "/run";
     ro.threads = in_.threads;
@@ -348,20 +361,36 @@ class Planner {
 
   void PrintText() const {
     std::cout << search_table_.ToText() << "\n";
-    Table t({"campaign", "configurations", "readings each", "readings", "cost (h)",
-             "predicted (" + in_.target.unit + ")",
-             "Monte Carlo [95 % CI] (" + in_.target.unit + ")", "meets target"},
-            "Campaigns for " + in_.target.metric + " ≤ " + Fixed(in_.target.shown, 4) + " " +
-                in_.target.unit + " in " + Fixed(100 * in_.confidence, 1) +
-                " % of calibrations (worst axis; " + std::to_string(in_.trials) +
-                " Monte-Carlo trials each)");
-    for (const Campaign& c : confirm_)
-      t.AddRow({c.label, std::to_string(c.configurations), std::to_string(c.repetitions),
-                std::to_string(c.configurations * c.repetitions), Fixed(c.cost / 3600, 2),
-                Fixed(c.predicted * 1e3, 4),
-                Fixed(c.mc * 1e3, 4) + " [" + Fixed(c.mc_low * 1e3, 4) + ", " +
-                    Fixed(c.mc_high * 1e3, 4) + "]",
-                Meets(c)});
+    const bool stopped = in_.stop_precision > 0;
+    std::vector<std::string> header = {"campaign",
+                                       "configurations",
+                                       "readings each",
+                                       "readings",
+                                       "cost (h)",
+                                       "predicted (" + in_.target.unit + ")",
+                                       "Monte Carlo [95 % CI] (" + in_.target.unit + ")",
+                                       "meets target"};
+    if (stopped) header.push_back("trials");
+    Table t(header, "Campaigns for " + in_.target.metric + " ≤ " + Fixed(in_.target.shown, 4) +
+                        " " + in_.target.unit + " in " + Fixed(100 * in_.confidence, 1) +
+                        " % of calibrations (worst axis; " + (stopped ? "up to " : "") +
+                        std::to_string(in_.trials) + " Monte-Carlo trials each" +
+                        (stopped ? ", stopped at relative precision " + Fixed(in_.stop_precision, 3)
+                                 : std::string()) +
+                        ")");
+    for (const Campaign& c : confirm_) {
+      std::vector<std::string> row = {c.label,
+                                      std::to_string(c.configurations),
+                                      std::to_string(c.repetitions),
+                                      std::to_string(c.configurations * c.repetitions),
+                                      Fixed(c.cost / 3600, 2),
+                                      Fixed(c.predicted * 1e3, 4),
+                                      Fixed(c.mc * 1e3, 4) + " [" + Fixed(c.mc_low * 1e3, 4) +
+                                          ", " + Fixed(c.mc_high * 1e3, 4) + "]",
+                                      Meets(c)};
+      if (stopped) row.push_back(std::to_string(c.trials));
+      t.AddRow(row);
+    }
     std::cout << t.ToText() << "\nsearch " << Fixed(search_seconds_, 1)
               << " s; the campaigns as a study: " << study_path_ << " (run it with another "
               << "seed to check), its run: " << run_dir_ << "\n";
@@ -426,6 +455,9 @@ int PlanAccuracyCommand(const std::vector<std::string>& args) {
       "time per configuration (move) and per reading")("trials",
                                                        po::value<int>()->default_value(10000),
                                                        "Monte-Carlo trials per confirmed campaign")(
+      "stop-precision", po::value<double>()->default_value(0.0),
+      "stop each confirmed campaign once its validation means (SE) and p95s (95 % interval "
+      "half-width) are known to this relative precision; --trials is then the maximum")(
       "seed", po::value<long long>(), "seed of the confirmation runs (default: the study's)")(
       "out", po::value<std::string>(), "folder for the confirmation study and run")(
       "threads", po::value<int>()->default_value(0), "threads (0: all cores)")(

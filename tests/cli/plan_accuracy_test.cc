@@ -93,6 +93,36 @@ TEST(PlanAccuracy, ThePlanDoesNotDependOnWhereItIsWritten) {
     EXPECT_EQ(original.cells[i].id, moved.cells[i].id);
 }
 
+// --stop-precision: the confirmation runs with the adaptive stopping rule, --trials being the
+// maximum: every campaign stops at a block boundary before it, the campaigns' study carries the
+// rule, and a precision outside (0, 1) is exit 2.
+TEST(PlanAccuracy, ConfirmationStopsWhenPreciseEnough) {
+  const std::string dir = testing::TempDir("plan_accuracy_stop");
+  const std::string study = dir + "/setup.yaml";
+  std::ofstream(study) << "name: setup\nseed: 4\ntrials: 10\nrobot: "
+                       << testing::SourcePath("studies/robots/paper.yaml")
+                       << "\npool: {size: 60}\nvalidation: {size: 10}\n";
+  const std::string plan = testing::LrcalBinary() + " plan-accuracy " + study +
+                           " --target rms_pos=0.08mm --configurations 40:60:10 --trials 5000 "
+                           "--format json --out " +
+                           dir + "/plan";
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(plan + " --stop-precision 0.1", &out), 0) << out;
+  const Json j = Json::parse(out.substr(out.find('{')));
+  for (const auto& c : j["campaigns"]) {
+    const long long trials = c["trials"].get<long long>();
+    EXPECT_LT(trials, 5000) << c.dump();
+    EXPECT_EQ(trials % 500, 0) << c.dump();  // decisions at multiples of the block
+  }
+  const Study s = LoadStudy(j["study"].get<std::string>());
+  EXPECT_TRUE(s.stop_when.enabled());
+  EXPECT_EQ(s.stop_when.block, 500);
+  EXPECT_EQ(testing::RunCommand(plan + " --stop-precision 1.5", &out), 2);
+  EXPECT_NE(out.find("--stop-precision: expected 0 (run every trial) or a relative precision"),
+            std::string::npos)
+      << out;
+}
+
 TEST(PlanAccuracy, BadTargetsAndRangesAreExitTwo) {
   std::string out;
   EXPECT_EQ(
