@@ -14,14 +14,16 @@ int main(int argc, char** argv) {
   const lrcal::RobotFile rig = lrcal::LoadRobotFile(argv[1]);
   lrcal::SamplingOptions sampling;
   sampling.ranger = rig.ranger;
+  // The file's planes (one here): 60 configurations whose beam hits them, readings, and the
+  // identification against the same planes.
+  const lrcal::PlaneSet& planes = *rig.planes;
   const lrcal::ConfigurationSet configs = lrcal::SampleConfigurations(
-      rig.robot, *rig.plane, 60, lrcal::RandomStream(7, 0, 0, lrcal::RandomPurpose::kPool),
-      sampling);
+      rig.robot, planes, {60}, lrcal::RandomStream(7, 0, 0, lrcal::RandomPurpose::kPool), sampling);
   lrcal::MeasurementSet data;
-  lrcal::SimulateReadings(rig.robot, rig.robot.true_values(), *rig.plane, rig.ranger, configs,
+  lrcal::SimulateReadings(rig.robot, rig.robot.true_values(), planes, rig.ranger, configs,
                           lrcal::NoiseModel{0.2e-3, 10},
                           lrcal::RandomStream(7, 0, 0, lrcal::RandomPurpose::kNoise), &data);
-  const lrcal::MeasurementModel model(rig.robot, *rig.plane,
+  const lrcal::MeasurementModel model(rig.robot, planes,
                                       lrcal::MakeParameterSet(rig.robot, lrcal::PlaneTerms{}));
   const lrcal::IdentificationSummary s = lrcal::Identify(model, data);
   double worst = 0;
