@@ -101,35 +101,36 @@ bool IsTaskCriterion(const po::variables_map& vm) {
   return vm["criterion"].as<std::string>() == "I";
 }
 
-// The poses of the task criterion: --poses, else --workspace poses over the joint ranges.
-ConfigurationSet TaskPoses(const po::variables_map& vm, const MeasurementModel& model) {
-  if (vm.count("poses"))
-    return ReadRobotConfigurations(vm["poses"].as<std::string>(), model.robot(),
-                                   &model.nominal_planes());
-  return WorkspacePoses(model.robot(), vm["workspace"].as<int>(), vm["seed"].as<long long>());
-}
+// The task criterion's poses (--poses, else --workspace poses over the joint ranges) and the
+// position rows of ∂(pose)/∂e at them (3M × n, nominal model), computed once per command;
+// empty (count 0) unless --criterion I.
+struct TaskPoseSet {
+  int count = 0;
+  std::string source;
+  Eigen::MatrixXd position_rows;
+};
 
-// The task criterion's matrix (the study's selection.criterion I): G (SI) times L⁻ᵀ with
-// W = LLᵀ = Σ_j J_jᵀJ_j over the poses' position Jacobians, so that A on it is
-// −tr(W (GᵀG)⁻¹), the summed predicted mean-square position error per unit reading variance.
-// W is singular for terms that do not move the tool (plane, ranger): a ridge of 1e-9·tr W/n.
-Eigen::MatrixXd TaskJacobian(const po::variables_map& vm, const MeasurementModel& model,
-                             const ConfigurationSet& pool) {
-  const ConfigurationSet poses = TaskPoses(vm, model);
-  const int n = model.num_parameters(), m = poses.size();
-  const std::vector<double> zero(n, 0.0);
+TaskPoseSet ResolveTaskPoses(const po::variables_map& vm, const MeasurementModel& model) {
+  TaskPoseSet task;
+  if (!IsTaskCriterion(vm)) return task;
+  const ConfigurationSet poses =
+      vm.count("poses")
+          ? ReadRobotConfigurations(vm["poses"].as<std::string>(), model.robot(),
+                                    &model.nominal_planes())
+          : WorkspacePoses(model.robot(), vm["workspace"].as<int>(), vm["seed"].as<long long>());
+  task.count = poses.size();
+  task.source = vm.count("poses") ? vm["poses"].as<std::string>() : "workspace";
+  const std::vector<double> zero(model.num_parameters(), 0.0);
   const Eigen::MatrixXd J6 = PoseJacobian(model, zero.data(), poses);
-  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(n, n);
-  for (int j = 0; j < m; ++j) W += J6.middleRows(6 * j, 3).transpose() * J6.middleRows(6 * j, 3);
-  W.diagonal().array() += 1e-9 * W.trace() / n + 1e-300;
-  const Eigen::LLT<Eigen::MatrixXd> llt(W);
-  const Eigen::MatrixXd G = DesignJacobian(model, pool, DesignScaling::kSI, 0, 0);
-  return llt.matrixL().solve(G.transpose()).transpose();
+  task.position_rows.resize(3 * task.count, model.num_parameters());
+  for (int j = 0; j < task.count; ++j)
+    task.position_rows.middleRows(3 * j, 3) = J6.middleRows(6 * j, 3);
+  return task;
 }
 
 SelectionOptions ResolveSelection(const po::variables_map& vm) {
   SelectionOptions options;
-  // I is A on the task-weighted G (TaskJacobian).
+  // I is A on the task-weighted G (TaskWeightedJacobian).
   const std::string criterion = vm["criterion"].as<std::string>();
   try {
     options.criterion =
@@ -154,10 +155,14 @@ double PositiveMm(const po::variables_map& vm, const std::string& name) {
   return v;
 }
 
-// G of the pool at the nominal model, columns scaled as asked (criterion I: task-weighted).
+// G of the pool at the nominal model, columns scaled as asked (criterion I: task-weighted, the
+// study's selection.criterion I).
 Eigen::MatrixXd ScaledJacobian(const po::variables_map& vm, const MeasurementModel& model,
-                               const ConfigurationSet& pool, DesignScaling scaling) {
-  if (IsTaskCriterion(vm)) return TaskJacobian(vm, model, pool);
+                               const ConfigurationSet& pool, DesignScaling scaling,
+                               const TaskPoseSet& task) {
+  if (task.count > 0)
+    return TaskWeightedJacobian(DesignJacobian(model, pool, DesignScaling::kSI, 0, 0),
+                                task.position_rows);
   return DesignJacobian(model, pool, scaling, PositiveMm(vm, "expected-angle-mrad") * 1e-3,
                         PositiveMm(vm, "expected-length-mm") * 1e-3);
 }
@@ -203,33 +208,26 @@ void CompareWithRandomDesigns(const Eigen::MatrixXd& G, const SelectionResult& c
 // W the poses' position rows, no ridge, computed directly (the score, −tr of the inverse of the
 // task-weighted matrix, loses ~1e-6 to its conditioning): √ of it is the RMS position error (m)
 // per 1 m of reading noise σ (per mm, mm).
-Json TaskJson(const po::variables_map& vm, const MeasurementModel& model,
-              const ConfigurationSet& pool, const std::vector<int>& chosen) {
-  const ConfigurationSet poses = TaskPoses(vm, model);
-  const int n = model.num_parameters(), m = poses.size();
-  const std::vector<double> zero(n, 0.0);
-  const Eigen::MatrixXd J6 = PoseJacobian(model, zero.data(), poses);
+Json TaskJson(const TaskPoseSet& task, const MeasurementModel& model, const ConfigurationSet& pool,
+              const std::vector<int>& chosen) {
   const Eigen::MatrixXd G = DesignJacobian(model, pool.Subset(chosen), DesignScaling::kSI, 0, 0);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(G.transpose() * G);
-  double sum = 0;
-  for (int j = 0; j < m; ++j) {
-    const Eigen::MatrixXd Jp = J6.middleRows(6 * j, 3);
-    sum += (Jp * ldlt.solve(Jp.transpose())).trace();
-  }
-  return {{"poses", m},
-          {"source", vm.count("poses") ? vm["poses"].as<std::string>() : "workspace"},
-          {"rms_position_per_unit_sigma", std::sqrt(sum / m)}};
+  const Eigen::MatrixXd& P = task.position_rows;
+  const double sum = (P * ldlt.solve(P.transpose())).trace();
+  return {{"poses", task.count},
+          {"source", task.source},
+          {"rms_position_per_unit_sigma", std::sqrt(sum / task.count)}};
 }
 
-std::string CriterionText(const po::variables_map& vm, const MeasurementModel& model,
+std::string CriterionText(const TaskPoseSet& task, const MeasurementModel& model,
                           const ConfigurationSet& pool, const SelectionOptions& options,
                           const SelectionResult& chosen) {
   std::ostringstream out;
-  if (!IsTaskCriterion(vm)) {
+  if (task.count == 0) {
     out << DesignCriterionName(options.criterion) << " = " << chosen.score;
     return out.str();
   }
-  const Json t = TaskJson(vm, model, pool, chosen.indices);
+  const Json t = TaskJson(task, model, pool, chosen.indices);
   out << "I (predicted RMS position error at " << t["poses"].get<int>() << " "
       << t["source"].get<std::string>()
       << " poses: " << t["rms_position_per_unit_sigma"].get<double>()
@@ -277,7 +275,8 @@ int DesignCommand(const std::vector<std::string>& args) {
                          ResolveParameterSet(setup.rig.robot, vm, setup.planes.size()));
   const SelectionOptions options = ResolveSelection(vm);
   const DesignScaling scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
-  const Eigen::MatrixXd G = ScaledJacobian(vm, model, pool.configs, scaling);
+  const TaskPoseSet task = ResolveTaskPoses(vm, model);  // empty unless --criterion I
+  const Eigen::MatrixXd G = ScaledJacobian(vm, model, pool.configs, scaling, task);
   const int k = vm["select"].as<int>();
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -314,7 +313,7 @@ int DesignCommand(const std::vector<std::string>& args) {
     j["method"] = SelectionMethodName(options.method);
     j["criterion"] =
         vm["criterion"].as<std::string>() == "I" ? "I" : DesignCriterionName(options.criterion);
-    if (IsTaskCriterion(vm)) j["task"] = TaskJson(vm, model, pool.configs, chosen.indices);
+    if (task.count > 0) j["task"] = TaskJson(task, model, pool.configs, chosen.indices);
     j["scaling"] = DesignScalingName(scaling);
     j["selected"] = chosen.indices;
     j["selected_per_plane"] = per_plane;
@@ -329,8 +328,8 @@ int DesignCommand(const std::vector<std::string>& args) {
   std::cout << "candidate pool: " << pool.source << "\n"
             << "chose " << k << " of " << pool.configs.size() << " by "
             << SelectionMethodName(options.method) << ", criterion "
-            << CriterionText(vm, model, pool.configs, options, chosen) << " (" << chosen.evaluations
-            << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
+            << CriterionText(task, model, pool.configs, options, chosen) << " ("
+            << chosen.evaluations << " evaluations, " << Fixed(seconds * 1e3, 1) << " ms)\n"
             << "chosen (0-based pool indices):";
   for (int i : chosen.indices) std::cout << " " << i;
   std::cout << "\n"

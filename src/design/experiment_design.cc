@@ -1,5 +1,6 @@
 #include "lrcal/design/experiment_design.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -362,6 +363,16 @@ Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, dou
   for (int k = 0; k < parameters.size(); ++k)
     expected[k] = parameters.IsAngular(k) ? angle : length;
   return expected;
+}
+
+Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
+                                     const Eigen::MatrixXd& position_rows) {
+  const int n = static_cast<int>(G.cols());
+  Eigen::MatrixXd W = position_rows.transpose() * position_rows;
+  W.diagonal().array() += 1e-9 * W.trace() / n + 1e-300;
+  const Eigen::LLT<Eigen::MatrixXd> llt(W);
+  // G·L⁻ᵀ = (L⁻¹·Gᵀ)ᵀ
+  return llt.matrixL().solve(G.transpose()).transpose();
 }
 
 Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,

@@ -255,20 +255,11 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
 
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
 
-// The task criterion's selection matrix (selection.criterion: I): the pool's G (SI) times L⁻ᵀ,
-// W = LLᵀ = Σ_j J_jᵀJ_j over the validation configurations' position Jacobians, so that A on it
-// is tr(W (GᵀG)⁻¹): the predicted mean-square validation position error, up to σ²/M. W is
-// singular for parameters that do not move the tool (plane terms): a ridge of 1e-9·tr W/n keeps
-// it invertible (those columns then weigh nothing).
+// The task criterion's selection matrix (selection.criterion: I): the pool's G (SI) weighted by
+// the validation configurations' position Jacobians (TaskWeightedJacobian).
 Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
-  const int n = c.model->num_parameters(), m = c.validation.size();
-  const Eigen::MatrixXd J = ValidationPoseJacobian(c).topRows(3 * m);
-  Eigen::MatrixXd W = J.transpose() * J;
-  W.diagonal().array() += 1e-9 * W.trace() / n + 1e-300;
-  const Eigen::LLT<Eigen::MatrixXd> llt(W);
-  const Eigen::MatrixXd G = DesignJacobian(*c.model, pool, DesignScaling::kSI, 0, 0);
-  // G·L⁻ᵀ = (L⁻¹·Gᵀ)ᵀ
-  return llt.matrixL().solve(G.transpose()).transpose();
+  return TaskWeightedJacobian(DesignJacobian(*c.model, pool, DesignScaling::kSI, 0, 0),
+                              ValidationPoseJacobian(c).topRows(3 * c.validation.size()));
 }
 
 // The selected design, its σ_min and the predicted covariance at the nominal model; the

@@ -109,6 +109,14 @@ Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
 /// `length` (m) for the others; the column weights of DesignScaling::kExpectedErrors.
 Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, double length);
 
+/// The task criterion's selection matrix (criterion I): G (N×n, SI) times L⁻ᵀ, where
+/// W = LLᵀ = PᵀP + ridge and P (3M×n) stacks the position rows of ∂(pose)/∂e at M poses, so that
+/// A on it is −tr(W·(GᵀG)⁻¹), the summed predicted mean-square position error at the poses per
+/// unit reading variance. W is singular for terms that move no pose (plane, ranger): a ridge of
+/// 1e-9·tr W/n keeps it invertible (those columns then weigh nothing).
+Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
+                                     const Eigen::MatrixXd& position_rows);
+
 /// The identification Jacobian of `pool` at the nominal model, columns scaled as `scaling` says
 /// (expected errors `angle` rad and `length` m for kExpectedErrors): what design selects from.
 Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
