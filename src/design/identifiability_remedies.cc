@@ -1,7 +1,6 @@
 #include "lrcal/design/identifiability_remedies.h"
 
 #include <Eigen/QR>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -49,36 +48,6 @@ std::string RemedyReport::ToString() const {
 
 namespace {
 
-// The directions (columns, SI) along which the readings of G do not change: zero columns and
-// the right singular vectors of the column-scaled live columns below the rank tolerance.
-Eigen::MatrixXd NullDirections(const Eigen::MatrixXd& G, const IdentifiabilityOptions& options) {
-  const int n = static_cast<int>(G.cols());
-  const Eigen::VectorXd norms = G.colwise().norm().transpose();
-  const double max_norm = n > 0 ? norms.maxCoeff() : 0.0;
-  std::vector<int> live, dead;
-  for (int j = 0; j < n; ++j)
-    (norms[j] <= options.zero_column_tolerance * max_norm ? dead : live).push_back(j);
-  const int nl = static_cast<int>(live.size());
-  Eigen::MatrixXd Gs(G.rows(), nl);
-  for (int k = 0; k < nl; ++k) Gs.col(k) = G.col(live[k]) / norms[live[k]];
-  std::vector<Eigen::VectorXd> out;
-  for (int j : dead) out.push_back(Eigen::VectorXd::Unit(n, j));
-  if (nl > 0) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Gs, Eigen::ComputeFullV);
-    const Eigen::VectorXd& s = svd.singularValues();
-    const double smax = s.size() ? s[0] : 0.0;
-    for (int k = 0; k < nl; ++k) {
-      if (k < s.size() && s[k] > options.rank_tolerance * smax) continue;
-      Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
-      for (int i = 0; i < nl; ++i) v[live[i]] = svd.matrixV()(i, k) / norms[live[i]];
-      out.push_back(v);
-    }
-  }
-  Eigen::MatrixXd N(n, static_cast<int>(out.size()));
-  for (std::size_t k = 0; k < out.size(); ++k) N.col(static_cast<int>(k)) = out[k];
-  return N;
-}
-
 // True if v (old coordinates, scaled by `weights`) lies in the span of N's columns.
 bool StillLost(const Eigen::VectorXd& v, const Eigen::MatrixXd& N, const Eigen::VectorXd& weights) {
   if (N.cols() == 0) return false;
@@ -110,7 +79,7 @@ std::vector<int> RecoveredByFixing(const Context& c, int k) {
   Eigen::MatrixXd Gr(c.G.rows(), n - 1);
   for (int j = 0, t = 0; j < n; ++j)
     if (j != k) Gr.col(t++) = c.G.col(j);
-  const Eigen::MatrixXd Nr = NullDirections(Gr, c.options->identifiability);
+  const Eigen::MatrixXd Nr = UnobservableDirections(Gr, c.options->identifiability);
   Eigen::MatrixXd N = Eigen::MatrixXd::Zero(n, Nr.cols());
   for (int j = 0, t = 0; j < n; ++j)
     if (j != k) N.row(j) = Nr.row(t++);
@@ -191,7 +160,7 @@ std::vector<int> RecoveredByAdding(const Context& c, const Plane& plane, PlaneTe
   for (int i = 0; i < c.configs->size(); ++i) all.AddFrom(*c.configs, i);
   for (int i = 0; i < extra.size(); ++i) all.AddFrom(extra, i);
   const Eigen::MatrixXd Na =
-      NullDirections(IdentificationJacobian(augmented, all), c.options->identifiability);
+      UnobservableDirections(IdentificationJacobian(augmented, all), c.options->identifiability);
   Eigen::MatrixXd N(model.num_parameters(), Na.cols());
   for (int j = 0; j < model.num_parameters(); ++j) N.row(j) = Na.row(old_to_new[j]);
   return Recovered(c, N);
@@ -305,7 +274,6 @@ RemedyReport FindRemedies(const MeasurementModel& model, const ConfigurationSet&
   }
   for (const auto& d : report.dependencies) {
     Eigen::VectorXd v = Eigen::VectorXd::Zero(ps.size());
-    std::string text;
     for (std::size_t k = 0; k < d.terms.size(); ++k)
       v[ps.Find(d.terms[k].first)] = d.terms[k].second;
     const std::string full = d.ToString();

@@ -79,21 +79,26 @@ void IdentifiabilityOptions::Validate(const std::string& source) const {
 namespace {
 
 // Parameters with (numerically) no effect are set aside before scaling, so that rounding is never
-// scaled into a fake dependence; the rest are scaled to unit columns.
-Eigen::MatrixXd ScaledLiveColumns(const Eigen::MatrixXd& G, const IdentifiabilityOptions& options,
-                                  IdentifiabilityReport* report, std::vector<int>* live) {
+// scaled into a fake dependence (`dead`); the rest (`live`) are scaled to unit columns.
+Eigen::MatrixXd LiveScaledColumns(const Eigen::MatrixXd& G, const IdentifiabilityOptions& options,
+                                  Eigen::VectorXd* norms, std::vector<int>* live,
+                                  std::vector<int>* dead) {
   const int n = static_cast<int>(G.cols());
-  report->column_norms = G.colwise().norm().transpose();
-  const double max_norm = n > 0 ? report->column_norms.maxCoeff() : 0.0;
-  for (int j = 0; j < n; ++j) {
-    if (report->column_norms[j] <= options.zero_column_tolerance * max_norm)
-      report->unidentifiable.push_back(report->names[j]);
-    else
-      live->push_back(j);
-  }
+  *norms = G.colwise().norm().transpose();
+  const double max_norm = n > 0 ? norms->maxCoeff() : 0.0;
+  for (int j = 0; j < n; ++j)
+    ((*norms)[j] <= options.zero_column_tolerance * max_norm ? dead : live)->push_back(j);
   const int nl = static_cast<int>(live->size());
   Eigen::MatrixXd Gs(G.rows(), nl);
-  for (int k = 0; k < nl; ++k) Gs.col(k) = G.col((*live)[k]) / report->column_norms[(*live)[k]];
+  for (int k = 0; k < nl; ++k) Gs.col(k) = G.col((*live)[k]) / (*norms)[(*live)[k]];
+  return Gs;
+}
+
+Eigen::MatrixXd ScaledLiveColumns(const Eigen::MatrixXd& G, const IdentifiabilityOptions& options,
+                                  IdentifiabilityReport* report, std::vector<int>* live) {
+  std::vector<int> dead;
+  Eigen::MatrixXd Gs = LiveScaledColumns(G, options, &report->column_norms, live, &dead);
+  for (int j : dead) report->unidentifiable.push_back(report->names[j]);
   return Gs;
 }
 
@@ -148,6 +153,31 @@ void FindDependencies(const Eigen::MatrixXd& Gs, const std::vector<int>& live,
 }
 
 }  // namespace
+
+Eigen::MatrixXd UnobservableDirections(const Eigen::MatrixXd& G,
+                                       const IdentifiabilityOptions& options) {
+  const int n = static_cast<int>(G.cols());
+  Eigen::VectorXd norms;
+  std::vector<int> live, dead;
+  const Eigen::MatrixXd Gs = LiveScaledColumns(G, options, &norms, &live, &dead);
+  std::vector<Eigen::VectorXd> out;
+  for (int j : dead) out.push_back(Eigen::VectorXd::Unit(n, j));
+  const int nl = static_cast<int>(live.size());
+  if (nl > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Gs, Eigen::ComputeFullV);
+    const Eigen::VectorXd& s = svd.singularValues();
+    const double smax = s.size() ? s[0] : 0.0;
+    for (int k = 0; k < nl; ++k) {
+      if (k < s.size() && s[k] > options.rank_tolerance * smax) continue;
+      Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+      for (int i = 0; i < nl; ++i) v[live[i]] = svd.matrixV()(i, k) / norms[live[i]];
+      out.push_back(v);
+    }
+  }
+  Eigen::MatrixXd N(n, static_cast<int>(out.size()));
+  for (std::size_t k = 0; k < out.size(); ++k) N.col(static_cast<int>(k)) = out[k];
+  return N;
+}
 
 IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
                                              const ConfigurationSet& configs, const double* e,

@@ -66,6 +66,12 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
                                              const double* e = nullptr,
                                              const IdentifiabilityOptions& options = {});
 
+/// The directions (columns, SI) along which G's readings do not change, by the same rules as
+/// AnalyzeIdentifiability: a unit vector per zero column, and the right singular vectors of the
+/// column-scaled live columns below the rank tolerance, unscaled. n × (n − rank).
+Eigen::MatrixXd UnobservableDirections(const Eigen::MatrixXd& G,
+                                       const IdentifiabilityOptions& options = {});
+
 /// The identification Jacobian G (m×n) at `e` (nullptr: nominal). Readings that miss the
 /// plane still give their row (the formula is finite unless the beam is parallel).
 Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
