@@ -11,7 +11,6 @@ uncertainty, the correlation map, identifiability, cross-validation, the predict
 the workspace and the calibrated files. Exit code 2 (with a message naming the file) for a
 missing or malformed calibration.json, 5 when the page cannot be written.
 """
-import base64
 import html
 import json
 import os
@@ -24,7 +23,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import CHECK, STYLE, write_atomically  # noqa: E402
+from report import CHECK, STYLE, figure_html, write_atomically  # noqa: E402
 
 
 class CalibrationDataError(Exception):
@@ -251,13 +250,7 @@ def build(folder):
              "<h2>Identifiability</h2>", identifiability_text(data),
              "<h2>Cross-validation</h2>", holdout_text(data),
              "<h2>Accuracy over the workspace</h2>", accuracy_text(data), "<h2>Figures</h2>"]
-    for png, caption in figures:
-        with open(png, "rb") as f:
-            encoded = base64.b64encode(f.read()).decode("ascii")
-        svg = os.path.relpath(png[:-4] + ".svg", folder)
-        parts.append(f"<figure><img class='figure' alt='{html.escape(caption)}' "
-                     f"src='data:image/png;base64,{encoded}'><figcaption>{html.escape(caption)} "
-                     f"(<a href='{html.escape(svg)}'>SVG</a>)</figcaption></figure>")
+    parts.extend(figure_html(png, caption, folder) for png, caption in figures)
     parts.append("<h2>Calibrated files</h2>")
     if data.get("calibrated_robot"):
         name = html.escape(data["calibrated_robot"])

@@ -88,6 +88,17 @@ window.addEventListener('load', function () {
 """
 
 
+def figure_html(png, caption, base_dir):
+    """A figure embedded as PNG (the page stays self-contained), with its caption and a link to
+    its SVG twin, relative to base_dir (where the page is)."""
+    with open(png, "rb") as f:
+        data = base64.b64encode(f.read()).decode("ascii")
+    svg = os.path.relpath(png[:-4] + ".svg", base_dir)
+    return (f"<figure><img class='figure' alt='{html.escape(caption)}' "
+            f"src='data:image/png;base64,{data}'><figcaption>{html.escape(caption)} "
+            f"(<a href='{html.escape(svg)}'>SVG</a>)</figcaption></figure>")
+
+
 def build(run_dir):
     t0 = time.time()
     run = la.Run(run_dir)
@@ -110,13 +121,7 @@ def build(run_dir):
     if status.get("note"):
         parts.append(f"<p class='partial'>{html.escape(status['note'])}</p>")
     parts.append("<h2>Figures</h2>")
-    for png, caption in figures:
-        with open(png, "rb") as f:
-            data = base64.b64encode(f.read()).decode("ascii")
-        svg = os.path.relpath(png[:-4] + ".svg", run.report_dir)
-        parts.append(f"<figure><img class='figure' alt='{html.escape(caption)}' "
-                     f"src='data:image/png;base64,{data}'><figcaption>{html.escape(caption)} "
-                     f"(<a href='{html.escape(svg)}'>SVG</a>)</figcaption></figure>")
+    parts.extend(figure_html(png, caption, run.report_dir) for png, caption in figures)
     parts.append("<h2>Tables</h2>")
     parts.append(markdown_to_html(run.summary_md))
     parts.append("<h2>Study settings</h2><pre>" + html.escape(json.dumps(study, indent=2)) + "</pre>")
