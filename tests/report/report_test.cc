@@ -186,6 +186,11 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
        {"Fit check", "Parameters", "Identifiability", "Cross-validation",
         "Accuracy over the workspace", "Calibrated files", "consistent with the stated noise"})
     EXPECT_NE(html.find(section), std::string::npos) << section;
+  EXPECT_EQ(RunCommand(LrcalBinary() + " accuracy --robot " + (cal / "calibrated.yaml").string() +
+                           " --workspace 0",
+                       &out),
+            2);
+  EXPECT_NE(out.find("--workspace: expected 1 to 100,000 poses, got 0"), std::string::npos) << out;
   // The map's poses, predicted again from the written file: the same accuracy.
   {
     std::ofstream poses(dir + "/poses.csv");
