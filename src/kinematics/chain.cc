@@ -19,6 +19,10 @@ void PrepareChainPoint(const RobotModel& robot, const double* v, ChainPoint* poi
     t.d = lv[kD];
     t.prismatic = robot.links()[i].joint == JointType::kPrismatic;
   }
+  point->base = robot.base();
+  point->tool = robot.tool();
+  point->has_base = !robot.base().IsIdentity();
+  point->has_tool = !robot.tool().IsIdentity();
 }
 
 Pose<double> ToolPose(const ChainPoint& point, const ConfigurationSet& configs, int c,
@@ -29,6 +33,12 @@ Pose<double> ToolPose(const ChainPoint& point, const ConfigurationSet& configs, 
   // Columns of R_{B,i}: x, y, z; o the origin of frame i.
   Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY(),
                   z = Eigen::Vector3d::UnitZ(), o = Eigen::Vector3d::Zero();
+  if (point.has_base) {
+    x = point.base.rotation.col(0);
+    y = point.base.rotation.col(1);
+    z = point.base.rotation.col(2);
+    o = point.base.translation;
+  }
   for (int i = 0; i < point.num_links; ++i) {
     const ChainPoint::LinkTrig& t = point.links[i];
     double ct, st, d = t.d;
@@ -62,6 +72,10 @@ Pose<double> ToolPose(const ChainPoint& point, const ConfigurationSet& configs, 
   pose.R_BT.col(1) = y;
   pose.R_BT.col(2) = z;
   pose.p_BT = o;
+  if (point.has_tool) {
+    pose.p_BT += pose.R_BT * point.tool.translation;
+    pose.R_BT = pose.R_BT * point.tool.rotation;
+  }
   if (frames) frames->tool = pose;
   return pose;
 }

@@ -12,8 +12,10 @@ const char* LinkValueName(int value) {
 }
 
 RobotModel::RobotModel(std::string name, std::vector<Link> links, Eigen::VectorXd true_errors,
-                       const std::string& where)
-    : name_(std::move(name)), links_(std::move(links)) {
+                       const std::string& where, RigidTransform base, RigidTransform tool)
+    : name_(std::move(name)), links_(std::move(links)), base_(base), tool_(tool) {
+  base_.Validate(where + ": base");
+  tool_.Validate(where + ": tool");
   if (links_.empty()) throw InputError(where, "a robot needs at least one link");
   if (links_.size() > 16) throw InputError(where, "at most 16 links are supported");
   nominal_values_.resize(num_values());

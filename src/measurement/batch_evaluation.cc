@@ -80,10 +80,12 @@ template <bool kJacobian, bool kSeveralPlanes>
   double* __restrict o0 = z2 + m;
   double* __restrict o1 = o0 + m;
   double* __restrict o2 = o1 + m;
-  std::fill(args.state, args.state + 12 * m, 0.0);
-  std::fill(x0, x0 + m, 1.0);
-  std::fill(y1, y1 + m, 1.0);
-  std::fill(z2, z2 + m, 1.0);
+  // The chain starts at frame 0: the base transform's axes and origin (the identity without one).
+  const Eigen::Matrix3d& rb = point.base.rotation;
+  const Eigen::Vector3d& pb = point.base.translation;
+  double* const start[12] = {x0, x1, x2, y0, y1, y2, z0, z1, z2, o0, o1, o2};
+  for (int k = 0; k < 12; ++k)
+    std::fill(start[k], start[k] + m, k < 9 ? rb(k % 3, k / 3) : pb(k - 9));
 
   for (int l = 0; l < point.num_links; ++l) {
     const ModelPoint::LinkTrig& t = point.links[l];
@@ -158,6 +160,23 @@ template <bool kJacobian, bool kSeveralPlanes>
       y0[i] = yt0;
       y1[i] = yt1;
       y2[i] = yt2;
+    }
+  }
+
+  if (point.has_tool) {  // the tool frame: p ← p + R·t, R ← R·R_tool
+    const Eigen::Matrix3d& rt = point.tool.rotation;
+    const Eigen::Vector3d& pt = point.tool.translation;
+#pragma GCC ivdep
+    for (int i = 0; i < m; ++i) {
+      const double r[3][3] = {{x0[i], y0[i], z0[i]}, {x1[i], y1[i], z1[i]}, {x2[i], y2[i], z2[i]}};
+      double* const axes[3][3] = {{x0, y0, z0}, {x1, y1, z1}, {x2, y2, z2}};
+      double* const origin[3] = {o0, o1, o2};
+      for (int row = 0; row < 3; ++row) {
+        origin[row][i] += r[row][0] * pt(0) + r[row][1] * pt(1) + r[row][2] * pt(2);
+        for (int col = 0; col < 3; ++col)
+          axes[row][col][i] =
+              r[row][0] * rt(0, col) + r[row][1] * rt(1, col) + r[row][2] * rt(2, col);
+      }
     }
   }
 

@@ -109,5 +109,12 @@ TEST(BatchEvaluator, MatchesWithAPrismaticJoint) {
   ExpectSame(model, configs);
 }
 
+TEST(BatchEvaluator, MatchesWithBaseAndToolTransforms) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const Plane plane = Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8);
+  MeasurementModel model(robot, plane, MakeParameterSet(robot, PlaneTerms{true, true}));
+  ExpectSame(model, testing::ConfigurationsFacing(robot, plane, 40, 4));
+}
+
 }  // namespace
 }  // namespace lrcal

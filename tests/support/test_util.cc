@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -29,6 +30,35 @@ const RobotFile& PaperRig() {
 const RobotModel& PaperRobot() { return PaperRig().robot; }
 
 const Plane& PaperPlane() { return (*PaperRig().planes)[0]; }
+
+const RobotModel& PaperRobotWithFrames() {
+  static const RobotModel robot = [] {
+    const RobotModel& paper = PaperRobot();
+    const RigidTransform base = RigidTransform::FromXyzRpy(Eigen::Vector3d(0.2, -0.1, 0.3),
+                                                           Eigen::Vector3d(0.05, -0.1, 0.7));
+    const RigidTransform tool = RigidTransform::FromXyzRpy(Eigen::Vector3d(0.03, -0.05, 0.1),
+                                                           Eigen::Vector3d(0.2, -0.3, 0.1));
+    return RobotModel("paper with frames", paper.links(), paper.true_errors(), "test", base, tool);
+  }();
+  return robot;
+}
+
+ConfigurationSet ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
+                                      unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-M_PI, M_PI);
+  ConfigurationSet out(robot.num_links());
+  ModelPoint point;
+  PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
+  std::vector<double> q(robot.num_links());
+  while (out.size() < count) {
+    for (double& v : q) v = u(rng);
+    ConfigurationSet one(robot.num_links());
+    one.Add(q);
+    if (std::fabs(plane.normal.dot(ToolPose(point, one, 0).R_BT.col(2))) >= 0.2) out.Add(q);
+  }
+  return out;
+}
 
 ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed) {
   const RobotModel& robot = PaperRobot();

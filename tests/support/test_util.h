@@ -20,6 +20,13 @@ const RobotFile& PaperRig();
 /// The paper's arm and plane.
 const RobotModel& PaperRobot();
 const Plane& PaperPlane();
+/// The paper's arm on a tilted, shifted base with the ranger mounted off the flange (a tool
+/// transform of 3–10 cm and 0.1–0.3 rad): the base and tool frames of a real rig.
+const RobotModel& PaperRobotWithFrames();
+/// `count` random configurations of `robot` whose beam meets `plane` at |n·b| ≥ 0.2 (any sign of
+/// the distance): for checks of formulas, not of readings.
+ConfigurationSet ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
+                                      unsigned seed = 1);
 /// `count` configurations of the paper's arm whose nominal beam hits `plane` (a usable reading),
 /// drawn from a fixed std::mt19937 seed (test data only; the library uses counter-based streams).
 ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed = 1);

@@ -23,9 +23,14 @@ struct ChainPoint {
   };
   int num_links = 0;
   LinkTrig links[kMaxLinks];
+  /// The robot's base and tool transforms; `has_base`/`has_tool` false when they are the
+  /// identity (then they cost nothing, and the bits are those of a chain without them).
+  RigidTransform base, tool;
+  bool has_base = false, has_tool = false;
 };
 
-/// Frames of the chain at one configuration, kept for the Jacobian.
+/// Frames of the chain at one configuration (in the base frame B, after the base transform),
+/// kept for the Jacobian; `tool` is the tool pose, after the tool transform.
 struct ChainFrames {
   Eigen::Vector3d o_prev[kMaxLinks], z_prev[kMaxLinks], x_common[kMaxLinks], y_twist[kMaxLinks],
       o[kMaxLinks];

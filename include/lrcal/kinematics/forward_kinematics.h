@@ -48,11 +48,21 @@ Eigen::Matrix<T, 4, 4> LinkTransform(const T& theta, const T& d, const T& a, con
   return rz * tz * tx * rx * ry;
 }
 
-/// Forward kinematics. `link_values` holds the robot's 5N link values (robot_model.h order, SI),
-/// `q` its N joint coordinates (rad, or m for prismatic joints).
+/// The homogeneous matrix of a fixed transform, in the scalar T.
+template <typename T>
+Eigen::Matrix<T, 4, 4> FixedTransformMatrix(const RigidTransform& t) {
+  Eigen::Matrix<T, 4, 4> X = Eigen::Matrix<T, 4, 4>::Identity();
+  X.template block<3, 3>(0, 0) = t.rotation.cast<T>();
+  X.template block<3, 1>(0, 3) = t.translation.cast<T>();
+  return X;
+}
+
+/// Forward kinematics: base · A_1 ··· A_N · tool (robot_model.h). `link_values` holds the
+/// robot's 5N link values (robot_model.h order, SI), `q` its N joint coordinates (rad, or m for
+/// prismatic joints).
 template <typename T>
 Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const double* q) {
-  Eigen::Matrix<T, 4, 4> X = Eigen::Matrix<T, 4, 4>::Identity();
+  Eigen::Matrix<T, 4, 4> X = FixedTransformMatrix<T>(model.base());
   for (int i = 0; i < model.num_links(); ++i) {
     const T* v = link_values + kValuesPerLink * i;
     T theta = v[kTheta];
@@ -64,6 +74,7 @@ Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const d
     }
     X = X * LinkTransform<T>(theta, d, v[kA], v[kAlpha], v[kBeta]);
   }
+  X = X * FixedTransformMatrix<T>(model.tool());
   Pose<T> pose;
   pose.R_BT = X.template block<3, 3>(0, 0);
   pose.p_BT = X.template block<3, 1>(0, 3);

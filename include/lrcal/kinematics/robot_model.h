@@ -4,8 +4,11 @@
 //   A_i = Rot(z, θ_i) · Trans(z, d_i) · Trans(x, a_i) · Rot(x, α_i) · Rot(y, β_i)
 // with θ_i = θ0_i + q_i for a revolute joint, d_i = d0_i + q_i for a prismatic one (the paper's
 // slide 'Kinematic Model'; β is Hayati's twist for (nearly) parallel consecutive axes). The last
-// frame is the tool frame: for the laser ranger its origin is where the beam starts and its +Z
-// axis is the beam direction.
+// frame is the chain's last frame N. Around the chain sit two fixed transforms (identity unless
+// the robot file or URDF gives them): the base transform (frame 0 in the robot's base frame B)
+// and the tool transform (the tool frame T in frame N), so the tool pose is
+//   X_BT = base · A_1 ··· A_N · tool.
+// The tool frame is the ranger's: its origin is where the beam starts, its +Z axis the beam.
 //
 // Per link the five "link values" are stored in the fixed order θ0, α, a, d, β (rad, rad, m, m,
 // rad): the robot file's order. The vector of all link values of an N-link robot has 5N entries,
@@ -21,6 +24,8 @@
 #include <array>
 #include <string>
 #include <vector>
+
+#include "lrcal/kinematics/rigid_transform.h"
 
 namespace lrcal {
 
@@ -55,13 +60,19 @@ class RobotModel {
  public:
   RobotModel() = default;
   /// Builds a model; throws InputError (where = `source`) if the description is inconsistent.
+  /// `base` and `tool` are the fixed transforms around the chain (identity by default).
   RobotModel(std::string name, std::vector<Link> links, Eigen::VectorXd true_errors,
-             const std::string& source = "robot");
+             const std::string& source = "robot", RigidTransform base = {},
+             RigidTransform tool = {});
 
   const std::string& name() const { return name_; }
   int num_links() const { return static_cast<int>(links_.size()); }
   int num_values() const { return kValuesPerLink * num_links(); }
   const std::vector<Link>& links() const { return links_; }
+  /// The chain's frame 0 in the robot's base frame B (fixed, not identified).
+  const RigidTransform& base() const { return base_; }
+  /// The tool (ranger) frame T in the chain's last frame N (fixed, not identified).
+  const RigidTransform& tool() const { return tool_; }
 
   /// All 5N nominal link values (SI).
   const Eigen::VectorXd& nominal_values() const { return nominal_values_; }
@@ -83,6 +94,7 @@ class RobotModel {
  private:
   std::string name_;
   std::vector<Link> links_;
+  RigidTransform base_, tool_;
   Eigen::VectorXd nominal_values_;
   Eigen::VectorXd true_errors_;
   std::vector<int> parameter_indices_;
