@@ -33,15 +33,22 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 
 void AddCommonOptions(po::options_description& options) {
   options.add_options()("robot", po::value<std::string>()->default_value("paper"),
-                        "robot file (YAML) or shipped robot name")(
+                        "robot file (YAML or URDF) or shipped robot name")(
+      "tool-link", po::value<std::string>(),
+      "URDF robots: the link whose frame is the ranger's (default: the URDF's only end link)")(
       "plane", po::value<std::vector<std::string>>()->composing(),
       "plane nx,ny,nz,f in the base frame (normalised); repeat for several planes (a CSV's "
       "plane column numbers them from 1 in this order); default: the robot file's plane(s)")(
       "format", po::value<std::string>()->default_value("text"), "output: text or json");
 }
 
-RobotFile LoadRobot(const std::string& name_or_path) {
-  return LoadRobotFile(ResolveRobotPath(name_or_path));
+RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link) {
+  return LoadRobotFile(ResolveRobotPath(name_or_path), tool_link);
+}
+
+RobotFile LoadRobot(const po::variables_map& vm) {
+  return LoadRobot(vm["robot"].as<std::string>(),
+                   vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "");
 }
 
 PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm) {
@@ -59,7 +66,7 @@ PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm) {
 }
 
 Setup ResolveSetup(const po::variables_map& vm) {
-  Setup setup{LoadRobot(vm["robot"].as<std::string>()), PlaneSet{}};
+  Setup setup{LoadRobot(vm), PlaneSet{}};
   setup.planes = ResolvePlanes(setup.rig, vm);
   return setup;
 }

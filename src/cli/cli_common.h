@@ -35,8 +35,10 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
            const std::vector<std::string>& args, po::variables_map* vm,
            const po::positional_options_description* positional = nullptr);
 
-/// --robot: a path or a shipped name ("paper").
-RobotFile LoadRobot(const std::string& name_or_path);
+/// --robot: a path (robot YAML or URDF) or a shipped name ("paper"); `tool_link` for a URDF.
+RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
+/// --robot and --tool-link.
+RobotFile LoadRobot(const po::variables_map& vm);
 /// --plane (repeated: several planes, in order) if given, else the robot file's plane(s);
 /// InputError if neither.
 PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm);
@@ -65,7 +67,8 @@ MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& r
 enum class Format { kText, kJson };
 Format ResolveFormat(const po::variables_map& vm);
 
-/// Adds --robot, --plane, --format to `options` (the options every science command takes).
+/// Adds --robot, --tool-link, --plane, --format to `options` (the options every science command
+/// takes).
 void AddCommonOptions(po::options_description& options);
 
 Json ToJson(const Eigen::VectorXd& v);
@@ -87,6 +90,7 @@ int MergeCommand(const std::vector<std::string>& args);
 int AggregateCommand(const std::vector<std::string>& args);
 int TrialCommand(const std::vector<std::string>& args);
 int AccuracyCommand(const std::vector<std::string>& args);
+int ExportCommand(const std::vector<std::string>& args);
 /// Predicted accuracy at poses (identification/pose_accuracy.h) as JSON {poses: [{q,
 /// position_std, orientation_std, position_radius_95}], rms_position, p95_position_radius_95,
 /// worst (1-based)} and as a text table.

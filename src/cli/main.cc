@@ -40,6 +40,8 @@ const std::vector<Command>& Commands() {
        IdentifiabilityCommand},
       {"accuracy", "predicted pose accuracy of a calibrated robot file at given poses",
        AccuracyCommand},
+      {"export", "write a robot (a calibrated one) as URDF, a D-H table or a robot YAML file",
+       ExportCommand},
   };
   return commands;
 }

@@ -3,19 +3,22 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include "io/yaml_util.h"
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/json.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/io/urdf.h"
 
 namespace lrcal {
 
 std::string ResolveRobotPath(const std::string& name_or_path, const std::string& relative_to) {
   namespace fs = std::filesystem;
   const bool looks_like_file =
-      name_or_path.size() > 5 && name_or_path.substr(name_or_path.size() - 5) == ".yaml";
+      (name_or_path.size() > 5 && name_or_path.substr(name_or_path.size() - 5) == ".yaml") ||
+      IsUrdfPath(name_or_path);
   const fs::path given(name_or_path);
   if (!relative_to.empty() && given.is_relative() &&
       (looks_like_file || name_or_path.find('/') != std::string::npos))
@@ -177,6 +180,27 @@ std::optional<PlaneSet> ParsePlanes(const YAML::Node& root, const std::string& p
   return PlaneSet(std::move(planes), std::move(names), Where(path, list, "planes"));
 }
 
+// base: / tool: {xyz: [x, y, z] (m), rpy: [roll, pitch, yaw] (rad)}, both optional (zero).
+RigidTransform ParseFixedTransform(const YAML::Node& root, const std::string& path,
+                                   const std::string& key) {
+  using namespace yaml;
+  const YAML::Node node = root[key];
+  if (!node) return {};
+  if (!node.IsMap())
+    throw InputError(Where(path, node, key),
+                     "expected a mapping {xyz: [x, y, z] (m), rpy: [roll, pitch, yaw] (rad)}");
+  CheckKeys(node, {"xyz", "rpy"}, path, key);
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
+  for (const char* part : {"xyz", "rpy"}) {
+    if (!node[part]) continue;
+    const std::vector<double> v = NumberList(node[part], path, key + "." + part);
+    if (v.size() != 3)
+      throw InputError(Where(path, node[part], key + "." + part), "expected 3 numbers");
+    (std::string(part) == "xyz" ? xyz : rpy) = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  return RigidTransform::FromXyzRpy(xyz, rpy);
+}
+
 RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
   using namespace yaml;
   RangerSpec ranger;
@@ -247,19 +271,25 @@ void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFil
   }
 }
 
-RobotFile LoadRobotFile(const std::string& path) {
+RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
+  if (IsUrdfPath(path)) return LoadUrdfRobotFile(path, tool_link);
+  if (!tool_link.empty())
+    throw InputError("--tool-link", "applies to a URDF robot; '" + path +
+                                        "' is a robot YAML file (its last frame is the tool)");
   YAML::Node root = yaml::LoadFile(path);
-  yaml::CheckKeys(
-      root,
-      {"name", "description", "links", "true_errors", "plane", "planes", "ranger", "calibration"},
-      path, "");
+  yaml::CheckKeys(root,
+                  {"name", "description", "links", "base", "tool", "true_errors", "plane", "planes",
+                   "ranger", "calibration"},
+                  path, "");
   if (root["calibration"] && !root["calibration"].IsMap())
     throw InputError(yaml::Where(path, root["calibration"], "calibration"),
                      "expected a mapping (the record lrcal identify --write-robot writes)");
   const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
   const std::vector<Link> links = ParseLinks(root, path);
   RobotFile file;
-  file.robot = RobotModel(name, links, ParseTrueErrors(root, path, links), path);
+  file.robot =
+      RobotModel(name, links, ParseTrueErrors(root, path, links), path,
+                 ParseFixedTransform(root, path, "base"), ParseFixedTransform(root, path, "tool"));
   file.planes = ParsePlanes(root, path);
   file.ranger = ParseRanger(root, path);
   file.path = path;
@@ -272,6 +302,7 @@ RobotFile LoadRobotFile(const std::string& path) {
 namespace {
 
 std::string Num(double x) {
+  if (x == 0) x = 0;  // no "-0"
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", x);
   return buf;
@@ -301,6 +332,20 @@ std::string LinkLine(const Link& link, const double* values) {
   return line + "], q_min: " + Num(link.q_min) + ", q_max: " + Num(link.q_max) + "}\n";
 }
 
+// base: / tool: lines for the transforms that are not the identity (m, rad).
+std::string FixedTransformText(const RobotModel& robot) {
+  std::string t;
+  const std::pair<const char*, const RigidTransform*> frames[] = {{"base", &robot.base()},
+                                                                  {"tool", &robot.tool()}};
+  for (const auto& [key, transform] : frames) {
+    if (transform->IsIdentity()) continue;
+    const Eigen::Vector3d xyz = transform->translation, rpy = transform->Rpy();
+    t += std::string(key) + ": {xyz: [" + Num(xyz.x()) + ", " + Num(xyz.y()) + ", " + Num(xyz.z()) +
+         "], rpy: [" + Num(rpy.x()) + ", " + Num(rpy.y()) + ", " + Num(rpy.z()) + "]}  # m, rad\n";
+  }
+  return t;
+}
+
 std::string RecordText(const CalibrationRecord& r) {
   std::string t = "calibration:\n";
   t += "  data: " + Quoted(r.data_file) + "\n  data_fnv1a: " + Quoted(r.data_fnv1a) +
@@ -324,32 +369,40 @@ std::string RecordText(const CalibrationRecord& r) {
 
 }  // namespace
 
-void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
-                              const Eigen::VectorXd& link_values, const PlaneSet& planes,
-                              const CalibrationRecord& record) {
+std::string RobotFileText(const RobotFile& rig, const Eigen::VectorXd& link_values,
+                          const std::optional<PlaneSet>& planes, const std::string& name,
+                          const CalibrationRecord* record) {
   const RobotModel& robot = rig.robot;
-  std::string t = "# A calibrated robot: written by lrcal identify --write-robot from " +
-                  record.data_file + ".\n# Nominal values are the estimates (SI: rad, m); the " +
-                  "record below says from what.\nname: " + Quoted(robot.name() + " (calibrated)") +
-                  "\nlinks:\n";
+  std::string t = "name: " + Quoted(name) + "\nlinks:\n";
   for (int i = 0; i < robot.num_links(); ++i)
     t += LinkLine(robot.links()[i], link_values.data() + kValuesPerLink * i);
+  t += FixedTransformText(robot);
   const auto plane_text = [](const Plane& plane) {
     return "{normal: [" + Num(plane.normal.x()) + ", " + Num(plane.normal.y()) + ", " +
            Num(plane.normal.z()) + "], offset: " + Num(plane.offset);
   };
-  if (planes.size() == 1) {
-    t += "plane: " + plane_text(planes[0]) + "}\n";
-  } else {
+  if (planes && planes->size() == 1) {
+    t += "plane: " + plane_text((*planes)[0]) + "}\n";
+  } else if (planes) {
     t += "planes:\n";
-    for (int p = 0; p < planes.size(); ++p)
-      t += "  - " + plane_text(planes[p]) +
-           (planes.name(p).empty() ? "" : ", name: " + Quoted(planes.name(p))) + "}\n";
+    for (int p = 0; p < planes->size(); ++p)
+      t += "  - " + plane_text((*planes)[p]) +
+           (planes->name(p).empty() ? "" : ", name: " + Quoted(planes->name(p))) + "}\n";
   }
   t += "ranger: {min_range: " + Num(rig.ranger.min_range) +
        ", max_range: " + Num(rig.ranger.max_range) +
        ", max_incidence_deg: " + Num(rig.ranger.max_incidence * 180.0 / M_PI) + "}\n";
-  WriteFileAtomically(path, t + RecordText(record));
+  return record ? t + RecordText(*record) : t;
+}
+
+void WriteCalibratedRobotFile(const std::string& path, const RobotFile& rig,
+                              const Eigen::VectorXd& link_values, const PlaneSet& planes,
+                              const CalibrationRecord& record) {
+  const std::string header = "# A calibrated robot: written by lrcal identify --write-robot from " +
+                             record.data_file + ".\n# Nominal values are the estimates (SI: rad, " +
+                             "m); the record below says from what.\n";
+  WriteFileAtomically(path, header + RobotFileText(rig, link_values, planes,
+                                                   rig.robot.name() + " (calibrated)", &record));
 }
 
 }  // namespace lrcal

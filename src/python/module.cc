@@ -223,8 +223,8 @@ struct Design {
 
 // --- functions ------------------------------------------------------------------------------
 
-RobotFile LoadRobot(const std::string& name_or_path) {
-  return LoadRobotFile(ResolveRobotPath(name_or_path));
+RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link) {
+  return LoadRobotFile(ResolveRobotPath(name_or_path), tool_link);
 }
 
 py::array_t<double> ForwardKinematicsPy(const RobotFile& rig, const Array& q,
@@ -507,10 +507,12 @@ void DefineRobot(py::module_& m) {
 A robot file: the arm (D-H links with the twist β, nominal values, simulated true errors, joint
 limits), its measurement plane if the file gives one, and the ranger's limits.
 
-Load one with Robot.load(path_or_name): a YAML robot file, or a shipped name ("paper").
+Load one with Robot.load(path_or_name): a YAML robot file, a URDF (with tool_link the ranger's
+link), or a shipped name ("paper").
 Link values are ordered theta, alpha, a, d, beta per link (SI: rad and m).)doc")
-      .def_static("load", &LoadRobot, py::arg("path"), R"doc(
-Loads a robot file (YAML) by path, or a shipped robot by name ("paper").
+      .def_static("load", &LoadRobot, py::arg("path"), py::arg("tool_link") = "", R"doc(
+Loads a robot file (YAML) or a URDF (path ending in .urdf; tool_link: the link whose frame is
+the ranger's, default the URDF's only end link) by path, or a shipped robot by name ("paper").
 Raises lrcal.InputError naming the file, line and key of anything wrong.)doc")
       .def_property_readonly("name", [](const RobotFile& r) { return r.robot.name(); })
       .def_readonly("path", &RobotFile::path, "Where the file was read from.")

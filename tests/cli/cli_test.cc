@@ -106,6 +106,59 @@ TEST_F(CliTest, SampleSimulateIdentifyRoundTrip) {
   EXPECT_NEAR(j["residual_rms"].get<double>(), 0.068e-3, 0.03e-3);
 }
 
+// A URDF arm from end to end, as the README's "Your own arm: URDF" shows: sample, simulate,
+// identify with --write-robot, export the calibrated model as URDF, and the exported URDF's
+// kinematics equal the calibrated robot file's.
+TEST_F(CliTest, UrdfArmCalibratesAndExportsWithTheSameKinematics) {
+  const std::string urdf =
+      "--robot " + testing::SourcePath("examples/urdf/ur5_ranger.urdf") + " --tool-link ranger";
+  const std::string plane = " --plane 0,0,1,0";
+  std::string out;
+  ASSERT_EQ(Run("sample " + urdf + plane + " --count 60 --seed 3 --out " + Path("c.csv"), &out), 0)
+      << out;
+  ASSERT_EQ(Run("simulate " + urdf + plane + " --configs " + Path("c.csv") + " --seed 2 --out " +
+                    Path("m.csv"),
+                &out),
+            0)
+      << out;
+  // The horizontal plane cannot see θ1, a1 or d4 of this arm (identifiability says so).
+  ASSERT_EQ(
+      Run("identifiability " + urdf + plane + " --configs " + Path("c.csv") + " --format json",
+          &out),
+      0)
+      << out;
+  EXPECT_EQ(Json::parse(out)["rank"], 21) << out;
+  ASSERT_EQ(Run("identify " + urdf + plane + " --data " + Path("m.csv") +
+                    " --fix theta1,a1,d4 --sigma-mm 0.2 --write-robot " + Path("cal.yaml"),
+                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("consistent with the stated noise"), std::string::npos) << out;
+  EXPECT_NE(testing::ReadFile(Path("cal.yaml")).find("tool: {xyz:"), std::string::npos);
+  ASSERT_EQ(
+      Run("export --robot " + Path("cal.yaml") + " --format urdf --out " + Path("cal.urdf"), &out),
+      0)
+      << out;
+  std::string from_yaml, from_urdf;
+  ASSERT_EQ(Run("kinematics --robot " + Path("cal.yaml") + " --configs " + Path("c.csv") +
+                    " --format json",
+                &from_yaml),
+            0);
+  ASSERT_EQ(Run("kinematics --robot " + Path("cal.urdf") + plane + " --configs " + Path("c.csv") +
+                    " --format json",
+                &from_urdf),
+            0)
+      << from_urdf;
+  const Json a = Json::parse(from_yaml), b = Json::parse(from_urdf);
+  ASSERT_EQ(a.size(), 60u);
+  ASSERT_EQ(b.size(), 60u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(a[i]["position"][k].get<double>(), b[i]["position"][k].get<double>(), 1e-12);
+    EXPECT_NEAR(a[i]["h"].get<double>(), b[i]["h"].get<double>(), 1e-12);
+  }
+}
+
 TEST_F(CliTest, IdentifiabilityFindsThePapersHorizontalPlaneRemark) {
   std::string out;
   ASSERT_EQ(Run("sample --robot paper --plane 0,0,1,0.3 --count 80 --seed 2 --out " + Path("c.csv"),

@@ -2,6 +2,7 @@
 as the lrcal program (sample, simulate, identify, identifiability, design)."""
 import csv
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -136,3 +137,20 @@ def test_docstrings_say_what_the_arguments_are():
     doc = lrcal.identify.__doc__
     for words in ("identify(robot", "estimate_plane", "(M, joints) rad", "lrcal.InputError"):
         assert words in doc
+
+
+def test_urdf_robot_loads_with_its_tool_link_as_the_program_does(tmp_path, cli):
+    urdf = str(pathlib.Path(__file__).resolve().parents[2] / "examples/urdf/ur5_ranger.urdf")
+    with pytest.raises(lrcal.InputError, match="--tool-link"):
+        lrcal.Robot.load(urdf)  # two end links: the ranger's must be named
+    arm = lrcal.Robot.load(urdf, tool_link="ranger")
+    assert arm.num_joints == 6 and arm.name == "ur5_ranger"
+    q = lrcal.sample_configurations(arm, 5, seed=2, plane=(0, 0, 1, 0), validation=True)
+    T = lrcal.forward_kinematics(arm, q)
+    configs = tmp_path / "q.csv"
+    configs.write_text("q1,q2,q3,q4,q5,q6\n" +
+                       "\n".join(",".join(repr(v) for v in row) for row in q) + "\n")
+    poses = json.loads(cli("kinematics", "--robot", urdf, "--tool-link", "ranger", "--plane",
+                           "0,0,1,0", "--configs", configs, "--format", "json").stdout)
+    # The module composes 4x4 matrices, the program its trig-free chain: rounding apart.
+    np.testing.assert_allclose(T[:, :3, 3], np.array([p["position"] for p in poses]), atol=1e-12)

@@ -1,9 +1,9 @@
 // Robot files: a robot model and the measurement set-up that travels with it.
 //
-// A robot YAML file (format: docs/FILE_FORMATS.md) gives the links of the chain (kinematics
-// layer) and, optionally, the plane the ranger measures and the ranger's limits (measurement
-// layer). The robot model itself knows nothing of planes or files; this reader splits the file
-// into the two.
+// A robot YAML file (format: docs/FILE_FORMATS.md) gives the links of the chain and the base and
+// tool transforms around it (kinematics layer) and, optionally, the plane the ranger measures and
+// the ranger's limits (measurement layer). The robot model itself knows nothing of planes or files;
+// this reader splits the file into the two.
 #pragma once
 
 #include <Eigen/Core>
@@ -45,10 +45,18 @@ struct RobotFile {
   std::optional<CalibrationRecord> calibration;
 };
 
-/// Reads a robot YAML file. Throws InputError naming the file, line and key on any problem.
-/// A `calibration:` mapping (written by WriteCalibratedRobotFile) is read into `calibration`,
-/// not into the model.
-RobotFile LoadRobotFile(const std::string& path);
+/// Reads a robot YAML file, or a URDF (a path ending in .urdf: io/urdf.h, with `tool_link` the
+/// ranger's link, empty for the URDF's only end link). Throws InputError naming the file, line
+/// and key on any problem, and for a `tool_link` given with a YAML file. A `calibration:`
+/// mapping (written by WriteCalibratedRobotFile) is read into `calibration`, not into the model.
+RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link = "");
+
+/// The robot YAML text of `rig` with `link_values` (5N, SI) as its nominal values, named `name`:
+/// links, base and tool transforms, `planes` if given, the ranger's limits and `record` if given.
+/// Numbers with 17 significant digits; true errors are not written.
+std::string RobotFileText(const RobotFile& rig, const Eigen::VectorXd& link_values,
+                          const std::optional<PlaneSet>& planes, const std::string& name,
+                          const CalibrationRecord* record = nullptr);
 
 /// Writes a robot file for the calibrated model: `rig`'s links with `link_values` (5N, SI) as
 /// their nominal values and no true errors, `planes` as its planes, `rig`'s ranger limits, and the

@@ -1,0 +1,41 @@
+// URDF in and out (format: docs/URDF.md).
+//
+// In: the serial chain of a URDF file (read with Debian's urdfdom) from its root link to a tool
+// link, converted to lrcal's D-H + β chain with base and tool transforms
+// (kinematics/dh_conversion.h): forward kinematics identical to the URDF's own. The tool link's
+// frame is the ranger's (origin where the beam starts, +Z along the beam). A URDF carries no
+// plane, ranger limits or true errors: planes come from --plane, the ranger's limits are lrcal's
+// defaults.
+//
+// Out: a URDF of a robot model at given link values (the calibrated model): one joint per link
+// about (along) its z axis, joint origins holding the rest of each D-H transform, and a fixed
+// joint to a link `tool` holding the tool transform. Read back, it gives the same forward
+// kinematics (tests: 1e-12).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/robot_model.h"
+
+namespace lrcal {
+
+/// True if `path` names a URDF file (ends in .urdf, any case).
+bool IsUrdfPath(const std::string& path);
+
+/// Reads a URDF's chain from its root link to `tool_link` (empty: the URDF's only leaf link).
+/// Revolute, continuous (range ±π), prismatic and fixed joints; anything else, a mimic joint, an
+/// unknown or ambiguous tool link is an InputError naming the file and the joint or link.
+RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link = "");
+
+/// A URDF document for `robot` with `link_values` (5N, SI) as its geometry; numbers with 17
+/// significant digits.
+std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& link_values);
+
+/// The D-H table of `robot` at `link_values` as CSV: one row per link (link, joint, theta0_rad,
+/// d_m, a_m, alpha_rad, beta_rad, q_min, q_max, parameters), preceded by `#` comment lines with
+/// the base and tool transforms (xyz m, rpy rad).
+std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& link_values);
+
+}  // namespace lrcal

@@ -1,0 +1,56 @@
+// lrcal export: a robot (a calibrated robot file, a URDF, a shipped robot) written for the
+// robot's software: URDF, a D-H table (CSV) or a robot YAML file.
+#include <iostream>
+
+#include "cli_common.h"
+#include "lrcal/core/error.h"
+#include "lrcal/core/json.h"
+#include "lrcal/io/robot_file.h"
+#include "lrcal/io/urdf.h"
+
+namespace lrcal::cli {
+
+namespace {
+
+std::string ExportText(const RobotFile& rig, const std::string& format,
+                       const po::variables_map& vm) {
+  const Eigen::VectorXd& values = rig.robot.nominal_values();
+  if (format == "urdf") return UrdfText(rig.robot, values);
+  if (format == "dh-table") return DhTableText(rig.robot, values);
+  if (format == "yaml") {
+    std::optional<PlaneSet> planes = rig.planes;
+    if (vm.count("plane")) planes = ResolvePlanes(rig, vm);
+    return "# Written by lrcal export from " + rig.path + " (format: docs/FILE_FORMATS.md).\n" +
+           RobotFileText(rig, values, planes, rig.robot.name(),
+                         rig.calibration ? &*rig.calibration : nullptr);
+  }
+  throw InputError("--format", "expected urdf, dh-table or yaml; got '" + format + "'");
+}
+
+}  // namespace
+
+int ExportCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal export options");
+  o.add_options()("robot", po::value<std::string>()->default_value("paper"),
+                  "robot file (YAML or URDF) or shipped robot name; its nominal values are "
+                  "written (a calibrated file's are the estimates)")(
+      "tool-link", po::value<std::string>(), "URDF robots: the ranger's link")(
+      "plane", po::value<std::vector<std::string>>()->composing(),
+      "yaml: plane(s) nx,ny,nz,f to write instead of the robot file's")(
+      "format", po::value<std::string>()->default_value("urdf"), "urdf, dh-table or yaml")(
+      "out", po::value<std::string>(), "file to write (default: standard output)");
+  po::variables_map vm;
+  if (!Parse("export", "--robot R --format urdf|dh-table|yaml [--out FILE]", o, args, &vm))
+    return 0;
+  const RobotFile rig = LoadRobot(vm);
+  const std::string text = ExportText(rig, vm["format"].as<std::string>(), vm);
+  if (!vm.count("out")) {
+    std::cout << text;
+    return 0;
+  }
+  WriteFileAtomically(vm["out"].as<std::string>(), text);
+  std::cerr << "lrcal export: wrote " << vm["out"].as<std::string>() << "\n";
+  return 0;
+}
+
+}  // namespace lrcal::cli

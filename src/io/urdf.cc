@@ -1,0 +1,235 @@
+#include "lrcal/io/urdf.h"
+
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+#include <vector>
+
+#include "lrcal/core/data_dir.h"
+#include "lrcal/core/error.h"
+#include "lrcal/kinematics/dh_conversion.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+
+namespace lrcal {
+
+bool IsUrdfPath(const std::string& path) {
+  if (path.size() < 5) return false;
+  std::string ext = path.substr(path.size() - 5);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".urdf";
+}
+
+namespace {
+
+std::string JoinList(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+RigidTransform FromUrdfPose(const urdf::Pose& pose) {
+  RigidTransform t;
+  const urdf::Rotation& r = pose.rotation;
+  t.rotation = Eigen::Quaterniond(r.w, r.x, r.y, r.z).normalized().toRotationMatrix();
+  t.translation = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
+  return t;
+}
+
+// The links with no child link: candidates for the tool.
+std::vector<std::string> LeafLinks(const urdf::ModelInterface& model) {
+  std::vector<urdf::LinkSharedPtr> links;
+  model.getLinks(links);
+  std::vector<std::string> leaves;
+  for (const auto& link : links)
+    if (link->child_links.empty()) leaves.push_back(link->name);
+  std::sort(leaves.begin(), leaves.end());
+  return leaves;
+}
+
+std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string& path,
+                           const std::string& tool_link) {
+  if (!tool_link.empty()) {
+    if (!model.getLink(tool_link)) {
+      std::vector<urdf::LinkSharedPtr> links;
+      model.getLinks(links);
+      std::vector<std::string> names;
+      for (const auto& link : links) names.push_back(link->name);
+      std::sort(names.begin(), names.end());
+      throw InputError(path, "no link named '" + tool_link + "' (--tool-link); the links are " +
+                                 JoinList(names));
+    }
+    return tool_link;
+  }
+  const std::vector<std::string> leaves = LeafLinks(model);
+  if (leaves.size() != 1)
+    throw InputError(path, "the URDF has " + std::to_string(leaves.size()) + " end links (" +
+                               JoinList(leaves) +
+                               "): give the ranger's link with --tool-link NAME");
+  return leaves.front();
+}
+
+// The joint's range: revolute/prismatic from <limit>, continuous ±π.
+void JointRange(const urdf::Joint& joint, const std::string& path, JointAxis* axis) {
+  if (joint.type == urdf::Joint::CONTINUOUS) return;  // the default ±π
+  if (!joint.limits || !(joint.limits->lower < joint.limits->upper))
+    throw InputError(path, "joint '" + joint.name +
+                               "': expected <limit lower=... upper=...> with lower < upper");
+  axis->q_min = joint.limits->lower;
+  axis->q_max = joint.limits->upper;
+}
+
+}  // namespace
+
+RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link) {
+  if (!PathExists(path)) throw InputError(path, "no such file");
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+  if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
+  const std::string tool = ChooseToolLink(*model, path, tool_link);
+  // The joints from the root to the tool link.
+  std::vector<urdf::JointConstSharedPtr> chain;
+  for (urdf::LinkConstSharedPtr link = model->getLink(tool); link && link->parent_joint;
+       link = model->getLink(link->parent_joint->parent_link_name))
+    chain.push_back(link->parent_joint);
+  std::reverse(chain.begin(), chain.end());
+  std::vector<JointAxis> axes;
+  RigidTransform pose;  // of the current link in the root frame, at q = 0
+  for (const auto& joint : chain) {
+    pose = pose * FromUrdfPose(joint->parent_to_joint_origin_transform);
+    if (joint->type == urdf::Joint::FIXED) continue;
+    if (joint->mimic)
+      throw InputError(
+          path, "joint '" + joint->name + "' mimics another; lrcal needs independent joints");
+    JointAxis axis;
+    switch (joint->type) {
+      case urdf::Joint::REVOLUTE:
+      case urdf::Joint::CONTINUOUS:
+        axis.joint = JointType::kRevolute;
+        break;
+      case urdf::Joint::PRISMATIC:
+        axis.joint = JointType::kPrismatic;
+        break;
+      default:
+        throw InputError(path, "joint '" + joint->name +
+                                   "': lrcal handles revolute, continuous, prismatic and fixed "
+                                   "joints, not floating, planar or unknown ones");
+    }
+    JointRange(*joint, path, &axis);
+    axis.point = pose.translation;
+    axis.direction = pose.rotation * Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
+    if (!(axis.direction.norm() > 1e-12))
+      throw InputError(path, "joint '" + joint->name + "': the axis is zero");
+    axes.push_back(axis);
+  }
+  if (axes.empty())
+    throw InputError(path, "no movable joint between the root link '" + model->getRoot()->name +
+                               "' and the tool link '" + tool + "'");
+  RobotFile file;
+  file.robot = RobotFromJointAxes(model->getName(), axes, pose, path);
+  file.path = path;
+  file.robot.source = path;
+  return file;
+}
+
+namespace {
+
+std::string Num(double x) {
+  if (x == 0) x = 0;  // no "-0"
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+std::string Origin(const RigidTransform& t) {
+  const Eigen::Vector3d rpy = t.Rpy();
+  return "<origin xyz=\"" + Num(t.translation.x()) + " " + Num(t.translation.y()) + " " +
+         Num(t.translation.z()) + "\" rpy=\"" + Num(rpy.x()) + " " + Num(rpy.y()) + " " +
+         Num(rpy.z()) + "\"/>";
+}
+
+std::string XmlEscaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
+  }
+  return out;
+}
+
+// Link i's transform at q = 0 (its θ0, d, a, α, β).
+RigidTransform LinkAtZero(const double* v) {
+  const Eigen::Matrix4d A = LinkTransform<double>(v[kTheta], v[kD], v[kA], v[kAlpha], v[kBeta]);
+  RigidTransform t;
+  t.rotation = A.block<3, 3>(0, 0);
+  t.translation = A.block<3, 1>(0, 3);
+  return t;
+}
+
+}  // namespace
+
+std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& values) {
+  std::string t =
+      "<?xml version=\"1.0\"?>\n<!-- Written by lrcal export: D-H + beta chain as "
+      "URDF joints (docs/URDF.md). -->\n<robot name=\"" +
+      XmlEscaped(robot.name()) + "\">\n  <link name=\"base_link\"/>\n";
+  RigidTransform origin = robot.base();  // what precedes joint i's motion, in link i-1
+  for (int i = 0; i < robot.num_links(); ++i) {
+    const Link& link = robot.links()[i];
+    const std::string parent = i == 0 ? "base_link" : "link" + std::to_string(i);
+    const std::string child = "link" + std::to_string(i + 1);
+    t += "  <link name=\"" + child + "\"/>\n  <joint name=\"joint" + std::to_string(i + 1) +
+         "\" type=\"" + (link.joint == JointType::kPrismatic ? "prismatic" : "revolute") +
+         "\">\n    <parent link=\"" + parent + "\"/>\n    <child link=\"" + child + "\"/>\n    " +
+         Origin(origin) + "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" + Num(link.q_min) +
+         "\" upper=\"" + Num(link.q_max) + "\" effort=\"0\" velocity=\"0\"/>\n  </joint>\n";
+    origin = LinkAtZero(values.data() + kValuesPerLink * i);
+  }
+  t += "  <link name=\"tool\"/>\n  <joint name=\"tool_joint\" type=\"fixed\">\n    <parent "
+       "link=\"link" +
+       std::to_string(robot.num_links()) + "\"/>\n    <child link=\"tool\"/>\n    " +
+       Origin(origin * robot.tool()) + "\n  </joint>\n</robot>\n";
+  return t;
+}
+
+std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& values) {
+  std::string t = "# D-H + beta table of " + robot.name() +
+                  " (lrcal export): A_i = Rz(theta0 + q) Tz(d) Tx(a) Rx(alpha) Ry(beta)\n";
+  const std::pair<const char*, const RigidTransform*> frames[] = {{"base", &robot.base()},
+                                                                  {"tool", &robot.tool()}};
+  for (const auto& [key, transform] : frames) {
+    const Eigen::Vector3d xyz = transform->translation, rpy = transform->Rpy();
+    t += std::string("# ") + key + " xyz_m: " + Num(xyz.x()) + " " + Num(xyz.y()) + " " +
+         Num(xyz.z()) + " rpy_rad: " + Num(rpy.x()) + " " + Num(rpy.y()) + " " + Num(rpy.z()) +
+         "\n";
+  }
+  t += "link,joint,theta0_rad,d_m,a_m,alpha_rad,beta_rad,q_min,q_max,parameters\n";
+  for (int i = 0; i < robot.num_links(); ++i) {
+    const Link& link = robot.links()[i];
+    const double* v = values.data() + kValuesPerLink * i;
+    std::vector<std::string> parameters;
+    for (int k = 0; k < kValuesPerLink; ++k)
+      if (link.is_parameter[k]) parameters.emplace_back(LinkValueName(k));
+    std::string list;
+    for (const std::string& p : parameters) list += (list.empty() ? "" : " ") + p;
+    t += std::to_string(i + 1) + "," +
+         (link.joint == JointType::kPrismatic ? "prismatic" : "revolute") + "," + Num(v[kTheta]) +
+         "," + Num(v[kD]) + "," + Num(v[kA]) + "," + Num(v[kAlpha]) + "," + Num(v[kBeta]) + "," +
+         Num(link.q_min) + "," + Num(link.q_max) + "," + list + "\n";
+  }
+  return t;
+}
+
+}  // namespace lrcal

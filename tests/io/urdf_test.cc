@@ -1,0 +1,228 @@
+// URDF in and out: lrcal's D-H + β model of a URDF chain against the URDF's own forward
+// kinematics, computed independently here from the joint origins and axes (urdfdom parses, Eigen
+// composes), on four arms; URDF → lrcal → URDF round trips; bad URDFs named by file and joint.
+#include "lrcal/io/urdf.h"
+
+#include <gtest/gtest.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Geometry>
+#include <fstream>
+#include <random>
+
+#include "lrcal/core/error.h"
+#include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/chain.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+// Chains of O(1 m) and O(1) rotations composed in two different ways: rounding only.
+constexpr double kTolerance = 1e-12;
+
+// The URDF's forward kinematics: root → tool link, each joint its origin then its motion
+// (rotation about / translation along its axis by q), the movable joints taking q in order.
+Eigen::Isometry3d UrdfForwardKinematics(const std::string& path, const std::string& tool_link,
+                                        const std::vector<double>& q) {
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+  EXPECT_TRUE(model) << path;
+  std::vector<urdf::JointConstSharedPtr> chain;
+  for (urdf::LinkConstSharedPtr link = model->getLink(tool_link); link->parent_joint;
+       link = model->getLink(link->parent_joint->parent_link_name))
+    chain.insert(chain.begin(), link->parent_joint);
+  Eigen::Isometry3d x = Eigen::Isometry3d::Identity();
+  std::size_t k = 0;
+  for (const auto& joint : chain) {
+    const urdf::Pose& o = joint->parent_to_joint_origin_transform;
+    x = x * Eigen::Translation3d(o.position.x, o.position.y, o.position.z) *
+        Eigen::Quaterniond(o.rotation.w, o.rotation.x, o.rotation.y, o.rotation.z);
+    const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
+    if (joint->type == urdf::Joint::FIXED) continue;
+    if (joint->type == urdf::Joint::PRISMATIC)
+      x = x * Eigen::Translation3d(q.at(k++) * axis);
+    else
+      x = x * Eigen::AngleAxisd(q.at(k++), axis.normalized());
+  }
+  EXPECT_EQ(k, q.size());
+  return x;
+}
+
+std::vector<double> RandomConfiguration(const RobotModel& robot, std::mt19937* rng) {
+  std::vector<double> q;
+  for (const Link& link : robot.links())
+    q.push_back(std::uniform_real_distribution<double>(link.q_min, link.q_max)(*rng));
+  return q;
+}
+
+// lrcal's reference and fast forward kinematics of `robot` against the URDF's at 200 random
+// configurations.
+void ExpectSameKinematics(const RobotModel& robot, const std::string& urdf,
+                          const std::string& tool_link) {
+  std::mt19937 rng(17);
+  ChainPoint point;
+  PrepareChainPoint(robot, robot.nominal_values().data(), &point);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::vector<double> q = RandomConfiguration(robot, &rng);
+    const Eigen::Isometry3d expected = UrdfForwardKinematics(urdf, tool_link, q);
+    const Pose<double> ref =
+        ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
+    ConfigurationSet one(robot.num_links());
+    one.Add(q);
+    const Pose<double> fast = ToolPose(point, one, 0);
+    for (const Pose<double>* pose : {&ref, &fast}) {
+      EXPECT_LT((pose->p_BT - expected.translation()).norm(), kTolerance) << urdf;
+      EXPECT_LT((pose->R_BT - expected.linear()).cwiseAbs().maxCoeff(), kTolerance) << urdf;
+    }
+  }
+}
+
+std::string Example(const std::string& name) {
+  return testing::SourcePath("examples/urdf/" + name);
+}
+
+TEST(Urdf, Puma560MatchesTheUrdfsOwnKinematics) {
+  const RobotFile rig = LoadRobotFile(Example("puma560.urdf"));
+  EXPECT_EQ(rig.robot.name(), "puma560_ranger");
+  EXPECT_EQ(rig.robot.num_links(), 6);
+  EXPECT_FALSE(rig.planes.has_value());
+  ExpectSameKinematics(rig.robot, Example("puma560.urdf"), "ranger");
+  // Axes 2 and 3 are parallel: link 2 is Hayati's (β a parameter, d fixed at 0).
+  EXPECT_TRUE(rig.robot.links()[1].is_parameter[kBeta]);
+  EXPECT_FALSE(rig.robot.links()[1].is_parameter[kD]);
+  EXPECT_EQ(rig.robot.links()[1].nominal[kD], 0.0);
+  EXPECT_TRUE(rig.robot.links()[2].is_parameter[kD]);
+  // Limits: revolute from <limit>, continuous ±π.
+  EXPECT_EQ(rig.robot.links()[0].q_min, -2.79);
+  EXPECT_EQ(rig.robot.links()[5].q_max, M_PI);
+}
+
+TEST(Urdf, Ur5WithAnOffsetRangerMatchesWithAChosenToolLink) {
+  const RobotFile rig = LoadRobotFile(Example("ur5_ranger.urdf"), "ranger");
+  ExpectSameKinematics(rig.robot, Example("ur5_ranger.urdf"), "ranger");
+  // Shoulder lift, elbow and wrist 1 are parallel: links 2 and 3 carry β.
+  for (int i : {1, 2}) EXPECT_TRUE(rig.robot.links()[i].is_parameter[kBeta]) << "link " << i + 1;
+  for (int i : {0, 3, 4, 5}) EXPECT_FALSE(rig.robot.links()[i].is_parameter[kBeta]);
+  EXPECT_FALSE(rig.robot.base().IsIdentity());  // the world joint's offset
+  EXPECT_FALSE(rig.robot.tool().IsIdentity());
+  // The camera link is the other end: the same chain up to the flange, another tool.
+  const RobotFile camera = LoadRobotFile(Example("ur5_ranger.urdf"), "camera");
+  ExpectSameKinematics(camera.robot, Example("ur5_ranger.urdf"), "camera");
+}
+
+TEST(Urdf, ScaraWithAPrismaticJointMatches) {
+  const RobotFile rig = LoadRobotFile(Example("scara_ranger.urdf"));
+  EXPECT_EQ(rig.robot.links()[2].joint, JointType::kPrismatic);
+  ExpectSameKinematics(rig.robot, Example("scara_ranger.urdf"), "ranger");
+}
+
+TEST(Urdf, PaperArmExportedMatchesAndReadsBack) {
+  const RobotModel& paper = testing::PaperRobotWithFrames();
+  const std::string path = testing::TempDir("urdf_paper") + "/paper.urdf";
+  std::ofstream(path) << UrdfText(paper, paper.nominal_values());
+  ExpectSameKinematics(paper, path, "tool");
+  const RobotFile back = LoadRobotFile(path);
+  ExpectSameKinematics(back.robot, path, "tool");
+  // The calibrated values, not the nominal ones, are what an export writes.
+  const Eigen::VectorXd truth = paper.true_values();
+  std::ofstream(path) << UrdfText(paper, truth);
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    const std::vector<double> q = RandomConfiguration(paper, &rng);
+    const Pose<double> pose = ForwardKinematics<double>(paper, truth.data(), q.data());
+    const Eigen::Isometry3d urdf = UrdfForwardKinematics(path, "tool", q);
+    EXPECT_LT((pose.p_BT - urdf.translation()).norm(), kTolerance);
+    EXPECT_LT((pose.R_BT - urdf.linear()).cwiseAbs().maxCoeff(), kTolerance);
+  }
+}
+
+TEST(Urdf, RoundTripKeepsTheKinematics) {
+  // URDF → lrcal → URDF: the written URDF's own kinematics equal the original's.
+  const std::string original = Example("ur5_ranger.urdf");
+  const RobotFile rig = LoadRobotFile(original, "ranger");
+  const std::string written = testing::TempDir("urdf_round_trip") + "/ur5.urdf";
+  std::ofstream(written) << UrdfText(rig.robot, rig.robot.nominal_values());
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::vector<double> q = RandomConfiguration(rig.robot, &rng);
+    const Eigen::Isometry3d a = UrdfForwardKinematics(original, "ranger", q);
+    const Eigen::Isometry3d b = UrdfForwardKinematics(written, "tool", q);
+    EXPECT_LT((a.translation() - b.translation()).norm(), kTolerance);
+    EXPECT_LT((a.linear() - b.linear()).cwiseAbs().maxCoeff(), kTolerance);
+  }
+  // And lrcal → YAML → lrcal keeps the model to the last digit.
+  const std::string yaml = testing::TempDir("urdf_round_trip") + "/ur5.yaml";
+  std::ofstream(yaml) << RobotFileText(rig, rig.robot.nominal_values(), std::nullopt, "ur5");
+  const RobotFile from_yaml = LoadRobotFile(yaml);
+  EXPECT_EQ(from_yaml.robot.nominal_values(), rig.robot.nominal_values());
+  ExpectSameKinematics(from_yaml.robot, original, "ranger");
+}
+
+TEST(Urdf, DhTableListsEveryLinkAndTheFrames) {
+  const RobotFile rig = LoadRobotFile(Example("puma560.urdf"));
+  const std::string table = DhTableText(rig.robot, rig.robot.nominal_values());
+  EXPECT_NE(table.find("# base xyz_m:"), std::string::npos);
+  EXPECT_NE(table.find("# tool xyz_m:"), std::string::npos);
+  EXPECT_NE(table.find("link,joint,theta0_rad,d_m,a_m,alpha_rad,beta_rad,q_min,q_max,parameters"),
+            std::string::npos);
+  EXPECT_NE(table.find("\n2,revolute,"), std::string::npos);
+  EXPECT_NE(table.find("theta alpha a beta\n"), std::string::npos);  // link 2, Hayati
+  EXPECT_NE(table.find("\n6,revolute,"), std::string::npos);
+}
+
+void ExpectInputError(const std::string& urdf_body, const std::string& tool_link,
+                      const std::string& expected) {
+  const std::string path = testing::TempDir("urdf_bad") + "/bad.urdf";
+  std::ofstream(path) << "<?xml version=\"1.0\"?>\n<robot name=\"bad\">\n"
+                      << urdf_body << "</robot>\n";
+  try {
+    LoadRobotFile(path, tool_link);
+    ADD_FAILURE() << "no error for " << expected;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
+}
+
+const char kTwoLinks[] = "<link name=\"a\"/><link name=\"b\"/>\n";
+
+TEST(Urdf, BadUrdfsAreNamedByFileJointOrLink) {
+  const std::string joint =
+      "<joint name=\"j\" type=\"TYPE\"><parent link=\"a\"/>"
+      "<child link=\"b\"/>LIMIT</joint>\n";
+  const auto with = [&](const std::string& type, const std::string& limit) {
+    std::string j = joint;
+    j.replace(j.find("TYPE"), 4, type);
+    j.replace(j.find("LIMIT"), 5, limit);
+    return kTwoLinks + j;
+  };
+  ExpectInputError(with("floating", ""), "", "joint 'j': lrcal handles revolute");
+  ExpectInputError(with("revolute", "<limit lower=\"1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>"),
+                   "", "joint 'j': expected <limit lower=... upper=...> with lower < upper");
+  ExpectInputError(with("fixed", ""), "", "no movable joint between the root link 'a'");
+  ExpectInputError(with("continuous", ""), "c", "no link named 'c' (--tool-link)");
+  ExpectInputError(std::string(kTwoLinks) + "<link name=\"c\"/>" +
+                       with("continuous", "").substr(sizeof(kTwoLinks) - 1) +
+                       "<joint name=\"k\" type=\"fixed\"><parent link=\"a\"/><child link=\"c\"/>"
+                       "</joint>\n",
+                   "", "2 end links (b, c): give the ranger's link with --tool-link");
+  ExpectInputError("<link name=\"a\"", "", "not a URDF that urdfdom can read");
+  ExpectInputError(kTwoLinks + std::string("<link name=\"c\"/>") +
+                       with("continuous", "").substr(sizeof(kTwoLinks) - 1) +
+                       "<joint name=\"m\" type=\"continuous\"><parent link=\"b\"/>"
+                       "<child link=\"c\"/><mimic joint=\"j\"/></joint>\n",
+                   "", "joint 'm' mimics another");
+}
+
+TEST(Urdf, ToolLinkIsForUrdfsOnly) {
+  try {
+    LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"), "ranger");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "--tool-link");
+  }
+}
+
+}  // namespace
+}  // namespace lrcal
