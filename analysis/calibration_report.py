@@ -254,9 +254,12 @@ def build(folder):
     parts.append("<h2>Calibrated files</h2>")
     if data.get("calibrated_robot"):
         name = html.escape(data["calibrated_robot"])
+        urdf = html.escape(data.get("calibrated_urdf", ""))
+        urdf_text = (f"<a href='{urdf}'>{urdf}</a>: the same model as URDF (lrcal export); "
+                     if urdf else "")
         parts.append(f"<p><a href='{name}'>{name}</a>: the calibrated robot file (every lrcal "
-                     "command takes it as --robot); <a href='calibration.json'>calibration.json"
-                     "</a>: everything on this page in SI.</p>")
+                     f"command takes it as --robot); {urdf_text}<a href='calibration.json'>"
+                     "calibration.json</a>: everything on this page in SI.</p>")
     else:
         parts.append("<p>None: the fit is not usable.</p>")
     parts.append(f"<script>{CHECK}</script></body></html>")

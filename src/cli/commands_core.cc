@@ -18,6 +18,7 @@
 #include "lrcal/identification/identification.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/urdf.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/paper/paper_case.h"
 
@@ -486,6 +487,11 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
     WriteCalibratedRobot(dir + "/calibrated.yaml", vm["data"].as<std::string>(), rig, model, s,
                          options);
     j["calibrated_robot"] = "calibrated.yaml";
+    // The same model as URDF, from the file just written (what lrcal export would write).
+    const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
+    WriteFileAtomically(dir + "/calibrated.urdf",
+                        UrdfText(calibrated.robot, calibrated.robot.nominal_values()));
+    j["calibrated_urdf"] = "calibrated.urdf";
   }
   WriteFileAtomically(dir + "/calibration.json", j.dump(2));
   const int code = RunAnalysisScript("analysis/calibration_report.py", dir);

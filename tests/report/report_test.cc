@@ -167,7 +167,8 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
       LrcalBinary() + " identify --data " + dir + "/m.csv --sigma-mm 0.2 --holdout 4";
   ASSERT_EQ(RunCommand(identify + " --report " + dir + "/cal", &out), 0) << out;
   const fs::path cal = fs::path(dir) / "cal";
-  for (const char* f : {"report.html", "calibration.json", "calibrated.yaml", "figures.json"})
+  for (const char* f :
+       {"report.html", "calibration.json", "calibrated.yaml", "calibrated.urdf", "figures.json"})
     EXPECT_TRUE(fs::exists(cal / f)) << f;
   const Json figures = Json::parse(Read(cal / "figures.json"));
   const std::vector<std::string> names = figures["figures"];
@@ -182,9 +183,9 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
   EXPECT_EQ(plain["parameters"], j["parameters"]);
   EXPECT_EQ(plain["holdout"], j["holdout"]);
   const std::string html = Read(cal / "report.html");
-  for (const char* section :
-       {"Fit check", "Parameters", "Identifiability", "Cross-validation",
-        "Accuracy over the workspace", "Calibrated files", "consistent with the stated noise"})
+  for (const char* section : {"Fit check", "Parameters", "Identifiability", "Cross-validation",
+                              "Accuracy over the workspace", "Calibrated files",
+                              "consistent with the stated noise", "calibrated.urdf"})
     EXPECT_NE(html.find(section), std::string::npos) << section;
   EXPECT_EQ(RunCommand(LrcalBinary() + " accuracy --robot " + (cal / "calibrated.yaml").string() +
                            " --workspace 0",
