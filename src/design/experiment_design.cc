@@ -85,6 +85,22 @@ class Spectrum {
     }
   }
 
+  // Upper bounds on λ_min(A + rho·g_r·g_rᵀ) for the rows r of G listed: the Rayleigh quotients
+  // of A's eigenvectors q_l after the update, min_l λ_l + rho·(q_lᵀg_r)². Exact evaluations
+  // (Score) can skip every row whose bound is below the best score found.
+  Eigen::VectorXd MinEigenvalueBounds(const Eigen::MatrixXd& G, const std::vector<int>& rows,
+                                      double rho) const {
+    Eigen::VectorXd bounds(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const Eigen::VectorXd z = Q_.transpose() * G.row(rows[r]).transpose();
+      bounds[static_cast<Eigen::Index>(r)] =
+          (lambda_.array() + rho * z.array().square()).minCoeff();
+    }
+    return bounds;
+  }
+  const Eigen::VectorXd& eigenvalues() const { return lambda_; }
+  const Eigen::MatrixXd& eigenvectors() const { return Q_; }
+
   // Score of A + rho·g·gᵀ, a design of m configurations.
   double Score(const Eigen::VectorXd& g, double rho, int m, DesignCriterion criterion) {
     z_.noalias() = Q_.transpose() * g;
@@ -188,6 +204,36 @@ class Spectrum {
   double log_det_ = 0, inv_trace_ = 0;
 };
 
+// E-optimality: the best of A + rho·g_r·g_rᵀ over `rows` by exact scores, evaluated in the
+// order of their Rayleigh bounds (MinEigenvalueBounds) and stopped when the next bound cannot
+// beat the best: the same choice as scoring every row (ties: the lowest position), at a few
+// exact evaluations. Returns the position in `rows`, or -1 if none scores above `floor`.
+int BestByBoundedScores(const Spectrum& spectrum, Spectrum* scorer, const Eigen::MatrixXd& G,
+                        const std::vector<int>& rows, double rho, int m, double floor,
+                        long long* evaluations) {
+  const Eigen::VectorXd bounds = spectrum.MinEigenvalueBounds(G, rows, rho);
+  // A bound in σ units, widened by rounding (relative 1e-12 of the largest eigenvalue).
+  const double slack = 1e-12 * std::fabs(spectrum.eigenvalues().maxCoeff());
+  std::vector<int> order(rows.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return bounds[a] > bounds[b] || (bounds[a] == bounds[b] && a < b);
+  });
+  double best = floor;
+  int best_pos = -1;
+  for (int pos : order) {
+    const double bound = std::sqrt(std::max(bounds[pos] + slack, 0.0));
+    if (bound < best) break;
+    const double s = scorer->Score(G.row(rows[pos]).transpose(), rho, m, DesignCriterion::kE);
+    ++*evaluations;
+    if (s > best || (s == best && best_pos >= 0 && pos < best_pos)) {
+      best = s;
+      best_pos = pos;
+    }
+  }
+  return best_pos;
+}
+
 // k distinct indices of 0..N-1 by a partial Fisher–Yates shuffle on the stream's draws.
 std::vector<int> RandomSubset(int N, int k, const RandomStream& stream, std::uint64_t first) {
   std::vector<int> p(N);
@@ -224,6 +270,15 @@ std::vector<int> Backward(const Eigen::MatrixXd& G, int k, DesignCriterion crite
   Spectrum spectrum;
   while (static_cast<int>(kept.size()) > k) {
     spectrum.Compute(A);
+    if (criterion == DesignCriterion::kE) {
+      const int best_pos =
+          BestByBoundedScores(spectrum, &spectrum, G, kept, -1.0, static_cast<int>(kept.size()) - 1,
+                              kMinusInf, evaluations);
+      const int drop = best_pos < 0 ? 0 : best_pos;
+      A.noalias() -= G.row(kept[drop]).transpose() * G.row(kept[drop]);
+      kept.erase(kept.begin() + drop);
+      continue;
+    }
     double best = -std::numeric_limits<double>::infinity();
     int best_pos = 0;
     for (int pos = 0; pos < static_cast<int>(kept.size()); ++pos) {
@@ -254,6 +309,19 @@ std::vector<int> Forward(const Eigen::MatrixXd& G, int k, DesignCriterion criter
   while (static_cast<int>(out.size()) < k) {
     spectrum.Compute(A);
     const DesignCriterion c = static_cast<int>(out.size()) < n ? DesignCriterion::kD : criterion;
+    if (c == DesignCriterion::kE) {
+      std::vector<int> free;
+      for (int j = 0; j < N; ++j)
+        if (!chosen[j]) free.push_back(j);
+      const int best_pos =
+          BestByBoundedScores(spectrum, &spectrum, G, free, 1.0, static_cast<int>(out.size()) + 1,
+                              kMinusInf, evaluations);
+      const int best_j = free[best_pos < 0 ? 0 : best_pos];
+      chosen[best_j] = true;
+      out.push_back(best_j);
+      A.noalias() += G.row(best_j).transpose() * G.row(best_j);
+      continue;
+    }
     double best = -std::numeric_limits<double>::infinity();
     int best_j = -1;
     for (int j = 0; j < N; ++j) {
@@ -274,51 +342,116 @@ std::vector<int> Forward(const Eigen::MatrixXd& G, int k, DesignCriterion criter
   return out;
 }
 
+// E-optimality: for a swap of design row i for candidate j, λ_min(A − g_i g_iᵀ + g_j g_jᵀ) ≤
+// λ_l − (q_lᵀg_i)² + (q_lᵀg_j)² for every eigenpair (λ_l, q_l) of A. A swap whose bound is
+// below the current σ_min² cannot improve it, so at a (nearly) locally optimal design a sweep
+// needs no eigendecomposition at all.
+struct SwapBounds {
+  bool valid = false;
+  Eigen::VectorXd lambda;
+  Eigen::MatrixXd Z2;  // (q_lᵀg_r)², N × n
+
+  void Compute(const Eigen::MatrixXd& G, const Eigen::MatrixXd& A) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+    lambda = eig.eigenvalues();
+    Z2 = (G * eig.eigenvectors()).array().square().matrix();
+    valid = true;
+  }
+
+  // True if some j in `outside` has a bound (in σ) above `floor` when swapped for row i.
+  bool AnyCanBeat(int i, const std::vector<int>& outside, double floor) const {
+    const double slack = 1e-12 * std::fabs(lambda.maxCoeff());
+    const Eigen::RowVectorXd base = lambda.transpose() - Z2.row(i);
+    const double target = floor * floor;
+    for (int j : outside)
+      if ((base + Z2.row(j)).minCoeff() + slack >= target) return true;
+    return false;
+  }
+};
+
+// The state of an exchange search: the design, its normal matrix and score.
+struct ExchangeState {
+  const Eigen::MatrixXd& G;
+  DesignCriterion criterion;
+  std::vector<int> design;
+  std::vector<bool> in;
+  Eigen::MatrixXd A;
+  double current = 0;
+  Spectrum spectrum;
+  // E: swap bounds from A's own eigenvectors (SwapBounds), refreshed after each accepted swap.
+  SwapBounds swap_bounds;
+  long long* evaluations;
+};
+
+// The best replacement for design row i among `outside` whose what-if score beats `floor`
+// (-1 if none); `without` receives A − g_i·g_iᵀ.
+int BestReplacement(ExchangeState* x, int i, const std::vector<int>& outside, double floor,
+                    Eigen::MatrixXd* without) {
+  const int k = static_cast<int>(x->design.size());
+  *without = x->A - x->G.row(i).transpose() * x->G.row(i);
+  x->spectrum.Compute(*without);
+  if (x->criterion == DesignCriterion::kE) {
+    const int best_pos = BestByBoundedScores(x->spectrum, &x->spectrum, x->G, outside, 1.0, k,
+                                             floor, x->evaluations);
+    return best_pos >= 0 ? outside[best_pos] : -1;
+  }
+  double best = floor;
+  int best_in = -1;
+  for (int j : outside) {
+    const double s = x->spectrum.Score(x->G.row(j).transpose(), 1.0, k, x->criterion);
+    ++*x->evaluations;
+    if (s > best) {
+      best = s;
+      best_in = j;
+    }
+  }
+  return best_in;
+}
+
+// Replaces design[pos] by its best improving replacement, if there is one; true if it did.
+bool ImproveAt(ExchangeState* x, int pos) {
+  const int i = x->design[pos], k = static_cast<int>(x->design.size());
+  // A swap must improve by more than the what-if's rounding (relative 1e-10).
+  const double floor = x->current + 1e-10 * std::fabs(x->current);
+  std::vector<int> outside;
+  for (int j = 0; j < static_cast<int>(x->G.rows()); ++j)
+    if (!x->in[j]) outside.push_back(j);
+  if (x->criterion == DesignCriterion::kE) {
+    if (!x->swap_bounds.valid) x->swap_bounds.Compute(x->G, x->A);
+    if (!x->swap_bounds.AnyCanBeat(i, outside, floor)) return false;  // no swap of i can improve
+  }
+  Eigen::MatrixXd without;
+  const int best_in = BestReplacement(x, i, outside, floor, &without);
+  if (best_in < 0) return false;
+  without.noalias() += x->G.row(best_in).transpose() * x->G.row(best_in);
+  const double exact = CriterionScore(without, k, x->criterion);
+  if (!(exact > x->current)) return false;  // the what-if was wrong at rounding level
+  x->A = without;
+  x->current = exact;
+  x->swap_bounds.valid = false;
+  x->in[i] = false;
+  x->in[best_in] = true;
+  x->design[pos] = best_in;
+  return true;
+}
+
 // Single swaps (one out, one in), DETMAX style: sweep over the design, and for each member take
 // the best improving replacement at once; stop after a sweep with no improvement.
 std::vector<int> Exchange(const Eigen::MatrixXd& G, std::vector<int> design,
                           DesignCriterion criterion, long long* evaluations) {
-  const int N = static_cast<int>(G.rows());
-  const int k = static_cast<int>(design.size());
-  std::vector<bool> in(N, false);
-  for (int i : design) in[i] = true;
-  Eigen::MatrixXd A = NormalMatrixOf(G, design);
-  double current = CriterionScore(A, k, criterion);
-  Spectrum spectrum;
+  ExchangeState x{
+      G,  criterion, design,     std::vector<bool>(G.rows(), false), NormalMatrixOf(G, design), 0,
+      {}, {},        evaluations};
+  for (int i : design) x.in[i] = true;
+  x.current = CriterionScore(x.A, static_cast<int>(design.size()), criterion);
   for (int sweep = 0; sweep < 1000; ++sweep) {
     bool improved = false;
-    for (int pos = 0; pos < k; ++pos) {
-      const int i = design[pos];
-      const Eigen::MatrixXd without = A - G.row(i).transpose() * G.row(i);
-      spectrum.Compute(without);
-      // A swap must improve by more than the what-if's rounding (relative 1e-10).
-      double best = current + 1e-10 * std::fabs(current);
-      int best_in = -1;
-      for (int j = 0; j < N; ++j) {
-        if (in[j]) continue;
-        const double s = spectrum.Score(G.row(j).transpose(), 1.0, k, criterion);
-        ++*evaluations;
-        if (s > best) {
-          best = s;
-          best_in = j;
-        }
-      }
-      if (best_in < 0) continue;
-      Eigen::MatrixXd swapped = without;
-      swapped.noalias() += G.row(best_in).transpose() * G.row(best_in);
-      const double exact = CriterionScore(swapped, k, criterion);
-      if (!(exact > current)) continue;  // the what-if was wrong at rounding level
-      A = swapped;
-      current = exact;
-      in[i] = false;
-      in[best_in] = true;
-      design[pos] = best_in;
-      improved = true;
-    }
+    for (int pos = 0; pos < static_cast<int>(x.design.size()); ++pos)
+      improved = ImproveAt(&x, pos) || improved;
     if (!improved) break;
   }
-  std::sort(design.begin(), design.end());
-  return design;
+  std::sort(x.design.begin(), x.design.end());
+  return x.design;
 }
 
 }  // namespace

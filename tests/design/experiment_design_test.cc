@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <tuple>
 
 #include "lrcal/core/error.h"
 #include "lrcal/design/configuration_sampling.h"
@@ -155,6 +156,53 @@ TEST(Selection, BackwardWithRankOneUpdatesMatchesBruteForceForEveryCriterion) {
     o.criterion = c;
     EXPECT_EQ(SelectConfigurations(G, 12, o, stream).indices, BruteBackward(G, 12, c))
         << DesignCriterionName(c);
+  }
+}
+
+// E-optimality prunes candidates by Rayleigh bounds and scores exactly only those that can win:
+// the choices must still be those of scoring every candidate, on a paper-sized problem too.
+TEST(Selection, BackwardEWithBoundsMatchesBruteForceOnLargerProblems) {
+  RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
+  SelectionOptions o;
+  o.method = SelectionMethod::kBackward;
+  o.criterion = DesignCriterion::kE;
+  const Eigen::MatrixXd small = RandomMatrix(60, 10, 22);
+  EXPECT_EQ(SelectConfigurations(small, 20, o, stream).indices,
+            BruteBackward(small, 20, DesignCriterion::kE));
+  const Eigen::MatrixXd paper_sized = RandomMatrix(101, 25, 23);
+  EXPECT_EQ(SelectConfigurations(paper_sized, 50, o, stream).indices,
+            BruteBackward(paper_sized, 50, DesignCriterion::kE));
+}
+
+// The exchange skips swaps whose Rayleigh bound cannot beat the design: its end must still be
+// a local optimum, no single swap raising σ_min by more than the acceptance margin (1e-10,
+// relative), checked by a fresh eigendecomposition of every swap.
+TEST(Selection, ExchangeEEndsWhereNoSingleSwapImproves) {
+  RandomStream stream(4, 0, 0, RandomPurpose::kSelection);
+  for (const auto& [rows, cols, k, seed] :
+       {std::tuple{40, 6, 9, 51u}, std::tuple{60, 10, 14, 52u}, std::tuple{101, 25, 30, 53u}}) {
+    const Eigen::MatrixXd G = RandomMatrix(rows, cols, seed);
+    SelectionOptions o;
+    o.method = SelectionMethod::kExchange;
+    o.criterion = DesignCriterion::kE;
+    const SelectionResult r = SelectConfigurations(G, k, o, stream);
+    std::vector<bool> in(rows, false);
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(cols, cols);
+    for (int i : r.indices) {
+      in[i] = true;
+      A += G.row(i).transpose() * G.row(i);
+    }
+    const double current = CriterionScore(A, k, DesignCriterion::kE);
+    EXPECT_NEAR(current, r.score, 1e-12 * r.score);
+    double best_swap = 0;
+    for (int i : r.indices)
+      for (int j = 0; j < rows; ++j) {
+        if (in[j]) continue;
+        const Eigen::MatrixXd B =
+            A - G.row(i).transpose() * G.row(i) + G.row(j).transpose() * G.row(j);
+        best_swap = std::max(best_swap, CriterionScore(B, k, DesignCriterion::kE));
+      }
+    EXPECT_LE(best_swap, current * (1 + 1e-10)) << rows << "x" << cols << " k " << k;
   }
 }
 
