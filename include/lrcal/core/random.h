@@ -20,15 +20,16 @@ namespace lrcal {
 
 /// What a stream of draws is for (part of its address).
 enum class RandomPurpose : std::uint32_t {
-  kNoise = 1,       ///< reading noise: index = configuration·R + repetition
-  kPool = 2,        ///< candidate configurations: index = attempt·joints + joint
-  kValidation = 3,  ///< validation configurations
-  kTruth = 4,       ///< per-trial parameter errors
-  kSelection = 5,   ///< random selection / exchange restarts
-  kPrediction = 6,  ///< draws of the linearised prediction of the validation metrics
-  kEncoder = 7,     ///< joint-encoder errors: index = (configuration·R + repetition)·joints + j
-  kPlaneForm = 8,   ///< plane flatness deviation at a configuration's hit point: index = slot
-  kOutlier = 9,     ///< gross errors: 2·(configuration·R + repetition) (+1 for the size)
+  kNoise = 1,         ///< reading noise: index = configuration·R + repetition
+  kPool = 2,          ///< candidate configurations: index = attempt·joints + joint
+  kValidation = 3,    ///< validation configurations
+  kTruth = 4,         ///< per-trial parameter errors
+  kSelection = 5,     ///< random selection / exchange restarts
+  kPrediction = 6,    ///< draws of the linearised prediction of the validation metrics
+  kEncoder = 7,       ///< joint-encoder errors: index = (configuration·R + repetition)·joints + j
+  kPlaneForm = 8,     ///< plane flatness deviation at a configuration's hit point: index = slot
+  kOutlier = 9,       ///< gross errors: 2·(configuration·R + repetition) (+1 for the size)
+  kSensitivity = 10,  ///< sensitivity plans (Saltelli's A, B; Morris' trajectories), bootstrap
 };
 
 class RandomStream {
