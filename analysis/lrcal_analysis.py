@@ -322,6 +322,50 @@ def sensitivity_figures(run, out_dir):
     return out
 
 
+def global_sensitivity_figure(run, out_dir):
+    """A study's sensitivity section (Sobol indices with their 95 % bootstrap intervals, or Morris
+    mu* against sigma), from summary.json."""
+    sens = run.summary.get("sensitivity")
+    if not sens or not sens.get("available"):
+        return []
+    inputs = sens["inputs"]
+    keys = [i["key"] for i in inputs]
+    metric, unit = sens["metric"], sens["unit"]
+    if sens["method"] == "sobol":
+        fig, ax = plt.subplots(figsize=(max(6, 1.4 * len(keys) + 2), 4.2))
+        xs = np.arange(len(keys))
+        for k, (what, label) in enumerate((("first", "first-order S"), ("total", "total T"))):
+            est = np.array([i[what][0] for i in inputs])
+            low = np.array([i[what][1] for i in inputs])
+            high = np.array([i[what][2] for i in inputs])
+            ax.bar(xs + (k - 0.5) * 0.38, est, 0.36, color=f"C{k}", label=label,
+                   yerr=[est - low, high - est], capsize=3)
+        ax.set_xticks(xs)
+        ax.set_xticklabels(keys, rotation=20, ha="right", fontsize=8)
+        ax.axhline(0, color="k", lw=0.6)
+        ax.set_ylabel("share of the variance")
+        ax.legend(fontsize=8)
+        ax.grid(axis="y", alpha=0.3)
+        caption = (f"Sobol indices of the cell mean of {metric} (identified model, x, y, z "
+                   "averaged) with their 95 % bootstrap intervals; the noise of the cell means is "
+                   f"{100 * sens['noise_variance'] / sens['variance']:.2f} % of the variance.")
+    else:
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        mu_star = [i["mu_star"] for i in inputs]
+        sigma = [i["sigma"] for i in inputs]
+        ax.scatter(mu_star, sigma, color="C0")
+        for x, y, key in zip(mu_star, sigma, keys):
+            ax.annotate(key, (x, y), fontsize=8, xytext=(4, 4), textcoords="offset points")
+        ax.set_xlabel(f"mu* ({unit} across the input's range)")
+        ax.set_ylabel(f"sigma ({unit})")
+        ax.grid(alpha=0.3)
+        caption = (f"Morris screening of the cell mean of {metric}: mu* (overall influence) "
+                   "against sigma (non-linearity or interactions).")
+    fig.suptitle(f"Which inputs matter for {metric}", fontsize=10)
+    fig.tight_layout()
+    return [(_save(fig, out_dir, "global_sensitivity"), caption)]
+
+
 def parameter_figures(run, out_dir, limit=4):
     """Empirical against predicted std per parameter, the bias with its Monte-Carlo error bar, and
     the correlation matrix, for the first cells; lengths (mm) and angles (mrad) on their own
@@ -436,5 +480,6 @@ def all_figures(run, out_dir):
     figures += distribution_figure(run, out_dir)
     figures += histogram_figures(run, out_dir)
     figures += sensitivity_figures(run, out_dir)
+    figures += global_sensitivity_figure(run, out_dir)
     figures += parameter_figures(run, out_dir)
     return figures

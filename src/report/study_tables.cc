@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "lrcal/core/text_table.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/paper/paper_case.h"
+#include "lrcal/study/sensitivity.h"
 
 namespace lrcal {
 
@@ -479,14 +481,149 @@ Json CellJson(const CellSummary& s) {
   return c;
 }
 
-Json SummaryJson(const Json& study, const StudyTablesResult& result) {
+Json SummaryJson(const Json& study, const StudyTablesResult& result, const Json& sensitivity) {
   Json js;
   js["study"] = study;
   js["complete"] = result.complete;
   Json cells = Json::array();
   for (const auto& s : result.cells) cells.push_back(CellJson(s));
   js["cells"] = cells;
+  if (!sensitivity.is_null()) js["sensitivity"] = sensitivity;
   return js;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sensitivity (study/sensitivity.h): the quantity of interest at each plan point is the cell's
+// mean over its trials of the identified model's metric, averaged over the x, y and z axes (mm or
+// mrad); its Monte-Carlo noise (the cell means' standard errors) is stated as a share of the
+// variance over the plan.
+
+struct SensitivityOutput {
+  Json json;             // null without a sensitivity section
+  std::string markdown;  // the summary.md section
+  Table csv{{"input", "min", "max", "method", "first", "first_low", "first_high", "total",
+             "total_low", "total_high", "mu", "mu_star", "sigma"}};
+};
+
+// The quantity of interest per cell id (NaN for a cell without ok trials) and its squared SE.
+std::map<std::string, std::pair<double, double>> CellQuantities(
+    const std::vector<CellSummary>& cells, int metric) {
+  std::map<std::string, std::pair<double, double>> q;
+  for (const CellSummary& s : cells) {
+    double mean = 0, se2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const Distribution& d = s.validation[3 * metric + a];
+      mean += (d.n > 0 ? d.mean : NAN) * 1e3 / 3;
+      se2 += d.mean_se * d.mean_se * 1e6 / 9;
+    }
+    q[s.cell.id] = {mean, se2};
+  }
+  return q;
+}
+
+std::string InputRange(const Json& input) {
+  return Fixed(input["min"].get<double>(), 4) + " to " + Fixed(input["max"].get<double>(), 4);
+}
+
+// Sobol indices with bootstrap intervals: the table, the CSV rows and the JSON inputs.
+std::string SobolSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed,
+                         SensitivityOutput* out) {
+  const int d = static_cast<int>(spec["inputs"].size()), bootstrap = spec["bootstrap"];
+  const SaltelliPlan plan{spec["samples"].get<int>(), d, {}};
+  const SobolIndices s = EstimateSobolIndices(plan, values, bootstrap, 0.95, seed);
+  Table table({"input", "range", "first-order S [95 % CI]", "total T [95 % CI]"});
+  const auto ci = [](const IntervalEstimate& e) {
+    return Fixed(e.estimate, 3) + " [" + Fixed(e.low, 3) + ", " + Fixed(e.high, 3) + "]";
+  };
+  Json inputs = Json::array();
+  for (int i = 0; i < d; ++i) {
+    const Json& in = spec["inputs"][i];
+    const std::string key = in["key"];
+    table.AddRow({key, InputRange(in), ci(s.first[i]), ci(s.total[i])});
+    out->csv.AddRow({key, CsvValue(in["min"].get<double>()), CsvValue(in["max"].get<double>()),
+                     "sobol", CsvValue(s.first[i].estimate), CsvValue(s.first[i].low),
+                     CsvValue(s.first[i].high), CsvValue(s.total[i].estimate),
+                     CsvValue(s.total[i].low), CsvValue(s.total[i].high), "", "", ""});
+    inputs.push_back({{"key", key},
+                      {"first", {s.first[i].estimate, s.first[i].low, s.first[i].high}},
+                      {"total", {s.total[i].estimate, s.total[i].low, s.total[i].high}}});
+  }
+  out->json["inputs"] = inputs;
+  return "Saltelli's plan, N = " + std::to_string(plan.base_samples) + " base samples, " +
+         std::to_string(d) +
+         " inputs; first-order by Saltelli et al. (2010), total by Jansen (1999), 95 % "
+         "percentile-bootstrap intervals (" +
+         std::to_string(bootstrap) + " resamples).\n\n" + table.ToMarkdown();
+}
+
+// Morris elementary effects: the table, the CSV rows and the JSON inputs.
+std::string MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed,
+                          const std::string& unit, SensitivityOutput* out) {
+  const int d = static_cast<int>(spec["inputs"].size()), levels = spec["levels"];
+  const MorrisPlan plan = MakeMorrisPlan(spec["samples"].get<int>(), d, levels, seed);
+  const MorrisEffects e = EstimateMorrisEffects(plan, values);
+  Table table(
+      {"input", "range", "mu* (" + unit + ")", "mu (" + unit + ")", "sigma (" + unit + ")"});
+  Json inputs = Json::array();
+  for (int i = 0; i < d; ++i) {
+    const Json& in = spec["inputs"][i];
+    const std::string key = in["key"];
+    table.AddRow(
+        {key, InputRange(in), Fixed(e.mu_star[i], 4), Fixed(e.mu[i], 4), Fixed(e.sigma[i], 4)});
+    out->csv.AddRow({key, CsvValue(in["min"].get<double>()), CsvValue(in["max"].get<double>()),
+                     "morris", "", "", "", "", "", "", CsvValue(e.mu[i]), CsvValue(e.mu_star[i]),
+                     CsvValue(e.sigma[i])});
+    inputs.push_back(
+        {{"key", key}, {"mu", e.mu[i]}, {"mu_star", e.mu_star[i]}, {"sigma", e.sigma[i]}});
+  }
+  out->json["inputs"] = inputs;
+  return "Morris' plan, " + std::to_string(plan.trajectories) + " trajectories on a " +
+         std::to_string(levels) +
+         "-level grid; elementary effects are the change of the quantity of interest across "
+         "each input's whole range (Δ of the unit cube scaled to 1).\n\n" +
+         table.ToMarkdown();
+}
+
+SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellSummary>& cells) {
+  SensitivityOutput out;
+  if (!study.contains("sensitivity")) return out;
+  const Json& spec = study["sensitivity"];
+  const std::string method = spec["method"], metric_name = spec["metric"];
+  int metric = 0;
+  while (metric < 3 && metric_name != kMetricNames[metric]) ++metric;
+  const std::uint64_t seed = study.value("seed", std::uint64_t{0});
+  const auto quantities = CellQuantities(cells, metric);
+  const Json& plan_cells = spec["plan_cells"];
+  Eigen::VectorXd values(static_cast<Eigen::Index>(plan_cells.size()));
+  double noise = 0;
+  for (std::size_t p = 0; p < plan_cells.size(); ++p) {
+    const auto it = quantities.find(plan_cells[p].get<std::string>());
+    values[static_cast<Eigen::Index>(p)] = it == quantities.end() ? NAN : it->second.first;
+    noise += it == quantities.end() ? 0 : it->second.second / static_cast<double>(values.size());
+  }
+  const std::string unit = metric % 2 == 0 ? "mm" : "mrad";
+  out.json = {{"method", method}, {"metric", metric_name}, {"unit", unit}};
+  std::ostringstream md;
+  md << "\n## Sensitivity (" << (method == "sobol" ? "Sobol indices" : "Morris effects")
+     << ")\n\nQuantity of interest: each cell's mean over its trials of the identified model's "
+     << metric_name << " (" << unit << "), averaged over x, y and z, at " << values.size()
+     << " plan points (" << cells.size() << " cells).";
+  out.json["available"] = values.allFinite();
+  if (!values.allFinite()) {
+    out.markdown = md.str() + " Some cells have no successful trial: no indices.\n";
+    return out;
+  }
+  const double variance = (values.array() - values.mean()).square().sum() /
+                          static_cast<double>(std::max<Eigen::Index>(1, values.size() - 1));
+  out.json["variance"] = variance;
+  out.json["noise_variance"] = noise;
+  md << " Variance over the plan " << Fixed(variance, 6) << " " << unit << "²; the cell means' "
+     << "Monte-Carlo noise is " << Percent(variance > 0 ? noise / variance : NAN)
+     << " of it (it adds to every total index and lowers the first-order ones).\n\n"
+     << (method == "sobol" ? SobolSection(spec, values, seed, &out)
+                           : MorrisSection(spec, values, seed, unit, &out));
+  out.markdown = md.str();
+  return out;
 }
 
 // validation.csv's columns; issue 14's are appended after the first ones, which scripts rely on.
@@ -557,7 +694,8 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
         "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
         "(Wilks: at least 95 % from N = 59).\n\n"
      << val.ToMarkdown();
-  md << PredictionSection(result.cells) << PaperLayoutSection(result.cells)
+  const SensitivityOutput sensitivity = SensitivityAnalysis(study, result.cells);
+  md << PredictionSection(result.cells) << PaperLayoutSection(result.cells) << sensitivity.markdown
      << ParameterSections(result.cells, &par_csv, &par_tex);
   if (any_paper)
     md << "\n## The paper's published numbers in lrcal's distributions\n\nPercentile of the "
@@ -575,7 +713,8 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   write("validation.csv", val_csv.ToCsv());
   write("parameters.csv", par_csv.ToCsv());
   if (any_paper) write("paper_placement.csv", place.ToCsv());
-  write("summary.json", SummaryJson(study, result).dump(1) + "\n");
+  if (!sensitivity.json.is_null()) write("sensitivity.csv", sensitivity.csv.ToCsv());
+  write("summary.json", SummaryJson(study, result, sensitivity.json).dump(1) + "\n");
   write("validation.tex", val.ToLatex());
   write("parameters.tex", par_tex.ToLatex());
   return result;

@@ -24,9 +24,12 @@ double PooledVariance(const Eigen::VectorXd& fa, const Eigen::VectorXd& fb) {
 }
 
 // First-order (Saltelli 2010) and total (Jansen 1999) indices of input i from the rows given.
+// f(B) is centred on the mean of f over A and B: E[f(AB_i) − f(A)] = 0, so the estimator keeps
+// its expectation, and its variance no longer grows with the square of f's mean.
 void Indices(const Eigen::VectorXd& fa, const Eigen::VectorXd& fb, const Eigen::VectorXd& fab,
              double variance, double* first, double* total) {
-  *first = Mean(fb.cwiseProduct(fab - fa)) / variance;
+  const double mean = 0.5 * (fa.mean() + fb.mean());
+  *first = Mean((fb.array() - mean).matrix().cwiseProduct(fab - fa)) / variance;
   *total = Mean((fa - fab).cwiseAbs2()) / (2 * variance);
 }
 

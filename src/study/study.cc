@@ -11,6 +11,7 @@
 #include "lrcal/core/hash.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/study/sensitivity.h"
 
 namespace lrcal {
 
@@ -488,6 +489,7 @@ Json Study::ToJson() const {
   if (stop_when.enabled()) j["stop_when"] = stop_when.ToJson();
   j["base"] = base;
   j["sweep"] = sweep;
+  if (!sensitivity.is_null()) j["sensitivity"] = sensitivity;
   Json cs = Json::array();
   for (const auto& c : cells) cs.push_back({{"id", c.id}, {"label", c.label}});
   j["cells"] = cs;
@@ -585,7 +587,8 @@ void HashRobotFile(Json* settings, const KeyLocator& where, const std::string& f
 // robot is a new cell.
 Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& folder) {
   Json settings = given;
-  for (const char* k : {"name", "description", "seed", "trials", "stop_when", "sweep"})
+  for (const char* k :
+       {"name", "description", "seed", "trials", "stop_when", "sweep", "sensitivity"})
     settings.erase(k);
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
@@ -652,6 +655,80 @@ std::vector<Axis> ParseSweep(const Json& given, const KeyLocator& where, Study* 
     throw InputError(where("sweep.axes"), "the axes give " + Json(cells).dump() +
                                               " cells; at most " + std::to_string(kMaxCells) +
                                               " are allowed in one study (split the sweep)");
+  return axes;
+}
+
+// The sensitivity section (sensitivity.h; docs/STUDIES.md): uncertain inputs, each uniform on
+// [min, max], sampled by Saltelli's or Morris' plan from the study's seed; the plan's points
+// become the cells of a zipped sweep, one axis per input.
+std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, Study* study) {
+  const Json& sn = given["sensitivity"];
+  if (given.contains("sweep"))
+    throw InputError(where("sensitivity"),
+                     "a study has either a sweep or a sensitivity analysis, not both");
+  if (!sn.is_object()) throw InputError(where("sensitivity"), "expected a mapping with 'inputs'");
+  OnlyKeys(sn, "sensitivity", {"method", "samples", "levels", "bootstrap", "metric", "inputs"},
+           "method, samples, levels, bootstrap, metric, inputs", where);
+  Json spec = {{"method", "sobol"},
+               {"samples", 32},
+               {"levels", 4},
+               {"bootstrap", 1000},
+               {"metric", "rms_pos"}};
+  spec.merge_patch(sn);
+  const KeyLocator at{where.file, where.lines, where.context, "sensitivity"};
+  const std::string method = Str(spec, "method", at);
+  if (method != "sobol" && method != "morris")
+    throw InputError(where("sensitivity.method"), "expected sobol or morris, got '" + method + "'");
+  const int samples = Int(spec, "samples", at, 2, 100000);
+  const int levels = Int(spec, "levels", at, 2, 100);
+  if (levels % 2 != 0)
+    throw InputError(where("sensitivity.levels"), "expected an even number of grid levels");
+  Int(spec, "bootstrap", at, 0, 100000);
+  const std::string metric = Str(spec, "metric", at);
+  if (metric != "rms_pos" && metric != "rms_ori" && metric != "max_pos" && metric != "max_ori")
+    throw InputError(where("sensitivity.metric"),
+                     "expected rms_pos, rms_ori, max_pos or max_ori, got '" + metric + "'");
+  const Json& inputs = spec["inputs"];
+  if (!inputs.is_array() || inputs.empty() || inputs.size() > 20)
+    throw InputError(where("sensitivity.inputs"),
+                     "expected a list of 1 to 20 inputs, each {key, min, max}");
+  std::vector<Axis> axes(inputs.size());
+  std::vector<double> lo(inputs.size()), hi(inputs.size());
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string ip = "sensitivity.inputs[" + std::to_string(i) + "]";
+    const KeyLocator in_at{where.file, where.lines, where.context, ip};
+    if (!inputs[i].is_object()) throw InputError(where(ip), "expected {key, min, max}");
+    OnlyKeys(inputs[i], ip, {"key", "min", "max"}, "key, min, max", where);
+    axes[i].key = Str(inputs[i], "key", in_at);
+    // Numeric settings (the ranger errors' default is the robot file's value, also numeric).
+    if (!KeyExists(StudyDefaults(), axes[i].key) ||
+        !(At(StudyDefaults(), axes[i].key).is_number() ||
+          At(StudyDefaults(), axes[i].key) == "robot_file"))
+      throw InputError(where(ip + ".key"), "'" + axes[i].key +
+                                               "' is not a numeric study setting (e.g. "
+                                               "noise.sigma_mm, truth.scale)");
+    lo[i] = Num(inputs[i], "min", in_at);
+    hi[i] = Num(inputs[i], "max", in_at);
+    if (!(lo[i] < hi[i])) throw InputError(where(ip), "expected min < max");
+    study->axis_keys.push_back(axes[i].key);
+  }
+  const int d = static_cast<int>(inputs.size());
+  const double cells = static_cast<double>(samples) * (method == "sobol" ? d + 2 : d + 1);
+  if (cells > kMaxCells)
+    throw InputError(where("sensitivity.samples"),
+                     "the plan has " + Json(cells).dump() + " points; at most " +
+                         std::to_string(kMaxCells) + " cells are allowed in one study");
+  const Eigen::MatrixXd points = method == "sobol"
+                                     ? MakeSaltelliPlan(samples, d, study->seed).points
+                                     : MakeMorrisPlan(samples, d, levels, study->seed).points;
+  for (int i = 0; i < d; ++i)
+    for (Eigen::Index r = 0; r < points.rows(); ++r) {
+      const double value = lo[i] + points(r, i) * (hi[i] - lo[i]);
+      axes[i].values.push_back(value);
+      axes[i].labels.push_back(axes[i].key + "=" + ValueLabel(Json(value)));
+      axes[i].value_paths.push_back("sensitivity.inputs[" + std::to_string(i) + "]");
+    }
+  study->sensitivity = spec;
   return axes;
 }
 
@@ -786,11 +863,16 @@ Study LoadStudy(const std::string& path) {
   study.path = path;
   ParseHeader(given, path, where, &study);
   study.base = ResolveBase(given, where, study.folder());
-  std::string combine;
-  const std::vector<Axis> axes = ParseSweep(given, where, &study, &combine);
+  std::string combine = "zip";
+  const bool sensitivity = given.contains("sensitivity");
+  const std::vector<Axis> axes = sensitivity ? ParseSensitivity(given, where, &study)
+                                             : ParseSweep(given, where, &study, &combine);
   std::map<std::string, std::string> seen;
+  Json plan_cells = Json::array();  // sensitivity: each plan point's cell (points may repeat)
   for (const auto& combo : Combinations(axes, combine)) {
     Cell cell = MakeCell(study.base, axes, combo, path, lines);
+    if (sensitivity) plan_cells.push_back(cell.id);
+    if (sensitivity && seen.count(cell.id)) continue;
     if (seen.count(cell.id))
       throw InputError(path, "sweep cells '" + seen[cell.id] + "' and '" + cell.label +
                                  "' have identical settings");
@@ -798,6 +880,7 @@ Study LoadStudy(const std::string& path) {
     cell.order = static_cast<int>(study.cells.size());
     study.cells.push_back(std::move(cell));
   }
+  if (sensitivity) study.sensitivity["plan_cells"] = plan_cells;
   return study;
 }
 

@@ -699,6 +699,21 @@ const std::vector<BadInput>& Cases() {
        2,
        {"different study", "seed"},
        "{lrcal} run quick --out a --quiet > /dev/null 2>&1"},
+      // A study's sensitivity section (study/sensitivity.h).
+      {"SensitivityUnknownInput",
+       {{"s.yaml", std::string(kStudy) +
+                       "sensitivity:\n  inputs: [{key: noise.sigma, min: 0.1, max: 0.3}]\n"}},
+       "run s.yaml --out a",
+       2,
+       {"s.yaml:6 key 'sensitivity.inputs[0].key'",
+        "'noise.sigma' is not a numeric study setting"}},
+      {"SensitivityWithASweep",
+       {{"s.yaml", std::string(kStudy) +
+                       "sweep: {axes: [{key: noise.sigma_mm, values: [0.1, 0.2]}]}\n"
+                       "sensitivity: {inputs: [{key: noise.sigma_mm, min: 0.1, max: 0.3}]}\n"}},
+       "run s.yaml --out a",
+       2,
+       {"key 'sensitivity'", "either a sweep or a sensitivity analysis, not both"}},
       // URDF robots, --tool-link, base/tool transforms, lrcal export.
       {"UrdfNotXml",
        {{"arm.urdf", "<robot name=\"x\"><link name=\"a\"</robot>\n"}},

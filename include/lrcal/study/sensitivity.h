@@ -5,7 +5,9 @@
 // S_i = Var(E[Y|X_i]) / Var(Y) (the share of the variance X_i explains alone) and the total index
 // T_i = E[Var(Y|X_~i)] / Var(Y) (its share including all interactions). Estimated from Saltelli's
 // plan: two independent N×d samples A and B and the d matrices AB_i (A with column i taken from
-// B), N(d+2) evaluations; S_i by Saltelli et al. (2010), mean(f(B)·(f(AB_i) − f(A))) / V, and T_i
+// B), N(d+2) evaluations; S_i by Saltelli et al. (2010), mean((f(B) − f̄)·(f(AB_i) − f(A))) / V
+// (f(B) centred on the mean f̄ of f over A and B, which keeps the expectation and removes the
+// variance that f's mean would add), and T_i
 // by Jansen (1999), mean((f(A) − f(AB_i))²) / (2V), V the variance of f over A and B together.
 // Confidence intervals: percentile bootstrap over the N rows (each resample takes whole rows, so
 // the estimators' correlations are kept).

@@ -111,6 +111,10 @@ struct Study {
   StopWhen stop_when;
   Json base;   ///< resolved base settings (before sweeps)
   Json sweep;  ///< the sweep section as given (canonical JSON)
+  /// The sensitivity section (method, samples, levels, bootstrap, metric, inputs) with its
+  /// defaults, and plan_cells: the cell id of each plan point in the plan's order (sensitivity.h).
+  /// Null for a study without one.
+  Json sensitivity;
   std::vector<std::string> axis_keys;
   std::vector<Cell> cells;
   /// The whole resolved study (name, seed, trials, stop_when if on, base, sweep): what a run

@@ -1,0 +1,96 @@
+// A study's sensitivity section: its plan becomes ordinary cells, repeated plan points share a
+// cell, the tables give the indices, and the numbers do not depend on the thread count.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "lrcal/core/error.h"
+#include "lrcal/study/sensitivity.h"
+#include "lrcal/study/study.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+// outlier_sigma_mm has no effect without outliers: lrcal leaves it out of a cell's identity at
+// outlier_fraction 0, so every plan point that differs only in it is the same cell.
+const char kStudy[] =
+    "name: sens\nseed: 5\ntrials: 20\npool: {size: 60}\nselection: {count: 40}\n"
+    "validation: {size: 10}\nsensitivity:\n  method: METHOD\n  samples: 6\n  bootstrap: 200\n"
+    "  inputs:\n    - {key: noise.sigma_mm, min: 0.1, max: 0.4}\n"
+    "    - {key: noise.outlier_sigma_mm, min: 1, max: 10}\n";
+
+std::string WriteStudy(const std::string& dir, const std::string& method) {
+  std::string text = kStudy;
+  text.replace(text.find("METHOD"), 6, method);
+  std::ofstream(dir + "/s.yaml") << text;
+  return dir + "/s.yaml";
+}
+
+TEST(SensitivityStudy, PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices) {
+  const std::string dir = testing::TempDir("sensitivity_sobol");
+  const Study study = LoadStudy(WriteStudy(dir, "sobol"));
+  // Saltelli: N(d+2) = 6·4 = 24 points; AB_2 differs from A only in outlier_sigma_mm (the same
+  // cells as A), and AB_1 only from B: 12 distinct cells.
+  ASSERT_EQ(study.sensitivity["plan_cells"].size(), 24u);
+  EXPECT_EQ(study.cells.size(), 12u);
+  EXPECT_EQ(study.sensitivity["plan_cells"][12], study.sensitivity["plan_cells"][6]);  // AB_1 = B
+  EXPECT_EQ(study.sensitivity["plan_cells"][18], study.sensitivity["plan_cells"][0]);  // AB_2 = A
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
+  const auto j = nlohmann::json::parse(testing::ReadFile(dir + "/run/tables/summary.json"));
+  const auto& s = j["sensitivity"];
+  ASSERT_EQ(s["method"], "sobol");
+  ASSERT_TRUE(s["available"].get<bool>());
+  ASSERT_EQ(s["inputs"].size(), 2u);
+  EXPECT_EQ(s["inputs"][1]["first"][0].get<double>(), 0.0);
+  EXPECT_EQ(s["inputs"][1]["total"][0].get<double>(), 0.0);
+  EXPECT_GT(s["inputs"][0]["total"][0].get<double>(), 0.5);  // σ is the only input that acts
+  const std::string csv = testing::ReadFile(dir + "/run/tables/sensitivity.csv");
+  EXPECT_EQ(csv.rfind("input,min,max,method,first,first_low,first_high,total", 0), 0u) << csv;
+  EXPECT_NE(testing::ReadFile(dir + "/run/tables/summary.md").find("## Sensitivity (Sobol"),
+            std::string::npos);
+  // The same tables with one thread: the plan and its cells are independent of scheduling.
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run1", 1).complete);
+  EXPECT_EQ(testing::ReadFile(dir + "/run1/tables/sensitivity.csv"), csv);
+}
+
+TEST(SensitivityStudy, MorrisScreensTheInputs) {
+  const std::string dir = testing::TempDir("sensitivity_morris");
+  const Study study = LoadStudy(WriteStudy(dir, "morris"));
+  EXPECT_EQ(study.sensitivity["plan_cells"].size(), 6u * 3);  // r(d+1)
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
+  const auto j = nlohmann::json::parse(testing::ReadFile(dir + "/run/tables/summary.json"));
+  const auto& in = j["sensitivity"]["inputs"];
+  EXPECT_GT(in[0]["mu_star"].get<double>(), 0.01);  // mm across σ's range
+  EXPECT_EQ(in[1]["mu_star"].get<double>(), 0.0);
+  EXPECT_EQ(in[1]["sigma"].get<double>(), 0.0);
+}
+
+TEST(SensitivityStudy, BadSectionsNameTheKey) {
+  const std::string dir = testing::TempDir("sensitivity_bad");
+  const auto expect_error = [&](const std::string& body, const std::string& expected) {
+    std::ofstream(dir + "/b.yaml") << "name: b\nseed: 1\ntrials: 5\n" << body;
+    try {
+      LoadStudy(dir + "/b.yaml");
+      ADD_FAILURE() << "no error for " << body;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  const std::string input = "  inputs: [{key: noise.sigma_mm, min: 0.1, max: 0.3}]\n";
+  expect_error("sensitivity:\n  method: fast\n" + input, "key 'sensitivity.method'");
+  expect_error("sensitivity:\n  method: morris\n  levels: 5\n" + input,
+               "key 'sensitivity.levels': expected an even number");
+  expect_error("sensitivity:\n  inputs: [{key: selection.method, min: 0, max: 1}]\n",
+               "'selection.method' is not a numeric study setting");
+  expect_error("sensitivity:\n  inputs: [{key: noise.sigma_mm, min: 0.3, max: 0.1}]\n",
+               "expected min < max");
+  expect_error("sensitivity:\n  metric: bias\n" + input, "key 'sensitivity.metric'");
+  expect_error("sweep: {axes: [{key: noise.sigma_mm, values: [0.1]}]}\nsensitivity:\n" + input,
+               "either a sweep or a sensitivity analysis");
+  expect_error("sensitivity:\n  samples: 100000\n" + input, "at most 100000 cells");
+}
+
+}  // namespace
+}  // namespace lrcal
