@@ -1,8 +1,10 @@
 #include "lrcal/study/study.h"
 
+#include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "io/yaml_util.h"
@@ -658,9 +660,37 @@ std::vector<Axis> ParseSweep(const Json& given, const KeyLocator& where, Study* 
   return axes;
 }
 
+// An uncertain input's law: uniform on [min, max], or normal (mean, std) through its quantile
+// function (Sobol plans only: Morris' grid reaches 0 and 1).
+struct InputDistribution {
+  bool normal = false;
+  double a = 0, b = 1;  // min, max or mean, std
+  double At(double u) const {
+    if (!normal) return a + u * (b - a);
+    const double p = std::min(u, 1 - std::numeric_limits<double>::epsilon() / 2);
+    return a + b * boost::math::quantile(boost::math::normal(), p);
+  }
+};
+
+InputDistribution ParseInputDistribution(const Json& input, const std::string& ip,
+                                         const std::string& method, const KeyLocator& where) {
+  const KeyLocator at{where.file, where.lines, where.context, ip};
+  InputDistribution d;
+  d.normal = input.contains("mean") || input.contains("std");
+  if (d.normal && (input.contains("min") || input.contains("max")))
+    throw InputError(where(ip), "give min and max (uniform) or mean and std (normal), not both");
+  if (d.normal && method != "sobol")
+    throw InputError(where(ip), "a normal input needs method sobol (Morris' grid reaches 0 and 1)");
+  d.a = Num(input, d.normal ? "mean" : "min", at);
+  d.b = Num(input, d.normal ? "std" : "max", at);
+  if (d.normal ? !(d.b > 0) : !(d.a < d.b))
+    throw InputError(where(ip), d.normal ? "expected std > 0" : "expected min < max");
+  return d;
+}
+
 // The sensitivity section (sensitivity.h; docs/STUDIES.md): uncertain inputs, each uniform on
-// [min, max], sampled by Saltelli's or Morris' plan from the study's seed; the plan's points
-// become the cells of a zipped sweep, one axis per input.
+// [min, max] or normal, sampled by Saltelli's or Morris' plan from the study's seed; the plan's
+// points become the cells of a zipped sweep, one axis per input.
 std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, Study* study) {
   const Json& sn = given["sensitivity"];
   if (given.contains("sweep"))
@@ -693,12 +723,14 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
     throw InputError(where("sensitivity.inputs"),
                      "expected a list of 1 to 20 inputs, each {key, min, max}");
   std::vector<Axis> axes(inputs.size());
-  std::vector<double> lo(inputs.size()), hi(inputs.size());
+  std::vector<InputDistribution> dist(inputs.size());
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const std::string ip = "sensitivity.inputs[" + std::to_string(i) + "]";
     const KeyLocator in_at{where.file, where.lines, where.context, ip};
-    if (!inputs[i].is_object()) throw InputError(where(ip), "expected {key, min, max}");
-    OnlyKeys(inputs[i], ip, {"key", "min", "max"}, "key, min, max", where);
+    if (!inputs[i].is_object())
+      throw InputError(where(ip), "expected {key, min, max} or {key, mean, std}");
+    OnlyKeys(inputs[i], ip, {"key", "min", "max", "mean", "std"}, "key, and min, max or mean, std",
+             where);
     axes[i].key = Str(inputs[i], "key", in_at);
     // Numeric settings (the ranger errors' default is the robot file's value, also numeric).
     if (!KeyExists(StudyDefaults(), axes[i].key) ||
@@ -707,9 +739,7 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
       throw InputError(where(ip + ".key"), "'" + axes[i].key +
                                                "' is not a numeric study setting (e.g. "
                                                "noise.sigma_mm, truth.scale)");
-    lo[i] = Num(inputs[i], "min", in_at);
-    hi[i] = Num(inputs[i], "max", in_at);
-    if (!(lo[i] < hi[i])) throw InputError(where(ip), "expected min < max");
+    dist[i] = ParseInputDistribution(inputs[i], ip, method, where);
     study->axis_keys.push_back(axes[i].key);
   }
   const int d = static_cast<int>(inputs.size());
@@ -723,7 +753,7 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
                                      : MakeMorrisPlan(samples, d, levels, study->seed).points;
   for (int i = 0; i < d; ++i)
     for (Eigen::Index r = 0; r < points.rows(); ++r) {
-      const double value = lo[i] + points(r, i) * (hi[i] - lo[i]);
+      const double value = dist[i].At(points(r, i));
       axes[i].values.push_back(value);
       axes[i].labels.push_back(axes[i].key + "=" + ValueLabel(Json(value)));
       axes[i].value_paths.push_back("sensitivity.inputs[" + std::to_string(i) + "]");

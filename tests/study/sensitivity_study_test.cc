@@ -2,6 +2,7 @@
 // cell, the tables give the indices, and the numbers do not depend on the thread count.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -67,6 +68,25 @@ TEST(SensitivityStudy, MorrisScreensTheInputs) {
   EXPECT_EQ(in[1]["sigma"].get<double>(), 0.0);
 }
 
+TEST(SensitivityStudy, NormalInputsFollowTheirLaw) {
+  const std::string dir = testing::TempDir("sensitivity_normal");
+  std::ofstream(dir + "/n.yaml")
+      << "name: n\nseed: 2\ntrials: 5\nsensitivity:\n  samples: 400\n"
+         "  inputs: [{key: truth.ranger_scale_ppm, mean: 100, std: 20}]\n";
+  const Study study = LoadStudy(dir + "/n.yaml");
+  // A and B: 800 independent draws (AB_1 repeats B's cells).
+  ASSERT_EQ(study.cells.size(), 800u);
+  double sum = 0, sum2 = 0;
+  for (const Cell& c : study.cells) {
+    const double v = c.settings["truth"]["ranger_scale_ppm"].get<double>();
+    sum += v;
+    sum2 += v * v;
+  }
+  const double mean = sum / 800, std = std::sqrt(sum2 / 800 - mean * mean);
+  EXPECT_NEAR(mean, 100, 4 * 20 / std::sqrt(800.0));
+  EXPECT_NEAR(std, 20, 4 * 20 / std::sqrt(1600.0));
+}
+
 TEST(SensitivityStudy, BadSectionsNameTheKey) {
   const std::string dir = testing::TempDir("sensitivity_bad");
   const auto expect_error = [&](const std::string& body, const std::string& expected) {
@@ -90,6 +110,14 @@ TEST(SensitivityStudy, BadSectionsNameTheKey) {
   expect_error("sweep: {axes: [{key: noise.sigma_mm, values: [0.1]}]}\nsensitivity:\n" + input,
                "either a sweep or a sensitivity analysis");
   expect_error("sensitivity:\n  samples: 100000\n" + input, "at most 100000 cells");
+  expect_error(
+      "sensitivity:\n  method: morris\n  inputs: [{key: noise.sigma_mm, mean: 0.2, std: "
+      "0.01}]\n",
+      "a normal input needs method sobol");
+  expect_error("sensitivity:\n  inputs: [{key: noise.sigma_mm, mean: 0.2, std: 0}]\n",
+               "expected std > 0");
+  expect_error("sensitivity:\n  inputs: [{key: noise.sigma_mm, min: 0.1, mean: 0.2, std: 1}]\n",
+               "not both");
 }
 
 }  // namespace
