@@ -12,9 +12,13 @@
 // first-order prediction (LinearisedValidationDraws, 4000 draws at one reading per configuration)
 // gives the quantile q₁(k). The mean of R readings has σ/√R, and the linearised errors scale with
 // it, so q(k, R) = q₁(k)/√R and the fewest readings are R(k) = ⌈(q₁(k)/target)²⌉. Cost:
-// k·(configuration cost) + k·R·(reading cost). Confirmation: the cheapest campaign, the next
-// cheaper one (one reading fewer per configuration) and the runner-ups are run as an ordinary
-// study (a file in --out, rerunnable with another seed).
+// k·(configuration cost) + k·R·(reading cost) (+ planes·(plane cost)). Confirmation: the cheapest
+// campaign, the next cheaper one (one reading fewer per configuration) and the runner-ups are run
+// as an ordinary study (a file in --out, rerunnable with another seed).
+//
+// Candidate planes: when the study's plane is a list of two or more, every subset of them (with
+// a number of planes in --planes) is searched like the whole set-up, each with its own pool drawn
+// for its planes; the confirmation study then sweeps the plane lists and pools too.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -98,10 +102,13 @@ std::vector<int> ParseRange(const std::string& text, const std::string& option, 
   return out;
 }
 
-// --cost configuration=30s,reading=1s (seconds per configuration move and per reading).
-void ParseCost(const std::string& text, double* per_configuration, double* per_reading) {
+// --cost configuration=30s,reading=1s[,plane=600s] (seconds per configuration move, per reading
+// and per plane set up).
+void ParseCost(const std::string& text, double* per_configuration, double* per_reading,
+               double* per_plane) {
   const std::string expected =
-      "expected configuration=SECONDSs,reading=SECONDSs, e.g. configuration=30s,reading=1s, got '" +
+      "expected configuration=SECONDSs,reading=SECONDSs[,plane=SECONDSs], e.g. "
+      "configuration=30s,reading=1s,plane=600s, got '" +
       text + "'";
   std::istringstream in(text);
   std::string part;
@@ -119,6 +126,8 @@ void ParseCost(const std::string& text, double* per_configuration, double* per_r
     } else if (key == "reading") {
       *per_reading = v;
       got_r = true;
+    } else if (key == "plane") {
+      *per_plane = v;
     } else {
       throw InputError("--cost", expected);
     }
@@ -134,7 +143,19 @@ double WorstAxisQuantile(const Eigen::MatrixXd& draws, const Target& t, double c
   return Quantile(&worst, 100 * confidence);
 }
 
+// Which of the set-up's candidate planes a campaign measures on (all of them when the set-up
+// has no candidates to choose from), with its own pool of candidate configurations.
+struct PlaneSubset {
+  Json planes;                     // the study's plane list for it; null: the set-up's as given
+  std::string label;               // e.g. "table+wall", empty without candidates
+  std::vector<std::string> names;  // the planes' names (or 1-based indices)
+  std::string pool_file;
+  std::vector<int> counts;  // configurations to consider
+  int num_planes = 1;       // planes to set up (for the cost)
+};
+
 struct Campaign {
+  int subset = 0;  // index into the planner's plane subsets
   int configurations = 0, repetitions = 0;
   double predicted = 0;  // SI: the quantile predicted
   double cost = 0;       // seconds
@@ -148,20 +169,29 @@ struct Campaign {
 // changes only the noise.
 std::string WriteStudy(const Study& base, const std::string& path, const std::string& name,
                        int trials, std::uint64_t seed, const std::vector<Campaign>& campaigns,
-                       const std::string& pool_file, const std::string& validation_file,
+                       const std::vector<PlaneSubset>& subsets, const std::string& validation_file,
                        double stop_precision = 0) {
   Json settings = Json::parse(base.base.dump());
   settings.erase("robot_file_fnv1a");
   settings["robot"] = fs::absolute(ResolveRobotPath(base.base["robot"], base.folder())).string();
   // The configuration files are beside the study file, named relative to it: the plan's
   // folder can be moved or copied to another machine.
-  settings["pool"] = {{"file", fs::path(pool_file).filename().string()},
+  const PlaneSubset& first = subsets.at(campaigns.at(0).subset);
+  settings["pool"] = {{"file", fs::path(first.pool_file).filename().string()},
                       {"min_singular_value", base.base["pool"]["min_singular_value"]}};
+  if (!first.planes.is_null()) settings["plane"] = first.planes;
   settings["validation"] = {{"file", fs::path(validation_file).filename().string()}};
-  Json counts = Json::array(), reps = Json::array(), labels = Json::array();
+  Json counts = Json::array(), reps = Json::array(), planes = Json::array(), pools = Json::array(),
+       plane_labels = Json::array();
+  bool several_subsets = false;
   for (const Campaign& c : campaigns) {
     counts.push_back(c.configurations);
     reps.push_back(c.repetitions);
+    const PlaneSubset& sub = subsets.at(c.subset);
+    several_subsets |= c.subset != campaigns[0].subset;
+    planes.push_back(sub.planes);
+    pools.push_back({{"file", fs::path(sub.pool_file).filename().string()}});
+    plane_labels.push_back("planes " + sub.label);
   }
   Json study = settings;
   study["name"] = name;
@@ -179,10 +209,14 @@ std::string WriteStudy(const Study& base, const std::string& path, const std::st
     study["selection"]["count"] = campaigns[0].configurations;
     study["noise"]["repetitions"] = campaigns[0].repetitions;
   } else {
-    study["sweep"] = {{"combine", "zip"},
-                      {"axes",
-                       {{{"key", "selection.count"}, {"values", counts}},
-                        {{"key", "noise.repetitions"}, {"values", reps}}}}};
+    Json axes = {{{"key", "selection.count"}, {"values", counts}},
+                 {{"key", "noise.repetitions"}, {"values", reps}}};
+    // Campaigns on different planes: each cell its plane list and its pool.
+    if (several_subsets) {
+      axes.push_back({{"key", "plane"}, {"values", planes}, {"labels", plane_labels}});
+      axes.push_back({{"key", "pool"}, {"values", pools}, {"labels", plane_labels}});
+    }
+    study["sweep"] = {{"combine", "zip"}, {"axes", axes}};
   }
   WriteFileAtomically(path,
                       "# Written by lrcal plan-accuracy (JSON is YAML). Run it with another seed "
@@ -220,7 +254,8 @@ void MonteCarloFigures(const std::string& run_dir, const Target& t, double confi
 // The inputs of a plan, from the options.
 struct PlanInputs {
   Target target;
-  double confidence = 0.95, per_configuration = 0, per_reading = 0;
+  double confidence = 0.95, per_configuration = 0, per_reading = 0, per_plane = 0;
+  std::string planes;  // --planes as given, or empty
   int trials = 0, threads = 0;
   double stop_precision = 0;  // 0: every campaign runs `trials`
   std::vector<int> repetitions;
@@ -235,7 +270,8 @@ PlanInputs ReadInputs(const po::variables_map& vm, const Study& study) {
   in.confidence = vm["confidence"].as<double>();
   if (!(in.confidence > 0 && in.confidence < 1))
     throw InputError("--confidence", "expected a share in (0, 1), e.g. 0.95");
-  ParseCost(vm["cost"].as<std::string>(), &in.per_configuration, &in.per_reading);
+  ParseCost(vm["cost"].as<std::string>(), &in.per_configuration, &in.per_reading, &in.per_plane);
+  if (vm.count("planes")) in.planes = vm["planes"].as<std::string>();
   in.trials = vm["trials"].as<int>();
   if (in.trials < 100 || in.trials > 10000000)
     throw InputError("--trials", "expected 100 to 10,000,000 trials per campaign");
@@ -255,44 +291,66 @@ class Planner {
  public:
   Planner(const Study& study, PlanInputs in) : study_(study), in_(std::move(in)) {}
 
-  // The set-up: its parameters, and its candidates and validation set, written as files (the
+  // The set-up: its validation set, and per plane subset its candidates, written as files (the
   // plan is for these configurations; a confirmation with another seed changes only the noise).
+  // A study whose plane is a list of two or more gives candidate planes: every subset with a
+  // number of planes in --planes is a choice of its own, with its own pool.
   void PrepareSetUp() {
     fs::create_directories(in_.out_dir);
     const auto base_cell = PrepareCell(study_, study_.cells.at(0));
-    const int n = base_cell->model->num_parameters();
-    const int pool = base_cell->pool.size();
-    pool_file_ = in_.out_dir + "/pool.csv";
     validation_file_ = in_.out_dir + "/validation.csv";
-    WriteConfigurations(pool_file_, base_cell->pool);
     WriteConfigurations(validation_file_, base_cell->validation);
-    counts_ = ParseRange(in_.configurations.empty()
-                             ? std::to_string(n + 1) + ":" + std::to_string(pool) + ":5"
-                             : in_.configurations,
-                         "--configurations", n);
-    if (counts_.back() > pool)
-      throw InputError("--configurations", "at most the pool's " + std::to_string(pool) +
-                                               " candidates (pool.size in the study)");
+    const Json& planes = study_.base["plane"];
+    if (!planes.is_array() || planes.size() < 2) {
+      if (!in_.planes.empty())
+        throw InputError("--planes",
+                         "the set-up has no candidate planes to choose from: give the "
+                         "study's plane as a list of two or more planes");
+      PlaneSubset all;
+      all.pool_file = in_.out_dir + "/pool.csv";
+      AddSubset(std::move(all), *base_cell);
+    } else {
+      const int K = static_cast<int>(planes.size());
+      const std::vector<int> sizes =
+          ParseRange(in_.planes.empty() ? "1:" + std::to_string(K) : in_.planes, "--planes", 1);
+      if (sizes.back() > K)
+        throw InputError("--planes", "the set-up has " + std::to_string(K) + " candidate planes");
+      for (int size : sizes)
+        for (int mask = 1; mask < (1 << K); ++mask)
+          if (__builtin_popcount(static_cast<unsigned>(mask)) == size) AddCandidateSubset(mask);
+    }
+    std::vector<std::string> header = {"configurations", "predicted at 1 reading",
+                                       "readings needed", "cost (h)"};
+    if (subsets_.size() > 1) header.insert(header.begin(), "planes");
+    search_table_ = Table(header,
+                          "First-order search (the quantile of the worst axis at one reading per "
+                          "configuration)");
   }
 
-  // The first-order search: one prepared cell per number of configurations, at one reading.
+  // The first-order search: one prepared cell per plane subset and number of configurations, at
+  // one reading.
   void Search() {
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<Campaign> one;
-    for (int k : counts_) {
-      Campaign c;
-      c.configurations = k;
-      c.repetitions = 1;
-      one.push_back(c);
-    }
-    const std::string path = in_.out_dir + "/search.yaml";
-    WriteStudy(study_, path, study_.name + "-search", 1, in_.seed, one, pool_file_,
-               validation_file_);
-    const Study search = LoadStudy(path);
-    for (const Cell& cell : search.cells) {
-      const auto ctx = PrepareCell(search, cell);
-      AddSearchRow(cell.typed.select_count, WorstAxisQuantile(LinearisedValidationDraws(*ctx, 4000),
-                                                              in_.target, in_.confidence));
+    for (std::size_t sub = 0; sub < subsets_.size(); ++sub) {
+      std::vector<Campaign> one;
+      for (int k : subsets_[sub].counts) {
+        Campaign c;
+        c.subset = static_cast<int>(sub);
+        c.configurations = k;
+        c.repetitions = 1;
+        one.push_back(c);
+      }
+      const std::string path = in_.out_dir + "/search" +
+                               (subsets_.size() > 1 ? "_" + std::to_string(sub + 1) : "") + ".yaml";
+      WriteStudy(study_, path, study_.name + "-search", 1, in_.seed, one, subsets_,
+                 validation_file_);
+      const Study search = LoadStudy(path);
+      for (const Cell& cell : search.cells) {
+        const auto ctx = PrepareCell(search, cell);
+        AddSearchRow(
+            static_cast<int>(sub), cell.typed.select_count,
+            WorstAxisQuantile(LinearisedValidationDraws(*ctx, 4000), in_.target, in_.confidence));
+      }
     }
     search_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (feasible_.empty())
@@ -300,8 +358,8 @@ class Planner {
                                        Fixed(in_.target.shown, 4) + " " + in_.target.unit +
                                        " by the first-order prediction; widen --configurations or "
                                        "--repetitions");
-    std::sort(feasible_.begin(), feasible_.end(),
-              [](const Campaign& a, const Campaign& b) { return a.cost < b.cost; });
+    std::stable_sort(feasible_.begin(), feasible_.end(),
+                     [](const Campaign& a, const Campaign& b) { return a.cost < b.cost; });
   }
 
   // Monte Carlo: the cheapest, the same with one reading fewer, and two runner-ups.
@@ -323,7 +381,7 @@ class Planner {
     }
     study_path_ = in_.out_dir + "/campaigns.yaml";
     WriteStudy(study_, study_path_, study_.name + "-campaigns", in_.trials, in_.seed, confirm_,
-               pool_file_, validation_file_, in_.stop_precision);
+               subsets_, validation_file_, in_.stop_precision);
     RunOptions ro;
     ro.out_dir = run_dir_ = in_.out_dir + "/run";
     ro.threads = in_.threads;
@@ -344,6 +402,7 @@ class Planner {
     const auto mm = [](double x) { return std::isnan(x) ? Json() : Json(x * 1e3); };
     for (const Campaign& c : confirm_)
       cs.push_back({{"label", c.label},
+                    {"planes", subsets_.size() > 1 ? Json(subsets_[c.subset].names) : Json()},
                     {"configurations", c.configurations},
                     {"repetitions", c.repetitions},
                     {"readings", c.configurations * c.repetitions},
@@ -360,7 +419,9 @@ class Planner {
   }
 
   void PrintText() const {
-    std::cout << search_table_.ToText() << "\n";
+    std::cout << search_table_.ToText()
+              << "(— : no campaign there: the prediction is not finite, e.g. parameters the "
+                 "planes cannot identify, or more readings than --repetitions allows)\n\n";
     const bool stopped = in_.stop_precision > 0;
     std::vector<std::string> header = {"campaign",
                                        "configurations",
@@ -371,6 +432,8 @@ class Planner {
                                        "Monte Carlo [95 % CI] (" + in_.target.unit + ")",
                                        "meets target"};
     if (stopped) header.push_back("trials");
+    const bool planes = subsets_.size() > 1;
+    if (planes) header.insert(header.begin() + 1, "planes");
     Table t(header, "Campaigns for " + in_.target.metric + " ≤ " + Fixed(in_.target.shown, 4) +
                         " " + in_.target.unit + " in " + Fixed(100 * in_.confidence, 1) +
                         " % of calibrations (worst axis; " + (stopped ? "up to " : "") +
@@ -389,6 +452,7 @@ class Planner {
                                           ", " + Fixed(c.mc_high * 1e3, 4) + "]",
                                       Meets(c)};
       if (stopped) row.push_back(std::to_string(c.trials));
+      if (planes) row.insert(row.begin() + 1, subsets_[c.subset].label);
       t.AddRow(row);
     }
     std::cout << t.ToText() << "\nsearch " << Fixed(search_seconds_, 1)
@@ -397,18 +461,73 @@ class Planner {
   }
 
  private:
-  void AddSearchRow(int k, double q1) {
+  // A subset: its pool (drawn for its planes, as a study of them would), the number of
+  // parameters and the counts to consider.
+  void AddSubset(PlaneSubset subset, const CellContext& cell) {
+    WriteConfigurations(subset.pool_file, cell.pool);
+    const int n = cell.model->num_parameters(), pool = cell.pool.size();
+    subset.num_planes = cell.planes.size();
+    subset.counts = ParseRange(in_.configurations.empty()
+                                   ? std::to_string(n + 1) + ":" + std::to_string(pool) + ":5"
+                                   : in_.configurations,
+                               "--configurations", n);
+    if (subset.counts.back() > pool)
+      throw InputError("--configurations",
+                       "at most the pool's " + std::to_string(pool) + " candidates" +
+                           (subset.label.empty() ? "" : " on planes " + subset.label) +
+                           " (pool.size in the study)");
+    subsets_.push_back(std::move(subset));
+  }
+
+  // The candidate planes of `mask`: the set-up with just them (their own names, shares and
+  // estimate flags), prepared as a study of its own to draw their pool.
+  void AddCandidateSubset(int mask) {
+    const Json& planes = study_.base["plane"];
+    PlaneSubset subset;
+    subset.planes = Json::array();
+    std::string tag;
+    for (int k = 0; k < static_cast<int>(planes.size()); ++k) {
+      if (!(mask & (1 << k))) continue;
+      subset.planes.push_back(planes[k]);
+      subset.names.push_back(planes[k].contains("name") ? planes[k]["name"].get<std::string>()
+                                                        : std::to_string(k + 1));
+      subset.label += (subset.label.empty() ? "" : "+") + subset.names.back();
+      tag += "_" + std::to_string(k + 1);
+    }
+    subset.pool_file = in_.out_dir + "/pool_planes" + tag + ".csv";
+    Json settings = Json::parse(study_.base.dump());
+    settings.erase("robot_file_fnv1a");
+    settings["robot"] =
+        fs::absolute(ResolveRobotPath(study_.base["robot"], study_.folder())).string();
+    settings["plane"] = subset.planes;
+    settings["name"] = study_.name + "-planes" + tag;
+    settings["seed"] = study_.seed;
+    settings["trials"] = 1;
+    const std::string path = in_.out_dir + "/setup_planes" + tag + ".yaml";
+    WriteFileAtomically(path, "# lrcal plan-accuracy: the set-up on planes " + subset.label +
+                                  " (JSON is YAML)\n" + settings.dump(2) + "\n");
+    const Study setup = LoadStudy(path);
+    AddSubset(std::move(subset), *PrepareCell(setup, setup.cells.at(0)));
+  }
+
+  void AddSearchRow(int sub, int k, double q1) {
+    const PlaneSubset& subset = subsets_[sub];
     const int needed =
         std::isfinite(q1)
             ? std::max(in_.repetitions.front(),
                        static_cast<int>(std::ceil(std::pow(q1 / in_.target.value, 2))))
             : -1;
     const bool ok = needed > 0 && needed <= in_.repetitions.back();
-    const double cost = k * in_.per_configuration + double(k) * needed * in_.per_reading;
-    search_table_.AddRow({std::to_string(k), Fixed(q1 * 1e3, 4), ok ? std::to_string(needed) : "—",
-                          ok ? Fixed(cost / 3600, 2) : "—"});
+    const double cost = subset.num_planes * in_.per_plane + k * in_.per_configuration +
+                        double(k) * needed * in_.per_reading;
+    std::vector<std::string> row = {std::to_string(k), Fixed(q1 * 1e3, 4),
+                                    ok ? std::to_string(needed) : "—",
+                                    ok ? Fixed(cost / 3600, 2) : "—"};
+    if (subsets_.size() > 1) row.insert(row.begin(), subset.label);
+    search_table_.AddRow(row);
     if (!ok) return;
     Campaign c;
+    c.subset = sub;
     c.configurations = k;
     c.repetitions = needed;
     c.predicted = q1 / std::sqrt(double(needed));
@@ -428,13 +547,11 @@ class Planner {
 
   const Study& study_;
   PlanInputs in_;
-  std::string pool_file_, validation_file_, study_path_, run_dir_;
-  std::vector<int> counts_;
+  std::string validation_file_, study_path_, run_dir_;
+  std::vector<PlaneSubset> subsets_;
   std::vector<Campaign> feasible_, confirm_;
   double search_seconds_ = 0;
-  Table search_table_{{"configurations", "predicted at 1 reading", "readings needed", "cost (h)"},
-                      "First-order search (the quantile of the worst axis at one reading per "
-                      "configuration)"};
+  Table search_table_{{}};
 };
 
 }  // namespace
@@ -452,9 +569,12 @@ int PlanAccuracyCommand(const std::vector<std::string>& args) {
       "step 5)")("repetitions", po::value<std::string>()->default_value("1:100"),
                  "FIRST:LAST readings per configuration to consider")(
       "cost", po::value<std::string>()->default_value("configuration=30s,reading=1s"),
-      "time per configuration (move) and per reading")("trials",
-                                                       po::value<int>()->default_value(10000),
-                                                       "Monte-Carlo trials per confirmed campaign")(
+      "time per configuration (move) and per reading, and per plane set up (plane=600s)")(
+      "planes", po::value<std::string>(),
+      "FIRST:LAST candidate planes a campaign may use, when the study's plane is a list of two "
+      "or more (default: 1 to all; every subset of those sizes is considered)")(
+      "trials", po::value<int>()->default_value(10000),
+      "Monte-Carlo trials per confirmed campaign")(
       "stop-precision", po::value<double>()->default_value(0.0),
       "stop each confirmed campaign once its validation means (SE) and p95s (95 % interval "
       "half-width) are known to this relative precision; --trials is then the maximum")(

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "lrcal/study/study.h"
 #include "test_util.h"
@@ -53,6 +54,53 @@ TEST(PlanAccuracy, FindsTheCheapestCampaignAndConfirmsIt) {
   EXPECT_EQ(s.cells.size(), campaigns.size());
   EXPECT_EQ(s.cells[0].typed.select_count, chosen["configurations"].get<int>());
   EXPECT_EQ(s.cells[0].typed.repetitions, chosen["repetitions"].get<int>());
+}
+
+// Candidate planes: each subset of them is a campaign choice with its own pool, the cost of
+// setting up a plane decides between one plane and more, and campaigns on different planes are
+// confirmed together (a sweep over their plane lists and pools).
+TEST(PlanAccuracy, ChoosesAmongCandidatePlanes) {
+  const std::string dir = testing::TempDir("plan_accuracy_planes");
+  const std::string study = dir + "/setup.yaml";
+  std::ofstream(study) << "name: setup\nseed: 6\ntrials: 10\nrobot: "
+                       << testing::SourcePath("studies/robots/paper.yaml")
+                       << "\npool: {size: 60}\nvalidation: {size: 10}\nplane:\n"
+                          "  - {normal: [0, 1, 4.6], offset: -0.69, name: paper}\n"
+                          "  - {normal: [0, 1, 0], offset: 0.9, name: wall_y}\n";
+  const auto plan = [&](const std::string& options) {
+    std::string out;
+    EXPECT_EQ(
+        testing::RunCommand(testing::LrcalBinary() + " plan-accuracy " + study +
+                                " --target rms_pos=0.08mm --trials 200 --format json " + options,
+                            &out),
+        0)
+        << out;
+    return Json::parse(out.substr(out.find('{')));
+  };
+  // A plane costs a day to set up: one plane, the cheapest in readings.
+  const Json dear = plan(
+      "--configurations 30:40:10 --cost configuration=30s,reading=1s,"
+      "plane=86400s --out " +
+      dir + "/dear");
+  ASSERT_EQ(dear["campaigns"][0]["planes"].size(), 1u) << dear.dump();
+  // One count only: the subsets compete at 30 configurations; the confirmed campaigns are on
+  // different plane lists, each with its own Monte-Carlo figure.
+  const Json mixed = plan(
+      "--configurations 30:30 --cost configuration=30s,reading=1s,plane=60s "
+      "--out " +
+      dir + "/mixed");
+  std::set<std::string> subsets;
+  for (const auto& c : mixed["campaigns"]) {
+    subsets.insert(c["planes"].dump());
+    EXPECT_TRUE(c["monte_carlo"].is_number()) << c.dump();
+    EXPECT_EQ(c["trials"], 200);
+  }
+  EXPECT_GE(subsets.size(), 2u) << mixed.dump();
+  const Study confirm = LoadStudy(mixed["study"].get<std::string>());
+  EXPECT_EQ(confirm.cells.size(), mixed["campaigns"].size());
+  for (std::size_t i = 0; i < confirm.cells.size(); ++i)
+    EXPECT_EQ(confirm.cells[i].typed.planes.size(),
+              static_cast<int>(mixed["campaigns"][i]["planes"].size()));
 }
 
 // The plan is a function of the study and its seed, not of where the study or --out are: the
@@ -140,6 +188,33 @@ TEST(PlanAccuracy, BadTargetsAndRangesAreExitTwo) {
           testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --cost walk=3s", &out),
       2);
   EXPECT_NE(out.find("--cost"), std::string::npos) << out;
+  // --planes needs candidate planes, and no more than there are.
+  EXPECT_EQ(
+      testing::RunCommand(
+          testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --planes 1:2", &out),
+      2);
+  EXPECT_NE(out.find("--planes: the set-up has no candidate planes to choose from"),
+            std::string::npos)
+      << out;
+  const std::string dir = testing::TempDir("plan_accuracy_bad_planes");
+  std::ofstream(dir + "/two.yaml") << "name: two\nseed: 1\ntrials: 10\nrobot: "
+                                   << testing::SourcePath("studies/robots/paper.yaml")
+                                   << "\nplane:\n  - {normal: [0, 1, 4.6], offset: -0.69}\n"
+                                      "  - {normal: [0, 1, 0], offset: 0.9}\n";
+  EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " plan-accuracy " + dir +
+                                    "/two.yaml --target rms_pos=0.05mm --planes 1:3 --out " + dir +
+                                    "/plan",
+                                &out),
+            2);
+  EXPECT_NE(out.find("--planes: the set-up has 2 candidate planes"), std::string::npos) << out;
+  EXPECT_EQ(
+      testing::RunCommand(testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --cost "
+                                                   "configuration=30s,reading=1s,plane=ten",
+                          &out),
+      2);
+  EXPECT_NE(out.find("--cost: expected configuration=SECONDSs,reading=SECONDSs[,plane=SECONDSs]"),
+            std::string::npos)
+      << out;
 }
 
 }  // namespace
