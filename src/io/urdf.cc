@@ -61,7 +61,8 @@ std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string&
       std::vector<std::string> names;
       for (const auto& link : links) names.push_back(link->name);
       std::sort(names.begin(), names.end());
-      throw InputError(path, "no link named '" + tool_link + "' (--tool-link); the links are " +
+      throw InputError(path, "no link named '" + tool_link +
+                                 "' (--tool-link, or a study's tool_link); the links are " +
                                  JoinList(names));
     }
     return tool_link;
@@ -70,7 +71,8 @@ std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string&
   if (leaves.size() != 1)
     throw InputError(path, "the URDF has " + std::to_string(leaves.size()) + " end links (" +
                                JoinList(leaves) +
-                               "): give the ranger's link with --tool-link NAME");
+                               "): give the ranger's link with --tool-link NAME (a study: "
+                               "tool_link: NAME)");
   return leaves.front();
 }
 

@@ -13,6 +13,7 @@
 #include "lrcal/core/hash.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/urdf.h"
 #include "lrcal/study/sensitivity.h"
 
 namespace lrcal {
@@ -155,7 +156,11 @@ void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string
     const std::string p = Join(path, it.key());
     // plane: checked by the typed parser; the robot file's hash is lrcal's own. pool.file and
     // validation.file (with lrcal's hash of them) are optional keys without a default.
-    if (path.empty() && (it.key() == "plane" || it.key() == "robot_file_fnv1a")) continue;
+    // tool_link (URDF robots) is optional without a default, so that earlier studies' settings
+    // and tables stay as they were.
+    if (path.empty() &&
+        (it.key() == "plane" || it.key() == "robot_file_fnv1a" || it.key() == "tool_link"))
+      continue;
     if ((path == "pool" || path == "validation") &&
         (it.key() == "file" || it.key() == "file_fnv1a"))
       continue;
@@ -420,6 +425,10 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   CellSettings c;
   c.robot = Str(s, "robot", where);
+  if (s.contains("tool_link")) c.tool_link = Str(s, "tool_link", where);
+  if (!c.tool_link.empty() && !IsUrdfPath(c.robot))
+    throw InputError(where("tool_link"), "applies to a URDF robot (robot: arm.urdf); '" + c.robot +
+                                             "' is a robot YAML file or a shipped name");
   ParsePlane(s, where, &c);
   ParseTruthAndNoise(s, where, &c);
   ParsePoolAndSelection(s, where, &c);
@@ -866,7 +875,7 @@ void DropNeutralKeys(Json* id) {
 
 bool IsRobotFilePath(const std::string& robot) {
   return robot.find('/') != std::string::npos ||
-         (robot.size() > 5 && robot.substr(robot.size() - 5) == ".yaml");
+         (robot.size() > 5 && robot.substr(robot.size() - 5) == ".yaml") || IsUrdfPath(robot);
 }
 
 }  // namespace
@@ -874,6 +883,8 @@ bool IsRobotFilePath(const std::string& robot) {
 Json CellIdentity(const Json& settings) {
   Json id = settings;
   DropNeutralKeys(&id);
+  // tool_link came with URDF robots: left out when empty (as if not given).
+  if (id.contains("tool_link") && id["tool_link"] == "") id.erase("tool_link");
   for (const char* section : {"pool", "validation"})
     if (id.contains(section) && id[section].is_object()) id[section].erase("file");
   if (id.contains("robot") && id["robot"].is_string() &&

@@ -734,7 +734,7 @@ const std::vector<BadInput>& Cases() {
          "type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/></joint></robot>\n"}},
        "export --robot arm.urdf --tool-link flange",
        2,
-       {"no link named 'flange' (--tool-link); the links are a, b"}},
+       {"no link named 'flange' (--tool-link, or a study's tool_link); the links are a, b"}},
       {"ToolLinkWithAYamlRobot",
        {},
        "export --robot paper --tool-link ranger",

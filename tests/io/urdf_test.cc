@@ -201,7 +201,7 @@ TEST(Urdf, BadUrdfsAreNamedByFileJointOrLink) {
   ExpectInputError(with("revolute", "<limit lower=\"1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>"),
                    "", "joint 'j': expected <limit lower=... upper=...> with lower < upper");
   ExpectInputError(with("fixed", ""), "", "no movable joint between the root link 'a'");
-  ExpectInputError(with("continuous", ""), "c", "no link named 'c' (--tool-link)");
+  ExpectInputError(with("continuous", ""), "c", "no link named 'c' (--tool-link");
   ExpectInputError(std::string(kTwoLinks) + "<link name=\"c\"/>" +
                        with("continuous", "").substr(sizeof(kTwoLinks) - 1) +
                        "<joint name=\"k\" type=\"fixed\"><parent link=\"a\"/><child link=\"c\"/>"

@@ -291,3 +291,37 @@ TEST(CellPrediction, AtTheTruthIsTheNominalFormulaForAnArmWhoseNominalIsTheTruth
 
 }  // namespace
 }  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// A URDF robot in a study: tool_link names the ranger's link (the example has a camera link
+// beside it); without it the study is refused with a message that says what to add.
+TEST(StudyUrdf, ToolLinkPicksTheRangerOfAUrdfRobot) {
+  const std::string dir = testing::TempDir("study_urdf");
+  const std::string base = "name: ur5\nseed: 3\ntrials: 4\nrobot: " +
+                           testing::SourcePath("examples/urdf/ur5_ranger.urdf") +
+                           "\nplane: {normal: [0, 0, 1], offset: 0}\npool: {size: 60}\n"
+                           "selection: {count: 40}\nvalidation: {size: 10}\n"
+                           "identification: {on_rank_deficient: fix}\n";
+  std::ofstream(dir + "/with.yaml") << base << "tool_link: ranger\n";
+  const RunResult r = testing::RunStudyFile(dir + "/with.yaml", dir + "/run", 2);
+  EXPECT_TRUE(r.complete);
+  std::ofstream(dir + "/without.yaml") << base;
+  try {
+    testing::RunStudyFile(dir + "/without.yaml", dir + "/run2", 2);
+    ADD_FAILURE() << "no error without tool_link";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tool_link: NAME"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir + "/yaml.yaml") << "name: y\nseed: 3\ntrials: 4\ntool_link: ranger\n";
+  try {
+    LoadStudy(dir + "/yaml.yaml");
+    ADD_FAILURE() << "no error for tool_link with a YAML robot";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'tool_link'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace lrcal

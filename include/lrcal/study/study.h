@@ -31,7 +31,8 @@ namespace lrcal {
 /// resolved settings JSON. The defaults live in one place, StudyDefaults(); the initial values
 /// here are only neutral zeros.
 struct CellSettings {
-  std::string robot;             ///< robot file path or shipped name
+  std::string robot;             ///< robot file path (YAML or URDF) or shipped name
+  std::string tool_link;         ///< URDF robots: the ranger's link (empty: the only end link)
   bool plane_from_robot = true;  ///< plane: robot
   PlaneSet planes;               ///< when !plane_from_robot: one plane or several
   /// Several planes: each one's share of the pool and validation draws (empty: equal shares).
