@@ -7,17 +7,18 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-${LRCAL_FUZZ_SECONDS:-60}}"
-bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev \
-  nlohmann-json3-dev
+bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liburdfdom-dev \
+  nlohmann-json3-dev librandom123-dev libboost-dev
 out=build-fuzz
 mkdir -p "$out/obj" "$out/findings"
 flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
        -fno-sanitize-recover=undefined -Iinclude -Isrc -I/usr/include/eigen3
        "-DLRCAL_SOURCE_DIR=\"$PWD\"")
 # The readers and what they need (no Ceres, no SQLite: the fuzzers build in about a minute).
-sources=(core/strings core/json core/hash core/data_dir kinematics/robot_model kinematics/configuration_set
-         measurement/plane measurement/parameter_set measurement/measurement_set io/csv io/robot_file io/yaml_util study/study
-         study/stop_when)
+sources=(core/strings core/json core/hash core/data_dir core/random kinematics/robot_model
+         kinematics/rigid_transform kinematics/dh_conversion kinematics/configuration_set
+         measurement/plane measurement/parameter_set measurement/measurement_set io/csv
+         io/robot_file io/urdf io/yaml_util study/study study/stop_when study/sensitivity)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
   local name=$1 obj="$out/obj/${1//\//_}.o"
@@ -32,7 +33,7 @@ wait
 targets=(expression csv robot_file study_file)
 for t in "${targets[@]}"; do
   clang++ "${flags[@]}" -fsanitize=fuzzer "tests/fuzz/${t}_fuzzer.cc" "${objects[@]}" \
-    -lyaml-cpp -o "$out/${t}_fuzzer"
+    -lyaml-cpp -lurdfdom_model -o "$out/${t}_fuzzer"
 done
 echo "fuzz: built ${#targets[@]} targets; running each for ${seconds} s"
 status=0

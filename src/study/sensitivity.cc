@@ -7,7 +7,6 @@
 #include <string>
 
 #include "lrcal/core/random.h"
-#include "lrcal/study/statistics.h"
 
 namespace lrcal {
 
@@ -33,12 +32,19 @@ void Indices(const Eigen::VectorXd& fa, const Eigen::VectorXd& fb, const Eigen::
   *total = Mean((fa - fab).cwiseAbs2()) / (2 * variance);
 }
 
+// The `percent` percentile of sorted values, interpolated between order statistics (Hyndman–Fan
+// type 7, as statistics.h's Quantile; kept here so that study files load without the store).
+double SortedPercentile(const std::vector<double>& v, double percent) {
+  const double h = static_cast<double>(v.size() - 1) * percent / 100.0;
+  const auto lo = static_cast<std::size_t>(std::floor(h));
+  return lo + 1 < v.size() ? v[lo] + (h - static_cast<double>(lo)) * (v[lo + 1] - v[lo]) : v[lo];
+}
+
 IntervalEstimate Interval(double estimate, std::vector<double>* replicates, double level) {
   if (replicates->empty()) return {estimate, estimate, estimate};
-  std::vector<double> copy = *replicates;
-  const double low = Quantile(replicates, 50 * (1 - level));
-  const double high = Quantile(&copy, 50 * (1 + level));
-  return {estimate, low, high};
+  std::sort(replicates->begin(), replicates->end());
+  return {estimate, SortedPercentile(*replicates, 50 * (1 - level)),
+          SortedPercentile(*replicates, 50 * (1 + level))};
 }
 
 }  // namespace
