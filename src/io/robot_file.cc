@@ -1,7 +1,6 @@
 #include "lrcal/io/robot_file.h"
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <utility>
 
@@ -301,12 +300,8 @@ RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
 
 namespace {
 
-std::string Num(double x) {
-  if (x == 0) x = 0;  // no "-0"
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
+// 17 significant digits (FormatExact), without "-0".
+std::string Num(double x) { return FormatExact(x == 0 ? 0.0 : x); }
 
 std::string Quoted(const std::string& text) {
   std::string out = "\"";

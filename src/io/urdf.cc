@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <utility>
 #include <vector>
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/core/strings.h"
 #include "lrcal/kinematics/dh_conversion.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 
@@ -140,12 +140,8 @@ RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_lin
 
 namespace {
 
-std::string Num(double x) {
-  if (x == 0) x = 0;  // no "-0"
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
+// 17 significant digits (FormatExact), without "-0".
+std::string Num(double x) { return FormatExact(x == 0 ? 0.0 : x); }
 
 std::string Origin(const RigidTransform& t) {
   const Eigen::Vector3d rpy = t.Rpy();
@@ -171,15 +167,6 @@ std::string XmlEscaped(const std::string& text) {
   return out;
 }
 
-// Link i's transform at q = 0 (its θ0, d, a, α, β).
-RigidTransform LinkAtZero(const double* v) {
-  const Eigen::Matrix4d A = LinkTransform<double>(v[kTheta], v[kD], v[kA], v[kAlpha], v[kBeta]);
-  RigidTransform t;
-  t.rotation = A.block<3, 3>(0, 0);
-  t.translation = A.block<3, 1>(0, 3);
-  return t;
-}
-
 }  // namespace
 
 std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& values) {
@@ -197,7 +184,7 @@ std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& values) {
          "\">\n    <parent link=\"" + parent + "\"/>\n    <child link=\"" + child + "\"/>\n    " +
          Origin(origin) + "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" + Num(link.q_min) +
          "\" upper=\"" + Num(link.q_max) + "\" effort=\"0\" velocity=\"0\"/>\n  </joint>\n";
-    origin = LinkAtZero(values.data() + kValuesPerLink * i);
+    origin = LinkRigidTransform(values.data() + kValuesPerLink * i);
   }
   t += "  <link name=\"tool\"/>\n  <joint name=\"tool_joint\" type=\"fixed\">\n    <parent "
        "link=\"link" +

@@ -1,7 +1,6 @@
 #include "lrcal/kinematics/dh_conversion.h"
 
 #include <Eigen/SVD>
-#include <array>
 #include <cmath>
 #include <initializer_list>
 
@@ -12,14 +11,6 @@
 namespace lrcal {
 
 namespace {
-
-RigidTransform LinkFrame(const std::array<double, kValuesPerLink>& v) {
-  const Eigen::Matrix4d A = LinkTransform<double>(v[kTheta], v[kD], v[kA], v[kAlpha], v[kBeta]);
-  RigidTransform t;
-  t.rotation = A.block<3, 3>(0, 0);
-  t.translation = A.block<3, 1>(0, 3);
-  return t;
-}
 
 // The angle (rad) that turns unit vector `from` into `to` about `axis` (both ⊥ axis).
 double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
@@ -135,7 +126,7 @@ RobotModel RobotFromJointAxes(const std::string& name, const std::vector<JointAx
       LinkToNextAxis(frame, unit[i + 1], parallel_tolerance, &links[i]);
     else
       LinkToTool(frame, tool_at_zero, &links[i]);
-    frame = frame * LinkFrame(links[i].nominal);
+    frame = frame * LinkRigidTransform(links[i].nominal.data());
   }
   RigidTransform tool = frame.Inverse() * tool_at_zero;
   // Re-orthonormalise the rounding of the products (a rotation within ~1e-16).

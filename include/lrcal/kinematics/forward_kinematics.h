@@ -48,6 +48,16 @@ Eigen::Matrix<T, 4, 4> LinkTransform(const T& theta, const T& d, const T& a, con
   return rz * tz * tx * rx * ry;
 }
 
+/// A link's transform with its joint at zero, from its five link values `v` (robot_model.h
+/// order, SI), as a RigidTransform: what the D-H conversion and the URDF writer compose.
+inline RigidTransform LinkRigidTransform(const double* v) {
+  const Eigen::Matrix4d A = LinkTransform<double>(v[kTheta], v[kD], v[kA], v[kAlpha], v[kBeta]);
+  RigidTransform t;
+  t.rotation = A.block<3, 3>(0, 0);
+  t.translation = A.block<3, 1>(0, 3);
+  return t;
+}
+
 /// The homogeneous matrix of a fixed transform, in the scalar T.
 template <typename T>
 Eigen::Matrix<T, 4, 4> FixedTransformMatrix(const RigidTransform& t) {
