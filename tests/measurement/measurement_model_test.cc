@@ -34,6 +34,39 @@ void PrintTo(const Case& c, std::ostream* os) {
 
 class JacobianTest : public ::testing::TestWithParam<Case> {};
 
+// Row i of the analytic Jacobian at estimate `e` (prepared as `point`) against Ceres jets of type
+// JetT through the reference kinematics and against central differences (step 1e-6); the
+// reading against the reference too. Returns the row.
+template <typename JetT>
+std::vector<double> ExpectRowMatches(const MeasurementModel& model, const ModelPoint& point,
+                                     const std::vector<double>& e, const ConfigurationSet& configs,
+                                     int i) {
+  const int n = model.num_parameters(), plane = configs.plane(i);
+  const double* q = configs.q(i);
+  double h = 0;
+  std::vector<double> row(n);
+  model.Evaluate(point, configs, i, &h, row.data());
+  EXPECT_NEAR(h, model.Distance<double>(e.data(), q, plane), 1e-12);
+  std::vector<JetT> ej(n);
+  for (int k = 0; k < n; ++k) ej[k] = JetT(e[k], k);
+  const JetT hj = model.Distance<JetT>(ej.data(), q, plane);
+  EXPECT_NEAR(hj.a, h, 1e-12);
+  const double step = 1e-6;
+  for (int k = 0; k < n; ++k) {
+    const std::string& name = model.parameters().names[k];
+    EXPECT_NEAR(row[k], hj.v[k], kAutodiffTolerance)
+        << "d h / d " << name << " at configuration " << i;
+    std::vector<double> ep = e, em = e;
+    ep[k] += step;
+    em[k] -= step;
+    const double fd = (model.Distance<double>(ep.data(), q, plane) -
+                       model.Distance<double>(em.data(), q, plane)) /
+                      (2 * step);
+    EXPECT_NEAR(row[k], fd, kFiniteDifferenceTolerance) << "d h / d " << name;
+  }
+  return row;
+}
+
 TEST_P(JacobianTest, AnalyticMatchesAutodiffAndCentralDifferences) {
   const RobotModel& robot = testing::PaperRobot();
   MeasurementModel model(
@@ -50,36 +83,7 @@ TEST_P(JacobianTest, AnalyticMatchesAutodiffAndCentralDifferences) {
       for (double& v : e) v = ue(rng);  // away from nominal too
     ModelPoint point;
     model.Prepare(e.data(), &point);
-    for (int i = 0; i < configs.size(); ++i) {
-      double h = 0;
-      std::vector<double> row(n);
-      model.Evaluate(point, configs, i, &h, row.data());
-
-      // Value: fast path against templated reference.
-      EXPECT_NEAR(h, model.Distance<double>(e.data(), configs.q(i)), 1e-12);
-
-      // Ceres Jets through the reference kinematics.
-      std::vector<Jet> ej(n);
-      for (int k = 0; k < n; ++k) ej[k] = Jet(e[k], k);
-      Jet hj = model.Distance<Jet>(ej.data(), configs.q(i));
-      EXPECT_NEAR(hj.a, h, 1e-12);
-      for (int k = 0; k < n; ++k)
-        EXPECT_NEAR(row[k], hj.v[k], kAutodiffTolerance)
-            << "d h / d " << model.parameters().names[k] << " at configuration " << i;
-
-      // Central differences.
-      const double step = 1e-6;
-      for (int k = 0; k < n; ++k) {
-        std::vector<double> ep = e, em = e;
-        ep[k] += step;
-        em[k] -= step;
-        double fd = (model.Distance<double>(ep.data(), configs.q(i)) -
-                     model.Distance<double>(em.data(), configs.q(i))) /
-                    (2 * step);
-        EXPECT_NEAR(row[k], fd, kFiniteDifferenceTolerance)
-            << "d h / d " << model.parameters().names[k];
-      }
-    }
+    for (int i = 0; i < configs.size(); ++i) ExpectRowMatches<Jet>(model, point, e, configs, i);
   }
 }
 
@@ -119,26 +123,7 @@ TEST(JacobianWithFrames, AnalyticMatchesAutodiffAndCentralDifferences) {
   for (double& v : e) v = ue(rng);
   ModelPoint point;
   model.Prepare(e.data(), &point);
-  for (int i = 0; i < configs.size(); ++i) {
-    double h = 0;
-    std::vector<double> row(n);
-    model.Evaluate(point, configs, i, &h, row.data());
-    std::vector<Jet> ej(n);
-    for (int k = 0; k < n; ++k) ej[k] = Jet(e[k], k);
-    const Jet hj = model.Distance<Jet>(ej.data(), configs.q(i));
-    EXPECT_NEAR(hj.a, h, 1e-12);
-    for (int k = 0; k < n; ++k) {
-      EXPECT_NEAR(row[k], hj.v[k], kAutodiffTolerance) << model.parameters().names[k];
-      const double step = 1e-6;
-      std::vector<double> ep = e, em = e;
-      ep[k] += step;
-      em[k] -= step;
-      const double fd = (model.Distance<double>(ep.data(), configs.q(i)) -
-                         model.Distance<double>(em.data(), configs.q(i))) /
-                        (2 * step);
-      EXPECT_NEAR(row[k], fd, kFiniteDifferenceTolerance) << model.parameters().names[k];
-    }
-  }
+  for (int i = 0; i < configs.size(); ++i) ExpectRowMatches<Jet>(model, point, e, configs, i);
 }
 
 // Three planes, every plane term and both ranger terms estimated (36 parameters): each row's
@@ -168,24 +153,7 @@ TEST(JacobianSeveralPlanes, AnalyticMatchesAutodiffAndCentralDifferences) {
   const ParameterSet& ps = model.parameters();
   for (int i = 0; i < configs.size(); ++i) {
     const int plane = configs.plane(i);
-    double h = 0;
-    std::vector<double> row(kParams);
-    model.Evaluate(point, configs, i, &h, row.data());
-    EXPECT_NEAR(h, model.Distance<double>(e.data(), configs.q(i), plane), 1e-12);
-    std::vector<BigJet> ej(kParams);
-    for (int k = 0; k < kParams; ++k) ej[k] = BigJet(e[k], k);
-    const BigJet hj = model.Distance<BigJet>(ej.data(), configs.q(i), plane);
-    for (int k = 0; k < kParams; ++k) {
-      EXPECT_NEAR(row[k], hj.v[k], kAutodiffTolerance)
-          << "d h / d " << ps.names[k] << " at configuration " << i;
-      std::vector<double> ep = e, em = e;
-      ep[k] += 1e-6;
-      em[k] -= 1e-6;
-      const double fd = (model.Distance<double>(ep.data(), configs.q(i), plane) -
-                         model.Distance<double>(em.data(), configs.q(i), plane)) /
-                        2e-6;
-      EXPECT_NEAR(row[k], fd, kFiniteDifferenceTolerance) << "d h / d " << ps.names[k];
-    }
+    const std::vector<double> row = ExpectRowMatches<BigJet>(model, point, e, configs, i);
     for (int p = 0; p < 3; ++p) {
       const PlaneColumns& c = ps.plane_columns[p];
       for (int k : {c.u[0], c.u[1], c.f}) {
