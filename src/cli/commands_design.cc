@@ -31,8 +31,8 @@ void AddDesignOptions(po::options_description& o) {
       "generate", po::value<int>(),
       "or: generate this many candidates (per plane; beam hits, non-singular)")(
       "seed", po::value<long long>()->default_value(1),
-      "seed for --generate, random starts, baseline")("select", po::value<int>()->required(),
-                                                      "configurations to choose (k)")(
+      "seed for --generate, exchange kicks, baseline")("select", po::value<int>()->required(),
+                                                       "configurations to choose (k)")(
       "criterion", po::value<std::string>()->default_value("E"),
       "E (=O3), D, A, O1, O2, O4, O5, or I (task: the predicted RMS position error at --poses, "
       "or at --workspace poses)")(

@@ -82,8 +82,10 @@ struct SelectionOptions {
   DesignCriterion criterion = DesignCriterion::kE;
   SelectionMethod method = SelectionMethod::kBackward;
   int samples = 1000;  ///< subsets tried by kSampled
-  /// kExchange: starts = backward-greedy design + (restarts−1) random, then the forward-greedy
-  /// design and the relaxation's rounded solution (design_certificate.h): the best end wins.
+  /// kExchange: starts = the backward- and forward-greedy designs and the relaxation's rounded
+  /// solution (design_certificate.h), then (restarts−1) kicks of the best end so far (⌈k/10⌉,
+  /// at least 2, of its members swapped for random candidates, iterated local search): the best
+  /// end wins.
   int restarts = 4;
   double exhaustive_limit = 5e6;  ///< most subsets kExhaustive will enumerate
   /// Throws InputError (where = `source`) naming the field and the range expected.
