@@ -697,6 +697,32 @@ InputDistribution ParseInputDistribution(const Json& input, const std::string& i
   return d;
 }
 
+// An uncertain input must be a numeric setting (the ranger errors' default is the robot file's
+// value, also numeric), or a number of the study's one plane: plane.tilt_deg and
+// plane.azimuth_deg when it is given by {tilt_deg, azimuth_deg, through}, plane.offset when by
+// {normal, offset}.
+void CheckSensitivityKey(const std::string& key, const Json& base, const std::string& where) {
+  if (key.rfind("plane.", 0) == 0) {
+    const bool known =
+        key == "plane.tilt_deg" || key == "plane.azimuth_deg" || key == "plane.offset";
+    if (!known)
+      throw InputError(where, "'" + key +
+                                  "' is not a numeric plane setting (plane.tilt_deg, "
+                                  "plane.azimuth_deg or plane.offset)");
+    if (!At(base, key).is_number())
+      throw InputError(where, "'" + key + "' needs the study's plane given as one mapping " +
+                                  (key == "plane.offset" ? "{normal, offset}"
+                                                         : "{tilt_deg, azimuth_deg, through}") +
+                                  " (not the robot file's plane or a list of planes)");
+    return;
+  }
+  if (!KeyExists(StudyDefaults(), key) ||
+      !(At(StudyDefaults(), key).is_number() || At(StudyDefaults(), key) == "robot_file"))
+    throw InputError(where, "'" + key +
+                                "' is not a numeric study setting (e.g. noise.sigma_mm, "
+                                "truth.scale, plane.tilt_deg)");
+}
+
 // The sensitivity section (sensitivity.h; docs/STUDIES.md): uncertain inputs, each uniform on
 // [min, max] or normal, sampled by Saltelli's or Morris' plan from the study's seed; the plan's
 // points become the cells of a zipped sweep, one axis per input.
@@ -741,13 +767,7 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
     OnlyKeys(inputs[i], ip, {"key", "min", "max", "mean", "std"}, "key, and min, max or mean, std",
              where);
     axes[i].key = Str(inputs[i], "key", in_at);
-    // Numeric settings (the ranger errors' default is the robot file's value, also numeric).
-    if (!KeyExists(StudyDefaults(), axes[i].key) ||
-        !(At(StudyDefaults(), axes[i].key).is_number() ||
-          At(StudyDefaults(), axes[i].key) == "robot_file"))
-      throw InputError(where(ip + ".key"), "'" + axes[i].key +
-                                               "' is not a numeric study setting (e.g. "
-                                               "noise.sigma_mm, truth.scale)");
+    CheckSensitivityKey(axes[i].key, study->base, where(ip + ".key"));
     dist[i] = ParseInputDistribution(inputs[i], ip, method, where);
     study->axis_keys.push_back(axes[i].key);
   }

@@ -714,6 +714,13 @@ const std::vector<BadInput>& Cases() {
        "run s.yaml --out a",
        2,
        {"key 'sensitivity'", "either a sweep or a sensitivity analysis, not both"}},
+      {"SensitivityPlaneTiltWithoutATiltPlane",
+       {{"s.yaml", std::string(kStudy) +
+                       "sensitivity:\n  inputs: [{key: plane.tilt_deg, min: 1, max: 20}]\n"}},
+       "run s.yaml --out a",
+       2,
+       {"s.yaml:6 key 'sensitivity.inputs[0].key'",
+        "needs the study's plane given as one mapping {tilt_deg, azimuth_deg, through}"}},
       // URDF robots, --tool-link, base/tool transforms, lrcal export.
       {"UrdfNotXml",
        {{"arm.urdf", "<robot name=\"x\"><link name=\"a\"</robot>\n"}},

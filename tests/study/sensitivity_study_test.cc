@@ -87,6 +87,38 @@ TEST(SensitivityStudy, NormalInputsFollowTheirLaw) {
   EXPECT_NEAR(std, 20, 4 * 20 / std::sqrt(1600.0));
 }
 
+// The plane's tilt is an uncertain input when the study gives its plane by tilt and azimuth:
+// each plan point's cell has its own plane (the other plane keys kept), and the tilt acts.
+TEST(SensitivityStudy, ThePlaneTiltIsAnInput) {
+  const std::string dir = testing::TempDir("sensitivity_tilt");
+  std::ofstream(dir + "/t.yaml")
+      << "name: t\nseed: 3\ntrials: 20\npool: {size: 60}\nselection: {count: 40}\n"
+         "validation: {size: 10}\n"
+         "plane: {tilt_deg: 12, azimuth_deg: 90, through: [0, 0, 0.15]}\n"
+         "sensitivity:\n  samples: 6\n  bootstrap: 100\n"
+         "  inputs: [{key: plane.tilt_deg, min: 5, max: 40}, {key: noise.sigma_mm, min: 0.1, "
+         "max: 0.11}]\n";
+  const Study study = LoadStudy(dir + "/t.yaml");
+  ASSERT_EQ(study.cells.size(), 24u);  // N(d+2), all distinct
+  double lo = 180, hi = 0;
+  for (const Cell& c : study.cells) {
+    const auto& plane = c.settings["plane"];
+    EXPECT_EQ(plane["azimuth_deg"], 90);
+    EXPECT_EQ(plane["through"], nlohmann::json::parse("[0, 0, 0.15]"));
+    lo = std::min(lo, plane["tilt_deg"].get<double>());
+    hi = std::max(hi, plane["tilt_deg"].get<double>());
+  }
+  EXPECT_GE(lo, 5);
+  EXPECT_LE(hi, 40);
+  EXPECT_GT(hi - lo, 15);  // 12 draws spread over the range
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/t.yaml", dir + "/run", 2).complete);
+  const auto j = nlohmann::json::parse(testing::ReadFile(dir + "/run/tables/summary.json"));
+  const auto& in = j["sensitivity"]["inputs"];
+  ASSERT_EQ(in[0]["key"], "plane.tilt_deg");
+  // The tilt changes the design's conditioning several-fold across 5–40°; σ barely moves.
+  EXPECT_GT(in[0]["total"][0].get<double>(), in[1]["total"][0].get<double>());
+}
+
 TEST(SensitivityStudy, BadSectionsNameTheKey) {
   const std::string dir = testing::TempDir("sensitivity_bad");
   const auto expect_error = [&](const std::string& body, const std::string& expected) {
@@ -118,6 +150,19 @@ TEST(SensitivityStudy, BadSectionsNameTheKey) {
                "expected std > 0");
   expect_error("sensitivity:\n  inputs: [{key: noise.sigma_mm, min: 0.1, mean: 0.2, std: 1}]\n",
                "not both");
+  expect_error("sensitivity:\n  inputs: [{key: plane.tilt_deg, min: 1, max: 20}]\n",
+               "'plane.tilt_deg' needs the study's plane given as one mapping {tilt_deg, "
+               "azimuth_deg, through}");
+  expect_error(
+      "plane: {normal: [0, 0, 1], offset: 0.2}\n"
+      "sensitivity:\n  inputs: [{key: plane.tilt_deg, min: 1, max: 20}]\n",
+      "'plane.tilt_deg' needs the study's plane given as one mapping");
+  expect_error("sensitivity:\n  inputs: [{key: plane.through, min: 1, max: 20}]\n",
+               "'plane.through' is not a numeric plane setting");
+  expect_error(
+      "plane: {tilt_deg: 10, azimuth_deg: 90, through: [0, 0, 0.15]}\n"
+      "sensitivity:\n  inputs: [{key: plane.tilt_deg, mean: 1, std: 20}]\n",
+      "expected an angle in [0, 180] degrees");
 }
 
 }  // namespace
