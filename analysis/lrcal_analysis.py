@@ -349,6 +349,15 @@ def global_sensitivity_figure(run, out_dir):
         caption = (f"Sobol indices of the cell mean of {metric} (identified model, x, y, z "
                    "averaged) with their 95 % bootstrap intervals; the noise of the cell means is "
                    f"{100 * sens['noise_variance'] / sens['variance']:.2f} % of the variance.")
+        if sens.get("quantity") == "trial":
+            share = sens["noise_total"]
+            ax.bar([len(keys) + 0.19], [share], 0.36, color="C1")
+            ax.set_xticks(list(xs) + [len(keys)])
+            ax.set_xticklabels(keys + ["noise (one trial)"], rotation=20, ha="right", fontsize=8)
+            caption = (f"Sobol indices of a single calibration's {metric} (one trial; identified "
+                       "model, x, y, z averaged), the trial's randomness one more input: its total "
+                       f"index {share:.3f}; the inputs' total indices are lower bounds. 95 % "
+                       "bootstrap intervals of the inputs' indices.")
     else:
         fig, ax = plt.subplots(figsize=(6.5, 4.5))
         mu_star = [i["mu_star"] for i in inputs]

@@ -505,33 +505,57 @@ struct SensitivityOutput {
              "total_low", "total_high", "mu", "mu_star", "sigma"}};
 };
 
-// The quantity of interest per cell id (NaN for a cell without ok trials) and its squared SE.
-std::map<std::string, std::pair<double, double>> CellQuantities(
-    const std::vector<CellSummary>& cells, int metric) {
-  std::map<std::string, std::pair<double, double>> q;
+// Per cell id: the quantity of interest (the cell mean; NaN for a cell without ok trials), its
+// squared SE, and the variance of a single trial's figure about it (mm² or mrad²).
+struct CellQuantity {
+  double mean = NAN, se2 = 0, trial_variance = NAN;
+};
+std::map<std::string, CellQuantity> CellQuantities(const std::vector<CellSummary>& cells,
+                                                   int metric) {
+  std::map<std::string, CellQuantity> q;
   for (const CellSummary& s : cells) {
-    double mean = 0, se2 = 0;
+    CellQuantity c;
+    c.mean = 0;
     for (int a = 0; a < 3; ++a) {
       const Distribution& d = s.validation[3 * metric + a];
-      mean += (d.n > 0 ? d.mean : NAN) * 1e3 / 3;
-      se2 += d.mean_se * d.mean_se * 1e6 / 9;
+      c.mean += (d.n > 0 ? d.mean : NAN) * 1e3 / 3;
+      c.se2 += d.mean_se * d.mean_se * 1e6 / 9;
     }
-    q[s.cell.id] = {mean, se2};
+    const Distribution& t = s.axis_mean[metric];
+    c.trial_variance = t.n > 1 ? t.std * t.std * 1e6 : NAN;
+    q[s.cell.id] = c;
   }
   return q;
 }
 
+// An input's law in words, and its CSV min and max (empty for a normal input).
+bool IsNormalInput(const Json& input) { return input.contains("mean"); }
 std::string InputRange(const Json& input) {
+  if (IsNormalInput(input))
+    return "normal, mean " + Fixed(input["mean"].get<double>(), 4) + ", std " +
+           Fixed(input["std"].get<double>(), 4);
   return Fixed(input["min"].get<double>(), 4) + " to " + Fixed(input["max"].get<double>(), 4);
 }
+std::string InputBound(const Json& input, const char* key) {
+  return IsNormalInput(input) ? "" : CsvValue(input[key].get<double>());
+}
 
-// Sobol indices with bootstrap intervals: the table, the CSV rows and the JSON inputs.
+// Sobol indices with bootstrap intervals: the table, the CSV rows and the JSON inputs. `scale`
+// turns indices of the cell means into indices of a single trial's figure (1 for the cell
+// means; see SensitivityAnalysis).
 std::string SobolSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed,
-                         SensitivityOutput* out) {
+                         double scale, SensitivityOutput* out) {
   const int d = static_cast<int>(spec["inputs"].size()), bootstrap = spec["bootstrap"];
   const SaltelliPlan plan{spec["samples"].get<int>(), d, {}};
-  const SobolIndices s = EstimateSobolIndices(plan, values, bootstrap, 0.95, seed);
-  Table table({"input", "range", "first-order S [95 % CI]", "total T [95 % CI]"});
+  SobolIndices s = EstimateSobolIndices(plan, values, bootstrap, 0.95, seed);
+  for (auto* list : {&s.first, &s.total})
+    for (IntervalEstimate& e : *list) {
+      e.estimate *= scale;
+      e.low *= scale;
+      e.high *= scale;
+    }
+  Table table({"input", "range", "first-order S [95 % CI]",
+               scale == 1 ? "total T [95 % CI]" : "total T, at least [95 % CI]"});
   const auto ci = [](const IntervalEstimate& e) {
     return Fixed(e.estimate, 3) + " [" + Fixed(e.low, 3) + ", " + Fixed(e.high, 3) + "]";
   };
@@ -540,8 +564,8 @@ std::string SobolSection(const Json& spec, const Eigen::VectorXd& values, std::u
     const Json& in = spec["inputs"][i];
     const std::string key = in["key"];
     table.AddRow({key, InputRange(in), ci(s.first[i]), ci(s.total[i])});
-    out->csv.AddRow({key, CsvValue(in["min"].get<double>()), CsvValue(in["max"].get<double>()),
-                     "sobol", CsvValue(s.first[i].estimate), CsvValue(s.first[i].low),
+    out->csv.AddRow({key, InputBound(in, "min"), InputBound(in, "max"), "sobol",
+                     CsvValue(s.first[i].estimate), CsvValue(s.first[i].low),
                      CsvValue(s.first[i].high), CsvValue(s.total[i].estimate),
                      CsvValue(s.total[i].low), CsvValue(s.total[i].high), "", "", ""});
     inputs.push_back({{"key", key},
@@ -570,9 +594,8 @@ std::string MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::
     const std::string key = in["key"];
     table.AddRow(
         {key, InputRange(in), Fixed(e.mu_star[i], 4), Fixed(e.mu[i], 4), Fixed(e.sigma[i], 4)});
-    out->csv.AddRow({key, CsvValue(in["min"].get<double>()), CsvValue(in["max"].get<double>()),
-                     "morris", "", "", "", "", "", "", CsvValue(e.mu[i]), CsvValue(e.mu_star[i]),
-                     CsvValue(e.sigma[i])});
+    out->csv.AddRow({key, InputBound(in, "min"), InputBound(in, "max"), "morris", "", "", "", "",
+                     "", "", CsvValue(e.mu[i]), CsvValue(e.mu_star[i]), CsvValue(e.sigma[i])});
     inputs.push_back(
         {{"key", key}, {"mu", e.mu[i]}, {"mu_star", e.mu_star[i]}, {"sigma", e.sigma[i]}});
   }
@@ -584,33 +607,67 @@ std::string MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::
          table.ToMarkdown();
 }
 
+// quantity: trial. A single calibration's figure Y = f(x) + ε, the noise ε one more input
+// (Marrel et al. 2012, stochastic simulators): Var Y = Var f + E[Var(Y|x)]. The noise's total
+// index is E[Var(Y|x)] / Var Y (exact); an input's first-order index is V_i / Var Y, the cell
+// means' index times Var(cell means) / Var Y; its total index is at least the cell means' one
+// times the same ratio (Jensen), so it is reported as a lower bound. Returns the ratio and adds
+// the JSON keys and the markdown paragraph.
+double TrialQuantity(const Eigen::VectorXd& within, double variance, double noise,
+                     const std::string& unit, SensitivityOutput* out, std::ostringstream* md) {
+  const double var_f = std::max(variance - noise, 0.0), mean_within = within.mean();
+  const double var_y = var_f + mean_within;
+  const double share = var_y > 0 ? mean_within / var_y : NAN;
+  out->json["quantity"] = "trial";
+  out->json["trial_variance"] = var_y;
+  out->json["noise_total"] = share;
+  *md << "Quantity of interest for the indices: a single calibration's figure (one trial), the "
+         "trial's randomness (reading noise, and whatever else the study draws per trial) one "
+         "more input (Marrel et al. 2012): its variance "
+      << Fixed(var_y, 6) << " " << unit << "² = the cell means' " << Fixed(var_f, 6)
+      << " (Monte-Carlo noise removed) + the mean within-cell variance " << Fixed(mean_within, 6)
+      << ". The noise's total index is " << Fixed(share, 3)
+      << "; the inputs' first-order indices are exact, their total indices lower bounds (the "
+         "noise's interactions with an input cannot be told from its own share; up to the cell "
+         "means' Monte-Carlo noise).\n\n";
+  return var_y > 0 ? variance / var_y : NAN;
+}
+
 SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellSummary>& cells) {
   SensitivityOutput out;
   if (!study.contains("sensitivity")) return out;
   const Json& spec = study["sensitivity"];
   const std::string method = spec["method"], metric_name = spec["metric"];
+  const bool trial = spec.value("quantity", std::string("cell_mean")) == "trial";
   int metric = 0;
   while (metric < 3 && metric_name != kMetricNames[metric]) ++metric;
   const std::uint64_t seed = study.value("seed", std::uint64_t{0});
   const auto quantities = CellQuantities(cells, metric);
   const Json& plan_cells = spec["plan_cells"];
-  Eigen::VectorXd values(static_cast<Eigen::Index>(plan_cells.size()));
+  const auto points = static_cast<Eigen::Index>(plan_cells.size());
+  Eigen::VectorXd values(points), within(points);
   double noise = 0;
-  for (std::size_t p = 0; p < plan_cells.size(); ++p) {
+  for (Eigen::Index p = 0; p < points; ++p) {
     const auto it = quantities.find(plan_cells[p].get<std::string>());
-    values[static_cast<Eigen::Index>(p)] = it == quantities.end() ? NAN : it->second.first;
-    noise += it == quantities.end() ? 0 : it->second.second / static_cast<double>(values.size());
+    const CellQuantity q = it == quantities.end() ? CellQuantity{} : it->second;
+    values[p] = q.mean;
+    within[p] = q.trial_variance;
+    noise += q.se2 / static_cast<double>(points);
   }
   const std::string unit = metric % 2 == 0 ? "mm" : "mrad";
   out.json = {{"method", method}, {"metric", metric_name}, {"unit", unit}};
   std::ostringstream md;
-  md << "\n## Sensitivity (" << (method == "sobol" ? "Sobol indices" : "Morris effects")
-     << ")\n\nQuantity of interest: each cell's mean over its trials of the identified model's "
-     << metric_name << " (" << unit << "), averaged over x, y and z, at " << values.size()
-     << " plan points (" << cells.size() << " cells).";
-  out.json["available"] = values.allFinite();
-  if (!values.allFinite()) {
-    out.markdown = md.str() + " Some cells have no successful trial: no indices.\n";
+  md << "\n## Sensitivity (" << (method == "sobol" ? "Sobol indices" : "Morris effects") << ")\n\n"
+     << (trial ? "Cell means" : "Quantity of interest")
+     << ": each cell's mean over its trials of the identified model's " << metric_name << " ("
+     << unit << "), averaged over x, y and z, at " << values.size() << " plan points ("
+     << cells.size() << " cells).";
+  out.json["available"] = values.allFinite() && (!trial || within.allFinite());
+  if (!out.json["available"].get<bool>()) {
+    out.markdown = md.str() +
+                   (trial ? " Some cells have fewer than two successful trials"
+                          : " Some cells have no successful trial") +
+                   ": no indices.\n";
     return out;
   }
   const double variance = (values.array() - values.mean()).square().sum() /
@@ -619,9 +676,13 @@ SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellS
   out.json["noise_variance"] = noise;
   md << " Variance over the plan " << Fixed(variance, 6) << " " << unit << "²; the cell means' "
      << "Monte-Carlo noise is " << Percent(variance > 0 ? noise / variance : NAN)
-     << " of it (it adds to every total index and lowers the first-order ones).\n\n"
-     << (method == "sobol" ? SobolSection(spec, values, seed, &out)
+     << " of it (it adds to every total index and lowers the first-order ones).\n\n";
+  const double scale = trial ? TrialQuantity(within, variance, noise, unit, &out, &md) : 1.0;
+  md << (method == "sobol" ? SobolSection(spec, values, seed, scale, &out)
                            : MorrisSection(spec, values, seed, unit, &out));
+  if (trial)
+    out.csv.AddRow({"noise (one trial)", "", "", "sobol", "", "", "",
+                    CsvValue(out.json["noise_total"].get<double>()), "", "", "", "", ""});
   out.markdown = md.str();
   return out;
 }

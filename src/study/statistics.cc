@@ -538,8 +538,17 @@ void ReadInBlocks(const TrialStore& store, const std::string& cell_id, long long
 }
 
 // The series of a cell, in one layout: validation (12, ok trials), nominal (12, every trial),
-// iterations, σ̂, σ_min (ok trials), then the parameter errors (ok trials).
-enum : int { kValidation = 0, kNominal = 12, kIterations = 24, kSigmaHat, kSigmaMin, kErrors };
+// iterations, σ̂, σ_min, the 4 axis means of the validation metrics (ok trials), then the
+// parameter errors (ok trials).
+enum : int {
+  kValidation = 0,
+  kNominal = 12,
+  kIterations = 24,
+  kSigmaHat,
+  kSigmaMin,
+  kAxisMean,
+  kErrors = kAxisMean + 4
+};
 
 class CellPasses {
  public:
@@ -548,7 +557,7 @@ class CellPasses {
       : store_(store), cell_(cell), end_(end), s_(summary) {
     num_params_ = static_cast<int>(cell.parameter_names.size());
     series_.resize(kErrors + num_params_);
-    for (int k = 0; k < kErrors; ++k) series_[k].quantiles = true;
+    for (int k = 0; k < kAxisMean; ++k) series_[k].quantiles = true;
     if (probes) {
       for (int k = 0; k < 12; ++k) series_[kValidation + k].probe = probes->validation[k];
       for (int k = 0; k < num_params_ && k < static_cast<int>(probes->errors.size()); ++k)
@@ -603,6 +612,15 @@ class CellPasses {
     return b;
   }
 
+  // An ok record's validation metrics, and their means over x, y, z (a single trial's figure).
+  template <typename Visit>
+  static void VisitValidation(Visit& visit, const TrialRecord& r) {
+    for (int k = 0; k < 12; ++k) visit(kValidation + k, r.validation[k]);
+    for (int m = 0; m < 4; ++m)
+      visit(kAxisMean + m,
+            (r.validation[3 * m] + r.validation[3 * m + 1] + r.validation[3 * m + 2]) / 3);
+  }
+
   // One pass over the records in canonical order; `count` also counts trials and statuses,
   // `covariance` also accumulates the parameter errors' covariance lanes.
   template <typename Visit>
@@ -618,7 +636,7 @@ class CellPasses {
         return;
       }
       if (count) ++s_->ok;
-      for (int k = 0; k < 12; ++k) visit(kValidation + k, r.validation[k]);
+      VisitValidation(visit, r);
       visit(kIterations, r.iterations);
       visit(kSigmaHat, r.sigma_hat);
       visit(kSigmaMin, r.sigma_min);
@@ -672,6 +690,7 @@ class CellPasses {
     s_->iterations = SeriesDistribution(series_[kIterations]);
     s_->sigma_hat = SeriesDistribution(series_[kSigmaHat]);
     s_->design_sigma_min = SeriesDistribution(series_[kSigmaMin]);
+    for (int m = 0; m < 4; ++m) s_->axis_mean[m] = SeriesDistribution(series_[kAxisMean + m]);
     const auto rank = [](const Series& x) {
       if (x.n == 0 || std::isnan(x.probe)) return kNan;
       return 100.0 * (x.probe_below + 0.5 * x.probe_equal) / x.n;

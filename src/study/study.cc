@@ -732,8 +732,9 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
     throw InputError(where("sensitivity"),
                      "a study has either a sweep or a sensitivity analysis, not both");
   if (!sn.is_object()) throw InputError(where("sensitivity"), "expected a mapping with 'inputs'");
-  OnlyKeys(sn, "sensitivity", {"method", "samples", "levels", "bootstrap", "metric", "inputs"},
-           "method, samples, levels, bootstrap, metric, inputs", where);
+  OnlyKeys(sn, "sensitivity",
+           {"method", "samples", "levels", "bootstrap", "metric", "quantity", "inputs"},
+           "method, samples, levels, bootstrap, metric, quantity, inputs", where);
   Json spec = {{"method", "sobol"},
                {"samples", 32},
                {"levels", 4},
@@ -753,6 +754,17 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
   if (metric != "rms_pos" && metric != "rms_ori" && metric != "max_pos" && metric != "max_ori")
     throw InputError(where("sensitivity.metric"),
                      "expected rms_pos, rms_ori, max_pos or max_ori, got '" + metric + "'");
+  // quantity (optional, not added when absent so that earlier runs' manifests stay the same):
+  // cell_mean (default) or trial, a single calibration's metric with the noise as an input.
+  if (spec.contains("quantity")) {
+    const std::string quantity = Str(spec, "quantity", at);
+    if (quantity != "cell_mean" && quantity != "trial")
+      throw InputError(where("sensitivity.quantity"),
+                       "expected cell_mean or trial, got '" + quantity + "'");
+    if (quantity == "trial" && method != "sobol")
+      throw InputError(where("sensitivity.quantity"),
+                       "quantity trial needs method sobol (the noise's share is a variance)");
+  }
   const Json& inputs = spec["inputs"];
   if (!inputs.is_array() || inputs.empty() || inputs.size() > 20)
     throw InputError(where("sensitivity.inputs"),

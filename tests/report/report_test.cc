@@ -113,25 +113,34 @@ TEST(Report, FiguresSayWhatTheyLeaveOutAndMarkPaperValuesOnlyWhereThereAreAny) {
       << captions;
 }
 
-// A study with a sensitivity section: the report draws its indices with their intervals.
+// A study with a sensitivity section: the report draws its indices with their intervals, and
+// for a single trial's figure (quantity: trial) the noise's share beside them.
 TEST(Report, SensitivityStudyDrawsItsIndices) {
-  const std::string dir = testing::TempDir("report_sensitivity");
-  const std::string study = dir + "/sens.yaml";
-  std::ofstream(study) << "name: sens\nseed: 3\ntrials: 10\npool: {size: 60}\nselection: "
-                          "{count: 40}\nvalidation: {size: 10}\nsensitivity:\n  samples: 4\n"
-                          "  bootstrap: 100\n  inputs:\n    - {key: noise.sigma_mm, min: 0.1, "
-                          "max: 0.4}\n    - {key: noise.form_sigma_mm, min: 0, max: 0.1}\n";
-  std::string out;
-  ASSERT_EQ(RunCommand(LrcalBinary() + " run " + study + " --out " + dir + "/run --quiet", &out), 0)
-      << out;
-  ASSERT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/run", &out), 0) << out;
-  const Json figures = Json::parse(Read(fs::path(dir) / "run/report/figures.json"));
-  const std::vector<std::string> names = figures["figures"];
-  EXPECT_NE(std::find(names.begin(), names.end(), "global_sensitivity.png"), names.end())
-      << figures.dump();
-  EXPECT_NE(figures["captions"].dump().find("Sobol indices of the cell mean of rms_pos"),
-            std::string::npos);
-  EXPECT_GT(fs::file_size(fs::path(dir) / "run/report/figures/global_sensitivity.png"), 10000u);
+  for (const std::string quantity : {"cell_mean", "trial"}) {
+    const std::string dir = testing::TempDir("report_sensitivity_" + quantity);
+    const std::string study = dir + "/sens.yaml";
+    std::ofstream(study) << "name: sens\nseed: 3\ntrials: 10\npool: {size: 60}\nselection: "
+                            "{count: 40}\nvalidation: {size: 10}\nsensitivity:\n  samples: 4\n"
+                            "  bootstrap: 100\n  quantity: "
+                         << quantity
+                         << "\n  inputs:\n    - {key: noise.sigma_mm, min: 0.1, "
+                            "max: 0.4}\n    - {key: noise.form_sigma_mm, min: 0, max: 0.1}\n";
+    std::string out;
+    ASSERT_EQ(RunCommand(LrcalBinary() + " run " + study + " --out " + dir + "/run --quiet", &out),
+              0)
+        << out;
+    ASSERT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/run", &out), 0) << out;
+    const Json figures = Json::parse(Read(fs::path(dir) / "run/report/figures.json"));
+    const std::vector<std::string> names = figures["figures"];
+    EXPECT_NE(std::find(names.begin(), names.end(), "global_sensitivity.png"), names.end())
+        << figures.dump();
+    EXPECT_NE(figures["captions"].dump().find(
+                  quantity == "trial" ? "Sobol indices of a single calibration's rms_pos"
+                                      : "Sobol indices of the cell mean of rms_pos"),
+              std::string::npos)
+        << quantity;
+    EXPECT_GT(fs::file_size(fs::path(dir) / "run/report/figures/global_sensitivity.png"), 10000u);
+  }
 }
 
 TEST(Report, PartialRunIsReportedAsPartial) {

@@ -8,7 +8,9 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/study/sensitivity.h"
+#include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
+#include "lrcal/study/trial_store.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -119,6 +121,78 @@ TEST(SensitivityStudy, ThePlaneTiltIsAnInput) {
   EXPECT_GT(in[0]["total"][0].get<double>(), in[1]["total"][0].get<double>());
 }
 
+// quantity: trial. The variance of a single calibration's figure, Var Y = Var f + E[Var(Y|x)],
+// must be that of every plan point's trials pooled (law of total variance, read back from the
+// store), the noise's total index E[Var(Y|x)] / Var Y, and the inputs' indices those of the cell
+// means times Var(cell means) / Var Y.
+TEST(SensitivityStudy, ASingleTrialsFigureHasTheNoiseAsAnInput) {
+  const std::string dir = testing::TempDir("sensitivity_trial");
+  const std::string body =
+      "seed: 4\ntrials: 60\npool: {size: 60}\nselection: {count: 40}\nvalidation: {size: 10}\n"
+      "sensitivity:\n  samples: 16\n  bootstrap: 200\n  metric: max_pos\n"
+      "  inputs: [{key: noise.sigma_mm, min: 0.1, max: 0.4}, {key: noise.encoder_sigma_mrad, "
+      "min: 0, max: 0.05}]\n";
+  std::ofstream(dir + "/t.yaml") << "name: t\n" << body << "  quantity: trial\n";
+  std::ofstream(dir + "/m.yaml") << "name: m\n" << body;
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/t.yaml", dir + "/t", 2).complete);
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/m.yaml", dir + "/m", 2).complete);
+  const auto t = nlohmann::json::parse(testing::ReadFile(dir + "/t/tables/summary.json"));
+  const auto m = nlohmann::json::parse(testing::ReadFile(dir + "/m/tables/summary.json"));
+  const auto& st = t["sensitivity"];
+  ASSERT_TRUE(st["available"].get<bool>());
+  EXPECT_EQ(st["quantity"], "trial");
+  EXPECT_FALSE(m["sensitivity"].contains("quantity"));
+  const double var_y = st["trial_variance"], variance = st["variance"];
+  EXPECT_EQ(variance, m["sensitivity"]["variance"].get<double>());  // the same cells
+  // Every plan point's trials, pooled (each point weighs its own cell's trials).
+  const Study study = LoadStudy(dir + "/t.yaml");
+  TrialStore store(dir + "/t/trials.sqlite");
+  std::vector<double> pooled;
+  double within = 0;
+  const auto& plan = study.sensitivity["plan_cells"];
+  for (const auto& id : plan) {
+    std::vector<double> y;
+    store.ForEachTrial(id.get<std::string>(), [&](const TrialRecord& r) {
+      if (r.status == TrialStatus::kOk)
+        y.push_back((r.validation[6] + r.validation[7] + r.validation[8]) / 3 * 1e3);  // max_pos
+    });
+    const Distribution d = Describe(y);
+    within += d.std * d.std / static_cast<double>(plan.size());
+    pooled.insert(pooled.end(), y.begin(), y.end());
+  }
+  const double pooled_var = std::pow(Describe(pooled).std, 2);
+  EXPECT_NEAR(var_y, pooled_var, 0.03 * pooled_var);  // equal up to the cells' finite trials
+  EXPECT_NEAR(st["noise_total"].get<double>(), within / var_y, 1e-9);
+  EXPECT_GT(st["noise_total"].get<double>(), 0.3);  // a single max error is mostly noise
+  for (int i = 0; i < 2; ++i)
+    for (const char* kind : {"first", "total"})
+      for (int e = 0; e < 3; ++e)
+        EXPECT_NEAR(st["inputs"][i][kind][e].get<double>(),
+                    m["sensitivity"]["inputs"][i][kind][e].get<double>() * variance / var_y, 1e-12)
+            << i << " " << kind << " " << e;
+  const std::string csv = testing::ReadFile(dir + "/t/tables/sensitivity.csv");
+  EXPECT_NE(csv.find("\nnoise (one trial),,,sobol,,,,"), std::string::npos) << csv;
+}
+
+// A normal input has no min and max: its table row states its law and the CSV leaves them empty
+// (writing the tables used to fail on such a study).
+TEST(SensitivityStudy, NormalInputsReachTheTables) {
+  const std::string dir = testing::TempDir("sensitivity_normal_tables");
+  std::ofstream(dir + "/n.yaml")
+      << "name: n\nseed: 3\ntrials: 5\npool: {size: 60}\nselection: {count: 40}\n"
+         "validation: {size: 10}\nsensitivity:\n  samples: 4\n  bootstrap: 50\n"
+         "  inputs: [{key: noise.sigma_mm, mean: 0.2, std: 0.05}, {key: "
+         "noise.encoder_sigma_mrad, min: 0, max: 0.1}]\n";
+  ASSERT_TRUE(testing::RunStudyFile(dir + "/n.yaml", dir + "/run", 2).complete);
+  const std::string csv = testing::ReadFile(dir + "/run/tables/sensitivity.csv");
+  EXPECT_NE(csv.find("\nnoise.sigma_mm,,,sobol,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nnoise.encoder_sigma_mrad,0.000000,0.100000,sobol,"), std::string::npos)
+      << csv;
+  EXPECT_NE(testing::ReadFile(dir + "/run/tables/summary.md")
+                .find("| noise.sigma_mm | normal, mean 0.2000, std 0.0500 |"),
+            std::string::npos);
+}
+
 TEST(SensitivityStudy, BadSectionsNameTheKey) {
   const std::string dir = testing::TempDir("sensitivity_bad");
   const auto expect_error = [&](const std::string& body, const std::string& expected) {
@@ -150,6 +224,9 @@ TEST(SensitivityStudy, BadSectionsNameTheKey) {
                "expected std > 0");
   expect_error("sensitivity:\n  inputs: [{key: noise.sigma_mm, min: 0.1, mean: 0.2, std: 1}]\n",
                "not both");
+  expect_error("sensitivity:\n  quantity: single\n" + input, "key 'sensitivity.quantity'");
+  expect_error("sensitivity:\n  method: morris\n  quantity: trial\n" + input,
+               "quantity trial needs method sobol");
   expect_error("sensitivity:\n  inputs: [{key: plane.tilt_deg, min: 1, max: 20}]\n",
                "'plane.tilt_deg' needs the study's plane given as one mapping {tilt_deg, "
                "azimuth_deg, through}");

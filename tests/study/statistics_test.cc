@@ -216,6 +216,21 @@ TEST(Statistics, StreamingSummaryHasTheBitsOfSortingEveryValue) {
   same(s.iterations, Describe(iterations), "iterations");
   same(s.sigma_hat, Describe(sigma_hat), "sigma_hat");
   same(s.design_sigma_min, Describe(sigma_min), "sigma_min");
+  // A single trial's figure (the mean over x, y, z of each metric): mean, std and their SEs.
+  for (int m = 0; m < 4; ++m) {
+    SCOPED_TRACE("axis mean " + std::to_string(m));
+    std::vector<double> axis_mean;
+    for (std::size_t t = 0; t < validation[0].size(); ++t)
+      axis_mean.push_back(
+          (validation[3 * m][t] + validation[3 * m + 1][t] + validation[3 * m + 2][t]) / 3);
+    const Distribution d = Describe(axis_mean);
+    EXPECT_EQ(s.axis_mean[m].n, d.n);
+    EXPECT_EQ(s.axis_mean[m].mean, d.mean);
+    EXPECT_EQ(s.axis_mean[m].std, d.std);
+    EXPECT_EQ(s.axis_mean[m].mean_se, d.mean_se);
+    EXPECT_EQ(s.axis_mean[m].std_se, d.std_se);
+    EXPECT_TRUE(std::isnan(s.axis_mean[m].p95));  // no quantiles for these
+  }
   EXPECT_EQ(s.validation_probe_rank[0], PercentileRank(validation[0], probes.validation[0]));
   EXPECT_EQ(s.validation_probe_rank[1], PercentileRank(validation[1], probes.validation[1]));
   EXPECT_TRUE(std::isnan(s.validation_probe_rank[2]));

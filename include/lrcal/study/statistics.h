@@ -102,6 +102,10 @@ struct CellSummary {
   /// σ_min of each ok trial's design: one value for a fixed design, a distribution when the
   /// pool or the selection is redrawn per trial.
   Distribution design_sigma_min;
+  /// Per ok trial, the mean over x, y and z of each validation metric of the identified model
+  /// (rms_pos, rms_ori, max_pos, max_ori; SI): a single calibration's figure. Mean, std and their
+  /// standard errors only (no quantiles).
+  std::array<Distribution, 4> axis_mean;
 };
 
 /// Values to place among a cell's trials while it is summarised (the paper's published numbers):
