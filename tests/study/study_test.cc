@@ -56,6 +56,21 @@ TEST(StudySchema, DocumentedDefaultsAreTheSchemasDefaults) {
   ExpectDocumented(StudyDefaults(), doc, "");
 }
 
+// Every study shipped in studies/ loads (the README and docs run them by name).
+TEST(StudySchema, EveryShippedStudyLoads) {
+  int count = 0;
+  for (const auto& e : std::filesystem::directory_iterator(testing::SourcePath("studies"))) {
+    if (e.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(e.path().string());
+    EXPECT_NO_THROW({
+      const Study study = LoadStudy(e.path().string());
+      EXPECT_FALSE(study.cells.empty());
+    });
+    ++count;
+  }
+  EXPECT_GE(count, 14);
+}
+
 std::string WriteStudy(const std::string& name, const std::string& body) {
   const std::string path = testing::TempDir("study_" + name) + "/s.yaml";
   std::ofstream(path) << "name: s\nseed: 1\ntrials: 3\nrobot: "
