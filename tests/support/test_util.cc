@@ -12,6 +12,8 @@
 #include "lrcal/core/random.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/kinematics/chain.h"
+#include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/report/run_tables.h"
 
 namespace lrcal::testing {
@@ -30,6 +32,27 @@ const RobotFile& PaperRig() {
 const RobotModel& PaperRobot() { return PaperRig().robot; }
 
 const Plane& PaperPlane() { return (*PaperRig().planes)[0]; }
+
+std::pair<double, double> GeometricJacobianDeviation(const RobotModel& robot, const double* q) {
+  const auto J = GeometricJacobian(robot, robot.nominal_values(), q);
+  const double step = 1e-6;
+  double linear = 0, angular = 0;
+  for (int j = 0; j < 6; ++j) {
+    double qp[6], qm[6];
+    std::copy(q, q + 6, qp);
+    std::copy(q, q + 6, qm);
+    qp[j] += step;
+    qm[j] -= step;
+    const auto pp = ForwardKinematics<double>(robot, robot.nominal_values().data(), qp);
+    const auto pm = ForwardKinematics<double>(robot, robot.nominal_values().data(), qm);
+    const Eigen::Vector3d v = (pp.p_BT - pm.p_BT) / (2 * step);
+    const Eigen::Matrix3d dR = (pp.R_BT - pm.R_BT) / (2 * step) * pp.R_BT.transpose();
+    const Eigen::Vector3d w(dR(2, 1), dR(0, 2), dR(1, 0));
+    linear = std::max(linear, (J.col(j).head<3>() - v).norm());
+    angular = std::max(angular, (J.col(j).tail<3>() - w).norm());
+  }
+  return {linear, angular};
+}
 
 const RobotModel& PaperRobotWithFrames() {
   static const RobotModel robot = [] {

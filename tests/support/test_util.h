@@ -3,6 +3,7 @@
 
 #include <random>
 #include <string>
+#include <utility>
 
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
@@ -23,6 +24,10 @@ const Plane& PaperPlane();
 /// The paper's arm on a tilted, shifted base with the ranger mounted off the flange (a tool
 /// transform of 3–10 cm and 0.1–0.3 rad): the base and tool frames of a real rig.
 const RobotModel& PaperRobotWithFrames();
+/// The geometric Jacobian of `robot` at its nominal values and q (6 joints) against central
+/// differences (step 1e-6) of its forward kinematics: the largest deviation of a column's linear
+/// part (m/rad) and of its angular part (the skew part of dR·Rᵀ, rad/rad).
+std::pair<double, double> GeometricJacobianDeviation(const RobotModel& robot, const double* q);
 /// `count` random configurations of `robot` whose beam meets `plane` at |n·b| ≥ 0.2 (any sign of
 /// the distance): for checks of formulas, not of readings.
 ConfigurationSet ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
