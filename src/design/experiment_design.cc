@@ -523,7 +523,48 @@ struct ExchangeState {
   // E: A's eigendecomposition for the swaps (SwapSpectrum), refreshed after each accepted swap.
   SwapSpectrum swaps;
   long long* evaluations;
+  // D and A: the swaps' quadratic forms (SwapForms), refreshed after each accepted swap.
+  struct SwapForms {
+    bool valid = false, usable = false;
+    Eigen::MatrixXd H1, H2;  // G·A⁻¹·Gᵀ and G·A⁻²·Gᵀ (A only), N × N
+    double log_det = 0, inv_trace = 0;
+  } forms;
 };
+
+// D and A: Fedorov's swap formulas. With h = G·A⁻¹·Gᵀ, swapping design row i for candidate j
+// multiplies det A by r = (1 − h_ii)(1 + h_jj) + h_ij² (the swap keeps A positive definite iff
+// r > 0), and by Woodbury with M = [[h_ii − 1, h_ij], [h_ij, 1 + h_jj]] and q = G·A⁻²·Gᵀ,
+// tr(A')⁻¹ = tr A⁻¹ − ((1 + h_jj)·q_ii − 2·h_ij·q_ij + (h_ii − 1)·q_jj) / det M: O(1) a swap.
+void ComputeSwapForms(ExchangeState* x) {
+  auto& f = x->forms;
+  f.valid = true;
+  const Eigen::LLT<Eigen::MatrixXd> llt(x->A);
+  f.usable = llt.info() == Eigen::Success;
+  if (!f.usable) return;
+  const Eigen::MatrixXd W = llt.matrixL().solve(x->G.transpose());  // L⁻¹Gᵀ, n × N
+  f.H1.noalias() = W.transpose() * W;
+  f.log_det = 2 * llt.matrixLLT().diagonal().array().log().sum();
+  if (x->criterion == DesignCriterion::kA) {
+    const Eigen::MatrixXd V = llt.matrixU().solve(W);  // A⁻¹Gᵀ
+    f.H2.noalias() = V.transpose() * V;
+    const Eigen::MatrixXd Linv =
+        llt.matrixL().solve(Eigen::MatrixXd::Identity(x->A.rows(), x->A.cols()));
+    f.inv_trace = Linv.squaredNorm();
+  }
+}
+
+// The score (D: log det; A: −tr A⁻¹) after swapping design row i for candidate j, from SwapForms;
+// −∞ when the swap leaves A singular.
+double SwapScore(const ExchangeState& x, int i, int j) {
+  const auto& f = x.forms;
+  const double hii = f.H1(i, i), hjj = f.H1(j, j), hij = f.H1(i, j);
+  const double r = (1 - hii) * (1 + hjj) + hij * hij;
+  if (!(r > 0)) return kMinusInf;
+  if (x.criterion == DesignCriterion::kD) return f.log_det + std::log(r);
+  const double change =
+      ((1 + hjj) * f.H2(i, i) - 2 * hij * f.H2(i, j) + (hii - 1) * f.H2(j, j)) / -r;
+  return -(f.inv_trace - change);
+}
 
 // E: replaces design[pos] by its best improving swap (SwapSpectrum); true if it did.
 bool ImproveAtE(ExchangeState* x, int pos, const std::vector<int>& outside) {
@@ -550,6 +591,34 @@ bool ImproveAtE(ExchangeState* x, int pos, const std::vector<int>& outside) {
   return true;
 }
 
+// D and A: replaces design[pos] by its best improving swap (SwapScore); true if it did.
+bool ImproveAtDA(ExchangeState* x, int pos, const std::vector<int>& outside, double floor) {
+  const int i = x->design[pos], k = static_cast<int>(x->design.size());
+  double best = floor;
+  int best_in = -1;
+  for (int j : outside) {
+    const double s = SwapScore(*x, i, j);
+    ++*x->evaluations;
+    if (s > best) {
+      best = s;
+      best_in = j;
+    }
+  }
+  if (best_in < 0) return false;
+  Eigen::MatrixXd A = x->A;
+  A.noalias() -= x->G.row(i).transpose() * x->G.row(i);
+  A.noalias() += x->G.row(best_in).transpose() * x->G.row(best_in);
+  const double exact = CriterionScore(A, k, x->criterion);
+  if (!(exact > x->current)) return false;  // the formula was wrong at rounding level
+  x->A = A;
+  x->current = exact;
+  x->forms.valid = false;
+  x->in[i] = false;
+  x->in[best_in] = true;
+  x->design[pos] = best_in;
+  return true;
+}
+
 // Replaces design[pos] by its best improving replacement, if there is one; true if it did.
 bool ImproveAt(ExchangeState* x, int pos) {
   const int i = x->design[pos], k = static_cast<int>(x->design.size());
@@ -559,6 +628,10 @@ bool ImproveAt(ExchangeState* x, int pos) {
   if (x->criterion == DesignCriterion::kE) return ImproveAtE(x, pos, outside);
   // A swap must improve by more than the what-if's rounding (relative 1e-10).
   const double floor = x->current + 1e-10 * std::fabs(x->current);
+  if (x->criterion == DesignCriterion::kD || x->criterion == DesignCriterion::kA) {
+    if (!x->forms.valid) ComputeSwapForms(x);
+    if (x->forms.usable) return ImproveAtDA(x, pos, outside, floor);
+  }
   Eigen::MatrixXd without = x->A - x->G.row(i).transpose() * x->G.row(i);
   x->spectrum.Compute(without);
   double best = floor;
@@ -588,8 +661,8 @@ bool ImproveAt(ExchangeState* x, int pos) {
 std::vector<int> Exchange(const Eigen::MatrixXd& G, std::vector<int> design,
                           DesignCriterion criterion, long long* evaluations) {
   ExchangeState x{
-      G,  criterion, design,     std::vector<bool>(G.rows(), false), NormalMatrixOf(G, design), 0,
-      {}, {},        evaluations};
+      G,  criterion,   design, std::vector<bool>(G.rows(), false), NormalMatrixOf(G, design), 0, {},
+      {}, evaluations, {}};
   for (int i : design) x.in[i] = true;
   x.current = CriterionScore(x.A, static_cast<int>(design.size()), criterion);
   for (int sweep = 0; sweep < 1000; ++sweep) {

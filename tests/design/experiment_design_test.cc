@@ -174,35 +174,39 @@ TEST(Selection, BackwardEWithBoundsMatchesBruteForceOnLargerProblems) {
             BruteBackward(paper_sized, 50, DesignCriterion::kE));
 }
 
-// The exchange skips swaps whose Rayleigh bound cannot beat the design: its end must still be
-// a local optimum, no single swap raising σ_min by more than the acceptance margin (1e-10,
+// The exchange scores swaps without a fresh decomposition (E: a rank-two eigenvalue count
+// pruned by Rayleigh bounds; D and A: Fedorov's formulas): its end must still be a local
+// optimum, no single swap raising the criterion by more than the acceptance margin (1e-10,
 // relative), checked by a fresh eigendecomposition of every swap.
-TEST(Selection, ExchangeEEndsWhereNoSingleSwapImproves) {
+TEST(Selection, ExchangeEndsWhereNoSingleSwapImproves) {
   RandomStream stream(4, 0, 0, RandomPurpose::kSelection);
-  for (const auto& [rows, cols, k, seed] :
-       {std::tuple{40, 6, 9, 51u}, std::tuple{60, 10, 14, 52u}, std::tuple{101, 25, 30, 53u}}) {
-    const Eigen::MatrixXd G = RandomMatrix(rows, cols, seed);
-    SelectionOptions o;
-    o.method = SelectionMethod::kExchange;
-    o.criterion = DesignCriterion::kE;
-    const SelectionResult r = SelectConfigurations(G, k, o, stream);
-    std::vector<bool> in(rows, false);
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(cols, cols);
-    for (int i : r.indices) {
-      in[i] = true;
-      A += G.row(i).transpose() * G.row(i);
-    }
-    const double current = CriterionScore(A, k, DesignCriterion::kE);
-    EXPECT_NEAR(current, r.score, 1e-12 * r.score);
-    double best_swap = 0;
-    for (int i : r.indices)
-      for (int j = 0; j < rows; ++j) {
-        if (in[j]) continue;
-        const Eigen::MatrixXd B =
-            A - G.row(i).transpose() * G.row(i) + G.row(j).transpose() * G.row(j);
-        best_swap = std::max(best_swap, CriterionScore(B, k, DesignCriterion::kE));
+  for (DesignCriterion c : {DesignCriterion::kE, DesignCriterion::kD, DesignCriterion::kA}) {
+    for (const auto& [rows, cols, k, seed] :
+         {std::tuple{40, 6, 9, 51u}, std::tuple{60, 10, 14, 52u}, std::tuple{101, 25, 30, 53u}}) {
+      const Eigen::MatrixXd G = RandomMatrix(rows, cols, seed);
+      SelectionOptions o;
+      o.method = SelectionMethod::kExchange;
+      o.criterion = c;
+      const SelectionResult r = SelectConfigurations(G, k, o, stream);
+      std::vector<bool> in(rows, false);
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(cols, cols);
+      for (int i : r.indices) {
+        in[i] = true;
+        A += G.row(i).transpose() * G.row(i);
       }
-    EXPECT_LE(best_swap, current * (1 + 1e-10)) << rows << "x" << cols << " k " << k;
+      const double current = CriterionScore(A, k, c);
+      EXPECT_NEAR(current, r.score, 1e-12 * std::fabs(r.score));
+      double best_swap = -std::numeric_limits<double>::infinity();
+      for (int i : r.indices)
+        for (int j = 0; j < rows; ++j) {
+          if (in[j]) continue;
+          const Eigen::MatrixXd B =
+              A - G.row(i).transpose() * G.row(i) + G.row(j).transpose() * G.row(j);
+          best_swap = std::max(best_swap, CriterionScore(B, k, c));
+        }
+      EXPECT_LE(best_swap, current + 1e-10 * std::fabs(current))
+          << DesignCriterionName(c) << " " << rows << "x" << cols << " k " << k;
+    }
   }
 }
 
