@@ -202,27 +202,26 @@ class Spectrum {
   double log_det_ = 0, inv_trace_ = 0;
 };
 
-// E-optimality: the best of A + rho·g_r·g_rᵀ over `rows` by exact scores, evaluated in the
-// order of their Rayleigh bounds (MinEigenvalueBounds) and stopped when the next bound cannot
-// beat the best: the same choice as scoring every row (ties: the lowest position), at a few
-// exact evaluations. Returns the position in `rows`, or -1 if none scores above `floor`.
-int BestByBoundedScores(const Spectrum& spectrum, Spectrum* scorer, const Eigen::MatrixXd& G,
-                        const std::vector<int>& rows, double rho, int m, double floor,
-                        long long* evaluations) {
-  const Eigen::VectorXd bounds = spectrum.MinEigenvalueBounds(G, rows, rho);
-  // A bound in σ units, widened by rounding (relative 1e-12 of the largest eigenvalue).
-  const double slack = 1e-12 * std::fabs(spectrum.eigenvalues().maxCoeff());
-  std::vector<int> order(rows.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return bounds[a] > bounds[b] || (bounds[a] == bounds[b] && a < b);
-  });
+// Branch and bound over candidate positions 0 … P−1: evaluates exact(pos, best) in the order of
+// `keys` (highest first; ties: the lowest position) and stops at the first position whose upper
+// bound bound(pos) is below the best exact score so far (which starts at `floor`). The same
+// choice as evaluating every position: the largest exact score above `floor`, ties to the lowest
+// position; -1 if none. exact(pos, best) may return any value below `best` once it knows it
+// cannot beat it.
+template <typename Bound, typename Exact>
+int BestInBoundOrder(const Eigen::VectorXd& keys, Bound bound, Exact exact, double floor,
+                     long long* evaluations) {
+  std::vector<int> order;  // only positions that can beat `floor`: the others come after the stop
+  order.reserve(static_cast<std::size_t>(keys.size()));
+  for (int pos = 0; pos < keys.size(); ++pos)
+    if (!(bound(pos) < floor)) order.push_back(pos);
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return keys[a] > keys[b] || (keys[a] == keys[b] && a < b); });
   double best = floor;
   int best_pos = -1;
   for (int pos : order) {
-    const double bound = std::sqrt(std::max(bounds[pos] + slack, 0.0));
-    if (bound < best) break;
-    const double s = scorer->Score(G.row(rows[pos]).transpose(), rho, m, DesignCriterion::kE);
+    if (bound(pos) < best) break;
+    const double s = exact(pos, best);
     ++*evaluations;
     if (s > best || (s == best && best_pos >= 0 && pos < best_pos)) {
       best = s;
@@ -230,6 +229,24 @@ int BestByBoundedScores(const Spectrum& spectrum, Spectrum* scorer, const Eigen:
     }
   }
   return best_pos;
+}
+
+// E-optimality: the best of A + rho·g_r·g_rᵀ over `rows` by exact scores, evaluated in the
+// order of their Rayleigh bounds (MinEigenvalueBounds) and stopped when the next bound cannot
+// beat the best (BestInBoundOrder). Returns the position in `rows`, or -1 if none scores above
+// `floor`.
+int BestByBoundedScores(const Spectrum& spectrum, Spectrum* scorer, const Eigen::MatrixXd& G,
+                        const std::vector<int>& rows, double rho, int m, double floor,
+                        long long* evaluations) {
+  const Eigen::VectorXd bounds = spectrum.MinEigenvalueBounds(G, rows, rho);
+  // A bound in σ units, widened by rounding (relative 1e-12 of the largest eigenvalue).
+  const double slack = 1e-12 * std::fabs(spectrum.eigenvalues().maxCoeff());
+  return BestInBoundOrder(
+      bounds, [&](int pos) { return std::sqrt(std::max(bounds[pos] + slack, 0.0)); },
+      [&](int pos, double) {
+        return scorer->Score(G.row(rows[pos]).transpose(), rho, m, DesignCriterion::kE);
+      },
+      floor, evaluations);
 }
 
 // λ_min(Λ + su·u·uᵀ + sv·v·vᵀ) for Λ = diag(lambda) (ascending) and signs su, sv = ±1, by
@@ -285,24 +302,12 @@ int BestSecondStep(const Spectrum& spectrum, const Eigen::MatrixXd& G, const std
                                      .minCoeff()
                                      .matrix();
   const double slack = 1e-12 * std::fabs(lambda.maxCoeff());
-  std::vector<int> order(rows.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return bounds[a] > bounds[b] || (bounds[a] == bounds[b] && a < b);
-  });
-  double best = kMinusInf;
-  int best_pos = -1;
-  for (int pos : order) {
-    const double bound = bounds[pos] + slack;
-    if (bound < best) break;
-    const double mu = RankTwoMinEigenvalue(lambda, u, rho, Z.row(pos), rho, bound, best);
-    ++*evaluations;
-    if (mu > best || (mu == best && best_pos >= 0 && pos < best_pos)) {
-      best = mu;
-      best_pos = pos;
-    }
-  }
-  return best_pos;
+  return BestInBoundOrder(
+      bounds, [&](int pos) { return bounds[pos] + slack; },
+      [&](int pos, double best) {
+        return RankTwoMinEigenvalue(lambda, u, rho, Z.row(pos), rho, bounds[pos] + slack, best);
+      },
+      kMinusInf, evaluations);
 }
 
 // k distinct indices of 0..N-1 by a partial Fisher–Yates shuffle on the stream's draws.
@@ -487,27 +492,17 @@ struct SwapSpectrum {
   int BestSwap(int i, const std::vector<int>& outside, double floor, long long* evaluations) const {
     const double slack = 1e-12 * std::fabs(lambda.maxCoeff());
     const Eigen::RowVectorXd base = lambda.transpose() - Z2.row(i);
-    std::vector<std::pair<double, int>> bounds;
-    bounds.reserve(outside.size());
-    for (int j : outside) {
-      const double bound = (base + Z2.row(j)).minCoeff() + slack;
-      if (bound >= floor) bounds.emplace_back(bound, j);
-    }
-    std::sort(bounds.begin(), bounds.end(), [](const auto& x, const auto& y) {
-      return x.first > y.first || (x.first == y.first && x.second < y.second);
-    });
-    double best = floor;
-    int best_j = -1;
-    for (const auto& [bound, j] : bounds) {
-      if (bound < best) break;
-      const double mu = RankTwoMinEigenvalue(lambda, Z.row(i), -1, Z.row(j), 1, bound, best);
-      ++*evaluations;
-      if (mu > best || (mu == best && best_j >= 0 && j < best_j)) {
-        best = mu;
-        best_j = j;
-      }
-    }
-    return best_j;
+    // Positions in `outside` (ascending, so the lowest position is the lowest index).
+    Eigen::VectorXd bounds(static_cast<Eigen::Index>(outside.size()));
+    for (std::size_t p = 0; p < outside.size(); ++p)
+      bounds[static_cast<Eigen::Index>(p)] = (base + Z2.row(outside[p])).minCoeff() + slack;
+    const int pos = BestInBoundOrder(
+        bounds, [&](int p) { return bounds[p]; },
+        [&](int p, double best) {
+          return RankTwoMinEigenvalue(lambda, Z.row(i), -1, Z.row(outside[p]), 1, bounds[p], best);
+        },
+        floor, evaluations);
+    return pos < 0 ? -1 : outside[pos];
   }
 };
 
@@ -566,6 +561,26 @@ double SwapScore(const ExchangeState& x, int i, int j) {
   return -(f.inv_trace - change);
 }
 
+// A with design row i swapped for candidate j.
+Eigen::MatrixXd SwappedNormalMatrix(const ExchangeState& x, int i, int j) {
+  Eigen::MatrixXd A = x.A;
+  A.noalias() -= x.G.row(i).transpose() * x.G.row(i);
+  A.noalias() += x.G.row(j).transpose() * x.G.row(j);
+  return A;
+}
+
+// Makes the swap of design[pos] for candidate j, whose normal matrix is A and exact score
+// `exact`; the swap data of the old design are stale.
+void AcceptSwap(ExchangeState* x, int pos, int j, Eigen::MatrixXd A, double exact) {
+  x->in[x->design[pos]] = false;
+  x->in[j] = true;
+  x->design[pos] = j;
+  x->A = std::move(A);
+  x->current = exact;
+  x->swaps.valid = false;
+  x->forms.valid = false;
+}
+
 // E: replaces design[pos] by its best improving swap (SwapSpectrum); true if it did.
 bool ImproveAtE(ExchangeState* x, int pos, const std::vector<int>& outside) {
   const int i = x->design[pos];
@@ -574,20 +589,14 @@ bool ImproveAtE(ExchangeState* x, int pos, const std::vector<int>& outside) {
   if (!x->swaps.valid) x->swaps.Compute(x->G, x->A);
   const int best_in = x->swaps.BestSwap(i, outside, floor * floor, x->evaluations);
   if (best_in < 0) return false;
-  Eigen::MatrixXd A = x->A;
-  A.noalias() -= x->G.row(i).transpose() * x->G.row(i);
-  A.noalias() += x->G.row(best_in).transpose() * x->G.row(best_in);
+  Eigen::MatrixXd A = SwappedNormalMatrix(*x, i, best_in);
   SwapSpectrum fresh;
   fresh.Compute(x->G, A);
   const double exact =
       ScoreFromEigenvalues(fresh.lambda, static_cast<int>(x->design.size()), DesignCriterion::kE);
   if (!(exact > x->current)) return false;  // the evaluation was wrong at rounding level
-  x->A = A;
-  x->current = exact;
-  x->swaps = std::move(fresh);
-  x->in[i] = false;
-  x->in[best_in] = true;
-  x->design[pos] = best_in;
+  AcceptSwap(x, pos, best_in, std::move(A), exact);
+  x->swaps = std::move(fresh);  // the new design's spectrum, already computed
   return true;
 }
 
@@ -605,17 +614,10 @@ bool ImproveAtDA(ExchangeState* x, int pos, const std::vector<int>& outside, dou
     }
   }
   if (best_in < 0) return false;
-  Eigen::MatrixXd A = x->A;
-  A.noalias() -= x->G.row(i).transpose() * x->G.row(i);
-  A.noalias() += x->G.row(best_in).transpose() * x->G.row(best_in);
+  Eigen::MatrixXd A = SwappedNormalMatrix(*x, i, best_in);
   const double exact = CriterionScore(A, k, x->criterion);
   if (!(exact > x->current)) return false;  // the formula was wrong at rounding level
-  x->A = A;
-  x->current = exact;
-  x->forms.valid = false;
-  x->in[i] = false;
-  x->in[best_in] = true;
-  x->design[pos] = best_in;
+  AcceptSwap(x, pos, best_in, std::move(A), exact);
   return true;
 }
 
@@ -648,11 +650,7 @@ bool ImproveAt(ExchangeState* x, int pos) {
   without.noalias() += x->G.row(best_in).transpose() * x->G.row(best_in);
   const double exact = CriterionScore(without, k, x->criterion);
   if (!(exact > x->current)) return false;  // the what-if was wrong at rounding level
-  x->A = without;
-  x->current = exact;
-  x->in[i] = false;
-  x->in[best_in] = true;
-  x->design[pos] = best_in;
+  AcceptSwap(x, pos, best_in, std::move(without), exact);
   return true;
 }
 
