@@ -127,17 +127,24 @@ void BM_NormalMatrixFixedLanes100x25(benchmark::State& state) {
 }
 BENCHMARK(BM_NormalMatrixFixedLanes100x25);
 
-// Choosing 50 of the paper's 101 candidates (25 parameters) by each method, E-optimality.
-void BM_Select50of101(benchmark::State& state) {
+// Choosing 50 of the paper's 101 candidates (25 parameters) with `options`; the chosen design's
+// score as a counter.
+void Select50of101(benchmark::State& state, const SelectionOptions& options, const char* label,
+                   const char* counter) {
   const CellContext& c = *Case(50).context;
   const Eigen::MatrixXd G = IdentificationJacobian(*c.model, c.pool);
-  SelectionOptions o;
-  o.method = static_cast<SelectionMethod>(state.range(0));
-  state.SetLabel(SelectionMethodName(o.method));
+  state.SetLabel(label);
   RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
   double score = 0;
-  for (auto _ : state) score = SelectConfigurations(G, 50, o, stream).score;
-  state.counters["sigma_min"] = score;
+  for (auto _ : state) score = SelectConfigurations(G, 50, options, stream).score;
+  state.counters[counter] = score;
+}
+
+// By each method, E-optimality.
+void BM_Select50of101(benchmark::State& state) {
+  SelectionOptions o;
+  o.method = static_cast<SelectionMethod>(state.range(0));
+  Select50of101(state, o, SelectionMethodName(o.method), "sigma_min");
 }
 BENCHMARK(BM_Select50of101)
     ->Arg(static_cast<int>(SelectionMethod::kBackward))
@@ -147,18 +154,12 @@ BENCHMARK(BM_Select50of101)
     ->Arg(static_cast<int>(SelectionMethod::kRandom))
     ->Unit(benchmark::kMillisecond);
 
-// Exchange, 50 of the paper's 101 candidates, by criterion (E is BM_Select50of101/3).
+// Exchange by criterion (E is BM_Select50of101/3).
 void BM_Exchange50of101(benchmark::State& state) {
-  const CellContext& c = *Case(50).context;
-  const Eigen::MatrixXd G = IdentificationJacobian(*c.model, c.pool);
   SelectionOptions o;
   o.method = SelectionMethod::kExchange;
   o.criterion = static_cast<DesignCriterion>(state.range(0));
-  state.SetLabel(DesignCriterionName(o.criterion));
-  RandomStream stream(1, 0, 0, RandomPurpose::kSelection);
-  double score = 0;
-  for (auto _ : state) score = SelectConfigurations(G, 50, o, stream).score;
-  state.counters["score"] = score;
+  Select50of101(state, o, DesignCriterionName(o.criterion), "score");
 }
 BENCHMARK(BM_Exchange50of101)
     ->Arg(static_cast<int>(DesignCriterion::kD))
