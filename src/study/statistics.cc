@@ -16,7 +16,7 @@
 #include <thread>
 #include <tuple>
 
-#include "identification/levenberg_marquardt.h"
+#include "lrcal/core/dense_kernels.h"
 
 namespace lrcal {
 

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <random>
 
-#include "identification/levenberg_marquardt.h"
+#include "core/dense_kernel_variants.h"
 #include "lrcal/identification/identification.h"
 #include "measurement/batch_evaluation.h"
 #include "test_util.h"

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <random>
 
-#include "identification/levenberg_marquardt.h"
+#include "lrcal/core/dense_kernels.h"
 #include "lrcal/core/random.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/io/csv.h"

@@ -1,0 +1,14 @@
+// The dense kernels (lrcal/core/dense_kernels.h) with a chosen instruction-set variant, for the
+// tests that check every variant gives the same bits and for the benchmarks.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "core/cpu_dispatch.h"
+
+namespace lrcal {
+
+/// NormalMatrix(J, A) run by the given variant (one this CPU supports: SupportedIsas()).
+void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa);
+
+}  // namespace lrcal

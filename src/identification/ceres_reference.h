@@ -1,0 +1,22 @@
+// The reference solver: Ceres' Levenberg–Marquardt on the same analytic cost as lrcal's own
+// solver (levenberg_marquardt.h), tested to agree with it to 1e-9 (least squares) and 1e-8
+// (robust losses). Private to src/identification: users call Identify() with
+// IdentificationOptions::Solver::kCeres.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "lrcal/identification/identification.h"
+
+namespace lrcal {
+
+/// Least squares from e = 0 with all configurations in one residual block (Ceres' per-block
+/// overhead paid once), then, with a robust loss, the refinement from that estimate with one
+/// block per configuration (Ceres applies a loss to a whole block's squared norm). Fills e,
+/// the iterations of both solves and Ceres' messages.
+Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           int* iterations, std::string* message);
+
+}  // namespace lrcal
