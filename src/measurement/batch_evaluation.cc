@@ -57,161 +57,252 @@ struct KernelArgs {
   double* J;
 };
 
-// The vectorised kernel: structure-of-arrays loops over all configurations, inlined into one
-// variant per instruction set (cpu_dispatch.h). Kept in one function on purpose: the compiler
-// vectorises and inlines it whole, and the variants must give the same bits.
-// Several planes: each configuration's plane normal and offset are gathered into arrays.
-template <bool kJacobian, bool kSeveralPlanes>
-// NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
-[[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
-  const int m = args.m;
-  const ModelPoint& point = *args.point;
-  double* __restrict h = args.h;
-  double* __restrict J = args.J;
-  double* __restrict x0 = args.state;
-  double* __restrict x1 = x0 + m;
-  double* __restrict x2 = x1 + m;
-  double* __restrict y0 = x2 + m;
-  double* __restrict y1 = y0 + m;
-  double* __restrict y2 = y1 + m;
-  double* __restrict z0 = y2 + m;
-  double* __restrict z1 = z0 + m;
-  double* __restrict z2 = z1 + m;
-  double* __restrict o0 = z2 + m;
-  double* __restrict o1 = o0 + m;
-  double* __restrict o2 = o1 + m;
-  // The chain starts at frame 0: the base transform's axes and origin (the identity without one).
+// The vectorised kernel: structure-of-arrays loops over all configurations, in force-inlined
+// steps that the compiler inlines into one function per instruction set (cpu_dispatch.h); every
+// variant gives the same bits (each configuration's arithmetic is the same sequence of
+// operations, and -ffp-contract=off forbids fused multiply-adds).
+//
+// The chain's running frame, 12 arrays of m: the axes x, y, z and the origin o, each as three
+// coordinate arrays (args.state).
+struct FrameArrays {
+  double* __restrict x0;
+  double* __restrict x1;
+  double* __restrict x2;
+  double* __restrict y0;
+  double* __restrict y1;
+  double* __restrict y2;
+  double* __restrict z0;
+  double* __restrict z1;
+  double* __restrict z2;
+  double* __restrict o0;
+  double* __restrict o1;
+  double* __restrict o2;
+};
+
+[[gnu::always_inline]] inline FrameArrays FrameArraysOf(double* state, int m) {
+  return {state,         state + m,     state + 2 * m,  state + 3 * m,
+          state + 4 * m, state + 5 * m, state + 6 * m,  state + 7 * m,
+          state + 8 * m, state + 9 * m, state + 10 * m, state + 11 * m};
+}
+
+// The chain starts at frame 0: the base transform's axes and origin (the identity without one).
+[[gnu::always_inline]] inline void StartAtBase(const ModelPoint& point, int m,
+                                               const FrameArrays& s) {
   const Eigen::Matrix3d& rb = point.base.rotation;
   const Eigen::Vector3d& pb = point.base.translation;
-  double* const start[12] = {x0, x1, x2, y0, y1, y2, z0, z1, z2, o0, o1, o2};
+  double* const start[12] = {s.x0, s.x1, s.x2, s.y0, s.y1, s.y2,
+                             s.z0, s.z1, s.z2, s.o0, s.o1, s.o2};
   for (int k = 0; k < 12; ++k)
     std::fill(start[k], start[k] + m, k < 9 ? rb(k % 3, k / 3) : pb(k - 9));
+}
 
-  for (int l = 0; l < point.num_links; ++l) {
-    const ModelPoint::LinkTrig& t = point.links[l];
-    const double* __restrict cq = args.cq + l * m;
-    const double* __restrict sq = args.sq + l * m;
-    const double* __restrict q = args.q + l * m;
-    double* f = args.frames + static_cast<std::size_t>(l) * kFrameArrays * m;
-    double* __restrict fz0 = f + (kZPrev + 0) * m;
-    double* __restrict fz1 = f + (kZPrev + 1) * m;
-    double* __restrict fz2 = f + (kZPrev + 2) * m;
-    double* __restrict fp0 = f + (kOPrev + 0) * m;
-    double* __restrict fp1 = f + (kOPrev + 1) * m;
-    double* __restrict fp2 = f + (kOPrev + 2) * m;
-    double* __restrict fx0 = f + (kXCommon + 0) * m;
-    double* __restrict fx1 = f + (kXCommon + 1) * m;
-    double* __restrict fx2 = f + (kXCommon + 2) * m;
-    double* __restrict fy0 = f + (kYTwist + 0) * m;
-    double* __restrict fy1 = f + (kYTwist + 1) * m;
-    double* __restrict fy2 = f + (kYTwist + 2) * m;
-    double* __restrict fo0 = f + (kO + 0) * m;
-    double* __restrict fo1 = f + (kO + 1) * m;
-    double* __restrict fo2 = f + (kO + 2) * m;
-    const double ct0 = t.cos_theta0, st0 = t.sin_theta0, ca = t.cos_alpha, sa = t.sin_alpha,
-                 cb = t.cos_beta, sb = t.sin_beta, a = t.a, d0 = t.d;
-    const double revolute = t.prismatic ? 0.0 : 1.0;
-#pragma GCC ivdep
-    for (int i = 0; i < m; ++i) {
-      // cos/sin(θ0 + q) by the addition theorem (revolute); θ0 alone and d0 + q (prismatic).
-      const double ct = revolute * (ct0 * cq[i] - st0 * sq[i]) + (1 - revolute) * ct0;
-      const double st = revolute * (st0 * cq[i] + ct0 * sq[i]) + (1 - revolute) * st0;
-      const double d = d0 + (1 - revolute) * q[i];
-      const double xc0 = ct * x0[i] + st * y0[i];
-      const double xc1 = ct * x1[i] + st * y1[i];
-      const double xc2 = ct * x2[i] + st * y2[i];
-      const double yr0 = ct * y0[i] - st * x0[i];
-      const double yr1 = ct * y1[i] - st * x1[i];
-      const double yr2 = ct * y2[i] - st * x2[i];
-      const double yt0 = ca * yr0 + sa * z0[i];
-      const double yt1 = ca * yr1 + sa * z1[i];
-      const double yt2 = ca * yr2 + sa * z2[i];
-      const double za0 = ca * z0[i] - sa * yr0;
-      const double za1 = ca * z1[i] - sa * yr1;
-      const double za2 = ca * z2[i] - sa * yr2;
-      if constexpr (kJacobian) {
-        fz0[i] = z0[i];
-        fz1[i] = z1[i];
-        fz2[i] = z2[i];
-        fp0[i] = o0[i];
-        fp1[i] = o1[i];
-        fp2[i] = o2[i];
-        fx0[i] = xc0;
-        fx1[i] = xc1;
-        fx2[i] = xc2;
-        fy0[i] = yt0;
-        fy1[i] = yt1;
-        fy2[i] = yt2;
-      }
-      o0[i] += a * xc0 + d * z0[i];
-      o1[i] += a * xc1 + d * z1[i];
-      o2[i] += a * xc2 + d * z2[i];
-      if constexpr (kJacobian) {
-        fo0[i] = o0[i];
-        fo1[i] = o1[i];
-        fo2[i] = o2[i];
-      }
-      x0[i] = cb * xc0 - sb * za0;
-      x1[i] = cb * xc1 - sb * za1;
-      x2[i] = cb * xc2 - sb * za2;
-      z0[i] = sb * xc0 + cb * za0;
-      z1[i] = sb * xc1 + cb * za1;
-      z2[i] = sb * xc2 + cb * za2;
-      y0[i] = yt0;
-      y1[i] = yt1;
-      y2[i] = yt2;
-    }
-  }
+// Link l's frames saved for the Jacobian (kFrameArrays arrays of m, kZPrev ... kO).
+struct LinkFrames {
+  double* __restrict z0;
+  double* __restrict z1;
+  double* __restrict z2;
+  double* __restrict p0;
+  double* __restrict p1;
+  double* __restrict p2;
+  double* __restrict x0;
+  double* __restrict x1;
+  double* __restrict x2;
+  double* __restrict y0;
+  double* __restrict y1;
+  double* __restrict y2;
+  double* __restrict o0;
+  double* __restrict o1;
+  double* __restrict o2;
+};
 
-  if (point.has_tool) {  // the tool frame: p ← p + R·t, R ← R·R_tool
-    const Eigen::Matrix3d& rt = point.tool.rotation;
-    const Eigen::Vector3d& pt = point.tool.translation;
-#pragma GCC ivdep
-    for (int i = 0; i < m; ++i) {
-      const double r[3][3] = {{x0[i], y0[i], z0[i]}, {x1[i], y1[i], z1[i]}, {x2[i], y2[i], z2[i]}};
-      double* const axes[3][3] = {{x0, y0, z0}, {x1, y1, z1}, {x2, y2, z2}};
-      double* const origin[3] = {o0, o1, o2};
-      for (int row = 0; row < 3; ++row) {
-        origin[row][i] += r[row][0] * pt(0) + r[row][1] * pt(1) + r[row][2] * pt(2);
-        for (int col = 0; col < 3; ++col)
-          axes[row][col][i] =
-              r[row][0] * rt(0, col) + r[row][1] * rt(1, col) + r[row][2] * rt(2, col);
-      }
-    }
-  }
+[[gnu::always_inline]] inline LinkFrames LinkFramesOf(double* frames, int l, int m) {
+  double* f = frames + static_cast<std::size_t>(l) * kFrameArrays * m;
+  return {f + (kZPrev + 0) * m,   f + (kZPrev + 1) * m,   f + (kZPrev + 2) * m,
+          f + (kOPrev + 0) * m,   f + (kOPrev + 1) * m,   f + (kOPrev + 2) * m,
+          f + (kXCommon + 0) * m, f + (kXCommon + 1) * m, f + (kXCommon + 2) * m,
+          f + (kYTwist + 0) * m,  f + (kYTwist + 1) * m,  f + (kYTwist + 2) * m,
+          f + (kO + 0) * m,       f + (kO + 1) * m,       f + (kO + 2) * m};
+}
 
-  // Readings: h = -(n·p + f)/(n·b); keep -1/(n·b) and the hit point for the Jacobian. With one
-  // plane its normal n and offset are scalars; with several, arrays over the configurations.
-  double* __restrict inv = args.scratch;
-  double* __restrict ph0 = inv + m;
-  double* __restrict ph1 = ph0 + m;
-  double* __restrict ph2 = ph1 + m;
-  double* __restrict nbs = ph2 + m;
-  double* __restrict pn0 = nbs + m;
-  double* __restrict pn1 = pn0 + m;
-  double* __restrict pn2 = pn1 + m;
-  double* __restrict pf = pn2 + m;
-  const Plane& plane0 = point.planes[0];
-  const double s0 = plane0.normal.x(), s1 = plane0.normal.y(), s2 = plane0.normal.z(),
-               sf = plane0.offset;
-  if constexpr (kSeveralPlanes) {
-    for (int i = 0; i < m; ++i) {
-      const Plane& p = point.planes[args.plane[i]];
-      pn0[i] = p.normal.x();
-      pn1[i] = p.normal.y();
-      pn2[i] = p.normal.z();
-      pf[i] = p.offset;
-    }
-  }
-  // n at configuration i: the one plane's, or configuration i's plane's.
-  const auto n0 = [&](int i) { return kSeveralPlanes ? pn0[i] : s0; };
-  const auto n1 = [&](int i) { return kSeveralPlanes ? pn1[i] : s1; };
-  const auto n2 = [&](int i) { return kSeveralPlanes ? pn2[i] : s2; };
-  const auto fo = [&](int i) { return kSeveralPlanes ? pf[i] : sf; };
+// The running frame through link l (D-H + β), saving the link's frames when the Jacobian is
+// wanted.
+template <bool kJacobian>
+[[gnu::always_inline]] inline void PropagateLink(const KernelArgs& args, int l,
+                                                 const FrameArrays& s) {
+  const int m = args.m;
+  const ModelPoint::LinkTrig& t = args.point->links[l];
+  const double* __restrict cq = args.cq + l * m;
+  const double* __restrict sq = args.sq + l * m;
+  const double* __restrict q = args.q + l * m;
+  const LinkFrames f = LinkFramesOf(args.frames, l, m);
+  double* __restrict x0 = s.x0;
+  double* __restrict x1 = s.x1;
+  double* __restrict x2 = s.x2;
+  double* __restrict y0 = s.y0;
+  double* __restrict y1 = s.y1;
+  double* __restrict y2 = s.y2;
+  double* __restrict z0 = s.z0;
+  double* __restrict z1 = s.z1;
+  double* __restrict z2 = s.z2;
+  double* __restrict o0 = s.o0;
+  double* __restrict o1 = s.o1;
+  double* __restrict o2 = s.o2;
+  const double ct0 = t.cos_theta0, st0 = t.sin_theta0, ca = t.cos_alpha, sa = t.sin_alpha,
+               cb = t.cos_beta, sb = t.sin_beta, a = t.a, d0 = t.d;
+  const double revolute = t.prismatic ? 0.0 : 1.0;
 #pragma GCC ivdep
   for (int i = 0; i < m; ++i) {
-    const double nb = n0(i) * z0[i] + n1(i) * z1[i] + n2(i) * z2[i];
-    const double hi = -(n0(i) * o0[i] + n1(i) * o1[i] + n2(i) * o2[i] + fo(i)) / nb;
+    // cos/sin(θ0 + q) by the addition theorem (revolute); θ0 alone and d0 + q (prismatic).
+    const double ct = revolute * (ct0 * cq[i] - st0 * sq[i]) + (1 - revolute) * ct0;
+    const double st = revolute * (st0 * cq[i] + ct0 * sq[i]) + (1 - revolute) * st0;
+    const double d = d0 + (1 - revolute) * q[i];
+    const double xc0 = ct * x0[i] + st * y0[i];
+    const double xc1 = ct * x1[i] + st * y1[i];
+    const double xc2 = ct * x2[i] + st * y2[i];
+    const double yr0 = ct * y0[i] - st * x0[i];
+    const double yr1 = ct * y1[i] - st * x1[i];
+    const double yr2 = ct * y2[i] - st * x2[i];
+    const double yt0 = ca * yr0 + sa * z0[i];
+    const double yt1 = ca * yr1 + sa * z1[i];
+    const double yt2 = ca * yr2 + sa * z2[i];
+    const double za0 = ca * z0[i] - sa * yr0;
+    const double za1 = ca * z1[i] - sa * yr1;
+    const double za2 = ca * z2[i] - sa * yr2;
+    if constexpr (kJacobian) {
+      f.z0[i] = z0[i];
+      f.z1[i] = z1[i];
+      f.z2[i] = z2[i];
+      f.p0[i] = o0[i];
+      f.p1[i] = o1[i];
+      f.p2[i] = o2[i];
+      f.x0[i] = xc0;
+      f.x1[i] = xc1;
+      f.x2[i] = xc2;
+      f.y0[i] = yt0;
+      f.y1[i] = yt1;
+      f.y2[i] = yt2;
+    }
+    o0[i] += a * xc0 + d * z0[i];
+    o1[i] += a * xc1 + d * z1[i];
+    o2[i] += a * xc2 + d * z2[i];
+    if constexpr (kJacobian) {
+      f.o0[i] = o0[i];
+      f.o1[i] = o1[i];
+      f.o2[i] = o2[i];
+    }
+    x0[i] = cb * xc0 - sb * za0;
+    x1[i] = cb * xc1 - sb * za1;
+    x2[i] = cb * xc2 - sb * za2;
+    z0[i] = sb * xc0 + cb * za0;
+    z1[i] = sb * xc1 + cb * za1;
+    z2[i] = sb * xc2 + cb * za2;
+    y0[i] = yt0;
+    y1[i] = yt1;
+    y2[i] = yt2;
+  }
+}
+
+// The tool frame: p ← p + R·t, R ← R·R_tool.
+[[gnu::always_inline]] inline void ApplyTool(const ModelPoint& point, int m, const FrameArrays& s) {
+  const Eigen::Matrix3d& rt = point.tool.rotation;
+  const Eigen::Vector3d& pt = point.tool.translation;
+  double* __restrict x0 = s.x0;
+  double* __restrict x1 = s.x1;
+  double* __restrict x2 = s.x2;
+  double* __restrict y0 = s.y0;
+  double* __restrict y1 = s.y1;
+  double* __restrict y2 = s.y2;
+  double* __restrict z0 = s.z0;
+  double* __restrict z1 = s.z1;
+  double* __restrict z2 = s.z2;
+  double* __restrict o0 = s.o0;
+  double* __restrict o1 = s.o1;
+  double* __restrict o2 = s.o2;
+#pragma GCC ivdep
+  for (int i = 0; i < m; ++i) {
+    const double r[3][3] = {{x0[i], y0[i], z0[i]}, {x1[i], y1[i], z1[i]}, {x2[i], y2[i], z2[i]}};
+    double* const axes[3][3] = {{x0, y0, z0}, {x1, y1, z1}, {x2, y2, z2}};
+    double* const origin[3] = {o0, o1, o2};
+    for (int row = 0; row < 3; ++row) {
+      origin[row][i] += r[row][0] * pt(0) + r[row][1] * pt(1) + r[row][2] * pt(2);
+      for (int col = 0; col < 3; ++col)
+        axes[row][col][i] =
+            r[row][0] * rt(0, col) + r[row][1] * rt(1, col) + r[row][2] * rt(2, col);
+    }
+  }
+}
+
+// What the readings leave for the Jacobian (args.scratch, 9 arrays of m): −1/(n·b), the hit
+// point, n·b, and (several planes) each configuration's plane normal and offset.
+struct ReadingArrays {
+  double* __restrict inv;
+  double* __restrict ph0;
+  double* __restrict ph1;
+  double* __restrict ph2;
+  double* __restrict nbs;
+  double* __restrict pn0;
+  double* __restrict pn1;
+  double* __restrict pn2;
+  double* __restrict pf;
+};
+
+[[gnu::always_inline]] inline ReadingArrays ReadingArraysOf(double* scratch, int m) {
+  return {scratch,         scratch + m,     scratch + 2 * m, scratch + 3 * m, scratch + 4 * m,
+          scratch + 5 * m, scratch + 6 * m, scratch + 7 * m, scratch + 8 * m};
+}
+
+// The plane normal n and offset f at configuration i: the one plane's (scalars), or
+// configuration i's plane's (gathered into arrays).
+template <bool kSeveralPlanes>
+struct PlaneAt {
+  const ReadingArrays& r;
+  double s0, s1, s2, sf;
+  [[gnu::always_inline]] double n0(int i) const { return kSeveralPlanes ? r.pn0[i] : s0; }
+  [[gnu::always_inline]] double n1(int i) const { return kSeveralPlanes ? r.pn1[i] : s1; }
+  [[gnu::always_inline]] double n2(int i) const { return kSeveralPlanes ? r.pn2[i] : s2; }
+  [[gnu::always_inline]] double f(int i) const { return kSeveralPlanes ? r.pf[i] : sf; }
+};
+
+template <bool kSeveralPlanes>
+[[gnu::always_inline]] inline PlaneAt<kSeveralPlanes> GatherPlanes(const KernelArgs& args,
+                                                                   const ReadingArrays& r) {
+  const ModelPoint& point = *args.point;
+  const Plane& plane0 = point.planes[0];
+  if constexpr (kSeveralPlanes) {
+    for (int i = 0; i < args.m; ++i) {
+      const Plane& p = point.planes[args.plane[i]];
+      r.pn0[i] = p.normal.x();
+      r.pn1[i] = p.normal.y();
+      r.pn2[i] = p.normal.z();
+      r.pf[i] = p.offset;
+    }
+  }
+  return {r, plane0.normal.x(), plane0.normal.y(), plane0.normal.z(), plane0.offset};
+}
+
+// Readings h = −(n·p + f)/(n·b); keeps −1/(n·b) and the hit point for the Jacobian. Returns the
+// number of beams along the plane (|n·b| ≤ kParallelBeamThreshold: no reading).
+template <bool kSeveralPlanes>
+[[gnu::always_inline]] inline int Readings(const KernelArgs& args, const FrameArrays& s,
+                                           const ReadingArrays& r,
+                                           const PlaneAt<kSeveralPlanes>& n) {
+  const int m = args.m;
+  double* __restrict h = args.h;
+  const double* __restrict z0 = s.z0;
+  const double* __restrict z1 = s.z1;
+  const double* __restrict z2 = s.z2;
+  const double* __restrict o0 = s.o0;
+  const double* __restrict o1 = s.o1;
+  const double* __restrict o2 = s.o2;
+  double* __restrict inv = r.inv;
+  double* __restrict ph0 = r.ph0;
+  double* __restrict ph1 = r.ph1;
+  double* __restrict ph2 = r.ph2;
+  double* __restrict nbs = r.nbs;
+#pragma GCC ivdep
+  for (int i = 0; i < m; ++i) {
+    const double nb = n.n0(i) * z0[i] + n.n1(i) * z1[i] + n.n2(i) * z2[i];
+    const double hi = -(n.n0(i) * o0[i] + n.n1(i) * o1[i] + n.n2(i) * o2[i] + n.f(i)) / nb;
     nbs[i] = nb;
     h[i] = hi;
     inv[i] = -1.0 / nb;
@@ -219,63 +310,102 @@ template <bool kJacobian, bool kSeveralPlanes>
     ph1[i] = o1[i] + hi * z1[i];
     ph2[i] = o2[i] + hi * z2[i];
   }
-  int parallel = 0;  // beams along the plane (|n·b| ≤ kParallelBeamThreshold): no reading
+  int parallel = 0;
   for (int i = 0; i < m; ++i) parallel += std::fabs(nbs[i]) <= kParallelBeamThreshold;
-  if constexpr (!kJacobian) return parallel == 0;
+  return parallel;
+}
 
-  const ParameterSet& ps = *args.parameters;
-  for (int k = 0; k < ps.num_robot(); ++k) {
-    const int index = ps.robot_values[k];
-    const int l = index / kValuesPerLink;
-    const double* f = args.frames + static_cast<std::size_t>(l) * kFrameArrays * m;
-    double* __restrict col = J + static_cast<std::size_t>(k) * m;
-    const int v = index % kValuesPerLink;
-    if (v == kD || v == kA) {
-      const double* __restrict a0 = f + (v == kD ? kZPrev : kXCommon) * m;
-      const double* __restrict a1 = a0 + m;
-      const double* __restrict a2 = a1 + m;
-#pragma GCC ivdep
-      for (int i = 0; i < m; ++i) col[i] = (n0(i) * a0[i] + n1(i) * a1[i] + n2(i) * a2[i]) * inv[i];
-      continue;
-    }
-    // θ: axis z_prev through o_prev; α: x_common through o; β: y_twist through o.
-    const double* __restrict c0 = f + (v == kTheta ? kOPrev : kO) * m;
-    const double* __restrict c1 = c0 + m;
-    const double* __restrict c2 = c1 + m;
-    const double* __restrict a0 = f + (v == kTheta ? kZPrev : v == kAlpha ? kXCommon : kYTwist) * m;
+// The Jacobian column of the link value at `index`: d and a move the origin along an axis
+// (n·axis/(−n·b)); θ, α and β turn about an axis through a point ((r × n)·axis/(−n·b), r from
+// that point to the hit point).
+template <bool kSeveralPlanes>
+[[gnu::always_inline]] inline void LinkColumn(const KernelArgs& args, int index,
+                                              const ReadingArrays& r,
+                                              const PlaneAt<kSeveralPlanes>& n,
+                                              double* __restrict col) {
+  const int m = args.m;
+  const int l = index / kValuesPerLink;
+  const double* f = args.frames + static_cast<std::size_t>(l) * kFrameArrays * m;
+  const double* __restrict inv = r.inv;
+  const int v = index % kValuesPerLink;
+  if (v == kD || v == kA) {
+    const double* __restrict a0 = f + (v == kD ? kZPrev : kXCommon) * m;
     const double* __restrict a1 = a0 + m;
     const double* __restrict a2 = a1 + m;
 #pragma GCC ivdep
-    for (int i = 0; i < m; ++i) {
-      const double r0 = ph0[i] - c0[i], r1 = ph1[i] - c1[i], r2 = ph2[i] - c2[i];
-      // (r × n)·axis
-      const double g = (r1 * n2(i) - r2 * n1(i)) * a0[i] + (r2 * n0(i) - r0 * n2(i)) * a1[i] +
-                       (r0 * n1(i) - r1 * n0(i)) * a2[i];
-      col[i] = g * inv[i];
-    }
+    for (int i = 0; i < m; ++i)
+      col[i] = (n.n0(i) * a0[i] + n.n1(i) * a1[i] + n.n2(i) * a2[i]) * inv[i];
+    return;
   }
-  for (int p = 0; p < ps.num_planes(); ++p) {
-    const PlaneColumns& pc = ps.plane_columns[p];
-    // 1 on the configurations aimed at plane p, 0 elsewhere (all are aimed at plane 0 in the
-    // single-plane kernel).
-    const double all_own = p == 0 ? 1.0 : 0.0;
-    const auto own = [&](int i) {
-      return kSeveralPlanes ? (args.plane[i] == p ? 1.0 : 0.0) : all_own;
-    };
-    for (int c = 0; c < 2; ++c) {
-      if (pc.u[c] < 0) continue;
-      double* __restrict col = J + static_cast<std::size_t>(pc.u[c]) * m;
-      const double d0 = point.dn_du[p](0, c), d1 = point.dn_du[p](1, c), d2 = point.dn_du[p](2, c);
+  // θ: axis z_prev through o_prev; α: x_common through o; β: y_twist through o.
+  const double* __restrict c0 = f + (v == kTheta ? kOPrev : kO) * m;
+  const double* __restrict c1 = c0 + m;
+  const double* __restrict c2 = c1 + m;
+  const double* __restrict a0 = f + (v == kTheta ? kZPrev : v == kAlpha ? kXCommon : kYTwist) * m;
+  const double* __restrict a1 = a0 + m;
+  const double* __restrict a2 = a1 + m;
+  const double* __restrict ph0 = r.ph0;
+  const double* __restrict ph1 = r.ph1;
+  const double* __restrict ph2 = r.ph2;
 #pragma GCC ivdep
-      for (int i = 0; i < m; ++i)
-        col[i] = own(i) * ((ph0[i] * d0 + ph1[i] * d1 + ph2[i] * d2) * inv[i]);
-    }
-    if (pc.f >= 0) {
-      double* __restrict col = J + static_cast<std::size_t>(pc.f) * m;
-#pragma GCC ivdep
-      for (int i = 0; i < m; ++i) col[i] = own(i) * inv[i];
-    }
+  for (int i = 0; i < m; ++i) {
+    const double r0 = ph0[i] - c0[i], r1 = ph1[i] - c1[i], r2 = ph2[i] - c2[i];
+    // (r × n)·axis
+    const double g = (r1 * n.n2(i) - r2 * n.n1(i)) * a0[i] + (r2 * n.n0(i) - r0 * n.n2(i)) * a1[i] +
+                     (r0 * n.n1(i) - r1 * n.n0(i)) * a2[i];
+    col[i] = g * inv[i];
   }
+}
+
+// The Jacobian columns of plane p's chart u (two) and offset f: nonzero only on the
+// configurations aimed at plane p (all are aimed at plane 0 in the single-plane kernel).
+template <bool kSeveralPlanes>
+[[gnu::always_inline]] inline void PlaneColumnsOf(const KernelArgs& args, int p,
+                                                  const ReadingArrays& r) {
+  const int m = args.m;
+  const PlaneColumns& pc = args.parameters->plane_columns[p];
+  const double* __restrict inv = r.inv;
+  const double* __restrict ph0 = r.ph0;
+  const double* __restrict ph1 = r.ph1;
+  const double* __restrict ph2 = r.ph2;
+  const double all_own = p == 0 ? 1.0 : 0.0;
+  const auto own = [&](int i) {
+    return kSeveralPlanes ? (args.plane[i] == p ? 1.0 : 0.0) : all_own;
+  };
+  for (int c = 0; c < 2; ++c) {
+    if (pc.u[c] < 0) continue;
+    double* __restrict col = args.J + static_cast<std::size_t>(pc.u[c]) * m;
+    const Eigen::Matrix<double, 3, 2>& dn_du = args.point->dn_du[p];
+    const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
+#pragma GCC ivdep
+    for (int i = 0; i < m; ++i)
+      col[i] = own(i) * ((ph0[i] * d0 + ph1[i] * d1 + ph2[i] * d2) * inv[i]);
+  }
+  if (pc.f >= 0) {
+    double* __restrict col = args.J + static_cast<std::size_t>(pc.f) * m;
+#pragma GCC ivdep
+    for (int i = 0; i < m; ++i) col[i] = own(i) * inv[i];
+  }
+}
+
+// The kernel: frames through the chain, the readings and (kJacobian) the Jacobian's columns.
+template <bool kJacobian, bool kSeveralPlanes>
+[[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
+  const int m = args.m;
+  const ModelPoint& point = *args.point;
+  const FrameArrays s = FrameArraysOf(args.state, m);
+  StartAtBase(point, m, s);
+  for (int l = 0; l < point.num_links; ++l) PropagateLink<kJacobian>(args, l, s);
+  if (point.has_tool) ApplyTool(point, m, s);
+  const ReadingArrays r = ReadingArraysOf(args.scratch, m);
+  const PlaneAt<kSeveralPlanes> n = GatherPlanes<kSeveralPlanes>(args, r);
+  const int parallel = Readings<kSeveralPlanes>(args, s, r, n);
+  if constexpr (!kJacobian) return parallel == 0;
+  const ParameterSet& ps = *args.parameters;
+  for (int k = 0; k < ps.num_robot(); ++k)
+    LinkColumn<kSeveralPlanes>(args, ps.robot_values[k], r, n,
+                               args.J + static_cast<std::size_t>(k) * m);
+  for (int p = 0; p < ps.num_planes(); ++p) PlaneColumnsOf<kSeveralPlanes>(args, p, r);
   return parallel == 0;
 }
 
