@@ -15,9 +15,10 @@ flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
        -fno-sanitize-recover=undefined -Iinclude -Isrc -I/usr/include/eigen3
        "-DLRCAL_SOURCE_DIR=\"$PWD\"")
 # The readers and what they need (no Ceres, no SQLite: the fuzzers build in about a minute).
-sources=(core/strings core/json core/hash core/data_dir core/random kinematics/robot_model
+sources=(core/strings core/json core/hash core/data_dir core/random core/settings kinematics/robot_model
          kinematics/rigid_transform kinematics/dh_conversion kinematics/configuration_set
-         measurement/plane measurement/parameter_set measurement/measurement_set io/csv
+         measurement/plane measurement/parameter_set measurement/measurement_set
+         measurement/noise_model identification/identification_options io/csv
          io/robot_file io/urdf io/yaml_util study/study study/stop_when study/sensitivity)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o

@@ -17,8 +17,8 @@ design = lrcal.design(robot, pool, 50, criterion="E", method="exchange")
 q = pool[design.indices]
 
 # Ten noisy readings (σ = 0.2 mm) per configuration of the "true" arm, then identify.
-readings = lrcal.simulate(robot, q, sigma=0.2e-3, repetitions=10, seed=1)
-result = lrcal.identify(robot, readings.q, readings.h, sigma=0.2e-3)
+readings = lrcal.simulate(robot, q, sigma_mm=0.2, repetitions=10, seed=1)
+result = lrcal.identify(robot, readings.q, readings.h, sigma_mm=0.2)
 print(result)
 
 # The identified errors against the truth the simulation used, in mm and mrad.

@@ -1,6 +1,7 @@
 // Shared pieces of the lrcal command-line program (private to src/cli).
 #pragma once
 
+#include <algorithm>
 #include <boost/program_options.hpp>
 #include <functional>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/io/robot_file.h"
@@ -70,6 +72,43 @@ Format ResolveFormat(const po::variables_map& vm);
 /// Adds --robot, --tool-link, --plane, --format to `options` (the options every science command
 /// takes).
 void AddCommonOptions(po::options_description& options);
+
+/// Adds one option per setting of an option struct (settings.h): --NAME with the struct's
+/// default in the setting's unit and its help line, the unit and range appended. `only`, if not
+/// empty, names the settings to add (the others are not options of this command).
+template <class Options>
+void AddSettingOptions(po::options_description& options,
+                       const std::vector<SettingField<Options>>& fields,
+                       const std::vector<std::string>& only = {}) {
+  for (const SettingField<Options>& f : fields) {
+    if (!only.empty() && std::find(only.begin(), only.end(), f.spec.name) == only.end()) continue;
+    const std::string option = f.spec.Spelling(Frontend::kCommandLine).substr(2);
+    const std::string help = std::string(f.spec.help) + "; " + f.spec.Expected().substr(9);
+    if (f.spec.integer)
+      options.add_options()(
+          option.c_str(),
+          po::value<long long>()->default_value(static_cast<long long>(f.Default())), help.c_str());
+    else
+      options.add_options()(option.c_str(), po::value<double>()->default_value(f.Default()),
+                            help.c_str());
+  }
+}
+
+/// Reads the options AddSettingOptions added into `options`, each checked by its spec (exit 2
+/// naming the option and the range in the option's unit).
+template <class Options>
+void ReadSettingOptions(const po::variables_map& vm,
+                        const std::vector<SettingField<Options>>& fields, Options* options) {
+  for (const SettingField<Options>& f : fields) {
+    const std::string option = f.spec.Spelling(Frontend::kCommandLine).substr(2);
+    if (!vm.count(option)) continue;  // not an option of this command
+    const double value =
+        f.spec.integer ? static_cast<double>(vm[option].as<long long>()) : vm[option].as<double>();
+    const double si = value * f.spec.to_si;
+    if (!f.spec.Allows(si)) throw SettingError(f.spec, si).Respelled(Frontend::kCommandLine);
+    f.Set(options, si);
+  }
+}
 
 Json ToJson(const Eigen::VectorXd& v);
 Json ToJson(const Eigen::MatrixXd& m);

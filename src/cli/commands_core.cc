@@ -142,12 +142,9 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) 
   IdentificationOptions options;
   options.solver = ParseName(kSolverNames, vm["solver"].as<std::string>(), "--solver", "solver");
   options.loss = ParseName(kRobustLossNames, vm["loss"].as<std::string>(), "--loss", "loss");
-  options.loss_scale = vm["loss-scale-mm"].as<double>() * 1e-3;
-  if (!(std::isfinite(options.loss_scale) && options.loss_scale > 0))
-    throw InputError("--loss-scale-mm", "expected a finite scale > 0 (mm)");
-  options.sigma = vm["sigma-mm"].as<double>() * 1e-3;
+  ReadSettingOptions(vm, IdentificationOptions::Settings(), &options);
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
-  if (std::string bad = options.Validate(); !bad.empty()) throw InputError("options", bad);
+  options.Validate();
   return options;
 }
 
@@ -285,18 +282,9 @@ int SimulateCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal simulate options");
   AddCommonOptions(o);
   o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
-      "sigma-mm", po::value<double>()->default_value(0.2), "noise of one reading (mm)")(
-      "repetitions", po::value<int>()->default_value(10), "readings per configuration")(
-      "encoder-sigma-mrad", po::value<double>()->default_value(0.0),
-      "joint-encoder noise, each joint, each reading (mrad); the CSV records the joint "
-      "angles without it")("form-sigma-mm", po::value<double>()->default_value(0.0),
-                           "plane flatness deviation at each configuration's hit point (mm)")(
-      "outlier-fraction", po::value<double>()->default_value(0.0),
-      "share of readings with a gross error")("outlier-sigma-mm",
-                                              po::value<double>()->default_value(5.0),
-                                              "standard deviation of a gross error (mm)")(
       "seed", po::value<long long>()->default_value(1), "random seed")(
       "out", po::value<std::string>()->required(), "measurement CSV to write");
+  AddSettingOptions(o, NoiseModel::Settings());
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
@@ -309,25 +297,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   NoiseModel noise;
   noise.ranger_offset = rig.ranger_offset;  // the robot file's true ranger errors
   noise.ranger_scale = rig.ranger_scale;
-  noise.sigma = vm["sigma-mm"].as<double>() * 1e-3;
-  noise.repetitions = vm["repetitions"].as<int>();
-  if (!(std::isfinite(noise.sigma) && noise.sigma >= 0))
-    throw InputError("--sigma-mm", "expected a finite noise >= 0 (mm)");
-  const auto non_negative = [&](const char* option, double scale, const char* unit) {
-    const double v = vm[option].as<double>();
-    if (!(std::isfinite(v) && v >= 0))
-      throw InputError(std::string("--") + option,
-                       std::string("expected a finite value >= 0 (") + unit + ")");
-    return v * scale;
-  };
-  noise.encoder_sigma = non_negative("encoder-sigma-mrad", 1e-3, "mrad");
-  noise.form_sigma = non_negative("form-sigma-mm", 1e-3, "mm");
-  noise.outlier_sigma = non_negative("outlier-sigma-mm", 1e-3, "mm");
-  noise.outlier_fraction = non_negative("outlier-fraction", 1.0, "a fraction");
-  if (noise.outlier_fraction > 1)
-    throw InputError("--outlier-fraction", "expected a fraction of readings in [0, 1]");
-  if (noise.repetitions < 1 || noise.repetitions > 1000000)
-    throw InputError("--repetitions", "expected 1 to 1,000,000 readings per configuration");
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
   if (static_cast<double>(noise.repetitions) * configs.size() > 1e7)
     throw InputError("--repetitions", "would write " + std::to_string(configs.size()) + " x " +
                                           std::to_string(noise.repetitions) +
@@ -517,11 +487,6 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
       "loss", po::value<std::string>()->default_value("none"),
       "robust loss: none, huber, cauchy (either solver)")(
-      "loss-scale-mm", po::value<double>()->default_value(1.0),
-      "robust loss scale (mm) on each configuration's residual sqrt(R)*(mean h - h); "
-      "e.g. 1.345 sigma for Huber, 2.385 sigma for Cauchy (95 % efficiency)")(
-      "sigma-mm", po::value<double>()->default_value(0.0),
-      "known noise of one reading (mm) for the given-sigma covariance")(
       "predict-at", po::value<std::string>(),
       "poses (a configurations CSV) to predict the calibrated arm's accuracy at, from the "
       "estimate's covariance (given sigma if --sigma-mm, else residual-based)")(
@@ -535,6 +500,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "write a calibration report into this folder: report.html (fit check, residuals, "
       "parameters, correlation, identifiability, cross-validation, accuracy over the "
       "workspace), calibration.json and the calibrated robot file");
+  AddSettingOptions(o, IdentificationOptions::Settings(), {"loss_scale_mm", "sigma_mm"});
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);

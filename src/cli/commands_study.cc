@@ -29,10 +29,9 @@ std::string DefaultOut(const Study& study) { return "output/" + study.name; }
 RunOptions ResolveRunOptions(const po::variables_map& vm, const Study& study) {
   RunOptions options;
   options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : DefaultOut(study);
-  options.threads = vm["threads"].as<int>();
+  ReadSettingOptions(vm, RunOptions::Settings(), &options);
   if (vm.count("shard"))
     ParseShard(vm["shard"].as<std::string>(), &options.shard_index, &options.shard_count);
-  options.max_new_trials = vm["max-trials"].as<long long>();
   options.progress = !vm["quiet"].as<bool>();
   const std::string schedule = vm["schedule"].as<std::string>();
   if (schedule != "static" && schedule != "dynamic")
@@ -115,13 +114,11 @@ int RunCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal run options");
   o.add_options()("study", po::value<std::string>(), "study file (default: studies/paper.yaml)")(
       "out", po::value<std::string>(), "run directory (default: output/<study name>)")(
-      "threads", po::value<int>()->default_value(0), "worker threads (0: all cores)")(
       "shard", po::value<std::string>(), "run only shard i/N of the trials (batch schedulers)")(
-      "max-trials", po::value<long long>()->default_value(0),
-      "stop after this many new trials (0: no limit); rerun to continue")(
       "schedule", po::value<std::string>()->default_value("static"),
       "MPI only: static (every P-th trial per rank) or dynamic (chunks from rank 0)")(
       "quiet", po::bool_switch(), "no progress output");
+  AddSettingOptions(o, RunOptions::Settings(), {"threads", "max_trials"});
   po::positional_options_description pos;
   pos.add("study", 1);
   po::variables_map vm;

@@ -83,6 +83,11 @@ int main(int argc, char** argv) {
     if (c.name != name) continue;
     try {
       return c.run(args);
+    } catch (const lrcal::SettingError& e) {  // a library check: in the option's words
+      if (!OtherMpiRank())
+        std::cerr << "lrcal " << name
+                  << ": error: " << e.Respelled(lrcal::Frontend::kCommandLine).what() << "\n";
+      return 2;
     } catch (const lrcal::InputError& e) {
       if (!OtherMpiRank()) std::cerr << "lrcal " << name << ": error: " << e.what() << "\n";
       return 2;

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <boost/math/special_functions/gamma.hpp>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -11,17 +12,6 @@
 #include "lrcal/core/text_table.h"
 
 namespace lrcal {
-
-std::string IdentificationOptions::Validate() const {
-  if (max_iterations < 1) return "max_iterations must be at least 1";
-  if (max_robust_iterations < 1) return "max_robust_iterations must be at least 1";
-  if (!(parameter_tolerance >= 0)) return "parameter_tolerance must be >= 0";
-  if (!(function_tolerance >= 0)) return "function_tolerance must be >= 0";
-  if (!(sigma >= 0) || !std::isfinite(sigma)) return "sigma must be a finite value >= 0 (m)";
-  if (!(loss_scale > 0) || !std::isfinite(loss_scale))
-    return "loss_scale must be a finite value > 0 (m)";
-  return "";
-}
 
 namespace {
 
@@ -155,8 +145,10 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
     s.loss = loss.str();
   }
   s.num_configurations = data.size();
-  if (std::string problem = options.Validate(); !problem.empty()) {
-    s.message = "invalid options: " + problem;
+  try {
+    options.Validate();
+  } catch (const SettingError& e) {
+    s.message = std::string("invalid options: ") + e.what();
     return s;
   }
   if (static_cast<int>(data.mean_h.size()) != data.size() ||

@@ -1,6 +1,7 @@
 #include "lrcal/measurement/simulation.h"
 
 #include <cmath>
+#include <limits>
 
 #include "lrcal/core/error.h"
 
@@ -29,27 +30,6 @@ void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& plan
                                    std::to_string(configs.num_planes_referenced()) +
                                    " but the set-up has " + std::to_string(planes.size()) +
                                    " plane(s)");
-}
-
-void NoiseModel::Validate(const std::string& source) const {
-  if (!(std::isfinite(sigma) && sigma >= 0))
-    throw InputError(source, "sigma: expected a finite standard deviation >= 0 (m), got " +
-                                 std::to_string(sigma));
-  if (repetitions < 1)
-    throw InputError(source, "repetitions: expected at least 1 reading per configuration");
-  const auto check = [&](double v, const char* what) {
-    if (!(std::isfinite(v) && v >= 0))
-      throw InputError(
-          source, std::string(what) + ": expected a finite value >= 0, got " + std::to_string(v));
-  };
-  check(encoder_sigma, "encoder_sigma");
-  check(form_sigma, "form_sigma");
-  check(outlier_sigma, "outlier_sigma");
-  if (!std::isfinite(ranger_offset) || !(std::fabs(ranger_scale) < 0.5))
-    throw InputError(source, "the ranger's errors: expected a finite offset and |scale| < 0.5");
-  if (!(outlier_fraction >= 0 && outlier_fraction <= 1))
-    throw InputError(source, "outlier_fraction: expected a fraction in [0, 1], got " +
-                                 std::to_string(outlier_fraction));
 }
 
 namespace {

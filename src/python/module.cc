@@ -86,6 +86,9 @@ void RegisterErrors(py::module_& m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const SettingError& e) {  // a library check: in Python's words (sigma_mm=)
+      const InputError respelled = e.Respelled(Frontend::kPython);
+      SetError(g_input_error, respelled.what(), respelled.where());
     } catch (const InputError& e) {
       SetError(g_input_error, e.what(), e.where());
     } catch (const StorageError& e) {
@@ -289,19 +292,44 @@ py::array_t<double> SampleConfigurationsPy(const RobotFile& rig, int count, long
   return ToArray(configs);
 }
 
-Readings SimulatePy(const RobotFile& rig, const Array& q, double sigma, int repetitions,
-                    long long seed, const py::object& plane_arg, const py::object& model) {
+// The noise settings as simulate() takes them: sigma_mm, repetitions, encoder_sigma_mrad,
+// form_sigma_mm, outlier_fraction, outlier_sigma_mm (NoiseModel::Settings(), in that order).
+struct NoiseArgs {
+  double sigma_mm;
+  long long repetitions;
+  double encoder_sigma_mrad, form_sigma_mm, outlier_fraction, outlier_sigma_mm;
+};
+
+// The noise model from its settings in their units (checked by the schema, named as Python
+// names them); `sigma` (m), the earlier spelling of sigma_mm, still accepted.
+NoiseModel ToNoiseModel(const NoiseArgs& a, const py::object& sigma_m) {
+  const auto& fields = NoiseModel::Settings();
+  std::vector<double> values = {a.sigma_mm,           static_cast<double>(a.repetitions),
+                                a.encoder_sigma_mrad, a.form_sigma_mm,
+                                a.outlier_fraction,   a.outlier_sigma_mm};
+  if (!sigma_m.is_none()) {
+    if (a.sigma_mm != fields[0].Default())
+      throw InputError("sigma", "give sigma_mm (mm) or sigma (m, the earlier spelling), not both");
+    values[0] = sigma_m.cast<double>() / fields[0].spec.to_si;
+  }
+  NoiseModel noise;
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    const double si = values[k] * fields[k].spec.to_si;
+    if (!fields[k].spec.Allows(si))
+      throw SettingError(fields[k].spec, si).Respelled(Frontend::kPython);
+    fields[k].Set(&noise, si);
+  }
+  return noise;
+}
+
+Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise_args,
+                    long long seed, const py::object& plane_arg, const py::object& model,
+                    const py::object& sigma_m) {
   const RobotModel& robot = rig.robot;
   const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
   const Plane plane = ResolvePlane(rig, plane_arg);
   const Eigen::VectorXd values = ResolveLinkValues(robot, model);
-  NoiseModel noise;
-  noise.sigma = sigma;
-  noise.repetitions = repetitions;
-  if (!(std::isfinite(sigma) && sigma >= 0))
-    throw InputError("sigma", "expected a finite noise >= 0 (m)");
-  if (repetitions < 1 || repetitions > 1000000)
-    throw InputError("repetitions", "expected 1 to 1,000,000 readings per configuration");
+  const NoiseModel noise = ToNoiseModel(noise_args, sigma_m);
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
@@ -328,18 +356,39 @@ Readings SimulatePy(const RobotFile& rig, const Array& q, double sigma, int repe
   auto wq = out.q.mutable_unchecked<2>();
   auto wc = out.configuration.mutable_unchecked<1>();
   for (py::ssize_t r = 0; r < m; ++r) {
-    const int i = kept[static_cast<std::size_t>(r / repetitions)];
+    const int i = kept[static_cast<std::size_t>(r / noise.repetitions)];
     for (int j = 0; j < n; ++j) wq(r, j) = configs.q(i)[j];
     wc(r) = i;
   }
   return out;
 }
 
+// A setting given in its unit (`value`, e.g. sigma_mm) or, in the earlier spelling, in SI
+// (`value_si`, e.g. sigma in m; None when not given): the SI value, checked by the spec.
+double SettingValue(const SettingField<IdentificationOptions>& field, double value,
+                    const py::object& value_si, const char* earlier) {
+  double si = value * field.spec.to_si;
+  if (!value_si.is_none()) {
+    if (value != field.Default())
+      throw InputError(earlier, std::string("give ") + field.spec.name + " (" + field.spec.unit +
+                                    ") or " + earlier + " (" + field.spec.si_unit +
+                                    ", the earlier spelling), not both");
+    si = value_si.cast<double>();
+  }
+  if (!field.spec.Allows(si)) throw SettingError(field.spec, si).Respelled(Frontend::kPython);
+  return si;
+}
+
+struct IdentifyArgs {
+  std::string solver, loss;
+  double loss_scale_mm, sigma_mm;
+  long long max_iterations;
+  py::object loss_scale, sigma;  // the earlier spellings, in m (None: not given)
+};
+
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
                                  const py::object& plane_arg, const std::string& estimate_plane,
-                                 const py::object& fix, bool auto_fix, const std::string& solver,
-                                 const std::string& loss, double loss_scale, double sigma,
-                                 int max_iterations) {
+                                 const py::object& fix, bool auto_fix, const IdentifyArgs& a) {
   const RobotModel& robot = rig.robot;
   const ConfigurationSet readings_q = ToConfigurations(q, robot.num_links(), "q");
   const std::vector<double> readings = ToVector(h, "h");
@@ -349,15 +398,19 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   const Plane plane = ResolvePlane(rig, plane_arg);
   const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
   IdentificationOptions options;
-  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
-  options.loss = ParseName(kRobustLossNames, loss, "loss", "loss");
-  options.loss_scale = loss_scale;
-  if (!(std::isfinite(loss_scale) && loss_scale > 0))
-    throw InputError("loss_scale", "expected a finite scale > 0 (m)");
-  options.sigma = sigma;
-  options.max_iterations = max_iterations;
+  options.solver = ParseName(kSolverNames, a.solver, "solver", "solver");
+  options.loss = ParseName(kRobustLossNames, a.loss, "loss", "loss");
+  const auto& fields = IdentificationOptions::Settings();
+  options.loss_scale = SettingValue(*FindSetting(fields, "loss_scale_mm"), a.loss_scale_mm,
+                                    a.loss_scale, "loss_scale");
+  options.sigma = SettingValue(*FindSetting(fields, "sigma_mm"), a.sigma_mm, a.sigma, "sigma");
+  const auto& iterations = *FindSetting(fields, "max_iterations");
+  const double max_iterations = static_cast<double>(a.max_iterations);
+  if (!iterations.spec.Allows(max_iterations))
+    throw SettingError(iterations.spec, max_iterations).Respelled(Frontend::kPython);
+  options.max_iterations = static_cast<int>(a.max_iterations);
   options.fix_dependent_parameters = auto_fix;
-  if (std::string bad = options.Validate(); !bad.empty()) throw InputError("options", bad);
+  options.Validate();
   py::gil_scoped_release release;
   return Identify(model, data, options);
 }
@@ -704,21 +757,56 @@ Draws count configurations (count, joints) uniformly within the joint limits who
 hits the plane within the ranger's limits and whose geometric Jacobian's smallest singular value
 is at least min_singular_value; validation=True drops the beam condition (validation poses).
 The same numbers as `lrcal sample --seed SEED [--validation]`.)doc");
-  m.def("simulate", &SimulatePy, py::arg("robot"), py::arg("q"), py::arg("sigma") = 0.2e-3,
-        py::arg("repetitions") = 10, py::arg("seed") = 1, py::arg("plane") = py::none(),
-        py::arg("model") = "true", R"doc(
+  // The noise settings' names and defaults are the schema's (NoiseModel::Settings()).
+  const auto& noise = NoiseModel::Settings();
+  const auto setting = [&](int k) { return py::arg(noise[k].spec.name) = noise[k].Default(); };
+  m.def(
+      "simulate",
+      [](const RobotFile& rig, const Array& q, double sigma_mm, long long repetitions,
+         double encoder_sigma_mrad, double form_sigma_mm, double outlier_fraction,
+         double outlier_sigma_mm, long long seed, const py::object& plane, const py::object& model,
+         const py::object& sigma) {
+        return SimulatePy(rig, q,
+                          {sigma_mm, repetitions, encoder_sigma_mrad, form_sigma_mm,
+                           outlier_fraction, outlier_sigma_mm},
+                          seed, plane, model, sigma);
+      },
+      py::arg("robot"), py::arg("q"), setting(0),
+      py::arg(noise[1].spec.name) = static_cast<long long>(noise[1].Default()), setting(2),
+      setting(3), setting(4), setting(5), py::arg("seed") = 1, py::arg("plane") = py::none(),
+      py::arg("model") = "true", py::arg("sigma") = py::none(), R"doc(
 Simulated noisy readings of the arm `model` ("true" by default: nominal + the file's true errors)
 at the configurations q (N, joints): `repetitions` readings per configuration with Gaussian noise
-of standard deviation sigma (m). Returns an lrcal.Readings (q, h, configuration, skipped), the
-same numbers as `lrcal simulate --seed SEED`.)doc");
+of standard deviation sigma_mm (mm), and a real rig's disturbances as `lrcal simulate` has them:
+encoder_sigma_mrad (joint-encoder noise, each joint and reading), form_sigma_mm (plane flatness),
+outlier_fraction and outlier_sigma_mm (gross errors). `sigma` (m) is the earlier spelling of
+sigma_mm. Returns an lrcal.Readings (q, h, configuration, skipped), the same numbers as
+`lrcal simulate --seed SEED` with the same settings.)doc");
 }
 
 void DefineCalibration(py::module_& m) {
-  m.def("identify", &IdentifyPy, py::arg("robot"), py::arg("q"), py::arg("h"),
-        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("solver") = "lm",
-        py::arg("loss") = "none", py::arg("loss_scale") = 1e-3, py::arg("sigma") = 0.0,
-        py::arg("max_iterations") = 100, R"doc(
+  // The numeric settings' names and defaults are the schema's (IdentificationOptions::Settings()).
+  const auto& fields = IdentificationOptions::Settings();
+  const auto setting = [&](const char* name) {
+    const auto& f = *FindSetting(fields, name);
+    return f.spec.integer ? (py::arg(f.spec.name) = static_cast<long long>(f.Default()))
+                          : (py::arg(f.spec.name) = f.Default());
+  };
+  m.def(
+      "identify",
+      [](const RobotFile& rig, const Array& q, const Array& h, const py::object& plane,
+         const std::string& estimate_plane, const py::object& fix, bool auto_fix,
+         const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
+         long long max_iterations, const py::object& loss_scale, const py::object& sigma) {
+        return IdentifyPy(
+            rig, q, h, plane, estimate_plane, fix, auto_fix,
+            {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma});
+      },
+      py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
+      py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
+      py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
+      setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
+      py::arg("sigma") = py::none(), R"doc(
 Identifies the geometric parameters (and plane terms) from laser readings.
 
 q (M, joints) rad and h (M,) m are single readings; readings at identical joint values are
@@ -727,8 +815,11 @@ plane: None (the robot file's), an lrcal.Plane or (nx, ny, nz, f), the nominal p
 estimate_plane: "none", "normal", "offset" or "normal,offset" (names plane_u1, plane_u2, plane_f).
 fix: parameter names kept at nominal (a list or "a1,d2"). auto_fix: if the set is rank-deficient,
 fix the suggested parameters and go on (else termination is 'rank_deficient').
-solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (either solver) with loss_scale m.
-sigma: the known σ of one reading (m) for covariance_given; 0 = unknown.
+solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (either solver) with scale
+loss_scale_mm (mm, as `lrcal identify --loss-scale-mm`) on each configuration's residual.
+sigma_mm: the known σ of one reading (mm, as --sigma-mm) for covariance_given and the fit check;
+0 = unknown. loss_scale and sigma (m) are the earlier spellings of the two, still accepted.
+max_iterations: 1 to 10,000.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc");
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",

@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <system_error>
 #include <thread>
@@ -570,16 +571,51 @@ class StudyRunner {
 
 }  // namespace
 
+namespace {
+constexpr double kNoMax = std::numeric_limits<double>::infinity();
+// The run's settings that are not numbers: named for each front end like the numeric ones.
+const SettingSpec kOutDir{"run", "out_dir", "out",           "",       1, "", 0, 0, false, false,
+                          "",    "",        "run directory", "out_dir"};
+const SettingSpec kShard{"run",
+                         "shard",
+                         "shard",
+                         "",
+                         1,
+                         "",
+                         0,
+                         0,
+                         false,
+                         false,
+                         "",
+                         "",
+                         "this process's part of the trials, i/N"};
+}  // namespace
+
+const std::vector<SettingField<RunOptions>>& RunOptions::Settings() {
+  using R = RunOptions;
+  static const std::vector<SettingField<R>> fields = {
+      {{"run", "threads", "threads", "", 1, "", 0, 4096, false, true, "worker threads", "all cores",
+        "worker threads"},
+       nullptr,
+       &R::threads},
+      {{"run", "max_new_trials", "max_trials", "", 1, "", 0, kNoMax, false, true,
+        "new trials to compute", "no limit", "stop after this many new trials"},
+       nullptr,
+       nullptr,
+       &R::max_new_trials},
+      {{"run", "batch_size", "batch_size", "", 1, "", 1, 1e6, false, true, "records per batch", "",
+        "trial records per SQLite transaction"},
+       nullptr,
+       &R::batch_size},
+  };
+  return fields;
+}
+
 void RunOptions::Validate() const {
-  if (out_dir.empty()) throw InputError("--out", "expected a run directory, got an empty name");
-  if (threads < 0 || threads > 4096)
-    throw InputError("--threads", "expected 0 (all cores) to 4096 worker threads, got " +
-                                      std::to_string(threads));
+  if (out_dir.empty()) throw SettingError(kOutDir, "expected a run directory, got an empty name");
+  CheckSettings(*this, Settings());
   if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
-    throw InputError("--shard", "expected i/N with 1 <= i <= N");
-  if (batch_size < 1) throw InputError("batch_size", "expected at least 1 record per batch");
-  if (max_new_trials < 0)
-    throw InputError("--max-trials", "expected 0 (no limit) or a positive number of trials");
+    throw SettingError(kShard, "expected i/N with 1 <= i <= N");
 }
 
 long PeakRssKb() {

@@ -30,25 +30,41 @@ std::string ResolveStudyPath(const std::string& name_or_path) {
   return name_or_path;  // LoadStudy reports "cannot open file"
 }
 
-// The one place the study settings' defaults are written (docs/STUDIES.md shows them; a test
-// checks that it shows these).
+// The defaults of an option struct's settings (settings.h) as a study section: each setting's
+// study name with the struct's initial value in the setting's unit.
+template <class Options>
+Json SettingDefaults(const std::vector<SettingField<Options>>& fields) {
+  Json section = Json::object();
+  for (const SettingField<Options>& f : fields)
+    section[f.spec.name] =
+        f.spec.integer ? Json(static_cast<long long>(f.Default())) : Json(f.Default());
+  return section;
+}
+
+// The one place the study settings' defaults are written, with those of the library's option
+// structs taken from their settings schema (docs/STUDIES.md shows them; a test checks that it
+// shows these).
 const Json& StudyDefaults() {
-  static const Json d = Json::parse(R"({
+  static const Json d = [] {
+    Json j = Json::parse(R"({
     "robot": "paper",
     "plane": "robot",
     "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0,
               "ranger_offset_mm": "robot_file", "ranger_scale_ppm": "robot_file"},
-    "noise": {"sigma_mm": 0.2, "repetitions": 10, "encoder_sigma_mrad": 0.0, "form_sigma_mm": 0.0,
-              "outlier_fraction": 0.0, "outlier_sigma_mm": 5.0},
     "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
     "selection": {"count": 50, "method": "backward", "criterion": "E", "samples": 1000,
                   "scaling": "si", "restarts": 4, "redraw": false},
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
-                       "max_iterations": 100, "on_rank_deficient": "fail",
+                       "on_rank_deficient": "fail",
                        "loss": "none", "loss_scale": 1.345, "estimate_ranger": "none"},
     "paper_case": 0
   })");
+    j["noise"] = SettingDefaults(NoiseModel::Settings());
+    j["identification"]["max_iterations"] = static_cast<long long>(
+        FindSetting(IdentificationOptions::Settings(), "max_iterations")->Default());
+    return j;
+  }();
   return d;
 }
 
@@ -227,6 +243,24 @@ bool Bool(const Json& s, const std::string& path, const KeyLocator& where) {
   return j.get<bool>();
 }
 
+// The settings of one option struct (settings.h) from their study keys (section.name, in the
+// settings' units), each checked by its spec; an error names the file, line and key.
+template <class Options>
+void ReadSetting(const Json& s, const KeyLocator& where, const SettingField<Options>& f,
+                 Options* options) {
+  const std::string key = f.spec.Spelling(Frontend::kStudyFile);
+  const double si = Num(s, key, where) * f.spec.to_si;
+  if (!f.spec.Allows(si))
+    throw SettingError(f.spec, si).Respelled(Frontend::kStudyFile, where(key));
+  f.Set(options, si);
+}
+
+template <class Options>
+void ReadSettings(const Json& s, const KeyLocator& where,
+                  const std::vector<SettingField<Options>>& fields, Options* options) {
+  for (const SettingField<Options>& f : fields) ReadSetting(s, where, f, options);
+}
+
 // Only `allowed` keys in the mapping at `path`.
 void OnlyKeys(const Json& map, const std::string& path, std::initializer_list<const char*> allowed,
               const std::string& expected, const KeyLocator& where) {
@@ -342,15 +376,7 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
       c->ranger_scale = x * 1e-6;
     }
   }
-  c->sigma = NonNegative(s, "noise.sigma_mm", where) * 1e-3;
-  c->repetitions = Int(s, "noise.repetitions", where, 1, 1000000);
-  c->encoder_sigma = NonNegative(s, "noise.encoder_sigma_mrad", where) * 1e-3;
-  c->form_sigma = NonNegative(s, "noise.form_sigma_mm", where) * 1e-3;
-  c->outlier_fraction = NonNegative(s, "noise.outlier_fraction", where);
-  if (c->outlier_fraction > 1)
-    throw InputError(where("noise.outlier_fraction"),
-                     "expected the fraction of readings with a gross error, in [0, 1]");
-  c->outlier_sigma = NonNegative(s, "noise.outlier_sigma_mm", where) * 1e-3;
+  ReadSettings(s, where, NoiseModel::Settings(), &c->noise);
 }
 
 void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings* c) {
@@ -399,7 +425,8 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
   }
   c->identification.solver = ParseName(kSolverNames, Str(s, "identification.solver", where),
                                        where("identification.solver"), "solver");
-  c->identification.max_iterations = Int(s, "identification.max_iterations", where, 1, 10000);
+  ReadSetting(s, where, *FindSetting(IdentificationOptions::Settings(), "max_iterations"),
+              &c->identification);
   const std::string rank = Str(s, "identification.on_rank_deficient", where);
   if (rank != "fail" && rank != "fix")
     throw InputError(where("identification.on_rank_deficient"),
@@ -414,12 +441,12 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
     throw InputError(where("identification.loss_scale"),
                      "expected a scale > 0 in units of the reading's standard deviation "
                      "(Huber 1.345, Cauchy 2.385 for 95 % efficiency)");
-  if (c->identification.loss != RobustLoss::kNone && !(c->sigma > 0))
+  if (c->identification.loss != RobustLoss::kNone && !(c->noise.sigma > 0))
     throw InputError(where("identification.loss"),
                      "a robust loss needs noise.sigma_mm > 0: its scale is in units of σ");
   // The scale applies to each configuration's weighted residual √R·(h̄ − h), whose standard
   // deviation is that of one reading.
-  c->identification.loss_scale = c->sigma > 0 ? scale * c->sigma : 1e-3;
+  c->identification.loss_scale = c->noise.sigma > 0 ? scale * c->noise.sigma : 1e-3;
 }
 
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {

@@ -284,7 +284,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->model, c->design.configs);
   if (!c->rank_deficient && design_report.full_rank()) {
-    c->predicted_covariance = ParameterCovariance(s.repetitions * GtG, s.sigma);
+    c->predicted_covariance = ParameterCovariance(s.noise.repetitions * GtG, s.noise.sigma);
     c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
   } else {
     if (!c->rank_deficient) c->rank_message = design_report.ToString();
@@ -312,7 +312,9 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
     const Eigen::MatrixXd Gt =
         IdentificationJacobian(*c->model, c->design.configs, c->fixed_truth.delta.data());
     c->predicted_std_truth =
-        ParameterCovariance(s.repetitions * (Gt.transpose() * Gt), s.sigma).diagonal().cwiseSqrt();
+        ParameterCovariance(s.noise.repetitions * (Gt.transpose() * Gt), s.noise.sigma)
+            .diagonal()
+            .cwiseSqrt();
   }
   c->nominal_validation =
       ComparePoses(*c->robot, truth, c->robot->nominal_values(), c->validation).stats;
@@ -420,11 +422,8 @@ bool DesignOfTrial(const CellContext& c, long long trial, const TrialTruth& trut
 int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTruth& truth,
                           const TrialDesign& design, TrialWorkspace* ws) {
   const CellSettings& s = c.cell->typed;
-  NoiseModel noise{s.sigma, s.repetitions, /*draw_mean=*/true};
-  noise.encoder_sigma = s.encoder_sigma;
-  noise.form_sigma = s.form_sigma;
-  noise.outlier_fraction = s.outlier_fraction;
-  noise.outlier_sigma = s.outlier_sigma;
+  NoiseModel noise = s.noise;
+  noise.draw_mean = true;
   noise.ranger_offset = c.ranger_offset;
   noise.ranger_scale = c.ranger_scale;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
@@ -564,7 +563,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   const SolveOutcome r = IdentifyTrial(c, design == &c.design, ws);
   rec.iterations = r.iterations;
   const int m = ws->data.size(), n = c.model->num_parameters();
-  rec.residual_rms = std::sqrt(2 * r.final_cost / (m * s.repetitions));  // per-config mean
+  rec.residual_rms = std::sqrt(2 * r.final_cost / (m * s.noise.repetitions));  // per-config mean
   rec.sigma_hat = m > n ? std::sqrt(2 * r.final_cost / (m - n)) : 0.0;
   if (StatusOf(r.termination) != TrialStatus::kOk) return finish(StatusOf(r.termination));
 

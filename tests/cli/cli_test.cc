@@ -665,11 +665,11 @@ INSTANTIATE_TEST_SUITE_P(
                  "expected a relative tolerance in [0, 1)"},
         BadInput{"SimulateInfiniteSigma", "q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0\n",
                  "simulate --configs {} --sigma-mm inf --out /tmp/lrcal_never.csv",
-                 "--sigma-mm: expected a finite noise >= 0 (mm)"},
+                 "--sigma-mm: expected a finite value >= 0 (mm), got inf"},
         BadInput{"SampleNanSingularValue", "", "sample --min-singular-value nan --out /tmp/x.csv",
                  "--min-singular-value: min_jacobian_singular_value: expected a finite value"},
         BadInput{"RunNegativeMaxTrials", "", "run quick --max-trials -5 --out /tmp/lrcal_never",
-                 "--max-trials: expected 0 (no limit) or a positive number of trials"},
+                 "--max-trials: expected 0 (no limit) or more new trials to compute, got -5"},
         BadInput{"IdentifyUnknownLoss", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,1\n",
                  "identify --data {} --loss tukey",
                  "--loss: unknown loss 'tukey'; expected none, "

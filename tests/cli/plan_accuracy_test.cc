@@ -53,7 +53,7 @@ TEST(PlanAccuracy, FindsTheCheapestCampaignAndConfirmsIt) {
   const Study s = LoadStudy(j["study"].get<std::string>());
   EXPECT_EQ(s.cells.size(), campaigns.size());
   EXPECT_EQ(s.cells[0].typed.select_count, chosen["configurations"].get<int>());
-  EXPECT_EQ(s.cells[0].typed.repetitions, chosen["repetitions"].get<int>());
+  EXPECT_EQ(s.cells[0].typed.noise.repetitions, chosen["repetitions"].get<int>());
 }
 
 // Candidate planes: each subset of them is a campaign choice with its own pool, the cost of

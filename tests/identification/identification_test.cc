@@ -2,6 +2,7 @@
 // estimated), the two solvers agree, and rank deficiency is never a "converged" answer.
 #include "lrcal/identification/identification.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -558,14 +559,26 @@ TEST(Identification, SuspectsAndTooFewConfigurations) {
   EXPECT_TRUE(too_few.identifiability.dependencies.empty());
 }
 
-TEST(Identification, OptionsValidationNamesTheField) {
+TEST(Identification, OptionsValidationNamesTheLibraryField) {
+  using ::testing::HasSubstr;
+  using ::testing::ThrowsMessage;
   IdentificationOptions o;
   o.max_iterations = 0;
-  EXPECT_NE(o.Validate().find("max_iterations"), std::string::npos);
+  EXPECT_THAT([&] { o.Validate(); },
+              ThrowsMessage<SettingError>(HasSubstr("identification.max_iterations: expected 1 "
+                                                    "to 10,000 iterations, got 0")));
   o = IdentificationOptions{};
   o.loss = RobustLoss::kHuber;
-  o.loss_scale = -1;
-  EXPECT_NE(o.Validate().find("loss_scale"), std::string::npos);
+  o.loss_scale = -1e-3;
+  EXPECT_THAT([&] { o.Validate(); },
+              ThrowsMessage<SettingError>(HasSubstr("identification.loss_scale: expected a finite "
+                                                    "value > 0 (m), got -0.001")));
+  // Identify itself refuses bad options without throwing, naming the field.
+  const RobotModel& robot = testing::PaperRobot();
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  const IdentificationSummary s = Identify(model, MeasurementSet{}, o);
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
+  EXPECT_THAT(s.message, HasSubstr("identification.loss_scale"));
 }
 
 }  // namespace

@@ -70,14 +70,14 @@ def test_sample_simulate_identify_match_the_program_bit_for_bit(tmp_path, cli, p
     q = lrcal.sample_configurations(paper, 60, seed=7)
     _, c = read_csv(configs)
     np.testing.assert_array_equal(q, c)
-    readings = lrcal.simulate(paper, q, sigma=0.2e-3, repetitions=10, seed=7)
+    readings = lrcal.simulate(paper, q, sigma_mm=0.2, repetitions=10, seed=7)
     header, m = read_csv(data)
     assert readings.q.shape == (600, 6) and readings.h.shape == (600,)
     np.testing.assert_array_equal(readings.q, m[:, :6])
     np.testing.assert_array_equal(readings.h, m[:, header.index("h")])
     np.testing.assert_array_equal(readings.configuration, np.repeat(np.arange(60), 10))
 
-    result = lrcal.identify(paper, readings.q, readings.h, sigma=0.2 * 1e-3)
+    result = lrcal.identify(paper, readings.q, readings.h, sigma_mm=0.2)
     assert result.termination == program["termination"] == "converged"
     assert result.names == [p["name"] for p in program["parameters"]]
     np.testing.assert_array_equal(result.estimate, [p["estimate"] for p in program["parameters"]])
@@ -154,3 +154,44 @@ def test_urdf_robot_loads_with_its_tool_link_as_the_program_does(tmp_path, cli):
                            "0,0,1,0", "--configs", configs, "--format", "json").stdout)
     # The module composes 4x4 matrices, the program its trig-free chain: rounding apart.
     np.testing.assert_allclose(T[:, :3, 3], np.array([p["position"] for p in poses]), atol=1e-12)
+
+
+def test_settings_have_the_command_lines_names_units_and_checks(tmp_path, cli, paper):
+    """The noise and identification settings come from one schema: the same names (sigma_mm,
+    encoder_sigma_mrad, loss_scale_mm...), units and ranges as lrcal simulate/identify."""
+    q = lrcal.sample_configurations(paper, 30, seed=3)
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    np.savetxt(configs, q, delimiter=",", header="q1,q2,q3,q4,q5,q6", comments="", fmt="%.17g")
+    disturbed = dict(sigma_mm=0.1, repetitions=4, encoder_sigma_mrad=0.05, form_sigma_mm=0.02,
+                     outlier_fraction=0.1, outlier_sigma_mm=2.0)
+    args = [a for k, v in disturbed.items() for a in ("--" + k.replace("_", "-"), v)]
+    cli("simulate", "--robot", "paper", "--configs", configs, "--seed", 5, "--out", data, *args)
+    readings = lrcal.simulate(paper, q, seed=5, **disturbed)
+    header, m = read_csv(data)
+    np.testing.assert_array_equal(readings.h, m[:, header.index("h")])
+
+    # The earlier spellings (metres) give the same numbers; both at once is refused.
+    earlier = lrcal.simulate(paper, q, sigma=0.1e-3, repetitions=4, seed=5)
+    np.testing.assert_array_equal(earlier.h, lrcal.simulate(paper, q, sigma_mm=0.1,
+                                                            repetitions=4, seed=5).h)
+    with pytest.raises(lrcal.InputError, match="not both"):
+        lrcal.simulate(paper, q, sigma_mm=0.3, sigma=0.1e-3)
+    a = lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_mm=0.3,
+                       sigma_mm=0.1)
+    b = lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale=0.3e-3,
+                       sigma=0.1e-3)
+    np.testing.assert_array_equal(a.estimate, b.estimate)
+
+    # Out of range: the command line's message in Python's words.
+    with pytest.raises(lrcal.InputError, match=r"^sigma_mm=: expected a finite value >= 0 \(mm\)"):
+        lrcal.simulate(paper, q, sigma_mm=-1)
+    with pytest.raises(lrcal.InputError, match=r"repetitions=: expected 1 to 1,000,000 readings"):
+        lrcal.simulate(paper, q, repetitions=0)
+    with pytest.raises(lrcal.InputError, match=r"outlier_fraction=: expected a value in \[0, 1\]"):
+        lrcal.simulate(paper, q, outlier_fraction=1.5)
+    with pytest.raises(lrcal.InputError, match=r"loss_scale_mm=: expected a finite value > 0"):
+        lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_mm=0)
+    with pytest.raises(lrcal.InputError, match=r"max_iterations=: expected 1 to 10,000"):
+        lrcal.identify(paper, readings.q, readings.h, max_iterations=0)
+    with pytest.raises(lrcal.InputError, match=r"threads=: expected 0 \(all cores\) to 4096"):
+        lrcal.run_study("quick", str(tmp_path / "run"), threads=-1)

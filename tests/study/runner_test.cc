@@ -424,7 +424,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadStudy{"WrongType", "noise: {sigma_mm: high}\n",
                  "bad.yaml:5 key 'noise.sigma_mm': expected a number"},
         BadStudy{"NegativeSigma", "noise: {sigma_mm: -0.2}\n",
-                 "key 'noise.sigma_mm': expected a value >= 0"},
+                 "key 'noise.sigma_mm': expected a finite value >= 0 (mm), got -0.2"},
         BadStudy{"MoreSelectedThanCandidates", "pool: {size: 40}\nselection: {count: 50}\n",
                  "key 'selection.count': cannot select 50 configurations from a pool of 40"},
         BadStudy{"FewerThanParameters", "selection: {count: 20}\n", "need at least as many"},

@@ -290,7 +290,9 @@ TEST(CellPrediction, AtTheTruthIsTheNominalFormulaForAnArmWhoseNominalIsTheTruth
   const Eigen::MatrixXd G = IdentificationJacobian(model, cell->design.configs);
   const CellSettings& s = cell->cell->typed;
   const Eigen::VectorXd expected =
-      ParameterCovariance(s.repetitions * (G.transpose() * G), s.sigma).diagonal().cwiseSqrt();
+      ParameterCovariance(s.noise.repetitions * (G.transpose() * G), s.noise.sigma)
+          .diagonal()
+          .cwiseSqrt();
   ASSERT_EQ(cell->predicted_std_truth.size(), expected.size());
   for (Eigen::Index k = 0; k < expected.size(); ++k)
     EXPECT_NEAR(cell->predicted_std_truth[k] / expected[k], 1.0, 1e-9) << k;

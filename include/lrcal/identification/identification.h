@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "lrcal/core/enum_names.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/measurement/measurement_set.h"
@@ -57,8 +58,13 @@ struct IdentificationOptions {
   /// identifiability analysis' suggested parameters at nominal and identify the rest.
   bool fix_dependent_parameters = false;
   IdentifiabilityOptions identifiability;
-  /// Checks the fields; returns "" or a message naming the bad field.
-  std::string Validate() const;
+  /// The numeric settings (settings.h): max_iterations (1 to 10,000), max_robust_iterations (1
+  /// to 1,000,000), parameter_tolerance and function_tolerance (≥ 0), sigma_mm (σ, ≥ 0 mm; the
+  /// command line's --sigma-mm) and loss_scale_mm (> 0 mm; --loss-scale-mm). A study gives σ as
+  /// noise.sigma_mm and the loss scale in multiples of σ (identification.loss_scale).
+  static const std::vector<SettingField<IdentificationOptions>>& Settings();
+  /// Throws SettingError naming the library field (identification.sigma, ...) and the range.
+  void Validate() const;
 };
 
 /// Solver names in study files and options.

@@ -26,6 +26,7 @@
 #include "lrcal/core/random.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/measurement/measurement_set.h"
+#include "lrcal/measurement/noise_model.h"
 
 namespace lrcal {
 
@@ -38,29 +39,6 @@ void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
 
 /// Throws InputError unless every configuration's plane index is one of `planes`.
 void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& planes);
-
-struct NoiseModel {
-  double sigma = 0.2e-3;  ///< m, standard deviation of one reading
-  int repetitions = 10;   ///< readings averaged per configuration
-  /// Draw each configuration's mean reading error directly as σ/√R·z (z at index `slot`),
-  /// instead of averaging R drawn readings. The distribution of the mean is exactly the same;
-  /// the cost no longer grows with R. The Monte-Carlo trials use this; `lrcal simulate` writes
-  /// every reading.
-  bool draw_mean = false;
-  double encoder_sigma = 0;     ///< rad, each joint, each reading
-  double form_sigma = 0;        ///< m, flatness deviation at each configuration's hit point
-  double outlier_fraction = 0;  ///< probability that a reading carries a gross error
-  double outlier_sigma = 5e-3;  ///< m, standard deviation of a gross error
-  /// The true ranger's errors: it reads (1 + ranger_scale)·h + ranger_offset (m) for a true
-  /// geometric distance h, before the random errors above.
-  double ranger_offset = 0;
-  double ranger_scale = 0;
-  /// Encoder noise or form error: the readings need the kinematics, not only exact readings.
-  bool DisturbsGeometry() const { return encoder_sigma > 0 || form_sigma > 0; }
-  /// Throws InputError (where = `source`) unless σ is finite and ≥ 0, R ≥ 1, the disturbance
-  /// σs are finite and ≥ 0 and the outlier fraction is in [0, 1].
-  void Validate(const std::string& source = "noise") const;
-};
 
 /// Noisy readings of the true model. Fills `data` with the configurations that have a reading
 /// (mean of R) and returns the number of configurations whose true beam missed; `misses` (if

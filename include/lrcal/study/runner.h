@@ -23,6 +23,7 @@
 #include <functional>
 #include <string>
 
+#include "lrcal/core/settings.h"
 #include "lrcal/study/collective.h"
 #include "lrcal/study/study.h"
 
@@ -64,7 +65,11 @@ struct RunOptions {
   /// when they end (rank 0 only). It must not throw; to stop the run it sets the run's
   /// StopToken. How the Python module reports progress and honours Ctrl-C.
   std::function<void(const RunProgress&)> on_progress;
-  /// Checks the fields; throws InputError naming the option and the range expected.
+  /// The numeric settings (settings.h): threads (0: all cores, to 4096), max_trials
+  /// (max_new_trials; 0: no limit) and batch_size (at least 1).
+  static const std::vector<SettingField<RunOptions>>& Settings();
+  /// Throws SettingError naming the library field (run.threads, run.out_dir, ...) and what was
+  /// expected; the command line says --threads, Python threads=.
   void Validate() const;
 };
 

@@ -21,6 +21,7 @@
 #include "lrcal/core/json.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/measurement/noise_model.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
 #include "lrcal/study/stopping.h"
@@ -47,14 +48,10 @@ struct CellSettings {
   /// truth.ranger_offset_mm / ranger_scale_ppm: the true ranger's errors (m, dimensionless);
   /// empty: the robot file's (× truth.scale for a robot_file truth).
   std::optional<double> ranger_offset, ranger_scale;
-  // Noise.
-  double sigma = 0;     ///< m, one reading
-  int repetitions = 0;  ///< readings averaged per configuration
-  // A real rig's disturbances (simulation.h): off at 0.
-  double encoder_sigma = 0;     ///< rad, joint-encoder noise per joint and reading
-  double form_sigma = 0;        ///< m, plane flatness deviation per configuration
-  double outlier_fraction = 0;  ///< share of readings with a gross error
-  double outlier_sigma = 0;     ///< m, σ of a gross error
+  /// noise: the reading noise and a real rig's disturbances (noise_model.h; its settings, their
+  /// units, defaults and ranges are NoiseModel::Settings()). The ranger's errors are the
+  /// truth's (ranger_offset, ranger_scale above).
+  NoiseModel noise;
   // Candidate pool.
   int pool_size = 0;
   /// pool.file: the candidates from a CSV of configurations (q1..qN, rad), as written in the

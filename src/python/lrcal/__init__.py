@@ -6,7 +6,7 @@ configuration), and the study runner:
     import lrcal
     robot = lrcal.Robot.load("paper")                      # a robot file or a shipped name
     q = lrcal.sample_configurations(robot, 60, seed=7)      # (60, 6) rad
-    readings = lrcal.simulate(robot, q, sigma=0.2e-3, repetitions=10, seed=7)
+    readings = lrcal.simulate(robot, q, sigma_mm=0.2, repetitions=10, seed=7)
     result = lrcal.identify(robot, readings.q, readings.h)
     print(result)                                           # the full report
     run = lrcal.run_study("quick", "output/quick")          # what `lrcal run quick` does

@@ -1,0 +1,96 @@
+#include "lrcal/core/settings.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace lrcal {
+
+namespace {
+
+// 1000000 → "1,000,000" (whole numbers from 10,000 on); other values as %.12g.
+std::string Number(double v) {
+  if (v == std::floor(v) && std::fabs(v) >= 1e4 && std::fabs(v) < 1e15) {
+    std::string digits = std::to_string(static_cast<long long>(std::fabs(v)));
+    for (int p = static_cast<int>(digits.size()) - 3; p > 0; p -= 3) digits.insert(p, ",");
+    return (v < 0 ? "-" : "") + digits;
+  }
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
+std::string Unit(const char* unit) {
+  return *unit ? std::string(" (") + unit + ")" : std::string();
+}
+
+}  // namespace
+
+std::string SettingSpec::Spelling(Frontend frontend) const {
+  switch (frontend) {
+    case Frontend::kLibrary:
+      return std::string(section) + "." + field;
+    case Frontend::kStudyFile:
+      return std::string(section) + "." + name;
+    case Frontend::kCommandLine: {
+      std::string option = std::string("--") + name;
+      for (char& c : option)
+        if (c == '_') c = '-';
+      return option;
+    }
+    case Frontend::kPython:
+      return std::string(python_name ? python_name : name) + "=";
+  }
+  return name;
+}
+
+std::string SettingSpec::Expected(bool si) const {
+  const bool bounded = std::isfinite(max);
+  const double lo = si ? min * to_si : min, hi = si ? max * to_si : max;
+  const char* u = si ? si_unit : unit;
+  if (integer) {
+    const std::string low = Number(lo) + (*min_note ? std::string(" (") + min_note + ")" : "");
+    const std::string what = *noun ? std::string(" ") + noun : std::string();
+    if (bounded) return "expected " + low + " to " + Number(hi) + what;
+    return "expected " + low + " or more" + what;
+  }
+  if (bounded) return "expected a value in [" + Number(lo) + ", " + Number(hi) + "]" + Unit(u);
+  return std::string("expected a finite value ") + (min_exclusive ? "> " : ">= ") + Number(lo) +
+         Unit(u);
+}
+
+bool SettingSpec::Allows(double value_si) const {
+  if (!std::isfinite(value_si)) return false;
+  const double v = value_si / to_si;
+  if (integer && v != std::floor(v)) return false;
+  const double lo = min * to_si, hi = max * to_si;
+  return (min_exclusive ? value_si > lo : value_si >= lo) && value_si <= hi;
+}
+
+void SettingSpec::Check(double value_si) const {
+  if (!Allows(value_si)) throw SettingError(*this, value_si);
+}
+
+double SettingSpec::FromSi(double value_si) const {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", value_si / to_si);
+  return std::strtod(buffer, nullptr);
+}
+
+SettingError::SettingError(const SettingSpec& spec, double value_si)
+    : InputError(spec.Spelling(Frontend::kLibrary),
+                 spec.Expected(/*si=*/true) + ", got " + Number(value_si)),
+      spec_(spec),
+      problem_(spec.Expected() + ", got " + Number(spec.FromSi(value_si))) {}
+
+SettingError::SettingError(const SettingSpec& spec, const std::string& problem)
+    : InputError(spec.Spelling(Frontend::kLibrary), problem), spec_(spec), problem_(problem) {}
+
+std::string SettingError::Problem() const { return problem_; }
+
+InputError SettingError::Respelled(Frontend frontend, const std::string& where) const {
+  return InputError(where.empty() ? spec_.Spelling(frontend) : where, Problem());
+}
+
+}  // namespace lrcal
