@@ -3,6 +3,7 @@
 // used to be refused are here too (exit 0). Placeholders in files and arguments:
 //   {dir}    the case's own temporary folder (files are written there)
 //   {robot}  studies/robots/paper.yaml      {study}  a valid small study file's header
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -58,7 +59,7 @@ TEST_P(BadInputTest, ExitCodeAndMessageNameWhereAndWhat) {
       testing::RunCommand("cd " + dir + " && " + testing::LrcalBinary() + " " + fill(c.args), &out);
   EXPECT_EQ(code, c.exit_code) << out;
   for (const std::string& e : c.expected)
-    EXPECT_NE(out.find(fill(e)), std::string::npos) << "expected '" << fill(e) << "' in:\n" << out;
+    EXPECT_THAT(out, ::testing::HasSubstr(fill(e))) << "expected '" << fill(e) << "' in:\n" << out;
 }
 
 std::string Nul() { return std::string("q1,q2,q3,q4,q5,q6\n0.1\0garbage,0,0,0,0,0\n", 39); }

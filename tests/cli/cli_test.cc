@@ -1,5 +1,6 @@
 // The lrcal program as a user runs it: JSON outputs, the sample → simulate → identify round
 // trip, and error messages that name the file, line and field with exit code 2.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -133,8 +134,8 @@ TEST_F(CliTest, UrdfArmCalibratesAndExportsWithTheSameKinematics) {
                 &out),
             0)
       << out;
-  EXPECT_NE(out.find("consistent with the stated noise"), std::string::npos) << out;
-  EXPECT_NE(testing::ReadFile(Path("cal.yaml")).find("tool: {xyz:"), std::string::npos);
+  EXPECT_THAT(out, ::testing::HasSubstr("consistent with the stated noise")) << out;
+  EXPECT_THAT(testing::ReadFile(Path("cal.yaml")), ::testing::HasSubstr("tool: {xyz:"));
   ASSERT_EQ(
       Run("export --robot " + Path("cal.yaml") + " --format urdf --out " + Path("cal.urdf"), &out),
       0)
@@ -202,7 +203,7 @@ TEST_F(CliTest, IdentifiabilityNamesTheRangerDependences) {
   EXPECT_EQ(j["dependencies"][1][0]["name"], "ranger_scale");
   EXPECT_EQ(j["suggested_fixed"], Json::array({"ranger_offset", "ranger_scale"}));
   EXPECT_NE(Run("identifiability --configs " + Path("c.csv") + " --estimate-ranger zero", &out), 0);
-  EXPECT_NE(out.find("--estimate-ranger: unknown ranger term 'zero'"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--estimate-ranger: unknown ranger term 'zero'")) << out;
 }
 
 // Issue 12's acceptance: three planes with normals and offsets estimated give 34 parameters,
@@ -238,8 +239,8 @@ TEST_F(CliTest, IdentifiabilityOnThreePlanesNamesTheLostCombinations) {
       Run("identifiability --configs " + Path("c.csv") + planes + " --estimate-plane normal,offset",
           &out),
       0);
-  EXPECT_NE(out.find("cheapest fix: fix"), std::string::npos) << out;
-  EXPECT_NE(out.find("add a known distance"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("cheapest fix: fix")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("add a known distance")) << out;
 
   ASSERT_EQ(Run("identifiability --configs " + Path("c.csv") + planes +
                     " --estimate-ranger offset,scale --format json",
@@ -330,8 +331,8 @@ TEST_F(CliTest, DesignTaskCriterionMinimisesThePredictedErrorAtThePoses) {
       Run("design --pool " + Path("pool.csv") + " --select 30 --baseline 10 --criterion I", &out),
       0)
       << out;
-  EXPECT_NE(out.find("criterion I (predicted RMS position error at 200 workspace poses"),
-            std::string::npos)
+  EXPECT_THAT(
+      out, ::testing::HasSubstr("criterion I (predicted RMS position error at 200 workspace poses"))
       << out;
 }
 
@@ -379,8 +380,9 @@ TEST_F(CliTest, RobotFileWithPlanesRoundTrip) {
   Write("bad.csv", "q1,q2,q3,q4,q5,q6,plane\n0,-0.7,0,0,0,0,ceiling\n");
   EXPECT_EQ(Run("kinematics --robot " + Path("rig.yaml") + " --configs " + Path("bad.csv"), &out),
             2);
-  EXPECT_NE(out.find("'ceiling' is not one of the 2 plane(s) given: expected 1 (table), 2 (wall)"),
-            std::string::npos)
+  EXPECT_THAT(out,
+              ::testing::HasSubstr(
+                  "'ceiling' is not one of the 2 plane(s) given: expected 1 (table), 2 (wall)"))
       << out;
 }
 
@@ -407,10 +409,10 @@ TEST_F(CliTest, IdentifyHoldoutChecksPredictionsOfHeldOutReadings) {
   EXPECT_NEAR(j["ratio"].get<double>(), 1.0, 0.3);
   EXPECT_TRUE(j["failed_folds"].empty());
   EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.1 --holdout 5", &out), 4);
-  EXPECT_NE(out.find("held-out readings are predicted WORSE than the fit says"), std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr("held-out readings are predicted WORSE than the fit says"))
       << out;
   EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --holdout 61", &out), 2);
-  EXPECT_NE(out.find("--holdout: expected 2 to 60 folds"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--holdout: expected 2 to 60 folds")) << out;
 }
 
 TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
@@ -418,8 +420,8 @@ TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
   ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0);
   EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --estimate-plane normal", &out), 3);
-  EXPECT_NE(out.find("--fix"), std::string::npos) << out;
-  EXPECT_NE(out.find("theta1"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--fix")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("theta1")) << out;
   EXPECT_EQ(
       Run("identify --data " + Path("m.csv") + " --estimate-plane normal --auto-fix --format json",
           &out),
@@ -442,8 +444,8 @@ TEST_F(CliTest, IdentifyChecksTheFitAgainstTheStatedNoise) {
   EXPECT_GT(fit["p_value"].get<double>(), 1e-3);
   EXPECT_EQ(fit["standardized_residuals"].size(), 60u);
   EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.04", &out), 4);
-  EXPECT_NE(out.find("INCONSISTENT with the stated noise"), std::string::npos) << out;
-  EXPECT_NE(out.find("wrong units"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("INCONSISTENT with the stated noise")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("wrong units")) << out;
   EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.04 --format json", &out), 4);
   EXPECT_FALSE(Json::parse(out.substr(0, out.rfind('}') + 1))["fit"]["consistent"].get<bool>());
   // Without σ: no test, σ̂ and the standardised residuals.
@@ -466,11 +468,11 @@ TEST_F(CliTest, IdentifyChecksTheFitAgainstTheStatedNoise) {
   }
   Write("few.csv", ten);
   EXPECT_EQ(Run("identify --data " + Path("few.csv"), &out), 2);
-  EXPECT_NE(out.find("few.csv"), std::string::npos) << out;
-  EXPECT_NE(out.find("25 parameters need at least as many configurations"), std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr("few.csv")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("25 parameters need at least as many configurations"))
       << out;
-  EXPECT_NE(out.find("10 given"), std::string::npos) << out;
-  EXPECT_EQ(out.find("dependence"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("10 given")) << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("dependence"))) << out;
 }
 
 // identify --write-robot: the calibrated model as a robot file whose nominal values are the
@@ -500,8 +502,8 @@ TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
     EXPECT_EQ(cal.robot.true_errors()[k], 0.0);
   }
   const std::string text = testing::ReadFile(Path("cal.yaml"));
-  EXPECT_NE(text.find("data_fnv1a"), std::string::npos);
-  EXPECT_NE(text.find("sigma: 0.00020000000000000001  # m, one reading; given"), std::string::npos)
+  EXPECT_THAT(text, ::testing::HasSubstr("data_fnv1a"));
+  EXPECT_THAT(text, ::testing::HasSubstr("sigma: 0.00020000000000000001  # m, one reading; given"))
       << text;
   ASSERT_EQ(Run("kinematics --robot " + Path("cal.yaml") + " --configs " + Path("c.csv"), &out), 0)
       << out;
@@ -546,9 +548,9 @@ TEST_F(CliTest, AccuracyAtPosesFromTheFitAndFromTheCalibratedFile) {
   EXPECT_GT(file["poses"][0]["position_radius_95"].get<double>(), 0);
   ASSERT_EQ(Run("accuracy --robot " + Path("cal.yaml") + " --configs " + Path("poses.csv"), &out),
             0);
-  EXPECT_NE(out.find("Predicted accuracy of the calibrated arm"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("Predicted accuracy of the calibrated arm")) << out;
   EXPECT_EQ(Run("accuracy --robot paper --configs " + Path("poses.csv"), &out), 2);
-  EXPECT_NE(out.find("--write-robot"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--write-robot")) << out;
 }
 
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
@@ -609,7 +611,7 @@ TEST_P(CliErrorTest, ExitsTwoWithAMessageNamingWhere) {
   for (std::size_t at; (at = args.find("{}")) != std::string::npos;) args.replace(at, 2, path);
   std::string out;
   EXPECT_EQ(Run(args, &out), 2) << out;
-  EXPECT_NE(out.find(p.expected), std::string::npos) << "message was: " << out;
+  EXPECT_THAT(out, ::testing::HasSubstr(p.expected)) << "message was: " << out;
 }
 
 INSTANTIATE_TEST_SUITE_P(

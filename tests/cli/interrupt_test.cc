@@ -1,5 +1,6 @@
 // SIGTERM while the cells of a study are still being prepared: the run stops at the next cell
 // with exit 130 and writes nothing (no half-made run directory).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -27,8 +28,8 @@ TEST(Interrupt, SigtermWhileCellsArePreparedStopsWithoutWritingAnything) {
           " run slow.yaml --out run --quiet & pid=$!; sleep 1; kill -TERM $pid; wait $pid)",
       &out);
   EXPECT_EQ(code, 130) << out;
-  EXPECT_NE(out.find("interrupted while the cells were prepared; nothing was written"),
-            std::string::npos)
+  EXPECT_THAT(
+      out, ::testing::HasSubstr("interrupted while the cells were prepared; nothing was written"))
       << out;
   EXPECT_FALSE(fs::exists(dir + "/run/manifest.json"));
 }

@@ -1,5 +1,6 @@
 // lrcal plan-accuracy end to end on a small set-up: the cheapest campaign by the first-order
 // prediction, confirmed by Monte Carlo, written as a study that runs again; bad options exit 2.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -166,8 +167,8 @@ TEST(PlanAccuracy, ConfirmationStopsWhenPreciseEnough) {
   EXPECT_TRUE(s.stop_when.enabled());
   EXPECT_EQ(s.stop_when.block, 500);
   EXPECT_EQ(testing::RunCommand(plan + " --stop-precision 1.5", &out), 2);
-  EXPECT_NE(out.find("--stop-precision: expected 0 (run every trial) or a relative precision"),
-            std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr(
+                       "--stop-precision: expected 0 (run every trial) or a relative precision"))
       << out;
 }
 
@@ -176,25 +177,25 @@ TEST(PlanAccuracy, BadTargetsAndRangesAreExitTwo) {
   EXPECT_EQ(
       testing::RunCommand(testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05", &out),
       2);
-  EXPECT_NE(out.find("--target"), std::string::npos) << out;
-  EXPECT_NE(out.find("needs its unit (mm)"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--target")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("needs its unit (mm)")) << out;
   EXPECT_EQ(testing::RunCommand(
                 testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --repetitions 5:1",
                 &out),
             2);
-  EXPECT_NE(out.find("--repetitions"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--repetitions")) << out;
   EXPECT_EQ(
       testing::RunCommand(
           testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --cost walk=3s", &out),
       2);
-  EXPECT_NE(out.find("--cost"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--cost")) << out;
   // --planes needs candidate planes, and no more than there are.
   EXPECT_EQ(
       testing::RunCommand(
           testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --planes 1:2", &out),
       2);
-  EXPECT_NE(out.find("--planes: the set-up has no candidate planes to choose from"),
-            std::string::npos)
+  EXPECT_THAT(out,
+              ::testing::HasSubstr("--planes: the set-up has no candidate planes to choose from"))
       << out;
   const std::string dir = testing::TempDir("plan_accuracy_bad_planes");
   std::ofstream(dir + "/two.yaml") << "name: two\nseed: 1\ntrials: 10\nrobot: "
@@ -206,14 +207,14 @@ TEST(PlanAccuracy, BadTargetsAndRangesAreExitTwo) {
                                     "/plan",
                                 &out),
             2);
-  EXPECT_NE(out.find("--planes: the set-up has 2 candidate planes"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--planes: the set-up has 2 candidate planes")) << out;
   EXPECT_EQ(
       testing::RunCommand(testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --cost "
                                                    "configuration=30s,reading=1s,plane=ten",
                           &out),
       2);
-  EXPECT_NE(out.find("--cost: expected configuration=SECONDSs,reading=SECONDSs[,plane=SECONDSs]"),
-            std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr(
+                       "--cost: expected configuration=SECONDSs,reading=SECONDSs[,plane=SECONDSs]"))
       << out;
 }
 

@@ -1,6 +1,7 @@
 // What lrcal run, merge and plan tell the user about a run: slices by --max-trials are not
 // interruptions, a finished run says there is nothing to do, a partial merge writes no tables,
 // and redrawn designs show their σ_min over the trials.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -30,23 +31,23 @@ TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
   const std::string dir = testing::TempDir("max_trials_slice");
   std::string out;
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet --max-trials 50", &out), 0) << out;
-  EXPECT_NE(out.find("stopped after 50 new trials (--max-trials): 50/200 trials recorded"),
-            std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr(
+                       "stopped after 50 new trials (--max-trials): 50/200 trials recorded"))
       << out;
-  EXPECT_EQ(out.find("interrupted"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("interrupted"))) << out;
   EXPECT_EQ(LastSessionEnd(dir + "/run"), "max_trials");
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
-  EXPECT_NE(out.find("150 trials computed"), std::string::npos) << out;
-  EXPECT_NE(out.find("50 were already recorded"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("150 trials computed")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("50 were already recorded")) << out;
   EXPECT_EQ(LastSessionEnd(dir + "/run"), "completed");
   // Once more: nothing to do, said so (not "0 trials computed").
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
-  EXPECT_NE(out.find("nothing to compute: all 200 trials of this run were already recorded"),
-            std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr(
+                       "nothing to compute: all 200 trials of this run were already recorded"))
       << out;
   // A short run does not print a meaningless overhead percentage.
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/small --quiet --threads 2", &out), 0) << out;
-  EXPECT_NE(out.find("too short to measure the runner's overhead"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("too short to measure the runner's overhead")) << out;
 }
 
 TEST(RunBookkeeping, MergingIncompleteShardsWritesNoTablesAndSaysWhatToFinish) {
@@ -56,8 +57,8 @@ TEST(RunBookkeeping, MergingIncompleteShardsWritesNoTablesAndSaysWhatToFinish) {
   ASSERT_EQ(Lrcal("run quick --shard 2/2 --out " + dir + "/s2 --quiet --max-trials 30", &out), 0)
       << out;
   ASSERT_EQ(Lrcal("merge " + dir + "/s1 " + dir + "/s2 --out " + dir + "/m", &out), 1) << out;
-  EXPECT_NE(out.find("tables not written"), std::string::npos) << out;
-  EXPECT_NE(out.find("unfinished or missing shards: 2"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("tables not written")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("unfinished or missing shards: 2")) << out;
   EXPECT_FALSE(fs::exists(dir + "/m/tables"));
   ASSERT_EQ(Lrcal("run quick --shard 2/2 --out " + dir + "/s2 --quiet", &out), 0) << out;
   ASSERT_EQ(Lrcal("merge " + dir + "/s1 " + dir + "/s2 --out " + dir + "/m", &out), 0) << out;
@@ -71,7 +72,7 @@ TEST(RunBookkeeping, PlanOfAShortStudySaysItsSecondsWithADecimal) {
   // Tenths under 10 s, whatever this machine's speed (a sanitizer build takes ~1 s here, a
   // release build ~0.2 s): "about 0.2 s" or "about 1.2 s", never "about 0 s".
   EXPECT_TRUE(std::regex_search(out, std::regex("trials, about [0-9]\\.[0-9] s"))) << out;
-  EXPECT_EQ(out.find("about 0 s"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("about 0 s"))) << out;
 }
 
 TEST(RunBookkeeping, RedrawnDesignsShowSigmaMinOverTheTrials) {
@@ -83,7 +84,7 @@ TEST(RunBookkeeping, RedrawnDesignsShowSigmaMinOverTheTrials) {
   std::string out;
   ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
   const std::string cells = testing::ReadFile(dir + "/run/tables/cells.csv");
-  EXPECT_NE(cells.find("(redrawn per trial)"), std::string::npos) << cells;
+  EXPECT_THAT(cells, ::testing::HasSubstr("(redrawn per trial)")) << cells;
 }
 
 }  // namespace

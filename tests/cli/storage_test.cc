@@ -1,6 +1,7 @@
 // Nothing lost, whatever the disk: a full store, a full file system, a table or output file that
 // cannot be written. Each stops with exit 5 and a message that names the file and says what is
 // safe; nothing already written is damaged; the same command resumes to the same bytes.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/mount.h>
 #include <sys/stat.h>
@@ -44,10 +45,10 @@ TEST(Storage, AFullTrialStoreStopsCleanlyAndTheSameCommandResumes) {
   std::string out;
   // SQLite refuses to grow the store past 12 pages, exactly as on a full disk.
   ASSERT_EQ(RunCommand("LRCAL_TEST_STORE_MAX_PAGES=12 " + command, &out), 5) << out;
-  EXPECT_NE(out.find("could not write results"), std::string::npos) << out;
-  EXPECT_NE(out.find("trials are safely recorded in " + run + "/trials.sqlite"), std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr("could not write results")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("trials are safely recorded in " + run + "/trials.sqlite"))
       << out;
-  EXPECT_NE(out.find("run the same command again"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("run the same command again")) << out;
   ExpectIntactManifest(run);
   EXPECT_FALSE(fs::exists(run + "/tables"));
   // The disk is freed: the same command finishes and gives the golden tables.
@@ -65,7 +66,7 @@ TEST(Storage, AFullFileSystemStopsCleanlyAndResumesOnceSpaceIsFreed) {
   std::string out;
   const int first = RunCommand(command, &out);
   EXPECT_EQ(first, 5) << out;
-  EXPECT_NE(out.find("could not write results"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("could not write results")) << out;
   if (fs::exists(run + "/manifest.json")) ExpectIntactManifest(run);
   // Run again on the still-full disk: refused the same way, and nothing already there damaged.
   EXPECT_EQ(RunCommand(command, &out), 5) << out;
@@ -87,10 +88,10 @@ TEST(Storage, TablesThatCannotBeWrittenLeaveTheRunIntactAndAggregateRewritesThem
   fs::remove(run + "/tables/summary.json");
   fs::create_directory(run + "/tables/summary.json.tmp");  // the write of summary.json fails
   ASSERT_EQ(RunCommand(LrcalBinary() + " aggregate " + run, &out), 5) << out;
-  EXPECT_NE(out.find(run + "/tables/summary.json.tmp"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr(run + "/tables/summary.json.tmp")) << out;
   EXPECT_EQ(ReadFile(run + "/manifest.json"), manifest);  // untouched
   ASSERT_EQ(RunCommand(LrcalBinary() + " status " + run, &out), 0) << out;
-  EXPECT_NE(out.find("tables: missing; write them with: lrcal aggregate"), std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr("tables: missing; write them with: lrcal aggregate"))
       << out;
   fs::remove(run + "/tables/summary.json.tmp");
   ASSERT_EQ(RunCommand(LrcalBinary() + " aggregate " + run, &out), 0) << out;
@@ -105,12 +106,12 @@ TEST(Storage, MergeAndReportThatCannotWriteAreExitFiveAndKeepTheirInputs) {
   // merge: the merged manifest cannot be written.
   fs::create_directories(dir + "/m/manifest.json.tmp");
   ASSERT_EQ(RunCommand(LrcalBinary() + " merge " + dir + "/a --out " + dir + "/m", &out), 5) << out;
-  EXPECT_NE(out.find("manifest.json.tmp"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("manifest.json.tmp")) << out;
   ExpectGoldenTables(dir + "/a");  // the input is untouched
   // report: report.html cannot be written (its temporary name is taken by a folder).
   fs::create_directories(dir + "/a/report/report.html.tmp");
   ASSERT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/a", &out), 5) << out;
-  EXPECT_NE(out.find("report.html.tmp"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("report.html.tmp")) << out;
   ExpectIntactManifest(dir + "/a");
 }
 
@@ -130,8 +131,8 @@ TEST_P(FullDeviceTest, AFullDeviceIsExitFiveNamingTheFile) {
   std::string out;
   EXPECT_EQ(RunCommand("cd " + dir + " && " + LrcalBinary() + " " + GetParam().args, &out), 5)
       << out;
-  EXPECT_NE(out.find("/dev/full"), std::string::npos) << out;
-  EXPECT_NE(out.find("No space left on device"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("/dev/full")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("No space left on device")) << out;
   struct stat st;
   ASSERT_EQ(::stat("/dev/full", &st), 0);
   EXPECT_TRUE(S_ISCHR(st.st_mode));

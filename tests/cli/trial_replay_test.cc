@@ -1,5 +1,6 @@
 // lrcal trial: a recorded trial is recomputed bit for bit; a tampered record, an unknown cell or
 // trial, and a study file changed since the run are reported.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -48,7 +49,7 @@ TEST_F(TrialReplayTest, RecomputesARecordedTrialBitForBit) {
   EXPECT_EQ(j["configurations"].size(), 30u);
   EXPECT_EQ(j["record"]["errors"].size(), j["parameters"].size());
   ASSERT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 0", &out), 0) << out;
-  EXPECT_NE(out.find("identical to the stored record, bit for bit"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("identical to the stored record, bit for bit")) << out;
 }
 
 TEST_F(TrialReplayTest, ATamperedRecordIsReportedWithTheFieldsThatDiffer) {
@@ -62,23 +63,23 @@ TEST_F(TrialReplayTest, ATamperedRecordIsReportedWithTheFieldsThatDiffer) {
   sqlite3_close(db);
   std::string out;
   EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 4", &out), 1) << out;
-  EXPECT_NE(out.find("DIFFERS from the stored record in: iterations val_rms_pos_y"),
-            std::string::npos)
+  EXPECT_THAT(out,
+              ::testing::HasSubstr("DIFFERS from the stored record in: iterations val_rms_pos_y"))
       << out;
 }
 
 TEST_F(TrialReplayTest, BadRequestsAndAChangedStudyAreClearErrors) {
   std::string out;
   EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell nope --trial 1", &out), 2) << out;
-  EXPECT_NE(out.find("--cell: no cell 'nope' in the run; cells: noise.sigma_mm=0.1"),
-            std::string::npos)
+  EXPECT_THAT(out,
+              ::testing::HasSubstr("--cell: no cell 'nope' in the run; cells: noise.sigma_mm=0.1"))
       << out;
   EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 30", &out), 2) << out;
-  EXPECT_NE(out.find("--trial: expected 0 to 29, got 30"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--trial: expected 0 to 29, got 30")) << out;
   EXPECT_EQ(Lrcal("trial " + dir_ + " --cell x --trial 1", &out), 2) << out;  // not a run
   WriteStudy(8);
   EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 1", &out), 2) << out;
-  EXPECT_NE(out.find("has changed since the run"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("has changed since the run")) << out;
 }
 
 }  // namespace

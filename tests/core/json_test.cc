@@ -1,6 +1,7 @@
 // Atomic, checked file writes and JSON differences.
 #include "lrcal/core/json.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -39,15 +40,15 @@ TEST(WriteFileAtomically, AFailedWriteKeepsTheOldFileAndNamesThePath) {
   WriteFileAtomically(path, "{\"complete\": true}\n");
   fs::create_directory(path + ".tmp");  // the temporary cannot be created
   const std::string message = Message(path, "{}\n");
-  EXPECT_NE(message.find(path + ".tmp"), std::string::npos) << message;
+  EXPECT_THAT(message, ::testing::HasSubstr(path + ".tmp")) << message;
   EXPECT_EQ(testing::ReadFile(path), "{\"complete\": true}\n");
 }
 
 TEST(WriteFileAtomically, AFullDeviceIsAnErrorAndIsNeverReplaced) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   const std::string message = Message("/dev/full", std::string(1 << 16, 'x'));
-  EXPECT_NE(message.find("/dev/full"), std::string::npos) << message;
-  EXPECT_NE(message.find("No space left on device"), std::string::npos) << message;
+  EXPECT_THAT(message, ::testing::HasSubstr("/dev/full")) << message;
+  EXPECT_THAT(message, ::testing::HasSubstr("No space left on device")) << message;
   struct stat st;
   ASSERT_EQ(::stat("/dev/full", &st), 0);
   EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/full was replaced";
@@ -56,9 +57,9 @@ TEST(WriteFileAtomically, AFullDeviceIsAnErrorAndIsNeverReplaced) {
 
 TEST(WriteFileAtomically, ADirectoryOrAMissingFolderIsAnErrorNamingIt) {
   const std::string dir = testing::TempDir("atomic_dir");
-  EXPECT_NE(Message(dir, "x").find("is a directory"), std::string::npos);
+  EXPECT_THAT(Message(dir, "x"), ::testing::HasSubstr("is a directory"));
   const std::string missing = dir + "/no/such/folder/file.csv";
-  EXPECT_NE(Message(missing, "x").find(missing), std::string::npos);
+  EXPECT_THAT(Message(missing, "x"), ::testing::HasSubstr(missing));
 }
 
 TEST(DiffJson, NamesEveryChangedAddedAndRemovedKey) {

@@ -3,6 +3,7 @@
 // E-optimal designs reach (almost) all of it.
 #include "lrcal/design/design_certificate.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -94,10 +95,9 @@ TEST(DesignCertificate, PaperArmDesignsAndTheLimitsOfTheCertificate) {
     EXPECT_LE(CertifyDesign(G, pick, DesignCriterion::kE, 1).achieved, cert.bound);
   }
   EXPECT_FALSE(CertifyDesign(G, r.indices, DesignCriterion::kO2).available);
-  EXPECT_NE(CertifyDesign(G, r.indices, DesignCriterion::kO2)
-                .ToString(DesignCriterion::kO2, 50, 101)
-                .find("no certificate"),
-            std::string::npos);
+  EXPECT_THAT(
+      CertifyDesign(G, r.indices, DesignCriterion::kO2).ToString(DesignCriterion::kO2, 50, 101),
+      ::testing::HasSubstr("no certificate"));
   std::cout << cert.ToString(DesignCriterion::kE, 50, 101) << "\n";
   std::cout << "bound with 300 iterations: " << DesignUpperBound(G, 50, DesignCriterion::kE, 300)
             << ", 1500: " << DesignUpperBound(G, 50, DesignCriterion::kE, 1500) << "\n";

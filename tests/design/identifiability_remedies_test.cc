@@ -6,6 +6,7 @@
 // plane by a second known plane.
 #include "lrcal/design/identifiability_remedies.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -96,7 +97,7 @@ TEST(IdentifiabilityRemedies, ThreeEstimatedPlanesLoseASpinAndAShift) {
     EXPECT_EQ(m.parameter, "plane1_f") << r.ToString();
     EXPECT_EQ(m.recovers, std::vector<int>{shift}) << r.ToString();
   }
-  EXPECT_NE(r.ToString().find("cheapest fix: fix"), std::string::npos) << r.ToString();
+  EXPECT_THAT(r.ToString(), ::testing::HasSubstr("cheapest fix: fix")) << r.ToString();
 }
 
 TEST(IdentifiabilityRemedies, RangerOffsetOnlyByFixingAndScaleByASecondKnownPlane) {

@@ -3,6 +3,7 @@
 // match the stated noise pass, understated noise and an unmodelled ranger error are flagged.
 #include "lrcal/identification/cross_validation.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -93,7 +94,7 @@ TEST(CrossValidation, ConsistentDataPassUnderstatedNoiseAndMissingTermsDoNot) {
   const CrossValidation low = CrossValidate(model, Simulated(configs, noise, 1), 5, understated);
   EXPECT_FALSE(low.consistent()) << low.ToString();
   EXPECT_GT(low.mean_z2, 2.5) << low.ToString();
-  EXPECT_NE(low.ToString().find("WORSE than the fit says"), std::string::npos);
+  EXPECT_THAT(low.ToString(), ::testing::HasSubstr("WORSE than the fit says"));
 
   const PlaneSet planes({testing::PaperPlane(), Plane::FromCoefficients(1, 0, 0, 0.9)}, {});
   ConfigurationSet both(6);
@@ -128,7 +129,7 @@ TEST(CrossValidation, FoldsOutOfRangeAndUnfittableFoldsAreReported) {
   const CrossValidation cv = CrossValidate(model, data, 2, IdentificationOptions{});
   EXPECT_EQ(cv.failed_folds.size(), 2u);
   EXPECT_TRUE(cv.predictions.empty());
-  EXPECT_NE(cv.ToString().find("fold 0:"), std::string::npos) << cv.ToString();
+  EXPECT_THAT(cv.ToString(), ::testing::HasSubstr("fold 0:")) << cv.ToString();
 }
 
 }  // namespace

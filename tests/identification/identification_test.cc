@@ -22,7 +22,7 @@ namespace {
 using testing::PaperRobot;
 
 // Noise-free data: the least-squares minimum is the truth; the solvers stop at rounding level.
-constexpr double kRecoveryTolerance = 1e-9;  // SI (m or rad), the requirement
+constexpr double kRecoveryTolerance = testing::tolerance::kRoundTrip;  // SI (m or rad)
 // Two solvers on the same noisy problem reach the same minimum to well below its uncertainty.
 constexpr double kSolverAgreement = 1e-9;  // relative to the largest |estimate error|
 
@@ -105,7 +105,7 @@ TEST_P(RecoveryTest, RankDeficientSetIsReportedNotConverged) {
   IdentificationSummary s = Identify(model, data, options);
   EXPECT_EQ(s.termination, Termination::kRankDeficient);
   EXPECT_FALSE(s.IsSolutionUsable());
-  EXPECT_NE(s.message.find("theta1"), std::string::npos) << s.message;
+  EXPECT_THAT(s.message, ::testing::HasSubstr("theta1")) << s.message;
 
   // Asked to fix the dependent parameters, it identifies the 22 others.
   options.fix_dependent_parameters = true;
@@ -271,7 +271,7 @@ TEST(Identification, RobustLossesAgreeWithCeres) {
         ASSERT_TRUE(ceres.IsSolutionUsable()) << ceres.FullReport();
         EXPECT_LT((lm.delta - ceres.delta).cwiseAbs().maxCoeff(), 1e-8)
             << lm.loss << ", " << outliers << " outliers";
-        EXPECT_NE(lm.BriefReport().find(NameOf(kRobustLossNames, loss)), std::string::npos);
+        EXPECT_THAT(lm.BriefReport(), ::testing::HasSubstr(NameOf(kRobustLossNames, loss)));
       }
   }
 }
@@ -304,7 +304,8 @@ TEST(Identification, RobustFitsConvergeOnCleanData) {
   const IdentificationSummary s = Identify(model, exact, o);
   ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
   for (int k = 0; k < model.num_parameters(); ++k)
-    EXPECT_NEAR(s.delta[k], robot.true_errors()[model.parameters().robot_values[k]], 1e-9);
+    EXPECT_NEAR(s.delta[k], robot.true_errors()[model.parameters().robot_values[k]],
+                kRecoveryTolerance);
 }
 
 // The ranger reads (1 + s)·h + o. Its offset is a translation along the beam, which d6 also is
@@ -323,9 +324,9 @@ TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
     ASSERT_EQ(r.suggested_fixed.size(), 1u) << term;
     EXPECT_EQ(r.suggested_fixed[0], std::string("ranger_") + term);
     const std::string text = r.ToString();
-    EXPECT_NE(text.find("d6"), std::string::npos) << text;
+    EXPECT_THAT(text, ::testing::HasSubstr("d6")) << text;
     if (std::string(term) == "scale") {
-      EXPECT_NE(text.find("a2"), std::string::npos) << text;
+      EXPECT_THAT(text, ::testing::HasSubstr("a2")) << text;
     }
   }
   Eigen::VectorXd truth = robot.true_values();
@@ -349,11 +350,12 @@ TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
     const ParameterSet& ps = model.parameters();
     for (int k = 0; k < ps.num_robot(); ++k)
       EXPECT_NEAR(s.delta[k],
-                  truth[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]], 1e-9)
+                  truth[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]],
+                  kRecoveryTolerance)
           << ps.names[k];
-    EXPECT_NEAR(s.delta[ps.ranger_offset_index], 0.4e-3, 1e-9);
-    EXPECT_NEAR(s.delta[ps.ranger_scale_index], 250e-6, 1e-9);
-    EXPECT_NE(s.ParameterTable().find("ppm"), std::string::npos);
+    EXPECT_NEAR(s.delta[ps.ranger_offset_index], 0.4e-3, kRecoveryTolerance);
+    EXPECT_NEAR(s.delta[ps.ranger_scale_index], 250e-6, kRecoveryTolerance);
+    EXPECT_THAT(s.ParameterTable(), ::testing::HasSubstr("ppm"));
   }
 }
 
@@ -468,7 +470,7 @@ TEST(Identification, ReadingOnAPlaneTheModelLacksIsAnInputError) {
   const IdentificationSummary s = Identify(model, data, IdentificationOptions{});
   EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_FALSE(s.IsSolutionUsable());
-  EXPECT_NE(s.message.find("plane"), std::string::npos) << s.message;
+  EXPECT_THAT(s.message, ::testing::HasSubstr("plane")) << s.message;
 }
 
 // The χ² fit test: the statistic is Σ R_i·r_i²/σ², its p-value the closed-form upper tail for an
@@ -516,7 +518,7 @@ TEST(Identification, FitCheckAgainstTheStatedNoise) {
     const IdentificationSummary bad = Identify(model, data, o);
     flagged_inflated += !bad.fit.consistent;
     if (seed == 0) {
-      EXPECT_NE(bad.fit.Explain().find("INCONSISTENT"), std::string::npos);
+      EXPECT_THAT(bad.fit.Explain(), ::testing::HasSubstr("INCONSISTENT"));
     }
   }
   EXPECT_LE(flagged, 2);                  // expected 0.2 of 200
@@ -538,7 +540,7 @@ TEST(Identification, SuspectsAndTooFewConfigurations) {
   const IdentificationSummary s = Identify(model, data, o);
   ASSERT_TRUE(s.IsSolutionUsable());
   EXPECT_EQ(s.fit.suspects, std::vector<int>{17});
-  EXPECT_NE(s.fit.Explain().find("18 ("), std::string::npos) << s.fit.Explain();
+  EXPECT_THAT(s.fit.Explain(), ::testing::HasSubstr("18 (")) << s.fit.Explain();
   MeasurementSet exact;
   SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
                    testing::PaperHittingConfigurations(25, 15), NoiseModel{0.2e-3, 10, true},
@@ -547,15 +549,15 @@ TEST(Identification, SuspectsAndTooFewConfigurations) {
   ASSERT_TRUE(square.IsSolutionUsable()) << square.FullReport();
   EXPECT_TRUE(std::isnan(square.sigma_hat));
   EXPECT_TRUE(std::isnan(square.std_residual[0]));
-  EXPECT_NE(square.ParameterTable().find("undefined"), std::string::npos);
+  EXPECT_THAT(square.ParameterTable(), ::testing::HasSubstr("undefined"));
   MeasurementSet few;
   SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
                    testing::PaperHittingConfigurations(10, 15), NoiseModel{0.2e-3, 10, true},
                    RandomStream(4, 0, 0, RandomPurpose::kNoise), &few);
   const IdentificationSummary too_few = Identify(model, few, o);
   EXPECT_EQ(too_few.termination, Termination::kInvalidInput);
-  EXPECT_NE(too_few.message.find("25 parameters need at least"), std::string::npos);
-  EXPECT_NE(too_few.message.find("10 given"), std::string::npos);
+  EXPECT_THAT(too_few.message, ::testing::HasSubstr("25 parameters need at least"));
+  EXPECT_THAT(too_few.message, ::testing::HasSubstr("10 given"));
   EXPECT_TRUE(too_few.identifiability.dependencies.empty());
 }
 

@@ -1,6 +1,7 @@
 // Robot files: the paper's file, and bad files named by file, line and key.
 #include "lrcal/io/robot_file.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -46,21 +47,17 @@ TEST(RobotFile, BadFilesNameFileLineAndKey) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: x, d: 0, parameters: [theta]}\n")
-                .find("r.yaml:2 key 'links[0].a'"),
-            std::string::npos);
-  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [gamma]}\n")
-                .find("unknown parameter 'gamma'"),
-            std::string::npos);
-  EXPECT_NE(message("linkz: []\n").find("unknown key"), std::string::npos);
-  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [theta]}\n"
-                    "true_errors:\n  links:\n    - {d: 1}\n")
-                .find("not a parameter"),
-            std::string::npos);
-  EXPECT_NE(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [theta]}\n"
-                    "plane: {normal: [0, 0, 0], offset: 1}\n")
-                .find("zero"),
-            std::string::npos);
+  EXPECT_THAT(message("links:\n  - {theta: 0, alpha: 0, a: x, d: 0, parameters: [theta]}\n"),
+              ::testing::HasSubstr("r.yaml:2 key 'links[0].a'"));
+  EXPECT_THAT(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [gamma]}\n"),
+              ::testing::HasSubstr("unknown parameter 'gamma'"));
+  EXPECT_THAT(message("linkz: []\n"), ::testing::HasSubstr("unknown key"));
+  EXPECT_THAT(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [theta]}\n"
+                      "true_errors:\n  links:\n    - {d: 1}\n"),
+              ::testing::HasSubstr("not a parameter"));
+  EXPECT_THAT(message("links:\n  - {theta: 0, alpha: 0, a: 0, d: 0, parameters: [theta]}\n"
+                      "plane: {normal: [0, 0, 0], offset: 1}\n"),
+              ::testing::HasSubstr("zero"));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // composes), on four arms; URDF → lrcal → URDF round trips; bad URDFs named by file and joint.
 #include "lrcal/io/urdf.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -20,7 +21,7 @@ namespace lrcal {
 namespace {
 
 // Chains of O(1 m) and O(1) rotations composed in two different ways: rounding only.
-constexpr double kTolerance = 1e-12;
+constexpr double kTolerance = testing::tolerance::kUrdf;  // m, rad
 
 // The URDF's forward kinematics: root → tool link, each joint its origin then its motion
 // (rotation about / translation along its axis by q), the movable joints taking q in order.
@@ -73,7 +74,7 @@ void ExpectSameKinematics(const RobotModel& robot, const std::string& urdf,
     const Pose<double> fast = ToolPose(point, one, 0);
     for (const Pose<double>* pose : {&ref, &fast}) {
       EXPECT_LT((pose->p_BT - expected.translation()).norm(), kTolerance) << urdf;
-      EXPECT_LT((pose->R_BT - expected.linear()).cwiseAbs().maxCoeff(), kTolerance) << urdf;
+      EXPECT_THAT(pose->R_BT, testing::EigenNear(expected.linear(), kTolerance)) << urdf;
     }
   }
 }
@@ -133,7 +134,7 @@ TEST(Urdf, PaperArmExportedMatchesAndReadsBack) {
     const Pose<double> pose = ForwardKinematics<double>(paper, truth.data(), q.data());
     const Eigen::Isometry3d urdf = UrdfForwardKinematics(path, "tool", q);
     EXPECT_LT((pose.p_BT - urdf.translation()).norm(), kTolerance);
-    EXPECT_LT((pose.R_BT - urdf.linear()).cwiseAbs().maxCoeff(), kTolerance);
+    EXPECT_THAT(pose.R_BT, testing::EigenNear(urdf.linear(), kTolerance));
   }
 }
 
@@ -149,7 +150,7 @@ TEST(Urdf, RoundTripKeepsTheKinematics) {
     const Eigen::Isometry3d a = UrdfForwardKinematics(original, "ranger", q);
     const Eigen::Isometry3d b = UrdfForwardKinematics(written, "tool", q);
     EXPECT_LT((a.translation() - b.translation()).norm(), kTolerance);
-    EXPECT_LT((a.linear() - b.linear()).cwiseAbs().maxCoeff(), kTolerance);
+    EXPECT_THAT(a.linear(), testing::EigenNear(b.linear(), kTolerance));
   }
   // And lrcal → YAML → lrcal keeps the model to the last digit.
   const std::string yaml = testing::TempDir("urdf_round_trip") + "/ur5.yaml";
@@ -162,13 +163,14 @@ TEST(Urdf, RoundTripKeepsTheKinematics) {
 TEST(Urdf, DhTableListsEveryLinkAndTheFrames) {
   const RobotFile rig = LoadRobotFile(Example("puma560.urdf"));
   const std::string table = DhTableText(rig.robot, rig.robot.nominal_values());
-  EXPECT_NE(table.find("# base xyz_m:"), std::string::npos);
-  EXPECT_NE(table.find("# tool xyz_m:"), std::string::npos);
-  EXPECT_NE(table.find("link,joint,theta0_rad,d_m,a_m,alpha_rad,beta_rad,q_min,q_max,parameters"),
-            std::string::npos);
-  EXPECT_NE(table.find("\n2,revolute,"), std::string::npos);
-  EXPECT_NE(table.find("theta alpha a beta\n"), std::string::npos);  // link 2, Hayati
-  EXPECT_NE(table.find("\n6,revolute,"), std::string::npos);
+  EXPECT_THAT(table, ::testing::HasSubstr("# base xyz_m:"));
+  EXPECT_THAT(table, ::testing::HasSubstr("# tool xyz_m:"));
+  EXPECT_THAT(table,
+              ::testing::HasSubstr(
+                  "link,joint,theta0_rad,d_m,a_m,alpha_rad,beta_rad,q_min,q_max,parameters"));
+  EXPECT_THAT(table, ::testing::HasSubstr("\n2,revolute,"));
+  EXPECT_THAT(table, ::testing::HasSubstr("theta alpha a beta\n"));  // link 2, Hayati
+  EXPECT_THAT(table, ::testing::HasSubstr("\n6,revolute,"));
 }
 
 void ExpectInputError(const std::string& urdf_body, const std::string& tool_link,
@@ -180,8 +182,8 @@ void ExpectInputError(const std::string& urdf_body, const std::string& tool_link
     LoadRobotFile(path, tool_link);
     ADD_FAILURE() << "no error for " << expected;
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(path)) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(expected)) << e.what();
   }
 }
 

@@ -33,7 +33,7 @@ TEST(RigidTransform, RpyRoundTripsIncludingGimbalLock) {
                                       Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
                                       Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
                                          .toRotationMatrix();
-    EXPECT_LT((t.rotation - expected).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_THAT(t.rotation, testing::EigenNear(expected, testing::tolerance::kRounding));
     const RigidTransform back = RigidTransform::FromXyzRpy(t.translation, t.Rpy());
     // Away from gimbal lock the angles' rounding grows as 1/cos(pitch); at it the branch is exact.
     const double cos_pitch = std::cos(rpy.y());
@@ -46,7 +46,8 @@ TEST(RigidTransform, InverseAndCompositionAndValidation) {
   const RigidTransform a =
       RigidTransform::FromXyzRpy(Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d(0.4, 0.5, -0.6));
   const RigidTransform identity = a * a.Inverse();
-  EXPECT_LT((identity.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_THAT(identity.rotation,
+              testing::EigenNear(Eigen::Matrix3d::Identity(), testing::tolerance::kRounding));
   EXPECT_LT(identity.translation.norm(), 1e-15);
   EXPECT_TRUE(RigidTransform().IsIdentity());
   EXPECT_FALSE(a.IsIdentity());
@@ -83,7 +84,7 @@ TEST(RobotFrames, ForwardKinematicsIsBaseTimesChainTimesTool) {
         AsIsometry(framed.base()) * chain_x * AsIsometry(framed.tool());
     const Pose<double> ref = ForwardKinematics<double>(framed, values.data(), q);
     EXPECT_LT((ref.p_BT - expected.translation()).norm(), kTolerance);
-    EXPECT_LT((ref.R_BT - expected.linear()).cwiseAbs().maxCoeff(), kTolerance);
+    EXPECT_THAT(ref.R_BT, testing::EigenNear(expected.linear(), kTolerance));
     // The fast path.
     ChainPoint point;
     PrepareChainPoint(framed, values.data(), &point);
@@ -91,7 +92,7 @@ TEST(RobotFrames, ForwardKinematicsIsBaseTimesChainTimesTool) {
     one.Add(q);
     const Pose<double> fast = ToolPose(point, one, 0);
     EXPECT_LT((fast.p_BT - ref.p_BT).norm(), kTolerance);
-    EXPECT_LT((fast.R_BT - ref.R_BT).cwiseAbs().maxCoeff(), kTolerance);
+    EXPECT_THAT(fast.R_BT, testing::EigenNear(ref.R_BT, kTolerance));
   }
 }
 

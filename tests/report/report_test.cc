@@ -1,6 +1,7 @@
 // lrcal report end to end: the analysis scripts on the output of studies/quick.yaml, the page in
 // headless Chromium (no console errors, every figure decoded, a screenshot written), a partial
 // run said so, and clear errors for missing or malformed run directories.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -56,18 +57,19 @@ TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
   // The snapshot of the store is gone once the figures are drawn.
   EXPECT_FALSE(fs::exists(report / "trials.snapshot.sqlite"));
   const std::string captions = figures["captions"].dump();
-  EXPECT_NE(captions.find("Red diamonds"), std::string::npos);  // paper cells: paper values
-  EXPECT_NE(captions.find("the swept settings (case 1, case 2), drawn as categories"),
-            std::string::npos)
+  EXPECT_THAT(captions, ::testing::HasSubstr("Red diamonds"));  // paper cells: paper values
+  EXPECT_THAT(captions,
+              ::testing::HasSubstr("the swept settings (case 1, case 2), drawn as categories"))
       << captions;
-  EXPECT_EQ(captions.find("Only the first"), std::string::npos);  // every cell is drawn
+  EXPECT_THAT(captions,
+              ::testing::Not(::testing::HasSubstr("Only the first")));  // every cell is drawn
   for (const auto& png : names) {
     EXPECT_GT(fs::file_size(report / "figures" / png), 10000u) << png;
     EXPECT_TRUE(fs::exists(report / "figures" / (png.substr(0, png.size() - 4) + ".svg"))) << png;
   }
   const std::string html = Read(report / "report.html");
-  EXPECT_EQ(html.find("Partial run"), std::string::npos);
-  EXPECT_NE(html.find("The paper"), std::string::npos);  // the placement table is in
+  EXPECT_THAT(html, ::testing::Not(::testing::HasSubstr("Partial run")));
+  EXPECT_THAT(html, ::testing::HasSubstr("The paper"));  // the placement table is in
 
   if (RunCommand("command -v chromium", &out) != 0) GTEST_SKIP() << "chromium is not installed";
   const std::string profile = dir + "/chromium-profile";
@@ -80,10 +82,11 @@ TEST(Report, QuickStudyReportRendersInHeadlessChromium) {
             0);
   const std::string title = "lrcal report: " + std::to_string(names.size()) + "/" +
                             std::to_string(names.size()) + " figures";
-  EXPECT_NE(out.find("<title>" + title + "</title>"), std::string::npos)
+  EXPECT_THAT(out, ::testing::HasSubstr("<title>" + title + "</title>"))
       << "expected the title '" << title << "'";
   const std::string console = Read(dir + "/console.log");
-  EXPECT_EQ(console.find("CONSOLE"), std::string::npos) << "console messages:\n" << console;
+  EXPECT_THAT(console, ::testing::Not(::testing::HasSubstr("CONSOLE"))) << "console messages:\n"
+                                                                        << console;
   // A screenshot into the run directory.
   const fs::path shot = report / "screenshot.png";
   ASSERT_EQ(RunCommand(Chromium(profile) + "--window-size=1280,2400 --screenshot=" + shot.string() +
@@ -107,9 +110,9 @@ TEST(Report, FiguresSayWhatTheyLeaveOutAndMarkPaperValuesOnlyWhereThereAreAny) {
   ASSERT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/run", &out), 0) << out;
   const Json figures = Json::parse(Read(fs::path(dir) / "run/report/figures.json"));
   const std::string captions = figures["captions"].dump();
-  EXPECT_EQ(captions.find("Red diamonds"), std::string::npos) << captions;
-  EXPECT_NE(captions.find("Only the first 4 of the 5 cells"), std::string::npos) << captions;
-  EXPECT_NE(captions.find("Validation accuracy against noise.repetitions."), std::string::npos)
+  EXPECT_THAT(captions, ::testing::Not(::testing::HasSubstr("Red diamonds"))) << captions;
+  EXPECT_THAT(captions, ::testing::HasSubstr("Only the first 4 of the 5 cells")) << captions;
+  EXPECT_THAT(captions, ::testing::HasSubstr("Validation accuracy against noise.repetitions."))
       << captions;
 }
 
@@ -134,10 +137,10 @@ TEST(Report, SensitivityStudyDrawsItsIndices) {
     const std::vector<std::string> names = figures["figures"];
     EXPECT_NE(std::find(names.begin(), names.end(), "global_sensitivity.png"), names.end())
         << figures.dump();
-    EXPECT_NE(figures["captions"].dump().find(
-                  quantity == "trial" ? "Sobol indices of a single calibration's rms_pos"
-                                      : "Sobol indices of the cell mean of rms_pos"),
-              std::string::npos)
+    EXPECT_THAT(
+        figures["captions"].dump(),
+        ::testing::HasSubstr(quantity == "trial" ? "Sobol indices of a single calibration's rms_pos"
+                                                 : "Sobol indices of the cell mean of rms_pos"))
         << quantity;
     EXPECT_GT(fs::file_size(fs::path(dir) / "run/report/figures/global_sensitivity.png"), 10000u);
   }
@@ -151,32 +154,32 @@ TEST(Report, PartialRunIsReportedAsPartial) {
                  " --quiet --max-trials 60",
              &out);
   ASSERT_EQ(RunCommand(LrcalBinary() + " report " + run, &out), 0) << out;
-  EXPECT_NE(out.find("PARTIAL"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("PARTIAL")) << out;
   const Json status = Json::parse(Read(fs::path(run) / "report" / "status.json"));
   EXPECT_FALSE(status["complete"].get<bool>());
   EXPECT_EQ(status["done"], 60);
-  EXPECT_NE(Read(fs::path(run) / "report" / "report.html").find("Partial run"), std::string::npos);
+  EXPECT_THAT(Read(fs::path(run) / "report" / "report.html"), ::testing::HasSubstr("Partial run"));
 }
 
 TEST(Report, MissingOrMalformedRunDirectoriesAreClearErrors) {
   const std::string dir = testing::TempDir("report_bad");
   std::string out;
   EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/nothing", &out), 2);
-  EXPECT_NE(out.find("no such run directory"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("no such run directory")) << out;
   fs::create_directories(dir + "/empty");
   EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/empty", &out), 2);
-  EXPECT_NE(out.find("manifest.json is missing"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("manifest.json is missing")) << out;
   fs::create_directories(dir + "/broken");
   std::ofstream(dir + "/broken/manifest.json") << "{ not json";
   EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/broken", &out), 2);
-  EXPECT_NE(out.find("broken/manifest.json: not valid JSON"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("broken/manifest.json: not valid JSON")) << out;
   // The analysis script alone, on a directory lrcal report has not prepared.
   std::ofstream(dir + "/empty/manifest.json") << "{}";
   EXPECT_EQ(RunCommand("/usr/bin/python3 " + testing::SourcePath("analysis/report.py") + " " + dir +
                            "/empty",
                        &out),
             2);
-  EXPECT_NE(out.find("summary.json: missing"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("summary.json: missing")) << out;
 }
 
 // identify --report DIR (issue 13 item 9): from a measured CSV to a page with the fit check,
@@ -217,12 +220,12 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
   for (const char* section : {"Fit check", "Parameters", "Identifiability", "Cross-validation",
                               "Accuracy over the workspace", "Calibrated files",
                               "consistent with the stated noise", "calibrated.urdf"})
-    EXPECT_NE(html.find(section), std::string::npos) << section;
+    EXPECT_THAT(html, ::testing::HasSubstr(section)) << section;
   EXPECT_EQ(RunCommand(LrcalBinary() + " accuracy --robot " + (cal / "calibrated.yaml").string() +
                            " --workspace 0",
                        &out),
             2);
-  EXPECT_NE(out.find("--workspace: expected 1 to 100,000 poses, got 0"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--workspace: expected 1 to 100,000 poses, got 0")) << out;
   // The map's poses, predicted again from the written file: the same accuracy.
   {
     std::ofstream poses(dir + "/poses.csv");
@@ -249,9 +252,10 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
                            (cal / "report.html").string() + " 2>" + dir + "/console.log",
                        &out),
             0);
-  EXPECT_NE(out.find("<title>lrcal report: 5/5 figures</title>"), std::string::npos);
+  EXPECT_THAT(out, ::testing::HasSubstr("<title>lrcal report: 5/5 figures</title>"));
   const std::string console = Read(dir + "/console.log");
-  EXPECT_EQ(console.find("CONSOLE"), std::string::npos) << "console messages:\n" << console;
+  EXPECT_THAT(console, ::testing::Not(::testing::HasSubstr("CONSOLE"))) << "console messages:\n"
+                                                                        << console;
 }
 
 // A report folder that cannot be created is a clear error (exit 2), after nothing was lost.
@@ -269,7 +273,7 @@ TEST(Report, CalibrationReportIntoAFileIsAClearError) {
                 LrcalBinary() + " identify --data " + dir + "/m.csv --report " + dir + "/afile/cal",
                 &out),
             2);
-  EXPECT_NE(out.find("--report: cannot create the folder"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--report: cannot create the folder")) << out;
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // `mpirun -np P lrcal run` over loopback: the tables are byte-identical to a single-process run
 // whatever P, and a job whose rank is killed resumes (with another P) to the same tables.
 // Skipped when lrcal is built without MPI or mpirun is missing.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -101,7 +102,7 @@ TEST(Mpi, StopWhenStopsTheCellsAtTheSameTrialsAsASingleProcess) {
   ExpectRanksMatchSingleProcess(dir, study, "");
   ExpectRanksMatchSingleProcess(dir + "/dynamic", study, "--schedule dynamic");
   const std::string summary = Tables(dir + "/np2").at("summary.json");
-  EXPECT_NE(summary.find("\"reason\": \"precision\""), std::string::npos);
+  EXPECT_THAT(summary, ::testing::HasSubstr("\"reason\": \"precision\""));
 }
 
 TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {

@@ -2,6 +2,7 @@
 // against two independent computations: the same Gaussian parameter errors pushed through the
 // exact (non-linear) pose comparison instead of the Jacobian, and the Monte-Carlo means of a
 // real study.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -73,7 +74,7 @@ TEST(ValidationPrediction, PredictsTheMonteCarloMeansOfAStudy) {
         << TrialStore::kMetricColumns[k];
   }
   const std::string csv = testing::ReadFile(dir + "/run/tables/validation.csv");
-  EXPECT_NE(csv.find(",mean_predicted\n"), std::string::npos);
+  EXPECT_THAT(csv, ::testing::HasSubstr(",mean_predicted\n"));
 }
 
 // selection.criterion: I minimises the predicted mean-square validation position error: its

@@ -1,6 +1,7 @@
 // A real rig's disturbances as study axes: outliers cost accuracy and a robust loss buys it back;
 // encoder noise and plane form error, which least squares cannot see, add to the validation
 // errors beyond the parameter covariance's prediction; a study without them keeps its numbers.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -96,7 +97,7 @@ TEST(RigDisturbances, RangerErrorsFromTheRobotFileAreEstimated) {
   }
   EXPECT_TRUE(found);
   const std::string csv = testing::ReadFile(dir + "/run/tables/parameters.csv");
-  EXPECT_NE(csv.find("ranger_offset,mm"), std::string::npos);
+  EXPECT_THAT(csv, ::testing::HasSubstr("ranger_offset,mm"));
   // The robot file's ranger errors, in SI.
   robot.replace(robot.find("ranger_scale_ppm: 0"), 19, "ranger_scale_ppm: 150");
   std::ofstream(dir + "/ranger2.yaml") << robot;

@@ -3,6 +3,7 @@
 // linear-Gaussian theory.
 #include "lrcal/study/runner.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -145,8 +146,8 @@ TEST(MonteCarlo, StatusOfShardsNamesTheTasksToResubmit) {
           testing::LrcalBinary() + " status " + dir + "/s1 " + dir + "/s2 " + dir + "/s3", &out),
       0)
       << out;
-  EXPECT_NE(out.find("unfinished or missing shards: 2,4"), std::string::npos) << out;
-  EXPECT_NE(out.find("sbatch --array=2,4"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("unfinished or missing shards: 2,4")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("sbatch --array=2,4")) << out;
 }
 
 TEST(MonteCarlo, ResumedInSlicesEqualsUninterrupted) {
@@ -234,8 +235,8 @@ TEST(MonteCarlo, KilledProcessResumesToTheSameTables) {
   RunSmall(study, dir + "/whole", 2);
   EXPECT_EQ(Tables(dir + "/whole"), Tables(killed));
   const std::string manifest = testing::ReadFile((fs::path(killed) / "manifest.json").string());
-  EXPECT_NE(manifest.find("\"running\""), std::string::npos);  // the killed session's entry
-  EXPECT_NE(manifest.find("\"completed\""), std::string::npos);
+  EXPECT_THAT(manifest, ::testing::HasSubstr("\"running\""));  // the killed session's entry
+  EXPECT_THAT(manifest, ::testing::HasSubstr("\"completed\""));
 }
 
 TEST(MonteCarlo, SigintStopsCleanlyAndResumes) {
@@ -250,11 +251,11 @@ TEST(MonteCarlo, SigintStopsCleanlyAndResumes) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 130);  // interrupted, everything in flight flushed
   const std::string manifest = testing::ReadFile((fs::path(run) / "manifest.json").string());
-  EXPECT_NE(manifest.find("\"interrupted\""), std::string::npos);
+  EXPECT_THAT(manifest, ::testing::HasSubstr("\"interrupted\""));
   std::string out;
   ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + run, &out), 0);
-  EXPECT_NE(out.find("remaining"), std::string::npos) << out;
-  EXPECT_NE(out.find("to finish: lrcal run"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("remaining")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("to finish: lrcal run")) << out;
 }
 
 TEST(MonteCarlo, SecondProcessOnTheSameDirectoryIsRefused) {
@@ -266,7 +267,7 @@ TEST(MonteCarlo, SecondProcessOnTheSameDirectoryIsRefused) {
   std::string out;
   EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + run, &out),
             2);
-  EXPECT_NE(out.find("another lrcal process is running"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("another lrcal process is running")) << out;
   kill(pid, SIGKILL);
   int status;
   waitpid(pid, &status, 0);
@@ -279,14 +280,14 @@ TEST(MonteCarlo, ChangedStudyIsRefusedWithWhatChanged) {
     RunSmall(SmallStudy(dir, 10, "noise: {repetitions: 5}\n"), dir + "/run", 2);
     FAIL() << "a changed study was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("base.noise.repetitions: 10 -> 5"), std::string::npos)
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("base.noise.repetitions: 10 -> 5"))
         << e.what();
   }
   try {
     RunSmall(SmallStudy(dir, 10, "", "[0.1, 0.2]", 12), dir + "/run", 2);
     FAIL() << "a changed seed was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("seed: 11 -> 12"), std::string::npos) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("seed: 11 -> 12")) << e.what();
   }
 }
 
@@ -411,7 +412,7 @@ TEST_P(BadStudyTest, FailsBeforeAnythingRunsNamingLineAndKey) {
     RunSmall(path, dir + "/run", 1);
     FAIL() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(GetParam().expected), std::string::npos) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(GetParam().expected)) << e.what();
   }
   EXPECT_FALSE(fs::exists(dir + "/run/trials.sqlite"));
 }

@@ -1,5 +1,6 @@
 // A study's sensitivity section: its plan becomes ordinary cells, repeated plan points share a
 // cell, the tables give the indices, and the numbers do not depend on the thread count.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -51,8 +52,8 @@ TEST(SensitivityStudy, PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices) 
   EXPECT_GT(s["inputs"][0]["total"][0].get<double>(), 0.5);  // σ is the only input that acts
   const std::string csv = testing::ReadFile(dir + "/run/tables/sensitivity.csv");
   EXPECT_EQ(csv.rfind("input,min,max,method,first,first_low,first_high,total", 0), 0u) << csv;
-  EXPECT_NE(testing::ReadFile(dir + "/run/tables/summary.md").find("## Sensitivity (Sobol"),
-            std::string::npos);
+  EXPECT_THAT(testing::ReadFile(dir + "/run/tables/summary.md"),
+              ::testing::HasSubstr("## Sensitivity (Sobol"));
   // The same tables with one thread: the plan and its cells are independent of scheduling.
   ASSERT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run1", 1).complete);
   EXPECT_EQ(testing::ReadFile(dir + "/run1/tables/sensitivity.csv"), csv);
@@ -171,7 +172,7 @@ TEST(SensitivityStudy, ASingleTrialsFigureHasTheNoiseAsAnInput) {
                     m["sensitivity"]["inputs"][i][kind][e].get<double>() * variance / var_y, 1e-12)
             << i << " " << kind << " " << e;
   const std::string csv = testing::ReadFile(dir + "/t/tables/sensitivity.csv");
-  EXPECT_NE(csv.find("\nnoise (one trial),,,sobol,,,,"), std::string::npos) << csv;
+  EXPECT_THAT(csv, ::testing::HasSubstr("\nnoise (one trial),,,sobol,,,,")) << csv;
 }
 
 // A normal input has no min and max: its table row states its law and the CSV leaves them empty
@@ -185,12 +186,11 @@ TEST(SensitivityStudy, NormalInputsReachTheTables) {
          "noise.encoder_sigma_mrad, min: 0, max: 0.1}]\n";
   ASSERT_TRUE(testing::RunStudyFile(dir + "/n.yaml", dir + "/run", 2).complete);
   const std::string csv = testing::ReadFile(dir + "/run/tables/sensitivity.csv");
-  EXPECT_NE(csv.find("\nnoise.sigma_mm,,,sobol,"), std::string::npos) << csv;
-  EXPECT_NE(csv.find("\nnoise.encoder_sigma_mrad,0.000000,0.100000,sobol,"), std::string::npos)
+  EXPECT_THAT(csv, ::testing::HasSubstr("\nnoise.sigma_mm,,,sobol,")) << csv;
+  EXPECT_THAT(csv, ::testing::HasSubstr("\nnoise.encoder_sigma_mrad,0.000000,0.100000,sobol,"))
       << csv;
-  EXPECT_NE(testing::ReadFile(dir + "/run/tables/summary.md")
-                .find("| noise.sigma_mm | normal, mean 0.2000, std 0.0500 |"),
-            std::string::npos);
+  EXPECT_THAT(testing::ReadFile(dir + "/run/tables/summary.md"),
+              ::testing::HasSubstr("| noise.sigma_mm | normal, mean 0.2000, std 0.0500 |"));
 }
 
 TEST(SensitivityStudy, BadSectionsNameTheKey) {
@@ -201,7 +201,7 @@ TEST(SensitivityStudy, BadSectionsNameTheKey) {
       LoadStudy(dir + "/b.yaml");
       ADD_FAILURE() << "no error for " << body;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(expected)) << e.what();
     }
   };
   const std::string input = "  inputs: [{key: noise.sigma_mm, min: 0.1, max: 0.3}]\n";

@@ -2,6 +2,7 @@
 // configuration's beam hits its own plane, a per-plane `estimate` sets that plane's terms, a pool
 // file's plane column is resolved against the list (and refused when it names a plane not
 // listed), and a validation file's plane column is not read.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -90,8 +91,8 @@ TEST(SeveralPlanes, PoolFilePlaneColumnIsResolvedAndValidationsIgnored) {
     PrepareCell(bad, bad.cells[0]);
     ADD_FAILURE() << "expected an InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("pool.csv:62 column 'plane': 'ceiling' is not one of"),
-              std::string::npos)
+    EXPECT_THAT(std::string(e.what()),
+                ::testing::HasSubstr("pool.csv:62 column 'plane': 'ceiling' is not one of"))
         << e.what();
   }
 }

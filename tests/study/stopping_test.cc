@@ -3,6 +3,7 @@
 // shards or restarts.
 #include "lrcal/study/stopping.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -238,8 +239,8 @@ TEST(StopWhen, StopsEveryCellWithThePrecisionStatedBitIdenticalAcrossThreadsShar
 
   std::string out;
   ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + dir + "/sliced", &out), 0);
-  EXPECT_NE(out.find("stopped early, precision reached"), std::string::npos) << out;
-  EXPECT_NE(out.find("complete (stop_when: 4 cells stopped early)"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("stopped early, precision reached")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("complete (stop_when: 4 cells stopped early)")) << out;
 }
 
 TEST(StopWhen, ACellThatNeverGetsPreciseRunsToTheMaximum) {
@@ -254,8 +255,8 @@ TEST(StopWhen, ACellThatNeverGetsPreciseRunsToTheMaximum) {
     EXPECT_EQ(c["stop"]["trials_used"], 150);
     EXPECT_GT(c["stop"]["relative_se"].get<double>(), 0.0001);
   }
-  EXPECT_NE(Tables(dir + "/run").at("summary.md").find("maximum 150 (precision not reached)"),
-            std::string::npos);
+  EXPECT_THAT(Tables(dir + "/run").at("summary.md"),
+              ::testing::HasSubstr("maximum 150 (precision not reached)"));
 }
 
 TEST(StopWhen, AnInterruptedAdaptiveRunIsNotComplete) {
@@ -268,7 +269,7 @@ TEST(StopWhen, AnInterruptedAdaptiveRunIsNotComplete) {
   EXPECT_EQ(r.computed, 250);
   std::string out;
   testing::RunCommand(testing::LrcalBinary() + " status " + dir + "/run", &out);
-  EXPECT_NE(out.find("the next decision at"), std::string::npos) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("the next decision at")) << out;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // identification solver a study names actually running in its trials.
 #include "lrcal/study/study.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -90,16 +91,16 @@ std::string LoadError(const std::string& name, const std::string& body) {
 
 TEST(StudySchema, SectionsGivenAsNothingOrScalarsAreErrorsNamingTheKey) {
   const std::string empty = LoadError("null_section", "noise:\npool: {size: 60}\n");
-  EXPECT_NE(empty.find("s.yaml:5 key 'noise'"), std::string::npos) << empty;
-  EXPECT_NE(empty.find("expected a mapping with keys encoder_sigma_mrad, form_sigma_mm, "
-                       "outlier_fraction, outlier_sigma_mm, repetitions, sigma_mm, got nothing"),
-            std::string::npos)
+  EXPECT_THAT(empty, ::testing::HasSubstr("s.yaml:5 key 'noise'")) << empty;
+  EXPECT_THAT(empty, ::testing::HasSubstr(
+                         "expected a mapping with keys encoder_sigma_mrad, form_sigma_mm, "
+                         "outlier_fraction, outlier_sigma_mm, repetitions, sigma_mm, got nothing"))
       << empty;
   const std::string scalar = LoadError("scalar_section", "selection: 5\n");
-  EXPECT_NE(scalar.find("key 'selection'"), std::string::npos) << scalar;
-  EXPECT_NE(scalar.find("got 5"), std::string::npos) << scalar;
+  EXPECT_THAT(scalar, ::testing::HasSubstr("key 'selection'")) << scalar;
+  EXPECT_THAT(scalar, ::testing::HasSubstr("got 5")) << scalar;
   const std::string solver = LoadError("bad_solver", "identification: {solver: gauss}\n");
-  EXPECT_NE(solver.find("unknown solver 'gauss'; expected lm or ceres"), std::string::npos)
+  EXPECT_THAT(solver, ::testing::HasSubstr("unknown solver 'gauss'; expected lm or ceres"))
       << solver;
 }
 
@@ -214,8 +215,8 @@ TEST(StudySchema, RobustLossScaleIsInSigmaAndLeavesOldCellsAlone) {
     LoadStudy(dir + "/bad.yaml");
     ADD_FAILURE() << "a loss without noise was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("identification.loss"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("sigma_mm"), std::string::npos) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("identification.loss")) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("sigma_mm")) << e.what();
   }
   std::ofstream(dir + "/bad.yaml") << "name: s\nseed: 1\ntrials: 2\n"
                                       "identification: {loss: huber, loss_scale: -1}\n";
@@ -231,9 +232,9 @@ TEST(DataDirectory, LrcalDataDirOverridesAndIsChecked) {
     DataDirectory();
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("LRCAL_DATA_DIR: '/nonexistent/lrcal' is not an lrcal "
-                                         "data folder"),
-              std::string::npos)
+    EXPECT_THAT(std::string(e.what()),
+                ::testing::HasSubstr("LRCAL_DATA_DIR: '/nonexistent/lrcal' is not an lrcal "
+                                     "data folder"))
         << e.what();
   }
   ::unsetenv("LRCAL_DATA_DIR");
@@ -329,14 +330,14 @@ TEST(StudyUrdf, ToolLinkPicksTheRangerOfAUrdfRobot) {
     testing::RunStudyFile(dir + "/without.yaml", dir + "/run2", 2);
     ADD_FAILURE() << "no error without tool_link";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("tool_link: NAME"), std::string::npos) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("tool_link: NAME")) << e.what();
   }
   std::ofstream(dir + "/yaml.yaml") << "name: y\nseed: 3\ntrials: 4\ntool_link: ranger\n";
   try {
     LoadStudy(dir + "/yaml.yaml");
     ADD_FAILURE() << "no error for tool_link with a YAML robot";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("key 'tool_link'"), std::string::npos) << e.what();
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("key 'tool_link'")) << e.what();
   }
 }
 

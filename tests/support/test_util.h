@@ -1,6 +1,9 @@
 // Shared helpers for lrcal's tests.
 #pragma once
 
+#include <gmock/gmock.h>
+
+#include <Eigen/Core>
 #include <random>
 #include <string>
 #include <utility>
@@ -11,6 +14,45 @@
 #include "lrcal/study/runner.h"
 
 namespace lrcal::testing {
+
+/// Named tolerances: what each kind of agreement is held to, in one place.
+namespace tolerance {
+/// Two computations of the same formula in a different order (rounding only): rotations composed
+/// from the same angles, exported and re-read kinematics (m, rad).
+inline constexpr double kRounding = 1e-15;
+/// lrcal's kinematics against a URDF composed independently in the test (m, rad).
+inline constexpr double kUrdf = 1e-12;
+/// An analytic Jacobian against Ceres' autodiff of the same model.
+inline constexpr double kAutodiff = 1e-11;
+/// An analytic Jacobian against central differences (step ~1e-6: truncation ~1e-10 plus
+/// rounding).
+inline constexpr double kCentralDifference = 1e-8;
+/// A noise-free identification against the truth it was simulated from (SI).
+inline constexpr double kRoundTrip = 1e-9;
+}  // namespace tolerance
+
+/// Matches an Eigen vector or matrix of `expected`'s shape whose every entry lies within
+/// `tolerance` of `expected`'s (the max-norm of the difference); on failure it says the largest
+/// deviation and where it is. Non-finite entries never match.
+MATCHER_P2(EigenNear, expected, tolerance,
+           std::string(negation ? "is not" : "is") + " within " +
+               ::testing::PrintToString(tolerance) + " of the expected matrix entry by entry") {
+  if (arg.rows() != expected.rows() || arg.cols() != expected.cols()) {
+    *result_listener << "whose shape is " << arg.rows() << "x" << arg.cols() << ", not "
+                     << expected.rows() << "x" << expected.cols();
+    return false;
+  }
+  const Eigen::MatrixXd difference = (Eigen::MatrixXd(arg) - Eigen::MatrixXd(expected)).cwiseAbs();
+  if (!difference.allFinite()) {
+    *result_listener << "which has a non-finite entry";
+    return false;
+  }
+  Eigen::Index row = 0, col = 0;
+  const double largest = difference.size() ? difference.maxCoeff(&row, &col) : 0.0;
+  *result_listener << "whose largest deviation is " << largest << " at (" << row << ", " << col
+                   << ")";
+  return largest <= tolerance;
+}
 
 /// Path of a file in the source tree (e.g. "studies/robots/paper.yaml").
 std::string SourcePath(const std::string& relative);
