@@ -32,6 +32,7 @@
 #include "lrcal/core/text_table.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/report/run_tables.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/statistics.h"
@@ -57,21 +58,17 @@ struct Target {
 Target ParseTarget(const std::string& text) {
   const auto eq = text.find('=');
   const std::string expected =
-      "expected METRIC=VALUE with a unit, e.g. rms_pos=0.05mm or rms_ori=0.1mrad (metrics "
-      "rms_pos, rms_ori, max_pos, max_ori), got '" +
-      text + "'";
+      "expected METRIC=VALUE with a unit, e.g. rms_pos=0.05mm or rms_ori=0.1mrad (metrics " +
+      NameList(kValidationMetricNames) + "), got '" + text + "'";
   if (eq == std::string::npos) throw InputError("--target", expected);
   Target t;
   t.metric = text.substr(0, eq);
-  const char* metrics[4] = {"rms_pos", "rms_ori", "max_pos", "max_ori"};
-  int m = -1;
-  for (int i = 0; i < 4; ++i)
-    if (t.metric == metrics[i]) m = i;
-  if (m < 0) throw InputError("--target", expected);
-  t.first = 3 * m;
+  ValidationMetric metric{};
+  if (!TryParseName(kValidationMetricNames, t.metric, &metric))
+    throw InputError("--target", expected);
+  t.first = 3 * static_cast<int>(metric);
   std::string value = text.substr(eq + 1);
-  const bool angular = m % 2 == 1;
-  t.unit = angular ? "mrad" : "mm";
+  t.unit = TableUnit(metric);
   if (value.size() > t.unit.size() &&
       value.compare(value.size() - t.unit.size(), t.unit.size(), t.unit) == 0)
     value.resize(value.size() - t.unit.size());

@@ -2,6 +2,7 @@
 // stored record bit for bit.
 #include "cli_common.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/study/trial_replay.h"
 #include "lrcal/study/trial_store.h"
 
@@ -18,10 +19,9 @@ Json RecordJson(const TrialRecord& r) {
   j["sigma_min"] = r.sigma_min;
   j["errors"] = r.errors;
   Json val = Json::object(), nom = Json::object();
-  for (int k = 0; k < 12; ++k) {
-    val[TrialStore::kMetricColumns[k]] =
-        std::isnan(r.validation[k]) ? Json() : Json(r.validation[k]);
-    nom[TrialStore::kMetricColumns[k]] = r.nominal[k];
+  for (int k = 0; k < kNumValidationColumns; ++k) {
+    val[ValidationColumnName(k)] = std::isnan(r.validation[k]) ? Json() : Json(r.validation[k]);
+    nom[ValidationColumnName(k)] = r.nominal[k];
   }
   j["validation"] = val;
   j["nominal_validation"] = nom;
@@ -65,8 +65,8 @@ void PrintReplay(const TrialReplay& t) {
               Fixed(t.recomputed.errors[k] * DisplayUnitOf(t.parameter_names[k]).factor, 6)});
   std::cout << e.ToText();
   Table v({"metric", "x", "y", "z"}, "Validation errors of the identified model (mm, mrad)");
-  for (int m = 0; m < 4; ++m)
-    v.AddRow({std::string(TrialStore::kMetricColumns[3 * m]).substr(0, 7),
+  for (int m = 0; m < kNumValidationMetrics; ++m)
+    v.AddRow({NameOf(kValidationMetricNames, static_cast<ValidationMetric>(m)),
               Fixed(t.recomputed.validation[3 * m] * 1e3, 6),
               Fixed(t.recomputed.validation[3 * m + 1] * 1e3, 6),
               Fixed(t.recomputed.validation[3 * m + 2] * 1e3, 6)});

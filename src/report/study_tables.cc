@@ -11,6 +11,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/paper/paper_case.h"
 #include "lrcal/study/sensitivity.h"
@@ -21,9 +22,11 @@ namespace {
 
 using Rows = std::vector<std::vector<std::string>>;
 
-const char* kMetricNames[4] = {"rms_pos", "rms_ori", "max_pos", "max_ori"};
+const char* MetricName(int m) {
+  return NameOf(kValidationMetricNames, static_cast<ValidationMetric>(m));
+}
 const char* kMetricTitles[4] = {"RMS pos (mm)", "RMS ori (mrad)", "max pos (mm)", "max ori (mrad)"};
-const char* kAxes[3] = {"x", "y", "z"};
+const auto& kAxes = kAxisNames;
 
 std::string MeanRange(const Distribution& d, double scale) {
   if (d.n == 0) return "—";
@@ -112,7 +115,7 @@ Rows PlaceCell(const CellSummary& s) {
   for (int m = 0; m < 4; ++m)
     for (int a = 0; a < 3; ++a) {
       const int k = 3 * m + a;
-      rows.push_back({label, std::string("validation ") + kMetricNames[m], kAxes[a],
+      rows.push_back({label, std::string("validation ") + MetricName(m), kAxes[a],
                       m % 2 == 0 ? "mm" : "mrad", Fixed(kPaperValidation[paper_case][a][m]),
                       Fixed(s.validation[k].p5 * 1e3), Fixed(s.validation[k].p50 * 1e3),
                       Fixed(s.validation[k].p95 * 1e3), Fixed(s.validation_probe_rank[k], 2)});
@@ -293,7 +296,7 @@ void AddValidationCsvRows(const CellSummary& s, bool identified, int axis, Table
     csv->AddRow({s.cell.id,
                  s.cell.label,
                  identified ? "identified" : "nominal",
-                 kMetricNames[m],
+                 MetricName(m),
                  kAxes[axis],
                  m % 2 == 0 ? "mm" : "mrad",
                  std::to_string(d.n),
@@ -471,9 +474,9 @@ Json CellJson(const CellSummary& s) {
   c["correlation"] = MatrixJson(s.correlation);
   Json v, nm;
   for (int k = 0; k < 12; ++k) {
-    v[TrialStore::kMetricColumns[k]] = DistJson(s.validation[k], 1.0);
-    v[TrialStore::kMetricColumns[k]]["mean_predicted"] = NullIfNan(PredictedMean(s, k));
-    nm[TrialStore::kMetricColumns[k]] = DistJson(s.nominal[k], 1.0);
+    v[ValidationColumnName(k)] = DistJson(s.validation[k], 1.0);
+    v[ValidationColumnName(k)]["mean_predicted"] = NullIfNan(PredictedMean(s, k));
+    nm[ValidationColumnName(k)] = DistJson(s.nominal[k], 1.0);
   }
   c["validation"] = v;
   c["nominal_validation"] = nm;
@@ -639,8 +642,8 @@ SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellS
   const Json& spec = study["sensitivity"];
   const std::string method = spec["method"], metric_name = spec["metric"];
   const bool trial = spec.value("quantity", std::string("cell_mean")) == "trial";
-  int metric = 0;
-  while (metric < 3 && metric_name != kMetricNames[metric]) ++metric;
+  const int metric = static_cast<int>(
+      ParseName(kValidationMetricNames, metric_name, "sensitivity.metric", "metric"));
   const std::uint64_t seed = study.value("seed", std::uint64_t{0});
   const auto quantities = CellQuantities(cells, metric);
   const Json& plan_cells = spec["plan_cells"];

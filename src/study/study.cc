@@ -14,6 +14,7 @@
 #include "lrcal/core/strings.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/study/sensitivity.h"
 
 namespace lrcal {
@@ -766,7 +767,7 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
                {"samples", 32},
                {"levels", 4},
                {"bootstrap", 1000},
-               {"metric", "rms_pos"}};
+               {"metric", NameOf(kValidationMetricNames, ValidationMetric::kRmsPosition)}};
   spec.merge_patch(sn);
   const KeyLocator at{where.file, where.lines, where.context, "sensitivity"};
   const std::string method = Str(spec, "method", at);
@@ -778,9 +779,10 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
     throw InputError(where("sensitivity.levels"), "expected an even number of grid levels");
   Int(spec, "bootstrap", at, 0, 100000);
   const std::string metric = Str(spec, "metric", at);
-  if (metric != "rms_pos" && metric != "rms_ori" && metric != "max_pos" && metric != "max_ori")
+  ValidationMetric parsed{};
+  if (!TryParseName(kValidationMetricNames, metric, &parsed))
     throw InputError(where("sensitivity.metric"),
-                     "expected rms_pos, rms_ori, max_pos or max_ori, got '" + metric + "'");
+                     "expected " + NameList(kValidationMetricNames) + ", got '" + metric + "'");
   // quantity (optional, not added when absent so that earlier runs' manifests stay the same):
   // cell_mean (default) or trial, a single calibration's metric with the noise as an input.
   if (spec.contains("quantity")) {

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "lrcal/core/error.h"
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
@@ -26,11 +27,11 @@ std::vector<std::string> Differences(const TrialRecord& a, const TrialRecord& b)
       (!a.errors.empty() &&
        std::memcmp(a.errors.data(), b.errors.data(), a.errors.size() * sizeof(double)) != 0))
     out.emplace_back("errors");
-  for (int k = 0; k < 12; ++k) {
+  for (int k = 0; k < kNumValidationColumns; ++k) {
     if (!SameBits(a.validation[k], b.validation[k]))
-      out.push_back(std::string("val_") + TrialStore::kMetricColumns[k]);
+      out.push_back(std::string("val_") + ValidationColumnName(k));
     if (!SameBits(a.nominal[k], b.nominal[k]))
-      out.push_back(std::string("nom_") + TrialStore::kMetricColumns[k]);
+      out.push_back(std::string("nom_") + ValidationColumnName(k));
   }
   return out;
 }

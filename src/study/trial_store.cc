@@ -8,13 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "lrcal/kinematics/validation_metric.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal {
-
-const char* const TrialStore::kMetricColumns[12] = {
-    "rms_pos_x", "rms_pos_y", "rms_pos_z", "rms_ori_x", "rms_ori_y", "rms_ori_z",
-    "max_pos_x", "max_pos_y", "max_pos_z", "max_ori_x", "max_ori_y", "max_ori_z"};
 
 namespace {
 
@@ -94,7 +91,8 @@ std::vector<double> StdFromJson(const std::string& text) {
 std::string TrialColumns() {
   std::string cols = "cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min";
   for (const char* prefix : {"val_", "nom_"})
-    for (const char* m : TrialStore::kMetricColumns) cols += std::string(", ") + prefix + m;
+    for (int k = 0; k < kNumValidationColumns; ++k)
+      cols += std::string(", ") + prefix + ValidationColumnName(k);
   return cols + ", errors, seconds";
 }
 
@@ -144,7 +142,8 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
       "CREATE TABLE IF NOT EXISTS trials(cell_id TEXT NOT NULL, trial INTEGER NOT NULL, "
       "status TEXT NOT NULL, iterations INTEGER, residual_rms REAL, sigma_hat REAL, sigma_min REAL";
   for (const char* prefix : {"val_", "nom_"})
-    for (const char* m : kMetricColumns) trials += std::string(", ") + prefix + m + " REAL";
+    for (int k = 0; k < kNumValidationColumns; ++k)
+      trials += std::string(", ") + prefix + ValidationColumnName(k) + " REAL";
   trials += ", errors BLOB, seconds REAL, PRIMARY KEY(cell_id, trial)) WITHOUT ROWID";
   Exec(trials);
 }

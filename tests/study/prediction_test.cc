@@ -11,6 +11,7 @@
 #include <list>
 #include <random>
 
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/report/run_tables.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/statistics.h"
@@ -52,7 +53,7 @@ TEST(ValidationPrediction, LinearPropagationMatchesTheExactPoseErrorsOfGaussianP
   // Both are Monte-Carlo means of 4000 draws (coefficient of variation of a metric ≲ 0.6): they
   // agree within 4 % when the Jacobian and the propagation are right.
   for (int k = 0; k < 12; ++k)
-    EXPECT_NEAR(c->predicted_validation[k] / mean[k], 1.0, 0.04) << TrialStore::kMetricColumns[k];
+    EXPECT_NEAR(c->predicted_validation[k] / mean[k], 1.0, 0.04) << ValidationColumnName(k);
 }
 
 TEST(ValidationPrediction, PredictsTheMonteCarloMeansOfAStudy) {
@@ -71,7 +72,7 @@ TEST(ValidationPrediction, PredictsTheMonteCarloMeansOfAStudy) {
     // nominal-versus-truth linearisation (the predicted std is ~1-3 % off at these errors).
     const double predicted = s.cell.predicted_validation[k];
     EXPECT_NEAR(s.validation[k].mean, predicted, 4 * s.validation[k].mean_se + 0.04 * predicted)
-        << TrialStore::kMetricColumns[k];
+        << ValidationColumnName(k);
   }
   const std::string csv = testing::ReadFile(dir + "/run/tables/validation.csv");
   EXPECT_THAT(csv, ::testing::HasSubstr(",mean_predicted\n"));

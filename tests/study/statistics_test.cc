@@ -15,6 +15,7 @@
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/trial_store.h"
 #include "test_util.h"
@@ -127,7 +128,7 @@ TEST(Statistics, P95IntervalsOfFortySeedsCoverTheReferenceP95AsOftenAsPromised) 
     }
   }
   for (int k = 0; k < 12; ++k) {
-    SCOPED_TRACE(TrialStore::kMetricColumns[k]);
+    SCOPED_TRACE(ValidationColumnName(k));
     EXPECT_GE(covered[k], 33);
     EXPECT_LE(covered[k], 40);
   }

@@ -91,8 +91,6 @@ class TrialStore {
 
   const std::string& path() const { return path_; }
 
-  static const char* const kMetricColumns[12];  ///< rms_pos_x ... max_ori_z
-
  private:
   void Exec(const std::string& sql) const;
   sqlite3* db_ = nullptr;

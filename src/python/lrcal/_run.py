@@ -17,11 +17,11 @@ try:
 except ImportError:  # pandas is optional: numpy structured arrays without it
     _pandas = None
 
-_METRICS = [f"{stat}_{kind}_{axis}" for stat in ("rms", "max") for kind in ("pos", "ori")
-            for axis in ("x", "y", "z")]
-_TRIAL_COLUMNS = (["cell_id", "trial", "status", "iterations", "residual_rms", "sigma_hat",
-                   "sigma_min"] + [f"val_{m}" for m in _METRICS] + [f"nom_{m}" for m in _METRICS]
-                  + ["seconds"])
+# The trial table's leading columns; the validation metrics' columns (val_rms_pos_x ...,
+# nom_...) are read from the run's own store, which names them (lrcal's one list of metric names:
+# lrcal/kinematics/validation_metric.h).
+_TRIAL_LEADING = ["cell_id", "trial", "status", "iterations", "residual_rms", "sigma_hat",
+                  "sigma_min"]
 _CELL_JSON = ("settings", "parameter_names", "predicted_std", "fixed_for_rank", "truth_errors",
               "predicted_std_truth")
 
@@ -109,7 +109,7 @@ class Run:
         self.cells = _records(
             ["cell_id", "ord", "label"] + list(_CELL_JSON) + ["design_sigma_min", "pool_report"],
             self._cells, as_pandas)
-        self.trials = _records(_TRIAL_COLUMNS, self._read_trials(), as_pandas)
+        self.trials = _records(self._trial_columns(), self._read_trials(), as_pandas)
         tables = os.path.join(path, "tables")
         self.tables = {os.path.splitext(os.path.basename(p))[0]: _read_csv(p, as_pandas)
                        for p in sorted(glob.glob(os.path.join(tables, "*.csv")))}
@@ -137,9 +137,20 @@ class Run:
                     rows.setdefault(r[0], (r[0], r[1], r[2], *decoded, r[3 + n], r[4 + n]))
         return sorted(rows.values(), key=lambda r: r[1])
 
+    def _trial_columns(self):
+        """The trial table's columns as the run's store names them: the leading ones, the
+        validation metrics of the identified (val_*) and nominal (nom_*) models, seconds."""
+        present = []
+        if self._stores:  # no store yet: no trials, no metric columns
+            with self._connect(self._stores[0]) as db:
+                present = [c[1] for c in db.execute("PRAGMA table_info(trials)")]
+        metrics = [c for c in present if c.startswith("val_")] + \
+                  [c for c in present if c.startswith("nom_")]
+        return _TRIAL_LEADING + metrics + ["seconds"]
+
     def _read_trials(self, with_errors=False):
         rows = {}
-        columns = ", ".join(_TRIAL_COLUMNS + (["errors"] if with_errors else []))
+        columns = ", ".join(self._trial_columns() + (["errors"] if with_errors else []))
         for store in self._stores:
             with self._connect(store) as db:
                 for r in db.execute(f"SELECT {columns} FROM trials"):
