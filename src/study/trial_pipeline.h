@@ -32,6 +32,7 @@
 #include "lrcal/kinematics/pose_errors.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial.h"
+#include "lrcal/study/trial_store.h"
 
 namespace lrcal {
 
@@ -119,5 +120,8 @@ struct TrialWorkspace {
 
 TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace,
                      TrialDetails* details = nullptr);
+
+/// What the trial store records of a prepared cell (trial_store.h).
+StoredCell ToStoredCell(const CellContext& context);
 
 }  // namespace lrcal

@@ -26,9 +26,7 @@
 
 struct sqlite3;
 
-namespace lrcal {
-struct CellContext;
-}
+namespace lrcal {}
 
 namespace lrcal {
 
@@ -96,7 +94,5 @@ class TrialStore {
   sqlite3* db_ = nullptr;
   std::string path_;
 };
-
-StoredCell ToStoredCell(const CellContext& context);
 
 }  // namespace lrcal
