@@ -26,7 +26,7 @@ void CheckTable(const std::vector<SettingField<Options>>& fields) {
     SCOPED_TRACE(f.spec.Spelling(Frontend::kLibrary));
     EXPECT_TRUE(names.insert(f.spec.name).second);
     EXPECT_TRUE(members.insert(f.spec.field).second);
-    EXPECT_TRUE(f.spec.Allows(f.Get(Options{})));
+    EXPECT_TRUE(f.spec.Allows(f.Default() * f.spec.to_si));
     EXPECT_STRNE(f.spec.help, "");
     EXPECT_EQ(FindSetting(fields, f.spec.name), &f);
     Options o;

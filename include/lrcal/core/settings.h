@@ -86,20 +86,23 @@ struct SettingField {
   double Options::*real = nullptr;
   int Options::*whole = nullptr;
   long long Options::*count = nullptr;
+  /// The member's value (SI); NaN if the field is bound to no member.
   double Get(const Options& o) const {
     if (real) return o.*real;
-    return whole ? static_cast<double>(o.*whole) : static_cast<double>(o.*count);
+    if (whole) return static_cast<double>(o.*whole);
+    if (count) return static_cast<double>(o.*count);
+    return std::numeric_limits<double>::quiet_NaN();
   }
   void Set(Options* o, double value_si) const {
-    if (real)
-      o->*real = value_si;
-    else if (whole)
-      o->*whole = static_cast<int>(value_si);
-    else
-      o->*count = static_cast<long long>(value_si);
+    if (real) o->*real = value_si;
+    if (whole) o->*whole = static_cast<int>(value_si);
+    if (count) o->*count = static_cast<long long>(value_si);
   }
   /// The default: the member's initial value in a default-constructed Options, in `unit`.
-  double Default() const { return spec.FromSi(Get(Options{})); }
+  double Default() const {
+    static const Options defaults{};
+    return spec.FromSi(Get(defaults));
+  }
 };
 
 /// Checks every field of `options` against its spec (throws SettingError for the first bad one).
