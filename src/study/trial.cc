@@ -578,6 +578,24 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   return finish(TrialStatus::kOk);
 }
 
+const char* TrialStatusReason(TrialStatus s) {
+  switch (s) {
+    case TrialStatus::kOk:
+      return "";
+    case TrialStatus::kRankDeficient:
+      return "the parameter set is not identifiable from the cell's configurations (with "
+             "identification.on_rank_deficient: fix, the suggested parameters are fixed instead)";
+    case TrialStatus::kNotConverged:
+      return "the solver stopped at identification.max_iterations without meeting a tolerance";
+    case TrialStatus::kNumericalFailure:
+      return "a non-finite cost or a failed factorisation during the identification";
+    case TrialStatus::kBeamMissed:
+      return "a beam missed its plane: the true arm's beam at a configuration of the design (no "
+             "reading), or the model's beam at an iterate of the identification";
+  }
+  return "";
+}
+
 Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws) {
   return LinearisedDraws(c, draws);
 }

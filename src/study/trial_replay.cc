@@ -27,8 +27,11 @@ std::vector<std::string> Differences(const TrialRecord& a, const TrialRecord& b)
       (!a.errors.empty() &&
        std::memcmp(a.errors.data(), b.errors.data(), a.errors.size() * sizeof(double)) != 0))
     out.emplace_back("errors");
+  // A failed trial has no validation of an identified model: the store keeps none (NULL), so
+  // there is nothing to compare unless both succeeded.
+  const bool both_ok = a.status == TrialStatus::kOk && b.status == TrialStatus::kOk;
   for (int k = 0; k < kNumValidationColumns; ++k) {
-    if (!SameBits(a.validation[k], b.validation[k]))
+    if (both_ok && !SameBits(a.validation[k], b.validation[k]))
       out.push_back(std::string("val_") + ValidationColumnName(k));
     if (!SameBits(a.nominal[k], b.nominal[k]))
       out.push_back(std::string("nom_") + ValidationColumnName(k));

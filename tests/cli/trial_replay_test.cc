@@ -6,6 +6,7 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "test_util.h"
 
@@ -80,6 +81,55 @@ TEST_F(TrialReplayTest, BadRequestsAndAChangedStudyAreClearErrors) {
   WriteStudy(8);
   EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 1", &out), 2) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("has changed since the run")) << out;
+}
+
+// Issue 31: a failed trial replays without a crash, says why it failed, and matches its record
+// (the store keeps no validation for it), in text and JSON, for every status a study produces.
+TEST(TrialReplayOfFailedTrials, EachStatusReplaysAndMatchesItsRecord) {
+  const std::string dir = testing::TempDir("trial_replay_statuses");
+  std::ofstream(dir + "/s.yaml")
+      << "name: statuses\nseed: 3\ntrials: 8\nrobot: "
+      << testing::SourcePath("studies/robots/paper.yaml")
+      << "\npool: {size: 40}\nselection: {count: 30}\nvalidation: {size: 5}\n"
+         "sweep:\n  axes:\n    - key: .\n      values:\n"
+         "        - {identification: {max_iterations: 100}}\n"
+         "        - {identification: {max_iterations: 1}}\n"
+         "        - {truth: {mode: random, length_sigma_mm: 150, angle_sigma_mrad: 150}}\n"
+         "      labels: [ok, one_iteration, wild_truth]\n";
+  std::string out;
+  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir + "/run/trials.sqlite").c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT c.label, t.trial, t.status FROM trials t JOIN cells c "
+                               "USING (cell_id) GROUP BY t.status",
+                               -1, &st, nullptr),
+            SQLITE_OK);
+  std::set<std::string> statuses;
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    const std::string label = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
+    const long long trial = sqlite3_column_int64(st, 1);
+    const std::string status = reinterpret_cast<const char*>(sqlite3_column_text(st, 2));
+    statuses.insert(status);
+    SCOPED_TRACE(status + " in cell " + label);
+    const std::string args =
+        "trial " + dir + "/run --cell " + label + " --trial " + std::to_string(trial);
+    ASSERT_EQ(Lrcal(args + " --format json", &out), 0) << out;
+    const auto j = nlohmann::json::parse(out);
+    EXPECT_TRUE(j["identical"].get<bool>()) << out;
+    EXPECT_EQ(j["record"]["status"], status);
+    EXPECT_EQ(j["failure"].is_null(), status == "ok");
+    ASSERT_EQ(Lrcal(args, &out), 0) << out;
+    EXPECT_THAT(out, ::testing::HasSubstr("identical to the stored record, bit for bit"));
+    if (status != "ok") {
+      EXPECT_THAT(out, ::testing::HasSubstr("the trial failed (" + status + "): "));
+      EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("Validation errors")));
+    }
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  EXPECT_EQ(statuses, (std::set<std::string>{"ok", "not_converged", "beam_missed"}));
 }
 
 }  // namespace

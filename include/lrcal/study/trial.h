@@ -19,6 +19,8 @@ inline constexpr EnumName<TrialStatus> kTrialStatusNames[] = {
     {TrialStatus::kNumericalFailure, "numerical_failure"},
     {TrialStatus::kBeamMissed, "beam_missed"}};
 inline const char* TrialStatusName(TrialStatus s) { return NameOf(kTrialStatusNames, s); }
+/// Why a trial ends with status `s`, in words ("" for kOk).
+const char* TrialStatusReason(TrialStatus s);
 
 /// What one trial leaves behind: one row of the trial store.
 struct TrialRecord {
