@@ -4,10 +4,12 @@
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cerrno>
 #include <ctime>
 #include <filesystem>
 #include <set>
@@ -95,8 +97,21 @@ Json StudyFingerprint(const Json& study) {
 
 DirectoryLock::DirectoryLock(const std::string& dir) {
   const std::string path = dir + "/lock";
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Never through a symbolic link (its target would be truncated and overwritten with our pid,
+  // even when the run is then refused), and never anything but a regular file (a FIFO would
+  // block).
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+  if (fd_ < 0 && errno == ELOOP)
+    throw InputError(path,
+                     "is a symbolic link; lrcal's lock file must be a regular file of the "
+                     "run directory (remove the link; its target is left untouched)");
   if (fd_ < 0) throw InputError(path, "cannot create the lock file");
+  struct stat info {};
+  if (::fstat(fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(path, "is not a regular file; lrcal's lock file must be one (remove it)");
+  }
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     ::close(fd_);
     fd_ = -1;

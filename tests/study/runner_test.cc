@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -271,6 +272,26 @@ TEST(MonteCarlo, SecondProcessOnTheSameDirectoryIsRefused) {
   kill(pid, SIGKILL);
   int status;
   waitpid(pid, &status, 0);
+}
+
+// Issue 31: a symbolic link named lock is never followed; its target keeps its bytes.
+TEST(MonteCarlo, ALockThatIsASymbolicLinkIsRefusedAndItsTargetKept) {
+  const std::string dir = testing::TempDir("mc_lock_link");
+  const std::string study = SmallStudy(dir, 4);
+  const std::string run = dir + "/run";
+  std::filesystem::create_directories(run);
+  std::ofstream(dir + "/precious.txt") << "keep me\n";
+  std::filesystem::create_symlink(dir + "/precious.txt", run + "/lock");
+  std::string out;
+  EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + run, &out),
+            2);
+  EXPECT_THAT(out, ::testing::HasSubstr(run + "/lock: is a symbolic link")) << out;
+  EXPECT_EQ(testing::ReadFile(dir + "/precious.txt"), "keep me\n");
+  std::filesystem::remove(run + "/lock");
+  ASSERT_EQ(::mkfifo((run + "/lock").c_str(), 0644), 0);
+  EXPECT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + run, &out),
+            2);
+  EXPECT_THAT(out, ::testing::HasSubstr("lock: is not a regular file")) << out;
 }
 
 TEST(MonteCarlo, ChangedStudyIsRefusedWithWhatChanged) {
