@@ -1,5 +1,6 @@
 #include "lrcal/io/robot_file.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <filesystem>
 #include <utility>
@@ -217,6 +218,38 @@ RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// A covariance as lrcal writes it: symmetric (to the rounding of its computation), with
+// non-negative variances and no negative eigenvalue beyond rounding. Anything else would give
+// accuracy statements that look better than the data allow (a negative variance) or are
+// meaningless (an asymmetric matrix).
+void CheckCovariance(const Eigen::MatrixXd& c, const std::string& where) {
+  const double scale = c.cwiseAbs().maxCoeff();
+  if (!c.allFinite()) throw InputError(where, "expected finite numbers");
+  if (c.size() == 0 || scale == 0) return;
+  constexpr double kRounding = 1e-9;  // relative: LDLᵀ solves are symmetric to ~1e-15
+  const Eigen::Index n = c.rows();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (c(i, i) < 0)
+      throw InputError(where, "row " + std::to_string(i) + " has a negative variance (" +
+                                  FormatExact(c(i, i)) + "); expected a covariance matrix");
+    for (Eigen::Index k = 0; k < i; ++k)
+      if (std::fabs(c(i, k) - c(k, i)) > kRounding * scale)
+        throw InputError(where, "is not symmetric: entries (" + std::to_string(i) + ", " +
+                                    std::to_string(k) + ") and (" + std::to_string(k) + ", " +
+                                    std::to_string(i) + ") differ; expected a covariance matrix");
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (c + c.transpose()),
+                                                           Eigen::EigenvaluesOnly);
+  if (eig.eigenvalues().minCoeff() < -kRounding * scale)
+    throw InputError(where, "has a negative eigenvalue (" +
+                                FormatExact(eig.eigenvalues().minCoeff()) +
+                                "): not a covariance matrix (positive semi-definite expected)");
+}
+
+}  // namespace
+
 // calibration: the record of identify --write-robot (parameters, estimate, covariance, sigma).
 CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path) {
   using namespace yaml;
@@ -225,7 +258,13 @@ CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path)
       path, "calibration");
   CalibrationRecord r;
   if (c["data"]) r.data_file = String(c["data"], path, "calibration.data");
-  if (c["sigma"]) r.sigma = Number(c["sigma"], path, "calibration.sigma");
+  if (c["sigma"]) {
+    r.sigma = Number(c["sigma"], path, "calibration.sigma");
+    if (!(r.sigma >= 0))
+      throw InputError(
+          Where(path, c["sigma"], "calibration.sigma"),
+          "expected the standard deviation of one reading, >= 0 (m), got " + FormatExact(r.sigma));
+  }
   if (c["parameters"]) r.parameters = StringList(c["parameters"], path, "calibration.parameters");
   const std::vector<double> estimate = c["estimate"]
                                            ? NumberList(c["estimate"], path, "calibration.estimate")
@@ -249,6 +288,7 @@ CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path)
                          "expected " + std::to_string(n) + " numbers");
       for (std::size_t k = 0; k < n; ++k) r.covariance(i, k) = row[k];
     }
+    CheckCovariance(r.covariance, Where(path, cov, "calibration.covariance"));
   }
   return r;
 }

@@ -60,5 +60,36 @@ TEST(RobotFile, BadFilesNameFileLineAndKey) {
               ::testing::HasSubstr("zero"));
 }
 
+// Issue 31: a calibrated file's covariance and σ are checked, not trusted: a negative variance
+// would give better-looking accuracy, an asymmetric matrix a meaningless one.
+TEST(RobotFile, ACalibrationRecordsCovarianceMustBeOne) {
+  const std::string dir = testing::TempDir("robot_covariance");
+  const auto load = [&](const std::string& sigma, const std::string& covariance) {
+    const std::string path = dir + "/cal.yaml";
+    std::ofstream(path) << "links:\n  - {theta: 0, alpha: 0, a: 0.5, d: 0, parameters: [theta, "
+                           "a]}\ncalibration:\n  sigma: "
+                        << sigma << "\n  parameters: [theta1, a1]\n  estimate: [0, 0.5]\n"
+                        << "  covariance: " << covariance << "\n";
+    try {
+      LoadRobotFile(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(load("2e-4", "[[4e-8, 1e-9], [1e-9, 9e-8]]"), "accepted");
+  EXPECT_EQ(load("0", "null"), "accepted");
+  EXPECT_THAT(load("2e-4", "[[-4e-8, 0], [0, 9e-8]]"),
+              ::testing::AllOf(::testing::HasSubstr("cal.yaml:7 key 'calibration.covariance'"),
+                               ::testing::HasSubstr("row 0 has a negative variance")));
+  EXPECT_THAT(load("2e-4", "[[4e-8, 1e-9], [0, 9e-8]]"),
+              ::testing::HasSubstr("is not symmetric: entries (1, 0) and (0, 1) differ"));
+  EXPECT_THAT(load("2e-4", "[[1e-8, 2e-8], [2e-8, 1e-8]]"),
+              ::testing::HasSubstr("has a negative eigenvalue"));
+  EXPECT_THAT(load("-2e-4", "null"),
+              ::testing::AllOf(::testing::HasSubstr("key 'calibration.sigma'"),
+                               ::testing::HasSubstr(">= 0 (m), got -0.0002")));
+}
+
 }  // namespace
 }  // namespace lrcal
