@@ -809,6 +809,13 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
              where);
     axes[i].key = Str(inputs[i], "key", in_at);
     CheckSensitivityKey(axes[i].key, study->base, where(ip + ".key"));
+    // The same input twice would be two columns of one plan varied together: every index of
+    // both would be meaningless (exactly zero), not an error anyone could see.
+    for (std::size_t j = 0; j < i; ++j)
+      if (axes[j].key == axes[i].key)
+        throw InputError(where(ip + ".key"), "'" + axes[i].key +
+                                                 "' is already sensitivity.inputs[" +
+                                                 std::to_string(j) + "]; list each input once");
     dist[i] = ParseInputDistribution(inputs[i], ip, method, where);
     study->axis_keys.push_back(axes[i].key);
   }

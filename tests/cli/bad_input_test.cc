@@ -708,6 +708,14 @@ const std::vector<BadInput>& Cases() {
        2,
        {"s.yaml:6 key 'sensitivity.inputs[0].key'",
         "'noise.sigma' is not a numeric study setting"}},
+      {"SensitivityInputListedTwice",
+       {{"s.yaml", std::string(kStudy) +
+                       "sensitivity:\n  inputs:\n    - {key: noise.sigma_mm, min: 0.1, max: 0.3}\n"
+                       "    - {key: noise.sigma_mm, min: 0.1, max: 0.3}\n"}},
+       "run s.yaml --out a",
+       2,
+       {"s.yaml:8 key 'sensitivity.inputs[1].key'",
+        "'noise.sigma_mm' is already sensitivity.inputs[0]; list each input once"}},
       {"SensitivityWithASweep",
        {{"s.yaml", std::string(kStudy) +
                        "sweep: {axes: [{key: noise.sigma_mm, values: [0.1, 0.2]}]}\n"
