@@ -751,6 +751,34 @@ void CheckSensitivityKey(const std::string& key, const Json& base, const std::st
                                 "truth.scale, plane.tilt_deg)");
 }
 
+// The sensitivity inputs: each {key, min, max} or {key, mean, std}, each key a numeric study
+// setting listed once; their keys become the study's axis keys.
+void ParseSensitivityInputs(const Json& inputs, const std::string& method, const KeyLocator& where,
+                            Study* study, std::vector<Axis>* axes_out,
+                            std::vector<InputDistribution>* dist_out) {
+  std::vector<Axis>& axes = *axes_out;
+  std::vector<InputDistribution>& dist = *dist_out;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string ip = "sensitivity.inputs[" + std::to_string(i) + "]";
+    const KeyLocator in_at{where.file, where.lines, where.context, ip};
+    if (!inputs[i].is_object())
+      throw InputError(where(ip), "expected {key, min, max} or {key, mean, std}");
+    OnlyKeys(inputs[i], ip, {"key", "min", "max", "mean", "std"}, "key, and min, max or mean, std",
+             where);
+    axes[i].key = Str(inputs[i], "key", in_at);
+    CheckSensitivityKey(axes[i].key, study->base, where(ip + ".key"));
+    // The same input twice would be two columns of one plan varied together: every index of
+    // both would be meaningless (exactly zero), not an error anyone could see.
+    for (std::size_t j = 0; j < i; ++j)
+      if (axes[j].key == axes[i].key)
+        throw InputError(where(ip + ".key"), "'" + axes[i].key +
+                                                 "' is already sensitivity.inputs[" +
+                                                 std::to_string(j) + "]; list each input once");
+    dist[i] = ParseInputDistribution(inputs[i], ip, method, where);
+    study->axis_keys.push_back(axes[i].key);
+  }
+}
+
 // The sensitivity section (sensitivity.h; docs/STUDIES.md): uncertain inputs, each uniform on
 // [min, max] or normal, sampled by Saltelli's or Morris' plan from the study's seed; the plan's
 // points become the cells of a zipped sweep, one axis per input.
@@ -800,25 +828,7 @@ std::vector<Axis> ParseSensitivity(const Json& given, const KeyLocator& where, S
                      "expected a list of 1 to 20 inputs, each {key, min, max}");
   std::vector<Axis> axes(inputs.size());
   std::vector<InputDistribution> dist(inputs.size());
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    const std::string ip = "sensitivity.inputs[" + std::to_string(i) + "]";
-    const KeyLocator in_at{where.file, where.lines, where.context, ip};
-    if (!inputs[i].is_object())
-      throw InputError(where(ip), "expected {key, min, max} or {key, mean, std}");
-    OnlyKeys(inputs[i], ip, {"key", "min", "max", "mean", "std"}, "key, and min, max or mean, std",
-             where);
-    axes[i].key = Str(inputs[i], "key", in_at);
-    CheckSensitivityKey(axes[i].key, study->base, where(ip + ".key"));
-    // The same input twice would be two columns of one plan varied together: every index of
-    // both would be meaningless (exactly zero), not an error anyone could see.
-    for (std::size_t j = 0; j < i; ++j)
-      if (axes[j].key == axes[i].key)
-        throw InputError(where(ip + ".key"), "'" + axes[i].key +
-                                                 "' is already sensitivity.inputs[" +
-                                                 std::to_string(j) + "]; list each input once");
-    dist[i] = ParseInputDistribution(inputs[i], ip, method, where);
-    study->axis_keys.push_back(axes[i].key);
-  }
+  ParseSensitivityInputs(inputs, method, where, study, &axes, &dist);
   const int d = static_cast<int>(inputs.size());
   const double cells = static_cast<double>(samples) * (method == "sobol" ? d + 2 : d + 1);
   if (cells > kMaxCells)
