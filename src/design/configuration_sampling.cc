@@ -144,4 +144,29 @@ CandidatePool UsableCandidates(const RobotModel& robot, const PlaneSet& planes,
   return out;
 }
 
+const SettingSpec& WorkspacePosesSetting() {
+  static const SettingSpec spec{"workspace",
+                                "count",
+                                "workspace",
+                                "",
+                                1,
+                                "",
+                                1,
+                                1e5,
+                                false,
+                                true,
+                                "poses",
+                                "",
+                                "poses drawn over the joint ranges"};
+  return spec;
+}
+
+ConfigurationSet WorkspacePoses(const RobotModel& robot, int count, std::uint64_t seed) {
+  WorkspacePosesSetting().Check(count);
+  SamplingOptions o;
+  o.require_beam_hit = false;
+  return SampleConfigurations(robot, Plane{}, count,
+                              RandomStream(seed, 0, 0, RandomPurpose::kValidation), o);
+}
+
 }  // namespace lrcal

@@ -6,6 +6,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/random.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/kinematics/pose_errors.h"
 
 namespace lrcal {
@@ -34,6 +35,13 @@ Eigen::MatrixXd PoseJacobian(const MeasurementModel& model, const double* e,
       }
   }
   return J;
+}
+
+Eigen::MatrixXd PositionRows(const Eigen::MatrixXd& pose_jacobian) {
+  const Eigen::Index m = pose_jacobian.rows() / 6;
+  Eigen::MatrixXd P(3 * m, pose_jacobian.cols());
+  for (Eigen::Index j = 0; j < m; ++j) P.middleRows(3 * j, 3) = pose_jacobian.middleRows(6 * j, 3);
+  return P;
 }
 
 namespace {
@@ -89,6 +97,22 @@ PoseAccuracySummary SummarizePoseAccuracy(const std::vector<PoseAccuracy>& poses
   s.p95_radius_95 = radii[std::min(radii.size() - 1,
                                    static_cast<std::size_t>(std::ceil(0.95 * radii.size())) - 1)];
   return s;
+}
+
+std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses) {
+  Table t({"pose", "position std x", "y", "z", "orientation std x", "y", "z", "95 % radius"},
+          "Predicted accuracy of the calibrated arm (position in mm, orientation in mrad)");
+  for (std::size_t j = 0; j < poses.size(); ++j) {
+    const PoseAccuracy& p = poses[j];
+    t.AddRow({std::to_string(j + 1), Fixed(p.position_std.x() * 1e3),
+              Fixed(p.position_std.y() * 1e3), Fixed(p.position_std.z() * 1e3),
+              Fixed(p.orientation_std.x() * 1e3), Fixed(p.orientation_std.y() * 1e3),
+              Fixed(p.orientation_std.z() * 1e3), Fixed(p.position_radius_95 * 1e3)});
+  }
+  const PoseAccuracySummary s = SummarizePoseAccuracy(poses);
+  return t.ToText() + "over these " + std::to_string(poses.size()) + " poses: RMS position error " +
+         Fixed(s.rms_position * 1e3) + " mm; 95th percentile of the 95 % radius " +
+         Fixed(s.p95_radius_95 * 1e3) + " mm; worst pose " + std::to_string(s.worst + 1) + "\n";
 }
 
 }  // namespace lrcal

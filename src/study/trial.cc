@@ -5,6 +5,8 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
 #include "lrcal/design/design_certificate.h"
+#include "lrcal/design/task_criterion.h"
+#include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/simulation.h"
@@ -255,11 +257,10 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
 
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
 
-// The task criterion's selection matrix (selection.criterion: I): the pool's G (SI) weighted by
-// the validation configurations' position Jacobians (TaskWeightedJacobian).
+// The task criterion's selection matrix (selection.criterion: I), weighted by the validation
+// configurations (task_criterion.h).
 Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
-  return TaskWeightedJacobian(DesignJacobian(*c.model, pool, DesignScaling::kSI, 0, 0),
-                              ValidationPoseJacobian(c).topRows(3 * c.validation.size()));
+  return TaskDesignJacobian(*c.model, pool, TaskPosesAt(*c.model, c.validation, "validation"));
 }
 
 // The selected design, its σ_min and the predicted covariance at the nominal model; the
@@ -321,28 +322,17 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
 }
 
 // The linearised validation errors: the Jacobian (6M × n, rows per configuration j: position
-// 3j..3j+2, then orientation 3M+3j..) of the validation pose errors with respect to the
-// parameters, by central differences at the nominal model.
+// 3j..3j+2, then orientation 3M+3j..) of the validation poses with respect to the parameters at
+// the nominal model (PoseJacobian, regrouped; its sign is irrelevant here: the draws enter only
+// through squares and magnitudes).
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
   const int n = c.model->num_parameters(), m = c.validation.size();
-  const std::vector<Pose<double>> poses =
-      ToolPoses(*c.robot, c.robot->nominal_values(), c.validation);
+  const std::vector<double> zero(n, 0.0);
+  const Eigen::MatrixXd J6 = PoseJacobian(*c.model, zero.data(), c.validation);
   Eigen::MatrixXd J(6 * m, n);
-  Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
-  constexpr double kStep = 1e-6;  // m or rad: truncation O(step²), rounding O(1e-16/step)
-  for (int k = 0; k < n; ++k) {
-    e[k] = kStep;
-    const PoseErrors plus =
-        ComparePoses(*c.robot, poses, c.model->LinkValues(e.data()), c.validation);
-    e[k] = -kStep;
-    const PoseErrors minus =
-        ComparePoses(*c.robot, poses, c.model->LinkValues(e.data()), c.validation);
-    e[k] = 0;
-    for (int j = 0; j < m; ++j)
-      for (int a = 0; a < 3; ++a) {
-        J(3 * j + a, k) = (plus.position(a, j) - minus.position(a, j)) / (2 * kStep);
-        J(3 * m + 3 * j + a, k) = (plus.orientation(a, j) - minus.orientation(a, j)) / (2 * kStep);
-      }
+  for (int j = 0; j < m; ++j) {
+    J.middleRows(3 * j, 3) = J6.middleRows(6 * j, 3);
+    J.middleRows(3 * m + 3 * j, 3) = J6.middleRows(6 * j + 3, 3);
   }
   return J;
 }

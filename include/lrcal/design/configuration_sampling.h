@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "lrcal/core/random.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/measurement/measurement_model.h"
 
 namespace lrcal {
@@ -69,5 +70,13 @@ struct CandidatePool {
 };
 CandidatePool UsableCandidates(const RobotModel& robot, const PlaneSet& planes,
                                const RangerSpec& ranger, const ConfigurationSet& pool);
+
+/// The number of workspace poses (`workspace.count`: --workspace, workspace=): 1 to 100,000.
+const SettingSpec& WorkspacePosesSetting();
+
+/// `count` poses drawn over the joint ranges (non-singular, no beam needed) from `seed`'s
+/// validation stream: the poses of an accuracy map over the workspace and of criterion I when no
+/// task poses are given. Throws SettingError for a count out of WorkspacePosesSetting()'s range.
+ConfigurationSet WorkspacePoses(const RobotModel& robot, int count, std::uint64_t seed);
 
 }  // namespace lrcal

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "lrcal/kinematics/configuration_set.h"
@@ -36,6 +37,9 @@ struct PoseAccuracySummary {
 Eigen::MatrixXd PoseJacobian(const MeasurementModel& model, const double* e,
                              const ConfigurationSet& configs);
 
+/// The position rows of a PoseJacobian (6M × n): 3M × n, rows 3j..3j+2 of configuration j.
+Eigen::MatrixXd PositionRows(const Eigen::MatrixXd& pose_jacobian);
+
 /// The predicted accuracy at every configuration for an estimate e with covariance C (n × n,
 /// SI). Throws InputError if C is not n × n.
 std::vector<PoseAccuracy> PredictPoseAccuracy(const MeasurementModel& model, const double* e,
@@ -43,5 +47,8 @@ std::vector<PoseAccuracy> PredictPoseAccuracy(const MeasurementModel& model, con
                                               const ConfigurationSet& configs);
 
 PoseAccuracySummary SummarizePoseAccuracy(const std::vector<PoseAccuracy>& poses);
+
+/// The predicted accuracy as a text table (mm, mrad) with its summary line.
+std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses);
 
 }  // namespace lrcal
