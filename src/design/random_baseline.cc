@@ -1,0 +1,62 @@
+#include "lrcal/design/random_baseline.h"
+
+#include "lrcal/core/random.h"
+
+namespace lrcal {
+
+namespace {
+
+Eigen::MatrixXd NormalMatrixOfRows(const Eigen::MatrixXd& G, const std::vector<int>& rows) {
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+  for (int r : rows) A += G.row(r).transpose() * G.row(r);
+  return A;
+}
+
+}  // namespace
+
+const SettingSpec& RandomBaselineSetting() {
+  static const SettingSpec spec{"baseline",
+                                "count",
+                                "baseline",
+                                "",
+                                1,
+                                "",
+                                1,
+                                1e6,
+                                false,
+                                true,
+                                "random designs",
+                                "",
+                                "random designs for the baseline"};
+  return spec;
+}
+
+std::vector<BaselineIndex> CompareWithRandomDesigns(const Eigen::MatrixXd& G,
+                                                    const std::vector<int>& chosen, int count,
+                                                    std::uint64_t seed) {
+  RandomBaselineSetting().Check(count);
+  const int k = static_cast<int>(chosen.size());
+  constexpr std::size_t kCriteria = std::size(kBaselineCriteria);
+  std::vector<std::vector<double>> random_scores(kCriteria);
+  SelectionOptions random_options;
+  random_options.method = SelectionMethod::kRandom;
+  for (int b = 0; b < count; ++b) {
+    const SelectionResult r = SelectConfigurations(
+        G, k, random_options,
+        RandomStream(seed, 2, static_cast<std::uint64_t>(b), RandomPurpose::kSelection));
+    const Eigen::MatrixXd A = NormalMatrixOfRows(G, r.indices);
+    for (std::size_t c = 0; c < kCriteria; ++c)
+      random_scores[c].push_back(CriterionScore(A, k, kBaselineCriteria[c]));
+  }
+  const Eigen::MatrixXd A_chosen = NormalMatrixOfRows(G, chosen);
+  std::vector<BaselineIndex> out(kCriteria);
+  for (std::size_t c = 0; c < kCriteria; ++c) {
+    out[c].criterion = kBaselineCriteria[c];
+    out[c].chosen = CriterionScore(A_chosen, k, kBaselineCriteria[c]);
+    out[c].random = Describe(random_scores[c]);
+    out[c].percentile = PercentileRank(random_scores[c], out[c].chosen);
+  }
+  return out;
+}
+
+}  // namespace lrcal
