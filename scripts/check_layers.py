@@ -27,7 +27,6 @@ PRIVATE_ALLOWED = {
         "the trial pipeline holds the solver's workspace (issue 25 item 4: a public trial API)",
     ("study", "io/yaml_util.h"): "the study reader uses the robot files' YAML helpers",
     ("report", "study/trial_pipeline.h"): "the report replays a trial (issue 25 item 4)",
-    ("cli", "study/trial_pipeline.h"): "plan and plan-accuracy prepare cells (issue 25 items 2, 4)",
 }
 
 

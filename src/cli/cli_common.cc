@@ -85,39 +85,10 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
                           ranger);
 }
 
-namespace {
-
-void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
-                      const std::string& path) {
-  for (int i = 0; i < configs.size(); ++i)
-    for (int j = 0; j < configs.num_joints(); ++j) {
-      const Link& link = robot.links()[j];
-      const double q = configs.q(i)[j];
-      if (q >= link.q_min - 1e-9 && q <= link.q_max + 1e-9) continue;
-      const bool prismatic = link.joint == JointType::kPrismatic;
-      throw InputError(
-          path + " configuration " + std::to_string(i + 1) + " column 'q" + std::to_string(j + 1) +
-              "'",
-          FormatExact(q) + " is outside the joint's range [" + FormatExact(link.q_min) + ", " +
-              FormatExact(link.q_max) + "] (the robot file's q_min, q_max); joint values are in " +
-              (prismatic ? "m: were they written in mm?" : "rad: were they written in degrees?"));
-    }
-}
-
-}  // namespace
-
-ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
-                                         const PlaneSet* planes) {
-  ConfigurationSet configs = ReadConfigurations(path, robot.num_links(), planes);
-  CheckJointRanges(configs, robot, path);
-  return configs;
-}
-
-MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
-                                     const PlaneSet* planes) {
-  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger, planes);
-  CheckJointRanges(data.configs, rig.robot, path);
-  return data;
+std::uint64_t ParseSeed(const po::variables_map& vm) {
+  const long long s = vm["seed"].as<long long>();
+  if (s < 0) throw InputError("--seed", "expected a non-negative integer");
+  return static_cast<std::uint64_t>(s);
 }
 
 Format ResolveFormat(const po::variables_map& vm) {
@@ -125,22 +96,6 @@ Format ResolveFormat(const po::variables_map& vm) {
   if (f == "text") return Format::kText;
   if (f == "json") return Format::kJson;
   throw InputError("--format", "expected text or json, got '" + f + "'");
-}
-
-Json ToJson(const Eigen::VectorXd& v) {
-  Json j = Json::array();
-  for (int i = 0; i < v.size(); ++i) j.push_back(v[i]);
-  return j;
-}
-
-Json ToJson(const Eigen::MatrixXd& m) {
-  Json j = Json::array();
-  for (int r = 0; r < m.rows(); ++r) {
-    Json row = Json::array();
-    for (int c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
-    j.push_back(row);
-  }
-  return j;
 }
 
 namespace {

@@ -13,7 +13,8 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
-#include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/io/result_json.h"
+#include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
@@ -21,7 +22,7 @@
 namespace lrcal::cli {
 
 namespace po = boost::program_options;
-using Json = nlohmann::ordered_json;
+using Json = ResultJson;
 
 /// A subcommand: name, one-line summary, and its entry point (args exclude the subcommand).
 struct Command {
@@ -55,16 +56,8 @@ Setup ResolveSetup(const po::variables_map& vm);
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
                                  int num_planes = 1);
 
-/// A configurations CSV (io/csv.h) for `robot`, with every joint value checked against the
-/// robot's joint range (q_min, q_max): beyond it is exit 2 naming the file, the configuration
-/// and the joint, and suggesting the likely unit mistake (degrees for rad, mm for m). Its
-/// optional `plane` column is resolved against `planes`.
-ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
-                                         const PlaneSet* planes = nullptr);
-/// A measurement CSV for `rig` (its ranger's range, its robot's joint ranges checked; its
-/// `plane` column resolved against `planes`).
-MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
-                                     const PlaneSet* planes = nullptr);
+/// --seed: a non-negative integer.
+std::uint64_t ParseSeed(const po::variables_map& vm);
 
 enum class Format { kText, kJson };
 Format ResolveFormat(const po::variables_map& vm);
@@ -110,9 +103,6 @@ void ReadSettingOptions(const po::variables_map& vm,
   }
 }
 
-Json ToJson(const Eigen::VectorXd& v);
-Json ToJson(const Eigen::MatrixXd& m);
-
 int KinematicsCommand(const std::vector<std::string>& args);
 int SampleCommand(const std::vector<std::string>& args);
 int SimulateCommand(const std::vector<std::string>& args);
@@ -130,18 +120,9 @@ int AggregateCommand(const std::vector<std::string>& args);
 int TrialCommand(const std::vector<std::string>& args);
 int AccuracyCommand(const std::vector<std::string>& args);
 int ExportCommand(const std::vector<std::string>& args);
-/// Predicted accuracy at poses (identification/pose_accuracy.h) as JSON {poses: [{q,
-/// position_std, orientation_std, position_radius_95}], rms_position, p95_position_radius_95,
-/// worst (1-based)} and as a text table.
-Json PoseAccuracyJson(const std::vector<PoseAccuracy>& poses, const ConfigurationSet& configs);
-std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses);
 /// Runs lrcal's Python script `relative` ("analysis/report.py": from the working directory, else
 /// lrcal's data folder) on `argument` with Debian's /usr/bin/python3 (where python3-pandas and
 /// python3-matplotlib are; LRCAL_PYTHON overrides). Returns the script's exit code (1 if it did
 /// not exit normally). Throws InputError when the script is not found.
 int RunAnalysisScript(const std::string& relative, const std::string& argument);
-/// `count` poses drawn uniformly over the robot's joint ranges (non-singular arm, no reading
-/// needed), from `seed`: the workspace over which accuracy is stated (--workspace).
-ConfigurationSet WorkspacePoses(const RobotModel& robot, int count, long long seed);
-
 }  // namespace lrcal::cli

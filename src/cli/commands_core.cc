@@ -8,135 +8,24 @@
 #include <sstream>
 
 #include "cli_common.h"
-#include "lrcal/build_info.h"
-#include "lrcal/core/hash.h"
 #include "lrcal/core/json.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/identifiability_remedies.h"
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/io/calibration_record.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/io/kinematics_report.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/paper/paper_case.h"
+#include "lrcal/report/calibration_report.h"
 
 namespace lrcal::cli {
 
 namespace {
-
-std::uint64_t ParseSeed(const po::variables_map& vm) {
-  const long long s = vm["seed"].as<long long>();
-  if (s < 0) throw InputError("--seed", "expected a non-negative integer");
-  return static_cast<std::uint64_t>(s);
-}
-
-Json IdentifiabilityJson(const IdentifiabilityReport& r) {
-  Json j;
-  j["n_params"] = r.num_params();
-  j["n_configurations"] = r.num_configurations;
-  j["rank"] = r.rank;
-  j["parameters"] = r.names;
-  j["singular_values"] = ToJson(r.singular_values);
-  j["condition_number"] = std::isfinite(r.condition_number) ? Json(r.condition_number) : Json();
-  j["unidentifiable"] = r.unidentifiable;
-  Json deps = Json::array();
-  for (const auto& d : r.dependencies) {
-    Json terms = Json::array();
-    for (const auto& [name, c] : d.terms) terms.push_back({{"name", name}, {"coefficient", c}});
-    deps.push_back(terms);
-  }
-  j["dependencies"] = deps;
-  j["suggested_fixed"] = r.suggested_fixed;
-  return j;
-}
-
-// What each remedy recovers; `cheapest_fix` has one entry per lost direction (null: none found).
-Json RemediesJson(const RemedyReport& r) {
-  Json j;
-  j["lost"] = r.lost;
-  Json list = Json::array();
-  for (const auto& m : r.remedies) {
-    Json e{{"kind", RemedyKindName(m.kind)}, {"action", m.action}, {"recovers", m.recovers}};
-    if (!m.parameter.empty()) e["parameter"] = m.parameter;
-    if (m.kind == Remedy::Kind::kAddPlane || m.kind == Remedy::Kind::kAddKnownDistance)
-      e["plane"] = {{"normal", {m.plane.normal[0], m.plane.normal[1], m.plane.normal[2]}},
-                    {"offset", m.plane.offset}};
-    list.push_back(e);
-  }
-  j["remedies"] = list;
-  Json cheapest = Json::array();
-  for (int c : r.cheapest) cheapest.push_back(c >= 0 ? Json(r.remedies[c].action) : Json());
-  j["cheapest_fix"] = cheapest;
-  j["unreachable"] = r.unreachable;
-  return j;
-}
-
-Json IdentificationJson(const IdentificationSummary& s) {
-  Json j;
-  Json params = Json::array();
-  for (std::size_t k = 0; k < s.names.size() && s.IsSolutionUsable(); ++k) {
-    params.push_back({{"name", s.names[k]},
-                      {"nominal", s.nominal[k]},
-                      {"estimate", s.estimate[k]},
-                      {"delta", s.delta[k]},
-                      {"std", s.std_residual[k]},
-                      {"std_given_sigma", s.std_given.size() ? Json(s.std_given[k]) : Json()}});
-  }
-  j["parameters"] = params;
-  j["covariance"] = s.IsSolutionUsable() ? ToJson(s.covariance_residual) : Json();
-  j["covariance_given_sigma"] = s.covariance_given.size() ? ToJson(s.covariance_given) : Json();
-  j["correlation"] = s.IsSolutionUsable() ? ToJson(s.correlation) : Json();
-  j["rank"] = s.identifiability.rank;
-  j["n_params"] = s.identifiability.num_params();
-  j["fixed_for_rank"] = s.fixed;
-  j["iterations"] = s.iterations;
-  j["termination"] = TerminationName(s.termination);
-  j["usable"] = s.IsSolutionUsable();
-  j["message"] = s.message;
-  j["residual_rms"] = s.residual_rms;
-  const auto number = [](double x) { return std::isnan(x) ? Json() : Json(x); };
-  j["sigma_hat"] = number(s.sigma_hat);
-  if (s.IsSolutionUsable()) {
-    Json fit = {{"dof", s.fit.dof}, {"standardized_residuals", s.fit.standardized}};
-    Json suspects = Json::array();
-    for (int i : s.fit.suspects) suspects.push_back(i + 1);
-    fit["suspects"] = suspects;  // 1-based configurations
-    if (s.fit.sigma_given) {
-      fit["chi2"] = s.fit.chi2;
-      fit["p_value"] = number(s.fit.p_value);
-      fit["consistent"] = s.fit.consistent;
-    } else {
-      fit["chi2"] = fit["p_value"] = fit["consistent"] = nullptr;  // no σ given: no test
-    }
-    j["fit"] = fit;
-  }
-  j["n_configurations"] = s.num_configurations;
-  j["solver"] = s.solver;
-  j["loss"] = s.loss;
-  if (!s.identifiability.full_rank()) j["identifiability"] = IdentifiabilityJson(s.identifiability);
-  return j;
-}
-
-void PrintIdentification(const IdentificationSummary& s) {
-  std::cout << s.BriefReport() << "\n";
-  if (!s.IsSolutionUsable()) {
-    std::cout << s.message << "\n";
-    if (!s.identifiability.full_rank()) std::cout << s.identifiability.ToString();
-    return;
-  }
-  std::cout << "sigma_hat per reading: "
-            << (std::isnan(s.sigma_hat) ? std::string("undefined")
-                                        : Fixed(s.sigma_hat * 1e3, 4) + " mm")
-            << "\n"
-            << s.fit.Explain() << s.ParameterTable();
-  if (!s.fixed.empty()) {
-    std::cout << "fixed at nominal because of rank deficiency:";
-    for (const auto& f : s.fixed) std::cout << " " << f;
-    std::cout << "\n";
-  }
-}
 
 IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) {
   IdentificationOptions options;
@@ -146,48 +35,6 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) 
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
   options.Validate();
   return options;
-}
-
-// Tool pose, beam and reading (and the Jacobian row) of configuration i, as JSON and a row of
-// `table`.
-Json KinematicsRow(const MeasurementModel& model, const ModelPoint& point,
-                   const ConfigurationSet& configs, int i, const RangerSpec& ranger, bool jacobian,
-                   Table* table) {
-  const ParameterSet& ps = model.parameters();
-  std::vector<double> row(ps.size());
-  double h;
-  const double nb = model.Evaluate(point, configs, i, &h, jacobian ? row.data() : nullptr);
-  const BeamMiss miss = ClassifyReading(h, nb, ranger);
-  const Pose<double> pose = ToolPose(point, configs, i);
-  Json j;
-  j["q"] = std::vector<double>(configs.q(i), configs.q(i) + configs.num_joints());
-  j["position"] = {pose.p_BT.x(), pose.p_BT.y(), pose.p_BT.z()};
-  j["rotation"] = ToJson(Eigen::MatrixXd(pose.R_BT));
-  j["beam"] = {pose.R_BT(0, 2), pose.R_BT(1, 2), pose.R_BT(2, 2)};
-  j["h"] = miss == BeamMiss::kNone ? Json(h) : Json();
-  j["status"] = BeamMissName(miss);
-  if (jacobian) {
-    Json g = Json::object();
-    for (int k = 0; k < ps.size(); ++k) g[ps.names[k]] = row[k];
-    j["jacobian"] = g;
-  }
-  table->AddRow({std::to_string(i + 1), Fixed(pose.p_BT.x(), 6), Fixed(pose.p_BT.y(), 6),
-                 Fixed(pose.p_BT.z(), 6), Fixed(pose.R_BT(0, 2), 6), Fixed(pose.R_BT(1, 2), 6),
-                 Fixed(pose.R_BT(2, 2), 6),
-                 miss == BeamMiss::kNone ? Fixed(h, 6) : std::string("—"), BeamMissName(miss)});
-  return j;
-}
-
-Table JacobianTable(const std::vector<std::string>& names, const Json& rows) {
-  std::vector<std::string> header = {"#"};
-  for (const auto& n : names) header.push_back(n);
-  Table t(header, "Identification Jacobian rows dh/de (m/rad for angles, m/m for lengths)");
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    std::vector<std::string> r = {std::to_string(i + 1)};
-    for (const auto& n : names) r.push_back(Fixed(rows[i]["jacobian"][n].get<double>(), 5));
-    t.AddRow(r);
-  }
-  return t;
 }
 
 }  // namespace
@@ -215,26 +62,13 @@ int KinematicsCommand(const std::vector<std::string>& args) {
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
   const ConfigurationSet configs =
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
-  const Eigen::VectorXd values = which == "true" ? robot.true_values() : robot.nominal_values();
-  ParameterSet ps = ResolveParameterSet(robot, vm, planes.size());
-  // The Jacobian is taken at the chosen model: its robot deltas relative to nominal.
-  MeasurementModel model(robot, planes, ps);
-  std::vector<double> e(ps.size(), 0.0);
-  for (int k = 0; k < ps.num_robot(); ++k)
-    e[k] = values[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]];
-  ModelPoint point;
-  model.Prepare(e.data(), &point);
-  const bool jac = vm["jacobian"].as<bool>();
-  Table table({"#", "x (m)", "y (m)", "z (m)", "beam x", "beam y", "beam z", "h (m)", "status"},
-              "Tool pose and laser reading per configuration (" + which + " model)");
-  Json out = Json::array();
-  for (int i = 0; i < configs.size(); ++i)
-    out.push_back(KinematicsRow(model, point, configs, i, rig.ranger, jac, &table));
+  const KinematicsReport report = ReportKinematics(
+      MeasurementModel(robot, planes, ResolveParameterSet(robot, vm, planes.size())),
+      which == "true", configs, rig.ranger, vm["jacobian"].as<bool>());
   if (ResolveFormat(vm) == Format::kJson) {
-    std::cout << out.dump(2) << "\n";
+    std::cout << report.rows.dump(2) << "\n";
   } else {
-    std::cout << table.ToText();
-    if (jac) std::cout << "\n" << JacobianTable(ps.names, out).ToText();
+    std::cout << report.ToText();
   }
   return 0;
 }
@@ -320,75 +154,12 @@ int SimulateCommand(const std::vector<std::string>& args) {
   return 0;
 }
 
-// The model Identify solved: `model`'s parameter set without the parameters it fixed for rank
-// deficiency (s.delta is laid out for it).
-MeasurementModel SolvedModel(const MeasurementModel& model, const IdentificationSummary& s) {
-  return MeasurementModel(model.robot(), model.nominal_planes(),
-                          WithoutParameters(model.robot(), model.parameters(), s.fixed));
-}
-
-// The estimate's covariance: with the given σ when --sigma-mm was given, else residual-based.
-const Eigen::MatrixXd& FitCovariance(const IdentificationSummary& s,
-                                     const IdentificationOptions& options) {
-  return options.sigma > 0 ? s.covariance_given : s.covariance_residual;
-}
-
-// identify --write-robot: the calibrated model (the parameter set Identify solved for, reduced
-// if it fixed parameters for rank deficiency) as a robot file with its record.
-void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
-                          const RobotFile& rig, const MeasurementModel& model,
-                          const IdentificationSummary& s, const IdentificationOptions& options) {
-  const MeasurementModel solved = SolvedModel(model, s);
-  CalibrationRecord r;
-  r.data_file = data_file;
-  std::ifstream in(data_file, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  r.data_fnv1a = HashHex(bytes.str());
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char date[32];
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  r.date = date;
-  r.lrcal = std::string(LRCAL_VERSION) + " (" + LRCAL_GIT_COMMIT + ")";
-  const bool given = options.sigma > 0;
-  r.sigma = given ? options.sigma : s.sigma_hat;
-  r.sigma_source = given ? "given (--sigma-mm)" : "residual (sigma_hat)";
-  r.parameters = s.names;
-  r.estimate = s.estimate;
-  if (given || !std::isnan(s.sigma_hat)) r.covariance = FitCovariance(s, options);
-  WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
-                           solved.PlanesAt(s.delta.data()), r);
+// identify --write-robot: the calibrated model as a robot file with its record.
+void WriteRobot(const std::string& path, const std::string& data_file, const RobotFile& rig,
+                const MeasurementModel& model, const IdentificationSummary& s,
+                const IdentificationOptions& options) {
+  WriteCalibratedRobot(path, data_file, rig, model, s, options);
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
-}
-
-// identify --holdout: configurations 1-based, like the fit's suspects.
-Json CrossValidationJson(const CrossValidation& cv) {
-  Json predictions = Json::array();
-  for (const auto& p : cv.predictions)
-    predictions.push_back({{"configuration", p.configuration + 1},
-                           {"fold", p.fold},
-                           {"error", p.error},
-                           {"predicted_std", p.predicted_std},
-                           {"z", p.z}});
-  Json failed = Json::array();
-  for (const auto& [fold, why] : cv.failed_folds)
-    failed.push_back({{"fold", fold}, {"reason", why}});
-  Json beyond = Json::array();
-  for (int i : cv.beyond_4) beyond.push_back(i + 1);
-  const bool any = !cv.predictions.empty();
-  return {{"folds", cv.folds},
-          {"assignment", "configuration i (0-based) in fold i mod K"},
-          {"predictions", predictions},
-          {"failed_folds", failed},
-          {"rms_error", any ? Json(cv.rms_error) : Json()},
-          {"rms_predicted", any ? Json(cv.rms_predicted) : Json()},
-          {"ratio", any ? Json(cv.rms_error / cv.rms_predicted) : Json()},
-          {"mean_z2", any ? Json(cv.mean_z2) : Json()},
-          {"mean_z2_tolerance", any ? Json(cv.mean_z2_tolerance) : Json()},
-          {"consistent", any ? Json(cv.consistent()) : Json()},
-          {"beyond_4", beyond}};
 }
 
 // identify --predict-at: the fit's covariance (given σ, else residual-based) at the poses.
@@ -425,45 +196,22 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
     if (cv) j["holdout"] = CrossValidationJson(*cv);
     std::cout << j.dump(2) << "\n";
   } else {
-    PrintIdentification(s);
+    std::cout << s.FullReport();
     std::cout << accuracy_text << (cv ? cv->ToString() : "");
   }
 }
 
-// identify --report DIR: everything the page shows, as calibration.json (SI), the calibrated robot
-// file, then report.html from analysis/calibration_report.py. Cross-validation uses --holdout K,
-// else 5 folds; the accuracy map 500 poses over the joint ranges (seed 1).
+// identify --report DIR: calibration.json and the calibrated robot (report/calibration_report.h),
+// then report.html from analysis/calibration_report.py.
 void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const RobotFile& rig, const MeasurementModel& model,
                             const MeasurementSet& data, const IdentificationSummary& s,
                             const IdentificationOptions& options) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError("--report", "cannot create the folder '" + dir + "': " + ec.message());
-  Json j = IdentificationJson(s);
-  j["data"] = {{"file", vm["data"].as<std::string>()}, {"configurations", data.size()}};
-  j["robot"] = rig.path;
-  j["sigma_given"] = options.sigma > 0 ? Json(options.sigma) : Json();
-  j["identifiability"] = IdentifiabilityJson(s.identifiability);
-  if (s.IsSolutionUsable()) {
-    const int folds = vm.count("holdout") ? vm["holdout"].as<int>() : std::min(5, data.size());
-    if (folds >= 2) j["holdout"] = CrossValidationJson(CrossValidate(model, data, folds, options));
-    const Eigen::MatrixXd& C = FitCovariance(s, options);
-    if (C.allFinite()) {
-      const ConfigurationSet poses = WorkspacePoses(model.robot(), 500, 1);
-      j["workspace_accuracy"] = PoseAccuracyJson(
-          PredictPoseAccuracy(SolvedModel(model, s), s.delta.data(), C, poses), poses);
-    }
-    WriteCalibratedRobot(dir + "/calibrated.yaml", vm["data"].as<std::string>(), rig, model, s,
-                         options);
-    j["calibrated_robot"] = "calibrated.yaml";
-    // The same model as URDF, from the file just written (what lrcal export would write).
-    const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
-    WriteFileAtomically(dir + "/calibrated.urdf",
-                        UrdfText(calibrated.robot, calibrated.robot.nominal_values()));
-    j["calibrated_urdf"] = "calibrated.urdf";
-  }
-  WriteFileAtomically(dir + "/calibration.json", j.dump(2));
+  CalibrationReportInputs in{vm["data"].as<std::string>(), &rig, &model, &data, &s, options};
+  if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
+  WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
+  if (s.IsSolutionUsable())
+    std::cerr << "lrcal identify: calibrated robot written to " << dir << "/calibrated.yaml\n";
   const int code = RunAnalysisScript("analysis/calibration_report.py", dir);
   if (code != 0)
     throw StorageError(dir + "/report.html: analysis/calibration_report.py failed (exit " +
@@ -527,8 +275,8 @@ int IdentifyCommand(const std::vector<std::string>& args) {
     return 3;
   }
   if (vm.count("write-robot") && s.IsSolutionUsable())
-    WriteCalibratedRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig,
-                         model, s, options);
+    WriteRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig, model, s,
+               options);
   if (vm.count("report"))
     WriteCalibrationReport(vm["report"].as<std::string>(), vm, rig, model, data, s, options);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
@@ -601,59 +349,11 @@ int PaperCommand(const std::vector<std::string>& args) {
   options.case1_selection.samples = vm["samples"].as<int>();
   options.case1_selection.Validate("--samples");
   const PaperCasesResult r = RunPaperCases(robot, (*rig.planes)[0], options);
-  const Table params = PaperParameterTable(robot, r);
-  const Table validation = PaperValidationTable(r);
   if (ResolveFormat(vm) == Format::kJson) {
-    Json j;
-    j["seed"] = options.seed;
-    j["pool"] = r.pool_report.ToString();
-    j["validation_sampling"] = r.validation_report.ToString();
-    Json cases = Json::array();
-    for (const auto& c : r.cases) {
-      Json cj;
-      cj["label"] = c.label;
-      cj["selected"] = c.selection.indices;
-      cj["sigma_min"] = c.selection.score;
-      cj["termination"] = TerminationName(c.summary.termination);
-      cj["iterations"] = c.summary.iterations;
-      cj["residual_rms"] = c.summary.residual_rms;
-      Json p = Json::object();
-      for (std::size_t k = 0; k < c.summary.names.size() && c.summary.IsSolutionUsable(); ++k)
-        p[c.summary.names[k]] = c.summary.delta[k];
-      cj["delta"] = p;
-      Json sd = Json::object();
-      for (std::size_t k = 0; k < c.summary.names.size() && c.summary.IsSolutionUsable(); ++k)
-        sd[c.summary.names[k]] = c.summary.std_given[k];
-      cj["std_given_sigma"] = sd;
-      cj["validation_rms_position"] = ToJson(Eigen::VectorXd(c.validation.stats.rms_position));
-      cj["validation_rms_orientation"] =
-          ToJson(Eigen::VectorXd(c.validation.stats.rms_orientation));
-      cj["validation_max_position"] = ToJson(Eigen::VectorXd(c.validation.stats.max_position));
-      cj["validation_max_orientation"] =
-          ToJson(Eigen::VectorXd(c.validation.stats.max_orientation));
-      cases.push_back(cj);
-    }
-    j["cases"] = cases;
-    j["nominal_validation_rms_position"] =
-        ToJson(Eigen::VectorXd(r.nominal_validation.stats.rms_position));
-    std::cout << j.dump(2) << "\n";
-    return 0;
+    std::cout << PaperCasesJson(r, options).dump(2) << "\n";
+  } else {
+    std::cout << PaperCasesText(robot, r, options);
   }
-  std::cout << "lrcal paper: one realisation (seed " << options.seed << ") of the paper's cases\n"
-            << "candidate pool: " << r.pool_report.ToString() << "\n"
-            << "validation set: " << r.validation_report.ToString() << "\n";
-  for (const auto& c : r.cases) {
-    std::cout << c.label << ": " << c.selection.indices.size() << " of " << r.pool.size()
-              << " by E-optimality ("
-              << SelectionMethodName(c.label == "case 1" ? options.case1_selection.method
-                                                         : options.case2_selection.method)
-              << ", " << c.selection.evaluations
-              << " evaluations), sigma_min(G) = " << c.selection.score << "; "
-              << c.summary.BriefReport() << "\n";
-  }
-  std::cout << "\n" << params.ToText() << "\n" << validation.ToText();
-  std::cout << "\nOne realisation cannot reproduce the paper's digits; `lrcal run "
-               "studies/paper.yaml` shows where they fall in the distribution.\n";
   return 0;
 }
 

@@ -3,31 +3,10 @@
 #include <iostream>
 
 #include "cli_common.h"
-#include "lrcal/core/error.h"
 #include "lrcal/core/json.h"
-#include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
 
 namespace lrcal::cli {
-
-namespace {
-
-std::string ExportText(const RobotFile& rig, const std::string& format,
-                       const po::variables_map& vm) {
-  const Eigen::VectorXd& values = rig.robot.nominal_values();
-  if (format == "urdf") return UrdfText(rig.robot, values);
-  if (format == "dh-table") return DhTableText(rig.robot, values);
-  if (format == "yaml") {
-    std::optional<PlaneSet> planes = rig.planes;
-    if (vm.count("plane")) planes = ResolvePlanes(rig, vm);
-    return "# Written by lrcal export from " + rig.path + " (format: docs/FILE_FORMATS.md).\n" +
-           RobotFileText(rig, values, planes, rig.robot.name(),
-                         rig.calibration ? &*rig.calibration : nullptr);
-  }
-  throw InputError("--format", "expected urdf, dh-table or yaml; got '" + format + "'");
-}
-
-}  // namespace
 
 int ExportCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal export options");
@@ -43,7 +22,9 @@ int ExportCommand(const std::vector<std::string>& args) {
   if (!Parse("export", "--robot R --format urdf|dh-table|yaml [--out FILE]", o, args, &vm))
     return 0;
   const RobotFile rig = LoadRobot(vm);
-  const std::string text = ExportText(rig, vm["format"].as<std::string>(), vm);
+  const std::string text = RobotExportText(
+      rig, vm["format"].as<std::string>(),
+      vm.count("plane") ? std::optional<PlaneSet>(ResolvePlanes(rig, vm)) : rig.planes);
   if (!vm.count("out")) {
     std::cout << text;
     return 0;

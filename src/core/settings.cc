@@ -72,6 +72,14 @@ void SettingSpec::Check(double value_si) const {
   if (!Allows(value_si)) throw SettingError(*this, value_si);
 }
 
+SettingSpec SettingSpec::Named(const char* section, const char* field, const char* name,
+                               const char* help, const char* python_name) {
+  SettingSpec spec{section, field, name, ""};
+  spec.help = help;
+  spec.python_name = python_name;
+  return spec;
+}
+
 double SettingSpec::FromSi(double value_si) const {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.12g", value_si / to_si);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/settings.h"
 
 namespace lrcal {
 
@@ -87,9 +88,10 @@ std::string PredictFold(const MeasurementModel& model, const MeasurementSet& dat
 CrossValidation CrossValidate(const MeasurementModel& model, const MeasurementSet& data, int folds,
                               const IdentificationOptions& options) {
   if (folds < 2 || folds > data.size())
-    throw InputError("--holdout", "expected 2 to " + std::to_string(data.size()) +
-                                      " folds (the number of configurations), got " +
-                                      std::to_string(folds));
+    throw SettingError(
+        SettingSpec::Named("identification", "holdout", "holdout", "cross-validation folds"),
+        "expected 2 to " + std::to_string(data.size()) +
+            " folds (the number of configurations), got " + std::to_string(folds));
   CrossValidation cv;
   cv.folds = folds;
   for (int f = 0; f < folds; ++f) {

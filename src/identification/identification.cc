@@ -257,21 +257,32 @@ std::string IdentificationSummary::ParameterTable() const {
 
 std::string IdentificationSummary::FullReport() const {
   std::ostringstream out;
-  out << BriefReport() << "\n" << message << "\n";
+  out << BriefReport() << "\n";
+  if (!IsSolutionUsable()) {
+    out << message << "\n";
+    if (!identifiability.full_rank()) out << identifiability.ToString();
+    return out.str();
+  }
+  out << "sigma_hat per reading: "
+      << (std::isnan(sigma_hat) ? std::string("undefined") : Fixed(sigma_hat * 1e3, 4) + " mm")
+      << "\n"
+      << fit.Explain() << ParameterTable();
   if (!fixed.empty()) {
-    out << "fixed at nominal (rank deficiency):";
+    out << "fixed at nominal because of rank deficiency:";
     for (const auto& f : fixed) out << " " << f;
     out << "\n";
   }
-  if (IsSolutionUsable()) {
-    out << "sigma_hat per reading: "
-        << (std::isnan(sigma_hat) ? std::string("undefined") : Fixed(sigma_hat * 1e3, 4) + " mm")
-        << "\n"
-        << fit.Explain() << ParameterTable();
-  } else if (!identifiability.full_rank()) {
-    out << identifiability.ToString();
-  }
   return out.str();
+}
+
+MeasurementModel SolvedModel(const MeasurementModel& model, const IdentificationSummary& s) {
+  return MeasurementModel(model.robot(), model.nominal_planes(),
+                          WithoutParameters(model.robot(), model.parameters(), s.fixed));
+}
+
+const Eigen::MatrixXd& FitCovariance(const IdentificationSummary& s,
+                                     const IdentificationOptions& options) {
+  return options.sigma > 0 ? s.covariance_given : s.covariance_residual;
 }
 
 }  // namespace lrcal

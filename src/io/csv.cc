@@ -275,7 +275,7 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const R
 // The file is written whole or not at all. A path that cannot be a file is bad input (exit 2);
 // a full or failing disk is a StorageError naming the file (exit 5).
 void WriteOutputFile(const std::string& path, const std::string& text) {
-  CheckOutputFile(path, "--out");
+  CheckOutputFile(path, "output file");
   WriteFileAtomically(path, text);
 }
 

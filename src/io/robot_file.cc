@@ -9,6 +9,7 @@
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/json.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/urdf.h"
 
@@ -30,9 +31,10 @@ std::string ResolveRobotPath(const std::string& name_or_path, const std::string&
   const fs::path local = fs::path("studies") / "robots" / (name_or_path + ".yaml");
   if (PathExists(local)) return local.string();
   if (std::string shipped = FindDataFile(local.string()); !shipped.empty()) return shipped;
-  throw InputError("--robot", "'" + name_or_path +
-                                  "' is neither a robot file nor a shipped robot name "
-                                  "(shipped: studies/robots/*.yaml, e.g. 'paper')");
+  throw SettingError(SettingSpec::Named("setup", "robot", "robot", "robot file or shipped name"),
+                     "'" + name_or_path +
+                         "' is neither a robot file nor a shipped robot name "
+                         "(shipped: studies/robots/*.yaml, e.g. 'paper')");
 }
 
 namespace {
@@ -313,8 +315,9 @@ void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFil
 RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
   if (IsUrdfPath(path)) return LoadUrdfRobotFile(path, tool_link);
   if (!tool_link.empty())
-    throw InputError("--tool-link", "applies to a URDF robot; '" + path +
-                                        "' is a robot YAML file (its last frame is the tool)");
+    throw SettingError(SettingSpec::Named("setup", "tool_link", "tool_link", "the ranger's link"),
+                       "applies to a URDF robot; '" + path +
+                           "' is a robot YAML file (its last frame is the tool)");
   YAML::Node root = yaml::LoadFile(path);
   yaml::CheckKeys(root,
                   {"name", "description", "links", "base", "tool", "true_errors", "plane", "planes",

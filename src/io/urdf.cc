@@ -11,6 +11,7 @@
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/kinematics/dh_conversion.h"
 #include "lrcal/kinematics/forward_kinematics.h"
@@ -219,6 +220,19 @@ std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& values) 
          Num(link.q_min) + "," + Num(link.q_max) + "," + list + "\n";
   }
   return t;
+}
+
+std::string RobotExportText(const RobotFile& rig, const std::string& format,
+                            const std::optional<PlaneSet>& planes) {
+  const Eigen::VectorXd& values = rig.robot.nominal_values();
+  if (format == "urdf") return UrdfText(rig.robot, values);
+  if (format == "dh-table") return DhTableText(rig.robot, values);
+  if (format == "yaml")
+    return "# Written by lrcal export from " + rig.path + " (format: docs/FILE_FORMATS.md).\n" +
+           RobotFileText(rig, values, planes, rig.robot.name(),
+                         rig.calibration ? &*rig.calibration : nullptr);
+  throw SettingError(SettingSpec::Named("export", "format", "format", "urdf, dh-table or yaml"),
+                     "expected urdf, dh-table or yaml; got '" + format + "'");
 }
 
 }  // namespace lrcal

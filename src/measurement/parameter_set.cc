@@ -85,7 +85,7 @@ ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
   }
   if (in.ranger.offset && in.ranger_offset_index < 0) fixed.push_back("ranger_offset");
   if (in.ranger.scale && in.ranger_scale_index < 0) fixed.push_back("ranger_scale");
-  return MakeParameterSet(robot, in.plane_terms, fixed, "--fix", in.ranger);
+  return MakeParameterSet(robot, in.plane_terms, fixed, "fix", in.ranger);
 }
 
 namespace {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "lrcal/core/error.h"
 
@@ -120,6 +121,62 @@ Table PaperValidationTable(const PaperCasesResult& result) {
     }
   }
   return t;
+}
+
+ResultJson PaperCasesJson(const PaperCasesResult& r, const PaperCaseOptions& options) {
+  ResultJson j;
+  j["seed"] = options.seed;
+  j["pool"] = r.pool_report.ToString();
+  j["validation_sampling"] = r.validation_report.ToString();
+  ResultJson cases = ResultJson::array();
+  for (const auto& c : r.cases) {
+    ResultJson cj;
+    cj["label"] = c.label;
+    cj["selected"] = c.selection.indices;
+    cj["sigma_min"] = c.selection.score;
+    cj["termination"] = TerminationName(c.summary.termination);
+    cj["iterations"] = c.summary.iterations;
+    cj["residual_rms"] = c.summary.residual_rms;
+    ResultJson p = ResultJson::object();
+    for (std::size_t k = 0; k < c.summary.names.size() && c.summary.IsSolutionUsable(); ++k)
+      p[c.summary.names[k]] = c.summary.delta[k];
+    cj["delta"] = p;
+    ResultJson sd = ResultJson::object();
+    for (std::size_t k = 0; k < c.summary.names.size() && c.summary.IsSolutionUsable(); ++k)
+      sd[c.summary.names[k]] = c.summary.std_given[k];
+    cj["std_given_sigma"] = sd;
+    cj["validation_rms_position"] = lrcal::ToJson(Eigen::VectorXd(c.validation.stats.rms_position));
+    cj["validation_rms_orientation"] =
+        lrcal::ToJson(Eigen::VectorXd(c.validation.stats.rms_orientation));
+    cj["validation_max_position"] = lrcal::ToJson(Eigen::VectorXd(c.validation.stats.max_position));
+    cj["validation_max_orientation"] =
+        lrcal::ToJson(Eigen::VectorXd(c.validation.stats.max_orientation));
+    cases.push_back(cj);
+  }
+  j["cases"] = cases;
+  j["nominal_validation_rms_position"] =
+      lrcal::ToJson(Eigen::VectorXd(r.nominal_validation.stats.rms_position));
+  return j;
+}
+
+std::string PaperCasesText(const RobotModel& robot, const PaperCasesResult& r,
+                           const PaperCaseOptions& options) {
+  std::ostringstream out;
+  out << "lrcal paper: one realisation (seed " << options.seed << ") of the paper's cases\n"
+      << "candidate pool: " << r.pool_report.ToString() << "\n"
+      << "validation set: " << r.validation_report.ToString() << "\n";
+  for (const auto& c : r.cases) {
+    out << c.label << ": " << c.selection.indices.size() << " of " << r.pool.size()
+        << " by E-optimality ("
+        << SelectionMethodName(c.label == "case 1" ? options.case1_selection.method
+                                                   : options.case2_selection.method)
+        << ", " << c.selection.evaluations << " evaluations), sigma_min(G) = " << c.selection.score
+        << "; " << c.summary.BriefReport() << "\n";
+  }
+  out << "\n" << PaperParameterTable(robot, r).ToText() << "\n" << PaperValidationTable(r).ToText();
+  out << "\nOne realisation cannot reproduce the paper's digits; `lrcal run "
+         "studies/paper.yaml` shows where they fall in the distribution.\n";
+  return out.str();
 }
 
 }  // namespace lrcal

@@ -17,6 +17,7 @@
 
 #include "lrcal/build_info.h"
 #include "lrcal/core/error.h"
+#include "lrcal/study/runner.h"
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/study.h"
 
@@ -139,10 +140,12 @@ std::string RunDirectory::RankStorePath(int rank) const {
 void RunDirectory::CreateAndLock() {
   std::error_code ec;
   if (fs::exists(path_, ec) && !fs::is_directory(path_, ec))
-    throw InputError("--out", "'" + path_ + "' is a file; expected a run directory");
+    throw SettingError(RunOptions::OutDirSetting(),
+                       "'" + path_ + "' is a file; expected a run directory");
   fs::create_directories(path_, ec);
   if (ec)
-    throw InputError("--out", "cannot create the run directory '" + path_ + "': " + ec.message());
+    throw SettingError(RunOptions::OutDirSetting(),
+                       "cannot create the run directory '" + path_ + "': " + ec.message());
   lock_ = std::make_unique<DirectoryLock>(path_);
 }
 
@@ -183,9 +186,9 @@ void RunDirectory::CheckCompatible(const Json& manifest, const Json& study,
   }
   const Json shard = {{"index", shard_index + 1}, {"count", shard_count}};
   if (manifest.contains("shard") && manifest["shard"] != shard)
-    throw InputError("--shard", "this run directory is shard " + manifest["shard"]["index"].dump() +
-                                    "/" + manifest["shard"]["count"].dump() +
-                                    "; rerun it with that --shard");
+    throw SettingError(RunOptions::ShardSetting(),
+                       "this run directory is shard " + manifest["shard"]["index"].dump() + "/" +
+                           manifest["shard"]["count"].dump() + "; rerun it with that shard");
 }
 
 Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_index, int shard_count,
@@ -265,7 +268,8 @@ void ParseShard(const std::string& text, int* index, int* count) {
     *index = i - 1;
     *count = n;
   } catch (const std::exception&) {
-    throw InputError("--shard", "expected i/N with 1 <= i <= N (e.g. 2/8), got '" + text + "'");
+    throw SettingError(RunOptions::ShardSetting(),
+                       "expected i/N with 1 <= i <= N (e.g. 2/8), got '" + text + "'");
   }
 }
 
@@ -274,9 +278,9 @@ void MergeRunStores(const std::vector<std::string>& shard_dirs, const std::strin
   std::error_code ec;
   for (const std::string& d : shard_dirs)
     if (fs::equivalent(d, out_dir, ec))
-      throw InputError("--out", "'" + out_dir +
-                                    "' is one of the directories to merge; merge into "
-                                    "a new directory");
+      throw SettingError(RunOptions::OutDirSetting(), "'" + out_dir +
+                                                          "' is one of the directories to merge; "
+                                                          "merge into a new directory");
   // A shard still running would give a partial snapshot: refuse until it has stopped.
   std::vector<std::unique_ptr<RunDirectory>> shards;
   for (const std::string& d : shard_dirs) {
@@ -442,6 +446,30 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
   info.shard_count = sc;
   info.study_file = manifest.value("study_file", std::string("STUDY.yaml"));
   return info;
+}
+
+std::string ShardAdvice(const std::vector<std::string>& dirs,
+                        const std::vector<RunStatusInfo>& infos) {
+  std::ostringstream out;
+  std::string unfinished;
+  std::set<int> present;
+  for (const auto& i : infos) {
+    present.insert(i.shard_index);
+    if (!i.complete) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i.shard_index);
+  }
+  const int n = infos.front().shard_count;
+  for (int i = 1; i <= n; ++i)
+    if (!present.count(i)) unfinished += (unfinished.empty() ? "" : ",") + std::to_string(i);
+  if (unfinished.empty()) {
+    out << "all " << n << " shards complete: lrcal merge ";
+    for (const auto& d : dirs) out << d << " ";
+    out << "--out DIR\n";
+    return out.str();
+  }
+  out << "unfinished or missing shards: " << unfinished << "\n"
+      << "resubmit: sbatch --array=" << unfinished << " studies/slurm/lrcal_array.sbatch "
+      << infos.front().study_file << " " << n << "\n";
+  return out.str();
 }
 
 }  // namespace lrcal

@@ -11,10 +11,12 @@
 #include <iostream>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <system_error>
 #include <thread>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/trial_store.h"
@@ -453,9 +455,10 @@ class StudyRunner {
         } catch (const std::system_error& e) {
           // Not every thread could start (a process limit): the others are stopped below.
           for (int k = i; k < threads_; ++k) queue.WorkerDone();
-          throw InputError("--threads", "could start only " + std::to_string(i) + " of " +
-                                            std::to_string(threads_) + " worker threads (" +
-                                            e.what() + "); run with fewer --threads");
+          throw SettingError(RunOptions::Settings()[0].spec,
+                             "could start only " + std::to_string(i) + " of " +
+                                 std::to_string(threads_) + " worker threads (" + e.what() +
+                                 "); run with fewer threads");
         }
       }
       WriterLoop(&queue, progress);
@@ -573,23 +576,20 @@ class StudyRunner {
 
 namespace {
 constexpr double kNoMax = std::numeric_limits<double>::infinity();
-// The run's settings that are not numbers: named for each front end like the numeric ones.
-const SettingSpec kOutDir{"run", "out_dir", "out",           "",       1, "", 0, 0, false, false,
-                          "",    "",        "run directory", "out_dir"};
-const SettingSpec kShard{"run",
-                         "shard",
-                         "shard",
-                         "",
-                         1,
-                         "",
-                         0,
-                         0,
-                         false,
-                         false,
-                         "",
-                         "",
-                         "this process's part of the trials, i/N"};
 }  // namespace
+
+// The run's settings that are not numbers: named for each front end like the numeric ones.
+const SettingSpec& RunOptions::OutDirSetting() {
+  static const SettingSpec spec =
+      SettingSpec::Named("run", "out_dir", "out", "run directory", "out_dir");
+  return spec;
+}
+
+const SettingSpec& RunOptions::ShardSetting() {
+  static const SettingSpec spec =
+      SettingSpec::Named("run", "shard", "shard", "this process's part of the trials, i/N");
+  return spec;
+}
 
 const std::vector<SettingField<RunOptions>>& RunOptions::Settings() {
   using R = RunOptions;
@@ -612,10 +612,11 @@ const std::vector<SettingField<RunOptions>>& RunOptions::Settings() {
 }
 
 void RunOptions::Validate() const {
-  if (out_dir.empty()) throw SettingError(kOutDir, "expected a run directory, got an empty name");
+  if (out_dir.empty())
+    throw SettingError(OutDirSetting(), "expected a run directory, got an empty name");
   CheckSettings(*this, Settings());
   if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
-    throw SettingError(kShard, "expected i/N with 1 <= i <= N");
+    throw SettingError(ShardSetting(), "expected i/N with 1 <= i <= N");
 }
 
 long PeakRssKb() {
@@ -640,6 +641,39 @@ RunResult RunStudy(const Study& study, const RunOptions& options, Collective* co
   if (!stop) stop = &own_stop;
   ActiveStop active(stop);
   return StudyRunner(study, options, collective, stop).Run();
+}
+
+std::string RunSummaryText(const RunResult& r, const RunOptions& options, int ranks) {
+  std::ostringstream out;
+  if (r.ranks_computed == 0 && r.done_before >= r.total) {
+    out << "lrcal run: nothing to compute: all " << r.total
+        << " trials of this run were already recorded\n";
+    return out.str();
+  }
+  out << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)
+      << " s (of " << r.total << " in this run; " << r.done_before << " were already recorded";
+  if (r.computed > 0)
+    out << "; " << Fixed(1e6 * r.trial_seconds / r.computed, 1) << " µs of compute per trial"
+        << (ranks > 1 ? " on rank 0" : "");
+  out << ")\n";
+  if (r.computed == 0) return out.str();
+  const int threads = options.threads > 0
+                          ? options.threads
+                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // The runner's overhead is only measurable when the trials take a while: on a run of a few
+  // milliseconds thread start-up dominates and a percentage would mislead.
+  const std::string overhead =
+      r.run_seconds >= 1.0
+          ? "runner overhead " + Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1) +
+                " % over the trials' own time"
+          : "too short to measure the runner's overhead";
+  out << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
+      << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
+      << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string()) << "; " << overhead
+      << "), tables " << Fixed(r.tables_seconds, 3) << " s; peak memory "
+      << r.peak_rss_kb_trials / 1024 << " MiB after the trials, " << r.peak_rss_kb / 1024
+      << " MiB with the tables\n";
+  return out.str();
 }
 
 }  // namespace lrcal

@@ -1,9 +1,15 @@
 #include "lrcal/study/trial_replay.h"
 
+#include <cmath>
 #include <cstring>
+#include <ostream>
+#include <sstream>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/settings.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/kinematics/validation_metric.h"
+#include "lrcal/measurement/parameter_set.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
@@ -74,10 +80,13 @@ TrialReplay ReplayTrial(const std::string& run_dir, const std::string& cell, lon
     if (c.id == cell || c.label == cell) found = &c;
     known += (known.empty() ? "" : ", ") + c.label + " (" + c.id + ")";
   }
-  if (!found) throw InputError("--cell", "no cell '" + cell + "' in the run; cells: " + known);
+  if (!found)
+    throw SettingError(SettingSpec::Named("replay", "cell", "cell", "cell id or label"),
+                       "no cell '" + cell + "' in the run; cells: " + known);
   if (trial < 0 || trial >= study.trials)
-    throw InputError("--trial", "expected 0 to " + std::to_string(study.trials - 1) + ", got " +
-                                    std::to_string(trial));
+    throw SettingError(
+        SettingSpec::Named("replay", "trial", "trial", "trial index"),
+        "expected 0 to " + std::to_string(study.trials - 1) + ", got " + std::to_string(trial));
   const auto context = PrepareCell(study, *found);
   TrialWorkspace workspace;
   TrialReplay out;
@@ -94,6 +103,114 @@ TrialReplay ReplayTrial(const std::string& run_dir, const std::string& cell, lon
   out.stored = StoredRecord(dir, found->id, trial);
   if (out.stored) out.differences = Differences(out.recomputed, *out.stored);
   return out;
+}
+
+namespace {
+
+ResultJson RecordJson(const TrialRecord& r) {
+  ResultJson j;
+  j["status"] = TrialStatusName(r.status);
+  j["iterations"] = r.iterations;
+  j["residual_rms"] = r.residual_rms;
+  j["sigma_hat"] = r.sigma_hat;
+  j["sigma_min"] = r.sigma_min;
+  j["errors"] = r.errors;
+  // A failed trial identified no model: its validation is null (as the store has it).
+  const bool ok = r.status == TrialStatus::kOk;
+  ResultJson val = ResultJson::object(), nom = ResultJson::object();
+  for (int k = 0; k < kNumValidationColumns; ++k) {
+    val[ValidationColumnName(k)] =
+        !ok || std::isnan(r.validation[k]) ? ResultJson() : ResultJson(r.validation[k]);
+    nom[ValidationColumnName(k)] = r.nominal[k];
+  }
+  j["validation"] = val;
+  j["nominal_validation"] = nom;
+  return j;
+}
+
+// The identified model's parameter errors and validation errors (a successful trial).
+void PrintIdentifiedModel(const TrialReplay& t, std::ostream& out) {
+  Table e({"parameter", "unit", "estimate - truth"}, "Parameter errors (mm, mrad, ppm)");
+  for (std::size_t k = 0; k < t.recomputed.errors.size() && k < t.parameter_names.size(); ++k)
+    e.AddRow({t.parameter_names[k], DisplayUnitOf(t.parameter_names[k]).unit,
+              Fixed(t.recomputed.errors[k] * DisplayUnitOf(t.parameter_names[k]).factor, 6)});
+  out << e.ToText();
+  Table v({"metric", "x", "y", "z"}, "Validation errors of the identified model (mm, mrad)");
+  for (int m = 0; m < kNumValidationMetrics; ++m)
+    v.AddRow({NameOf(kValidationMetricNames, static_cast<ValidationMetric>(m)),
+              Fixed(t.recomputed.validation[3 * m] * 1e3, 6),
+              Fixed(t.recomputed.validation[3 * m + 1] * 1e3, 6),
+              Fixed(t.recomputed.validation[3 * m + 2] * 1e3, 6)});
+  out << v.ToText() << t.configurations.size()
+      << " configurations read (--format json lists them with their readings and "
+         "residuals)\n";
+}
+
+}  // namespace
+
+ResultJson TrialReplay::ToJson() const {
+  const TrialReplay& t = *this;
+  ResultJson j;
+  j["run"] = t.run_dir;
+  j["cell_id"] = t.cell_id;
+  j["cell_label"] = t.cell_label;
+  j["trial"] = t.trial;
+  j["stored"] = t.stored.has_value();
+  j["identical"] = t.identical();
+  j["differences"] = t.differences;
+  j["parameters"] = t.parameter_names;
+  j["record"] = RecordJson(t.recomputed);
+  const TrialStatus status = t.recomputed.status;
+  j["failure"] = status == TrialStatus::kOk ? ResultJson() : ResultJson(TrialStatusReason(status));
+  // The readings the trial had (none when a beam missed before any was taken); the residuals
+  // only when it identified a model.
+  const auto residual = [](const std::vector<double>& v, std::size_t i) {
+    return i < v.size() ? ResultJson(v[i]) : ResultJson();
+  };
+  ResultJson configs = ResultJson::array();
+  for (int i = 0; i < t.configurations.size(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    configs.push_back(
+        {{"q", std::vector<double>(t.configurations.q(i),
+                                   t.configurations.q(i) + t.configurations.num_joints())},
+         {"mean_h", k < t.mean_h.size() ? ResultJson(t.mean_h[k]) : ResultJson()},
+         {"repetitions", k < t.repetitions.size() ? ResultJson(t.repetitions[k]) : ResultJson()},
+         {"residual_nominal", residual(t.details.distance_error_nominal, k)},
+         {"residual_identified", residual(t.details.distance_error_identified, k)}});
+  }
+  j["configurations"] = configs;
+  j["estimate_delta"] = lrcal::ToJson(t.estimate_delta);
+  return j;
+}
+
+std::string TrialReplay::ToText() const {
+  const TrialReplay& t = *this;
+  std::ostringstream out;
+  out << "trial " << t.trial << " of cell " << t.cell_label << " (" << t.cell_id << ") in "
+      << t.run_dir << ": " << TrialStatusName(t.recomputed.status) << ", "
+      << t.recomputed.iterations << " iterations, "
+      << (t.recomputed.iterations > 0
+              ? "residual RMS " + Fixed(t.recomputed.residual_rms * 1e3, 6) + " mm, "
+              : std::string("no identification, "))
+      << "design sigma_min " << Fixed(t.recomputed.sigma_min, 6) << "\n";
+  if (t.recomputed.status != TrialStatus::kOk) {
+    // A failed trial identified no model: no parameter errors, no validation to show.
+    out << "the trial failed (" << TrialStatusName(t.recomputed.status)
+        << "): " << TrialStatusReason(t.recomputed.status) << "\n"
+        << t.configurations.size() << " configurations with readings\n";
+  } else {
+    PrintIdentifiedModel(t, out);
+  }
+  if (!t.stored) {
+    out << "not recorded in the run: nothing to compare with\n";
+  } else if (t.identical()) {
+    out << "identical to the stored record, bit for bit\n";
+  } else {
+    out << "DIFFERS from the stored record in:";
+    for (const auto& d : t.differences) out << " " << d;
+    out << "\n";
+  }
+  return out.str();
 }
 
 }  // namespace lrcal

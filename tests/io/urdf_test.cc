@@ -221,8 +221,10 @@ TEST(Urdf, ToolLinkIsForUrdfsOnly) {
   try {
     LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"), "ranger");
     ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.where(), "--tool-link");
+  } catch (const SettingError& e) {
+    EXPECT_EQ(e.where(), "setup.tool_link");
+    EXPECT_EQ(e.Respelled(Frontend::kCommandLine).where(), "--tool-link");
+    EXPECT_EQ(e.Respelled(Frontend::kPython).where(), "tool_link=");
   }
 }
 

@@ -55,6 +55,10 @@ struct SettingSpec {
   void Check(double value_si) const;
   /// An SI value in `unit`, rounded to 12 significant digits (so 0.2e-3 m reads 0.2 mm).
   double FromSi(double value_si) const;
+  /// A setting that is not a number (a folder, a name, a choice), for SettingError's spelling
+  /// only: {section, field, name}, no unit and no range.
+  static SettingSpec Named(const char* section, const char* field, const char* name,
+                           const char* help = "", const char* python_name = nullptr);
 };
 
 /// A setting out of its range. what() names the library field and the SI value; front ends

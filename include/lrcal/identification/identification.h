@@ -140,8 +140,9 @@ struct IdentificationSummary {
   bool IsSolutionUsable() const { return termination == Termination::kConverged; }
   /// One line: solver, loss, termination, iterations, sizes, cost, residual RMS.
   std::string BriefReport() const;
-  /// The brief report, the solver's message, σ̂ and the parameter table (or, when the set is
-  /// rank-deficient, the identifiability report).
+  /// `lrcal identify`'s text: the brief report, then σ̂, the fit check, the parameter table and
+  /// the parameters fixed for rank deficiency; or, unusable, the solver's message (and, when the
+  /// set is rank-deficient, the identifiability report).
   std::string FullReport() const;
   /// The identified parameters as a text table (delta and std in mm / mrad); "" unless usable.
   std::string ParameterTable() const;
@@ -155,5 +156,13 @@ Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double
 /// Identifies the model's parameter set from `data`.
 IdentificationSummary Identify(const MeasurementModel& model, const MeasurementSet& data,
                                const IdentificationOptions& options = {});
+
+/// The model Identify solved: `model`'s parameter set without the parameters it fixed for rank
+/// deficiency (s.delta is laid out for it).
+MeasurementModel SolvedModel(const MeasurementModel& model, const IdentificationSummary& s);
+
+/// The estimate's covariance: with the given σ when options.sigma > 0, else residual-based.
+const Eigen::MatrixXd& FitCovariance(const IdentificationSummary& s,
+                                     const IdentificationOptions& options);
 
 }  // namespace lrcal

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
 #include "lrcal/io/robot_file.h"
@@ -37,5 +38,11 @@ std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& link_values
 /// d_m, a_m, alpha_rad, beta_rad, q_min, q_max, parameters), preceded by `#` comment lines with
 /// the base and tool transforms (xyz m, rpy rad).
 std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& link_values);
+
+/// `rig` (its nominal values) for the robot's software, as `lrcal export --format` writes it:
+/// "urdf" (UrdfText), "dh-table" (DhTableText) or "yaml" (a robot file with `planes` and the
+/// calibration record). Throws SettingError (`format`) for another format.
+std::string RobotExportText(const RobotFile& rig, const std::string& format,
+                            const std::optional<PlaneSet>& planes);
 
 }  // namespace lrcal

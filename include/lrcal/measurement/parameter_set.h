@@ -80,12 +80,12 @@ struct ParameterSet {
 /// plane). Throws InputError (where = `source`) for an unknown or non-parameter name in `fixed`.
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed = {},
-                              const std::string& source = "--fix", RangerTerms ranger = {});
+                              const std::string& source = "fix", RangerTerms ranger = {});
 
 /// The same with several planes: `planes` has one entry per plane (1 ≤ size ≤ kMaxPlanes).
 ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTerms>& planes,
                               const std::vector<std::string>& fixed,
-                              const std::string& source = "--fix", RangerTerms ranger = {});
+                              const std::string& source = "fix", RangerTerms ranger = {});
 
 /// `in` without the parameters `names` (robot parameters or plane terms): what remains when
 /// an identifiability analysis says to fix them. Throws InputError for an unknown name.

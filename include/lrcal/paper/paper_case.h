@@ -10,12 +10,14 @@
 // identifiability_test.cc).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/io/result_json.h"
 #include "lrcal/kinematics/pose_errors.h"
 #include "lrcal/measurement/simulation.h"
 
@@ -64,5 +66,13 @@ extern const double kPaperValidation[3][3][4];
 Table PaperParameterTable(const RobotModel& robot, const PaperCasesResult& result);
 /// Validation errors, ours beside the paper's, in mm / mrad.
 Table PaperValidationTable(const PaperCasesResult& result);
+
+/// `lrcal paper --format json`: per case the selection, termination, the estimates (SI) with
+/// their standard deviations at the given σ, and the validation metrics.
+ResultJson PaperCasesJson(const PaperCasesResult& r, const PaperCaseOptions& options);
+
+/// `lrcal paper`'s text: the pool, each case's selection and fit, and the paper's two tables.
+std::string PaperCasesText(const RobotModel& robot, const PaperCasesResult& r,
+                           const PaperCaseOptions& options);
 
 }  // namespace lrcal

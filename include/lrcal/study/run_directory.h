@@ -98,6 +98,10 @@ struct RunStatusInfo {
 };
 RunStatusInfo GetRunStatus(const std::string& run_dir);
 std::string RunStatus(const std::string& run_dir);
+/// Shards of one study (`dirs` with their statuses): which array tasks to resubmit, or the
+/// command that merges them.
+std::string ShardAdvice(const std::vector<std::string>& dirs,
+                        const std::vector<RunStatusInfo>& infos);
 
 /// Parses "i/N" (1-based i) into index i−1 and count N. Throws InputError.
 void ParseShard(const std::string& text, int* index, int* count);

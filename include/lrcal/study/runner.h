@@ -68,6 +68,10 @@ struct RunOptions {
   /// The numeric settings (settings.h): threads (0: all cores, to 4096), max_trials
   /// (max_new_trials; 0: no limit) and batch_size (at least 1).
   static const std::vector<SettingField<RunOptions>>& Settings();
+  /// The run directory (`out`: --out, out_dir=) and the shard (`shard`: --shard, shard=), for
+  /// errors in each front end's words.
+  static const SettingSpec& OutDirSetting();
+  static const SettingSpec& ShardSetting();
   /// Throws SettingError naming the library field (run.threads, run.out_dir, ...) and what was
   /// expected; the command line says --threads, Python threads=.
   void Validate() const;
@@ -97,6 +101,11 @@ struct RunResult {
 /// calls this. `stop` (optional) is the run's stop token; without one the run makes its own.
 RunResult RunStudy(const Study& study, const RunOptions& options, Collective* collective = nullptr,
                    StopToken* stop = nullptr);
+
+/// What a run did, for its end: the trials computed and already recorded, µs per trial, and the
+/// wall time of preparation, trials and tables with the runner's overhead and peak memory (`ranks`
+/// MPI ranks; this is rank 0's view).
+std::string RunSummaryText(const RunResult& r, const RunOptions& options, int ranks);
 
 /// Installs the SIGINT/SIGTERM handlers: the first signal sets the stop token of the run in
 /// progress (if any), the second exits at once with code 130.

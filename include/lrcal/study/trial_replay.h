@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lrcal/io/result_json.h"
 #include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/study/trial.h"
 
@@ -28,6 +29,12 @@ struct TrialReplay {
   Eigen::VectorXd estimate_delta;   ///< identified errors in the estimate layout
   TrialDetails details;             ///< residuals and pose errors, nominal and identified
   bool identical() const { return stored.has_value() && differences.empty(); }
+  /// `lrcal trial --format json`: the record, the failure's reason, every configuration with its
+  /// reading and residuals, the estimate (SI).
+  ResultJson ToJson() const;
+  /// `lrcal trial`'s text: the trial, its parameter and validation errors (mm, mrad, ppm) and
+  /// whether it matches its record.
+  std::string ToText() const;
 };
 
 /// Replays trial `trial` of the cell `cell` (its id or label) of the run in `run_dir`. The study

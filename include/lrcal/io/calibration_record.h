@@ -1,0 +1,43 @@
+// The calibrated model as a robot file: its record (data provenance, σ, estimate, covariance),
+// writing it, and reading back which parameters a record estimated.
+#pragma once
+
+#include <string>
+
+#include "lrcal/identification/identification.h"
+#include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/io/robot_file.h"
+
+namespace lrcal {
+
+/// The record of an identification of `data_file` (hashed, dated, with lrcal's version): σ is
+/// the given one (options.sigma > 0) or else σ̂, and the covariance is FitCovariance's when
+/// defined (empty otherwise).
+CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
+                                        const IdentificationSummary& s,
+                                        const IdentificationOptions& options);
+
+/// The calibrated model of an identification (its solved model, SolvedModel) written as a robot
+/// file at `path` with its record; every command takes it as a robot. Throws StorageError.
+void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
+                          const RobotFile& rig, const MeasurementModel& model,
+                          const IdentificationSummary& s, const IdentificationOptions& options);
+
+/// The parameter set the calibration record `r` names: plane and ranger terms from their names,
+/// robot parameters not named are fixed, in MakeParameterSet's order. `source` names the record in
+/// errors.
+ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord& r, int num_planes,
+                                const std::string& source);
+
+/// The record's covariance in the order of `ps` (RecordParameterSet of the same record). Throws
+/// InputError naming `source` when the record names a parameter `ps` lacks or misses one.
+Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet& ps,
+                                 const std::string& source);
+
+/// The predicted accuracy at `poses` of the calibrated robot file `rig` (its nominal values are
+/// the estimates; its record's covariance, reordered to the parameter set it names on `planes`).
+/// Throws SettingError (`robot`) when the file has no record with a covariance.
+std::vector<PoseAccuracy> PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSet& planes,
+                                                    const ConfigurationSet& poses);
+
+}  // namespace lrcal

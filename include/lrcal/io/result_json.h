@@ -1,0 +1,47 @@
+// Results as JSON, the form `--format json` prints, the calibration report's calibration.json
+// holds and the Python module returns: one builder per result type, shared by every front end so
+// that a field has one name and one unit (SI unless its name says otherwise).
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "lrcal/design/design_choice.h"
+#include "lrcal/design/identifiability_remedies.h"
+#include "lrcal/identification/cross_validation.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/identification/pose_accuracy.h"
+
+namespace lrcal {
+
+/// JSON of a result: keys in the order written (the order a reader meets them), unlike the
+/// sorted-key Json of manifests and hashes (core/json.h).
+using ResultJson = nlohmann::ordered_json;
+
+/// A vector as a JSON array.
+ResultJson ToJson(const Eigen::VectorXd& v);
+/// A matrix as a JSON array of rows.
+ResultJson ToJson(const Eigen::MatrixXd& m);
+
+/// Rank, singular values, dependencies and suggested fixes.
+ResultJson IdentifiabilityJson(const IdentifiabilityReport& r);
+/// What each remedy recovers; `cheapest_fix` has one entry per lost direction (null: none found).
+ResultJson RemediesJson(const RemedyReport& r);
+/// An identification: parameters with their standard deviations, covariance, correlation, fit
+/// check (suspects 1-based) and termination.
+ResultJson IdentificationJson(const IdentificationSummary& s);
+/// K-fold cross-validation (configurations 1-based, like the fit's suspects).
+ResultJson CrossValidationJson(const CrossValidation& cv);
+/// Predicted accuracy at poses (`configs` gives each pose's joint values), with the summary
+/// (`worst` 1-based).
+ResultJson PoseAccuracyJson(const std::vector<PoseAccuracy>& poses,
+                            const ConfigurationSet& configs);
+/// A design certificate with its statement.
+ResultJson CertificateJson(const DesignCertificate& certificate, const std::string& statement);
+/// A design choice: the selected pool indices (0-based), scores, the random baseline, the
+/// certificate and, for criterion I, the task's prediction.
+ResultJson DesignChoiceJson(const DesignRequest& request, const DesignChoice& choice);
+
+}  // namespace lrcal

@@ -1,0 +1,30 @@
+// A robot's data files: configuration and measurement CSVs (io/csv.h) read for a given robot,
+// every joint value checked against the robot's joint range and every reading against its
+// ranger's range, so that a unit mistake (degrees for rad, mm for m) is an error naming the file,
+// the configuration and the joint, never a silently wrong calibration.
+#pragma once
+
+#include <string>
+
+#include "lrcal/io/robot_file.h"
+#include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/measurement_set.h"
+
+namespace lrcal {
+
+/// Throws InputError (file, configuration, column, the range and the likely unit mistake) for
+/// the first joint value of `configs` outside `robot`'s joint range (q_min, q_max, ±1e-9).
+void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
+                      const std::string& path);
+
+/// A configurations CSV for `robot`, joint ranges checked; its optional `plane` column is
+/// resolved against `planes`.
+ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
+                                         const PlaneSet* planes = nullptr);
+
+/// A measurement CSV for `rig` (its ranger's range and its robot's joint ranges checked; its
+/// `plane` column resolved against `planes`).
+MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
+                                     const PlaneSet* planes = nullptr);
+
+}  // namespace lrcal

@@ -1,0 +1,37 @@
+// The calibration report's data: everything `identify --report DIR` shows, written as
+// DIR/calibration.json (SI) beside the calibrated robot file and its URDF; report.html is drawn
+// from them by the report's Python part.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "lrcal/core/settings.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/io/robot_file.h"
+
+namespace lrcal {
+
+/// What the report covers.
+struct CalibrationReportInputs {
+  std::string data_file;  ///< the measurement CSV the fit used, as given
+  const RobotFile* rig = nullptr;
+  const MeasurementModel* model = nullptr;  ///< the model identified (before any rank fixes)
+  const MeasurementSet* data = nullptr;
+  const IdentificationSummary* summary = nullptr;
+  IdentificationOptions options;
+  /// Cross-validation folds (2 or more); 0: min(5, configurations).
+  int holdout = 0;
+  int workspace_poses = 500;         ///< poses of the accuracy map over the joint ranges
+  std::uint64_t workspace_seed = 1;  ///< their seed
+};
+
+/// The report's folder as a setting, for errors in each front end's words (--report, report=).
+const SettingSpec& ReportFolderSetting();
+
+/// Writes dir/calibration.json and, when the solution is usable, dir/calibrated.yaml and
+/// dir/calibrated.urdf (what `lrcal export` would write from it). Creates `dir`. Throws
+/// SettingError (ReportFolderSetting: dir cannot be created) or StorageError.
+void WriteCalibrationReportData(const std::string& dir, const CalibrationReportInputs& in);
+
+}  // namespace lrcal

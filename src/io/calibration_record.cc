@@ -1,0 +1,108 @@
+#include "lrcal/io/calibration_record.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+
+#include "lrcal/build_info.h"
+#include "lrcal/core/error.h"
+#include "lrcal/core/hash.h"
+#include "lrcal/core/settings.h"
+
+namespace lrcal {
+
+CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
+                                        const IdentificationSummary& s,
+                                        const IdentificationOptions& options) {
+  CalibrationRecord r;
+  r.data_file = data_file;
+  std::ifstream in(data_file, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  r.data_fnv1a = HashHex(bytes.str());
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  r.date = date;
+  r.lrcal = std::string(LRCAL_VERSION) + " (" + LRCAL_GIT_COMMIT + ")";
+  const bool given = options.sigma > 0;
+  r.sigma = given ? options.sigma : s.sigma_hat;
+  r.sigma_source = given ? "given (--sigma-mm)" : "residual (sigma_hat)";
+  r.parameters = s.names;
+  r.estimate = s.estimate;
+  if (given || !std::isnan(s.sigma_hat)) r.covariance = FitCovariance(s, options);
+  return r;
+}
+
+void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
+                          const RobotFile& rig, const MeasurementModel& model,
+                          const IdentificationSummary& s, const IdentificationOptions& options) {
+  const MeasurementModel solved = SolvedModel(model, s);
+  WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
+                           solved.PlanesAt(s.delta.data()),
+                           MakeCalibrationRecord(data_file, s, options));
+}
+
+ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord& r, int num_planes,
+                                const std::string& source) {
+  const auto named = [&](const std::string& name) {
+    return std::find(r.parameters.begin(), r.parameters.end(), name) != r.parameters.end();
+  };
+  std::vector<PlaneTerms> planes(num_planes);
+  std::vector<std::string> fixed;
+  for (int p = 0; p < num_planes; ++p) {
+    const std::string u1 = PlaneTermName(p, num_planes, "u1"),
+                      u2 = PlaneTermName(p, num_planes, "u2");
+    planes[p].normal = named(u1) || named(u2);
+    planes[p].offset = named(PlaneTermName(p, num_planes, "f"));
+    if (planes[p].normal && !named(u1)) fixed.push_back(u1);
+    if (planes[p].normal && !named(u2)) fixed.push_back(u2);
+  }
+  RangerTerms ranger;
+  ranger.offset = named("ranger_offset");
+  ranger.scale = named("ranger_scale");
+  for (int k : robot.parameter_indices())
+    if (!named(robot.ValueName(k))) fixed.push_back(robot.ValueName(k));
+  return MakeParameterSet(robot, planes, fixed, source, ranger);
+}
+
+Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet& ps,
+                                 const std::string& source) {
+  const int n = ps.size();
+  if (n != static_cast<int>(r.parameters.size()))
+    throw InputError(source, "names a parameter this robot does not have");
+  std::vector<int> at(n);
+  for (int k = 0; k < n; ++k) {
+    at[k] = -1;
+    for (int i = 0; i < n; ++i)
+      if (r.parameters[i] == ps.names[k]) at[k] = i;
+    if (at[k] < 0) throw InputError(source, "missing " + ps.names[k]);
+  }
+  Eigen::MatrixXd C(n, n);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) C(a, b) = r.covariance(at[a], at[b]);
+  return C;
+}
+
+std::vector<PoseAccuracy> PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSet& planes,
+                                                    const ConfigurationSet& poses) {
+  if (!rig.calibration || rig.calibration->covariance.size() == 0)
+    throw SettingError(SettingSpec::Named("setup", "robot", "robot", "a calibrated robot file"),
+                       "'" + rig.path +
+                           "' has no calibration record with a covariance: write one with lrcal "
+                           "identify --write-robot (give sigma_mm, or more configurations than "
+                           "parameters)");
+  const CalibrationRecord& r = *rig.calibration;
+  const std::string source = rig.path + " calibration.parameters";
+  const ParameterSet ps = RecordParameterSet(rig.robot, r, planes.size(), source);
+  const Eigen::MatrixXd C = RecordCovariance(r, ps, source);
+  const MeasurementModel model(rig.robot, planes, ps);
+  const std::vector<double> zero(ps.size(), 0.0);  // the file's nominal values are the estimates
+  return PredictPoseAccuracy(model, zero.data(), C, poses);
+}
+
+}  // namespace lrcal

@@ -1,0 +1,201 @@
+#include "lrcal/io/result_json.h"
+
+#include <cmath>
+
+namespace lrcal {
+
+namespace {
+
+ResultJson Vec3(const Eigen::Vector3d& v) { return ResultJson::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+ResultJson ToJson(const Eigen::VectorXd& v) {
+  ResultJson j = ResultJson::array();
+  for (int i = 0; i < v.size(); ++i) j.push_back(v[i]);
+  return j;
+}
+
+ResultJson ToJson(const Eigen::MatrixXd& m) {
+  ResultJson j = ResultJson::array();
+  for (int r = 0; r < m.rows(); ++r) {
+    ResultJson row = ResultJson::array();
+    for (int c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    j.push_back(row);
+  }
+  return j;
+}
+
+ResultJson IdentifiabilityJson(const IdentifiabilityReport& r) {
+  ResultJson j;
+  j["n_params"] = r.num_params();
+  j["n_configurations"] = r.num_configurations;
+  j["rank"] = r.rank;
+  j["parameters"] = r.names;
+  j["singular_values"] = ToJson(r.singular_values);
+  j["condition_number"] =
+      std::isfinite(r.condition_number) ? ResultJson(r.condition_number) : ResultJson();
+  j["unidentifiable"] = r.unidentifiable;
+  ResultJson deps = ResultJson::array();
+  for (const auto& d : r.dependencies) {
+    ResultJson terms = ResultJson::array();
+    for (const auto& [name, c] : d.terms) terms.push_back({{"name", name}, {"coefficient", c}});
+    deps.push_back(terms);
+  }
+  j["dependencies"] = deps;
+  j["suggested_fixed"] = r.suggested_fixed;
+  return j;
+}
+
+ResultJson RemediesJson(const RemedyReport& r) {
+  ResultJson j;
+  j["lost"] = r.lost;
+  ResultJson list = ResultJson::array();
+  for (const auto& m : r.remedies) {
+    ResultJson e{{"kind", RemedyKindName(m.kind)}, {"action", m.action}, {"recovers", m.recovers}};
+    if (!m.parameter.empty()) e["parameter"] = m.parameter;
+    if (m.kind == Remedy::Kind::kAddPlane || m.kind == Remedy::Kind::kAddKnownDistance)
+      e["plane"] = {{"normal", {m.plane.normal[0], m.plane.normal[1], m.plane.normal[2]}},
+                    {"offset", m.plane.offset}};
+    list.push_back(e);
+  }
+  j["remedies"] = list;
+  ResultJson cheapest = ResultJson::array();
+  for (int c : r.cheapest)
+    cheapest.push_back(c >= 0 ? ResultJson(r.remedies[c].action) : ResultJson());
+  j["cheapest_fix"] = cheapest;
+  j["unreachable"] = r.unreachable;
+  return j;
+}
+
+ResultJson IdentificationJson(const IdentificationSummary& s) {
+  ResultJson j;
+  ResultJson params = ResultJson::array();
+  for (std::size_t k = 0; k < s.names.size() && s.IsSolutionUsable(); ++k) {
+    params.push_back(
+        {{"name", s.names[k]},
+         {"nominal", s.nominal[k]},
+         {"estimate", s.estimate[k]},
+         {"delta", s.delta[k]},
+         {"std", s.std_residual[k]},
+         {"std_given_sigma", s.std_given.size() ? ResultJson(s.std_given[k]) : ResultJson()}});
+  }
+  j["parameters"] = params;
+  j["covariance"] = s.IsSolutionUsable() ? ToJson(s.covariance_residual) : ResultJson();
+  j["covariance_given_sigma"] =
+      s.covariance_given.size() ? ToJson(s.covariance_given) : ResultJson();
+  j["correlation"] = s.IsSolutionUsable() ? ToJson(s.correlation) : ResultJson();
+  j["rank"] = s.identifiability.rank;
+  j["n_params"] = s.identifiability.num_params();
+  j["fixed_for_rank"] = s.fixed;
+  j["iterations"] = s.iterations;
+  j["termination"] = TerminationName(s.termination);
+  j["usable"] = s.IsSolutionUsable();
+  j["message"] = s.message;
+  j["residual_rms"] = s.residual_rms;
+  const auto number = [](double x) { return std::isnan(x) ? ResultJson() : ResultJson(x); };
+  j["sigma_hat"] = number(s.sigma_hat);
+  if (s.IsSolutionUsable()) {
+    ResultJson fit = {{"dof", s.fit.dof}, {"standardized_residuals", s.fit.standardized}};
+    ResultJson suspects = ResultJson::array();
+    for (int i : s.fit.suspects) suspects.push_back(i + 1);
+    fit["suspects"] = suspects;  // 1-based configurations
+    if (s.fit.sigma_given) {
+      fit["chi2"] = s.fit.chi2;
+      fit["p_value"] = number(s.fit.p_value);
+      fit["consistent"] = s.fit.consistent;
+    } else {
+      fit["chi2"] = fit["p_value"] = fit["consistent"] = nullptr;  // no σ given: no test
+    }
+    j["fit"] = fit;
+  }
+  j["n_configurations"] = s.num_configurations;
+  j["solver"] = s.solver;
+  j["loss"] = s.loss;
+  if (!s.identifiability.full_rank()) j["identifiability"] = IdentifiabilityJson(s.identifiability);
+  return j;
+}
+
+ResultJson CrossValidationJson(const CrossValidation& cv) {
+  ResultJson predictions = ResultJson::array();
+  for (const auto& p : cv.predictions)
+    predictions.push_back({{"configuration", p.configuration + 1},
+                           {"fold", p.fold},
+                           {"error", p.error},
+                           {"predicted_std", p.predicted_std},
+                           {"z", p.z}});
+  ResultJson failed = ResultJson::array();
+  for (const auto& [fold, why] : cv.failed_folds)
+    failed.push_back({{"fold", fold}, {"reason", why}});
+  ResultJson beyond = ResultJson::array();
+  for (int i : cv.beyond_4) beyond.push_back(i + 1);
+  const bool any = !cv.predictions.empty();
+  return {{"folds", cv.folds},
+          {"assignment", "configuration i (0-based) in fold i mod K"},
+          {"predictions", predictions},
+          {"failed_folds", failed},
+          {"rms_error", any ? ResultJson(cv.rms_error) : ResultJson()},
+          {"rms_predicted", any ? ResultJson(cv.rms_predicted) : ResultJson()},
+          {"ratio", any ? ResultJson(cv.rms_error / cv.rms_predicted) : ResultJson()},
+          {"mean_z2", any ? ResultJson(cv.mean_z2) : ResultJson()},
+          {"mean_z2_tolerance", any ? ResultJson(cv.mean_z2_tolerance) : ResultJson()},
+          {"consistent", any ? ResultJson(cv.consistent()) : ResultJson()},
+          {"beyond_4", beyond}};
+}
+
+ResultJson PoseAccuracyJson(const std::vector<PoseAccuracy>& poses,
+                            const ConfigurationSet& configs) {
+  ResultJson list = ResultJson::array();
+  for (std::size_t j = 0; j < poses.size(); ++j)
+    list.push_back(
+        {{"q", std::vector<double>(configs.q(static_cast<int>(j)),
+                                   configs.q(static_cast<int>(j)) + configs.num_joints())},
+         {"position_std", Vec3(poses[j].position_std)},
+         {"orientation_std", Vec3(poses[j].orientation_std)},
+         {"position_radius_95", poses[j].position_radius_95}});
+  const PoseAccuracySummary s = SummarizePoseAccuracy(poses);
+  return {{"poses", list},
+          {"rms_position", s.rms_position},
+          {"p95_position_radius_95", s.p95_radius_95},
+          {"worst", s.worst + 1}};
+}
+
+ResultJson CertificateJson(const DesignCertificate& certificate, const std::string& statement) {
+  ResultJson j = {{"available", certificate.available},
+                  {"statement", statement},
+                  {"iterations", certificate.iterations}};
+  if (certificate.available) {
+    j["bound"] = certificate.bound;
+    j["achieved"] = certificate.achieved;
+    j["efficiency"] = certificate.efficiency;
+  }
+  return j;
+}
+
+ResultJson DesignChoiceJson(const DesignRequest& request, const DesignChoice& choice) {
+  ResultJson j;
+  j["method"] = SelectionMethodName(request.selection.method);
+  j["criterion"] = request.CriterionName();
+  if (choice.task_rms_per_sigma)
+    j["task"] = {{"poses", request.task.count},
+                 {"source", request.task.source},
+                 {"rms_position_per_unit_sigma", *choice.task_rms_per_sigma}};
+  j["scaling"] = DesignScalingName(request.scaling);
+  j["selected"] = choice.chosen.indices;
+  j["selected_per_plane"] = choice.per_plane;
+  j["score"] = choice.chosen.score;
+  j["evaluations"] = choice.chosen.evaluations;
+  j["seconds"] = choice.seconds;
+  ResultJson indices = ResultJson::object();
+  for (const BaselineIndex& b : choice.baseline)
+    indices[DesignCriterionName(b.criterion)] = {{"chosen", b.chosen},
+                                                 {"random_mean", b.random.mean},
+                                                 {"random_p5", b.random.p5},
+                                                 {"random_p95", b.random.p95},
+                                                 {"percentile", b.percentile}};
+  j["indices"] = indices;
+  j["certificate"] = CertificateJson(choice.certificate, choice.certificate_statement);
+  return j;
+}
+
+}  // namespace lrcal

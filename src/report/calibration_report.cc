@@ -1,0 +1,76 @@
+#include "lrcal/report/calibration_report.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "lrcal/core/error.h"
+#include "lrcal/core/json.h"
+#include "lrcal/core/settings.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/io/calibration_record.h"
+#include "lrcal/io/result_json.h"
+#include "lrcal/io/urdf.h"
+
+namespace lrcal {
+
+namespace {
+
+// Cross-validation and the accuracy map over the workspace, added to `j` for a usable fit.
+void AddPredictions(const CalibrationReportInputs& in, ResultJson* j) {
+  const IdentificationSummary& s = *in.summary;
+  const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
+  if (folds >= 2)
+    (*j)["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
+  const Eigen::MatrixXd& C = FitCovariance(s, in.options);
+  if (!C.allFinite()) return;
+  const ConfigurationSet poses =
+      WorkspacePoses(in.model->robot(), in.workspace_poses, in.workspace_seed);
+  (*j)["workspace_accuracy"] = PoseAccuracyJson(
+      PredictPoseAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, poses), poses);
+}
+
+}  // namespace
+
+const SettingSpec& ReportFolderSetting() {
+  static const SettingSpec spec{"identification",
+                                "report",
+                                "report",
+                                "",
+                                1,
+                                "",
+                                0,
+                                0,
+                                false,
+                                false,
+                                "",
+                                "",
+                                "folder of the calibration report"};
+  return spec;
+}
+
+void WriteCalibrationReportData(const std::string& dir, const CalibrationReportInputs& in) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    throw SettingError(ReportFolderSetting(),
+                       "cannot create the folder '" + dir + "': " + ec.message());
+  const IdentificationSummary& s = *in.summary;
+  ResultJson j = IdentificationJson(s);
+  j["data"] = {{"file", in.data_file}, {"configurations", in.data->size()}};
+  j["robot"] = in.rig->path;
+  j["sigma_given"] = in.options.sigma > 0 ? ResultJson(in.options.sigma) : ResultJson();
+  j["identifiability"] = IdentifiabilityJson(s.identifiability);
+  if (s.IsSolutionUsable()) {
+    AddPredictions(in, &j);
+    WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_file, *in.rig, *in.model, s, in.options);
+    j["calibrated_robot"] = "calibrated.yaml";
+    // The same model as URDF, from the file just written (what lrcal export would write).
+    const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
+    WriteFileAtomically(dir + "/calibrated.urdf",
+                        UrdfText(calibrated.robot, calibrated.robot.nominal_values()));
+    j["calibrated_urdf"] = "calibrated.urdf";
+  }
+  WriteFileAtomically(dir + "/calibration.json", j.dump(2));
+}
+
+}  // namespace lrcal
