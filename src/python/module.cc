@@ -25,18 +25,28 @@
 #include "lrcal/core/random.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/design/configuration_sampling.h"
+#include "lrcal/design/design_choice.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/io/calibration_record.h"
+#include "lrcal/io/kinematics_report.h"
+#include "lrcal/io/result_json.h"
+#include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/simulation.h"
+#include "lrcal/report/accuracy_plan.h"
+#include "lrcal/report/report_data.h"
 #include "lrcal/report/run_tables.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/study.h"
+#include "lrcal/study/study_plan.h"
+#include "lrcal/study/trial_replay.h"
 
 namespace py = pybind11;
 
@@ -218,10 +228,10 @@ struct Readings {
 /// A chosen design.
 struct Design {
   std::vector<int> indices;  ///< rows of the pool given, ascending
-  double score = 0;
-  long long evaluations = 0;
+  DesignChoice choice;       ///< what ChooseDesign found (indices into the usable candidates)
   std::string criterion, method, scaling;
   std::vector<std::pair<int, std::string>> rejected;  ///< pool rows whose beam misses
+  std::string json;  ///< `lrcal design --format json`'s fields (DesignChoiceJson)
 };
 
 // --- functions ------------------------------------------------------------------------------
@@ -430,25 +440,67 @@ IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
   return AnalyzeIdentifiability(model, configs, nullptr, options);
 }
 
-Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const std::string& criterion,
-                const std::string& method, const std::string& scaling, double expected_angle,
-                double expected_length, int restarts, int samples, long long seed,
-                const py::object& plane_arg, const std::string& estimate_plane,
-                const py::object& fix) {
+struct DesignArgs {
+  std::string criterion, method, scaling;
+  py::object expected_angle, expected_length;  // the earlier spellings, rad and m (None: not given)
+  int restarts, samples;
+  long long seed;
+  py::object poses;  // criterion I: the task poses (M, joints); None: `workspace` poses
+  int workspace, baseline;
+  double expected_angle_mrad, expected_length_mm;
+};
+
+// A design setting given in its unit, or in SI by its earlier spelling (not both).
+double DesignSetting(const SettingSpec& spec, double value, const py::object& value_si,
+                     const char* earlier) {
+  double si = value * spec.to_si;
+  if (!value_si.is_none()) {
+    if (value != 1.0)  // the default in its unit: the newer spelling was given too
+      throw InputError(earlier, std::string("give ") + spec.name + " (" + spec.unit + ") or " +
+                                    earlier + " (" + spec.si_unit +
+                                    ", the earlier spelling), not both");
+    si = value_si.cast<double>();
+  }
+  if (!spec.Allows(si)) throw SettingError(spec, si).Respelled(Frontend::kPython);
+  return si;
+}
+
+DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model, int k) {
+  DesignRequest request;
+  request.count = k;
+  request.seed = ToSeed(a.seed);
+  if (a.criterion == "I") {
+    request.task =
+        a.poses.is_none()
+            ? TaskPosesAt(model, WorkspacePoses(model.robot(), a.workspace, request.seed),
+                          "workspace")
+            : TaskPosesAt(
+                  model,
+                  ToConfigurations(a.poses.cast<Array>(), model.robot().num_links(), "poses"),
+                  "given");
+  } else {
+    request.selection.criterion = ParseDesignCriterion(a.criterion, "criterion");
+  }
+  request.selection.method = ParseSelectionMethod(a.method, "method");
+  request.selection.restarts = a.restarts;
+  request.selection.samples = a.samples;
+  request.selection.Validate("design");
+  request.scaling = ParseDesignScaling(a.scaling, "scaling");
+  const auto& specs = DesignRequest::Settings();
+  request.expected_angle =
+      DesignSetting(specs[0], a.expected_angle_mrad, a.expected_angle, "expected_angle");
+  request.expected_length =
+      DesignSetting(specs[1], a.expected_length_mm, a.expected_length, "expected_length");
+  request.baseline = a.baseline;
+  return request;
+}
+
+Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const py::object& plane_arg,
+                const std::string& estimate_plane, const py::object& fix, const DesignArgs& a) {
   const RobotModel& robot = rig.robot;
   const Plane plane = ResolvePlane(rig, plane_arg);
   const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
-  SelectionOptions options;
-  options.criterion = ParseDesignCriterion(criterion, "criterion");
-  options.method = ParseSelectionMethod(method, "method");
-  options.restarts = restarts;
-  options.samples = samples;
-  options.Validate("design");
-  const DesignScaling scale = ParseDesignScaling(scaling, "scaling");
-  for (const auto& [value, name] :
-       {std::pair{expected_angle, "expected_angle"}, std::pair{expected_length, "expected_length"}})
-    if (!(std::isfinite(value) && value > 0))
-      throw InputError(name, "expected a finite value > 0 (rad or m)");
+  const DesignRequest request = ToDesignRequest(a, model, k);
   const CandidatePool pool = UsableCandidates(robot, plane, rig.ranger,
                                               ToConfigurations(pool_q, robot.num_links(), "pool"));
   if (pool.configs.size() == 0)
@@ -457,20 +509,16 @@ Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const std::str
   for (std::size_t i = 0; i < pool.misses.size(); ++i)
     if (pool.misses[i] != BeamMiss::kNone)
       out.rejected.emplace_back(static_cast<int>(i), BeamMissName(pool.misses[i]));
-  SelectionResult chosen;
   {
     py::gil_scoped_release release;
-    const Eigen::MatrixXd G =
-        DesignJacobian(model, pool.configs, scale, expected_angle, expected_length);
-    chosen = SelectConfigurations(G, k, options,
-                                  RandomStream(ToSeed(seed), 1, 0, RandomPurpose::kSelection));
+    out.choice = ChooseDesign(model, pool.configs, request);
   }
-  for (int i : chosen.indices) out.indices.push_back(pool.kept[static_cast<std::size_t>(i)]);
-  out.score = chosen.score;
-  out.evaluations = chosen.evaluations;
-  out.criterion = DesignCriterionName(options.criterion);
-  out.method = SelectionMethodName(options.method);
-  out.scaling = DesignScalingName(scale);
+  for (int i : out.choice.chosen.indices)
+    out.indices.push_back(pool.kept[static_cast<std::size_t>(i)]);
+  out.criterion = request.CriterionName();
+  out.method = SelectionMethodName(request.selection.method);
+  out.scaling = DesignScalingName(request.scaling);
+  out.json = DesignChoiceJson(request, out.choice).dump();
   return out;
 }
 
@@ -661,15 +709,42 @@ and the parameters to fix for a full-rank set (suggested_fixed). str() gives the
 A chosen design: indices (rows of the pool given, ascending), the criterion's score of the chosen
 set, the candidate evaluations spent, and the pool rows rejected because their beam misses.)doc")
       .def_readonly("indices", &Design::indices)
-      .def_readonly("score", &Design::score)
-      .def_readonly("evaluations", &Design::evaluations)
+      .def_property_readonly("score", [](const Design& d) { return d.choice.chosen.score; })
+      .def_property_readonly("evaluations",
+                             [](const Design& d) { return d.choice.chosen.evaluations; })
+      .def_property_readonly("seconds", [](const Design& d) { return d.choice.seconds; })
+      .def_property_readonly("certificate",
+                             [](const Design& d) { return d.choice.certificate_statement; })
+      .def_property_readonly("efficiency",
+                             [](const Design& d) -> py::object {
+                               if (!d.choice.certificate.available) return py::none();
+                               return py::float_(d.choice.certificate.efficiency);
+                             })
+      .def_property_readonly("task_rms_per_sigma",
+                             [](const Design& d) -> py::object {
+                               if (!d.choice.task_rms_per_sigma) return py::none();
+                               return py::float_(*d.choice.task_rms_per_sigma);
+                             })
+      .def_property_readonly(
+          "baseline",
+          [](const Design& d) {
+            py::list rows;
+            for (const BaselineIndex& b : d.choice.baseline)
+              rows.append(
+                  py::dict(py::arg("criterion") = DesignCriterionName(b.criterion),
+                           py::arg("chosen") = b.chosen, py::arg("random_mean") = b.random.mean,
+                           py::arg("random_p5") = b.random.p5, py::arg("random_p95") = b.random.p95,
+                           py::arg("percentile") = b.percentile));
+            return rows;
+          })
+      .def_readonly("json", &Design::json)
       .def_readonly("criterion", &Design::criterion)
       .def_readonly("method", &Design::method)
       .def_readonly("scaling", &Design::scaling)
       .def_readonly("rejected", &Design::rejected)
       .def("__repr__", [](const Design& d) {
         return "lrcal.Design(" + std::to_string(d.indices.size()) + " configurations, " +
-               d.criterion + " = " + Num(d.score) + ")";
+               d.criterion + " = " + Num(d.choice.chosen.score) + ")";
       });
 }
 
@@ -827,18 +902,38 @@ Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc");
 What the configurations q (N, joints) can identify of the parameter set (estimate_plane, fix as
 in identify), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
 `lrcal identifiability`.)doc");
-  m.def("design", &DesignPy, py::arg("robot"), py::arg("pool"), py::arg("k"),
-        py::arg("criterion") = "E", py::arg("method") = "exchange", py::arg("scaling") = "si",
-        py::arg("expected_angle") = 1e-3, py::arg("expected_length") = 1e-3,
-        py::arg("restarts") = 4, py::arg("samples") = 1000, py::arg("seed") = 1,
-        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(), R"doc(
+  m.def(
+      "design",
+      [](const RobotFile& rig, const Array& pool, int k, const std::string& criterion,
+         const std::string& method, const std::string& scaling, const py::object& expected_angle,
+         const py::object& expected_length, int restarts, int samples, long long seed,
+         const py::object& plane, const std::string& estimate_plane, const py::object& fix,
+         const py::object& poses, int workspace, int baseline, double expected_angle_mrad,
+         double expected_length_mm) {
+        return DesignPy(rig, pool, k, plane, estimate_plane, fix,
+                        DesignArgs{criterion, method, scaling, expected_angle, expected_length,
+                                   restarts, samples, seed, poses, workspace, baseline,
+                                   expected_angle_mrad, expected_length_mm});
+      },
+      py::arg("robot"), py::arg("pool"), py::arg("k"), py::arg("criterion") = "E",
+      py::arg("method") = "exchange", py::arg("scaling") = "si",
+      py::arg("expected_angle") = py::none(), py::arg("expected_length") = py::none(),
+      py::arg("restarts") = 4, py::arg("samples") = 1000, py::arg("seed") = 1,
+      py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+      py::arg("fix") = py::none(), py::arg("poses") = py::none(), py::arg("workspace") = 200,
+      py::arg("baseline") = 1000, py::arg("expected_angle_mrad") = 1.0,
+      py::arg("expected_length_mm") = 1.0, R"doc(
 Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
-identification Jacobian at the nominal model (as `lrcal design --pool`).
-criterion: E (= O3, σ_min), D, A, O1, O2, O4, O5. method: exhaustive, greedy, backward, exchange,
-sampled, random. scaling of G's columns: si (the paper), unit, expected (× expected_angle rad /
-expected_length m). Candidates whose nominal beam misses the plane are left out (Design.rejected).
-Returns an lrcal.Design whose indices are rows of `pool`.)doc");
+identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
+(design/design_choice.h), numbers and checks.
+criterion: E (= O3, σ_min), D, A, O1, O2, O4, O5, or I (the task criterion: the predicted RMS
+position error at `poses` (M, joints), else at `workspace` poses drawn over the joint ranges).
+method: exhaustive, greedy, backward, exchange, sampled, random. scaling of G's columns: si (the
+paper), unit, expected (× expected_angle_mrad / expected_length_mm; expected_angle in rad and
+expected_length in m are the earlier spellings). The choice is compared with `baseline` random
+designs (Design.baseline) and certified (Design.certificate, Design.efficiency). Candidates whose
+nominal beam misses the plane are left out (Design.rejected). Returns an lrcal.Design whose
+indices are rows of `pool`; Design.json holds `lrcal design --format json`'s fields.)doc");
 }
 
 void DefineStudy(py::module_& m) {
@@ -856,6 +951,192 @@ thread. The trials run with the GIL released, so other Python threads keep runni
 Ctrl-C (KeyboardInterrupt) or an exception raised by `progress` stops the run like the command
 line's first Ctrl-C: finished trials are kept, and the exception is raised; run again to resume.
 Returns an lrcal.RunResult. Read the results with lrcal.load_run(out_dir).)doc");
+  m.def(
+      "plan_accuracy",
+      [](const std::string& study_arg, const std::string& target, double confidence,
+         const std::string& cost, const std::optional<std::string>& configurations,
+         const std::string& repetitions, const std::optional<std::string>& planes, int trials,
+         double stop_precision, const std::optional<long long>& seed,
+         const std::optional<std::string>& out_dir, int threads) {
+        const Study study = LoadStudy(ResolveStudyPath(study_arg));
+        AccuracyPlanOptions o;
+        o.target = AccuracyTarget::Parse(target);
+        o.confidence = confidence;
+        o.cost = CampaignCosts::Parse(cost);
+        if (configurations) o.configurations = *configurations;
+        o.repetitions = repetitions;
+        if (planes) o.planes = *planes;
+        o.trials = trials;
+        o.stop_precision = stop_precision;
+        if (seed) o.seed = ToSeed(*seed);
+        if (out_dir) o.out_dir = *out_dir;
+        o.threads = threads;
+        std::string json;
+        {
+          py::gil_scoped_release release;
+          json = PlanAccuracy(study, o).ToJson().dump();
+        }
+        return py::module_::import("json").attr("loads")(json);
+      },
+      py::arg("study"), py::arg("target"), py::arg("confidence") = 0.95,
+      py::arg("cost") = "configuration=30s,reading=1s", py::arg("configurations") = py::none(),
+      py::arg("repetitions") = "1:100", py::arg("planes") = py::none(), py::arg("trials") = 10000,
+      py::arg("stop_precision") = 0.0, py::arg("seed") = py::none(),
+      py::arg("out_dir") = py::none(), py::arg("threads") = 0, R"doc(
+The cheapest campaign that meets an accuracy target, as `lrcal plan-accuracy STUDY --target ...`
+(report/accuracy_plan.h: the same search, confirmation run and numbers). target: e.g.
+"rms_pos=0.05mm" (also rms_ori, max_pos, max_ori, with mm or mrad); cost:
+"configuration=30s,reading=1s[,plane=600s]"; configurations, repetitions, planes: FIRST:LAST[:STEP]
+ranges. Returns the plan as `--format json` prints it: a dict with target, search_seconds,
+campaigns (label, configurations, repetitions, cost_seconds, predicted and monte_carlo in the
+target's unit, meets_target, ...), study and run (the confirmation study file and run folder).)doc");
+}
+
+// --- one function per command (the command's library call, its JSON as Python objects) -------
+
+py::object FromJson(const std::string& json) {
+  return py::module_::import("json").attr("loads")(json);
+}
+
+// `planes`: None (the robot file's, one or several), an lrcal.Plane, four numbers, or a list of
+// planes.
+PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes) {
+  if (planes.is_none()) {
+    if (rig.planes) return *rig.planes;
+    throw InputError("plane", "the robot file '" + rig.path +
+                                  "' has no plane: pass plane=lrcal.Plane((nx, ny, nz), f)");
+  }
+  if (py::isinstance<py::list>(planes) && py::len(planes) > 0 &&
+      py::isinstance<Plane>(planes.cast<py::list>()[0])) {
+    std::vector<Plane> list;
+    for (const py::handle p : planes.cast<py::list>()) list.push_back(p.cast<Plane>());
+    return PlaneSet(std::move(list), {}, "plane");
+  }
+  return PlaneSet(ResolvePlane(rig, planes));
+}
+
+py::object KinematicsPy(const RobotFile& rig, const Array& q, const std::string& which,
+                        const py::object& plane, const std::string& estimate_plane,
+                        const std::string& estimate_ranger, const py::object& fix, bool jacobian) {
+  if (which != "nominal" && which != "true")
+    throw InputError("model", "expected 'nominal' or 'true', got '" + which + "'");
+  const PlaneSet planes = ResolvePlanes(rig, plane);
+  const ConfigurationSet configs = ToConfigurations(q, rig.robot.num_links(), "q");
+  CheckJointRanges(configs, rig.robot, "q");
+  const ParameterSet ps = MakeParameterSet(
+      rig.robot,
+      std::vector<PlaneTerms>(planes.size(), PlaneTerms::Parse(estimate_plane, "estimate_plane")),
+      ToNames(fix), "fix", RangerTerms::Parse(estimate_ranger, "estimate_ranger"));
+  return FromJson(ReportKinematics(MeasurementModel(rig.robot, planes, ps), which == "true",
+                                   configs, rig.ranger, jacobian)
+                      .rows.dump());
+}
+
+py::object AccuracyPy(const RobotFile& rig, const py::object& poses, const py::object& workspace,
+                      long long seed, const py::object& plane) {
+  if (poses.is_none() == workspace.is_none())
+    throw InputError("poses/workspace",
+                     "give exactly one: poses (M, joints) or a number of "
+                     "poses to draw over the joint ranges");
+  const PlaneSet planes = ResolvePlanes(rig, plane);
+  ConfigurationSet configs(rig.robot.num_links());
+  if (!poses.is_none()) {
+    configs = ToConfigurations(poses.cast<Array>(), rig.robot.num_links(), "poses");
+    CheckJointRanges(configs, rig.robot, "poses");
+  } else {
+    configs = WorkspacePoses(rig.robot, workspace.cast<int>(), ToSeed(seed));
+  }
+  std::vector<PoseAccuracy> predicted;
+  {
+    py::gil_scoped_release release;
+    predicted = PredictCalibratedAccuracy(rig, planes, configs);
+  }
+  ResultJson j = PoseAccuracyJson(predicted, configs);
+  j["sigma"] = rig.calibration->sigma;
+  if (!workspace.is_none()) j["workspace"] = {{"poses", configs.size()}, {"seed", seed}};
+  return FromJson(j.dump());
+}
+
+void DefineCommands(py::module_& m) {
+  m.def("kinematics", &KinematicsPy, py::arg("robot"), py::arg("q"), py::arg("model") = "nominal",
+        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+        py::arg("estimate_ranger") = "none", py::arg("fix") = py::none(),
+        py::arg("jacobian") = false, R"doc(
+Tool pose, beam and laser reading per configuration q (M, joints, rad), as `lrcal kinematics
+--format json`: a list of dicts with q, position (m), rotation (3x3), beam, h (m; None when the
+beam misses), status and, with jacobian=True, jacobian {parameter: dh/de}. model: "nominal" or
+"true" (the robot file's simulated true values). plane: None (the robot file's planes), an
+lrcal.Plane, four numbers or a list of planes; estimate_plane, estimate_ranger, fix as in identify.
+Joint values outside the robot's joint ranges are refused (degrees for rad?).)doc");
+  m.def("accuracy", &AccuracyPy, py::arg("robot"), py::arg("poses") = py::none(),
+        py::arg("workspace") = py::none(), py::arg("seed") = 1, py::arg("plane") = py::none(),
+        R"doc(
+The predicted accuracy of a calibrated robot file (written by identify --write-robot) at poses
+(M, joints, rad) or at `workspace` poses drawn over the joint ranges (seed), as `lrcal accuracy
+--format json`: a dict with poses [{q, position_std (m), orientation_std (rad),
+position_radius_95 (m)}], rms_position, p95_position_radius_95, worst (1-based) and sigma (m).)doc");
+  m.def(
+      "export",
+      [](const RobotFile& rig, const std::string& format, const py::object& plane) {
+        return RobotExportText(
+            rig, format,
+            plane.is_none() ? rig.planes : std::optional<PlaneSet>(ResolvePlanes(rig, plane)));
+      },
+      py::arg("robot"), py::arg("format") = "urdf", py::arg("plane") = py::none(), R"doc(
+The robot (its nominal values: a calibrated file's are the estimates) as text for the robot's
+software, as `lrcal export --format`: "urdf", "dh-table" (CSV) or "yaml" (a robot file with its
+calibration record; plane: the planes to write instead of the file's).)doc");
+  m.def(
+      "plan",
+      [](const std::string& study, int threads) {
+        const Study s = LoadStudy(ResolveStudyPath(study));
+        std::string json;
+        {
+          py::gil_scoped_release release;
+          json = PlanStudy(s, threads).ToJson().dump();
+        }
+        return FromJson(json);
+      },
+      py::arg("study"), py::arg("threads") = 0, R"doc(
+A dry run of a study, as `lrcal plan --format json`: every cell prepared and a few trials timed.
+Returns a dict with study, threads, total_trials, estimate_seconds and cells [{label, id, trials,
+prepare_seconds, seconds_per_trial, estimate_seconds, settings}].)doc");
+  m.def(
+      "replay_trial",
+      [](const std::string& run_dir, const std::string& cell, long long trial) {
+        std::string json, text;
+        {
+          py::gil_scoped_release release;
+          const TrialReplay t = ReplayTrial(run_dir, cell, trial);
+          json = t.ToJson().dump();
+          text = t.ToText();
+        }
+        py::dict out = FromJson(json);
+        out["text"] = text;
+        return out;
+      },
+      py::arg("run_dir"), py::arg("cell"), py::arg("trial"), R"doc(
+Replays one recorded trial of a run, as `lrcal trial RUN_DIR --cell CELL --trial N --format json`:
+a dict with the recomputed record, whether it is identical to the stored one (identical,
+differences), the failure's reason, every configuration with its mean reading and residuals, and
+the estimate (SI); "text" holds the command's text output. cell: its id or label.)doc");
+  m.def(
+      "_prepare_report",
+      [](const std::string& run_dir) {
+        const ReportData d = PrepareReportData(run_dir);
+        return py::dict(py::arg("dir") = d.dir, py::arg("done") = d.done,
+                        py::arg("expected") = d.expected, py::arg("complete") = d.complete,
+                        py::arg("note") = d.note);
+      },
+      py::arg("run_dir"));
+  m.def(
+      "_remove_report_snapshot",
+      [](const std::string& dir) {
+        ReportData d;
+        d.dir = dir;
+        RemoveReportSnapshot(d);
+      },
+      py::arg("report_dir"));
 }
 
 }  // namespace
@@ -874,6 +1155,7 @@ PYBIND11_MODULE(_lrcal, m) {
   lp::DefineKinematics(m);
   lp::DefineCalibration(m);
   lp::DefineStudy(m);
+  lp::DefineCommands(m);
   m.def("set_data_directory", &lrcal::SetEmbeddedDataDirectory, py::arg("path"),
         "Registers where lrcal's shipped data is (the package does this on import).");
   m.def(

@@ -120,6 +120,49 @@ def test_identifiability_and_design_match_the_program(tmp_path, cli, paper):
     assert design.criterion == "E" and design.method == "exchange"
 
 
+def test_design_with_every_criterion_is_the_programs_design(tmp_path, cli, paper):
+    """The same library call (design/design_choice.h): selection, criterion I's prediction, the
+    random baseline and the certificate are the program's, bit for bit."""
+    pool = tmp_path / "pool.csv"
+    cli("sample", "--robot", "paper", "--count", 70, "--seed", 5, "--out", pool)
+    _, q = read_csv(pool)
+    for criterion in ("D", "I"):
+        program = json.loads(cli("design", "--robot", "paper", "--pool", pool, "--select", 30,
+                                 "--criterion", criterion, "--workspace", 25, "--baseline", 50,
+                                 "--method", "backward", "--format", "json").stdout)
+        design = lrcal.design(paper, q, 30, criterion=criterion, workspace=25, baseline=50,
+                              method="backward")
+        mine = json.loads(design.json)
+        for key in ("selected", "score", "criterion", "indices", "certificate", "task",
+                    "selected_per_plane", "evaluations"):
+            assert mine.get(key) == program.get(key), key
+        assert design.indices == program["selected"]
+        assert design.certificate == program["certificate"]["statement"]
+        assert [b["criterion"] for b in design.baseline] == list(program["indices"])
+    assert design.task_rms_per_sigma == program["task"]["rms_position_per_unit_sigma"]
+    with pytest.raises(lrcal.InputError, match="expected_length_mm="):
+        lrcal.design(paper, q, 30, expected_length_mm=0)
+    with pytest.raises(lrcal.InputError, match="baseline="):
+        lrcal.design(paper, q, 30, baseline=0)
+
+
+def test_plan_accuracy_is_the_programs_plan(tmp_path):
+    study = tmp_path / "setup.yaml"
+    study.write_text("name: setup\nseed: 4\ntrials: 10\nrobot: paper\n"
+                     "pool: {size: 50}\nvalidation: {size: 8}\n")
+    plan = lrcal.plan_accuracy(str(study), "rms_pos=0.1mm", configurations="30:50:10",
+                               trials=100, out_dir=str(tmp_path / "plan"), threads=2)
+    assert plan["target"] == {"metric": "rms_pos", "value": 0.1, "unit": "mm",
+                              "confidence": 0.95}
+    chosen = plan["campaigns"][0]
+    assert chosen["label"] == "chosen" and chosen["predicted"] <= 0.1
+    assert chosen["trials"] == 100 and pathlib.Path(plan["study"]).is_file()
+    with pytest.raises(lrcal.InputError, match="target=: the value needs its unit"):
+        lrcal.plan_accuracy(str(study), "rms_pos=0.1")
+    with pytest.raises(lrcal.InputError, match="confidence="):
+        lrcal.plan_accuracy(str(study), "rms_pos=0.1mm", confidence=1.5)
+
+
 def test_design_indices_are_rows_of_the_pool_given(paper):
     anywhere = lrcal.sample_configurations(paper, 150, seed=9, validation=True)
     design = lrcal.design(paper, anywhere, 30, method="greedy")
@@ -132,7 +175,7 @@ def test_design_indices_are_rows_of_the_pool_given(paper):
 def test_docstrings_say_what_the_arguments_are():
     for function in (lrcal.identify, lrcal.simulate, lrcal.design, lrcal.identifiability,
                      lrcal.forward_kinematics, lrcal.laser_readings, lrcal.run_study,
-                     lrcal.load_run, lrcal.sample_configurations):
+                     lrcal.load_run, lrcal.sample_configurations, lrcal.plan_accuracy):
         assert function.__doc__ and len(function.__doc__) > 200, function.__name__
     doc = lrcal.identify.__doc__
     for words in ("identify(robot", "estimate_plane", "(M, joints) rad", "lrcal.InputError"):
