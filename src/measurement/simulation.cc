@@ -70,20 +70,24 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
 }
 
 // The gross errors' contribution to reading r of slot (raw), or to the mean of R (draw_mean).
+// Reading k owns the block of four words at draws 4k..4k+3: word 0 decides whether it is an
+// outlier, words 2 and 3 give its gross error (Box-Muller). The decision and the error never
+// share a word: a shared word would tie the error's sign to the decision (every gross error
+// positive when the decision's word also sets the Box-Muller angle).
 double OutlierError(const NoiseModel& noise, const RandomStream& outliers, std::uint64_t slot,
                     int r) {
   const int R = noise.repetitions;
   if (!noise.draw_mean) {
     const std::uint64_t k = slot * R + r;
-    return outliers.Uniform(2 * k) <= noise.outlier_fraction
-               ? noise.outlier_sigma * outliers.Normal(2 * k + 1)
+    return outliers.Uniform(4 * k) <= noise.outlier_fraction
+               ? noise.outlier_sigma * outliers.Normal(4 * k + 2)
                : 0.0;
   }
   int count = 0;
   for (int rr = 0; rr < R; ++rr)
-    count += outliers.Uniform(2 * (slot * R + rr)) <= noise.outlier_fraction;
+    count += outliers.Uniform(4 * (slot * R + rr)) <= noise.outlier_fraction;
   return count ? std::sqrt(static_cast<double>(count)) * noise.outlier_sigma *
-                     outliers.Normal(2 * slot * R + 1) / R
+                     outliers.Normal(4 * slot * R + 2) / R
                : 0.0;
 }
 

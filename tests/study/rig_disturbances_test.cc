@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 
 #include "lrcal/core/error.h"
 #include "lrcal/io/robot_file.h"
@@ -43,17 +44,37 @@ std::vector<std::pair<double, double>> RmsPosition(const std::string& dir, const
 
 TEST(RigDisturbances, ARobustLossBuysBackWhatOutliersCost) {
   const std::string dir = testing::TempDir("rig_outliers");
-  // 5 % of readings off by N(0, 5 mm) with one reading per configuration; least squares and
-  // Huber at 1.345 σ, on the same readings (common random numbers).
-  const auto cells = RmsPosition(dir,
-                                 "noise: {repetitions: 1, outlier_fraction: 0.05}\n"
-                                 "sweep:\n  axes:\n    - {key: identification.loss, values: "
-                                 "[none, huber]}\n",
-                                 150);
-  ASSERT_EQ(cells.size(), 2u);
-  const auto& [ls, ls_se] = cells[0];
-  const auto& [huber, huber_se] = cells[1];
-  EXPECT_LT(huber + 3 * huber_se, 0.5 * ls) << "least squares " << ls << ", Huber " << huber;
+  // One reading per configuration: without outliers, then 5 % of readings off by N(0, 5 mm) with
+  // least squares and with Huber at 1.345 σ, on the same readings (common random numbers).
+  const auto cells =
+      RmsPosition(dir,
+                  "noise: {repetitions: 1}\n"
+                  "sweep:\n  axes:\n    - {key: '.', values: [{}, "
+                  "{noise: {outlier_fraction: 0.05}}, "
+                  "{noise: {outlier_fraction: 0.05}, identification: {loss: huber}}]}\n",
+                  150);
+  ASSERT_EQ(cells.size(), 3u);
+  const auto& [clean, clean_se] = cells[0];
+  const auto& [ls, ls_se] = cells[1];
+  EXPECT_GT(ls - 3 * ls_se, clean + 3 * clean_se) << "clean " << clean << ", outliers " << ls;
+  // Huber buys back at least half of what outliers cost: per trial (the three cells see the same
+  // readings), d = (least squares − Huber) − ½·(least squares − clean), whose mean must be
+  // positive by 3 standard errors.
+  TrialStore store(dir + "/run/trials.sqlite");
+  std::vector<std::map<long long, double>> rms(3);
+  const std::vector<StoredCell> stored = store.Cells();
+  for (int c = 0; c < 3; ++c)
+    store.ForEachTrial(stored[c].id, [&](const TrialRecord& r) {
+      if (r.status == TrialStatus::kOk)
+        rms[c][r.trial] = (r.validation[0] + r.validation[1] + r.validation[2]) / 3;
+    });
+  std::vector<double> d;
+  for (const auto& [t, value] : rms[1])
+    if (rms[0].count(t) && rms[2].count(t))
+      d.push_back((value - rms[2][t]) - 0.5 * (value - rms[0][t]));
+  const Distribution paired = Describe(d);
+  EXPECT_GT(paired.mean - 3 * paired.mean_se, 0.0)
+      << "mean " << paired.mean << " ± " << paired.mean_se << " over " << paired.n << " trials";
 }
 
 TEST(RigDisturbances, EncoderNoiseAndFormErrorCostAccuracy) {
