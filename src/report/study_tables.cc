@@ -522,9 +522,12 @@ std::map<std::string, CellQuantity> CellQuantities(const std::vector<CellSummary
     for (int a = 0; a < 3; ++a) {
       const Distribution& d = s.validation[3 * metric + a];
       c.mean += (d.n > 0 ? d.mean : NAN) * 1e3 / 3;
-      c.se2 += d.mean_se * d.mean_se * 1e6 / 9;
     }
+    // The cell mean's Monte-Carlo variance from the per-trial mean over x, y, z: the three axes
+    // of one trial are correlated (about 0.67 for rms_pos), so their squared standard errors do
+    // not add.
     const Distribution& t = s.axis_mean[metric];
+    c.se2 = t.n > 1 ? t.mean_se * t.mean_se * 1e6 : 0;
     c.trial_variance = t.n > 1 ? t.std * t.std * 1e6 : NAN;
     q[s.cell.id] = c;
   }

@@ -149,7 +149,7 @@ TEST(SensitivityStudy, ASingleTrialsFigureHasTheNoiseAsAnInput) {
   const Study study = LoadStudy(dir + "/t.yaml");
   TrialStore store(dir + "/t/trials.sqlite");
   std::vector<double> pooled;
-  double within = 0;
+  double within = 0, noise = 0;
   const auto& plan = study.sensitivity["plan_cells"];
   for (const auto& id : plan) {
     std::vector<double> y;
@@ -159,11 +159,15 @@ TEST(SensitivityStudy, ASingleTrialsFigureHasTheNoiseAsAnInput) {
     });
     const Distribution d = Describe(y);
     within += d.std * d.std / static_cast<double>(plan.size());
+    noise += d.std * d.std / static_cast<double>(d.n) / static_cast<double>(plan.size());
     pooled.insert(pooled.end(), y.begin(), y.end());
   }
   const double pooled_var = std::pow(Describe(pooled).std, 2);
   EXPECT_NEAR(var_y, pooled_var, 0.03 * pooled_var);  // equal up to the cells' finite trials
   EXPECT_NEAR(st["noise_total"].get<double>(), within / var_y, 1e-9);
+  // The cell means' Monte-Carlo noise: the variance of each plan point's mean over its trials of
+  // the axis-averaged metric (the axes of a trial are correlated: their SEs do not add).
+  EXPECT_NEAR(m["sensitivity"]["noise_variance"].get<double>(), noise, 1e-9 * noise);
   EXPECT_GT(st["noise_total"].get<double>(), 0.3);  // a single max error is mostly noise
   for (int i = 0; i < 2; ++i)
     for (const char* kind : {"first", "total"})
