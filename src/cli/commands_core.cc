@@ -44,8 +44,10 @@ int KinematicsCommand(const std::vector<std::string>& args) {
   AddCommonOptions(o);
   o.add_options()("configs", po::value<std::string>()->required(),
                   "configurations CSV (q1..qN, rad)")(
-      "model", po::value<std::string>()->default_value("nominal"), "nominal or true")(
-      "jacobian", po::bool_switch(), "also print the identification Jacobian row")(
+      "model", po::value<std::string>()->default_value("nominal"),
+      "nominal, or true: the simulated truth (every true link value, the ranger's true offset and "
+      "scale): what simulate --sigma-mm 0 reads")("jacobian", po::bool_switch(),
+                                                  "also print the identification Jacobian row")(
       "estimate-ranger", po::value<std::string>()->default_value("none"),
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
@@ -62,9 +64,9 @@ int KinematicsCommand(const std::vector<std::string>& args) {
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
   const ConfigurationSet configs =
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
-  const KinematicsReport report = ReportKinematics(
-      MeasurementModel(robot, planes, ResolveParameterSet(robot, vm, planes.size())),
-      which == "true", configs, rig.ranger, vm["jacobian"].as<bool>());
+  const KinematicsReport report =
+      ReportKinematics(rig, planes, ResolveParameterSet(robot, vm, planes.size()), which == "true",
+                       configs, vm["jacobian"].as<bool>());
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << report.rows.dump(2) << "\n";
   } else {

@@ -8,13 +8,20 @@ namespace {
 
 // Tool pose, beam and reading (and the Jacobian row) of configuration i, as JSON and a row of
 // `table`.
+// The ranger errors of the true model that its parameter set does not carry: they are applied to
+// the reading after the model's own terms.
+struct RangerErrors {
+  double offset = 0, scale = 0;
+};
+
 ResultJson KinematicsRow(const MeasurementModel& model, const ModelPoint& point,
                          const ConfigurationSet& configs, int i, const RangerSpec& ranger,
-                         bool jacobian, Table* table) {
+                         const RangerErrors& outside, bool jacobian, Table* table) {
   const ParameterSet& ps = model.parameters();
   std::vector<double> row(ps.size());
   double h;
   const double nb = model.Evaluate(point, configs, i, &h, jacobian ? row.data() : nullptr);
+  h = (1 + outside.scale) * h + outside.offset;
   const BeamMiss miss = ClassifyReading(h, nb, ranger);
   const Pose<double> pose = ToolPose(point, configs, i);
   ResultJson j;
@@ -48,18 +55,39 @@ Table JacobianTable(const std::vector<std::string>& names, const ResultJson& row
   return t;
 }
 
+// `robot` with its simulated true values as its nominal ones (and no errors).
+RobotModel AtTrueValues(const RobotModel& robot) {
+  std::vector<Link> links = robot.links();
+  const Eigen::VectorXd truth = robot.true_values();
+  for (int j = 0; j < robot.num_links(); ++j)
+    for (int v = 0; v < kValuesPerLink; ++v) links[j].nominal[v] = truth[kValuesPerLink * j + v];
+  return RobotModel(robot.name(), links, Eigen::VectorXd::Zero(robot.num_values()), robot.source,
+                    robot.base(), robot.tool());
+}
+
 }  // namespace
 
-KinematicsReport ReportKinematics(const MeasurementModel& model, bool true_model,
-                                  const ConfigurationSet& configs, const RangerSpec& ranger,
-                                  bool jacobian) {
-  const RobotModel& robot = model.robot();
-  const ParameterSet& ps = model.parameters();
-  const Eigen::VectorXd values = true_model ? robot.true_values() : robot.nominal_values();
-  // The Jacobian is taken at the chosen model: its robot deltas relative to nominal.
-  std::vector<double> e(ps.size(), 0.0);
-  for (int k = 0; k < ps.num_robot(); ++k)
-    e[k] = values[ps.robot_values[k]] - robot.nominal_values()[ps.robot_values[k]];
+KinematicsReport ReportKinematics(const RobotFile& rig, const PlaneSet& planes,
+                                  const ParameterSet& parameters, bool true_model,
+                                  const ConfigurationSet& configs, bool jacobian) {
+  // The true model: every link value at its true value (the parameters of the set and the
+  // fixed ones alike) and the ranger's true offset and scale, so that it reads what a
+  // noise-free simulation reads.
+  const RobotModel robot = true_model ? AtTrueValues(rig.robot) : rig.robot;
+  const MeasurementModel model(robot, planes, parameters);
+  std::vector<double> e(parameters.size(), 0.0);
+  RangerErrors outside;
+  if (true_model) {
+    outside = {rig.ranger_offset, rig.ranger_scale};
+    if (parameters.ranger_offset_index >= 0) {
+      e[parameters.ranger_offset_index] = rig.ranger_offset;
+      outside.offset = 0;
+    }
+    if (parameters.ranger_scale_index >= 0) {
+      e[parameters.ranger_scale_index] = rig.ranger_scale;
+      outside.scale = 0;
+    }
+  }
   ModelPoint point;
   model.Prepare(e.data(), &point);
   KinematicsReport report;
@@ -68,8 +96,9 @@ KinematicsReport ReportKinematics(const MeasurementModel& model, bool true_model
             std::string("Tool pose and laser reading per configuration (") +
                 (true_model ? "true" : "nominal") + " model)");
   for (int i = 0; i < configs.size(); ++i)
-    report.rows.push_back(KinematicsRow(model, point, configs, i, ranger, jacobian, &report.poses));
-  if (jacobian) report.jacobian = JacobianTable(ps.names, report.rows);
+    report.rows.push_back(
+        KinematicsRow(model, point, configs, i, rig.ranger, outside, jacobian, &report.poses));
+  if (jacobian) report.jacobian = JacobianTable(parameters.names, report.rows);
   return report;
 }
 

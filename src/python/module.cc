@@ -1027,9 +1027,8 @@ py::object KinematicsPy(const RobotFile& rig, const Array& q, const std::string&
       rig.robot,
       std::vector<PlaneTerms>(planes.size(), PlaneTerms::Parse(estimate_plane, "estimate_plane")),
       ToNames(fix), "fix", RangerTerms::Parse(estimate_ranger, "estimate_ranger"));
-  return FromJson(ReportKinematics(MeasurementModel(rig.robot, planes, ps), which == "true",
-                                   configs, rig.ranger, jacobian)
-                      .rows.dump());
+  return FromJson(
+      ReportKinematics(rig, planes, ps, which == "true", configs, jacobian).rows.dump());
 }
 
 py::object AccuracyPy(const RobotFile& rig, const py::object& poses, const py::object& workspace,

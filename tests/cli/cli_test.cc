@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "lrcal/core/strings.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/io/csv.h"
@@ -74,6 +75,41 @@ TEST_F(CliTest, KinematicsDistanceMatchesTheFormula) {
     EXPECT_NEAR(j["h"].get<double>(), h, 1e-12);
   } else {
     EXPECT_TRUE(j["h"].is_null());
+  }
+}
+
+TEST_F(CliTest, KinematicsOfTheTrueModelReadsWhatNoiseFreeSimulationReads) {
+  // A rig whose true ranger reads 0.3 mm long with a 150 ppm scale error, d6 fixed (its true
+  // error still moves the true arm): --model true must include all of it.
+  std::string robot = testing::ReadFile(testing::SourcePath("studies/robots/paper.yaml"));
+  const std::string unit_line = "  length_unit: mm\n";
+  robot.replace(robot.find(unit_line), unit_line.size(),
+                unit_line + "  ranger_offset_mm: 0.3\n  ranger_scale_ppm: 150\n");
+  const std::string rig = Write("rig.yaml", robot);
+  std::string out;
+  ASSERT_EQ(Run("sample --robot " + rig + " --count 6 --seed 3 --out " + Path("q.csv"), &out), 0)
+      << out;
+  ASSERT_EQ(Run("simulate --robot " + rig + " --configs " + Path("q.csv") +
+                    " --sigma-mm 0 --repetitions 1 --out " + Path("m.csv"),
+                &out),
+            0)
+      << out;
+  for (const std::string fix : {"", " --fix d6", " --estimate-ranger offset,scale"}) {
+    ASSERT_EQ(Run("kinematics --robot " + rig + " --configs " + Path("q.csv") +
+                      " --model true --format json" + fix,
+                  &out),
+              0)
+        << out;
+    const Json rows = Json::parse(out);
+    std::istringstream m(testing::ReadFile(Path("m.csv")));
+    std::string line;
+    std::getline(m, line);  // header: q1..q6,h,repetition
+    for (const auto& row : rows) {
+      if (row["h"].is_null()) continue;  // the true beam misses: simulate skips it too
+      ASSERT_TRUE(std::getline(m, line));
+      const std::vector<std::string> cells = SplitList(line);
+      EXPECT_NEAR(row["h"].get<double>(), std::stod(cells.at(6)), testing::tolerance::kUrdf) << fix;
+    }
   }
 }
 

@@ -10,6 +10,7 @@
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/measurement_model.h"
+#include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
 
@@ -22,11 +23,13 @@ struct KinematicsReport {
   std::string ToText() const;
 };
 
-/// The report of `model` at the robot's nominal values (`true_model` false) or at its simulated
-/// true values (the robot parameters of model's set moved to their true values), for `configs`,
-/// readings classified against `ranger`'s limits.
-KinematicsReport ReportKinematics(const MeasurementModel& model, bool true_model,
-                                  const ConfigurationSet& configs, const RangerSpec& ranger,
-                                  bool jacobian);
+/// The report for `parameters` on `planes` at the robot's nominal values (`true_model` false), or
+/// at the simulated truth (`true_model` true: every link value at its true value and the
+/// ranger's true offset and scale applied, so h is what a noise-free simulation reads), for
+/// `configs`, readings classified against the ranger's limits. The Jacobian rows are taken
+/// there.
+KinematicsReport ReportKinematics(const RobotFile& rig, const PlaneSet& planes,
+                                  const ParameterSet& parameters, bool true_model,
+                                  const ConfigurationSet& configs, bool jacobian);
 
 }  // namespace lrcal
