@@ -126,6 +126,16 @@ DirectoryLock::DirectoryLock(const std::string& dir) {
   }
 }
 
+bool DirectoryLock::IsHeld(const std::string& dir) {
+  const std::string path = dir + "/lock";
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd < 0) return false;  // no lock file: no run ever locked it
+  const bool held = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::flock(fd, LOCK_UN);
+  ::close(fd);
+  return held;
+}
+
 DirectoryLock::~DirectoryLock() {
   if (fd_ >= 0) {
     ::flock(fd_, LOCK_UN);
@@ -327,8 +337,14 @@ namespace {
 
 // Whether RUN_DIR/tables/ is there and matches the records (its summary.json says whether every
 // trial was in when it was written).
-std::string TablesStatus(const std::string& run_dir, bool run_complete) {
+std::string TablesStatus(const std::string& run_dir, bool run_complete, int shard_count) {
   const std::string summary = run_dir + "/tables/summary.json";
+  // A shard holds only its part of every cell: its tables are the merged run's.
+  if (shard_count > 1 && !fs::exists(summary))
+    return run_complete ? "tables: none for a shard; when every shard is done, combine them with: "
+                          "lrcal merge SHARD_DIR... --out DIR (lrcal status SHARD_DIR... says "
+                          "which are)\n"
+                        : "tables: none for a shard (lrcal merge writes them)\n";
   if (!fs::exists(summary))
     return run_complete ? "tables: missing; write them with: lrcal aggregate " + run_dir + "\n"
                         : "tables: not written yet (they are written when every trial is done)\n";
@@ -430,10 +446,18 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
     out << "stop_when: a shard cannot see the other shards' trials, so it runs up to the "
            "maximum; lrcal merge applies the rule\n";
   const auto& sessions = manifest["sessions"];
-  if (!sessions.empty())
-    out << "last session: " << sessions.back().value("start", std::string()) << " → "
-        << sessions.back().value("ended", std::string()) << "\n";
-  out << TablesStatus(run_dir, total_done >= total);
+  if (!sessions.empty()) {
+    // A session records "running" until it closes; if no process holds the directory's lock,
+    // the process that ran it is gone without closing it (killed, or its machine went down).
+    std::string ended = sessions.back().value("ended", std::string());
+    if (ended == "running" && !DirectoryLock::IsHeld(run_dir))
+      ended =
+          "stopped without closing (its process is gone: killed, or the machine went down; "
+          "the trials it committed are kept)";
+    out << "last session: " << sessions.back().value("start", std::string()) << " → " << ended
+        << "\n";
+  }
+  out << TablesStatus(run_dir, total_done >= total, sc);
   if (total_done < total) {
     out << "to finish: lrcal run " << manifest.value("study_file", std::string("STUDY.yaml"))
         << " --out " << run_dir;

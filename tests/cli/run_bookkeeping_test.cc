@@ -54,6 +54,12 @@ TEST(RunBookkeeping, MergingIncompleteShardsWritesNoTablesAndSaysWhatToFinish) {
   const std::string dir = testing::TempDir("merge_incomplete");
   std::string out;
   ASSERT_EQ(Lrcal("run quick --shard 1/2 --out " + dir + "/s1 --quiet", &out), 0) << out;
+  // A finished shard has no tables of its own: status points to merge, not to aggregate.
+  ASSERT_EQ(Lrcal("status " + dir + "/s1", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("tables: none for a shard; when every shard is done, "
+                                        "combine them with: lrcal merge"))
+      << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("aggregate"))) << out;
   ASSERT_EQ(Lrcal("run quick --shard 2/2 --out " + dir + "/s2 --quiet --max-trials 30", &out), 0)
       << out;
   ASSERT_EQ(Lrcal("merge " + dir + "/s1 " + dir + "/s2 --out " + dir + "/m", &out), 1) << out;

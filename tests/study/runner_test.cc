@@ -226,8 +226,20 @@ TEST(MonteCarlo, KilledProcessResumesToTheSameTables) {
   waitpid(pid, &status, 0);
   const long long stored = StoredTrials(killed);
   EXPECT_LT(stored, 16000) << "the run finished before the kill: the test proved nothing";
-  // Resume, then compare with an uninterrupted run.
+  // The morning after: the session still says "running" in the manifest, but status sees that
+  // no process holds the run's lock and says the run stopped; while a process holds it (here
+  // this one), status says it is running.
   std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + killed, &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("stopped without closing (its process is gone")) << out;
+  {
+    const DirectoryLock held(killed);
+    EXPECT_TRUE(DirectoryLock::IsHeld(killed));
+    ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + killed, &out), 0) << out;
+    EXPECT_THAT(out, ::testing::HasSubstr(" → running\n")) << out;
+  }
+  EXPECT_FALSE(DirectoryLock::IsHeld(killed));
+  // Resume, then compare with an uninterrupted run.
   ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + study + " --out " + killed +
                                     " --threads 2 --quiet",
                                 &out),

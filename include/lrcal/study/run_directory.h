@@ -32,6 +32,10 @@ class DirectoryLock {
   ~DirectoryLock();
   DirectoryLock(const DirectoryLock&) = delete;
   DirectoryLock& operator=(const DirectoryLock&) = delete;
+  /// True if a process (this one included, through another DirectoryLock) holds the lock of
+  /// `dir`: a run is going on there. The lock is the kernel's, released when its process ends,
+  /// however it ends (kill -9 too).
+  static bool IsHeld(const std::string& dir);
 
  private:
   int fd_ = -1;
