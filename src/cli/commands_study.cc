@@ -124,16 +124,25 @@ int PlanCommand(const std::vector<std::string>& args) {
 int StatusCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal status options");
   o.add_options()("dirs", po::value<std::vector<std::string>>()->multitoken()->required(),
-                  "run directories (several: the shards of one study)");
+                  "run directories (several: the shards of one study)")(
+      "format", po::value<std::string>()->default_value("text"),
+      "text or json (one object per directory, in a list when several are given)");
   po::positional_options_description pos;
   pos.add("dirs", -1);
   po::variables_map vm;
-  if (!Parse("status", "RUN_DIR...", o, args, &vm, &pos)) return 0;
+  if (!Parse("status", "RUN_DIR... [--format json]", o, args, &vm, &pos)) return 0;
+  const Format format = ResolveFormat(vm);
   const auto dirs = vm["dirs"].as<std::vector<std::string>>();
   std::vector<RunStatusInfo> infos;
+  Json list = Json::array();
   for (const std::string& d : dirs) {
     infos.push_back(GetRunStatus(d));
-    std::cout << infos.back().text;
+    if (format == Format::kText) std::cout << infos.back().text;
+    list.push_back(Json::parse(infos.back().json.dump()));
+  }
+  if (format == Format::kJson) {
+    std::cout << (list.size() == 1 ? list[0] : list).dump(2) << "\n";
+    return 0;
   }
   if (infos.size() > 1 && infos.front().shard_count > 1) std::cout << ShardAdvice(dirs, infos);
   return 0;

@@ -1120,6 +1120,20 @@ a dict with the recomputed record, whether it is identical to the stored one (id
 differences), the failure's reason, every configuration with its mean reading and residuals, and
 the estimate (SI); "text" holds the command's text output. cell: its id or label.)doc");
   m.def(
+      "status",
+      [](const std::string& run_dir) {
+        const RunStatusInfo info = GetRunStatus(run_dir);
+        py::dict out = FromJson(info.json.dump());
+        out["text"] = info.text;
+        return out;
+      },
+      py::arg("run_dir"), R"doc(
+A run directory's progress, as `lrcal status RUN_DIR --format json`: a dict with done and total
+trials, complete, cells [{id, label, done, total, stopped_early}], last_session {start, end,
+state (running, stopped: its process is gone, completed, interrupted, max_trials, ...),
+trials_computed, seconds, trials_per_second}, to_finish and report (the commands that finish or
+report it) and "text", the command's text. Safe on a run in progress.)doc");
+  m.def(
       "_prepare_report",
       [](const std::string& run_dir) {
         const ReportData d = PrepareReportData(run_dir);

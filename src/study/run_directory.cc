@@ -10,6 +10,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <set>
@@ -17,6 +19,7 @@
 
 #include "lrcal/build_info.h"
 #include "lrcal/core/error.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/study.h"
@@ -199,6 +202,13 @@ void RunDirectory::CheckCompatible(const Json& manifest, const Json& study,
     throw SettingError(RunOptions::ShardSetting(),
                        "this run directory is shard " + manifest["shard"]["index"].dump() + "/" +
                            manifest["shard"]["count"].dump() + "; rerun it with that shard");
+}
+
+void RunDirectory::AppendLog(const std::string& line) const {
+  std::FILE* f = std::fopen((fs::path(path_) / "run.log").c_str(), "a");
+  if (!f) return;
+  std::fprintf(f, "%s  %s\n", UtcNow().c_str(), line.c_str());
+  std::fclose(f);
 }
 
 Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_index, int shard_count,
@@ -401,6 +411,86 @@ CellProgress AdaptiveCellProgress(const std::vector<const TrialStore*>& stores,
   return p;
 }
 
+// Seconds since the epoch of a manifest time ("2026-11-25T14:07:57Z"); NaN if it is not one.
+double EpochSeconds(const std::string& utc) {
+  std::tm t{};
+  const char* end = ::strptime(utc.c_str(), "%Y-%m-%dT%H:%M:%SZ", &t);
+  if (!end || *end != '\0') return std::nan("");
+  return static_cast<double>(::timegm(&t));
+}
+
+// "42 s", "3 min 5 s", "2 h 07 min".
+std::string FormatDuration(double seconds) {
+  const long long s = std::llround(seconds);
+  char buf[48];
+  if (s < 60) {
+    std::snprintf(buf, sizeof buf, "%lld s", s);
+  } else if (s < 3600) {
+    std::snprintf(buf, sizeof buf, "%lld min %lld s", s / 60, s % 60);
+  } else {
+    std::snprintf(buf, sizeof buf, "%lld h %02lld min", s / 3600, (s % 3600) / 60);
+  }
+  return buf;
+}
+
+// The last session of a run as status shows it.
+struct SessionState {
+  std::string start, end, ended;
+  std::string state;              // running, stopped (gone without closing), or how it ended
+  long long trials = -1;          // trials it computed (-1: not recorded: it did not close)
+  double seconds = std::nan("");  // its wall time (so far, if running)
+};
+
+SessionState LastSession(const Json& manifest, const std::string& run_dir) {
+  SessionState s;
+  const auto& sessions = manifest["sessions"];
+  if (sessions.empty()) return s;
+  const Json& last = sessions.back();
+  s.start = last.value("start", std::string());
+  s.end = last.value("end", std::string());
+  s.ended = s.state = last.value("ended", std::string());
+  s.trials = last.value("trials_computed", -1LL);
+  if (s.ended != "running") {
+    s.seconds = EpochSeconds(s.end) - EpochSeconds(s.start);
+  } else if (DirectoryLock::IsHeld(run_dir)) {
+    s.seconds = static_cast<double>(std::time(nullptr)) - EpochSeconds(s.start);
+  } else {
+    // A session records "running" until it closes; no process holds the directory's lock, so
+    // the process that ran it is gone without closing it (killed, or its machine went down).
+    s.state = "stopped";
+    s.ended =
+        "stopped without closing (its process is gone: killed, or the machine went down; the "
+        "trials it committed are kept)";
+  }
+  return s;
+}
+
+std::string SessionText(const SessionState& s) {
+  if (s.start.empty()) return "";
+  std::string text = "last session: " + s.start + " → " + s.ended;
+  if (s.state == "running" && std::isfinite(s.seconds))
+    text += " (for " + FormatDuration(s.seconds) + " so far)";
+  if (s.trials >= 0 && std::isfinite(s.seconds)) {
+    text += ": " + std::to_string(s.trials) + " trials in " + FormatDuration(s.seconds);
+    if (s.seconds > 0 && s.trials > 0)
+      text += " (" + Fixed(static_cast<double>(s.trials) / s.seconds, 1) + " trials/s)";
+  }
+  return text + "\n";
+}
+
+Json SessionJson(const SessionState& s) {
+  if (s.start.empty()) return Json();
+  const auto number = [](double x) { return std::isfinite(x) ? Json(x) : Json(); };
+  const bool rate = s.trials > 0 && s.seconds > 0;
+  return {{"start", s.start},
+          {"end", s.end.empty() ? Json() : Json(s.end)},
+          {"state", s.state},
+          {"ended", s.ended},
+          {"trials_computed", s.trials >= 0 ? Json(s.trials) : Json()},
+          {"seconds", number(s.seconds)},
+          {"trials_per_second", rate ? Json(static_cast<double>(s.trials) / s.seconds) : Json()}};
+}
+
 }  // namespace
 
 std::string RunStatus(const std::string& run_dir) { return GetRunStatus(run_dir).text; }
@@ -426,6 +516,7 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
   std::vector<const TrialStore*> store_list;
   for (const auto& st : stores) store_list.push_back(st.get());
   int stopped_early = 0;
+  Json cells_json = Json::array();
   for (const auto& c : manifest["study"]["cells"]) {
     const std::string id = c["id"];
     std::set<long long> union_done;
@@ -438,6 +529,11 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
     total += p.total;
     stopped_early += p.stopped_early;
     out << p.text << "\n";
+    cells_json.push_back({{"id", id},
+                          {"label", c["label"]},
+                          {"done", p.done},
+                          {"total", p.total},
+                          {"stopped_early", p.stopped_early}});
   }
   out << "total: " << total_done << "/" << total << (total_done >= total ? " — complete" : "");
   if (adaptive) out << " (stop_when: " << stopped_early << " cells stopped early)";
@@ -445,26 +541,27 @@ RunStatusInfo GetRunStatus(const std::string& run_dir) {
   if (rule.enabled() && sc > 1)
     out << "stop_when: a shard cannot see the other shards' trials, so it runs up to the "
            "maximum; lrcal merge applies the rule\n";
-  const auto& sessions = manifest["sessions"];
-  if (!sessions.empty()) {
-    // A session records "running" until it closes; if no process holds the directory's lock,
-    // the process that ran it is gone without closing it (killed, or its machine went down).
-    std::string ended = sessions.back().value("ended", std::string());
-    if (ended == "running" && !DirectoryLock::IsHeld(run_dir))
-      ended =
-          "stopped without closing (its process is gone: killed, or the machine went down; "
-          "the trials it committed are kept)";
-    out << "last session: " << sessions.back().value("start", std::string()) << " → " << ended
-        << "\n";
-  }
-  out << TablesStatus(run_dir, total_done >= total, sc);
+  const SessionState session = LastSession(manifest, run_dir);
+  out << SessionText(session) << TablesStatus(run_dir, total_done >= total, sc);
+  std::string finish;
   if (total_done < total) {
-    out << "to finish: lrcal run " << manifest.value("study_file", std::string("STUDY.yaml"))
-        << " --out " << run_dir;
-    if (sc > 1) out << " --shard " << si << "/" << sc;
-    out << "\n";
+    finish = "lrcal run " + manifest.value("study_file", std::string("STUDY.yaml")) + " --out " +
+             run_dir + (sc > 1 ? " --shard " + std::to_string(si) + "/" + std::to_string(sc) : "");
+    out << "to finish: " << finish << "\n";
   }
+  // Figures and report.html of what is recorded, partial or not (a shard's are the merged run's).
+  if (total_done > 0 && sc == 1) out << "report: lrcal report " << run_dir << "\n";
   info.text = out.str();
+  info.json = {{"run", run_dir},
+               {"study", manifest["study"]["name"]},
+               {"shard", {{"index", si}, {"count", sc}}},
+               {"cells", cells_json},
+               {"done", total_done},
+               {"total", total},
+               {"complete", total_done >= total},
+               {"last_session", SessionJson(session)},
+               {"to_finish", finish.empty() ? Json() : Json(finish)},
+               {"report", total_done > 0 && sc == 1 ? Json("lrcal report " + run_dir) : Json()}};
   info.complete = total_done >= total;
   info.shard_index = si;
   info.shard_count = sc;

@@ -227,6 +227,8 @@ class StudyRunner {
       Json& session = manifest_["sessions"][session_];
       session["end"] = UtcNow();
       session["ended"] = "stopped: results could not be written";
+      dir_.AppendLog("session " + std::to_string(session_ + 1) +
+                     " stopped: results could not be written");
       dir_.WriteManifest(manifest_);
     } catch (const std::exception&) {
     }
@@ -272,6 +274,14 @@ class StudyRunner {
         manifest_ = RunDirectory::StartSession(manifest, study_, options_.shard_index,
                                                options_.shard_count, threads_, ranks_, &session_);
         dir_.WriteManifest(manifest_);
+        dir_.AppendLog(
+            "session " + std::to_string(session_ + 1) + " started: study '" + study_.name + "', " +
+            std::to_string(study_.cells.size()) + " cells x " + std::to_string(study_.trials) +
+            " trials, " + std::to_string(threads_) + " threads" +
+            (ranks_ > 1 ? ", " + std::to_string(ranks_) + " MPI ranks" : "") +
+            (options_.shard_count > 1 ? ", shard " + std::to_string(options_.shard_index + 1) +
+                                            "/" + std::to_string(options_.shard_count)
+                                      : ""));
         TrialStore main_store(dir_.MainStorePath());
         main_store.SetMeta("study", study_.ToJson().dump());
         for (const auto& context : contexts_) main_store.PutCell(ToStoredCell(*context));
@@ -538,6 +548,13 @@ class StudyRunner {
       result_.peak_rss_kb = PeakRssKb();
       session["peak_rss_kb"] = {{"after_trials", result_.peak_rss_kb_trials}};
       dir_.WriteManifest(manifest_);
+      dir_.AppendLog(
+          "session " + std::to_string(session_ + 1) + " ended (" +
+          session["ended"].get<std::string>() + "): " + std::to_string(result_.ranks_computed) +
+          " trials computed, " + std::to_string(result_.done_before) + " recorded before, of " +
+          std::to_string(result_.total) + "; prepare " + Fixed(result_.prepare_seconds, 1) +
+          " s, trials " + Fixed(result_.run_seconds, 1) + " s; peak memory " +
+          std::to_string(result_.peak_rss_kb / 1024) + " MiB");
       dir_.Unlock();
     } else {
       // Completeness is rank 0's to judge (from the merged store); this rank knows its stop

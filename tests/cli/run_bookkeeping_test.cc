@@ -36,10 +36,31 @@ TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
       << out;
   EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("interrupted"))) << out;
   EXPECT_EQ(LastSessionEnd(dir + "/run"), "max_trials");
+  // Status, as JSON: progress, the last session's rate, and the commands that go on from here.
+  ASSERT_EQ(Lrcal("status " + dir + "/run --format json", &out), 0) << out;
+  const auto status = nlohmann::json::parse(out);
+  EXPECT_EQ(status["done"], 50);
+  EXPECT_EQ(status["total"], 200);
+  EXPECT_FALSE(status["complete"].get<bool>());
+  EXPECT_EQ(status["cells"].size(), 2u);
+  EXPECT_EQ(status["last_session"]["state"], "max_trials");
+  EXPECT_EQ(status["last_session"]["trials_computed"], 50);
+  EXPECT_GE(status["last_session"]["seconds"].get<double>(), 0.0);
+  EXPECT_THAT(status["to_finish"].get<std::string>(), ::testing::HasSubstr("lrcal run "));
+  EXPECT_EQ(status["report"], "lrcal report " + dir + "/run");
+  ASSERT_EQ(Lrcal("status " + dir + "/run", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("→ max_trials: 50 trials in ")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("report: lrcal report " + dir + "/run")) << out;
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("150 trials computed")) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("50 were already recorded")) << out;
   EXPECT_EQ(LastSessionEnd(dir + "/run"), "completed");
+  // run.log: the run's history in words, one line per session start and end.
+  const std::string log = testing::ReadFile(dir + "/run/run.log");
+  EXPECT_THAT(log, ::testing::HasSubstr("session 1 started: study 'quick', 2 cells x 100 trials"));
+  EXPECT_THAT(log, ::testing::HasSubstr("session 1 ended (max_trials): 50 trials computed"));
+  EXPECT_THAT(log, ::testing::HasSubstr("session 2 ended (completed): 150 trials computed, 50 "
+                                        "recorded before, of 200"));
   // Once more: nothing to do, said so (not "0 trials computed").
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
   EXPECT_THAT(out, ::testing::HasSubstr(

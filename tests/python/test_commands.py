@@ -1,6 +1,6 @@
 """One Python function per command, through the same library call as the program: the same
 numbers, bit for bit, and the same checks (sample, kinematics, accuracy, export, plan,
-replay_trial, report; design and plan_accuracy are in test_calibration.py, run_study and load_run
+replay_trial, status, report; design and plan_accuracy are in test_calibration.py, run_study and load_run
 in test_study.py)."""
 import json
 import os
@@ -88,6 +88,11 @@ def test_plan_replay_and_report_of_a_run(tmp_path, cli):
         lrcal.replay_trial(run, cell, 9)
     with pytest.raises(lrcal.InputError, match="cell=: no cell 'nope'"):
         lrcal.replay_trial(run, "nope", 0)
+    status = lrcal.status(run)
+    assert "text" in status and status.pop("text").startswith("study small in ")
+    assert status == json.loads(cli("status", run, "--format", "json").stdout)
+    assert status["complete"] and status["done"] == 12
+    assert status["last_session"]["state"] == "completed"
     written = lrcal.report(run)
     assert written["complete"] and written["done"] == 12
     assert os.path.isfile(written["path"])

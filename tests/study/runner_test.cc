@@ -232,11 +232,15 @@ TEST(MonteCarlo, KilledProcessResumesToTheSameTables) {
   std::string out;
   ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + killed, &out), 0) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("stopped without closing (its process is gone")) << out;
+  ASSERT_EQ(
+      testing::RunCommand(testing::LrcalBinary() + " status " + killed + " --format json", &out), 0)
+      << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("\"state\": \"stopped\"")) << out;
   {
     const DirectoryLock held(killed);
     EXPECT_TRUE(DirectoryLock::IsHeld(killed));
     ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " status " + killed, &out), 0) << out;
-    EXPECT_THAT(out, ::testing::HasSubstr(" → running\n")) << out;
+    EXPECT_THAT(out, ::testing::HasSubstr(" → running (for ")) << out;
   }
   EXPECT_FALSE(DirectoryLock::IsHeld(killed));
   // Resume, then compare with an uninterrupted run.

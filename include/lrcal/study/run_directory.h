@@ -64,6 +64,10 @@ class RunDirectory {
   Json ReadManifest() const;
   /// Writes the manifest atomically (never a partial file).
   void WriteManifest(const Json& manifest) const;
+  /// Appends "UTC-TIME  line" to RUN_DIR/run.log, the run's history in words (sessions started
+  /// and ended, with what they did). A courtesy to the reader: a log that cannot be written
+  /// stops nothing.
+  void AppendLog(const std::string& line) const;
 
   /// Refuses (InputError naming what changed) if the manifest holds another study or shard.
   static void CheckCompatible(const Json& manifest, const Json& study,
@@ -96,6 +100,11 @@ std::string UtcNow();
 /// finishes it).
 struct RunStatusInfo {
   std::string text;
+  /// The same as JSON (`lrcal status --format json`): run, study, shard, cells [{id, label,
+  /// done, total, stopped_early}], done, total, complete, last_session {start, end, state
+  /// (running, stopped, completed, interrupted, max_trials, ...), ended, trials_computed,
+  /// seconds, trials_per_second}, to_finish and report (commands, or null).
+  Json json;
   bool complete = false;
   int shard_index = 1, shard_count = 1;  ///< 1-based
   std::string study_file;

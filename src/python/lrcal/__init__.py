@@ -23,7 +23,7 @@ from ._lrcal import (Design, Dependency, Error, Identifiability, Identification,
                      Plane, Ranger, Readings, Robot, RunProgress, RunResult, StorageError,
                      __version__, accuracy, data_directory, design, export, forward_kinematics,
                      identifiability, identify, kinematics, laser_readings, plan, plan_accuracy,
-                     replay_trial, run_study, sample_configurations, simulate)
+                     replay_trial, run_study, sample_configurations, simulate, status)
 from ._lrcal import set_data_directory as _set_data_directory
 from ._report import report
 from ._run import Run, load_run
@@ -39,4 +39,4 @@ __all__ = ["Design", "Dependency", "Error", "Identifiability", "Identification",
            "StorageError", "__version__", "accuracy", "data_directory", "design", "export",
            "forward_kinematics", "identifiability", "identify", "kinematics", "laser_readings",
            "load_run", "plan", "plan_accuracy", "replay_trial", "report", "run_study", "sample",
-           "sample_configurations", "simulate"]
+           "sample_configurations", "simulate", "status"]
