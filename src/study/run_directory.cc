@@ -190,13 +190,27 @@ void RunDirectory::WriteManifest(const Json& manifest) const {
 void RunDirectory::CheckCompatible(const Json& manifest, const Json& study,
                                    const std::string& study_path, int shard_index,
                                    int shard_count) {
-  const auto changes = DiffJson(StudyFingerprint(manifest["study"]), StudyFingerprint(study));
+  Json before = StudyFingerprint(manifest["study"]), after = StudyFingerprint(study);
+  before.erase("trials");
+  after.erase("trials");
+  const auto changes = DiffJson(before, after);
   if (!changes.empty()) {
     std::string msg = "this run directory holds a different study; changed:";
     for (const auto& c : changes) msg += "\n  " + c;
     msg += "\nrun it in a new directory (--out), or restore the study file";
     throw InputError(study_path, msg);
   }
+  // More trials extend the run (every trial is a pure function of its index: the recorded ones
+  // stay valid); fewer would leave recorded trials outside the study.
+  const long long recorded = manifest["study"].value("trials", 0LL);
+  const long long wanted = study.value("trials", 0LL);
+  if (wanted < recorded)
+    throw InputError(study_path + " key 'trials'",
+                     std::to_string(wanted) +
+                         " trials per cell, but this run directory holds up "
+                         "to " +
+                         std::to_string(recorded) + "; give trials: " + std::to_string(recorded) +
+                         " or more (more extends the run), or run it in a new directory (--out)");
   const Json shard = {{"index", shard_index + 1}, {"count", shard_count}};
   if (manifest.contains("shard") && manifest["shard"] != shard)
     throw SettingError(RunOptions::ShardSetting(),
@@ -365,6 +379,10 @@ std::string TablesStatus(const std::string& run_dir, bool run_complete, int shar
     return "tables: " + summary + " is damaged; rewrite them with: lrcal aggregate " + run_dir +
            "\n";
   }
+  if (tables_complete && !run_complete)  // the study was extended (more trials) since
+    return "tables: " + run_dir +
+           "/tables/summary.md, written before the run was extended; rewritten when every "
+           "trial is done\n";
   if (tables_complete) return "tables: " + run_dir + "/tables/summary.md (complete)\n";
   return std::string("tables: written from a partial run") +
          (run_complete ? "; rewrite them with: lrcal aggregate " + run_dir : "") + "\n";

@@ -71,6 +71,41 @@ TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
   EXPECT_THAT(out, ::testing::HasSubstr("too short to measure the runner's overhead")) << out;
 }
 
+// More trials later: every trial is a pure function of its index, so raising `trials` extends a
+// run (the tables equal a fresh run's with the new count, byte for byte); fewer is refused.
+TEST(RunBookkeeping, RaisingTrialsExtendsARunToTheTablesOfAFreshOne) {
+  const std::string dir = testing::TempDir("extend_trials");
+  std::string quick = testing::ReadFile(testing::SourcePath("studies/quick.yaml"));
+  const auto with_trials = [&](const std::string& name, int trials) {
+    std::string text = quick;
+    text.replace(text.find("trials: 100"), 11, "trials: " + std::to_string(trials));
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  const std::string s100 = with_trials("quick.yaml", 100);
+  std::string out;
+  ASSERT_EQ(Lrcal("run " + s100 + " --out " + dir + "/run --quiet", &out), 0) << out;
+  const std::string s150 = with_trials("quick.yaml", 150);
+  ASSERT_EQ(Lrcal("status " + dir + "/run", &out), 0) << out;
+  ASSERT_EQ(Lrcal("run " + s150 + " --out " + dir + "/run --quiet --max-trials 20", &out), 0)
+      << out;
+  ASSERT_EQ(Lrcal("status " + dir + "/run", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("total: 220/300")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("written before the run was extended")) << out;
+  ASSERT_EQ(Lrcal("run " + s150 + " --out " + dir + "/run --quiet", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("80 trials computed")) << out;
+  ASSERT_EQ(Lrcal("run " + s150 + " --out " + dir + "/fresh --quiet", &out), 0) << out;
+  for (const char* table : {"summary.md", "validation.csv", "parameters.csv", "cells.csv"})
+    EXPECT_EQ(testing::ReadFile(dir + "/run/tables/" + table),
+              testing::ReadFile(dir + "/fresh/tables/" + table))
+        << table;
+  const std::string s50 = with_trials("quick.yaml", 50);
+  EXPECT_EQ(Lrcal("run " + s50 + " --out " + dir + "/run --quiet", &out), 2) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("key 'trials': 50 trials per cell, but this run "
+                                        "directory holds up to 150"))
+      << out;
+}
+
 TEST(RunBookkeeping, MergingIncompleteShardsWritesNoTablesAndSaysWhatToFinish) {
   const std::string dir = testing::TempDir("merge_incomplete");
   std::string out;
