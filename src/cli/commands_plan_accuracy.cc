@@ -49,8 +49,9 @@ int PlanAccuracyCommand(const std::vector<std::string>& args) {
       "stop each confirmed campaign once its validation means (SE) and p95s (95 % interval "
       "half-width) are known to this relative precision; --trials is then the maximum")(
       "seed", po::value<long long>(), "seed of the confirmation runs (default: the study's)")(
-      "out", po::value<std::string>(), "folder for the confirmation study and run")(
-      "threads", po::value<int>()->default_value(0), "threads (0: all cores)")(
+      "out", po::value<std::string>(),
+      "folder for the confirmation study and run (default: output/STUDY-plan-HASH, named by the "
+      "plan's settings)")("threads", po::value<int>()->default_value(0), "threads (0: all cores)")(
       "format", po::value<std::string>()->default_value("text"), "text or json");
   po::positional_options_description pos;
   pos.add("study", 1);

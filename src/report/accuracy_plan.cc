@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "lrcal/core/descriptive_statistics.h"
+#include "lrcal/core/hash.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/report/run_tables.h"
@@ -157,6 +158,23 @@ struct PlanInputs {
   std::uint64_t seed = 0;
 };
 
+// What a plan's results depend on (not its threads): kept in its folder as plan.json.
+Json PlanSettings(const PlanInputs& in, const Study& study) {
+  return {{"study", {{"name", study.name}, {"base", study.base}}},
+          {"target", {{"metric", in.target.name()}, {"value", in.target.value}}},
+          {"confidence", in.confidence},
+          {"cost",
+           {{"configuration", in.per_configuration},
+            {"reading", in.per_reading},
+            {"plane", in.per_plane}}},
+          {"planes", in.planes},
+          {"configurations", in.configurations},
+          {"repetitions", in.repetitions},
+          {"trials", in.trials},
+          {"stop_precision", in.stop_precision},
+          {"seed", in.seed}};
+}
+
 PlanInputs Resolve(const AccuracyPlanOptions& o, const Study& study) {
   o.Validate();
   PlanInputs in;
@@ -171,8 +189,12 @@ PlanInputs Resolve(const AccuracyPlanOptions& o, const Study& study) {
   in.stop_precision = o.stop_precision;
   in.repetitions = ParseRange(o.repetitions, "repetitions", 1);
   in.configurations = o.configurations;
-  in.out_dir = o.out_dir.empty() ? "output/" + study.name + "-plan" : o.out_dir;
   in.seed = o.seed ? *o.seed : study.seed;
+  // The default folder is named by the plan's settings: another seed, cost or target plans in a
+  // folder of its own instead of being refused by the last plan's.
+  in.out_dir = o.out_dir.empty() ? "output/" + study.name + "-plan-" +
+                                       HashHex(PlanSettings(in, study).dump()).substr(0, 8)
+                                 : o.out_dir;
   return in;
 }
 
@@ -185,7 +207,9 @@ class Planner {
   // A study whose plane is a list of two or more gives candidate planes: every subset with a
   // number of planes in --planes is a choice of its own, with its own pool.
   void PrepareSetUp() {
+    CheckFolder();
     fs::create_directories(in_.out_dir);
+    WriteFileAtomically(in_.out_dir + "/plan.json", PlanSettings(in_, study_).dump(2) + "\n");
     const auto base_cell = PrepareCell(study_, study_.cells.at(0));
     validation_file_ = in_.out_dir + "/validation.csv";
     WriteConfigurations(validation_file_, base_cell->validation);
@@ -295,6 +319,22 @@ class Planner {
   }
 
  private:
+  // A folder that holds a plan with other settings is refused before any work (its
+  // confirmation run would refuse them after the search); the same settings go on (the run
+  // resumes).
+  void CheckFolder() const {
+    const std::string path = in_.out_dir + "/plan.json";
+    if (!fs::exists(path)) return;
+    const std::vector<std::string> changes =
+        DiffJson(ReadJsonFile(path), PlanSettings(in_, study_));
+    if (changes.empty()) return;
+    std::string what;
+    for (const std::string& c : changes) what += "\n  " + c;
+    Refuse("out", "'" + in_.out_dir + "' holds a plan with other settings; changed:" + what +
+                      "\ngive another folder, or leave it out (each plan's default folder "
+                      "is named by its settings)");
+  }
+
   // A subset: its pool (drawn for its planes, as a study of them would), the number of
   // parameters and the counts to consider.
   void AddSubset(PlaneSubset subset, const CellContext& cell) {

@@ -172,6 +172,36 @@ TEST(PlanAccuracy, ConfirmationStopsWhenPreciseEnough) {
       << out;
 }
 
+// Another seed or cost is another plan: by default in a folder named by its settings; in a
+// folder given with --out that holds other settings, refused before the search.
+TEST(PlanAccuracy, EachPlanHasItsFolderAndAFolderKeepsItsSettings) {
+  const std::string dir = testing::TempDir("plan_accuracy_folders");
+  std::ofstream(dir + "/setup.yaml") << "name: setup\nseed: 4\ntrials: 10\nrobot: "
+                                     << testing::SourcePath("studies/robots/paper.yaml")
+                                     << "\npool: {size: 50}\nvalidation: {size: 8}\n";
+  const std::string plan = "cd " + dir + " && " + testing::LrcalBinary() +
+                           " plan-accuracy setup.yaml --target rms_pos=0.1mm "
+                           "--configurations 30:50:10 --trials 100 --threads 2 --format json";
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(plan, &out), 0) << out;
+  const std::string first = Json::parse(out.substr(out.find('{')))["run"];
+  ASSERT_EQ(testing::RunCommand(plan + " --seed 99", &out), 0) << out;
+  const std::string second = Json::parse(out.substr(out.find('{')))["run"];
+  EXPECT_NE(first, second);
+  EXPECT_THAT(first, ::testing::StartsWith("output/setup-plan-"));
+  // The same settings again: the same folder, whose run is complete.
+  ASSERT_EQ(testing::RunCommand(plan, &out), 0) << out;
+  EXPECT_EQ(Json::parse(out.substr(out.find('{')))["run"], first);
+  // A folder given with --out holding another plan: refused at once, saying what changed.
+  const std::string folder = first.substr(0, first.size() - 4);  // without "/run"
+  EXPECT_EQ(
+      testing::RunCommand(plan + " --cost configuration=60s,reading=1s --out " + folder, &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--out: '" + folder +
+                                        "' holds a plan with other settings; changed:"))
+      << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("cost.configuration: 30.0 -> 60.0")) << out;
+}
+
 TEST(PlanAccuracy, BadTargetsAndRangesAreExitTwo) {
   std::string out;
   EXPECT_EQ(

@@ -77,8 +77,11 @@ struct AccuracyPlanOptions {
   int trials = 10000;         ///< Monte-Carlo trials per confirmed campaign, 100 to 10,000,000
   double stop_precision = 0;  ///< 0, or stop a campaign at this relative precision, in (0, 1)
   std::optional<std::uint64_t> seed;  ///< of the confirmation runs; none: the study's
-  std::string out_dir;                ///< empty: output/STUDY-plan (STUDY: the study's name)
-  int threads = 0;                    ///< 0: all cores
+  /// The plan's folder (its settings in plan.json; a folder holding another plan's settings is
+  /// refused). Empty: output/STUDY-plan-HASH, STUDY the study's name and HASH 8 hex digits of
+  /// the settings, so that another seed, cost or target gets a folder of its own.
+  std::string out_dir;
+  int threads = 0;  ///< 0: all cores
 
   /// Every setting's name at the interfaces (target, confidence, cost, configurations,
   /// repetitions, planes, trials, stop_precision, seed, out), for SettingError.
