@@ -1100,6 +1100,10 @@ calibration record; plane: the planes to write instead of the file's).)doc");
 A dry run of a study, as `lrcal plan --format json`: every cell prepared and a few trials timed.
 Returns a dict with study, threads, total_trials, estimate_seconds and cells [{label, id, trials,
 prepare_seconds, seconds_per_trial, estimate_seconds, settings}].)doc");
+}
+
+// A run directory's commands: replay a trial, its status, its report.
+void DefineRunCommands(py::module_& m) {
   m.def(
       "replay_trial",
       [](const std::string& run_dir, const std::string& cell, long long trial) {
@@ -1169,6 +1173,7 @@ PYBIND11_MODULE(_lrcal, m) {
   lp::DefineCalibration(m);
   lp::DefineStudy(m);
   lp::DefineCommands(m);
+  lp::DefineRunCommands(m);
   m.def("set_data_directory", &lrcal::SetEmbeddedDataDirectory, py::arg("path"),
         "Registers where lrcal's shipped data is (the package does this on import).");
   m.def(
