@@ -373,20 +373,27 @@ Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise
   return out;
 }
 
-// A setting given in its unit (`value`, e.g. sigma_mm) or, in the earlier spelling, in SI
-// (`value_si`, e.g. sigma in m; None when not given): the SI value, checked by the spec.
-double SettingValue(const SettingField<IdentificationOptions>& field, double value,
+// A setting given in its unit (`value`, e.g. sigma_mm; `default_value` when not given) or, in
+// the earlier spelling, in SI (`value_si`, e.g. sigma in m; None when not given): the SI value,
+// checked by the spec.
+double SettingValue(const SettingSpec& spec, double default_value, double value,
                     const py::object& value_si, const char* earlier) {
-  double si = value * field.spec.to_si;
+  double si = value * spec.to_si;
   if (!value_si.is_none()) {
-    if (value != field.Default())
-      throw InputError(earlier, std::string("give ") + field.spec.name + " (" + field.spec.unit +
-                                    ") or " + earlier + " (" + field.spec.si_unit +
+    if (value != default_value)
+      throw InputError(earlier, std::string("give ") + spec.name + " (" + spec.unit + ") or " +
+                                    earlier + " (" + spec.si_unit +
                                     ", the earlier spelling), not both");
     si = value_si.cast<double>();
   }
-  if (!field.spec.Allows(si)) throw SettingError(field.spec, si).Respelled(Frontend::kPython);
+  if (!spec.Allows(si)) throw SettingError(spec, si).Respelled(Frontend::kPython);
   return si;
+}
+
+// The same for a setting of IdentificationOptions (its default from the schema).
+double SettingValue(const SettingField<IdentificationOptions>& field, double value,
+                    const py::object& value_si, const char* earlier) {
+  return SettingValue(field.spec, field.Default(), value, value_si, earlier);
 }
 
 struct IdentifyArgs {
@@ -450,21 +457,6 @@ struct DesignArgs {
   double expected_angle_mrad, expected_length_mm;
 };
 
-// A design setting given in its unit, or in SI by its earlier spelling (not both).
-double DesignSetting(const SettingSpec& spec, double value, const py::object& value_si,
-                     const char* earlier) {
-  double si = value * spec.to_si;
-  if (!value_si.is_none()) {
-    if (value != 1.0)  // the default in its unit: the newer spelling was given too
-      throw InputError(earlier, std::string("give ") + spec.name + " (" + spec.unit + ") or " +
-                                    earlier + " (" + spec.si_unit +
-                                    ", the earlier spelling), not both");
-    si = value_si.cast<double>();
-  }
-  if (!spec.Allows(si)) throw SettingError(spec, si).Respelled(Frontend::kPython);
-  return si;
-}
-
 DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model, int k) {
   DesignRequest request;
   request.count = k;
@@ -487,10 +479,12 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
   request.selection.Validate("design");
   request.scaling = ParseDesignScaling(a.scaling, "scaling");
   const auto& specs = DesignRequest::Settings();
-  request.expected_angle =
-      DesignSetting(specs[0], a.expected_angle_mrad, a.expected_angle, "expected_angle");
+  const DesignRequest defaults;
+  request.expected_angle = SettingValue(specs[0], specs[0].FromSi(defaults.expected_angle),
+                                        a.expected_angle_mrad, a.expected_angle, "expected_angle");
   request.expected_length =
-      DesignSetting(specs[1], a.expected_length_mm, a.expected_length, "expected_length");
+      SettingValue(specs[1], specs[1].FromSi(defaults.expected_length), a.expected_length_mm,
+                   a.expected_length, "expected_length");
   request.baseline = a.baseline;
   return request;
 }

@@ -449,8 +449,7 @@ void AccuracyPlanOptions::Validate() const {
     Refuse("target", "expected a target > 0 with its unit, e.g. rms_pos=0.05mm");
   if (!(confidence > 0 && confidence < 1))
     Refuse("confidence", "expected a share in (0, 1), e.g. 0.95");
-  if (trials < 100 || trials > 10000000)
-    Refuse("trials", "expected 100 to 10,000,000 trials per campaign");
+  Spec("trials").Check(trials);
   if (!(stop_precision >= 0 && stop_precision < 1))
     Refuse("stop_precision",
            "expected 0 (run every trial) or a relative precision in (0, 1), e.g. 0.05");
