@@ -3,6 +3,9 @@
 #include <ceres/ceres.h>
 
 #include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
 
 namespace lrcal {
 
@@ -71,6 +74,43 @@ class OneConfigurationCost : public ceres::CostFunction {
   int i_;
 };
 
+// Any kind's weighted residuals √w·(y − y(e)) at a set of configurations, from its evaluator's
+// analytic Jacobian: all configurations in one block, or one configuration (`subset`).
+class KindCost : public ceres::CostFunction {
+ public:
+  KindCost(const MeasurementKind& kind, ConfigurationSet configs, const double* y,
+           const double* weights)
+      : configs_(std::move(configs)), y_(y), weights_(weights) {
+    evaluator_ = kind.Bind(configs_);
+    set_num_residuals(evaluator_->num_rows());
+    mutable_parameter_block_sizes()->push_back(kind.num_parameters());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int m = evaluator_->num_rows(), n = evaluator_->num_parameters();
+    predicted_.resize(m);
+    const bool jacobian = jacobians && jacobians[0];
+    J_.resize(static_cast<std::size_t>(m) * n);
+    if (!evaluator_->Predict(parameters[0], predicted_.data(), jacobian ? J_.data() : nullptr))
+      return false;
+    for (int i = 0; i < m; ++i) {
+      const double w = std::sqrt(weights_[i]);
+      residuals[i] = w * (y_[i] - predicted_[i]);
+      if (jacobian)
+        for (int k = 0; k < n; ++k)
+          jacobians[0][i * n + k] = -w * J_[static_cast<std::size_t>(k) * m + i];
+    }
+    return true;
+  }
+
+ private:
+  ConfigurationSet configs_;
+  std::unique_ptr<MeasurementEvaluator> evaluator_;
+  const double* y_;
+  const double* weights_;
+  mutable std::vector<double> predicted_, J_;
+};
+
 ceres::Solver::Options CeresOptions(const IdentificationOptions& options) {
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
@@ -101,15 +141,21 @@ Termination CeresTermination(const ceres::Solver::Summary& summary) {
 
 }  // namespace
 
-Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
-                           const IdentificationOptions& options, Eigen::VectorXd* e,
-                           int* iterations, std::string* message) {
-  e->setZero(model.num_parameters());
+namespace {
+
+// Least squares from e = 0 with `all` as the one residual block, then, with a robust loss, the
+// refinement from that estimate with one block `one(i)` per configuration, each with its own
+// loss: Ceres applies a loss to the squared norm of a whole block.
+template <typename All, typename One>
+Termination SolveLeastSquaresThenRobust(int num_parameters, int num_configurations, const All& all,
+                                        const One& one, const IdentificationOptions& options,
+                                        Eigen::VectorXd* e, int* iterations, std::string* message) {
+  e->setZero(num_parameters);
   const ceres::Solver::Options so = CeresOptions(options);
   // Least squares first: all configurations in one block, Ceres' per-block overhead paid once
   // (DESIGN.md).
   ceres::Problem least_squares;
-  least_squares.AddResidualBlock(new LaserPlaneCost(model, data), nullptr, e->data());
+  least_squares.AddResidualBlock(all(), nullptr, e->data());
   ceres::Solver::Summary summary;
   ceres::Solve(so, &least_squares, &summary);
   *iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -118,23 +164,49 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
     return CeresTermination(summary);
   // A robust loss then refines from the least-squares estimate (started at the nominal model,
   // every residual of a few mm would count as an outlier at a sub-mm scale, and the non-convex
-  // Cauchy loss would hardly move). One block per configuration, each with its own loss on its
-  // weighted residual √R·(h̄ − h): Ceres applies a loss to the squared norm of a whole block.
+  // Cauchy loss would hardly move).
   ceres::Solver::Options robust_options = so;
   robust_options.max_num_iterations = options.max_robust_iterations;
   ceres::Problem robust;
-  for (int i = 0; i < data.size(); ++i) {
+  for (int i = 0; i < num_configurations; ++i) {
     ceres::LossFunction* loss =
         options.loss == RobustLoss::kHuber
             ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
             : new ceres::CauchyLoss(options.loss_scale);
-    robust.AddResidualBlock(new OneConfigurationCost(model, data, i), loss, e->data());
+    robust.AddResidualBlock(one(i), loss, e->data());
   }
   ceres::Solver::Summary robust_summary;
   ceres::Solve(robust_options, &robust, &robust_summary);
   *iterations += static_cast<int>(robust_summary.iterations.size()) - 1;
   *message = "least squares: " + summary.message + "; robust refinement: " + robust_summary.message;
   return CeresTermination(robust_summary);
+}
+
+}  // namespace
+
+Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& data,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           int* iterations, std::string* message) {
+  return SolveLeastSquaresThenRobust(
+      model.num_parameters(), data.size(), [&] { return new LaserPlaneCost(model, data); },
+      [&](int i) { return new OneConfigurationCost(model, data, i); }, options, e, iterations,
+      message);
+}
+
+Termination SolveWithCeres(const MeasurementKind& kind, const MeasuredValues& data,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           int* iterations, std::string* message) {
+  const int k = kind.rows_per_configuration();
+  std::vector<double> weights;
+  for (int i = 0; i < data.size(); ++i) weights.insert(weights.end(), k, data.repetitions[i]);
+  return SolveLeastSquaresThenRobust(
+      kind.num_parameters(), data.size(),
+      [&] { return new KindCost(kind, data.configs, data.y.data(), weights.data()); },
+      [&](int i) {
+        return new KindCost(kind, data.configs.Subset({i}), data.y.data() + i * k,
+                            weights.data() + i * k);
+      },
+      options, e, iterations, message);
 }
 
 }  // namespace lrcal

@@ -19,4 +19,11 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
                            const IdentificationOptions& options, Eigen::VectorXd* e,
                            int* iterations, std::string* message);
 
+/// The same for any measurement kind (measurement_kind.h), on its evaluator's analytic Jacobian:
+/// least squares with every value in one block; a robust loss (kinds with one value per
+/// configuration) one block per configuration.
+Termination SolveWithCeres(const MeasurementKind& kind, const MeasuredValues& data,
+                           const IdentificationOptions& options, Eigen::VectorXd* e,
+                           int* iterations, std::string* message);
+
 }  // namespace lrcal

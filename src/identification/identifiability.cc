@@ -179,17 +179,16 @@ Eigen::MatrixXd UnobservableDirections(const Eigen::MatrixXd& G,
   return N;
 }
 
-IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
-                                             const ConfigurationSet& configs, const double* e,
-                                             const IdentifiabilityOptions& options) {
+IdentifiabilityReport AnalyzeJacobian(const Eigen::MatrixXd& G,
+                                      const std::vector<std::string>& names, int num_configurations,
+                                      const IdentifiabilityOptions& options) {
   options.Validate();
   IdentifiabilityReport report;
-  report.names = model.parameters().names;
-  report.num_configurations = configs.size();
-  const Eigen::MatrixXd G = IdentificationJacobian(model, configs, e);
+  report.names = names;
+  report.num_configurations = num_configurations;
   std::vector<int> live;
   const Eigen::MatrixXd Gs = ScaledLiveColumns(G, options, &report, &live);
-  RankFromSingularValues(Gs, model.num_parameters(), options, &report);
+  RankFromSingularValues(Gs, static_cast<int>(G.cols()), options, &report);
   if (report.rank < static_cast<int>(live.size())) FindDependencies(Gs, live, options, &report);
   for (const auto& name : report.unidentifiable) report.suggested_fixed.push_back(name);
   // Keep suggested_fixed in parameter-set order.
@@ -200,6 +199,22 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
       ordered.push_back(name);
   report.suggested_fixed = ordered;
   return report;
+}
+
+IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
+                                             const ConfigurationSet& configs, const double* e,
+                                             const IdentifiabilityOptions& options) {
+  options.Validate();
+  return AnalyzeJacobian(IdentificationJacobian(model, configs, e), model.parameters().names,
+                         configs.size(), options);
+}
+
+IdentifiabilityReport AnalyzeIdentifiability(const MeasurementKind& kind,
+                                             const ConfigurationSet& configs, const double* e,
+                                             const IdentifiabilityOptions& options) {
+  options.Validate();
+  return AnalyzeJacobian(MeasurementJacobian(kind, configs, e), kind.parameter_names(),
+                         configs.size(), options);
 }
 
 }  // namespace lrcal

@@ -17,40 +17,35 @@ void LevenbergMarquardt::Nominal::Factorize() {
     L0.resize(0, 0);
 }
 
-double LevenbergMarquardt::Linearize(const MeasurementModel& model, const double* mean_h,
+double LevenbergMarquardt::Linearize(MeasurementEvaluator& model, const double* mean_h,
                                      const Eigen::VectorXd& e, Eigen::VectorXd* r,
                                      Eigen::MatrixXd* J) {
-  const int n = model.num_parameters(), m = batch_.size();
-  model.Prepare(e.data(), &point_);
+  const int n = model.num_parameters(), m = model.num_rows();
   J->resize(m, n);
   r->resize(m);
   h_.resize(m);
-  if (!batch_.Evaluate(model, point_, h_.data(), J->data()))
+  if (!model.Predict(e.data(), h_.data(), J->data()))
     return std::numeric_limits<double>::quiet_NaN();
   J->array().colwise() *= sqrt_w_.array();
   *r = sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_);
   return 0.5 * r->squaredNorm();
 }
 
-double LevenbergMarquardt::Cost(const MeasurementModel& model, const double* mean_h,
+double LevenbergMarquardt::Cost(MeasurementEvaluator& model, const double* mean_h,
                                 const Eigen::VectorXd& e) {
-  const int m = batch_.size();
-  model.Prepare(e.data(), &point_);
+  const int m = model.num_rows();
   h_.resize(m);
-  if (!batch_.Evaluate(model, point_, h_.data(), nullptr))
-    return std::numeric_limits<double>::quiet_NaN();
+  if (!model.Predict(e.data(), h_.data(), nullptr)) return std::numeric_limits<double>::quiet_NaN();
   return 0.5 *
          sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_).squaredNorm();
 }
 
-bool LevenbergMarquardt::StartLeastSquares(const MeasurementModel& model,
-                                           const ConfigurationSet& configs, const double* mean_h,
+bool LevenbergMarquardt::StartLeastSquares(MeasurementEvaluator& model, const double* mean_h,
                                            const double* weights, const Nominal* nominal,
                                            Eigen::VectorXd* e, double* cost, Result* result) {
-  const int n = model.num_parameters(), m = configs.size();
+  const int n = model.num_parameters(), m = model.num_rows();
   e->setZero(n);
   if (m < n || n == 0) return false;  // kInvalidInput
-  batch_.SetConfigurations(configs);
   sqrt_w_ = Eigen::Map<const Eigen::VectorXd>(weights, m).cwiseSqrt();
   if (nominal) {
     J_ = nominal->G;
@@ -117,7 +112,7 @@ bool LevenbergMarquardt::LeastSquaresStep(int iteration, double lambda, const No
   return true;
 }
 
-LevenbergMarquardt::Next LevenbergMarquardt::LeastSquaresIteration(const MeasurementModel& model,
+LevenbergMarquardt::Next LevenbergMarquardt::LeastSquaresIteration(MeasurementEvaluator& model,
                                                                    const double* mean_h,
                                                                    StepControl* control,
                                                                    Eigen::VectorXd* e, double* cost,
@@ -167,13 +162,11 @@ LevenbergMarquardt::Next LevenbergMarquardt::LeastSquaresIteration(const Measure
 // The Monte-Carlo hot path (~45 µs per case-2 trial on the EPYC): its bit-for-bit results are
 // pinned by the golden tables and the Ceres agreement tests.
 LevenbergMarquardt::Result LevenbergMarquardt::SolveLeastSquares(
-    const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
-    const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
-    const Nominal* nominal) {
+    MeasurementEvaluator& model, const double* mean_h, const double* weights,
+    const IdentificationOptions& options, Eigen::VectorXd* e, const Nominal* nominal) {
   Result result;
   double cost = 0;
-  if (!StartLeastSquares(model, configs, mean_h, weights, nominal, e, &cost, &result))
-    return result;
+  if (!StartLeastSquares(model, mean_h, weights, nominal, e, &cost, &result)) return result;
   StepControl control(options.parameter_tolerance, options.function_tolerance);
   for (int iter = 1; iter <= options.max_iterations; ++iter) {
     result.iterations = iter;
@@ -199,7 +192,15 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& mod
                                                      const double* mean_h, const double* weights,
                                                      const IdentificationOptions& options,
                                                      Eigen::VectorXd* e, const Nominal* nominal) {
-  Result result = SolveLeastSquares(model, configs, mean_h, weights, options, e, nominal);
+  ranger_.Bind(model, configs);
+  return Solve(ranger_, mean_h, weights, options, e, nominal);
+}
+
+LevenbergMarquardt::Result LevenbergMarquardt::Solve(MeasurementEvaluator& model,
+                                                     const double* mean_h, const double* weights,
+                                                     const IdentificationOptions& options,
+                                                     Eigen::VectorXd* e, const Nominal* nominal) {
+  Result result = SolveLeastSquares(model, mean_h, weights, options, e, nominal);
   if (options.loss == RobustLoss::kNone || result.termination != Termination::kConverged)
     return result;
   RefineRobust(model, mean_h, options, e, &result);
@@ -275,7 +276,7 @@ void LevenbergMarquardt::RobustStep(double lambda, bool newton_failed, bool* use
   step_ = scale_.cwiseProduct(step_);
 }
 
-double LevenbergMarquardt::RobustCostAtTrial(const MeasurementModel& model, const double* mean_h,
+double LevenbergMarquardt::RobustCostAtTrial(MeasurementEvaluator& model, const double* mean_h,
                                              const IdentificationOptions& options) {
   const double cost = Cost(model, mean_h, e_trial_);
   if (!std::isfinite(cost)) return cost;
@@ -284,7 +285,7 @@ double LevenbergMarquardt::RobustCostAtTrial(const MeasurementModel& model, cons
 }
 
 LevenbergMarquardt::Next LevenbergMarquardt::RobustIteration(
-    const MeasurementModel& model, const double* mean_h, const IdentificationOptions& options,
+    MeasurementEvaluator& model, const double* mean_h, const IdentificationOptions& options,
     bool used_newton, StepControl* control, bool* newton_failed, Eigen::VectorXd* e, double* cost,
     Result* result) {
   e_trial_ = *e + step_;
@@ -340,7 +341,7 @@ LevenbergMarquardt::Next LevenbergMarquardt::RobustIteration(
 // reweights). Stops on a small step or cost decrease like the least-squares loop (the same
 // StepControl); a step that cannot lower the cost when undamped means the minimum is reached to
 // rounding.
-void LevenbergMarquardt::RefineRobust(const MeasurementModel& model, const double* mean_h,
+void LevenbergMarquardt::RefineRobust(MeasurementEvaluator& model, const double* mean_h,
                                       const IdentificationOptions& options, Eigen::VectorXd* e,
                                       Result* result) {
   double cost = Linearize(model, mean_h, *e, &r_, &J_);

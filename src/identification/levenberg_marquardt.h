@@ -10,7 +10,8 @@
 
 #include "lrcal/core/dense_kernels.h"
 #include "lrcal/identification/identification.h"
-#include "measurement/batch_evaluation.h"
+#include "lrcal/measurement/measurement_kind.h"
+#include "lrcal/measurement/ranger_measurement.h"
 
 namespace lrcal {
 
@@ -100,19 +101,24 @@ class LevenbergMarquardt {
   Result Solve(const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
                const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
                const Nominal* nominal = nullptr);
+  /// The same for any measurement kind (measurement_kind.h): `measured` and `weights` have
+  /// evaluator.num_rows() entries (a configuration's repetitions on each of its rows); `nominal`,
+  /// if given, is the evaluator's prediction and Jacobian at e = 0. With a ranger's evaluator
+  /// this is the overload above, bit for bit.
+  Result Solve(MeasurementEvaluator& evaluator, const double* measured, const double* weights,
+               const IdentificationOptions& options, Eigen::VectorXd* e,
+               const Nominal* nominal = nullptr);
 
  private:
   // What one iteration decided.
   enum class Next { kIterate, kStop };
-  Result SolveLeastSquares(const MeasurementModel& model, const ConfigurationSet& configs,
-                           const double* mean_h, const double* weights,
+  Result SolveLeastSquares(MeasurementEvaluator& model, const double* mean_h, const double* weights,
                            const IdentificationOptions& options, Eigen::VectorXd* e,
                            const Nominal* nominal);
   // The first linearisation (from `nominal` when given), normal equations and column scaling.
   // False when the solve cannot start (result->termination says why); *cost the cost at e = 0.
-  bool StartLeastSquares(const MeasurementModel& model, const ConfigurationSet& configs,
-                         const double* mean_h, const double* weights, const Nominal* nominal,
-                         Eigen::VectorXd* e, double* cost, Result* result);
+  bool StartLeastSquares(MeasurementEvaluator& model, const double* mean_h, const double* weights,
+                         const Nominal* nominal, Eigen::VectorXd* e, double* cost, Result* result);
   // The first normal equations (cached per cell when every weight is the same) and the
   // column scaling; false if a column is zero (rank deficiency outright).
   bool FirstNormalEquations(const double* weights, const Nominal* nominal);
@@ -121,12 +127,12 @@ class LevenbergMarquardt {
   bool LeastSquaresStep(int iteration, double lambda, const Nominal* nominal,
                         Termination* termination);
   // Judges, tries and takes (or refuses) step_ from *e; kStop when the loop ends.
-  Next LeastSquaresIteration(const MeasurementModel& model, const double* mean_h,
+  Next LeastSquaresIteration(MeasurementEvaluator& model, const double* mean_h,
                              StepControl* control, Eigen::VectorXd* e, double* cost,
                              Result* result);
 
   // The robust refinement from *e to the minimum of ½·Σρ(r_i²); adds its iterations.
-  void RefineRobust(const MeasurementModel& model, const double* mean_h,
+  void RefineRobust(MeasurementEvaluator& model, const double* mean_h,
                     const IdentificationOptions& options, Eigen::VectorXd* e, Result* result);
   struct RobustWeights {
     Eigen::VectorXd rho1;       // ρ'(r_i²): the gradient's weights
@@ -143,29 +149,29 @@ class LevenbergMarquardt {
   // singular or its last step at this damping was refused; *used_newton says which.
   void RobustStep(double lambda, bool newton_failed, bool* used_newton);
   // The robust cost at e_trial_ from residuals alone (no Jacobian); NaN if a beam is missed.
-  double RobustCostAtTrial(const MeasurementModel& model, const double* mean_h,
+  double RobustCostAtTrial(MeasurementEvaluator& model, const double* mean_h,
                            const IdentificationOptions& options);
   // One robust iteration from *e (step_ already solved); kStop when the loop ends.
-  Next RobustIteration(const MeasurementModel& model, const double* mean_h,
+  Next RobustIteration(MeasurementEvaluator& model, const double* mean_h,
                        const IdentificationOptions& options, bool used_newton, StepControl* control,
                        bool* newton_failed, Eigen::VectorXd* e, double* cost, Result* result);
 
   // Weighted residuals √w·(h̄ − h) and Jacobian √w·G at e into (r, J); returns the cost, NaN if a
   // beam runs parallel to the plane.
-  double Linearize(const MeasurementModel& model, const double* mean_h, const Eigen::VectorXd& e,
+  double Linearize(MeasurementEvaluator& model, const double* mean_h, const Eigen::VectorXd& e,
                    Eigen::VectorXd* r, Eigen::MatrixXd* J);
   // The cost alone (no Jacobian).
-  double Cost(const MeasurementModel& model, const double* mean_h, const Eigen::VectorXd& e);
+  double Cost(MeasurementEvaluator& model, const double* mean_h, const Eigen::VectorXd& e);
   // A_ = JᵀJ, g_ = Jᵀr from J_, r_.
   void FormNormalEquations();
 
-  BatchEvaluator batch_;
+  // The ranger's evaluator for the MeasurementModel overload of Solve (warm across solves).
+  RangerEvaluator ranger_;
   Eigen::MatrixXd J_, J_trial_;
   Eigen::VectorXd r_, r_trial_, h_, sqrt_w_;
   Eigen::MatrixXd A_, As_;
   RowMajorMatrixXd L_;
   Eigen::VectorXd g_, step_, rhs_, e_trial_, scale_;
-  ModelPoint point_;
   // The first factorisation comes from the cell's Nominal (equal weights, factor cached).
   bool first_factor_cached_ = false;
   // The robust refinement's state.

@@ -109,6 +109,11 @@ bool ParsePlaneTermName(const std::string& name, int* plane, std::string* term) 
 bool IsAngularName(const std::string& name) {
   for (const char* prefix : {"theta", "alpha", "beta"})
     if (name.rfind(prefix, 0) == 0) return true;
+  // A frame's rotation terms (a tracker's instrument_roll, ...).
+  for (const std::string suffix : {"_roll", "_pitch", "_yaw"})
+    if (name.size() > suffix.size() &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+      return true;
   int plane;
   std::string term;
   return ParsePlaneTermName(name, &plane, &term) && term != "f";

@@ -9,6 +9,7 @@
 
 #include "identification/levenberg_marquardt.h"
 #include "lrcal/identification/identifiability.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "test_util.h"
 
@@ -581,6 +582,93 @@ TEST(Identification, OptionsValidationNamesTheLibraryField) {
   const IdentificationSummary s = Identify(model, MeasurementSet{}, o);
   EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_THAT(s.message, HasSubstr("identification.loss_scale"));
+}
+
+}  // namespace
+}  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// The measurement interface (measurement_kind.h) with the ranger behind it: the solver's bits are
+// the ranger's own path, and the kind-neutral identification agrees with the ranger's to
+// rounding, for both solvers and with a robust loss, and names the same dependences.
+TEST(MeasurementKindIdentification, RangerThroughTheInterfaceIsTheRangerPath) {
+  const RobotModel& robot = PaperRobot();
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  MeasurementSet data = NoisyReadings(model, 60, 2);
+  std::vector<double> weights(data.repetitions.begin(), data.repetitions.end());
+  // The bare solver: the MeasurementModel overload binds a RangerEvaluator, bit for bit.
+  IdentificationOptions options;
+  LevenbergMarquardt direct, through;
+  Eigen::VectorXd a, b;
+  direct.Solve(model, data.configs, data.mean_h.data(), weights.data(), options, &a);
+  RangerEvaluator evaluator;
+  evaluator.Bind(model, data.configs);
+  through.Solve(evaluator, data.mean_h.data(), weights.data(), options, &b);
+  EXPECT_EQ(a, b);
+
+  const RangerMeasurement kind(model, testing::PaperRig().ranger);
+  const MeasuredValues values = ToMeasuredValues(data);
+  for (auto solver :
+       {IdentificationOptions::Solver::kLevenbergMarquardt, IdentificationOptions::Solver::kCeres})
+    for (RobustLoss loss : {RobustLoss::kNone, RobustLoss::kHuber}) {
+      options.solver = solver;
+      options.loss = loss;
+      options.loss_scale = 0.5e-3;
+      options.sigma = 0.2e-3;
+      const IdentificationSummary ranger = Identify(model, data, options);
+      const IdentificationSummary generic = Identify(kind, values, options);
+      ASSERT_TRUE(generic.IsSolutionUsable()) << generic.FullReport();
+      EXPECT_EQ(generic.names, ranger.names);
+      EXPECT_EQ(generic.iterations, ranger.iterations) << generic.solver << ", " << generic.loss;
+      EXPECT_THAT(generic.delta, testing::EigenNear(ranger.delta, kSolverAgreement));
+      EXPECT_THAT(generic.nominal, testing::EigenNear(ranger.nominal, 0.0));
+      EXPECT_NEAR(generic.sigma_hat, ranger.sigma_hat, 1e-9 * ranger.sigma_hat);
+      EXPECT_NEAR(generic.fit.chi2, ranger.fit.chi2, 1e-9 * ranger.fit.chi2);
+      EXPECT_EQ(generic.fit.suspects, ranger.fit.suspects);
+      EXPECT_THAT(generic.std_given,
+                  testing::EigenNear(ranger.std_given, 1e-9 * ranger.std_given.maxCoeff()));
+    }
+}
+
+TEST(MeasurementKindIdentification, RankDeficiencyIsNamedAndFixedLikeTheRangerPath) {
+  // A horizontal plane: θ1, a1 and d-type terms cannot all be seen (RecoveryTest above).
+  const RobotModel& robot = PaperRobot();
+  const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
+  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 80, 4);
+  const MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
+  const RangerMeasurement kind(model, testing::PaperRig().ranger);
+  const IdentifiabilityReport a = AnalyzeIdentifiability(model, configs);
+  const IdentifiabilityReport b = AnalyzeIdentifiability(kind, configs);
+  ASSERT_FALSE(a.full_rank());
+  EXPECT_EQ(b.rank, a.rank);
+  EXPECT_EQ(b.suggested_fixed, a.suggested_fixed);
+  EXPECT_EQ(b.unidentifiable, a.unidentifiable);
+
+  MeasurementSet data = Exact(robot, robot.nominal_values(), horizontal, configs);
+  const IdentificationSummary refused = Identify(kind, ToMeasuredValues(data));
+  EXPECT_EQ(refused.termination, Termination::kRankDeficient);
+  EXPECT_THAT(refused.message, ::testing::HasSubstr("rank-deficient"));
+  IdentificationOptions options;
+  options.fix_dependent_parameters = true;
+  const IdentificationSummary fixed = Identify(kind, ToMeasuredValues(data), options);
+  const IdentificationSummary ranger = Identify(model, data, options);
+  ASSERT_TRUE(fixed.IsSolutionUsable()) << fixed.FullReport();
+  EXPECT_EQ(fixed.fixed, ranger.fixed);
+  EXPECT_EQ(fixed.names, ranger.names);
+}
+
+TEST(MeasurementKindIdentification, InconsistentOrTooFewValuesAreRefusedInWords) {
+  const RobotModel& robot = PaperRobot();
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  const RangerMeasurement kind(model, testing::PaperRig().ranger);
+  MeasuredValues values = ToMeasuredValues(NoisyReadings(model, 20, 0));
+  const IdentificationSummary few = Identify(kind, values);
+  EXPECT_EQ(few.termination, Termination::kInvalidInput);
+  EXPECT_THAT(few.message, ::testing::HasSubstr("need at least as many measured values; 20 given"));
+  values.y.pop_back();
+  EXPECT_THAT(Identify(kind, values).message, ::testing::HasSubstr("inconsistent"));
 }
 
 }  // namespace

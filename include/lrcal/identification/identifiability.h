@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/measurement_model.h"
 
 namespace lrcal {
@@ -65,6 +66,20 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
                                              const ConfigurationSet& configs,
                                              const double* e = nullptr,
                                              const IdentifiabilityOptions& options = {});
+
+/// The same for any measurement kind (measurement_kind.h): its Jacobian's rows are every measured
+/// component (rows_per_configuration per configuration). For the ranger this is the overload
+/// above (the same report, tested).
+IdentifiabilityReport AnalyzeIdentifiability(const MeasurementKind& kind,
+                                             const ConfigurationSet& configs,
+                                             const double* e = nullptr,
+                                             const IdentifiabilityOptions& options = {});
+
+/// The analysis of a Jacobian G (rows: measured values, SI; columns: the terms `names`) taken at
+/// `num_configurations` configurations: what both overloads above compute.
+IdentifiabilityReport AnalyzeJacobian(const Eigen::MatrixXd& G,
+                                      const std::vector<std::string>& names, int num_configurations,
+                                      const IdentifiabilityOptions& options = {});
 
 /// The directions (columns, SI) along which G's readings do not change, by the same rules as
 /// AnalyzeIdentifiability: a unit vector per zero column, and the right singular vectors of the

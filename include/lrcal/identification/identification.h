@@ -101,10 +101,15 @@ struct FitCheck {
   /// P(χ²_dof ≥ chi2): below 0.001 the fit is inconsistent with σ. NaN without σ or dof.
   double p_value = std::numeric_limits<double>::quiet_NaN();
   bool consistent = true;  ///< p_value ≥ 0.001 (true when there is no test)
-  /// √R_i·(h̄_i − h_i)/s per configuration, s = σ if given, else σ̂ (empty when neither is).
+  /// √R_i·(ȳ_i − y_i)/s per measured value, s = σ if given, else σ̂ (empty when neither is).
+  /// For the ranger a measured value is a configuration's mean reading h̄_i.
   std::vector<double> standardized;
-  /// Configurations (0-based, data order) with |standardized| > 4: readings to check.
+  /// Measured values (0-based, data order) with |standardized| > 4: readings to check. For the
+  /// ranger these are configurations; a kind with k values per configuration has value c of
+  /// configuration i at i·k + c.
   std::vector<int> suspects;
+  /// Measured values per configuration (measurement_kind.h): 1 for the ranger.
+  int rows_per_configuration = 1;
   /// The verdict in words, with the likely causes when the fit is inconsistent.
   std::string Explain() const;
 };
@@ -155,6 +160,15 @@ Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double
 
 /// Identifies the model's parameter set from `data`.
 IdentificationSummary Identify(const MeasurementModel& model, const MeasurementSet& data,
+                               const IdentificationOptions& options = {});
+
+/// Identifies any measurement kind's terms (measurement_kind.h) from `data`: the same solvers,
+/// identifiability check, covariance and fit check as the ranger's overload above, on every
+/// measured value (rows_per_configuration per configuration, each weighted by its
+/// configuration's repetitions). A robust loss is refused for kinds with more than one value per
+/// configuration (message). For a RangerMeasurement it agrees with the overload above to
+/// rounding (its statistics come from the batch kernel instead of the per-configuration path).
+IdentificationSummary Identify(const MeasurementKind& kind, const MeasuredValues& data,
                                const IdentificationOptions& options = {});
 
 /// The model Identify solved: `model`'s parameter set without the parameters it fixed for rank

@@ -92,8 +92,8 @@ ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTe
 ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
                                const std::vector<std::string>& names);
 
-/// True for names of quantities in rad (theta*, alpha*, beta*, plane*_u*); false for metres
-/// (and for the dimensionless ranger_scale: see DisplayUnitOf).
+/// True for names of quantities in rad (theta*, alpha*, beta*, plane*_u*, a frame's *_roll,
+/// *_pitch, *_yaw); false for metres (and for the dimensionless ranger_scale: see DisplayUnitOf).
 bool IsAngularName(const std::string& name);
 
 /// How a quantity is shown to users: "mrad" (×1e3 from rad), "mm" (×1e3 from m) or, for the

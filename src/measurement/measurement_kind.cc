@@ -1,0 +1,78 @@
+#include "lrcal/measurement/measurement_kind.h"
+
+#include <cmath>
+
+#include "lrcal/core/error.h"
+
+namespace lrcal {
+
+namespace {
+
+// The rig disturbances NoiseModel describes for the ranger: refused, not ignored, elsewhere.
+void CheckNoiseFitsKind(const MeasurementKind& kind, const NoiseModel& noise) {
+  noise.Validate();
+  if (std::string(kind.name()) == "ranger") return;
+  const char* term = noise.encoder_sigma > 0                                 ? "encoder noise"
+                     : noise.form_sigma > 0                                  ? "plane form error"
+                     : noise.outlier_fraction > 0                            ? "outliers"
+                     : (noise.ranger_offset != 0 || noise.ranger_scale != 0) ? "ranger errors"
+                                                                             : nullptr;
+  if (term)
+    throw InputError("noise", std::string(term) + " is simulated for the ranger only; the " +
+                                  kind.name() + " measurement takes sigma and repetitions");
+}
+
+}  // namespace
+
+int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& configs,
+                         const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
+                         std::vector<std::string>* misses) {
+  CheckNoiseFitsKind(truth, noise);
+  const int k = truth.rows_per_configuration(), R = noise.repetitions;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(truth.num_parameters());
+  std::unique_ptr<MeasurementEvaluator> evaluator = truth.Bind(configs);
+  std::vector<double> exact(evaluator->num_rows());
+  evaluator->Predict(zero.data(), exact.data(), nullptr);
+  const std::vector<std::string> reasons = truth.MissReasons(configs, zero.data());
+  if (misses) *misses = reasons;
+  *data = MeasuredValues{ConfigurationSet(configs.num_joints()), {}, {}};
+  int missed = 0;
+  std::vector<double> z(static_cast<std::size_t>(R) * k);
+  for (int i = 0; i < configs.size(); ++i) {
+    if (reasons[i] != "ok" || !std::isfinite(exact[static_cast<std::size_t>(i) * k])) {
+      ++missed;
+      continue;
+    }
+    data->configs.AddFrom(configs, i);
+    data->repetitions.push_back(R);
+    if (noise.draw_mean) {
+      stream.Normals(static_cast<std::uint64_t>(i) * k, k, z.data());
+      for (int c = 0; c < k; ++c)
+        data->y.push_back(exact[static_cast<std::size_t>(i) * k + c] +
+                          noise.sigma / std::sqrt(static_cast<double>(R)) * z[c]);
+      continue;
+    }
+    stream.Normals(static_cast<std::uint64_t>(i) * R * k, R * k, z.data());
+    for (int c = 0; c < k; ++c) {
+      double sum = 0;
+      for (int r = 0; r < R; ++r)
+        sum += exact[static_cast<std::size_t>(i) * k + c] + noise.sigma * z[r * k + c];
+      data->y.push_back(sum / R);
+    }
+  }
+  return missed;
+}
+
+Eigen::MatrixXd MeasurementJacobian(const MeasurementKind& kind, const ConfigurationSet& configs,
+                                    const double* e) {
+  std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(configs);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kind.num_parameters());
+  Eigen::MatrixXd G(evaluator->num_rows(), kind.num_parameters());
+  std::vector<double> y(evaluator->num_rows());
+  if (!evaluator->Predict(e ? e : zero.data(), y.data(), G.data()))
+    throw InputError(std::string(kind.name()) + " measurement",
+                     "a prediction is undefined at this estimate (a beam parallel to its plane)");
+  return G;
+}
+
+}  // namespace lrcal

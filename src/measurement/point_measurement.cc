@@ -1,0 +1,226 @@
+#include "lrcal/measurement/point_measurement.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "lrcal/core/error.h"
+#include "lrcal/kinematics/chain.h"
+
+namespace lrcal {
+
+namespace {
+
+constexpr const char* kInstrumentTerms[6] = {"instrument_x",     "instrument_y",
+                                             "instrument_z",     "instrument_roll",
+                                             "instrument_pitch", "instrument_yaw"};
+constexpr const char* kAxes[3] = {"x", "y", "z"};
+
+// The point's differential motion ∂P/∂v for link value `index` (base frame), from the chain's
+// frames at one configuration: the ranger's hit-point formulas (measurement_model.h).
+Eigen::Vector3d PointMotion(const ChainFrames& f, int index, const Eigen::Vector3d& P) {
+  const int link = index / kValuesPerLink;
+  switch (index % kValuesPerLink) {
+    case kTheta:
+      return f.z_prev[link].cross(P - f.o_prev[link]);
+    case kD:
+      return f.z_prev[link];
+    case kA:
+      return f.x_common[link];
+    case kAlpha:
+      return f.x_common[link].cross(P - f.o[link]);
+    default:  // kBeta
+      return f.y_twist[link].cross(P - f.o[link]);
+  }
+}
+
+class PointEvaluator : public MeasurementEvaluator {
+ public:
+  PointEvaluator(const PointMeasurement& kind, const ConfigurationSet& configs)
+      : kind_(kind), configs_(configs) {}
+  int num_rows() const override { return 3 * configs_.size(); }
+  int num_parameters() const override { return kind_.num_parameters(); }
+  bool Predict(const double* e, double* y, double* J) override {
+    kind_.StateAt(e, &state_);
+    PrepareChainPoint(kind_.robot(), state_.link_values.data(), &chain_);
+    const int m = num_rows();
+    if (J) std::fill(J, J + static_cast<std::size_t>(m) * num_parameters(), 0.0);
+    for (int i = 0; i < configs_.size(); ++i) {
+      const Pose<double> pose = ToolPose(chain_, configs_, i, J ? &frames_ : nullptr);
+      const int target = configs_.plane(i);
+      const Eigen::Vector3d P = pose.p_BT + pose.R_BT * state_.targets[target];
+      const Eigen::Vector3d value = state_.R_BI.transpose() * (P - state_.p_BI);
+      for (int c = 0; c < 3; ++c) y[3 * i + c] = value[c];
+      if (J) FillRows(pose, P, target, i, m, J);
+    }
+    return true;
+  }
+
+ private:
+  void Put(double* J, int m, int column, int i, const Eigen::Vector3d& rows) const {
+    if (column < 0) return;
+    for (int c = 0; c < 3; ++c) J[static_cast<std::size_t>(column) * m + 3 * i + c] = rows[c];
+  }
+  void FillRows(const Pose<double>& pose, const Eigen::Vector3d& P, int target, int i, int m,
+                double* J) const {
+    const Eigen::Matrix3d Rt = state_.R_BI.transpose();
+    const std::vector<int>& values = kind_.robot_values();
+    for (int k = 0; k < static_cast<int>(values.size()); ++k)
+      Put(J, m, k, i, Rt * PointMotion(frames_, values[k], P));
+    for (int c = 0; c < 3; ++c) Put(J, m, kind_.instrument_column(c), i, -Rt.col(c));
+    // y = Rxᵀ·Ryᵀ·Rzᵀ·v, v = R_BI0ᵀ·(P − p_BI); dR/dφ = R·[e]× for each elementary rotation.
+    const Eigen::Vector3d u2 =
+        state_.Rz.transpose() * (state_.R_BI0.transpose() * (P - state_.p_BI));
+    const Eigen::Vector3d u1 = state_.Ry.transpose() * u2;
+    const Eigen::Vector3d value = state_.Rx.transpose() * u1;
+    Put(J, m, kind_.instrument_column(3), i, -Eigen::Vector3d::UnitX().cross(value));
+    Put(J, m, kind_.instrument_column(4), i,
+        -(state_.Rx.transpose() * Eigen::Vector3d::UnitY().cross(u1)));
+    Put(J, m, kind_.instrument_column(5), i,
+        -(state_.Rx.transpose() * (state_.Ry.transpose() * Eigen::Vector3d::UnitZ().cross(u2))));
+    const Eigen::Matrix3d dy_dt = Rt * pose.R_BT;
+    for (int c = 0; c < 3; ++c) Put(J, m, kind_.target_column(target, c), i, dy_dt.col(c));
+  }
+
+  const PointMeasurement& kind_;
+  const ConfigurationSet& configs_;
+  PointMeasurement::State state_;
+  ChainPoint chain_;
+  ChainFrames frames_;
+};
+
+}  // namespace
+
+std::string TargetTermName(int k, int num_targets, const std::string& axis) {
+  return num_targets == 1 ? "target_" + axis : "target" + std::to_string(k + 1) + "_" + axis;
+}
+
+void PointSetup::Validate(const std::string& source) const {
+  instrument.Validate(source + ": instrument");
+  if (!instrument.translation.allFinite())
+    throw InputError(source, "the instrument's position must be finite");
+  if (targets.empty() || static_cast<int>(targets.size()) > kMaxTargets)
+    throw InputError(source, "expected 1 to " + std::to_string(kMaxTargets) + " targets, got " +
+                                 std::to_string(targets.size()));
+  for (std::size_t k = 0; k < targets.size(); ++k)
+    if (!targets[k].allFinite())
+      throw InputError(source, "target " + std::to_string(k + 1) + "'s offset must be finite");
+}
+
+PointMeasurement::PointMeasurement(const RobotModel& robot, PointSetup setup,
+                                   const std::vector<std::string>& fixed, const std::string& source)
+    : robot_(&robot), setup_(std::move(setup)), fixed_(fixed) {
+  setup_.Validate();
+  CheckTermNames(fixed, source);
+  const auto is_fixed = [&](const std::string& name) {
+    return std::find(fixed.begin(), fixed.end(), name) != fixed.end();
+  };
+  for (int index = 0; index < robot.num_values(); ++index) {
+    const std::string name = LinkValueFullName(index);
+    if (!robot.links()[index / kValuesPerLink].is_parameter[index % kValuesPerLink] ||
+        is_fixed(name))
+      continue;
+    robot_values_.push_back(index);
+    names_.push_back(name);
+  }
+  for (int k = 0; k < 6; ++k) {
+    if (is_fixed(kInstrumentTerms[k])) continue;
+    instrument_columns_[k] = static_cast<int>(names_.size());
+    names_.emplace_back(kInstrumentTerms[k]);
+  }
+  const int targets = static_cast<int>(setup_.targets.size());
+  target_columns_.assign(3 * targets, -1);
+  for (int t = 0; t < targets; ++t)
+    for (int c = 0; c < 3; ++c) {
+      const std::string name = TargetTermName(t, targets, kAxes[c]);
+      if (is_fixed(name)) continue;
+      target_columns_[3 * t + c] = static_cast<int>(names_.size());
+      names_.push_back(name);
+    }
+}
+
+std::vector<std::string> PointMeasurement::AllTermNames() const {
+  std::vector<std::string> names;
+  for (int index = 0; index < robot_->num_values(); ++index)
+    if (robot_->links()[index / kValuesPerLink].is_parameter[index % kValuesPerLink])
+      names.push_back(LinkValueFullName(index));
+  for (const char* term : kInstrumentTerms) names.emplace_back(term);
+  const int targets = static_cast<int>(setup_.targets.size());
+  for (int t = 0; t < targets; ++t)
+    for (const char* axis : kAxes) names.push_back(TargetTermName(t, targets, axis));
+  return names;
+}
+
+void PointMeasurement::CheckTermNames(const std::vector<std::string>& names,
+                                      const std::string& source) const {
+  const std::vector<std::string> all = AllTermNames();
+  for (const std::string& name : names)
+    if (std::find(all.begin(), all.end(), name) == all.end())
+      throw InputError(source, "'" + name +
+                                   "' is not a term of the point measurement: expected a robot "
+                                   "parameter, instrument_x … instrument_yaw, or " +
+                                   TargetTermName(0, static_cast<int>(setup_.targets.size()), "x") +
+                                   " … " + all.back());
+}
+
+Eigen::VectorXd PointMeasurement::NominalValues() const {
+  Eigen::VectorXd nominal = Eigen::VectorXd::Zero(num_parameters());
+  for (std::size_t k = 0; k < robot_values_.size(); ++k)
+    nominal[static_cast<Eigen::Index>(k)] = robot_->nominal_values()[robot_values_[k]];
+  for (int c = 0; c < 3; ++c)
+    if (instrument_columns_[c] >= 0)
+      nominal[instrument_columns_[c]] = setup_.instrument.translation[c];
+  for (int t = 0; t < static_cast<int>(setup_.targets.size()); ++t)
+    for (int c = 0; c < 3; ++c)
+      if (target_column(t, c) >= 0) nominal[target_column(t, c)] = setup_.targets[t][c];
+  return nominal;
+}
+
+void PointMeasurement::StateAt(const double* e, State* s) const {
+  s->link_values = robot_->nominal_values();
+  for (std::size_t k = 0; k < robot_values_.size(); ++k) s->link_values[robot_values_[k]] += e[k];
+  double d[6];
+  for (int k = 0; k < 6; ++k) d[k] = instrument_columns_[k] >= 0 ? e[instrument_columns_[k]] : 0.0;
+  s->R_BI0 = setup_.instrument.rotation;
+  s->Rx = Eigen::AngleAxisd(d[3], Eigen::Vector3d::UnitX()).toRotationMatrix();
+  s->Ry = Eigen::AngleAxisd(d[4], Eigen::Vector3d::UnitY()).toRotationMatrix();
+  s->Rz = Eigen::AngleAxisd(d[5], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  s->R_BI = s->R_BI0 * s->Rz * s->Ry * s->Rx;
+  s->p_BI = setup_.instrument.translation + Eigen::Vector3d(d[0], d[1], d[2]);
+  s->targets = setup_.targets;
+  for (std::size_t t = 0; t < s->targets.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int column = target_column(static_cast<int>(t), c);
+      if (column >= 0) s->targets[t][c] += e[column];
+    }
+}
+
+std::unique_ptr<MeasurementEvaluator> PointMeasurement::Bind(
+    const ConfigurationSet& configs) const {
+  if (configs.num_joints() != robot_->num_links())
+    throw InputError("configurations", "the robot has " + std::to_string(robot_->num_links()) +
+                                           " joints, the configurations " +
+                                           std::to_string(configs.num_joints()));
+  if (configs.num_planes_referenced() > static_cast<int>(setup_.targets.size()))
+    throw InputError("configurations", "a configuration names target " +
+                                           std::to_string(configs.num_planes_referenced()) +
+                                           " but the set-up has " +
+                                           std::to_string(setup_.targets.size()) + " target(s)");
+  return std::make_unique<PointEvaluator>(*this, configs);
+}
+
+std::vector<std::string> PointMeasurement::MissReasons(const ConfigurationSet& configs,
+                                                       const double*) const {
+  return std::vector<std::string>(configs.size(), "ok");
+}
+
+std::unique_ptr<MeasurementKind> PointMeasurement::Without(
+    const std::vector<std::string>& names) const {
+  CheckTermNames(names, "fix");
+  std::vector<std::string> fixed = fixed_;
+  for (const std::string& name : names)
+    if (std::find(fixed.begin(), fixed.end(), name) == fixed.end()) fixed.push_back(name);
+  return std::make_unique<PointMeasurement>(*robot_, setup_, fixed);
+}
+
+}  // namespace lrcal

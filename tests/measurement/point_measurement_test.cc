@@ -1,0 +1,298 @@
+// The tracker's point measurement (point_measurement.h): its analytic Jacobian against Ceres
+// autodiff through the independent reference kinematics and against central differences, its
+// simulation's noise, its identifiability against an independent rank, and a noise-free round
+// trip through the identification (identification_test.cc has the ranger's).
+#include "lrcal/measurement/point_measurement.h"
+
+#include <ceres/jet.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <random>
+
+#include "lrcal/core/error.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/identification.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+using testing::EigenNear;
+using ::testing::HasSubstr;
+namespace tolerance = testing::tolerance;
+
+constexpr int kMaxTerms = 48;
+using Jet = ceres::Jet<double, kMaxTerms>;
+
+// A tracker 2 m in front of the arm, turned and tilted, seeing two reflectors on the tool.
+PointSetup TrackerSetup() {
+  PointSetup setup;
+  setup.instrument =
+      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.0, -0.4, 0.3), Eigen::Vector3d(0.1, -0.2, 2.8));
+  setup.targets = {Eigen::Vector3d(0.05, 0.0, 0.10), Eigen::Vector3d(-0.03, 0.04, 0.12)};
+  return setup;
+}
+
+// Random configurations of the paper's arm, each seeing target (i mod targets).
+ConfigurationSet RandomConfigurations(const RobotModel& robot, int count, int targets,
+                                      unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> angle(-2.5, 2.5);
+  ConfigurationSet configs(robot.num_links());
+  for (int i = 0; i < count; ++i) {
+    std::vector<double> q(robot.num_links());
+    for (double& v : q) v = angle(rng);
+    configs.Add(q, i % targets);
+  }
+  return configs;
+}
+
+// The point in the instrument's frame written out independently of the library: the reference
+// kinematics, the instrument's orientation as R_BI0·Rz(yaw)·Ry(pitch)·Rx(roll) from Eigen's
+// angle-axis rotations, with every term (estimated or not) taken from `all` (AllTermNames order).
+template <typename T>
+Eigen::Matrix<T, 3, 1> ReferencePoint(const PointMeasurement& kind, const std::vector<T>& all,
+                                      const double* q, int target) {
+  const RobotModel& robot = kind.robot();
+  std::vector<T> values(robot.num_values());
+  for (int k = 0; k < robot.num_values(); ++k) values[k] = T(robot.nominal_values()[k]);
+  const std::vector<std::string> names = kind.AllTermNames();
+  int column = 0;
+  for (; column < static_cast<int>(names.size()); ++column) {
+    const int index = robot.FindValue(names[column]);
+    if (index < 0) break;
+    values[index] += all[column];
+  }
+  const Pose<T> pose = ForwardKinematics<T>(robot, values.data(), q);
+  const T* inst = &all[column];
+  using V = Eigen::Matrix<T, 3, 1>;
+  const Eigen::Matrix<T, 3, 3> R_BI = kind.setup().instrument.rotation.cast<T>() *
+                                      Eigen::AngleAxis<T>(inst[5], V::UnitZ()).toRotationMatrix() *
+                                      Eigen::AngleAxis<T>(inst[4], V::UnitY()).toRotationMatrix() *
+                                      Eigen::AngleAxis<T>(inst[3], V::UnitX()).toRotationMatrix();
+  const V p_BI = kind.setup().instrument.translation.cast<T>() + V(inst[0], inst[1], inst[2]);
+  const T* t = &all[column + 6 + 3 * target];
+  const V offset = kind.setup().targets[target].cast<T>() + V(t[0], t[1], t[2]);
+  return R_BI.transpose() * (pose.p_BT + pose.R_BT * offset - p_BI);
+}
+
+// Every term's deviation (AllTermNames order) from the estimate e of `kind`.
+template <typename T>
+std::vector<T> AllTerms(const PointMeasurement& kind, const std::vector<T>& e) {
+  std::vector<T> all(kind.AllTermNames().size(), T(0));
+  const std::vector<std::string> names = kind.AllTermNames();
+  for (int k = 0; k < kind.num_parameters(); ++k) {
+    const auto it = std::find(names.begin(), names.end(), kind.parameter_names()[k]);
+    all[it - names.begin()] = e[k];
+  }
+  return all;
+}
+
+class PointJacobianTest : public ::testing::TestWithParam<std::vector<std::string>> {};
+
+TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PointMeasurement kind(robot, TrackerSetup(), GetParam());
+  const ConfigurationSet configs = RandomConfigurations(robot, 12, 2, 7);
+  const int n = kind.num_parameters(), m = 3 * configs.size();
+  ASSERT_LE(n, kMaxTerms);
+  // Away from nominal: rotation terms of 0.05 rad, lengths of 5 mm.
+  std::vector<double> e(n);
+  for (int k = 0; k < n; ++k)
+    e[k] = (k % 2 ? 1 : -1) * (IsAngularName(kind.parameter_names()[k]) ? 0.05 : 0.005);
+  std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(configs);
+  std::vector<double> y(m);
+  Eigen::MatrixXd J(m, n);
+  ASSERT_TRUE(evaluator->Predict(e.data(), y.data(), J.data()));
+
+  std::vector<Jet> ej(n);
+  for (int k = 0; k < n; ++k) ej[k] = Jet(e[k], k);
+  const std::vector<Jet> all_jets = AllTerms(kind, ej);
+  Eigen::MatrixXd autodiff(m, n), central(m, n);
+  Eigen::VectorXd reference(m);
+  constexpr double kStep = 1e-6;
+  for (int i = 0; i < configs.size(); ++i) {
+    const Eigen::Matrix<Jet, 3, 1> p =
+        ReferencePoint(kind, all_jets, configs.q(i), configs.plane(i));
+    for (int c = 0; c < 3; ++c) {
+      reference[3 * i + c] = p[c].a;
+      for (int k = 0; k < n; ++k) autodiff(3 * i + c, k) = p[c].v[k];
+    }
+  }
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> ep = e, em = e;
+    ep[k] += kStep;
+    em[k] -= kStep;
+    std::vector<double> yp(m), ym(m);
+    evaluator->Predict(ep.data(), yp.data(), nullptr);
+    evaluator->Predict(em.data(), ym.data(), nullptr);
+    for (int r = 0; r < m; ++r) central(r, k) = (yp[r] - ym[r]) / (2 * kStep);
+  }
+  EXPECT_THAT(Eigen::Map<Eigen::VectorXd>(y.data(), m), EigenNear(reference, tolerance::kUrdf));
+  EXPECT_THAT(J, EigenNear(autodiff, tolerance::kAutodiff));
+  EXPECT_THAT(J, EigenNear(central, tolerance::kCentralDifference));
+}
+
+INSTANTIATE_TEST_SUITE_P(Terms, PointJacobianTest,
+                         ::testing::Values(std::vector<std::string>{},
+                                           std::vector<std::string>{"instrument_roll", "target2_y",
+                                                                    "theta1", "d6"},
+                                           std::vector<std::string>{"instrument_x", "instrument_y",
+                                                                    "instrument_z", "target1_x"}));
+
+// A robot whose nominal values are `robot`'s true ones (nominal + true errors).
+RobotModel TrueRobot(const RobotModel& robot, const Eigen::VectorXd& errors) {
+  std::vector<Link> links = robot.links();
+  for (int index = 0; index < robot.num_values(); ++index)
+    links[index / kValuesPerLink].nominal[index % kValuesPerLink] += errors[index];
+  return RobotModel("truth", links, Eigen::VectorXd::Zero(robot.num_values()), "test", robot.base(),
+                    robot.tool());
+}
+
+TEST(PointMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PointMeasurement full(robot, TrackerSetup());
+  const ConfigurationSet configs = RandomConfigurations(robot, 60, 2, 11);
+  // The terms a point cannot see (found by the analysis) are held at nominal in the truth too.
+  const IdentifiabilityReport report = AnalyzeIdentifiability(full, configs);
+  ASSERT_FALSE(report.full_rank());
+  const std::unique_ptr<MeasurementKind> kind = full.Without(report.suggested_fixed);
+  const auto& point_kind = dynamic_cast<const PointMeasurement&>(*kind);
+  // Truth: every identifiable term off nominal by 1–3 mm or 1–3 mrad.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> size(1e-3, 3e-3);
+  Eigen::VectorXd truth(kind->num_parameters()),
+      link_errors = Eigen::VectorXd::Zero(robot.num_values());
+  PointSetup true_setup = TrackerSetup();
+  for (int k = 0; k < kind->num_parameters(); ++k) truth[k] = (k % 2 ? 1 : -1) * size(rng);
+  for (std::size_t k = 0; k < point_kind.robot_values().size(); ++k)
+    link_errors[point_kind.robot_values()[k]] = truth[static_cast<Eigen::Index>(k)];
+  const RobotModel true_robot = TrueRobot(robot, link_errors);
+  // The truth kind: the true robot, instrument and targets, estimating the same terms.
+  PointMeasurement::State state;
+  point_kind.StateAt(truth.data(), &state);
+  true_setup.instrument.rotation = state.R_BI;
+  true_setup.instrument.translation = state.p_BI;
+  true_setup.targets = state.targets;
+  const PointMeasurement true_kind(true_robot, true_setup, point_kind.fixed());
+
+  NoiseModel exact;
+  exact.sigma = 0;
+  exact.repetitions = 1;
+  MeasuredValues data;
+  ASSERT_EQ(SimulateMeasurements(true_kind, configs, exact,
+                                 RandomStream(1, 0, 0, RandomPurpose::kNoise), &data),
+            0);
+  for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
+                      IdentificationOptions::Solver::kCeres}) {
+    IdentificationOptions options;
+    options.solver = solver;
+    const IdentificationSummary s = Identify(*kind, data, options);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.message;
+    EXPECT_THAT(s.delta, EigenNear(truth, tolerance::kRoundTrip)) << s.solver;
+    EXPECT_LT(s.residual_rms, 1e-12);
+  }
+}
+
+TEST(PointMeasurement, IdentifiabilityRankMatchesAnIndependentJacobian) {
+  const RobotModel& robot = testing::PaperRobot();
+  const PointMeasurement kind(robot, TrackerSetup());
+  const ConfigurationSet configs = RandomConfigurations(robot, 40, 2, 3);
+  const IdentifiabilityReport report = AnalyzeIdentifiability(kind, configs);
+  // The rank of central differences of the reference point, columns scaled to unit norm.
+  const int n = kind.num_parameters(), m = 3 * configs.size();
+  Eigen::MatrixXd G(m, n);
+  constexpr double kStep = 1e-6;
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> ep(n, 0.0), em(n, 0.0);
+    ep[k] = kStep;
+    em[k] = -kStep;
+    const std::vector<double> ap = AllTerms(kind, ep), am = AllTerms(kind, em);
+    for (int i = 0; i < configs.size(); ++i) {
+      const Eigen::Vector3d d = (ReferencePoint(kind, ap, configs.q(i), configs.plane(i)) -
+                                 ReferencePoint(kind, am, configs.q(i), configs.plane(i))) /
+                                (2 * kStep);
+      G.block<3, 1>(3 * i, k) = d;
+    }
+  }
+  for (int k = 0; k < n; ++k)
+    if (G.col(k).norm() > 1e-9) G.col(k).normalize();
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(G).singularValues();
+  int rank = 0;
+  for (int k = 0; k < sv.size(); ++k) rank += sv[k] > 1e-6 * sv[0];
+  EXPECT_EQ(report.rank, rank) << report.ToString();
+  EXPECT_EQ(report.num_params(), static_cast<int>(report.suggested_fixed.size()) + report.rank);
+  // A shift of the instrument along z and of the first joint's d move every point alike.
+  EXPECT_THAT(report.suggested_fixed, ::testing::Contains(::testing::AnyOf("d1", "instrument_z")));
+}
+
+TEST(PointMeasurement, SimulatedNoiseHasTheStatedLaw) {
+  const RobotModel& robot = testing::PaperRobot();
+  const PointMeasurement kind(robot, TrackerSetup());
+  const ConfigurationSet configs = RandomConfigurations(robot, 2000, 2, 9);
+  NoiseModel noise;
+  noise.sigma = 1e-3;
+  noise.repetitions = 4;
+  const RandomStream stream(3, 0, 0, RandomPurpose::kNoise);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kind.num_parameters());
+  std::vector<double> exact(3 * configs.size());
+  kind.Bind(configs)->Predict(zero.data(), exact.data(), nullptr);
+  for (bool draw_mean : {false, true}) {
+    noise.draw_mean = draw_mean;
+    MeasuredValues data;
+    ASSERT_EQ(SimulateMeasurements(kind, configs, noise, stream, &data), 0);
+    ASSERT_EQ(data.y.size(), exact.size());
+    double sum = 0, sum2 = 0;
+    for (std::size_t r = 0; r < exact.size(); ++r) {
+      const double error = data.y[r] - exact[r];
+      sum += error;
+      sum2 += error * error;
+    }
+    const double count = static_cast<double>(exact.size());
+    const double expected_sd = noise.sigma / 2;  // σ/√R
+    // The mean within 4 standard errors; the variance within 4 of its standard errors
+    // (√(2/count) relative for a normal sample).
+    EXPECT_NEAR(sum / count, 0.0, 4 * expected_sd / std::sqrt(count)) << draw_mean;
+    EXPECT_NEAR(sum2 / count / (expected_sd * expected_sd), 1.0, 4 * std::sqrt(2 / count))
+        << draw_mean;
+  }
+  noise.outlier_fraction = 0.1;
+  MeasuredValues data;
+  try {
+    SimulateMeasurements(kind, configs, noise, stream, &data);
+    ADD_FAILURE() << "outliers were accepted for the point measurement";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("outliers is simulated for the ranger only"));
+  }
+}
+
+TEST(PointMeasurement, BadTermsAndTargetsAreNamed) {
+  const RobotModel& robot = testing::PaperRobot();
+  try {
+    PointMeasurement(robot, TrackerSetup(), {"instrument_w"}, "--fix");
+    ADD_FAILURE() << "an unknown term was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--fix"));
+    EXPECT_THAT(e.what(), HasSubstr("'instrument_w' is not a term of the point measurement: "
+                                    "expected a robot parameter, instrument_x … instrument_yaw, "
+                                    "or target1_x … target2_z"));
+  }
+  PointSetup one = TrackerSetup();
+  one.targets.resize(1);
+  const PointMeasurement kind(robot, one);
+  EXPECT_THAT(kind.parameter_names(), ::testing::Contains("target_x"));
+  EXPECT_EQ(DisplayUnitOf("instrument_yaw").unit, std::string("mrad"));
+  const ConfigurationSet configs = RandomConfigurations(robot, 4, 2, 1);  // target index 1
+  try {
+    kind.Bind(configs);
+    ADD_FAILURE() << "a configuration naming a missing target was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("names target 2 but the set-up has 1 target(s)"));
+  }
+}
+
+}  // namespace
+}  // namespace lrcal
