@@ -33,6 +33,8 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) 
   options.loss = ParseName(kRobustLossNames, vm["loss"].as<std::string>(), "--loss", "loss");
   ReadSettingOptions(vm, IdentificationOptions::Settings(), &options);
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
+  if (vm.count("prior-sigma"))
+    options.priors = PriorSigmas::Parse(vm["prior-sigma"].as<std::string>(), "--prior-sigma");
   options.Validate();
   return options;
 }
@@ -234,6 +236,11 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "fix", po::value<std::string>(), "parameters to keep at nominal, comma-separated")(
       "auto-fix", po::bool_switch(),
       "if the set is rank-deficient, fix the suggested parameters and go on")(
+      "prior-sigma", po::value<std::string>(),
+      "prior standard deviations around the nominal values, by class or term, each with its "
+      "unit: theta=1mrad,a=0.5mm,d6=0.2mm,ranger_scale=200ppm (classes: theta, alpha, a, d, "
+      "beta, plane_u, plane_f, ranger_offset, ranger_scale). With --sigma-mm: the maximum "
+      "a-posteriori estimate; a direction the readings cannot see is set by its prior")(
       "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
       "loss", po::value<std::string>()->default_value("none"),
       "robust loss: none, huber, cauchy (either solver)")(

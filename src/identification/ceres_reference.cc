@@ -111,6 +111,29 @@ class KindCost : public ceres::CostFunction {
   mutable std::vector<double> predicted_, J_;
 };
 
+// The priors' residuals √w_p·(0 − e_k), k = terms[p].
+class PriorCost : public ceres::CostFunction {
+ public:
+  PriorCost(const CeresPriors& priors, int num_parameters) : priors_(priors), n_(num_parameters) {
+    set_num_residuals(static_cast<int>(priors.terms.size()));
+    mutable_parameter_block_sizes()->push_back(num_parameters);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    for (std::size_t p = 0; p < priors_.terms.size(); ++p) {
+      const double w = std::sqrt(priors_.weights[p]);
+      residuals[p] = -w * parameters[0][priors_.terms[p]];
+      if (jacobians && jacobians[0])
+        for (int k = 0; k < n_; ++k) jacobians[0][p * n_ + k] = k == priors_.terms[p] ? -w : 0.0;
+    }
+    return true;
+  }
+
+ private:
+  CeresPriors priors_;
+  int n_;
+};
+
 ceres::Solver::Options CeresOptions(const IdentificationOptions& options) {
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
@@ -145,17 +168,21 @@ namespace {
 
 // Least squares from e = 0 with `all` as the one residual block, then, with a robust loss, the
 // refinement from that estimate with one block `one(i)` per configuration, each with its own
-// loss: Ceres applies a loss to the squared norm of a whole block.
+// loss: Ceres applies a loss to the squared norm of a whole block. `priors` (if it has terms) is
+// one more block in both problems, without a loss.
 template <typename All, typename One>
 Termination SolveLeastSquaresThenRobust(int num_parameters, int num_configurations, const All& all,
-                                        const One& one, const IdentificationOptions& options,
-                                        Eigen::VectorXd* e, int* iterations, std::string* message) {
+                                        const One& one, const CeresPriors& priors,
+                                        const IdentificationOptions& options, Eigen::VectorXd* e,
+                                        int* iterations, std::string* message) {
   e->setZero(num_parameters);
   const ceres::Solver::Options so = CeresOptions(options);
   // Least squares first: all configurations in one block, Ceres' per-block overhead paid once
   // (DESIGN.md).
   ceres::Problem least_squares;
   least_squares.AddResidualBlock(all(), nullptr, e->data());
+  if (!priors.terms.empty())
+    least_squares.AddResidualBlock(new PriorCost(priors, num_parameters), nullptr, e->data());
   ceres::Solver::Summary summary;
   ceres::Solve(so, &least_squares, &summary);
   *iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -175,6 +202,8 @@ Termination SolveLeastSquaresThenRobust(int num_parameters, int num_configuratio
             : new ceres::CauchyLoss(options.loss_scale);
     robust.AddResidualBlock(one(i), loss, e->data());
   }
+  if (!priors.terms.empty())
+    robust.AddResidualBlock(new PriorCost(priors, num_parameters), nullptr, e->data());
   ceres::Solver::Summary robust_summary;
   ceres::Solve(robust_options, &robust, &robust_summary);
   *iterations += static_cast<int>(robust_summary.iterations.size()) - 1;
@@ -189,13 +218,13 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
                            int* iterations, std::string* message) {
   return SolveLeastSquaresThenRobust(
       model.num_parameters(), data.size(), [&] { return new LaserPlaneCost(model, data); },
-      [&](int i) { return new OneConfigurationCost(model, data, i); }, options, e, iterations,
-      message);
+      [&](int i) { return new OneConfigurationCost(model, data, i); }, CeresPriors{}, options, e,
+      iterations, message);
 }
 
 Termination SolveWithCeres(const MeasurementKind& kind, const MeasuredValues& data,
-                           const IdentificationOptions& options, Eigen::VectorXd* e,
-                           int* iterations, std::string* message) {
+                           const CeresPriors& priors, const IdentificationOptions& options,
+                           Eigen::VectorXd* e, int* iterations, std::string* message) {
   const int k = kind.rows_per_configuration();
   std::vector<double> weights;
   for (int i = 0; i < data.size(); ++i) weights.insert(weights.end(), k, data.repetitions[i]);
@@ -206,7 +235,7 @@ Termination SolveWithCeres(const MeasurementKind& kind, const MeasuredValues& da
         return new KindCost(kind, data.configs.Subset({i}), data.y.data() + i * k,
                             weights.data() + i * k);
       },
-      options, e, iterations, message);
+      priors, options, e, iterations, message);
 }
 
 }  // namespace lrcal

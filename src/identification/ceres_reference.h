@@ -19,11 +19,17 @@ Termination SolveWithCeres(const MeasurementModel& model, const MeasurementSet& 
                            const IdentificationOptions& options, Eigen::VectorXd* e,
                            int* iterations, std::string* message);
 
+/// Priors as Ceres sees them: one residual √w_p·(0 − e_k) per term k = terms[p] (prior.h).
+struct CeresPriors {
+  std::vector<int> terms;
+  std::vector<double> weights;
+};
+
 /// The same for any measurement kind (measurement_kind.h), on its evaluator's analytic Jacobian:
-/// least squares with every value in one block; a robust loss (kinds with one value per
-/// configuration) one block per configuration.
+/// least squares with every value in one block, the priors (if any) in another; a robust loss
+/// (kinds with one value per configuration) one block per configuration, beside the priors'.
 Termination SolveWithCeres(const MeasurementKind& kind, const MeasuredValues& data,
-                           const IdentificationOptions& options, Eigen::VectorXd* e,
-                           int* iterations, std::string* message);
+                           const CeresPriors& priors, const IdentificationOptions& options,
+                           Eigen::VectorXd* e, int* iterations, std::string* message);
 
 }  // namespace lrcal

@@ -10,6 +10,7 @@
 #include "identification/ceres_reference.h"
 #include "identification/levenberg_marquardt.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/measurement/ranger_measurement.h"
 
 namespace lrcal {
 
@@ -51,23 +52,32 @@ const Model* CheckIdentifiable(const Model& model_in, const std::vector<std::str
 
 // The χ² test against the stated σ and the standardised residuals (FitCheck) from the
 // unweighted residuals y − y(e) of every measured value and their weights (repetitions).
+// Rows from `data_rows` on are not readings (the priors' rows): they count in χ² and its degrees
+// of freedom, not among the standardised residuals.
 void CheckFit(const std::vector<double>& residuals, const std::vector<double>& weights,
-              int num_parameters, int rows_per_configuration, const IdentificationOptions& options,
-              IdentificationSummary* s) {
+              int num_parameters, int rows_per_configuration, int data_rows,
+              const IdentificationOptions& options, IdentificationSummary* s) {
   FitCheck& fit = s->fit;
   const int m = static_cast<int>(residuals.size());
   fit.rows_per_configuration = rows_per_configuration;
   fit.dof = m - num_parameters;
   fit.sigma_given = options.sigma > 0;
+  fit.num_priors = m - data_rows;
   if (fit.sigma_given) {
     fit.chi2 = 2 * s->final_cost / (options.sigma * options.sigma);
+    if (fit.num_priors > 0) {
+      fit.chi2_priors = 0;
+      for (int i = data_rows; i < m; ++i)
+        fit.chi2_priors +=
+            weights[i] * residuals[i] * residuals[i] / (options.sigma * options.sigma);
+    }
     if (fit.dof > 0)
       fit.p_value = boost::math::gamma_q(0.5 * fit.dof, 0.5 * fit.chi2);  // χ² upper tail
     fit.consistent = !(fit.p_value < 1e-3);
   }
   const double scale = fit.sigma_given ? options.sigma : s->sigma_hat;
   if (!(scale > 0)) return;
-  for (int i = 0; i < m; ++i) {
+  for (int i = 0; i < data_rows; ++i) {
     const double z = std::sqrt(weights[i]) * residuals[i] / scale;
     fit.standardized.push_back(z);
     if (std::fabs(z) > 4) fit.suspects.push_back(i);
@@ -77,7 +87,7 @@ void CheckFit(const std::vector<double>& residuals, const std::vector<double>& w
 // σ̂, the fit check and the covariances at the estimate, from the Jacobian G at e (rows: measured
 // values), the weights and the unweighted residuals; s->final_cost is set.
 void SummarizeFit(const Eigen::MatrixXd& G, const std::vector<double>& weights,
-                  const std::vector<double>& residuals, int rows_per_configuration,
+                  const std::vector<double>& residuals, int rows_per_configuration, int data_rows,
                   const IdentificationOptions& options, IdentificationSummary* summary) {
   IdentificationSummary& s = *summary;
   const int m = static_cast<int>(G.rows()), n = static_cast<int>(G.cols());
@@ -86,7 +96,7 @@ void SummarizeFit(const Eigen::MatrixXd& G, const std::vector<double>& weights,
       Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(weights.data(), m)).asDiagonal() * G;
   const Eigen::MatrixXd Ainv = ParameterCovariance(A, 1.0);
   s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : std::nan("");
-  CheckFit(residuals, weights, n, rows_per_configuration, options, &s);
+  CheckFit(residuals, weights, n, rows_per_configuration, data_rows, options, &s);
   s.covariance_residual = s.sigma_hat * s.sigma_hat * Ainv;
   s.std_residual = s.covariance_residual.diagonal().cwiseSqrt();
   if (options.sigma > 0) {
@@ -126,7 +136,7 @@ void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet&
   s.delta = e;
   s.nominal = RangerMeasurement(model_ref).NominalValues();
   s.estimate = s.nominal + s.delta;
-  SummarizeFit(IdentificationJacobian(*model, data.configs, e.data()), weights, residuals, 1,
+  SummarizeFit(IdentificationJacobian(*model, data.configs, e.data()), weights, residuals, 1, m,
                options, &s);
 }
 
@@ -156,6 +166,9 @@ bool ValidOptions(const IdentificationOptions& options, IdentificationSummary* s
 
 IdentificationSummary Identify(const MeasurementModel& model_in, const MeasurementSet& data,
                                const IdentificationOptions& options) {
+  // The maximum a-posteriori estimate is the kind-neutral path's (prior.h).
+  if (!options.priors.empty())
+    return Identify(RangerMeasurement(model_in), ToMeasuredValues(data), options);
   IdentificationSummary s;
   DescribeSolver(options, &s);
   s.num_configurations = data.size();
@@ -241,32 +254,86 @@ bool CheckMeasuredValues(const MeasurementKind& kind, const MeasuredValues& data
   return true;
 }
 
-// Costs, residuals and covariance at e for any kind (the ranger's own path: EstimateStatistics).
-void EstimateKindStatistics(const MeasurementKind& kind, const MeasuredValues& data,
-                            const std::vector<double>& weights, const Eigen::VectorXd& e,
-                            const IdentificationOptions& options, IdentificationSummary* summary) {
+// The rows an identification of a kind solves: every measured value (weighted by its
+// configuration's repetitions), then, with priors, one row per term that has a prior (measured 0,
+// weight (σ/σ_k)²: prior.h).
+struct Rows {
+  std::vector<double> measured, weights;
+  int data_rows = 0;
+  Eigen::VectorXd prior_sigma;   // per term, 0 where it has none (empty without priors)
+  std::vector<int> prior_terms;  // the columns with a prior, ascending
+};
+
+Rows MakeRows(const MeasurementKind& kind, const MeasuredValues& data,
+              const IdentificationOptions& options) {
+  Rows rows;
+  const int k = kind.rows_per_configuration();
+  rows.measured = data.y;
+  for (int i = 0; i < data.size(); ++i)
+    rows.weights.insert(rows.weights.end(), k, data.repetitions[i]);
+  rows.data_rows = static_cast<int>(rows.measured.size());
+  if (options.priors.empty()) return rows;
+  rows.prior_sigma = options.priors.SigmasOf(kind.parameter_names());
+  for (int t = 0; t < kind.num_parameters(); ++t) {
+    if (!(rows.prior_sigma[t] > 0)) continue;
+    rows.prior_terms.push_back(t);
+    rows.measured.push_back(0);
+    const double ratio = options.sigma / rows.prior_sigma[t];
+    rows.weights.push_back(ratio * ratio);
+  }
+  return rows;
+}
+
+// The identifiability of a kind's rows: with priors, the Jacobian gains the priors' rows (scaled
+// like weighted readings), so a direction the readings cannot see but a prior sets is no
+// deficiency.
+IdentifiabilityReport AnalyzeRows(const MeasurementKind& kind, const MeasuredValues& data,
+                                  const IdentificationOptions& options) {
+  if (options.priors.empty())
+    return AnalyzeIdentifiability(kind, data.configs, nullptr, options.identifiability);
+  const Rows rows = MakeRows(kind, data, options);
+  const Eigen::MatrixXd G = MeasurementJacobian(kind, data.configs);
+  const int m = static_cast<int>(G.rows()), p = static_cast<int>(rows.prior_terms.size());
+  Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(m + p, G.cols());
+  augmented.topRows(m) = G;
+  for (int r = 0; r < p; ++r)
+    augmented(m + r, rows.prior_terms[r]) = std::sqrt(rows.weights[rows.data_rows + r]);
+  return AnalyzeJacobian(augmented, kind.parameter_names(), data.size(), options.identifiability);
+}
+
+// Costs, residuals and covariance at e for any kind's rows (the ranger's own path:
+// EstimateStatistics). The residual RMS is over the readings alone.
+void EstimateKindStatistics(MeasurementEvaluator& evaluator, const Rows& rows,
+                            const Eigen::VectorXd& nominal, const Eigen::VectorXd& e,
+                            int rows_per_configuration, const IdentificationOptions& options,
+                            IdentificationSummary* summary) {
   IdentificationSummary& s = *summary;
-  std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(data.configs);
-  const int m = evaluator->num_rows(), n = kind.num_parameters();
+  const int m = evaluator.num_rows(), n = evaluator.num_parameters();
   std::vector<double> y(m), residuals(m);
   Eigen::MatrixXd G(m, n);
   auto cost_at = [&](const Eigen::VectorXd& x, double* rms, double* J) {
-    evaluator->Predict(x.data(), y.data(), J);
+    evaluator.Predict(x.data(), y.data(), J);
     double c = 0, ss = 0;
     for (int i = 0; i < m; ++i) {
-      residuals[i] = data.y[i] - y[i];
-      c += 0.5 * weights[i] * residuals[i] * residuals[i];
-      ss += residuals[i] * residuals[i];
+      residuals[i] = rows.measured[i] - y[i];
+      c += 0.5 * rows.weights[i] * residuals[i] * residuals[i];
+      if (i < rows.data_rows) ss += residuals[i] * residuals[i];
     }
-    if (rms) *rms = std::sqrt(ss / m);
+    if (rms) *rms = std::sqrt(ss / rows.data_rows);
     return c;
   };
   s.initial_cost = cost_at(Eigen::VectorXd::Zero(n), nullptr, nullptr);
   s.final_cost = cost_at(e, &s.residual_rms, G.data());
   s.delta = e;
-  s.nominal = kind.NominalValues();
+  s.nominal = nominal;
   s.estimate = s.nominal + s.delta;
-  SummarizeFit(G, weights, residuals, kind.rows_per_configuration(), options, &s);
+  SummarizeFit(G, rows.weights, residuals, rows_per_configuration, rows.data_rows, options, &s);
+  if (rows.prior_sigma.size() == 0) return;
+  s.prior_sigma = rows.prior_sigma;
+  s.posterior_to_prior.resize(n);
+  for (int k = 0; k < n; ++k)
+    s.posterior_to_prior[k] =
+        rows.prior_sigma[k] > 0 ? s.std_given[k] / rows.prior_sigma[k] : std::nan("");
 }
 
 }  // namespace
@@ -275,14 +342,13 @@ IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredVal
                                const IdentificationOptions& options) {
   IdentificationSummary s;
   DescribeSolver(options, &s);
+  if (!options.priors.empty()) s.loss += " with priors";
   s.num_configurations = data.size();
   if (!ValidOptions(options, &s) || !CheckMeasuredValues(kind_in, data, options, &s)) return s;
   std::unique_ptr<MeasurementKind> reduced;
   const MeasurementKind* kind = CheckIdentifiable(
       kind_in, kind_in.parameter_names(), options,
-      [&](const MeasurementKind& k) {
-        return AnalyzeIdentifiability(k, data.configs, nullptr, options.identifiability);
-      },
+      [&](const MeasurementKind& k) { return AnalyzeRows(k, data, options); },
       [](const MeasurementKind& k, const std::vector<std::string>& names) {
         return k.Without(names);
       },
@@ -290,22 +356,34 @@ IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredVal
   if (!kind) return s;
 
   s.names = kind->parameter_names();
-  const int k = kind->rows_per_configuration();
-  std::vector<double> weights;
-  for (int i = 0; i < data.size(); ++i) weights.insert(weights.end(), k, data.repetitions[i]);
+  const Rows rows = MakeRows(*kind, data, options);
+  std::unique_ptr<MeasurementEvaluator> readings = kind->Bind(data.configs);
+  PriorRowsEvaluator evaluator(*readings, rows.prior_terms);
   Eigen::VectorXd e;
   if (options.solver == IdentificationOptions::Solver::kCeres) {
-    s.termination = SolveWithCeres(*kind, data, options, &e, &s.iterations, &s.message);
+    s.termination = SolveWithCeres(
+        *kind, data,
+        {rows.prior_terms,
+         std::vector<double>(rows.weights.begin() + rows.data_rows, rows.weights.end())},
+        options, &e, &s.iterations, &s.message);
   } else {
-    std::unique_ptr<MeasurementEvaluator> evaluator = kind->Bind(data.configs);
     LevenbergMarquardt lm;
-    LevenbergMarquardt::Result r = lm.Solve(*evaluator, data.y.data(), weights.data(), options, &e);
+    LevenbergMarquardt::Result r =
+        lm.Solve(evaluator, rows.measured.data(), rows.weights.data(), options, &e);
     s.termination = r.termination;
     s.iterations = r.iterations;
     s.message = std::string("lrcal Levenberg-Marquardt: ") + TerminationName(r.termination);
   }
-  EstimateKindStatistics(*kind, data, weights, e, options, &s);
+  EstimateKindStatistics(evaluator, rows, kind->NominalValues(), e, kind->rows_per_configuration(),
+                         options, &s);
   return s;
+}
+
+std::vector<std::string> IdentificationSummary::SetByPrior() const {
+  std::vector<std::string> set;
+  for (Eigen::Index k = 0; k < posterior_to_prior.size(); ++k)
+    if (posterior_to_prior[k] > kSetByPrior) set.push_back(names[k]);
+  return set;
 }
 
 Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double sigma) {
@@ -317,6 +395,9 @@ std::string FitCheck::Explain() const {
   std::ostringstream out;
   if (sigma_given) {
     out << "fit: chi2 = " << chi2 << " on " << dof << " degrees of freedom";
+    if (num_priors > 0)
+      out << " (readings " << chi2 - chi2_priors << ", the " << num_priors << " priors "
+          << chi2_priors << ")";
     if (dof <= 0) {
       out << " (as many configurations as parameters: no test)";
     } else if (consistent) {
@@ -328,6 +409,8 @@ std::string FitCheck::Explain() const {
              "error the model does not have (readings on a second plane, the ranger's offset or "
              "scale, noisy joint encoders, a fixed parameter that is not at its nominal value); "
              "wrong units (readings in mm, joint angles in degrees); outlying readings";
+      if (num_priors > 0)
+        out << "; priors tighter than the terms' true deviations (a large priors' part of chi2)";
       if (!suspects.empty()) out << " (see the suspects below)";
     }
     out << "\n";
@@ -359,19 +442,38 @@ std::string IdentificationSummary::BriefReport() const {
 
 std::string IdentificationSummary::ParameterTable() const {
   if (!IsSolutionUsable()) return "";
-  Table t({"parameter", "unit", "nominal (SI)", "delta", "std", "std (given sigma)"},
-          "Identified parameters (delta and std in the unit shown: mrad, mm, ppm)");
+  const bool priors = prior_sigma.size() > 0;
+  std::vector<std::string> header = {"parameter", "unit", "nominal (SI)",
+                                     "delta",     "std",  "std (given sigma)"};
+  if (priors) header.insert(header.end(), {"prior std", "posterior/prior"});
+  Table t(header, "Identified parameters (delta and std in the unit shown: mrad, mm, ppm)");
   for (std::size_t k = 0; k < names.size(); ++k) {
     const DisplayUnit u = DisplayUnitOf(names[k]);
-    t.AddRow({names[k], u.unit, Fixed(nominal[k], 6), Fixed(delta[k] * u.factor),
-              std::isnan(std_residual[k]) ? "undefined" : Fixed(std_residual[k] * u.factor),
-              std_given.size() ? Fixed(std_given[k] * u.factor) : "—"});
+    std::vector<std::string> row = {
+        names[k],
+        u.unit,
+        Fixed(nominal[k], 6),
+        Fixed(delta[k] * u.factor),
+        std::isnan(std_residual[k]) ? "undefined" : Fixed(std_residual[k] * u.factor),
+        std_given.size() ? Fixed(std_given[k] * u.factor) : "—"};
+    if (priors) {
+      const bool has = prior_sigma[static_cast<Eigen::Index>(k)] > 0;
+      row.push_back(has ? Fixed(prior_sigma[static_cast<Eigen::Index>(k)] * u.factor) : "—");
+      row.push_back(has ? Fixed(posterior_to_prior[static_cast<Eigen::Index>(k)], 3) : "—");
+    }
+    t.AddRow(row);
   }
   std::string text = t.ToText();
   if (std::isnan(sigma_hat))
     text +=
         "std: undefined (as many configurations as parameters: no residual to estimate the "
         "noise from; give --sigma-mm for the given-sigma column)\n";
+  if (priors) {
+    const std::vector<std::string> set = SetByPrior();
+    text += "set by the prior (posterior/prior std above " + Fixed(kSetByPrior, 1) + "):";
+    for (const std::string& name : set) text += " " + name;
+    text += set.empty() ? " none\n" : "\n";
+  }
   return text;
 }
 

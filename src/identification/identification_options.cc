@@ -37,6 +37,12 @@ const std::vector<SettingField<IdentificationOptions>>& IdentificationOptions::S
   return fields;
 }
 
-void IdentificationOptions::Validate() const { CheckSettings(*this, Settings()); }
+void IdentificationOptions::Validate() const {
+  CheckSettings(*this, Settings());
+  if (!priors.empty() && !(sigma > 0))
+    throw SettingError(SettingSpec::Named("identification", "priors", "prior_sigma"),
+                       "priors are weighed against the readings' noise: give the noise of one "
+                       "reading as well");
+}
 
 }  // namespace lrcal

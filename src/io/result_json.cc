@@ -68,19 +68,55 @@ ResultJson RemediesJson(const RemedyReport& r) {
   return j;
 }
 
-ResultJson IdentificationJson(const IdentificationSummary& s) {
-  ResultJson j;
+namespace {
+
+ResultJson OrNull(double x) { return std::isnan(x) ? ResultJson() : ResultJson(x); }
+
+// The parameters of a usable identification, with their priors when it had any.
+ResultJson ParametersJson(const IdentificationSummary& s) {
   ResultJson params = ResultJson::array();
   for (std::size_t k = 0; k < s.names.size() && s.IsSolutionUsable(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
     params.push_back(
         {{"name", s.names[k]},
-         {"nominal", s.nominal[k]},
-         {"estimate", s.estimate[k]},
-         {"delta", s.delta[k]},
-         {"std", s.std_residual[k]},
-         {"std_given_sigma", s.std_given.size() ? ResultJson(s.std_given[k]) : ResultJson()}});
+         {"nominal", s.nominal[i]},
+         {"estimate", s.estimate[i]},
+         {"delta", s.delta[i]},
+         {"std", s.std_residual[i]},
+         {"std_given_sigma", s.std_given.size() ? ResultJson(s.std_given[i]) : ResultJson()}});
+    if (s.prior_sigma.size() == 0) continue;  // without priors the JSON is as before them
+    const bool has = s.prior_sigma[i] > 0;
+    params.back()["prior_sigma"] = has ? ResultJson(s.prior_sigma[i]) : ResultJson();
+    params.back()["posterior_to_prior"] = has ? ResultJson(s.posterior_to_prior[i]) : ResultJson();
   }
-  j["parameters"] = params;
+  return params;
+}
+
+ResultJson FitJson(const FitCheck& f) {
+  ResultJson fit = {{"dof", f.dof}, {"standardized_residuals", f.standardized}};
+  ResultJson suspects = ResultJson::array();
+  for (int i : f.suspects) suspects.push_back(i + 1);
+  fit["suspects"] = suspects;  // 1-based configurations
+  if (f.num_priors > 0) {      // without priors the JSON is as before them
+    fit["num_priors"] = f.num_priors;
+    fit["chi2_priors"] = OrNull(f.chi2_priors);
+  }
+  if (f.sigma_given) {
+    fit["chi2"] = f.chi2;
+    fit["p_value"] = OrNull(f.p_value);
+    fit["consistent"] = f.consistent;
+  } else {
+    fit["chi2"] = fit["p_value"] = fit["consistent"] = nullptr;  // no σ given: no test
+  }
+  return fit;
+}
+
+}  // namespace
+
+ResultJson IdentificationJson(const IdentificationSummary& s) {
+  ResultJson j;
+  j["parameters"] = ParametersJson(s);
+  if (s.prior_sigma.size()) j["set_by_prior"] = s.SetByPrior();
   j["covariance"] = s.IsSolutionUsable() ? ToJson(s.covariance_residual) : ResultJson();
   j["covariance_given_sigma"] =
       s.covariance_given.size() ? ToJson(s.covariance_given) : ResultJson();
@@ -93,22 +129,8 @@ ResultJson IdentificationJson(const IdentificationSummary& s) {
   j["usable"] = s.IsSolutionUsable();
   j["message"] = s.message;
   j["residual_rms"] = s.residual_rms;
-  const auto number = [](double x) { return std::isnan(x) ? ResultJson() : ResultJson(x); };
-  j["sigma_hat"] = number(s.sigma_hat);
-  if (s.IsSolutionUsable()) {
-    ResultJson fit = {{"dof", s.fit.dof}, {"standardized_residuals", s.fit.standardized}};
-    ResultJson suspects = ResultJson::array();
-    for (int i : s.fit.suspects) suspects.push_back(i + 1);
-    fit["suspects"] = suspects;  // 1-based configurations
-    if (s.fit.sigma_given) {
-      fit["chi2"] = s.fit.chi2;
-      fit["p_value"] = number(s.fit.p_value);
-      fit["consistent"] = s.fit.consistent;
-    } else {
-      fit["chi2"] = fit["p_value"] = fit["consistent"] = nullptr;  // no σ given: no test
-    }
-    j["fit"] = fit;
-  }
+  j["sigma_hat"] = OrNull(s.sigma_hat);
+  if (s.IsSolutionUsable()) j["fit"] = FitJson(s.fit);
   j["n_configurations"] = s.num_configurations;
   j["solver"] = s.solver;
   j["loss"] = s.loss;

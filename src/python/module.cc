@@ -401,6 +401,7 @@ struct IdentifyArgs {
   double loss_scale_mm, sigma_mm;
   long long max_iterations;
   py::object loss_scale, sigma;  // the earlier spellings, in m (None: not given)
+  std::string prior_sigma;       // as --prior-sigma; "" = no priors
 };
 
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
@@ -427,6 +428,7 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
     throw SettingError(iterations.spec, max_iterations).Respelled(Frontend::kPython);
   options.max_iterations = static_cast<int>(a.max_iterations);
   options.fix_dependent_parameters = auto_fix;
+  if (!a.prior_sigma.empty()) options.priors = PriorSigmas::Parse(a.prior_sigma, "prior_sigma=");
   options.Validate();
   py::gil_scoped_release release;
   return Identify(model, data, options);
@@ -752,7 +754,8 @@ The result of lrcal.identify. Arrays are SI (m, rad); index k belongs to names[k
   sigma_hat (m), residual_rms (m), initial_cost, final_cost (½Σr², m²), iterations,
   num_configurations, termination ('converged', 'max_iterations', 'rank_deficient',
   'beam_missed', 'numerical_failure', 'invalid_input'), usable, message, fixed (parameters fixed
-  for rank), identifiability, solver.
+  for rank), identifiability, solver; with priors prior_sigma (SI, 0 where none),
+  posterior_to_prior (NaN where no prior) and set_by_prior (posterior/prior above 0.9).
 str() gives the full text report; repr() the one-line summary.)doc")
       .def_readonly("names", &S::names)
       .def_readonly("nominal", &S::nominal)
@@ -776,6 +779,9 @@ str() gives the full text report; repr() the one-line summary.)doc")
       .def_readonly("fixed", &S::fixed)
       .def_readonly("identifiability", &S::identifiability)
       .def_readonly("solver", &S::solver)
+      .def_readonly("prior_sigma", &S::prior_sigma)
+      .def_readonly("posterior_to_prior", &S::posterior_to_prior)
+      .def_property_readonly("set_by_prior", &S::SetByPrior)
       .def("__str__", &S::FullReport)
       .def("__repr__", &S::BriefReport);
 }
@@ -866,16 +872,17 @@ void DefineCalibration(py::module_& m) {
       [](const RobotFile& rig, const Array& q, const Array& h, const py::object& plane,
          const std::string& estimate_plane, const py::object& fix, bool auto_fix,
          const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
-         long long max_iterations, const py::object& loss_scale, const py::object& sigma) {
-        return IdentifyPy(
-            rig, q, h, plane, estimate_plane, fix, auto_fix,
-            {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma});
+         long long max_iterations, const py::object& loss_scale, const py::object& sigma,
+         const std::string& prior_sigma) {
+        return IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
+                          {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
+                           prior_sigma});
       },
       py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
       py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
       setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
-      py::arg("sigma") = py::none(), R"doc(
+      py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", R"doc(
 Identifies the geometric parameters (and plane terms) from laser readings.
 
 q (M, joints) rad and h (M,) m are single readings; readings at identical joint values are
@@ -889,6 +896,9 @@ loss_scale_mm (mm, as `lrcal identify --loss-scale-mm`) on each configuration's 
 sigma_mm: the known σ of one reading (mm, as --sigma-mm) for covariance_given and the fit check;
 0 = unknown. loss_scale and sigma (m) are the earlier spellings of the two, still accepted.
 max_iterations: 1 to 10,000.
+prior_sigma: prior standard deviations as `lrcal identify --prior-sigma` takes them
+("theta=1mrad,a=0.5mm,d6=0.2mm": a class or a term, each with its unit); with sigma_mm, the
+maximum a-posteriori estimate (prior_sigma, posterior_to_prior and set_by_prior on the result).
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc");
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",

@@ -466,6 +466,35 @@ TEST_F(CliTest, IdentifyRefusesRankDeficientSetAndSuggestsTheFix) {
   EXPECT_EQ(Json::parse(out)["fixed_for_rank"].size(), 1u);
 }
 
+// identify --prior-sigma on a horizontal plane, which cannot see theta1, a1 and d3: the maximum
+// a-posteriori estimate converges (exit 0) where least squares is refused, and says which terms
+// the priors set, in text and JSON.
+TEST_F(CliTest, IdentifyWithPriorsSetsWhatTheReadingsCannotSee) {
+  std::string out;
+  const std::string plane = " --plane 0,0,1,0.3";
+  ASSERT_EQ(Run("sample --count 60 --out " + Path("c.csv") + plane, &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv") + plane +
+                    " --sigma-mm 0.2 --seed 3",
+                &out),
+            0)
+      << out;
+  const std::string identify = "identify --data " + Path("m.csv") + plane + " --sigma-mm 0.2";
+  EXPECT_EQ(Run(identify, &out), 3) << out;
+  const std::string priors = " --prior-sigma theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d=5mm";
+  ASSERT_EQ(Run(identify + priors, &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("least squares with priors"));
+  EXPECT_THAT(out, ::testing::HasSubstr("set by the prior (posterior/prior std above 0.9): "
+                                        "theta1 a1 d3"));
+  ASSERT_EQ(Run(identify + priors + " --format json", &out), 0) << out;
+  const Json j = Json::parse(out);
+  EXPECT_EQ(j["set_by_prior"], Json({"theta1", "a1", "d3"}));
+  EXPECT_EQ(j["fit"]["num_priors"], 25);
+  for (const Json& p : j["parameters"]) {
+    EXPECT_DOUBLE_EQ(p["prior_sigma"].get<double>(), 5e-3) << p["name"];
+    EXPECT_GT(p["posterior_to_prior"].get<double>(), 0) << p["name"];
+  }
+}
+
 // identify with --sigma-mm: a consistent fit passes; a stated σ of a fifth of the real one is
 // exit 4 with the verdict in words; too few configurations are exit 2 naming the file.
 TEST_F(CliTest, IdentifyChecksTheFitAgainstTheStatedNoise) {

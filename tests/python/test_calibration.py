@@ -91,6 +91,33 @@ def test_sample_simulate_identify_match_the_program_bit_for_bit(tmp_path, cli, p
     assert result.usable and "converged" in repr(result) and "theta1" in str(result)
 
 
+def test_identify_with_priors_matches_the_program_bit_for_bit(tmp_path, cli, paper):
+    """lrcal.identify(prior_sigma=...) is `lrcal identify --prior-sigma`: the same maximum
+    a-posteriori estimate, covariance and posterior/prior ratios, and the same refusals."""
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    priors = "theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d6=0.2mm,d=5mm"
+    cli("sample", "--robot", "paper", "--count", 40, "--seed", 3, "--out", configs)
+    cli("simulate", "--robot", "paper", "--configs", configs, "--seed", 3, "--out", data)
+    program = json.loads(cli("identify", "--robot", "paper", "--data", data, "--sigma-mm", 0.2,
+                             "--prior-sigma", priors, "--format", "json").stdout)
+    header, m = read_csv(data)
+    result = lrcal.identify(paper, m[:, :6], m[:, header.index("h")], sigma_mm=0.2,
+                            prior_sigma=priors)
+    assert "with priors" in repr(result)
+    np.testing.assert_array_equal(result.estimate, [p["estimate"] for p in program["parameters"]])
+    np.testing.assert_array_equal(result.covariance_given, program["covariance_given_sigma"])
+    np.testing.assert_array_equal(result.prior_sigma,
+                                  [p["prior_sigma"] for p in program["parameters"]])
+    np.testing.assert_array_equal(result.posterior_to_prior,
+                                  [p["posterior_to_prior"] for p in program["parameters"]])
+    assert result.prior_sigma[result.names.index("d6")] == 0.2e-3
+    assert result.set_by_prior == program["set_by_prior"]
+    with pytest.raises(lrcal.InputError, match=r"prior_sigma=: 'd=1': 'd' is a length"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], sigma_mm=0.2, prior_sigma="d=1")
+    with pytest.raises(lrcal.InputError, match="prior_sigma=: priors are weighed"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], prior_sigma="d=1mm")
+
+
 def test_identification_recovers_the_true_errors_without_noise(paper):
     q = lrcal.sample_configurations(paper, 60, seed=11)
     h = lrcal.laser_readings(paper, q, model="true")

@@ -24,6 +24,7 @@
 #include "lrcal/core/enum_names.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/prior.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/measurement/measurement_set.h"
 
@@ -58,12 +59,17 @@ struct IdentificationOptions {
   /// identifiability analysis' suggested parameters at nominal and identify the rest.
   bool fix_dependent_parameters = false;
   IdentifiabilityOptions identifiability;
+  /// Prior standard deviations of the estimated terms (prior.h): when given, the maximum
+  /// a-posteriori estimate around the nominal values, which needs `sigma` (the priors are weighed
+  /// against the readings' noise). Empty: least squares, bit for bit as without this field.
+  PriorSigmas priors;
   /// The numeric settings (settings.h): max_iterations (1 to 10,000), max_robust_iterations (1
   /// to 1,000,000), parameter_tolerance and function_tolerance (≥ 0), sigma_mm (σ, ≥ 0 mm; the
   /// command line's --sigma-mm) and loss_scale_mm (> 0 mm; --loss-scale-mm). A study gives σ as
   /// noise.sigma_mm and the loss scale in multiples of σ (identification.loss_scale).
   static const std::vector<SettingField<IdentificationOptions>>& Settings();
-  /// Throws SettingError naming the library field (identification.sigma, ...) and the range.
+  /// Throws SettingError naming the library field (identification.sigma, ...) and the range;
+  /// with priors, naming identification.priors unless sigma > 0.
   void Validate() const;
 };
 
@@ -110,6 +116,11 @@ struct FitCheck {
   std::vector<int> suspects;
   /// Measured values per configuration (measurement_kind.h): 1 for the ranger.
   int rows_per_configuration = 1;
+  /// With priors (prior.h): how many terms have one, and their part of chi2, Σ e_k²/σ_k² (the
+  /// rest is the readings'). A large part says the priors are tighter than the terms' true
+  /// deviations. NaN without σ.
+  int num_priors = 0;
+  double chi2_priors = std::numeric_limits<double>::quiet_NaN();
   /// The verdict in words, with the likely causes when the fit is inconsistent.
   std::string Explain() const;
 };
@@ -141,6 +152,15 @@ struct IdentificationSummary {
   /// The cost minimised, in words: "least squares", or "huber loss, scale 0.269 mm" (the
   /// scale on each configuration's weighted residual √R·(h̄ − h)).
   std::string loss = "least squares";
+  /// With priors (IdentificationOptions::priors): each estimated term's prior σ (SI, 0 where it
+  /// has none) and the ratio of its posterior standard deviation (given σ) to it (NaN where it
+  /// has none): near 1 the prior alone sets the term. Empty without priors.
+  Eigen::VectorXd prior_sigma;
+  Eigen::VectorXd posterior_to_prior;
+  /// Above this ratio a term is "set by the prior": the readings barely inform it.
+  static constexpr double kSetByPrior = 0.9;
+  /// The terms set by the prior (posterior_to_prior > kSetByPrior), in parameter order.
+  std::vector<std::string> SetByPrior() const;
 
   bool IsSolutionUsable() const { return termination == Termination::kConverged; }
   /// One line: solver, loss, termination, iterations, sizes, cost, residual RMS.
@@ -165,8 +185,11 @@ IdentificationSummary Identify(const MeasurementModel& model, const MeasurementS
 /// Identifies any measurement kind's terms (measurement_kind.h) from `data`: the same solvers,
 /// identifiability check, covariance and fit check as the ranger's overload above, on every
 /// measured value (rows_per_configuration per configuration, each weighted by its
-/// configuration's repetitions). A robust loss is refused for kinds with more than one value per
-/// configuration (message). For a RangerMeasurement it agrees with the overload above to
+/// configuration's repetitions). With priors (options.priors) the maximum a-posteriori estimate
+/// (prior.h): the identifiability check, the covariance and the fit check (χ² over the readings
+/// and the prior rows, dof = values + priors − terms) are those of the augmented system, and the
+/// ranger's overload above comes here. A robust loss is refused for kinds with more than one value
+/// per configuration (message). For a RangerMeasurement it agrees with the overload above to
 /// rounding (its statistics come from the batch kernel instead of the per-configuration path).
 IdentificationSummary Identify(const MeasurementKind& kind, const MeasuredValues& data,
                                const IdentificationOptions& options = {});

@@ -1,0 +1,157 @@
+#include "lrcal/identification/prior.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/core/strings.h"
+#include "lrcal/measurement/parameter_set.h"
+
+namespace lrcal {
+
+namespace {
+
+// Every class of term a measurement kind has (parameter_set.h, point_measurement.h).
+constexpr const char* kClasses[] = {"theta",
+                                    "alpha",
+                                    "a",
+                                    "d",
+                                    "beta",
+                                    "plane_u",
+                                    "plane_f",
+                                    "ranger_offset",
+                                    "ranger_scale",
+                                    "instrument_x",
+                                    "instrument_y",
+                                    "instrument_z",
+                                    "instrument_roll",
+                                    "instrument_pitch",
+                                    "instrument_yaw",
+                                    "target_x",
+                                    "target_y",
+                                    "target_z"};
+
+struct Unit {
+  const char* name;
+  double to_si;
+  char dimension;  // 'a' angle, 'l' length, 's' scale
+};
+constexpr Unit kUnits[] = {{"rad", 1, 'a'},          {"mrad", 1e-3, 'a'}, {"urad", 1e-6, 'a'},
+                           {"deg", M_PI / 180, 'a'}, {"m", 1, 'l'},       {"mm", 1e-3, 'l'},
+                           {"um", 1e-6, 'l'},        {"ppm", 1e-6, 's'}};
+
+// The dimension of a class's terms.
+char DimensionOf(const std::string& cls) {
+  if (cls == "ranger_scale") return 's';
+  // A class is angular when its first member is ("theta" → "theta1", "plane_u" → "plane_u1").
+  const std::string member = cls == "plane_u" ? "plane_u1" : cls;
+  return IsAngularName(member) ? 'a' : 'l';
+}
+
+const char* DimensionName(char dimension) {
+  return dimension == 'a'   ? "an angle (rad, mrad, urad or deg)"
+         : dimension == 'l' ? "a length (m, mm or um)"
+                            : "a scale (ppm)";
+}
+
+}  // namespace
+
+std::string TermClass(const std::string& name) {
+  std::string cls;
+  for (char c : name)
+    if (!std::isdigit(static_cast<unsigned char>(c))) cls += c;
+  return cls;
+}
+
+PriorSigmas PriorSigmas::Parse(const std::string& text, const std::string& source) {
+  PriorSigmas priors;
+  for (const std::string& item : SplitList(text)) {
+    const std::size_t eq = item.find('=');
+    const std::string where = "'" + item + "'";
+    if (eq == std::string::npos)
+      throw InputError(source, where + ": expected NAME=VALUE UNIT, e.g. theta=1mrad");
+    const std::string key = item.substr(0, eq);
+    const std::string cls = TermClass(key);
+    if (std::find(std::begin(kClasses), std::end(kClasses), cls) == std::end(kClasses))
+      throw InputError(source, where + ": '" + key +
+                                   "' is neither a term nor a class of terms (theta, alpha, a, "
+                                   "d, beta, plane_u, plane_f, ranger_offset, ranger_scale, "
+                                   "instrument_*, target_*, or one of their names: d6)");
+    for (const Entry& e : priors.entries)
+      if (e.key == key) throw InputError(source, where + ": '" + key + "' is given twice");
+    std::string value = item.substr(eq + 1);
+    const Unit* unit = nullptr;
+    for (const Unit& u : kUnits) {  // the longest unit that ends the value ("mm" before "m")
+      const std::string name = u.name;
+      if (value.size() > name.size() &&
+          value.compare(value.size() - name.size(), name.size(), name) == 0 &&
+          (!unit || name.size() > std::string(unit->name).size()))
+        unit = &u;
+    }
+    const char dimension = DimensionOf(cls);
+    if (!unit || unit->dimension != dimension)
+      throw InputError(
+          source, where + ": '" + key + "' is " + DimensionName(dimension) + ": give its unit");
+    double number = 0;
+    if (!ParseDecimal(value.substr(0, value.size() - std::string(unit->name).size()), &number) ||
+        !(number > 0))
+      throw InputError(source, where + ": expected a finite value > 0");
+    priors.entries.push_back({key, number * unit->to_si});
+  }
+  return priors;
+}
+
+double PriorSigmas::SigmaOf(const std::string& name) const {
+  const std::string cls = TermClass(name);
+  double by_class = 0;
+  for (const Entry& e : entries) {
+    if (e.key == name) return e.sigma;
+    if (e.key == cls) by_class = e.sigma;
+  }
+  return by_class;
+}
+
+Eigen::VectorXd PriorSigmas::SigmasOf(const std::vector<std::string>& names) const {
+  Eigen::VectorXd sigmas(static_cast<Eigen::Index>(names.size()));
+  for (std::size_t k = 0; k < names.size(); ++k)
+    sigmas[static_cast<Eigen::Index>(k)] = SigmaOf(names[k]);
+  return sigmas;
+}
+
+std::string PriorSigmas::ToString() const {
+  std::ostringstream out;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const std::string cls = TermClass(entries[k].key);
+    const DisplayUnit unit = DisplayUnitOf(DimensionOf(cls) == 'a'   ? "theta1"
+                                           : DimensionOf(cls) == 's' ? "ranger_scale"
+                                                                     : "a1");
+    out << (k ? ", " : "") << entries[k].key << "=" << entries[k].sigma * unit.factor << " "
+        << unit.unit;
+  }
+  return out.str();
+}
+
+PriorRowsEvaluator::PriorRowsEvaluator(MeasurementEvaluator& data, std::vector<int> terms)
+    : data_(data), terms_(std::move(terms)) {}
+
+int PriorRowsEvaluator::num_rows() const {
+  return data_.num_rows() + static_cast<int>(terms_.size());
+}
+
+bool PriorRowsEvaluator::Predict(const double* e, double* y, double* J) {
+  const int m = data_.num_rows(), rows = num_rows(), n = num_parameters();
+  scratch_.resize(J ? static_cast<std::size_t>(m) * n : 0);
+  if (!data_.Predict(e, y, J ? scratch_.data() : nullptr)) return false;
+  for (std::size_t p = 0; p < terms_.size(); ++p) y[m + p] = e[terms_[p]];
+  if (!J) return true;
+  for (int k = 0; k < n; ++k) {
+    double* column = J + static_cast<std::size_t>(k) * rows;
+    std::copy_n(scratch_.data() + static_cast<std::size_t>(k) * m, m, column);
+    for (std::size_t p = 0; p < terms_.size(); ++p) column[m + p] = terms_[p] == k ? 1.0 : 0.0;
+  }
+  return true;
+}
+
+}  // namespace lrcal
