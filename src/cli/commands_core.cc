@@ -19,6 +19,7 @@
 #include "lrcal/io/kinematics_report.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/paper/paper_case.h"
 #include "lrcal/report/calibration_report.h"
@@ -296,6 +297,23 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   return s.IsSolutionUsable() ? 0 : 1;
 }
 
+namespace {
+
+// identifiability --prior-sigma: what readings of the stated noise at these configurations tell
+// against the priors (prior.h).
+std::optional<PriorInformation> PriorInformationAt(const po::variables_map& vm,
+                                                   const MeasurementModel& model,
+                                                   const ConfigurationSet& configs) {
+  if (!vm.count("prior-sigma")) return std::nullopt;
+  const PriorSigmas priors =
+      PriorSigmas::Parse(vm["prior-sigma"].as<std::string>(), "--prior-sigma");
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  return InformationFromPriors(RangerMeasurement(model), configs, noise, priors);
+}
+
+}  // namespace
+
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identifiability options");
   AddCommonOptions(o);
@@ -306,7 +324,12 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "plane terms in the set: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters to leave out, comma-separated")(
       "rank-tolerance", po::value<double>()->default_value(1e-8),
-      "relative singular value below which a direction is unobservable");
+      "relative singular value below which a direction is unobservable")(
+      "prior-sigma", po::value<std::string>(),
+      "prior standard deviations as identify takes them (theta=1mrad,a=0.5mm,...): also say, "
+      "per term, how much readings with --sigma-mm and --repetitions would inform it against "
+      "its prior (posterior/prior std; above 0.9 the prior alone sets it)");
+  AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -324,13 +347,16 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   remedy_options.ranger = rig.ranger;
   remedy_options.identifiability = options;
   const RemedyReport remedies = FindRemedies(model, configs, r, remedy_options);
+  const std::optional<PriorInformation> priors = PriorInformationAt(vm, model, configs);
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = IdentifiabilityJson(r);
     if (!r.full_rank()) j["remedies"] = RemediesJson(remedies);
+    if (priors) j["priors"] = PriorInformationJson(*priors);
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << r.ToString();
     if (!r.full_rank()) std::cout << "how to recover what is lost:\n" << remedies.ToString();
+    if (priors) std::cout << priors->ToString();
   }
   return 0;
 }

@@ -1,12 +1,15 @@
 #include "lrcal/identification/prior.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/core/text_table.h"
 #include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
@@ -130,6 +133,81 @@ std::string PriorSigmas::ToString() const {
     out << (k ? ", " : "") << entries[k].key << "=" << entries[k].sigma * unit.factor << " "
         << unit.unit;
   }
+  return out.str();
+}
+
+PriorInformation InformationFromPriors(const Eigen::MatrixXd& G, const std::vector<double>& weights,
+                                       double sigma, const PriorSigmas& priors,
+                                       const std::vector<std::string>& names) {
+  if (!(sigma > 0)) throw InputError("priors", "the noise of one reading must be > 0");
+  PriorInformation info;
+  info.names = names;
+  info.sigma = sigma;
+  info.prior_sigma = priors.SigmasOf(names);
+  const Eigen::Index n = G.cols();
+  const Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(weights.data(), G.rows());
+  Eigen::MatrixXd A = G.transpose() * w.asDiagonal() * G / (sigma * sigma);
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (info.prior_sigma[k] > 0) A(k, k) += 1 / (info.prior_sigma[k] * info.prior_sigma[k]);
+  // Proper when the information matrix is positive definite, judged on its unit-diagonal form
+  // with the identifiability analysis' default tolerance on singular values (1e-8, squared).
+  const Eigen::VectorXd d = A.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::VectorXd lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                                     d.asDiagonal() * A * d.asDiagonal(), Eigen::EigenvaluesOnly)
+                                     .eigenvalues();
+  info.defined = n > 0 && lambda[0] > 1e-16 * lambda[n - 1];
+  info.posterior_sigma = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  if (info.defined)
+    info.posterior_sigma = A.ldlt().solve(Eigen::MatrixXd::Identity(n, n)).diagonal().cwiseSqrt();
+  // Undefined, no ratio means anything: the unbounded direction is the message.
+  info.posterior_to_prior.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k)
+    info.posterior_to_prior[k] = info.defined && info.prior_sigma[k] > 0
+                                     ? info.posterior_sigma[k] / info.prior_sigma[k]
+                                     : std::numeric_limits<double>::quiet_NaN();
+  return info;
+}
+
+PriorInformation InformationFromPriors(const MeasurementKind& kind, const ConfigurationSet& configs,
+                                       const NoiseModel& noise, const PriorSigmas& priors) {
+  noise.Validate();
+  if (!(noise.sigma > 0))
+    throw SettingError(FindSetting(NoiseModel::Settings(), "sigma_mm")->spec,
+                       "priors are weighed against the readings' noise: expected a value > 0");
+  const Eigen::MatrixXd G = MeasurementJacobian(kind, configs);
+  return InformationFromPriors(G, std::vector<double>(G.rows(), noise.repetitions), noise.sigma,
+                               priors, kind.parameter_names());
+}
+
+std::vector<std::string> PriorInformation::SetByPrior() const {
+  std::vector<std::string> set;
+  for (Eigen::Index k = 0; k < posterior_to_prior.size(); ++k)
+    if (posterior_to_prior[k] > kSetByPriorRatio) set.push_back(names[k]);
+  return set;
+}
+
+std::string PriorInformation::ToString() const {
+  std::ostringstream out;
+  Table t({"parameter", "unit", "prior std", "posterior std", "posterior/prior"},
+          "What the readings tell against the priors (sigma " + Fixed(sigma * 1e3, 4) +
+              " mm per reading)");
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    const DisplayUnit u = DisplayUnitOf(names[k]);
+    const bool has = prior_sigma[i] > 0;
+    t.AddRow(
+        {names[k], u.unit, has ? Fixed(prior_sigma[i] * u.factor) : "—",
+         std::isfinite(posterior_sigma[i]) ? Fixed(posterior_sigma[i] * u.factor) : "unbounded",
+         std::isfinite(posterior_to_prior[i]) ? Fixed(posterior_to_prior[i], 3) : "—"});
+  }
+  out << t.ToText();
+  if (!defined)
+    out << "the readings and the priors together leave a direction unbounded: give a prior to "
+           "every term the analysis above says to fix\n";
+  const std::vector<std::string> set = SetByPrior();
+  out << "set by the prior (posterior/prior std above " << Fixed(kSetByPriorRatio, 1) << "):";
+  for (const std::string& name : set) out << " " << name;
+  out << (set.empty() ? " none\n" : "\n");
   return out.str();
 }
 

@@ -138,6 +138,25 @@ ResultJson IdentificationJson(const IdentificationSummary& s) {
   return j;
 }
 
+ResultJson PriorInformationJson(const PriorInformation& info) {
+  const auto finite = [](double x) { return std::isfinite(x) ? ResultJson(x) : ResultJson(); };
+  ResultJson terms = ResultJson::array();
+  for (std::size_t k = 0; k < info.names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    terms.push_back(
+        {{"name", info.names[k]},
+         {"prior_sigma", info.prior_sigma[i] > 0 ? ResultJson(info.prior_sigma[i]) : ResultJson()},
+         {"posterior_sigma", finite(info.posterior_sigma[i])},
+         {"posterior_to_prior", finite(info.posterior_to_prior[i])}});
+  }
+  ResultJson j;
+  j["sigma"] = info.sigma;
+  j["terms"] = terms;
+  j["set_by_prior"] = info.SetByPrior();
+  j["defined"] = info.defined;
+  return j;
+}
+
 ResultJson CrossValidationJson(const CrossValidation& cv) {
   ResultJson predictions = ResultJson::array();
   for (const auto& p : cv.predictions)

@@ -489,6 +489,16 @@ TEST_F(CliTest, IdentifyWithPriorsSetsWhatTheReadingsCannotSee) {
   const Json j = Json::parse(out);
   EXPECT_EQ(j["set_by_prior"], Json({"theta1", "a1", "d3"}));
   EXPECT_EQ(j["fit"]["num_priors"], 25);
+  // The same question before any reading: identifiability at the configurations.
+  ASSERT_EQ(Run("identifiability --configs " + Path("c.csv") + plane + priors +
+                    " --sigma-mm 0.2 --format json",
+                &out),
+            0)
+      << out;
+  const Json before = Json::parse(out)["priors"];
+  EXPECT_EQ(before["set_by_prior"], Json({"theta1", "a1", "d3"}));
+  EXPECT_TRUE(before["defined"].get<bool>());
+  EXPECT_EQ(before["terms"].size(), 25u);
   for (const Json& p : j["parameters"]) {
     EXPECT_DOUBLE_EQ(p["prior_sigma"].get<double>(), 5e-3) << p["name"];
     EXPECT_GT(p["posterior_to_prior"].get<double>(), 0) << p["name"];

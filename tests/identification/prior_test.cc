@@ -229,3 +229,45 @@ TEST(Priors, PosteriorCovarianceCoversTruthsDrawnFromThePriors) {
 
 }  // namespace
 }  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// Before any reading: the posterior of readings at the configurations against the priors is the
+// inverse of GᵀWG/σ² + diag(1/σ_k²), computed here independently; the horizontal plane's
+// unseen terms are set by their priors, and a term with neither readings nor a prior leaves
+// the posterior undefined.
+TEST(PriorInformation, IsThePosteriorOfReadingsAtTheConfigurations) {
+  const RobotModel& robot = testing::PaperRobot();
+  const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
+  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 60, 8);
+  const MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
+  const RangerMeasurement kind(model);
+  NoiseModel noise;
+  noise.sigma = kSigma;
+  noise.repetitions = 10;
+  const PriorSigmas priors = PriorSigmas::Parse("theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d=5mm");
+  const PriorInformation info = InformationFromPriors(kind, configs, noise, priors);
+  ASSERT_TRUE(info.defined);
+  const Eigen::MatrixXd G = IdentificationJacobian(model, configs);
+  const Eigen::VectorXd prior = priors.SigmasOf(model.parameters().names);
+  const Eigen::MatrixXd A = 10 * G.transpose() * G / (kSigma * kSigma) +
+                            Eigen::MatrixXd(prior.array().square().inverse().matrix().asDiagonal());
+  const Eigen::VectorXd posterior = A.inverse().diagonal().cwiseSqrt();
+  EXPECT_THAT(info.posterior_sigma, EigenNear(posterior, 1e-6 * posterior.maxCoeff()));
+  EXPECT_THAT(info.SetByPrior(), ElementsAre("theta1", "a1", "d3"));
+  EXPECT_THAT(info.ToString(), HasSubstr("set by the prior (posterior/prior std above 0.9): "
+                                         "theta1 a1 d3"));
+
+  const PriorInformation partial =
+      InformationFromPriors(kind, configs, noise, PriorSigmas::Parse("theta=5mrad"));
+  EXPECT_FALSE(partial.defined);
+  EXPECT_TRUE(partial.SetByPrior().empty());
+  EXPECT_THAT(partial.ToString(), HasSubstr("leave a direction unbounded"));
+  noise.sigma = 0;
+  EXPECT_THAT([&] { InformationFromPriors(kind, configs, noise, priors); },
+              ::testing::ThrowsMessage<InputError>(HasSubstr("noise.sigma")));
+}
+
+}  // namespace
+}  // namespace lrcal

@@ -157,8 +157,8 @@ struct IdentificationSummary {
   /// has none): near 1 the prior alone sets the term. Empty without priors.
   Eigen::VectorXd prior_sigma;
   Eigen::VectorXd posterior_to_prior;
-  /// Above this ratio a term is "set by the prior": the readings barely inform it.
-  static constexpr double kSetByPrior = 0.9;
+  /// Above this ratio a term is "set by the prior" (prior.h): the readings barely inform it.
+  static constexpr double kSetByPrior = kSetByPriorRatio;
   /// The terms set by the prior (posterior_to_prior > kSetByPrior), in parameter order.
   std::vector<std::string> SetByPrior() const;
 

@@ -24,6 +24,10 @@
 
 namespace lrcal {
 
+/// Above this ratio of a term's posterior to its prior standard deviation the term is "set by the
+/// prior": the readings barely inform it.
+inline constexpr double kSetByPriorRatio = 0.9;
+
 /// The class of a term: its name without digits ("theta3" → "theta", "plane2_u1" → "plane_u",
 /// "target2_x" → "target_x").
 std::string TermClass(const std::string& name);
@@ -47,6 +51,34 @@ struct PriorSigmas {
   /// "theta=1 mrad, d6=0.2 mm": the entries in their display units (DisplayUnitOf).
   std::string ToString() const;
 };
+
+/// How much readings inform each term against its prior, before any reading is taken: with the
+/// readings' Jacobian G (rows: measured values), their weights w (repetitions), the noise σ of
+/// one reading and the priors σ_k, the posterior covariance is (GᵀWG/σ² + diag(1/σ_k²))⁻¹.
+struct PriorInformation {
+  std::vector<std::string> names;
+  double sigma = 0;                    ///< m, the noise of one reading assumed
+  Eigen::VectorXd prior_sigma;         ///< SI, 0 where a term has no prior
+  Eigen::VectorXd posterior_sigma;     ///< SI; infinite where neither readings nor priors see
+  Eigen::VectorXd posterior_to_prior;  ///< NaN where a term has no prior, or !defined
+  /// Every direction is seen by the readings or set by a prior (the posterior is proper).
+  bool defined = false;
+  /// The terms whose posterior/prior ratio is above kSetByPriorRatio: the priors alone set them.
+  std::vector<std::string> SetByPrior() const;
+  /// A table: term, unit, prior, posterior, posterior/prior; then the terms set by the prior.
+  std::string ToString() const;
+};
+
+/// PriorInformation of the terms `names` (G's columns). Throws InputError unless sigma > 0.
+PriorInformation InformationFromPriors(const Eigen::MatrixXd& G, const std::vector<double>& weights,
+                                       double sigma, const PriorSigmas& priors,
+                                       const std::vector<std::string>& names);
+
+/// The same for a kind's terms at `configs` (at the nominal model), each configuration the mean
+/// of noise.repetitions readings of noise σ. Throws SettingError naming noise.sigma unless it is
+/// > 0 (priors are weighed against it).
+PriorInformation InformationFromPriors(const MeasurementKind& kind, const ConfigurationSet& configs,
+                                       const NoiseModel& noise, const PriorSigmas& priors);
 
 /// A kind's evaluator with one more row per term that has a prior: row m + p predicts the term's
 /// deviation e_k (its measured value is 0, the nominal) with Jacobian row e_kᵀ. With weights

@@ -32,6 +32,10 @@ ResultJson RemediesJson(const RemedyReport& r);
 /// An identification: parameters with their standard deviations, covariance, correlation, fit
 /// check (suspects 1-based) and termination.
 ResultJson IdentificationJson(const IdentificationSummary& s);
+/// What readings tell against priors (`lrcal identifiability --prior-sigma`): sigma (m), per term
+/// prior_sigma, posterior_sigma (null where unbounded), posterior_to_prior (null without a
+/// prior), then set_by_prior and defined.
+ResultJson PriorInformationJson(const PriorInformation& info);
 /// K-fold cross-validation (configurations 1-based, like the fit's suspects).
 ResultJson CrossValidationJson(const CrossValidation& cv);
 /// Predicted accuracy at poses (`configs` gives each pose's joint values), with the summary
