@@ -28,14 +28,21 @@ namespace lrcal::cli {
 
 namespace {
 
-IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm) {
+// --prior (the robot file's tolerances:) and --prior-sigma (over them): the priors to use.
+PriorSigmas ResolvePriors(const po::variables_map& vm, const RobotFile& rig) {
+  return PriorsFor(rig, vm.count("prior") && vm["prior"].as<bool>(),
+                   vm.count("prior-sigma") ? vm["prior-sigma"].as<std::string>() : "", "--prior",
+                   "--prior-sigma");
+}
+
+IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm,
+                                                   const RobotFile& rig) {
   IdentificationOptions options;
   options.solver = ParseName(kSolverNames, vm["solver"].as<std::string>(), "--solver", "solver");
   options.loss = ParseName(kRobustLossNames, vm["loss"].as<std::string>(), "--loss", "loss");
   ReadSettingOptions(vm, IdentificationOptions::Settings(), &options);
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
-  if (vm.count("prior-sigma"))
-    options.priors = PriorSigmas::Parse(vm["prior-sigma"].as<std::string>(), "--prior-sigma");
+  options.priors = ResolvePriors(vm, rig);
   options.Validate();
   return options;
 }
@@ -242,6 +249,8 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "unit: theta=1mrad,a=0.5mm,d6=0.2mm,ranger_scale=200ppm (classes: theta, alpha, a, d, "
       "beta, plane_u, plane_f, ranger_offset, ranger_scale). With --sigma-mm: the maximum "
       "a-posteriori estimate; a direction the readings cannot see is set by its prior")(
+      "prior", po::bool_switch(),
+      "use the robot file's tolerances: as priors (--prior-sigma entries replace the same keys)")(
       "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
       "loss", po::value<std::string>()->default_value("none"),
       "robust loss: none, huber, cauchy (either solver)")(
@@ -267,7 +276,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const PlaneSet& planes = setup.planes;
   const MeasurementSet data = ReadRobotMeasurements(vm["data"].as<std::string>(), rig, &planes);
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
-  const IdentificationOptions options = ResolveIdentificationOptions(vm);
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
   const IdentificationSummary s = Identify(model, data, options);
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
     throw InputError(vm["data"].as<std::string>(), s.message);
@@ -302,11 +311,11 @@ namespace {
 // identifiability --prior-sigma: what readings of the stated noise at these configurations tell
 // against the priors (prior.h).
 std::optional<PriorInformation> PriorInformationAt(const po::variables_map& vm,
+                                                   const RobotFile& rig,
                                                    const MeasurementModel& model,
                                                    const ConfigurationSet& configs) {
-  if (!vm.count("prior-sigma")) return std::nullopt;
-  const PriorSigmas priors =
-      PriorSigmas::Parse(vm["prior-sigma"].as<std::string>(), "--prior-sigma");
+  const PriorSigmas priors = ResolvePriors(vm, rig);
+  if (priors.empty()) return std::nullopt;
   NoiseModel noise;
   ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
   return InformationFromPriors(RangerMeasurement(model), configs, noise, priors);
@@ -328,7 +337,9 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "prior-sigma", po::value<std::string>(),
       "prior standard deviations as identify takes them (theta=1mrad,a=0.5mm,...): also say, "
       "per term, how much readings with --sigma-mm and --repetitions would inform it against "
-      "its prior (posterior/prior std; above 0.9 the prior alone sets it)");
+      "its prior (posterior/prior std; above 0.9 the prior alone sets it)")(
+      "prior", po::bool_switch(),
+      "the same with the robot file's tolerances: (--prior-sigma entries replace the same keys)");
   AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
@@ -347,7 +358,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   remedy_options.ranger = rig.ranger;
   remedy_options.identifiability = options;
   const RemedyReport remedies = FindRemedies(model, configs, r, remedy_options);
-  const std::optional<PriorInformation> priors = PriorInformationAt(vm, model, configs);
+  const std::optional<PriorInformation> priors = PriorInformationAt(vm, rig, model, configs);
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = IdentifiabilityJson(r);
     if (!r.full_rank()) j["remedies"] = RemediesJson(remedies);

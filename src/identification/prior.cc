@@ -123,6 +123,17 @@ Eigen::VectorXd PriorSigmas::SigmasOf(const std::vector<std::string>& names) con
   return sigmas;
 }
 
+PriorSigmas PriorSigmas::OverriddenBy(const PriorSigmas& over) const {
+  PriorSigmas merged;
+  for (const Entry& e : entries) {
+    const bool replaced = std::any_of(over.entries.begin(), over.entries.end(),
+                                      [&](const Entry& o) { return o.key == e.key; });
+    if (!replaced) merged.entries.push_back(e);
+  }
+  merged.entries.insert(merged.entries.end(), over.entries.begin(), over.entries.end());
+  return merged;
+}
+
 std::string PriorSigmas::ToString() const {
   std::ostringstream out;
   for (std::size_t k = 0; k < entries.size(); ++k) {

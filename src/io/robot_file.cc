@@ -12,6 +12,7 @@
 #include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/urdf.h"
+#include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
 
@@ -295,6 +296,93 @@ CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path)
   return r;
 }
 
+// A standard deviation from a robot file: a number > 0 (SI out, `scale` from the file's unit).
+double Tolerance(const YAML::Node& node, const std::string& path, const std::string& key,
+                 double scale) {
+  const double value = yaml::Number(node, path, key);
+  if (!(value > 0))
+    throw InputError(yaml::Where(path, node, key), "expected a standard deviation > 0");
+  return value * scale;
+}
+
+// tolerances.every_link or tolerances.links[i]: a link's values' tolerances, as classes
+// ("theta") or, for link `link` (1-based), names ("theta3").
+void ParseLinkTolerances(const YAML::Node& node, const std::string& path, const std::string& ctx,
+                         const std::vector<Link>& links, int link, double as, double ls,
+                         PriorSigmas* priors) {
+  yaml::CheckKeys(node, {"theta", "alpha", "a", "d", "beta"}, path, ctx);
+  for (int v = 0; v < kValuesPerLink; ++v) {
+    const YAML::Node value = node[LinkValueName(v)];
+    if (!value) continue;
+    const std::string key = ctx + "." + LinkValueName(v);
+    if (link > 0 && !links[link - 1].is_parameter[v])
+      throw InputError(yaml::Where(path, value, key),
+                       "a tolerance is given for a value that is not a parameter of link " +
+                           std::to_string(link));
+    priors->entries.push_back({LinkValueName(v) + (link > 0 ? std::to_string(link) : std::string()),
+                               Tolerance(value, path, key, IsAngle(v) ? as : ls)});
+  }
+}
+
+// tolerances.planes: one {u, f} per plane of the file (u: both chart coordinates).
+void ParsePlaneTolerances(const YAML::Node& tp, const std::string& path, int num_planes, double as,
+                          double ls, PriorSigmas* priors) {
+  if (!tp.IsSequence() || static_cast<int>(tp.size()) != num_planes)
+    throw InputError(
+        yaml::Where(path, tp, "tolerances.planes"),
+        "expected a list of " + std::to_string(num_planes) + " entries, one per plane of the file");
+  for (int p = 0; p < num_planes; ++p) {
+    const std::string ctx = "tolerances.planes[" + std::to_string(p) + "]";
+    yaml::CheckKeys(tp[p], {"u", "f"}, path, ctx);
+    if (tp[p]["u"]) {
+      const double u = Tolerance(tp[p]["u"], path, ctx + ".u", as);
+      priors->entries.push_back({PlaneTermName(p, num_planes, "u1"), u});
+      priors->entries.push_back({PlaneTermName(p, num_planes, "u2"), u});
+    }
+    if (tp[p]["f"])
+      priors->entries.push_back(
+          {PlaneTermName(p, num_planes, "f"), Tolerance(tp[p]["f"], path, ctx + ".f", ls)});
+  }
+}
+
+// tolerances: the prior standard deviations `identify --prior` uses (identification/prior.h).
+PriorSigmas ParseTolerances(const YAML::Node& root, const std::string& path,
+                            const std::vector<Link>& links, int num_planes) {
+  using namespace yaml;
+  PriorSigmas priors;
+  const YAML::Node t = root["tolerances"];
+  if (!t) return priors;
+  CheckKeys(t,
+            {"angle_unit", "length_unit", "every_link", "links", "planes", "ranger_offset_mm",
+             "ranger_scale_ppm"},
+            path, "tolerances");
+  const double as =
+      AngleScale(t["angle_unit"] ? String(t["angle_unit"], path, "tolerances.angle_unit") : "rad",
+                 Where(path, t["angle_unit"], "tolerances.angle_unit"));
+  const double ls =
+      LengthScale(t["length_unit"] ? String(t["length_unit"], path, "tolerances.length_unit") : "m",
+                  Where(path, t["length_unit"], "tolerances.length_unit"));
+  if (t["every_link"])
+    ParseLinkTolerances(t["every_link"], path, "tolerances.every_link", links, 0, as, ls, &priors);
+  if (const YAML::Node tl = t["links"]) {
+    if (!tl.IsSequence() || tl.size() != links.size())
+      throw InputError(
+          Where(path, tl, "tolerances.links"),
+          "expected a list of " + std::to_string(links.size()) + " entries, one per link");
+    for (std::size_t i = 0; i < tl.size(); ++i)
+      ParseLinkTolerances(tl[i], path, "tolerances.links[" + std::to_string(i) + "]", links,
+                          static_cast<int>(i) + 1, as, ls, &priors);
+  }
+  if (t["planes"]) ParsePlaneTolerances(t["planes"], path, num_planes, as, ls, &priors);
+  if (t["ranger_offset_mm"])
+    priors.entries.push_back({"ranger_offset", Tolerance(t["ranger_offset_mm"], path,
+                                                         "tolerances.ranger_offset_mm", 1e-3)});
+  if (t["ranger_scale_ppm"])
+    priors.entries.push_back({"ranger_scale", Tolerance(t["ranger_scale_ppm"], path,
+                                                        "tolerances.ranger_scale_ppm", 1e-6)});
+  return priors;
+}
+
 // true_errors.ranger_offset_mm / ranger_scale_ppm: the true ranger's errors (SI out).
 void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFile* file) {
   using namespace yaml;
@@ -312,6 +400,21 @@ void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFil
   }
 }
 
+PriorSigmas PriorsFor(const RobotFile& rig, bool use_tolerances, const std::string& prior_sigma,
+                      const std::string& tolerances_option, const std::string& prior_sigma_option) {
+  PriorSigmas priors;
+  if (use_tolerances) {
+    if (rig.tolerances.empty())
+      throw InputError(tolerances_option, "the robot file " + rig.path +
+                                              " has no tolerances: (docs/FILE_FORMATS.md); give "
+                                              "them there, or the priors by name");
+    priors = rig.tolerances;
+  }
+  if (!prior_sigma.empty())
+    priors = priors.OverriddenBy(PriorSigmas::Parse(prior_sigma, prior_sigma_option));
+  return priors;
+}
+
 RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
   if (IsUrdfPath(path)) return LoadUrdfRobotFile(path, tool_link);
   if (!tool_link.empty())
@@ -320,8 +423,8 @@ RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
                            "' is a robot YAML file (its last frame is the tool)");
   YAML::Node root = yaml::LoadFile(path);
   yaml::CheckKeys(root,
-                  {"name", "description", "links", "base", "tool", "true_errors", "plane", "planes",
-                   "ranger", "calibration"},
+                  {"name", "description", "links", "base", "tool", "true_errors", "tolerances",
+                   "plane", "planes", "ranger", "calibration"},
                   path, "");
   if (root["calibration"] && !root["calibration"].IsMap())
     throw InputError(yaml::Where(path, root["calibration"], "calibration"),
@@ -337,6 +440,7 @@ RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
   file.path = path;
   file.robot.source = path;
   ParseRangerErrors(root, path, &file);
+  file.tolerances = ParseTolerances(root, path, links, file.planes ? file.planes->size() : 0);
   if (root["calibration"]) file.calibration = ParseCalibration(root["calibration"], path);
   return file;
 }

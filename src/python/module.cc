@@ -402,6 +402,7 @@ struct IdentifyArgs {
   long long max_iterations;
   py::object loss_scale, sigma;  // the earlier spellings, in m (None: not given)
   std::string prior_sigma;       // as --prior-sigma; "" = no priors
+  bool prior = false;            // as --prior: the robot file's tolerances
 };
 
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
@@ -428,7 +429,7 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
     throw SettingError(iterations.spec, max_iterations).Respelled(Frontend::kPython);
   options.max_iterations = static_cast<int>(a.max_iterations);
   options.fix_dependent_parameters = auto_fix;
-  if (!a.prior_sigma.empty()) options.priors = PriorSigmas::Parse(a.prior_sigma, "prior_sigma=");
+  options.priors = PriorsFor(rig, a.prior, a.prior_sigma, "prior=", "prior_sigma=");
   options.Validate();
   py::gil_scoped_release release;
   return Identify(model, data, options);
@@ -859,30 +860,7 @@ sigma_mm. Returns an lrcal.Readings (q, h, configuration, skipped), the same num
 `lrcal simulate --seed SEED` with the same settings.)doc");
 }
 
-void DefineCalibration(py::module_& m) {
-  // The numeric settings' names and defaults are the schema's (IdentificationOptions::Settings()).
-  const auto& fields = IdentificationOptions::Settings();
-  const auto setting = [&](const char* name) {
-    const auto& f = *FindSetting(fields, name);
-    return f.spec.integer ? (py::arg(f.spec.name) = static_cast<long long>(f.Default()))
-                          : (py::arg(f.spec.name) = f.Default());
-  };
-  m.def(
-      "identify",
-      [](const RobotFile& rig, const Array& q, const Array& h, const py::object& plane,
-         const std::string& estimate_plane, const py::object& fix, bool auto_fix,
-         const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
-         long long max_iterations, const py::object& loss_scale, const py::object& sigma,
-         const std::string& prior_sigma) {
-        return IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
-                          {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
-                           prior_sigma});
-      },
-      py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
-      py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
-      py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
-      setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
-      py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", R"doc(
+constexpr const char* kIdentifyDoc = R"doc(
 Identifies the geometric parameters (and plane terms) from laser readings.
 
 q (M, joints) rad and h (M,) m are single readings; readings at identical joint values are
@@ -899,7 +877,35 @@ max_iterations: 1 to 10,000.
 prior_sigma: prior standard deviations as `lrcal identify --prior-sigma` takes them
 ("theta=1mrad,a=0.5mm,d6=0.2mm": a class or a term, each with its unit); with sigma_mm, the
 maximum a-posteriori estimate (prior_sigma, posterior_to_prior and set_by_prior on the result).
-Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc");
+prior: True to use the robot file's tolerances: as priors (as --prior); prior_sigma's entries
+replace the same keys.
+Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc";
+
+void DefineCalibration(py::module_& m) {
+  // The numeric settings' names and defaults are the schema's (IdentificationOptions::Settings()).
+  const auto& fields = IdentificationOptions::Settings();
+  const auto setting = [&](const char* name) {
+    const auto& f = *FindSetting(fields, name);
+    return f.spec.integer ? (py::arg(f.spec.name) = static_cast<long long>(f.Default()))
+                          : (py::arg(f.spec.name) = f.Default());
+  };
+  m.def(
+      "identify",
+      [](const RobotFile& rig, const Array& q, const Array& h, const py::object& plane,
+         const std::string& estimate_plane, const py::object& fix, bool auto_fix,
+         const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
+         long long max_iterations, const py::object& loss_scale, const py::object& sigma,
+         const std::string& prior_sigma, bool prior) {
+        return IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
+                          {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
+                           prior_sigma, prior});
+      },
+      py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
+      py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
+      py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
+      setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
+      py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", py::arg("prior") = false,
+      kIdentifyDoc);
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
         py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8, R"doc(

@@ -499,6 +499,17 @@ TEST_F(CliTest, IdentifyWithPriorsSetsWhatTheReadingsCannotSee) {
   EXPECT_EQ(before["set_by_prior"], Json({"theta1", "a1", "d3"}));
   EXPECT_TRUE(before["defined"].get<bool>());
   EXPECT_EQ(before["terms"].size(), 25u);
+  // The same priors as a robot file's tolerances: --prior gives the same estimate, bit for bit.
+  std::string robot = testing::ReadFile(testing::SourcePath("studies/robots/paper.yaml"));
+  robot +=
+      "tolerances:\n  angle_unit: mrad\n  length_unit: mm\n"
+      "  every_link: {theta: 5, alpha: 5, beta: 5, a: 5, d: 5}\n";
+  const std::string file = Write("tolerant.yaml", robot);
+  ASSERT_EQ(Run(identify + " --robot " + file + " --prior --format json", &out), 0) << out;
+  EXPECT_EQ(Json::parse(out)["parameters"], j["parameters"]);
+  EXPECT_EQ(Run(identify + " --prior", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--prior: the robot file"));
+  EXPECT_THAT(out, ::testing::HasSubstr("has no tolerances:"));
   for (const Json& p : j["parameters"]) {
     EXPECT_DOUBLE_EQ(p["prior_sigma"].get<double>(), 5e-3) << p["name"];
     EXPECT_GT(p["posterior_to_prior"].get<double>(), 0) << p["name"];

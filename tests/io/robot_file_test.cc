@@ -93,3 +93,66 @@ TEST(RobotFile, ACalibrationRecordsCovarianceMustBeOne) {
 
 }  // namespace
 }  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// tolerances: the priors `identify --prior` uses, by class for every link and by name per link,
+// plane and ranger term, in the file's units; errors named by file, line and key.
+TEST(RobotFile, TolerancesAreThePriorsByClassAndByName) {
+  const std::string dir = testing::TempDir("robot_tolerances");
+  const std::string two_links =
+      "links:\n  - {theta: 0, alpha: 0, a: 0.5, d: 0, parameters: [theta, a]}\n"
+      "  - {theta: 0, alpha: 0, a: 0.4, d: 0, parameters: [theta, a, d]}\n"
+      "planes:\n  - {normal: [0, 0, 1], offset: 0.3}\n  - {normal: [1, 0, 0], offset: 0.9}\n";
+  const auto load = [&](const std::string& tolerances) {
+    const std::string path = dir + "/r.yaml";
+    std::ofstream(path) << two_links << tolerances;
+    return LoadRobotFile(path);
+  };
+  const RobotFile rig = load(
+      "tolerances:\n  angle_unit: mrad\n  length_unit: mm\n"
+      "  every_link: {theta: 1, a: 0.5}\n  links:\n    - {}\n    - {d: 0.2}\n"
+      "  planes:\n    - {u: 2, f: 1}\n    - {f: 3}\n"
+      "  ranger_offset_mm: 0.5\n  ranger_scale_ppm: 200\n");
+  const PriorSigmas& p = rig.tolerances;
+  EXPECT_DOUBLE_EQ(p.SigmaOf("theta2"), 1e-3);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("a1"), 0.5e-3);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("d2"), 0.2e-3);
+  EXPECT_EQ(p.SigmaOf("d1"), 0.0);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("plane1_u2"), 2e-3);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("plane1_f"), 1e-3);
+  EXPECT_EQ(p.SigmaOf("plane2_u1"), 0.0);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("plane2_f"), 3e-3);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("ranger_offset"), 0.5e-3);
+  EXPECT_DOUBLE_EQ(p.SigmaOf("ranger_scale"), 200e-6);
+  // The command line's entries replace the file's of the same key; a name still beats a class.
+  const PriorSigmas over = p.OverriddenBy(PriorSigmas::Parse("a=2mm,d2=1mm"));
+  EXPECT_DOUBLE_EQ(over.SigmaOf("a1"), 2e-3);
+  EXPECT_DOUBLE_EQ(over.SigmaOf("d2"), 1e-3);
+  EXPECT_DOUBLE_EQ(over.SigmaOf("theta1"), 1e-3);
+  EXPECT_TRUE(load("").tolerances.empty());
+
+  const auto message = [&](const std::string& tolerances) {
+    try {
+      load(tolerances);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(message("tolerances:\n  links:\n    - {d: 1}\n    - {}\n"),
+              ::testing::HasSubstr("r.yaml:9 key 'tolerances.links[0].d': a tolerance is given "
+                                   "for a value that is not a parameter of link 1"));
+  EXPECT_THAT(message("tolerances:\n  every_link: {theta: -1}\n"),
+              ::testing::HasSubstr("key 'tolerances.every_link.theta': expected a standard "
+                                   "deviation > 0"));
+  EXPECT_THAT(message("tolerances:\n  planes:\n    - {u: 1}\n"),
+              ::testing::HasSubstr("'tolerances.planes': expected a list of 2 entries"));
+  EXPECT_THAT(message("tolerances:\n  links:\n    - {}\n"),
+              ::testing::HasSubstr("'tolerances.links': expected a list of 2 entries"));
+  EXPECT_THAT(message("tolerances:\n  base: {x: 1}\n"), ::testing::HasSubstr("unknown key"));
+}
+
+}  // namespace
+}  // namespace lrcal

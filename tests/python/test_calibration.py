@@ -112,6 +112,17 @@ def test_identify_with_priors_matches_the_program_bit_for_bit(tmp_path, cli, pap
                                   [p["posterior_to_prior"] for p in program["parameters"]])
     assert result.prior_sigma[result.names.index("d6")] == 0.2e-3
     assert result.set_by_prior == program["set_by_prior"]
+    # The robot file's tolerances: as priors (prior=True), the keyword's entries over them.
+    robot = tmp_path / "tolerant.yaml"
+    robot.write_text((pathlib.Path(__file__).parents[2] / "studies/robots/paper.yaml").read_text()
+                     + "tolerances:\n  angle_unit: mrad\n  length_unit: mm\n"
+                       "  every_link: {theta: 5, alpha: 5, beta: 5, a: 5, d: 5}\n")
+    tolerant = lrcal.Robot.load(str(robot))
+    from_file = lrcal.identify(tolerant, m[:, :6], m[:, header.index("h")], sigma_mm=0.2,
+                               prior=True, prior_sigma="d6=0.2mm")
+    np.testing.assert_array_equal(from_file.estimate, result.estimate)
+    with pytest.raises(lrcal.InputError, match="prior=: the robot file"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], sigma_mm=0.2, prior=True)
     with pytest.raises(lrcal.InputError, match=r"prior_sigma=: 'd=1': 'd' is a length"):
         lrcal.identify(paper, m[:, :6], m[:, header.index("h")], sigma_mm=0.2, prior_sigma="d=1")
     with pytest.raises(lrcal.InputError, match="prior_sigma=: priors are weighed"):

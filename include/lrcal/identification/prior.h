@@ -48,6 +48,10 @@ struct PriorSigmas {
   double SigmaOf(const std::string& name) const;
   /// The priors of `names` (SI), 0 where a term has none.
   Eigen::VectorXd SigmasOf(const std::vector<std::string>& names) const;
+  /// These priors with `over`'s entries in place of any of the same key (a robot file's
+  /// tolerances with the command line's --prior-sigma over them). A term's own entry still wins
+  /// over its class's, whichever of the two gave it.
+  PriorSigmas OverriddenBy(const PriorSigmas& over) const;
   /// "theta=1 mrad, d6=0.2 mm": the entries in their display units (DisplayUnitOf).
   std::string ToString() const;
 };

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "lrcal/identification/prior.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/plane.h"
 
@@ -40,10 +41,22 @@ struct RobotFile {
   /// (1 + ranger_scale)·h + ranger_offset (m) for a true distance h. For simulation.
   double ranger_offset = 0;
   double ranger_scale = 0;
+  /// The file's `tolerances:` (prior standard deviations around its nominal values, by class for
+  /// every link and by name per link, plane and ranger term): what `identify --prior` uses.
+  /// Empty when the file has none; never written back (a calibrated file's record has the
+  /// posterior covariance instead).
+  PriorSigmas tolerances;
   /// The record of a calibrated robot file (identify --write-robot), if it has one: what
   /// `lrcal accuracy` propagates to poses.
   std::optional<CalibrationRecord> calibration;
 };
+
+/// The priors a calibration uses: `rig`'s tolerances when `use_tolerances` (an InputError at
+/// `tolerances_option` if it has none), with `prior_sigma` (PriorSigmas::Parse's text, errors at
+/// `prior_sigma_option`; "" for none) replacing the same keys. What `identify --prior
+/// --prior-sigma ...` and Python's prior=, prior_sigma= mean.
+PriorSigmas PriorsFor(const RobotFile& rig, bool use_tolerances, const std::string& prior_sigma,
+                      const std::string& tolerances_option, const std::string& prior_sigma_option);
 
 /// Reads a robot YAML file, or a URDF (a path ending in .urdf: io/urdf.h, with `tool_link` the
 /// ranger's link, empty for the URDF's only end link). Throws InputError naming the file, line
