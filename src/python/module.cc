@@ -38,6 +38,7 @@
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/report/accuracy_plan.h"
 #include "lrcal/report/report_data.h"
@@ -450,6 +451,30 @@ IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
   return AnalyzeIdentifiability(model, configs, nullptr, options);
 }
 
+PriorInformation PriorInformationPy(const RobotFile& rig, const Array& q,
+                                    const std::string& prior_sigma, bool prior, double sigma_mm,
+                                    long long repetitions, const py::object& plane_arg,
+                                    const std::string& estimate_plane, const py::object& fix) {
+  const RobotModel& robot = rig.robot;
+  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
+  const MeasurementModel model(robot, ResolvePlane(rig, plane_arg),
+                               ResolveParameters(robot, estimate_plane, fix));
+  const PriorSigmas priors = PriorsFor(rig, prior, prior_sigma, "prior=", "prior_sigma=");
+  if (priors.empty())
+    throw InputError("prior_sigma=",
+                     "give priors (prior_sigma=, or prior=True for the robot "
+                     "file's tolerances:)");
+  NoiseModel noise;
+  const auto& fields = NoiseModel::Settings();
+  const auto& sigma = *FindSetting(fields, "sigma_mm");
+  const auto& count = *FindSetting(fields, "repetitions");
+  noise.sigma = SettingValue(sigma.spec, sigma.Default(), sigma_mm, py::none(), "sigma");
+  noise.repetitions = static_cast<int>(SettingValue(
+      count.spec, count.Default(), static_cast<double>(repetitions), py::none(), "repetitions"));
+  py::gil_scoped_release release;
+  return InformationFromPriors(RangerMeasurement(model), configs, noise, priors);
+}
+
 struct DesignArgs {
   std::string criterion, method, scaling;
   py::object expected_angle, expected_length;  // the earlier spellings, rad and m (None: not given)
@@ -686,6 +711,17 @@ skipped: [(row, why)] for configurations whose beam missed (no reading).)doc")
       .def("__str__", &Dependency::ToString)
       .def("__repr__", &Dependency::ToString);
 
+  py::class_<PriorInformation>(m, "PriorInformation", R"doc(
+What readings tell against priors (lrcal.prior_information). Arrays are SI; index k belongs to
+names[k]. str() gives the table of `lrcal identifiability --prior-sigma`.)doc")
+      .def_readonly("names", &PriorInformation::names)
+      .def_readonly("sigma", &PriorInformation::sigma)
+      .def_readonly("prior_sigma", &PriorInformation::prior_sigma)
+      .def_readonly("posterior_sigma", &PriorInformation::posterior_sigma)
+      .def_readonly("posterior_to_prior", &PriorInformation::posterior_to_prior)
+      .def_readonly("defined", &PriorInformation::defined)
+      .def_property_readonly("set_by_prior", &PriorInformation::SetByPrior)
+      .def("__str__", &PriorInformation::ToString);
   py::class_<IdentifiabilityReport>(m, "Identifiability", R"doc(
 What a set of configurations can identify: rank of the identification Jacobian G, singular values
 of its unit-norm columns, the parameters with no effect (unidentifiable), the exact dependences,
@@ -912,6 +948,20 @@ void DefineCalibration(py::module_& m) {
 What the configurations q (N, joints) can identify of the parameter set (estimate_plane, fix as
 in identify), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
 `lrcal identifiability`.)doc");
+  m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
+        py::arg("prior_sigma") = "", py::arg("prior") = false,
+        py::arg("sigma_mm") = FindSetting(NoiseModel::Settings(), "sigma_mm")->Default(),
+        py::arg("repetitions") =
+            static_cast<long long>(FindSetting(NoiseModel::Settings(), "repetitions")->Default()),
+        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+        py::arg("fix") = py::none(), R"doc(
+What readings at the configurations q (N, joints) would tell against priors, before any reading
+is taken: `lrcal identifiability --prior-sigma ... --sigma-mm S --repetitions R`'s table.
+prior_sigma as in identify ("theta=1mrad,a=0.5mm"); prior=True uses the robot file's
+tolerances: (prior_sigma's entries replace the same keys). sigma_mm (> 0) and repetitions: the
+noise of one reading and the readings averaged per configuration. Returns an
+lrcal.PriorInformation: names, prior_sigma, posterior_sigma (SI, inf where unbounded),
+posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the table.)doc");
   m.def(
       "design",
       [](const RobotFile& rig, const Array& pool, int k, const std::string& criterion,

@@ -129,6 +129,29 @@ def test_identify_with_priors_matches_the_program_bit_for_bit(tmp_path, cli, pap
         lrcal.identify(paper, m[:, :6], m[:, header.index("h")], prior_sigma="d=1mm")
 
 
+def test_prior_information_matches_identifiability_with_priors(tmp_path, cli, paper):
+    """lrcal.prior_information is `lrcal identifiability --prior-sigma`'s table, bit for bit."""
+    configs = tmp_path / "c.csv"
+    priors = "theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d=5mm"
+    plane = "0,0,1,0.3"
+    cli("sample", "--robot", "paper", "--count", 60, "--plane", plane, "--out", configs)
+    program = json.loads(cli("identifiability", "--robot", "paper", "--configs", configs,
+                             "--plane", plane, "--prior-sigma", priors, "--sigma-mm", 0.2,
+                             "--repetitions", 10, "--format", "json").stdout)["priors"]
+    _, q = read_csv(configs)
+    info = lrcal.prior_information(paper, q[:, :6], prior_sigma=priors, sigma_mm=0.2,
+                                   repetitions=10, plane=(0, 0, 1, 0.3))
+    assert info.defined and info.set_by_prior == program["set_by_prior"] == ["theta1", "a1", "d3"]
+    np.testing.assert_array_equal(info.posterior_sigma,
+                                  [t["posterior_sigma"] for t in program["terms"]])
+    assert "set by the prior" in str(info)
+    with pytest.raises(lrcal.InputError, match="sigma_mm="):
+        lrcal.prior_information(paper, q[:, :6], prior_sigma=priors, sigma_mm=0,
+                                plane=(0, 0, 1, 0.3))
+    with pytest.raises(lrcal.InputError, match="give priors"):
+        lrcal.prior_information(paper, q[:, :6])
+
+
 def test_identification_recovers_the_true_errors_without_noise(paper):
     q = lrcal.sample_configurations(paper, 60, seed=11)
     h = lrcal.laser_readings(paper, q, model="true")

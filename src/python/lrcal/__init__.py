@@ -20,10 +20,11 @@ import os as _os
 
 from . import _config
 from ._lrcal import (Design, Dependency, Error, Identifiability, Identification, InputError,
-                     Plane, Ranger, Readings, Robot, RunProgress, RunResult, StorageError,
-                     __version__, accuracy, data_directory, design, export, forward_kinematics,
-                     identifiability, identify, kinematics, laser_readings, plan, plan_accuracy,
-                     replay_trial, run_study, sample_configurations, simulate, status)
+                     Plane, PriorInformation, Ranger, Readings, Robot, RunProgress, RunResult,
+                     StorageError, __version__, accuracy, data_directory, design, export,
+                     forward_kinematics, identifiability, identify, kinematics, laser_readings,
+                     plan, plan_accuracy, prior_information, replay_trial, run_study,
+                     sample_configurations, simulate, status)
 from ._lrcal import set_data_directory as _set_data_directory
 from ._report import report
 from ._run import Run, load_run
@@ -35,8 +36,8 @@ _set_data_directory(_os.path.normpath(_os.path.join(_os.path.dirname(__file__),
                                                     _config.DATA_DIR_FROM_PACKAGE)))
 
 __all__ = ["Design", "Dependency", "Error", "Identifiability", "Identification", "InputError",
-           "Plane", "Ranger", "Readings", "Robot", "Run", "RunProgress", "RunResult",
+           "Plane", "PriorInformation", "Ranger", "Readings", "Robot", "Run", "RunProgress", "RunResult",
            "StorageError", "__version__", "accuracy", "data_directory", "design", "export",
            "forward_kinematics", "identifiability", "identify", "kinematics", "laser_readings",
-           "load_run", "plan", "plan_accuracy", "replay_trial", "report", "run_study", "sample",
+           "load_run", "plan", "plan_accuracy", "prior_information", "replay_trial", "report", "run_study", "sample",
            "sample_configurations", "simulate", "status"]
