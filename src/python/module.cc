@@ -694,6 +694,20 @@ Raises lrcal.InputError naming the file, line and key of anything wrong.)doc")
       });
 }
 
+void DefinePriorInformation(py::module_& m) {
+  py::class_<PriorInformation>(m, "PriorInformation", R"doc(
+What readings tell against priors (lrcal.prior_information). Arrays are SI; index k belongs to
+names[k]. str() gives the table of `lrcal identifiability --prior-sigma`.)doc")
+      .def_readonly("names", &PriorInformation::names)
+      .def_readonly("sigma", &PriorInformation::sigma)
+      .def_readonly("prior_sigma", &PriorInformation::prior_sigma)
+      .def_readonly("posterior_sigma", &PriorInformation::posterior_sigma)
+      .def_readonly("posterior_to_prior", &PriorInformation::posterior_to_prior)
+      .def_readonly("defined", &PriorInformation::defined)
+      .def_property_readonly("set_by_prior", &PriorInformation::SetByPrior)
+      .def("__str__", &PriorInformation::ToString);
+}
+
 void DefineResults(py::module_& m) {
   py::class_<Readings>(m, "Readings", R"doc(
 Simulated single readings, one row per reading (as a measurement CSV holds them):
@@ -711,17 +725,6 @@ skipped: [(row, why)] for configurations whose beam missed (no reading).)doc")
       .def("__str__", &Dependency::ToString)
       .def("__repr__", &Dependency::ToString);
 
-  py::class_<PriorInformation>(m, "PriorInformation", R"doc(
-What readings tell against priors (lrcal.prior_information). Arrays are SI; index k belongs to
-names[k]. str() gives the table of `lrcal identifiability --prior-sigma`.)doc")
-      .def_readonly("names", &PriorInformation::names)
-      .def_readonly("sigma", &PriorInformation::sigma)
-      .def_readonly("prior_sigma", &PriorInformation::prior_sigma)
-      .def_readonly("posterior_sigma", &PriorInformation::posterior_sigma)
-      .def_readonly("posterior_to_prior", &PriorInformation::posterior_to_prior)
-      .def_readonly("defined", &PriorInformation::defined)
-      .def_property_readonly("set_by_prior", &PriorInformation::SetByPrior)
-      .def("__str__", &PriorInformation::ToString);
   py::class_<IdentifiabilityReport>(m, "Identifiability", R"doc(
 What a set of configurations can identify: rank of the identification Jacobian G, singular values
 of its unit-norm columns, the parameters with no effect (unidentifiable), the exact dependences,
@@ -1227,6 +1230,7 @@ PYBIND11_MODULE(_lrcal, m) {
   lp::DefineRig(m);
   lp::DefineRobot(m);
   lp::DefineResults(m);
+  lp::DefinePriorInformation(m);
   lp::DefineIdentification(m);
   lp::DefineRun(m);
   lp::DefineKinematics(m);
