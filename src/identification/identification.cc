@@ -243,12 +243,18 @@ bool CheckMeasuredValues(const MeasurementKind& kind, const MeasuredValues& data
                  " values per configuration: use least squares";
     return false;
   }
+  // A prior is one more value (prior.h): with priors, fewer readings than terms can do.
   const int values = k * data.size();
-  if (values < kind.num_parameters()) {
+  const int priors =
+      options.priors.empty()
+          ? 0
+          : static_cast<int>((options.priors.SigmasOf(kind.parameter_names()).array() > 0).count());
+  if (values + priors < kind.num_parameters()) {
     s->names = kind.parameter_names();
     s->message = std::to_string(kind.num_parameters()) +
-                 " parameters need at least as many measured values; " + std::to_string(values) +
-                 " given (" + std::to_string(data.size()) + " configurations)";
+                 " parameters need at least as many measured values" +
+                 (priors ? " and priors" : "") + "; " + std::to_string(values) + " given (" +
+                 std::to_string(data.size()) + " configurations)";
     return false;
   }
   return true;

@@ -271,3 +271,25 @@ TEST(PriorInformation, IsThePosteriorOfReadingsAtTheConfigurations) {
 
 }  // namespace
 }  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// With a prior on every term, fewer configurations than terms still give an estimate: the
+// posterior is proper, and the data-only refusal names what is missing.
+TEST(Priors, FewerReadingsThanTermsAreEnoughWithPriorsOnEveryTerm) {
+  const RobotModel& robot = testing::PaperRobot();
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  const MeasurementSet data = Readings(robot, robot.true_values(), testing::PaperPlane(),
+                                       testing::PaperHittingConfigurations(12, 2), 5);
+  const IdentificationSummary s =
+      Identify(model, data, WithPriors("theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d=5mm"));
+  ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
+  EXPECT_EQ(s.fit.dof, 12);  // 12 readings + 25 priors − 25 terms
+  const IdentificationSummary partial = Identify(model, data, WithPriors("theta=5mrad"));
+  EXPECT_EQ(partial.termination, Termination::kInvalidInput);
+  EXPECT_THAT(partial.message, HasSubstr("need at least as many measured values and priors"));
+}
+
+}  // namespace
+}  // namespace lrcal
