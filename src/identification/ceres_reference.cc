@@ -226,8 +226,7 @@ Termination SolveWithCeres(const MeasurementKind& kind, const MeasuredValues& da
                            const CeresPriors& priors, const IdentificationOptions& options,
                            Eigen::VectorXd* e, int* iterations, std::string* message) {
   const int k = kind.rows_per_configuration();
-  std::vector<double> weights;
-  for (int i = 0; i < data.size(); ++i) weights.insert(weights.end(), k, data.repetitions[i]);
+  const std::vector<double> weights = data.RowWeights(k);
   return SolveLeastSquaresThenRobust(
       kind.num_parameters(), data.size(),
       [&] { return new KindCost(kind, data.configs, data.y.data(), weights.data()); },

@@ -228,6 +228,35 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
 
 namespace {
 
+// The rows an identification of a kind solves: every measured value (weighted by its
+// configuration's repetitions), then, with priors, one row per term that has a prior (measured 0,
+// weight (σ/σ_k)²: prior.h).
+struct Rows {
+  std::vector<double> measured, weights;
+  int data_rows = 0;
+  Eigen::VectorXd prior_sigma;   // per term, 0 where it has none (empty without priors)
+  std::vector<int> prior_terms;  // the columns with a prior, ascending
+};
+
+Rows MakeRows(const MeasurementKind& kind, const MeasuredValues& data,
+              const IdentificationOptions& options) {
+  Rows rows;
+  const int k = kind.rows_per_configuration();
+  rows.measured = data.y;
+  rows.weights = data.RowWeights(k);
+  rows.data_rows = static_cast<int>(rows.measured.size());
+  if (options.priors.empty()) return rows;
+  rows.prior_sigma = options.priors.SigmasOf(kind.parameter_names());
+  for (int t = 0; t < kind.num_parameters(); ++t) {
+    if (!(rows.prior_sigma[t] > 0)) continue;
+    rows.prior_terms.push_back(t);
+    rows.measured.push_back(0);
+    const double ratio = options.sigma / rows.prior_sigma[t];
+    rows.weights.push_back(ratio * ratio);
+  }
+  return rows;
+}
+
 // The measured values' consistency and the kind's limits; false (s->message says why).
 bool CheckMeasuredValues(const MeasurementKind& kind, const MeasuredValues& data,
                          const IdentificationOptions& options, IdentificationSummary* s) {
@@ -245,10 +274,7 @@ bool CheckMeasuredValues(const MeasurementKind& kind, const MeasuredValues& data
   }
   // A prior is one more value (prior.h): with priors, fewer readings than terms can do.
   const int values = k * data.size();
-  const int priors =
-      options.priors.empty()
-          ? 0
-          : static_cast<int>((options.priors.SigmasOf(kind.parameter_names()).array() > 0).count());
+  const int priors = static_cast<int>(MakeRows(kind, data, options).prior_terms.size());
   if (values + priors < kind.num_parameters()) {
     s->names = kind.parameter_names();
     s->message = std::to_string(kind.num_parameters()) +
@@ -258,36 +284,6 @@ bool CheckMeasuredValues(const MeasurementKind& kind, const MeasuredValues& data
     return false;
   }
   return true;
-}
-
-// The rows an identification of a kind solves: every measured value (weighted by its
-// configuration's repetitions), then, with priors, one row per term that has a prior (measured 0,
-// weight (σ/σ_k)²: prior.h).
-struct Rows {
-  std::vector<double> measured, weights;
-  int data_rows = 0;
-  Eigen::VectorXd prior_sigma;   // per term, 0 where it has none (empty without priors)
-  std::vector<int> prior_terms;  // the columns with a prior, ascending
-};
-
-Rows MakeRows(const MeasurementKind& kind, const MeasuredValues& data,
-              const IdentificationOptions& options) {
-  Rows rows;
-  const int k = kind.rows_per_configuration();
-  rows.measured = data.y;
-  for (int i = 0; i < data.size(); ++i)
-    rows.weights.insert(rows.weights.end(), k, data.repetitions[i]);
-  rows.data_rows = static_cast<int>(rows.measured.size());
-  if (options.priors.empty()) return rows;
-  rows.prior_sigma = options.priors.SigmasOf(kind.parameter_names());
-  for (int t = 0; t < kind.num_parameters(); ++t) {
-    if (!(rows.prior_sigma[t] > 0)) continue;
-    rows.prior_terms.push_back(t);
-    rows.measured.push_back(0);
-    const double ratio = options.sigma / rows.prior_sigma[t];
-    rows.weights.push_back(ratio * ratio);
-  }
-  return rows;
 }
 
 // The identifiability of a kind's rows: with priors, the Jacobian gains the priors' rows (scaled

@@ -24,6 +24,13 @@ void CheckNoiseFitsKind(const MeasurementKind& kind, const NoiseModel& noise) {
 
 }  // namespace
 
+std::vector<double> MeasuredValues::RowWeights(int rows_per_configuration) const {
+  std::vector<double> weights;
+  weights.reserve(static_cast<std::size_t>(rows_per_configuration) * repetitions.size());
+  for (int r : repetitions) weights.insert(weights.end(), rows_per_configuration, r);
+  return weights;
+}
+
 int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& configs,
                          const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
                          std::vector<std::string>* misses) {

@@ -82,6 +82,9 @@ struct MeasuredValues {
   std::vector<double> y;
   std::vector<int> repetitions;
   int size() const { return configs.size(); }
+  /// Each measured value's weight: its configuration's repetitions, on each of its
+  /// `rows_per_configuration` values (what the solvers weigh the residuals by).
+  std::vector<double> RowWeights(int rows_per_configuration) const;
 };
 
 /// Simulated measurements: `truth` (the kind built on the true geometry) predicts the exact
