@@ -31,7 +31,7 @@ int AccuracyCommand(const std::vector<std::string>& args) {
       vm.count("configs")
           ? ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot, &setup.planes)
           : WorkspacePoses(rig.robot, vm["workspace"].as<int>(), ParseSeed(vm));
-  const std::vector<PoseAccuracy> poses = PredictCalibratedAccuracy(rig, setup.planes, configs);
+  const AccuracyPrediction poses = PredictCalibratedAccuracy(rig, setup.planes, configs);
   const CalibrationRecord& r = *rig.calibration;
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = PoseAccuracyJson(poses, configs);
@@ -45,7 +45,7 @@ int AccuracyCommand(const std::vector<std::string>& args) {
     if (vm.count("workspace"))
       std::cout << configs.size() << " poses drawn over the joint ranges (seed "
                 << vm["seed"].as<long long>() << ")\n";
-    std::cout << PoseAccuracyText(poses);
+    std::cout << AccuracyPredictionText(poses);
   }
   return 0;
 }

@@ -35,6 +35,14 @@ PriorSigmas ResolvePriors(const po::variables_map& vm, const RobotFile& rig) {
                    "--prior-sigma");
 }
 
+// What is known of the terms a calibration holds at nominal: the robot file's tolerances (used
+// for this whether or not --prior makes them priors), with --prior-sigma over them.
+PriorSigmas KnownTolerances(const po::variables_map& vm, const RobotFile& rig) {
+  return PriorsFor(rig, !rig.tolerances.empty(),
+                   vm.count("prior-sigma") ? vm["prior-sigma"].as<std::string>() : "", "--prior",
+                   "--prior-sigma");
+}
+
 IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm,
                                                    const RobotFile& rig) {
   IdentificationOptions options;
@@ -169,36 +177,40 @@ int SimulateCommand(const std::vector<std::string>& args) {
 // identify --write-robot: the calibrated model as a robot file with its record.
 void WriteRobot(const std::string& path, const std::string& data_file, const RobotFile& rig,
                 const MeasurementModel& model, const IdentificationSummary& s,
-                const IdentificationOptions& options) {
-  WriteCalibratedRobot(path, data_file, rig, model, s, options);
+                const IdentificationOptions& options, const UnestimatedTerms& held) {
+  WriteCalibratedRobot(path, data_file, rig, model, s, options, held);
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
 }
 
-// identify --predict-at: the fit's covariance (given σ, else residual-based) at the poses.
+// identify --predict-at: the total predicted accuracy at the poses (total_accuracy.h): the fit's
+// covariance (ChooseSigma's σ) and the terms held at nominal.
 void PredictAt(const std::string& file, const MeasurementModel& model,
-               const IdentificationSummary& s, const IdentificationOptions& options, Json* json,
-               std::string* text) {
+               const IdentificationSummary& s, const IdentificationOptions& options,
+               const UnestimatedTerms& held, Json* json, std::string* text) {
   const ConfigurationSet poses =
       ReadRobotConfigurations(file, model.robot(), &model.nominal_planes());
-  const Eigen::MatrixXd& C = FitCovariance(s, options);
+  const SigmaUsed used = ChooseSigma(s, options);
+  const Eigen::MatrixXd& C = CovarianceFor(s, used);
   if (!C.allFinite())
     throw InputError("--predict-at",
                      "the covariance is undefined (as many configurations as parameters); "
                      "give --sigma-mm");
-  const std::vector<PoseAccuracy> predicted =
-      PredictPoseAccuracy(SolvedModel(model, s), s.delta.data(), C, poses);
+  AccuracyPrediction predicted =
+      PredictTotalAccuracy(SolvedModel(model, s), s.delta.data(), C, held, poses);
+  predicted.sigma_used = used;
   *json = PoseAccuracyJson(predicted, poses);
-  *text = PoseAccuracyText(predicted);
+  *text = AccuracyPredictionText(predicted);
 }
 
 // identify's output: the fit, and what --predict-at and --holdout add, as text or JSON.
 void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& model,
                           const MeasurementSet& data, const IdentificationSummary& s,
-                          const IdentificationOptions& options) {
+                          const IdentificationOptions& options, const UnestimatedTerms& held) {
   Json accuracy;
   std::string accuracy_text;
   if (vm.count("predict-at") && s.IsSolutionUsable())
-    PredictAt(vm["predict-at"].as<std::string>(), model, s, options, &accuracy, &accuracy_text);
+    PredictAt(vm["predict-at"].as<std::string>(), model, s, options, held, &accuracy,
+              &accuracy_text);
   std::optional<CrossValidation> cv;
   if (vm.count("holdout") && s.IsSolutionUsable())
     cv = CrossValidate(model, data, vm["holdout"].as<int>(), options);
@@ -220,6 +232,7 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const MeasurementSet& data, const IdentificationSummary& s,
                             const IdentificationOptions& options) {
   CalibrationReportInputs in{vm["data"].as<std::string>(), &rig, &model, &data, &s, options};
+  in.known = KnownTolerances(vm, rig);
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
   WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
   if (s.IsSolutionUsable())
@@ -281,7 +294,11 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
     throw InputError(vm["data"].as<std::string>(), s.message);
 
-  PrintIdentifyResults(vm, model, data, s, options);
+  const UnestimatedTerms held =
+      s.IsSolutionUsable()
+          ? FindUnestimatedTerms(SolvedModel(model, s), s, data, options, KnownTolerances(vm, rig))
+          : UnestimatedTerms{};
+  PrintIdentifyResults(vm, model, data, s, options, held);
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "
                  "configurations; fix the suggested parameters (--fix "
@@ -295,7 +312,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   }
   if (vm.count("write-robot") && s.IsSolutionUsable())
     WriteRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig, model, s,
-               options);
+               options, held);
   if (vm.count("report"))
     WriteCalibrationReport(vm["report"].as<std::string>(), vm, rig, model, data, s, options);
   if (s.IsSolutionUsable() && !s.fit.consistent) {

@@ -57,7 +57,36 @@ double Radius95(const Eigen::Matrix3d& sigma, const Eigen::MatrixXd& z) {
   return std::sqrt(r2[k]);
 }
 
+// Fixed standard normal draws for Radius95 (made once; read-only afterwards, so thread-safe).
+const Eigen::MatrixXd& RadiusDraws() {
+  static const Eigen::MatrixXd z = [] {
+    constexpr int kDraws = 20000;
+    Eigen::MatrixXd d(3, kDraws);
+    RandomStream(0, 0, 0, RandomPurpose::kPrediction).Normals(0, 3 * kDraws, d.data());
+    return d;
+  }();
+  return z;
+}
+
 }  // namespace
+
+PoseAccuracy PoseAccuracyFromCovariance(const Eigen::Matrix<double, 6, 6>& data,
+                                        const Eigen::Matrix<double, 6, 6>& total) {
+  PoseAccuracy a;
+  a.position_std = data.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+  a.orientation_std = data.diagonal().tail<3>().cwiseMax(0.0).cwiseSqrt();
+  a.position_radius_95 = Radius95(data.topLeftCorner<3, 3>(), RadiusDraws());
+  if (total == data) {
+    a.position_std_total = a.position_std;
+    a.orientation_std_total = a.orientation_std;
+    a.position_radius_95_total = a.position_radius_95;
+    return a;
+  }
+  a.position_std_total = total.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+  a.orientation_std_total = total.diagonal().tail<3>().cwiseMax(0.0).cwiseSqrt();
+  a.position_radius_95_total = Radius95(total.topLeftCorner<3, 3>(), RadiusDraws());
+  return a;
+}
 
 std::vector<PoseAccuracy> PredictPoseAccuracy(const MeasurementModel& model, const double* e,
                                               const Eigen::MatrixXd& covariance,
@@ -67,16 +96,11 @@ std::vector<PoseAccuracy> PredictPoseAccuracy(const MeasurementModel& model, con
     throw InputError("covariance", "expected " + std::to_string(n) + " x " + std::to_string(n) +
                                        " (one row and column per estimated parameter)");
   const Eigen::MatrixXd J = PoseJacobian(model, e, configs);
-  constexpr int kDraws = 20000;
-  Eigen::MatrixXd z(3, kDraws);
-  RandomStream(0, 0, 0, RandomPurpose::kPrediction).Normals(0, 3 * kDraws, z.data());
   std::vector<PoseAccuracy> out(configs.size());
   for (int j = 0; j < configs.size(); ++j) {
     const Eigen::MatrixXd Jj = J.middleRows(6 * j, 6);
     const Eigen::Matrix<double, 6, 6> S = Jj * covariance * Jj.transpose();
-    out[j].position_std = S.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
-    out[j].orientation_std = S.diagonal().tail<3>().cwiseMax(0.0).cwiseSqrt();
-    out[j].position_radius_95 = Radius95(S.topLeftCorner<3, 3>(), z);
+    out[j] = PoseAccuracyFromCovariance(S, S);
   }
   return out;
 }
@@ -97,22 +121,6 @@ PoseAccuracySummary SummarizePoseAccuracy(const std::vector<PoseAccuracy>& poses
   s.p95_radius_95 = radii[std::min(radii.size() - 1,
                                    static_cast<std::size_t>(std::ceil(0.95 * radii.size())) - 1)];
   return s;
-}
-
-std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses) {
-  Table t({"pose", "position std x", "y", "z", "orientation std x", "y", "z", "95 % radius"},
-          "Predicted accuracy of the calibrated arm (position in mm, orientation in mrad)");
-  for (std::size_t j = 0; j < poses.size(); ++j) {
-    const PoseAccuracy& p = poses[j];
-    t.AddRow({std::to_string(j + 1), Fixed(p.position_std.x() * 1e3),
-              Fixed(p.position_std.y() * 1e3), Fixed(p.position_std.z() * 1e3),
-              Fixed(p.orientation_std.x() * 1e3), Fixed(p.orientation_std.y() * 1e3),
-              Fixed(p.orientation_std.z() * 1e3), Fixed(p.position_radius_95 * 1e3)});
-  }
-  const PoseAccuracySummary s = SummarizePoseAccuracy(poses);
-  return t.ToText() + "over these " + std::to_string(poses.size()) + " poses: RMS position error " +
-         Fixed(s.rms_position * 1e3) + " mm; 95th percentile of the 95 % radius " +
-         Fixed(s.p95_radius_95 * 1e3) + " mm; worst pose " + std::to_string(s.worst + 1) + "\n";
 }
 
 }  // namespace lrcal

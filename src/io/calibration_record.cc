@@ -15,7 +15,8 @@ namespace lrcal {
 
 CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
                                         const IdentificationSummary& s,
-                                        const IdentificationOptions& options) {
+                                        const IdentificationOptions& options,
+                                        const UnestimatedTerms& held) {
   CalibrationRecord r;
   r.data_file = data_file;
   std::ifstream in(data_file, std::ios::binary);
@@ -29,22 +30,30 @@ CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
   r.date = date;
   r.lrcal = std::string(LRCAL_VERSION) + " (" + LRCAL_GIT_COMMIT + ")";
-  const bool given = options.sigma > 0;
-  r.sigma = given ? options.sigma : s.sigma_hat;
-  r.sigma_source = given ? "given (--sigma-mm)" : "residual (sigma_hat)";
+  const SigmaUsed used = ChooseSigma(s, options);
+  r.sigma = used.sigma;
+  r.sigma_source = used.source == "given" ? "given (--sigma-mm)"
+                   : options.sigma > 0    ? "residual (sigma_hat; the chi-squared check rejected "
+                                            "the given sigma)"
+                                          : "residual (sigma_hat)";
   r.parameters = s.names;
   r.estimate = s.estimate;
-  if (given || !std::isnan(s.sigma_hat)) r.covariance = FitCovariance(s, options);
+  if (std::isfinite(used.sigma)) r.covariance = CovarianceFor(s, used);
+  r.held = held.names;
+  r.held_sigma = held.sigma;
+  r.held_defaulted = held.defaulted;
+  r.estimate_shift = held.estimate_shift;
   return r;
 }
 
 void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
                           const RobotFile& rig, const MeasurementModel& model,
-                          const IdentificationSummary& s, const IdentificationOptions& options) {
+                          const IdentificationSummary& s, const IdentificationOptions& options,
+                          const UnestimatedTerms& held) {
   const MeasurementModel solved = SolvedModel(model, s);
   WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
                            solved.PlanesAt(s.delta.data()),
-                           MakeCalibrationRecord(data_file, s, options));
+                           MakeCalibrationRecord(data_file, s, options, held));
 }
 
 ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord& r, int num_planes,
@@ -88,8 +97,8 @@ Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet&
   return C;
 }
 
-std::vector<PoseAccuracy> PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSet& planes,
-                                                    const ConfigurationSet& poses) {
+AccuracyPrediction PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSet& planes,
+                                             const ConfigurationSet& poses) {
   if (!rig.calibration || rig.calibration->covariance.size() == 0)
     throw SettingError(SettingSpec::Named("setup", "robot", "robot", "a calibrated robot file"),
                        "'" + rig.path +
@@ -101,8 +110,30 @@ std::vector<PoseAccuracy> PredictCalibratedAccuracy(const RobotFile& rig, const 
   const ParameterSet ps = RecordParameterSet(rig.robot, r, planes.size(), source);
   const Eigen::MatrixXd C = RecordCovariance(r, ps, source);
   const MeasurementModel model(rig.robot, planes, ps);
+  UnestimatedTerms held;
+  held.names = r.held;
+  held.sigma = r.held_sigma;
+  held.defaulted = r.held_defaulted;
+  held.estimate_shift = r.held.empty() ? Eigen::MatrixXd(ps.size(), 0) : r.estimate_shift;
+  const ParameterSet all = CompleteParameterSet(rig.robot, planes.size());
+  for (const std::string& name : held.names)
+    if (all.Find(name) < 0 || ps.Find(name) >= 0)
+      throw InputError(rig.path + " calibration.held",
+                       "'" + name + "' is not a term this set-up holds at nominal");
+  // The shift's rows follow the record's parameters; reorder them like the covariance.
+  if (!held.empty()) {
+    const Eigen::MatrixXd shift = held.estimate_shift;
+    for (int a = 0; a < ps.size(); ++a) {
+      const auto it = std::find(r.parameters.begin(), r.parameters.end(), ps.names[a]);
+      held.estimate_shift.row(a) = shift.row(it - r.parameters.begin());
+    }
+  }
   const std::vector<double> zero(ps.size(), 0.0);  // the file's nominal values are the estimates
-  return PredictPoseAccuracy(model, zero.data(), C, poses);
+  AccuracyPrediction p = PredictTotalAccuracy(model, zero.data(), C, held, poses);
+  p.sigma_used.sigma = r.sigma;
+  p.sigma_used.source = r.sigma_source.rfind("given", 0) == 0 ? "given" : "residual";
+  p.sigma_used.reason = "the record's: " + r.sigma_source;
+  return p;
 }
 
 }  // namespace lrcal

@@ -184,21 +184,43 @@ ResultJson CrossValidationJson(const CrossValidation& cv) {
           {"beyond_4", beyond}};
 }
 
-ResultJson PoseAccuracyJson(const std::vector<PoseAccuracy>& poses,
+ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction,
                             const ConfigurationSet& configs) {
+  const std::vector<PoseAccuracy>& poses = prediction.poses;
   ResultJson list = ResultJson::array();
-  for (std::size_t j = 0; j < poses.size(); ++j)
-    list.push_back(
-        {{"q", std::vector<double>(configs.q(static_cast<int>(j)),
-                                   configs.q(static_cast<int>(j)) + configs.num_joints())},
-         {"position_std", Vec3(poses[j].position_std)},
-         {"orientation_std", Vec3(poses[j].orientation_std)},
-         {"position_radius_95", poses[j].position_radius_95}});
+  for (std::size_t j = 0; j < poses.size(); ++j) {
+    const PoseAccuracy& p = poses[j];
+    const double* q = configs.q(static_cast<int>(j));
+    list.push_back({{"q", std::vector<double>(q, q + configs.num_joints())},
+                    {"position_std", Vec3(p.position_std)},
+                    {"orientation_std", Vec3(p.orientation_std)},
+                    {"position_radius_95", p.position_radius_95},
+                    {"position_std_total", Vec3(p.position_std_total)},
+                    {"orientation_std_total", Vec3(p.orientation_std_total)},
+                    {"position_radius_95_total", p.position_radius_95_total}});
+  }
+  ResultJson sources = ResultJson::array();
+  for (const AccuracySource& s : prediction.sources)
+    sources.push_back({{"name", s.name},
+                       {"prior_sigma", s.prior_sigma > 0 ? ResultJson(s.prior_sigma) : ResultJson()},
+                       {"defaulted", s.defaulted},
+                       {"absorbed_by", s.absorbed_by.empty() ? ResultJson() : ResultJson(s.absorbed_by)},
+                       {"position_rms", s.position_rms},
+                       {"orientation_rms", s.orientation_rms},
+                       {"share", s.share}});
   const PoseAccuracySummary s = SummarizePoseAccuracy(poses);
   return {{"poses", list},
           {"rms_position", s.rms_position},
           {"p95_position_radius_95", s.p95_radius_95},
-          {"worst", s.worst + 1}};
+          {"rms_position_total", prediction.rms_position_total},
+          {"p95_position_radius_95_total", prediction.p95_radius_95_total},
+          {"worst", s.worst + 1},
+          {"sources", sources},
+          {"defaulted", prediction.defaulted},
+          {"sigma_used",
+           {{"sigma", prediction.sigma_used.sigma},
+            {"source", prediction.sigma_used.source},
+            {"reason", prediction.sigma_used.reason}}}};
 }
 
 ResultJson CertificateJson(const DesignCertificate& certificate, const std::string& statement) {

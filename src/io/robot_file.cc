@@ -1,6 +1,7 @@
 #include "lrcal/io/robot_file.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <utility>
@@ -253,11 +254,62 @@ void CheckCovariance(const Eigen::MatrixXd& c, const std::string& where) {
 
 }  // namespace
 
+// calibration.held, held_sigma, held_defaulted, estimate_shift: the terms held at nominal.
+void ParseHeldTerms(const YAML::Node& c, const std::string& path, CalibrationRecord* r) {
+  using namespace yaml;
+  if (!c["held"]) {
+    for (const char* key : {"held_sigma", "held_defaulted", "estimate_shift"})
+      if (c[key])
+        throw InputError(Where(path, c[key], std::string("calibration.") + key),
+                         "given without calibration.held (the terms it belongs to)");
+    return;
+  }
+  r->held = StringList(c["held"], path, "calibration.held");
+  const std::size_t k = r->held.size(), n = r->parameters.size();
+  const std::vector<double> sigma =
+      c["held_sigma"] ? NumberList(c["held_sigma"], path, "calibration.held_sigma")
+                      : std::vector<double>{};
+  if (sigma.size() != k)
+    throw InputError(Where(path, c["held_sigma"] ? c["held_sigma"] : c, "calibration.held_sigma"),
+                     "expected one prior standard deviation (SI) per name in calibration.held");
+  for (std::size_t i = 0; i < k; ++i)
+    if (!(sigma[i] > 0) || !std::isfinite(sigma[i]))
+      throw InputError(Where(path, c["held_sigma"], "calibration.held_sigma"),
+                       "entry " + std::to_string(i + 1) + " (" + r->held[i] +
+                           "): expected a standard deviation > 0, got " + FormatExact(sigma[i]));
+  r->held_sigma = Eigen::Map<const Eigen::VectorXd>(sigma.data(), static_cast<Eigen::Index>(k));
+  if (c["held_defaulted"]) {
+    r->held_defaulted = StringList(c["held_defaulted"], path, "calibration.held_defaulted");
+    for (const std::string& name : r->held_defaulted)
+      if (std::find(r->held.begin(), r->held.end(), name) == r->held.end())
+        throw InputError(Where(path, c["held_defaulted"], "calibration.held_defaulted"),
+                         "'" + name + "' is not in calibration.held");
+  }
+  const YAML::Node shift = c["estimate_shift"];
+  if (!shift || !shift.IsSequence() || shift.size() != n)
+    throw InputError(Where(path, shift ? shift : c, "calibration.estimate_shift"),
+                     "expected " + std::to_string(n) + " rows (one per parameter) of " +
+                         std::to_string(k) + " numbers (one per held term)");
+  r->estimate_shift.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(k));
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string key = "calibration.estimate_shift[" + std::to_string(i) + "]";
+    const std::vector<double> row = NumberList(shift[i], path, key);
+    if (row.size() != k)
+      throw InputError(Where(path, shift[i], key), "expected " + std::to_string(k) + " numbers");
+    for (std::size_t j = 0; j < k; ++j) {
+      if (!std::isfinite(row[j])) throw InputError(Where(path, shift[i], key), "expected finite numbers");
+      r->estimate_shift(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = row[j];
+    }
+  }
+}
+
 // calibration: the record of identify --write-robot (parameters, estimate, covariance, sigma).
 CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path) {
   using namespace yaml;
   CheckKeys(
-      c, {"data", "data_fnv1a", "date", "lrcal", "sigma", "parameters", "estimate", "covariance"},
+      c,
+      {"data", "data_fnv1a", "date", "lrcal", "sigma", "parameters", "estimate", "covariance",
+       "held", "held_sigma", "held_defaulted", "estimate_shift"},
       path, "calibration");
   CalibrationRecord r;
   if (c["data"]) r.data_file = String(c["data"], path, "calibration.data");
@@ -293,6 +345,7 @@ CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path)
     }
     CheckCovariance(r.covariance, Where(path, cov, "calibration.covariance"));
   }
+  ParseHeldTerms(c, path, &r);
   return r;
 }
 
@@ -488,6 +541,22 @@ std::string FixedTransformText(const RobotModel& robot) {
   return t;
 }
 
+std::string Joined(const std::vector<std::string>& names) {
+  std::string t;
+  for (std::size_t k = 0; k < names.size(); ++k) t += (k ? ", " : "") + names[k];
+  return t;
+}
+
+std::string MatrixRows(const Eigen::MatrixXd& m) {
+  std::string t;
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    t += "    - [";
+    for (Eigen::Index j = 0; j < m.cols(); ++j) t += (j ? ", " : "") + Num(m(i, j));
+    t += "]\n";
+  }
+  return t;
+}
+
 std::string RecordText(const CalibrationRecord& r) {
   std::string t = "calibration:\n";
   t += "  data: " + Quoted(r.data_file) + "\n  data_fnv1a: " + Quoted(r.data_fnv1a) +
@@ -498,15 +567,20 @@ std::string RecordText(const CalibrationRecord& r) {
   t += "]\n  estimate: [";  // SI
   for (Eigen::Index k = 0; k < r.estimate.size(); ++k) t += (k ? ", " : "") + Num(r.estimate[k]);
   t += "]\n  covariance:";
-  if (r.covariance.size() == 0) return t + " null  # undefined: no residual degrees of freedom\n";
-  t += "  # SI, in the order of parameters\n";
-  for (Eigen::Index i = 0; i < r.covariance.rows(); ++i) {
-    t += "    - [";
-    for (Eigen::Index j = 0; j < r.covariance.cols(); ++j)
-      t += (j ? ", " : "") + Num(r.covariance(i, j));
-    t += "]\n";
+  if (r.covariance.size() == 0) {
+    t += " null  # undefined: no residual degrees of freedom\n";
+  } else {
+    t += "  # SI, in the order of parameters\n";
+    t += MatrixRows(r.covariance);
   }
-  return t;
+  if (r.held.empty()) return t;
+  t += "  held: [" + Joined(r.held) + "]  # terms held at nominal\n  held_sigma: [";
+  for (Eigen::Index k = 0; k < r.held_sigma.size(); ++k)
+    t += (k ? ", " : "") + Num(r.held_sigma[k]);
+  t += "]  # SI, their prior standard deviations\n";
+  t += "  held_defaulted: [" + Joined(r.held_defaulted) + "]  # sigma is lrcal's default\n";
+  t += "  estimate_shift:  # d(estimate)/d(held term): rows parameters, columns held\n";
+  return t + MatrixRows(r.estimate_shift);
 }
 
 }  // namespace

@@ -1108,7 +1108,7 @@ py::object AccuracyPy(const RobotFile& rig, const py::object& poses, const py::o
   } else {
     configs = WorkspacePoses(rig.robot, workspace.cast<int>(), ToSeed(seed));
   }
-  std::vector<PoseAccuracy> predicted;
+  AccuracyPrediction predicted;
   {
     py::gil_scoped_release release;
     predicted = PredictCalibratedAccuracy(rig, planes, configs);

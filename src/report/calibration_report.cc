@@ -15,18 +15,21 @@ namespace lrcal {
 
 namespace {
 
-// Cross-validation and the accuracy map over the workspace, added to `j` for a usable fit.
-void AddPredictions(const CalibrationReportInputs& in, ResultJson* j) {
+// Cross-validation and the total accuracy map over the workspace, added to `j` for a usable fit.
+void AddPredictions(const CalibrationReportInputs& in, const UnestimatedTerms& held,
+                    ResultJson* j) {
   const IdentificationSummary& s = *in.summary;
   const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
   if (folds >= 2)
     (*j)["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
-  const Eigen::MatrixXd& C = FitCovariance(s, in.options);
+  const SigmaUsed used = ChooseSigma(s, in.options);
+  const Eigen::MatrixXd& C = CovarianceFor(s, used);
   if (!C.allFinite()) return;
   const ConfigurationSet poses =
       WorkspacePoses(in.model->robot(), in.workspace_poses, in.workspace_seed);
-  (*j)["workspace_accuracy"] = PoseAccuracyJson(
-      PredictPoseAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, poses), poses);
+  AccuracyPrediction p = PredictTotalAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, held, poses);
+  p.sigma_used = used;
+  (*j)["workspace_accuracy"] = PoseAccuracyJson(p, poses);
 }
 
 }  // namespace
@@ -61,8 +64,11 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
   j["sigma_given"] = in.options.sigma > 0 ? ResultJson(in.options.sigma) : ResultJson();
   j["identifiability"] = IdentifiabilityJson(s.identifiability);
   if (s.IsSolutionUsable()) {
-    AddPredictions(in, &j);
-    WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_file, *in.rig, *in.model, s, in.options);
+    const UnestimatedTerms held =
+        FindUnestimatedTerms(SolvedModel(*in.model, s), s, *in.data, in.options, in.known);
+    AddPredictions(in, held, &j);
+    WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_file, *in.rig, *in.model, s, in.options,
+                         held);
     j["calibrated_robot"] = "calibrated.yaml";
     // The same model as URDF, from the file just written (what lrcal export would write).
     const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");

@@ -22,7 +22,17 @@ struct PoseAccuracy {
   Eigen::Vector3d position_std = Eigen::Vector3d::Zero();     ///< m, base x, y, z
   Eigen::Vector3d orientation_std = Eigen::Vector3d::Zero();  ///< rad, rotation vector x, y, z
   double position_radius_95 = 0;                              ///< m
+  /// The total (total_accuracy.h): the data part above plus everything the calibration held at
+  /// nominal, propagated from its prior. Equal to the data part when nothing is held.
+  Eigen::Vector3d position_std_total = Eigen::Vector3d::Zero();     ///< m
+  Eigen::Vector3d orientation_std_total = Eigen::Vector3d::Zero();  ///< rad
+  double position_radius_95_total = 0;                              ///< m
 };
+
+/// A pose's accuracy from its 6 × 6 pose covariances (position m, then rotation vector rad): the
+/// data part `data` and the total `total` (pass `data` twice when nothing is held).
+PoseAccuracy PoseAccuracyFromCovariance(const Eigen::Matrix<double, 6, 6>& data,
+                                        const Eigen::Matrix<double, 6, 6>& total);
 
 /// Over a set of poses: the RMS of the predicted position error (√ of the mean of tr Σ_p), the
 /// 95th percentile of the per-pose 95 % radius, and the pose where that radius is largest.
@@ -47,8 +57,5 @@ std::vector<PoseAccuracy> PredictPoseAccuracy(const MeasurementModel& model, con
                                               const ConfigurationSet& configs);
 
 PoseAccuracySummary SummarizePoseAccuracy(const std::vector<PoseAccuracy>& poses);
-
-/// The predicted accuracy as a text table (mm, mrad) with its summary line.
-std::string PoseAccuracyText(const std::vector<PoseAccuracy>& poses);
 
 }  // namespace lrcal

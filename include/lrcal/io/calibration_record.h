@@ -5,23 +5,26 @@
 #include <string>
 
 #include "lrcal/identification/identification.h"
-#include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/robot_file.h"
 
 namespace lrcal {
 
-/// The record of an identification of `data_file` (hashed, dated, with lrcal's version): σ is
-/// the given one (options.sigma > 0) or else σ̂, and the covariance is FitCovariance's when
-/// defined (empty otherwise).
+/// The record of an identification of `data_file` (hashed, dated, with lrcal's version): σ and
+/// the covariance are ChooseSigma's (the given σ unless the χ² check rejects it, else σ̂; the
+/// covariance empty when undefined), with the terms `held` at nominal (total_accuracy.h).
 CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
                                         const IdentificationSummary& s,
-                                        const IdentificationOptions& options);
+                                        const IdentificationOptions& options,
+                                        const UnestimatedTerms& held = {});
 
 /// The calibrated model of an identification (its solved model, SolvedModel) written as a robot
-/// file at `path` with its record; every command takes it as a robot. Throws StorageError.
+/// file at `path` with its record (and the terms `held` at nominal); every command takes it as a
+/// robot. Throws StorageError.
 void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
                           const RobotFile& rig, const MeasurementModel& model,
-                          const IdentificationSummary& s, const IdentificationOptions& options);
+                          const IdentificationSummary& s, const IdentificationOptions& options,
+                          const UnestimatedTerms& held = {});
 
 /// The parameter set the calibration record `r` names: plane and ranger terms from their names,
 /// robot parameters not named are fixed, in MakeParameterSet's order. `source` names the record in
@@ -34,10 +37,11 @@ ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord
 Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet& ps,
                                  const std::string& source);
 
-/// The predicted accuracy at `poses` of the calibrated robot file `rig` (its nominal values are
-/// the estimates; its record's covariance, reordered to the parameter set it names on `planes`).
-/// Throws SettingError (`robot`) when the file has no record with a covariance.
-std::vector<PoseAccuracy> PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSet& planes,
-                                                    const ConfigurationSet& poses);
+/// The total predicted accuracy at `poses` of the calibrated robot file `rig` (its nominal values
+/// are the estimates; its record's covariance, reordered to the parameter set it names on
+/// `planes`, and its held terms). Throws SettingError (`robot`) when the file has no record with a
+/// covariance, InputError naming the record when a held term is not a term of the set-up.
+AccuracyPrediction PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSet& planes,
+                                             const ConfigurationSet& poses);
 
 }  // namespace lrcal

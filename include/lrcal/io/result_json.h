@@ -12,7 +12,7 @@
 #include "lrcal/design/identifiability_remedies.h"
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identification.h"
-#include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/identification/total_accuracy.h"
 
 namespace lrcal {
 
@@ -38,9 +38,13 @@ ResultJson IdentificationJson(const IdentificationSummary& s);
 ResultJson PriorInformationJson(const PriorInformation& info);
 /// K-fold cross-validation (configurations 1-based, like the fit's suspects).
 ResultJson CrossValidationJson(const CrossValidation& cv);
-/// Predicted accuracy at poses (`configs` gives each pose's joint values), with the summary
-/// (`worst` 1-based).
-ResultJson PoseAccuracyJson(const std::vector<PoseAccuracy>& poses,
+/// Predicted accuracy at poses (`configs` gives each pose's joint values; SI): per pose the data
+/// part (position_std, orientation_std, position_radius_95) and the total (the same names with
+/// _total); the summary (rms_position, p95_position_radius_95 and their _total; `worst`
+/// 1-based); `sources` (name, prior_sigma, defaulted, absorbed_by, position_rms,
+/// orientation_rms, share), `defaulted` (held terms with the default σ) and `sigma_used`
+/// (sigma, source "given" or "residual", reason).
+ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction,
                             const ConfigurationSet& configs);
 /// A design certificate with its statement.
 ResultJson CertificateJson(const DesignCertificate& certificate, const std::string& statement);

@@ -28,6 +28,13 @@ struct CalibrationRecord {
   std::vector<std::string> parameters;  ///< the estimated quantities
   Eigen::VectorXd estimate;             ///< their values, SI
   Eigen::MatrixXd covariance;           ///< their covariance, SI (empty if undefined)
+  /// What the calibration held at nominal (total_accuracy.h): the terms, their prior σ (SI),
+  /// those whose σ is the stated default, and how each moves the estimate (parameters × held).
+  /// Empty in records written before lrcal stated totals: then the total is the data part.
+  std::vector<std::string> held;
+  Eigen::VectorXd held_sigma;
+  std::vector<std::string> held_defaulted;
+  Eigen::MatrixXd estimate_shift;
 };
 
 /// What a robot file holds.

@@ -20,6 +20,9 @@ struct CalibrationReportInputs {
   const MeasurementSet* data = nullptr;
   const IdentificationSummary* summary = nullptr;
   IdentificationOptions options;
+  /// What is known of the terms held at nominal (the robot file's tolerances, --prior-sigma):
+  /// the total accuracy statement propagates them (total_accuracy.h); defaults elsewhere.
+  PriorSigmas known{};
   /// Cross-validation folds (2 or more); 0: min(5, configurations).
   int holdout = 0;
   int workspace_poses = 500;         ///< poses of the accuracy map over the joint ranges
