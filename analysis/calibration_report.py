@@ -147,16 +147,22 @@ def accuracy_figure(data, fig_dir, out):
     if not acc or not acc.get("poses"):
         return
     radius = np.array([p["position_radius_95"] for p in acc["poses"]]) * 1e3
+    total = np.array([p.get("position_radius_95_total", p["position_radius_95"])
+                      for p in acc["poses"]]) * 1e3
     fig, ax = plt.subplots(figsize=(7, 3.2))
-    ax.hist(radius, bins=30, color="#4a7ab5")
-    ax.axvline(acc["p95_position_radius_95"] * 1e3, color="#c0392b", lw=1,
-               label="95th percentile")
+    bins = np.linspace(0, max(total.max(), radius.max()) * 1.02 + 1e-12, 40)
+    ax.hist(radius, bins=bins, color="#9db4d6", label="reading noise only (data part)")
+    ax.hist(total, bins=bins, color="#4a7ab5", alpha=0.8,
+            label="total (with the terms held at nominal)")
+    ax.axvline(acc.get("p95_position_radius_95_total", acc["p95_position_radius_95"]) * 1e3,
+               color="#c0392b", lw=1, label="95th percentile of the total")
     ax.set_xlabel("radius holding the position error with 95 % probability (mm)")
     ax.set_ylabel("poses")
-    ax.legend()
+    ax.legend(fontsize=8)
     save(fig, fig_dir, "accuracy",
          f"Predicted accuracy of the calibrated arm at {len(radius)} poses drawn over the joint "
-         "ranges (first-order propagation of the parameter covariance).", out)
+         "ranges (first-order propagation): from the reading noise alone, and in total with "
+         "everything the calibration did not estimate, each from its tolerance.", out)
 
 
 def fit_text(data):
@@ -228,9 +234,44 @@ def accuracy_text(data):
     acc = data.get("workspace_accuracy")
     if not acc:
         return "<p>Not available: the covariance is undefined (give --sigma-mm).</p>"
-    return (f"<p>Over {len(acc['poses'])} poses drawn over the joint ranges: RMS position error "
-            f"{acc['rms_position'] * 1e3:.4f} mm; 95th percentile of the 95 % radius "
-            f"{acc['p95_position_radius_95'] * 1e3:.4f} mm; worst pose {acc['worst']}.</p>")
+    text = (f"<p>Over {len(acc['poses'])} poses drawn over the joint ranges: RMS position error "
+            f"<b>{acc.get('rms_position_total', acc['rms_position']) * 1e3:.4f} mm in total</b> "
+            f"({acc['rms_position'] * 1e3:.4f} mm from the reading noise alone); 95th percentile "
+            f"of the total 95 % radius "
+            f"{acc.get('p95_position_radius_95_total', acc['p95_position_radius_95']) * 1e3:.4f} mm"
+            f"; worst pose (data part) {acc['worst']}.</p>")
+    used = acc.get("sigma_used")
+    if used:
+        text += (f"<p>σ of one reading used: {used['sigma'] * 1e3:.4f} mm "
+                 f"({html.escape(used['reason'])}).</p>")
+    sources = acc.get("sources") or []
+    if sources:
+        rows = "".join(
+            f"<tr><td>{html.escape(s['name'])}</td>"
+            f"<td>{'' if s['prior_sigma'] is None else html.escape(prior_text(s))}</td>"
+            f"<td>{html.escape(s['absorbed_by'] or ('-' if s['prior_sigma'] is None else 'not seen'))}</td>"
+            f"<td>{s['position_rms'] * 1e3:.4f}</td><td>{s['orientation_rms'] * 1e3:.4f}</td>"
+            f"<td>{s['share'] * 100:.1f} %</td></tr>" for s in sources)
+        text += ("<table><tr><th>source</th><th>prior</th><th>absorbed by</th>"
+                 "<th>position RMS (mm)</th><th>orientation RMS (mrad)</th><th>share</th></tr>"
+                 + rows + "</table>")
+    if acc.get("defaulted"):
+        text += ("<p><b>Warning:</b> no tolerance was known for "
+                 + html.escape(", ".join(acc["defaulted"]))
+                 + "; lrcal's stated defaults (" + html.escape(acc.get("defaults", ""))
+                 + ") were used. Give them in the robot file's <code>tolerances:</code>.</p>")
+    return text
+
+
+def prior_text(source):
+    name, sigma = source["name"], source["prior_sigma"]
+    if name == "ranger_scale":
+        value = f"{sigma * 1e6:.1f} ppm"
+    elif name.startswith(("theta", "alpha", "beta")) or "_u" in name:
+        value = f"{sigma * 1e3:.3f} mrad"
+    else:
+        value = f"{sigma * 1e3:.3f} mm"
+    return value + (" (default)" if source["defaulted"] else "")
 
 
 def build(folder):

@@ -295,7 +295,8 @@ std::string AccuracyPredictionText(const AccuracyPrediction& p) {
     t += "warning: no tolerance known for " + std::to_string(p.defaulted.size()) +
          " held terms; the stated defaults (" + p.defaults.ToString() + ") were used for:";
     for (const std::string& name : p.defaulted) t += " " + name;
-    t += "\n         give them in the robot file's tolerances: or with --prior-sigma\n";
+    t += "\n         give them when calibrating: the robot file's tolerances:, or identify "
+         "--prior-sigma\n";
   }
   return t;
 }

@@ -132,7 +132,8 @@ AccuracyPrediction PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSe
   AccuracyPrediction p = PredictTotalAccuracy(model, zero.data(), C, held, poses);
   p.sigma_used.sigma = r.sigma;
   p.sigma_used.source = r.sigma_source.rfind("given", 0) == 0 ? "given" : "residual";
-  p.sigma_used.reason = "the record's: " + r.sigma_source;
+  p.sigma_used.reason =
+      r.sigma_source.empty() ? "the record's sigma" : "the record's sigma: " + r.sigma_source;
   return p;
 }
 

@@ -308,7 +308,8 @@ CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path)
   using namespace yaml;
   CheckKeys(
       c,
-      {"data", "data_fnv1a", "date", "lrcal", "sigma", "parameters", "estimate", "covariance",
+      {"data", "data_fnv1a", "date", "lrcal", "sigma", "sigma_source", "parameters", "estimate",
+       "covariance",
        "held", "held_sigma", "held_defaulted", "estimate_shift"},
       path, "calibration");
   CalibrationRecord r;
@@ -320,6 +321,8 @@ CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path)
           Where(path, c["sigma"], "calibration.sigma"),
           "expected the standard deviation of one reading, >= 0 (m), got " + FormatExact(r.sigma));
   }
+  if (c["sigma_source"])
+    r.sigma_source = String(c["sigma_source"], path, "calibration.sigma_source");
   if (c["parameters"]) r.parameters = StringList(c["parameters"], path, "calibration.parameters");
   const std::vector<double> estimate = c["estimate"]
                                            ? NumberList(c["estimate"], path, "calibration.estimate")
@@ -561,7 +564,8 @@ std::string RecordText(const CalibrationRecord& r) {
   std::string t = "calibration:\n";
   t += "  data: " + Quoted(r.data_file) + "\n  data_fnv1a: " + Quoted(r.data_fnv1a) +
        "\n  date: " + Quoted(r.date) + "\n  lrcal: " + Quoted(r.lrcal) + "\n";
-  t += "  sigma: " + Num(r.sigma) + "  # m, one reading; " + r.sigma_source + "\n";
+  t += "  sigma: " + Num(r.sigma) + "  # m, one reading\n";
+  t += "  sigma_source: " + Quoted(r.sigma_source) + "\n";
   t += "  parameters: [";
   for (std::size_t k = 0; k < r.parameters.size(); ++k) t += (k ? ", " : "") + r.parameters[k];
   t += "]\n  estimate: [";  // SI

@@ -91,6 +91,48 @@ TEST(RobotFile, ACalibrationRecordsCovarianceMustBeOne) {
                                ::testing::HasSubstr(">= 0 (m), got -0.0002")));
 }
 
+// The terms a calibration held at nominal (total_accuracy.h): checked like the covariance, each
+// error naming the file, line and key.
+TEST(RobotFile, ACalibrationRecordsHeldTermsAreChecked) {
+  const std::string dir = testing::TempDir("robot_held");
+  const auto load = [&](const std::string& held) {
+    const std::string path = dir + "/cal.yaml";
+    std::ofstream(path) << "links:\n  - {theta: 0, alpha: 0, a: 0.5, d: 0, parameters: [theta, "
+                           "a, d]}\ncalibration:\n  sigma: 2e-4\n  sigma_source: \"given\"\n"
+                           "  parameters: [theta1, a1]\n  estimate: [0, 0.5]\n"
+                           "  covariance: [[4e-8, 0], [0, 9e-8]]\n"
+                        << held;
+    try {
+      const RobotFile file = LoadRobotFile(path);
+      return "accepted " + std::to_string(file.calibration->held.size()) + " " +
+             std::to_string(file.calibration->estimate_shift.rows()) + "x" +
+             std::to_string(file.calibration->estimate_shift.cols());
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+  };
+  const std::string good =
+      "  held: [d1, ranger_offset]\n  held_sigma: [1e-3, 5e-4]\n  held_defaulted: [d1]\n"
+      "  estimate_shift:\n    - [0, 0]\n    - [1, -1]\n";
+  EXPECT_EQ(load(good), "accepted 2 2x2");
+  EXPECT_EQ(load(""), "accepted 0 0x0");
+  EXPECT_THAT(load("  held: [d1]\n  held_sigma: [0]\n  estimate_shift: [[0], [1]]\n"),
+              ::testing::AllOf(::testing::HasSubstr("cal.yaml:10 key 'calibration.held_sigma'"),
+                               ::testing::HasSubstr("entry 1 (d1): expected a standard deviation > 0")));
+  EXPECT_THAT(load("  held: [d1]\n  held_sigma: [1e-3, 1e-3]\n  estimate_shift: [[0], [1]]\n"),
+              ::testing::HasSubstr("expected one prior standard deviation (SI) per name"));
+  EXPECT_THAT(load("  held: [d1]\n  held_sigma: [1e-3]\n  estimate_shift: [[0], [1, 2]]\n"),
+              ::testing::AllOf(::testing::HasSubstr("key 'calibration.estimate_shift[1]'"),
+                               ::testing::HasSubstr("expected 1 numbers")));
+  EXPECT_THAT(load("  held: [d1]\n  held_sigma: [1e-3]\n"),
+              ::testing::HasSubstr("expected 2 rows (one per parameter) of 1 numbers"));
+  EXPECT_THAT(load("  held: [d1]\n  held_sigma: [1e-3]\n  held_defaulted: [a1]\n"
+                   "  estimate_shift: [[0], [1]]\n"),
+              ::testing::HasSubstr("'a1' is not in calibration.held"));
+  EXPECT_THAT(load("  held_sigma: [1e-3]\n"),
+              ::testing::HasSubstr("given without calibration.held"));
+}
+
 }  // namespace
 }  // namespace lrcal
 

@@ -42,7 +42,8 @@ ResultJson CrossValidationJson(const CrossValidation& cv);
 /// part (position_std, orientation_std, position_radius_95) and the total (the same names with
 /// _total); the summary (rms_position, p95_position_radius_95 and their _total; `worst`
 /// 1-based); `sources` (name, prior_sigma, defaulted, absorbed_by, position_rms,
-/// orientation_rms, share), `defaulted` (held terms with the default σ) and `sigma_used`
+/// orientation_rms, share), `defaulted` (held terms with the default σ), `defaults` (the
+/// stated defaults in words) and `sigma_used`
 /// (sigma, source "given" or "residual", reason).
 ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction,
                             const ConfigurationSet& configs);
