@@ -19,8 +19,8 @@ double DefaultTolerances::Of(const std::string& name) const {
 
 std::string DefaultTolerances::ToString() const {
   return Fixed(length * 1e3, 3) + " mm, " + Fixed(angle * 1e3, 3) + " mrad, " +
-         Fixed(ranger_offset * 1e3, 3) + " mm (ranger offset), " +
-         Fixed(ranger_scale * 1e6, 1) + " ppm (ranger scale)";
+         Fixed(ranger_offset * 1e3, 3) + " mm (ranger offset), " + Fixed(ranger_scale * 1e6, 1) +
+         " ppm (ranger scale)";
 }
 
 ParameterSet CompleteParameterSet(const RobotModel& robot, int num_planes) {
@@ -59,8 +59,8 @@ Eigen::MatrixXd Columns(const Eigen::MatrixXd& m, const std::vector<int>& at) {
 
 }  // namespace
 
-UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved, const IdentificationSummary& s,
-                                      const MeasurementSet& data,
+UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
+                                      const IdentificationSummary& s, const MeasurementSet& data,
                                       const IdentificationOptions& options,
                                       const PriorSigmas& known, const DefaultTolerances& defaults) {
   const ParameterSet all = CompleteParameterSet(solved.robot(), solved.num_planes());
@@ -103,7 +103,8 @@ UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved, const Iden
 
 SigmaUsed ChooseSigma(const IdentificationSummary& s, const IdentificationOptions& options) {
   SigmaUsed used;
-  if (options.sigma > 0 && !(s.fit.sigma_given && !s.fit.consistent && std::isfinite(s.sigma_hat))) {
+  if (options.sigma > 0 &&
+      !(s.fit.sigma_given && !s.fit.consistent && std::isfinite(s.sigma_hat))) {
     used.sigma = options.sigma;
     used.source = "given";
     used.reason = "the given sigma, consistent with the residuals (chi-squared check)";
@@ -112,8 +113,8 @@ SigmaUsed ChooseSigma(const IdentificationSummary& s, const IdentificationOption
   used.sigma = s.sigma_hat;
   used.source = "residual";
   used.reason = options.sigma > 0
-                    ? "the chi-squared check rejects the given sigma " + Fixed(options.sigma * 1e3) +
-                          " mm (p = " + Fixed(s.fit.p_value, 6) +
+                    ? "the chi-squared check rejects the given sigma " +
+                          Fixed(options.sigma * 1e3) + " mm (p = " + Fixed(s.fit.p_value, 6) +
                           "): the residuals' sigma " + Fixed(s.sigma_hat * 1e3) + " mm is used"
                     : "no sigma given: the residuals' sigma is used";
   return used;
@@ -204,8 +205,8 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
     AccuracySource src;
     src.name = held.names[c];
     src.prior_sigma = held.sigma[c];
-    src.defaulted = std::find(held.defaulted.begin(), held.defaulted.end(), src.name) !=
-                    held.defaulted.end();
+    src.defaulted =
+        std::find(held.defaulted.begin(), held.defaulted.end(), src.name) != held.defaulted.end();
     src.absorbed_by = AbsorbedBy(held, c, covariance, solved.parameters().names);
     src.position_rms = std::sqrt(pos_ms[c] / m);
     src.orientation_rms = std::sqrt(ori_ms[c] / m);
@@ -256,10 +257,9 @@ std::string SourceTable(const AccuracyPrediction& p) {
       continue;
     }
     const DisplayUnit u = DisplayUnitOf(s.name);
-    const std::string prior =
-        s.prior_sigma > 0 ? Fixed(s.prior_sigma * u.factor, 3) + " " + u.unit +
-                                (s.defaulted ? " (default)" : "")
-                          : "-";
+    const std::string prior = s.prior_sigma > 0 ? Fixed(s.prior_sigma * u.factor, 3) + " " +
+                                                      u.unit + (s.defaulted ? " (default)" : "")
+                                                : "-";
     t.AddRow({s.name, prior,
               s.prior_sigma > 0 ? (s.absorbed_by.empty() ? "(not seen)" : s.absorbed_by) : "-",
               Fixed(s.position_rms * 1e3), Fixed(s.orientation_rms * 1e3),
@@ -284,7 +284,8 @@ std::string AccuracyPredictionText(const AccuracyPrediction& p) {
   std::string t = PoseTable(p);
   t += "over these " + std::to_string(m) + " poses: RMS position error " +
        Fixed(m ? std::sqrt(data_ms / m) * 1e3 : 0) + " mm from the reading noise alone, " +
-       Fixed(p.rms_position_total * 1e3) + " mm in total; 95th percentile of the total 95 % radius " +
+       Fixed(p.rms_position_total * 1e3) +
+       " mm in total; 95th percentile of the total 95 % radius " +
        Fixed(p.p95_radius_95_total * 1e3) + " mm (data part " + Fixed(Percentile95(radii) * 1e3) +
        " mm)\n";
   if (!p.sigma_used.source.empty())

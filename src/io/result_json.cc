@@ -184,8 +184,7 @@ ResultJson CrossValidationJson(const CrossValidation& cv) {
           {"beyond_4", beyond}};
 }
 
-ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction,
-                            const ConfigurationSet& configs) {
+ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction, const ConfigurationSet& configs) {
   const std::vector<PoseAccuracy>& poses = prediction.poses;
   ResultJson list = ResultJson::array();
   for (std::size_t j = 0; j < poses.size(); ++j) {
@@ -201,13 +200,14 @@ ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction,
   }
   ResultJson sources = ResultJson::array();
   for (const AccuracySource& s : prediction.sources)
-    sources.push_back({{"name", s.name},
-                       {"prior_sigma", s.prior_sigma > 0 ? ResultJson(s.prior_sigma) : ResultJson()},
-                       {"defaulted", s.defaulted},
-                       {"absorbed_by", s.absorbed_by.empty() ? ResultJson() : ResultJson(s.absorbed_by)},
-                       {"position_rms", s.position_rms},
-                       {"orientation_rms", s.orientation_rms},
-                       {"share", s.share}});
+    sources.push_back(
+        {{"name", s.name},
+         {"prior_sigma", s.prior_sigma > 0 ? ResultJson(s.prior_sigma) : ResultJson()},
+         {"defaulted", s.defaulted},
+         {"absorbed_by", s.absorbed_by.empty() ? ResultJson() : ResultJson(s.absorbed_by)},
+         {"position_rms", s.position_rms},
+         {"orientation_rms", s.orientation_rms},
+         {"share", s.share}});
   const PoseAccuracySummary s = SummarizePoseAccuracy(poses);
   return {{"poses", list},
           {"rms_position", s.rms_position},

@@ -254,6 +254,29 @@ void CheckCovariance(const Eigen::MatrixXd& c, const std::string& where) {
 
 }  // namespace
 
+// calibration.estimate_shift: one row per parameter, one column per held term, finite.
+void ParseEstimateShift(const YAML::Node& c, const std::string& path, CalibrationRecord* r) {
+  using namespace yaml;
+  const std::size_t k = r->held.size(), n = r->parameters.size();
+  const YAML::Node shift = c["estimate_shift"];
+  if (!shift || !shift.IsSequence() || shift.size() != n)
+    throw InputError(Where(path, shift ? shift : c, "calibration.estimate_shift"),
+                     "expected " + std::to_string(n) + " rows (one per parameter) of " +
+                         std::to_string(k) + " numbers (one per held term)");
+  r->estimate_shift.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(k));
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string key = "calibration.estimate_shift[" + std::to_string(i) + "]";
+    const std::vector<double> row = NumberList(shift[i], path, key);
+    if (row.size() != k)
+      throw InputError(Where(path, shift[i], key), "expected " + std::to_string(k) + " numbers");
+    for (std::size_t j = 0; j < k; ++j) {
+      if (!std::isfinite(row[j]))
+        throw InputError(Where(path, shift[i], key), "expected finite numbers");
+      r->estimate_shift(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = row[j];
+    }
+  }
+}
+
 // calibration.held, held_sigma, held_defaulted, estimate_shift: the terms held at nominal.
 void ParseHeldTerms(const YAML::Node& c, const std::string& path, CalibrationRecord* r) {
   using namespace yaml;
@@ -265,7 +288,7 @@ void ParseHeldTerms(const YAML::Node& c, const std::string& path, CalibrationRec
     return;
   }
   r->held = StringList(c["held"], path, "calibration.held");
-  const std::size_t k = r->held.size(), n = r->parameters.size();
+  const std::size_t k = r->held.size();
   const std::vector<double> sigma =
       c["held_sigma"] ? NumberList(c["held_sigma"], path, "calibration.held_sigma")
                       : std::vector<double>{};
@@ -285,33 +308,16 @@ void ParseHeldTerms(const YAML::Node& c, const std::string& path, CalibrationRec
         throw InputError(Where(path, c["held_defaulted"], "calibration.held_defaulted"),
                          "'" + name + "' is not in calibration.held");
   }
-  const YAML::Node shift = c["estimate_shift"];
-  if (!shift || !shift.IsSequence() || shift.size() != n)
-    throw InputError(Where(path, shift ? shift : c, "calibration.estimate_shift"),
-                     "expected " + std::to_string(n) + " rows (one per parameter) of " +
-                         std::to_string(k) + " numbers (one per held term)");
-  r->estimate_shift.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(k));
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::string key = "calibration.estimate_shift[" + std::to_string(i) + "]";
-    const std::vector<double> row = NumberList(shift[i], path, key);
-    if (row.size() != k)
-      throw InputError(Where(path, shift[i], key), "expected " + std::to_string(k) + " numbers");
-    for (std::size_t j = 0; j < k; ++j) {
-      if (!std::isfinite(row[j])) throw InputError(Where(path, shift[i], key), "expected finite numbers");
-      r->estimate_shift(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = row[j];
-    }
-  }
+  ParseEstimateShift(c, path, r);
 }
 
 // calibration: the record of identify --write-robot (parameters, estimate, covariance, sigma).
 CalibrationRecord ParseCalibration(const YAML::Node& c, const std::string& path) {
   using namespace yaml;
-  CheckKeys(
-      c,
-      {"data", "data_fnv1a", "date", "lrcal", "sigma", "sigma_source", "parameters", "estimate",
-       "covariance",
-       "held", "held_sigma", "held_defaulted", "estimate_shift"},
-      path, "calibration");
+  CheckKeys(c,
+            {"data", "data_fnv1a", "date", "lrcal", "sigma", "sigma_source", "parameters",
+             "estimate", "covariance", "held", "held_sigma", "held_defaulted", "estimate_shift"},
+            path, "calibration");
   CalibrationRecord r;
   if (c["data"]) r.data_file = String(c["data"], path, "calibration.data");
   if (c["sigma"]) {

@@ -27,7 +27,8 @@ void AddPredictions(const CalibrationReportInputs& in, const UnestimatedTerms& h
   if (!C.allFinite()) return;
   const ConfigurationSet poses =
       WorkspacePoses(in.model->robot(), in.workspace_poses, in.workspace_seed);
-  AccuracyPrediction p = PredictTotalAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, held, poses);
+  AccuracyPrediction p =
+      PredictTotalAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, held, poses);
   p.sigma_used = used;
   (*j)["workspace_accuracy"] = PoseAccuracyJson(p, poses);
 }

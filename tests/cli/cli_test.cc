@@ -590,8 +590,15 @@ TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
   }
   const std::string text = testing::ReadFile(Path("cal.yaml"));
   EXPECT_THAT(text, ::testing::HasSubstr("data_fnv1a"));
-  EXPECT_THAT(text, ::testing::HasSubstr("sigma: 0.00020000000000000001  # m, one reading; given"))
+  EXPECT_THAT(text, ::testing::HasSubstr("sigma: 0.00020000000000000001  # m, one reading\n"
+                                         "  sigma_source: \"given (--sigma-mm)\""))
       << text;
+  EXPECT_THAT(text, ::testing::HasSubstr("held: [d1, plane_u1, plane_u2, ranger_offset, "
+                                         "ranger_scale]"));
+  ASSERT_TRUE(cal.calibration.has_value());
+  EXPECT_EQ(cal.calibration->sigma_source, "given (--sigma-mm)");
+  EXPECT_EQ(cal.calibration->estimate_shift.rows(), 25);
+  EXPECT_EQ(cal.calibration->estimate_shift.cols(), 5);
   ASSERT_EQ(Run("kinematics --robot " + Path("cal.yaml") + " --configs " + Path("c.csv"), &out), 0)
       << out;
   ASSERT_EQ(Run("identify --robot " + Path("cal.yaml") + " --data " + Path("m.csv") +
@@ -635,8 +642,8 @@ TEST_F(CliTest, AccuracyAtPosesFromTheFitAndFromTheCalibratedFile) {
     EXPECT_NEAR(fit[key].get<double>(), file[key].get<double>(), 1e-6 * file[key].get<double>());
   // The paper's plane is given, not estimated, and no tolerance is known: the total holds the
   // plane and ranger terms at lrcal's defaults and names them.
-  EXPECT_EQ(file["defaulted"], Json({"plane_u1", "plane_u2", "plane_f", "ranger_offset",
-                                     "ranger_scale"}));
+  EXPECT_EQ(file["defaulted"],
+            Json({"plane_u1", "plane_u2", "plane_f", "ranger_offset", "ranger_scale"}));
   ASSERT_EQ(fit["sources"].size(), file["sources"].size());
   for (std::size_t k = 0; k < file["sources"].size(); ++k) {
     EXPECT_EQ(fit["sources"][k]["name"], file["sources"][k]["name"]);
@@ -658,10 +665,11 @@ TEST_F(CliTest, AccuracyAtPosesFromTheFitAndFromTheCalibratedFile) {
 // ranger offset (absorbed by d7, default tolerance, warned about) and holds it at every pose.
 TEST_F(CliTest, TotalAccuracyCoversTheRangerOffsetTheReadingsCannotSee) {
   std::string out;
-  const std::string rig = " --robot " + testing::SourcePath("examples/rigs/seven_joint_ranger.yaml");
+  const std::string rig =
+      " --robot " + testing::SourcePath("examples/rigs/seven_joint_ranger.yaml");
   ASSERT_EQ(Run("sample" + rig + " --count 60 --seed 3 --out " + Path("c.csv"), &out), 0) << out;
-  ASSERT_EQ(Run("simulate" + rig + " --configs " + Path("c.csv") + " --sigma-mm 0.05 --seed 2 --out " +
-                    Path("m.csv"),
+  ASSERT_EQ(Run("simulate" + rig + " --configs " + Path("c.csv") +
+                    " --sigma-mm 0.05 --seed 2 --out " + Path("m.csv"),
                 &out),
             0)
       << out;
@@ -673,15 +681,15 @@ TEST_F(CliTest, TotalAccuracyCoversTheRangerOffsetTheReadingsCannotSee) {
                 &out),
             0)
       << out;
-  ASSERT_EQ(Run("accuracy --robot " + Path("cal.yaml") + " --configs " + Path("v.csv") +
-                    " --format json",
-                &out),
-            0)
+  ASSERT_EQ(
+      Run("accuracy --robot " + Path("cal.yaml") + " --configs " + Path("v.csv") + " --format json",
+          &out),
+      0)
       << out;
   const Json acc = Json::parse(out);
-  ASSERT_EQ(Run("kinematics" + rig + " --model true --configs " + Path("v.csv") + " --format json",
-                &out),
-            0);
+  ASSERT_EQ(
+      Run("kinematics" + rig + " --model true --configs " + Path("v.csv") + " --format json", &out),
+      0);
   const Json truth = Json::parse(out);
   ASSERT_EQ(Run("kinematics --robot " + Path("cal.yaml") + " --configs " + Path("v.csv") +
                     " --format json",
@@ -694,8 +702,8 @@ TEST_F(CliTest, TotalAccuracyCoversTheRangerOffsetTheReadingsCannotSee) {
   for (std::size_t j = 0; j < truth.size(); ++j) {
     double e2 = 0;
     for (int a = 0; a < 3; ++a) {
-      const double d = truth[j]["position"][a].get<double>() -
-                       calibrated[j]["position"][a].get<double>();
+      const double d =
+          truth[j]["position"][a].get<double>() - calibrated[j]["position"][a].get<double>();
       e2 += d * d;
     }
     sum2 += e2;

@@ -85,8 +85,8 @@ TEST(AccuracyPrediction, AConfoundedRangerOffsetMovesEveryPoseByItself) {
   const RobotModel& robot = testing::PaperRobot();
   const ConfigurationSet configs = testing::PaperHittingConfigurations(50, 4);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const MeasurementSet data = ReadingsOfTruth(
-      Eigen::VectorXd::Zero(CompleteParameterSet(robot, 1).size()), configs, 7);
+  const MeasurementSet data =
+      ReadingsOfTruth(Eigen::VectorXd::Zero(CompleteParameterSet(robot, 1).size()), configs, 7);
   const IdentificationSummary s = Identify(model, data, GivenSigma());
   ASSERT_TRUE(s.IsSolutionUsable());
   const PriorSigmas known = PriorSigmas::Parse("ranger_offset=0.3mm,plane_u=0.2mrad,plane_f=0.1mm");
@@ -122,7 +122,8 @@ TEST(AccuracyPrediction, WithNothingHeldTheTotalIsTheDataPart) {
   const ConfigurationSet configs = testing::PaperHittingConfigurations(50, 4);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const IdentificationSummary s = Identify(
-      model, ReadingsOfTruth(Eigen::VectorXd::Zero(CompleteParameterSet(robot, 1).size()), configs, 3),
+      model,
+      ReadingsOfTruth(Eigen::VectorXd::Zero(CompleteParameterSet(robot, 1).size()), configs, 3),
       GivenSigma());
   ASSERT_TRUE(s.IsSolutionUsable());
   UnestimatedTerms none;
@@ -174,8 +175,8 @@ TEST(AccuracyPrediction, TotalRadiusCoversTruthsDrawnFromThePriors) {
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
   const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 60, 8);
   const ConfigurationSet pool = testing::PaperHittingConfigurations(300, 21);
-  const MeasurementModel model(robot, horizontal,
-                               MakeParameterSet(robot, PlaneTerms{true, false}, {"theta1", "a1", "d3"}));
+  const MeasurementModel model(
+      robot, horizontal, MakeParameterSet(robot, PlaneTerms{true, false}, {"theta1", "a1", "d3"}));
   const PriorSigmas known = PriorSigmas::Parse(
       "theta=1mrad,alpha=1mrad,beta=1mrad,a=0.5mm,d=0.5mm,plane_u=0.5mrad,plane_f=0.3mm,"
       "ranger_offset=0.2mm,ranger_scale=100ppm");
@@ -209,7 +210,8 @@ TEST(AccuracyPrediction, TotalRadiusCoversTruthsDrawnFromThePriors) {
   }
   const double expected = 0.95 * trials, se = std::sqrt(trials * 0.95 * 0.05);
   EXPECT_NEAR(inside_total, expected, 4 * se) << inside_total << " of " << trials << " inside";
-  EXPECT_LT(inside_data, expected - 4 * se) << inside_data << " of " << trials << " inside (data only)";
+  EXPECT_LT(inside_data, expected - 4 * se)
+      << inside_data << " of " << trials << " inside (data only)";
   ::testing::Test::RecordProperty("inside_total_95", inside_total);
   ::testing::Test::RecordProperty("inside_data_95", inside_data);
 }

@@ -116,9 +116,10 @@ TEST(RobotFile, ACalibrationRecordsHeldTermsAreChecked) {
       "  estimate_shift:\n    - [0, 0]\n    - [1, -1]\n";
   EXPECT_EQ(load(good), "accepted 2 2x2");
   EXPECT_EQ(load(""), "accepted 0 0x0");
-  EXPECT_THAT(load("  held: [d1]\n  held_sigma: [0]\n  estimate_shift: [[0], [1]]\n"),
-              ::testing::AllOf(::testing::HasSubstr("cal.yaml:10 key 'calibration.held_sigma'"),
-                               ::testing::HasSubstr("entry 1 (d1): expected a standard deviation > 0")));
+  EXPECT_THAT(
+      load("  held: [d1]\n  held_sigma: [0]\n  estimate_shift: [[0], [1]]\n"),
+      ::testing::AllOf(::testing::HasSubstr("cal.yaml:10 key 'calibration.held_sigma'"),
+                       ::testing::HasSubstr("entry 1 (d1): expected a standard deviation > 0")));
   EXPECT_THAT(load("  held: [d1]\n  held_sigma: [1e-3, 1e-3]\n  estimate_shift: [[0], [1]]\n"),
               ::testing::HasSubstr("expected one prior standard deviation (SI) per name"));
   EXPECT_THAT(load("  held: [d1]\n  held_sigma: [1e-3]\n  estimate_shift: [[0], [1, 2]]\n"),

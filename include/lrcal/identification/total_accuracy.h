@@ -62,15 +62,15 @@ ParameterSet CompleteParameterSet(const RobotModel& robot, int num_planes);
 /// the requested set without the terms fixed for rank deficiency): their σ from `known` (the
 /// robot file's tolerances and --prior-sigma), else the defaults; S at the estimate. The noise σ
 /// and the priors of the estimated terms are `options`' (σ cancels without priors).
-UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved, const IdentificationSummary& s,
-                                      const MeasurementSet& data,
+UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
+                                      const IdentificationSummary& s, const MeasurementSet& data,
                                       const IdentificationOptions& options,
                                       const PriorSigmas& known,
                                       const DefaultTolerances& defaults = {});
 
 /// One source of error at the predicted poses.
 struct AccuracySource {
-  std::string name;  ///< "estimated parameters (reading noise)" or a held term's name
+  std::string name;        ///< "estimated parameters (reading noise)" or a held term's name
   double prior_sigma = 0;  ///< SI; 0 for the estimated parameters
   bool defaulted = false;  ///< prior_sigma is the stated default
   /// The estimated term that absorbs most of this term's deviation (|S_ik|·σ_k/std_i largest,
@@ -78,14 +78,14 @@ struct AccuracySource {
   std::string absorbed_by;
   double position_rms = 0;     ///< m, RMS over the poses of this source's position error
   double orientation_rms = 0;  ///< rad
-  double share = 0;  ///< its part of the total mean-square position error, 0..1
+  double share = 0;            ///< its part of the total mean-square position error, 0..1
 };
 
 /// Which σ of one reading a statement's data part uses, and why.
 struct SigmaUsed {
-  double sigma = 0;         ///< m
-  std::string source;       ///< "given" or "residual"
-  std::string reason;       ///< why, in words (e.g. the χ² check rejected the given σ)
+  double sigma = 0;    ///< m
+  std::string source;  ///< "given" or "residual"
+  std::string reason;  ///< why, in words (e.g. the χ² check rejected the given σ)
 };
 
 /// The σ an identification's statements use: the given σ unless the fit check rejects it (then

@@ -45,8 +45,7 @@ ResultJson CrossValidationJson(const CrossValidation& cv);
 /// orientation_rms, share), `defaulted` (held terms with the default σ), `defaults` (the
 /// stated defaults in words) and `sigma_used`
 /// (sigma, source "given" or "residual", reason).
-ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction,
-                            const ConfigurationSet& configs);
+ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction, const ConfigurationSet& configs);
 /// A design certificate with its statement.
 ResultJson CertificateJson(const DesignCertificate& certificate, const std::string& statement);
 /// A design choice: the selected pool indices (0-based), scores, the random baseline, the
