@@ -6,8 +6,8 @@
 #   asan     every unit test built with AddressSanitizer + UndefinedBehaviorSanitizer
 #   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
 #   docs     the API reference (Doxygen) builds without a warning
-#   fuzz     libFuzzer on the CSV readers, robot files, study files and the number parser
-#            (ASan + UBSan, about a minute each: scripts/fuzz.sh)
+#   fuzz     libFuzzer on the CSV readers, robot files, URDFs, study files and the number parser
+#            (ASan + UBSan, 45 s each: scripts/fuzz.sh)
 # Usage: bash scripts/checks.sh [format|layers|tidy|docs|asan|tsan|fuzz ...]  (default: all, in order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -62,7 +62,7 @@ for s in "${stages[@]}"; do
         ctest --test-dir build-tsan -j2 --output-on-failure -L study ;;
     fuzz)
       stage fuzz
-      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-60}" ;;
+      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-45}" ;;
     *) echo "unknown stage '$s' (format, layers, tidy, docs, asan, tsan, fuzz)" >&2; exit 2 ;;
   esac
 done

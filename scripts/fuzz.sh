@@ -6,8 +6,8 @@
 #   bash scripts/fuzz.sh [seconds per target, default 60]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds="${1:-${LRCAL_FUZZ_SECONDS:-60}}"
-bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liburdfdom-dev \
+seconds="${1:-${LRCAL_FUZZ_SECONDS:-45}}"
+bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liburdfdom-dev libtinyxml-dev \
   nlohmann-json3-dev librandom123-dev libboost-dev
 out=build-fuzz
 mkdir -p "$out/obj" "$out/findings"
@@ -32,10 +32,10 @@ for s in "${sources[@]}"; do
   (( $(jobs -r | wc -l) >= 2 )) && wait -n
 done
 wait
-targets=(expression csv robot_file study_file)
+targets=(expression csv robot_file study_file urdf)
 for t in "${targets[@]}"; do
   clang++ "${flags[@]}" -fsanitize=fuzzer "tests/fuzz/${t}_fuzzer.cc" "${objects[@]}" \
-    -lyaml-cpp -lurdfdom_model -o "$out/${t}_fuzzer"
+    -lyaml-cpp -lurdfdom_model -ltinyxml -o "$out/${t}_fuzzer"
 done
 echo "fuzz: built ${#targets[@]} targets; running each for ${seconds} s"
 status=0

@@ -14,7 +14,7 @@ packages=(g++ cmake make git pkg-config
   libeigen3-dev libceres-dev libyaml-cpp-dev libsqlite3-dev librandom123-dev nlohmann-json3-dev
   libboost-program-options-dev libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
   python3 python3-pandas python3-numpy python3-matplotlib chromium
-  pybind11-dev python3-dev python3-pytest liburdfdom-dev)
+  pybind11-dev python3-dev python3-pytest liburdfdom-dev libtinyxml-dev)
 bash scripts/install_packages.sh "${packages[@]}"
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLRCAL_WERROR="${LRCAL_WERROR:-OFF}"

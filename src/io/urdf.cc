@@ -1,11 +1,14 @@
 #include "lrcal/io/urdf.h"
 
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <map>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -77,6 +80,70 @@ std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string&
   return leaves.front();
 }
 
+// Each link's parent link (from the first joint naming it as child), read from the URDF's
+// <joint> elements with TinyXML. A joint whose parent is its child is an InputError.
+std::map<std::string, std::string> ParentLinks(const TiXmlElement& robot, const std::string& path) {
+  std::map<std::string, std::string> parent_of;
+  for (const TiXmlElement* j = robot.FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint")) {
+    const TiXmlElement* parent = j->FirstChildElement("parent");
+    const TiXmlElement* child = j->FirstChildElement("child");
+    const char* p = parent ? parent->Attribute("link") : nullptr;
+    const char* c = child ? child->Attribute("link") : nullptr;
+    if (!p || !c) continue;  // urdfdom names the joint
+    const char* name = j->Attribute("name");
+    if (std::string(p) == c)
+      throw InputError(path, "joint '" + std::string(name ? name : "") + "' has link '" + c +
+                                 "' as both its parent and its child: a URDF is a tree");
+    parent_of.emplace(c, p);
+  }
+  return parent_of;
+}
+
+// Walks up from every link, iteratively; a link met twice on one walk closes a cycle.
+void CheckNoCycle(const std::map<std::string, std::string>& parent_of, const std::string& path) {
+  std::set<std::string> reaches_root;
+  for (const auto& start : parent_of) {
+    std::vector<std::string> walk;
+    std::set<std::string> on_walk;
+    std::string link = start.first;
+    while (!reaches_root.count(link)) {
+      if (!on_walk.insert(link).second) {
+        std::string cycle;
+        for (auto it = std::find(walk.begin(), walk.end(), link); it != walk.end(); ++it)
+          cycle += "'" + *it + "' -> ";
+        throw InputError(path, "the joints form a cycle: " + cycle + "'" + link +
+                                   "' (each link's parent, in turn); a URDF is a tree");
+      }
+      walk.push_back(link);
+      const auto up = parent_of.find(link);
+      if (up == parent_of.end()) break;
+      link = up->second;
+    }
+    reaches_root.insert(walk.begin(), walk.end());
+  }
+}
+
+// A URDF's tree checked before urdfdom builds it: urdfdom walks the tree by recursion (a very
+// deep chain overflows the stack) and lrcal walks from the tool link to the root (a cycle would
+// never end). Read with TinyXML (urdfdom's own XML reader), iteratively: at most kMaxUrdfLinks
+// links, no joint whose parent is its child, no cycle. Anything else (a malformed file, a link
+// with two parents) is left to urdfdom's own checks.
+void CheckUrdfTree(const std::string& path) {
+  TiXmlDocument doc(path.c_str());
+  if (!doc.LoadFile()) return;  // urdfdom reports the XML error
+  const TiXmlElement* robot = doc.FirstChildElement("robot");
+  if (!robot) return;
+  int links = 0;
+  for (const TiXmlElement* e = robot->FirstChildElement("link"); e;
+       e = e->NextSiblingElement("link"))
+    ++links;
+  if (links > kMaxUrdfLinks)
+    throw InputError(path, "the URDF has " + std::to_string(links) +
+                               " links; lrcal reads at most " + std::to_string(kMaxUrdfLinks));
+  CheckNoCycle(ParentLinks(*robot, path), path);
+}
+
 // The joint's range: revolute/prismatic from <limit>, continuous ±π.
 void JointRange(const urdf::Joint& joint, const std::string& path, JointAxis* axis) {
   if (joint.type == urdf::Joint::CONTINUOUS) return;  // the default ±π
@@ -91,6 +158,7 @@ void JointRange(const urdf::Joint& joint, const std::string& path, JointAxis* ax
 
 RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link) {
   if (!PathExists(path)) throw InputError(path, "no such file");
+  CheckUrdfTree(path);
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
   if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
   const std::string tool = ChooseToolLink(*model, path, tool_link);

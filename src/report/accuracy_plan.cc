@@ -267,10 +267,16 @@ class Planner {
     }
     search_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (feasible_.empty())
-      Refuse("target", "no campaign in the ranges reaches " + Fixed(in_.target.shown(), 4) + " " +
-                           in_.target.unit() +
-                           " by the first-order prediction; widen the configurations or "
-                           "repetitions to consider");
+      Refuse(
+          "target", "no campaign in the ranges reaches " +
+                        [&] {
+                          std::ostringstream v;
+                          v << in_.target.shown();  // 6 significant digits
+                          return v.str();
+                        }() +
+                        " " + in_.target.unit() +
+                        " by the first-order prediction; widen the configurations or "
+                        "repetitions to consider");
     std::stable_sort(
         feasible_.begin(), feasible_.end(),
         [](const PlannedCampaign& a, const PlannedCampaign& b) { return a.cost < b.cost; });
@@ -385,12 +391,11 @@ class Planner {
 
   void AddSearchRow(int sub, int k, double q1) {
     const PlaneSubset& subset = subsets_[sub];
-    const int needed =
-        std::isfinite(q1)
-            ? std::max(in_.repetitions.front(),
-                       static_cast<int>(std::ceil(std::pow(q1 / in_.target.value, 2))))
-            : -1;
-    const bool ok = needed > 0 && needed <= in_.repetitions.back();
+    // Readings needed per configuration, as a double first: far below reach it exceeds any int
+    // (a cast would overflow and plan a 1-reading campaign).
+    const double needed_real = std::ceil(std::pow(q1 / in_.target.value, 2));
+    const bool ok = std::isfinite(q1) && needed_real <= in_.repetitions.back();
+    const int needed = ok ? std::max(in_.repetitions.front(), static_cast<int>(needed_real)) : -1;
     const double cost = subset.num_planes * in_.per_plane + k * in_.per_configuration +
                         double(k) * needed * in_.per_reading;
     std::vector<std::string> row = {std::to_string(k), Fixed(q1 * 1e3, 4),

@@ -238,6 +238,16 @@ TEST(PlanAccuracy, BadTargetsAndRangesAreExitTwo) {
                                 &out),
             2);
   EXPECT_THAT(out, ::testing::HasSubstr("--planes: the set-up has 2 candidate planes")) << out;
+  // Issue 31: a target far below reach overflowed the readings count and planned a 1-reading
+  // campaign with exit 0; it is refused before any Monte Carlo.
+  EXPECT_EQ(
+      testing::RunCommand(
+          testing::LrcalBinary() + " plan-accuracy " + testing::SourcePath("studies/quick.yaml") +
+              " --target rms_pos=0.00001mm --trials 100 --out " + dir + "/unreachable",
+          &out),
+      2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--target: no campaign in the ranges reaches 1e-05 mm"))
+      << out;
   EXPECT_EQ(
       testing::RunCommand(testing::LrcalBinary() + " plan-accuracy --target rms_pos=0.05mm --cost "
                                                    "configuration=30s,reading=1s,plane=ten",

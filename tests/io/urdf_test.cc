@@ -217,6 +217,32 @@ TEST(Urdf, BadUrdfsAreNamedByFileJointOrLink) {
                    "", "joint 'm' mimics another");
 }
 
+// Issue 31: a tree checked before urdfdom builds it. A cycle through the tool link looped until
+// memory ran out, a joint that is its own parent likewise, and 150,000 chained links overflowed
+// urdfdom's recursion (a signal, in the CLI and in Python): each is now a clear error.
+TEST(Urdf, CyclesOwnParentsAndVeryDeepTreesAreRefused) {
+  const auto revolute = [](const std::string& name, const std::string& parent,
+                           const std::string& child) {
+    return "<joint name=\"" + name + "\" type=\"revolute\"><parent link=\"" + parent +
+           "\"/><child link=\"" + child +
+           "\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+           "velocity=\"1\"/></joint>\n";
+  };
+  const std::string links =
+      "<link name=\"base\"/><link name=\"a\"/><link name=\"b\"/>"
+      "<link name=\"c\"/>\n";
+  ExpectInputError(
+      links + revolute("j1", "base", "a") + revolute("j2", "c", "b") + revolute("j3", "b", "c"),
+      "c", "the joints form a cycle: 'b' -> 'c' -> 'b'");
+  ExpectInputError(links + revolute("j1", "base", "a") + revolute("j2", "a", "a"), "a",
+                   "joint 'j2' has link 'a' as both its parent and its child");
+  std::string deep = "<link name=\"l0\"/>\n";
+  for (int i = 1; i <= kMaxUrdfLinks; ++i)
+    deep += "<link name=\"l" + std::to_string(i) + "\"/>" +
+            revolute("j" + std::to_string(i), "l" + std::to_string(i - 1), "l" + std::to_string(i));
+  ExpectInputError(deep, "l1000", "the URDF has 1001 links; lrcal reads at most 1000");
+}
+
 TEST(Urdf, ToolLinkIsForUrdfsOnly) {
   try {
     LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"), "ranger");

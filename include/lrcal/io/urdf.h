@@ -25,9 +25,14 @@ namespace lrcal {
 /// True if `path` names a URDF file (ends in .urdf, any case).
 bool IsUrdfPath(const std::string& path);
 
+/// The most links a URDF may have (its tree is checked before it is built: no cycle, no joint
+/// that is its own parent, at most this many links).
+inline constexpr int kMaxUrdfLinks = 1000;
+
 /// Reads a URDF's chain from its root link to `tool_link` (empty: the URDF's only leaf link).
 /// Revolute, continuous (range ±π), prismatic and fixed joints; anything else, a mimic joint, an
-/// unknown or ambiguous tool link is an InputError naming the file and the joint or link.
+/// unknown or ambiguous tool link, a cycle among the joints, a joint whose parent is its child
+/// and more than kMaxUrdfLinks links are InputErrors naming the file and the joint or link.
 RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link = "");
 
 /// A URDF document for `robot` with `link_values` (5N, SI) as its geometry; numbers with 17
