@@ -152,10 +152,11 @@ int SimulateCommand(const std::vector<std::string>& args) {
   noise.ranger_offset = rig.ranger_offset;  // the robot file's true ranger errors
   noise.ranger_scale = rig.ranger_scale;
   ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
-  if (static_cast<double>(noise.repetitions) * configs.size() > 1e7)
+  if (static_cast<double>(noise.repetitions) * configs.size() > static_cast<double>(kMaxCsvRows))
     throw InputError("--repetitions", "would write " + std::to_string(configs.size()) + " x " +
                                           std::to_string(noise.repetitions) +
-                                          " readings; at most 10,000,000 lines per file");
+                                          " readings; at most " + std::to_string(kMaxCsvRows) +
+                                          " lines per file (what lrcal reads back)");
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;

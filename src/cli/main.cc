@@ -1,5 +1,6 @@
 // lrcal: kinematic calibration of robot arms with a laser ranger, and Monte-Carlo studies of it.
 // A thin layer over the library: each subcommand parses its options and calls lrcal/.
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -67,6 +68,9 @@ void PrintUsage(std::ostream& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) would kill lrcal with SIGXFSZ mid-write; ignored, the write
+  // fails with EFBIG instead and is reported like a full disk (exit 5, nothing computed lost).
+  std::signal(SIGXFSZ, SIG_IGN);
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
       !std::strcmp(argv[1], "help")) {
     PrintUsage(std::cout);

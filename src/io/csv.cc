@@ -25,8 +25,15 @@ double CsvTable::Number(std::size_t row, int column) const {
   double value = 0;
   if (!ParseDecimal(cell, &value))
     throw InputError(Location(path, lines[row]) + " column '" + header[column] + "'",
-                     "expected a finite number, got '" + cell + "'");
+                     "expected a finite number, got '" + CellExcerpt(cell) + "'");
   return value;
+}
+
+std::string CellExcerpt(const std::string& cell) {
+  constexpr std::size_t kShown = 40;
+  return cell.size() <= kShown
+             ? cell
+             : cell.substr(0, kShown) + "... (" + std::to_string(cell.size()) + " characters)";
 }
 
 namespace {
@@ -37,6 +44,13 @@ std::string ReadWholeFile(const std::string& path) {
     throw InputError(path, "is a directory; expected a CSV file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open file");
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > static_cast<std::uintmax_t>(kMaxCsvBytes))
+    throw InputError(path, "is " + std::to_string(bytes >> 20) +
+                               " MiB; lrcal reads CSV files of "
+                               "up to " +
+                               std::to_string(kMaxCsvBytes >> 20) +
+                               " MiB (split the data, or average repeated readings first)");
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
@@ -102,7 +116,7 @@ void CheckHeader(const CsvTable& t, int line) {
   for (std::size_t a = 0; a < t.header.size(); ++a)
     for (std::size_t b = a + 1; b < t.header.size(); ++b)
       if (t.header[a] == t.header[b] && !t.header[a].empty())
-        throw InputError(Location(t.path, line) + " column '" + t.header[a] + "'",
+        throw InputError(Location(t.path, line) + " column '" + CellExcerpt(t.header[a]) + "'",
                          "repeated: columns " + std::to_string(a + 1) + " and " +
                              std::to_string(b + 1) + " have the same name");
 }
@@ -134,6 +148,9 @@ CsvTable ReadCsv(const std::string& path) {
                        "expected " + std::to_string(t.header.size()) +
                            " cells (header: " + std::to_string(t.header.size()) +
                            " columns), got " + std::to_string(cells.size()));
+    if (static_cast<long long>(t.rows.size()) >= kMaxCsvRows)
+      throw InputError(Location(path, number), "more than " + std::to_string(kMaxCsvRows) +
+                                                   " data rows; lrcal reads at most that many");
     t.rows.push_back(std::move(cells));
     t.lines.push_back(number);
   }
@@ -166,7 +183,7 @@ std::vector<int> JointColumns(const CsvTable& t, int num_joints) {
   }
   for (const std::string& name : t.header)
     if (NamesAnotherJoint(name, num_joints))
-      throw InputError(Location(t.path, 1) + " column '" + name + "'",
+      throw InputError(Location(t.path, 1) + " column '" + CellExcerpt(name) + "'",
                        "the robot has only " + std::to_string(num_joints) +
                            " joints (wrong robot or wrong file?)");
   return cols;
@@ -187,7 +204,7 @@ InputError UnknownPlane(const CsvTable& t, std::size_t r, const std::string& ref
     known += (k ? ", " : "") + std::to_string(k + 1) +
              (planes && !planes->name(k).empty() ? " (" + planes->name(k) + ")" : "");
   return InputError(Location(t.path, t.lines[r]) + " column 'plane'",
-                    "'" + ref + "' is not one of the " + std::to_string(np) +
+                    "'" + CellExcerpt(ref) + "' is not one of the " + std::to_string(np) +
                         " plane(s) given: expected " + known +
                         (np == 1 ? "; give the set-up's planes (robot file planes: or "
                                    "repeated --plane)"

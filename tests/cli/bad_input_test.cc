@@ -91,6 +91,20 @@ const std::vector<BadInput>& Cases() {
        2,
        {"column 'q99999999999'", "only 6 joints"}},
       {"CsvNulByte", {{"c.csv", Nul()}}, "kinematics --configs c.csv", 2, {"c.csv:2", "NUL byte"}},
+      // Issue 31: a 20 MB cell was echoed whole in the error; cells are cut at 40 characters.
+      {"CsvLongCellIsCutInTheMessage",
+       {{"c.csv", "q1,q2,q3,q4,q5,q6\n0,0," + std::string(5000, 'x') + ",0,0,0\n"}},
+       "kinematics --configs c.csv",
+       2,
+       {"c.csv:2 column 'q3'", "got '" + std::string(40, 'x') + "... (5000 characters)'"}},
+      // simulate writes no more rows than lrcal reads back.
+      {"SimulateNoMoreThanLrcalReads",
+       {{"c.csv",
+         "q1,q2,q3,q4,q5,q6\n0.1,0.2,0.3,0.4,0.5,0.6\n0.2,0.2,0.3,0.4,0.5,0.6\n"
+         "0.3,0.2,0.3,0.4,0.5,0.6\n"}},
+       "simulate --configs c.csv --repetitions 700000 --out m.csv",
+       2,
+       {"--repetitions", "at most 2000000 lines per file"}},
       {"CsvUnclosedQuote",
        {{"c.csv", "q1,q2,q3,q4,q5,q6\n\"0.1,0,0,0,0,0\n"}},
        "kinematics --configs c.csv",

@@ -726,6 +726,22 @@ TEST_F(CliTest, TotalAccuracyCoversTheRangerOffsetTheReadingsCannotSee) {
     }
 }
 
+// Issue 31: a file-size limit (ulimit -f) killed lrcal with SIGXFSZ; the write now fails like
+// a full disk: exit 5 naming the file, nothing half-written in its place.
+TEST_F(CliTest, AFileSizeLimitIsAStorageErrorNotASignal) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 300 --out " + Path("c.csv"), &out), 0) << out;
+  const int code =
+      testing::RunCommand("ulimit -f 20 && " + testing::LrcalBinary() + " simulate --configs " +
+                              Path("c.csv") + " --out " + Path("m.csv"),
+                          &out);
+  EXPECT_EQ(code, 5) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("could not write results: cannot write " + Path("m.csv")))
+      << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("File too large")) << out;
+  EXPECT_FALSE(std::ifstream(Path("m.csv")).good());
+}
+
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
   std::string out;
   ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E "

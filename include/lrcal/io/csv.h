@@ -30,8 +30,16 @@ struct CsvTable {
   double Number(std::size_t row, int column) const;
 };
 
+/// The largest CSV file lrcal reads (bytes) and the most data rows: about 2,000,000 readings of
+/// a 7-joint arm, some 4 GB in memory. `lrcal simulate` writes no more rows than this.
+inline constexpr long long kMaxCsvBytes = 256LL << 20;
+inline constexpr long long kMaxCsvRows = 2000000;
+/// A cell as error messages show it: at most 40 characters, longer ones cut with "...".
+std::string CellExcerpt(const std::string& cell);
+
 /// Reads a CSV file with a header line (see the file comment). InputError naming the file and
-/// line for a folder, an empty file, a NUL byte, repeated column names or a ragged row.
+/// line for a folder, an empty file, a NUL byte, repeated column names, a ragged row, or a file
+/// beyond kMaxCsvBytes or kMaxCsvRows.
 CsvTable ReadCsv(const std::string& path);
 
 /// Configurations q1..qN. An optional `plane` column says which plane each row's beam is aimed at
