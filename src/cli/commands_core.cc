@@ -51,6 +51,7 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm,
   ReadSettingOptions(vm, IdentificationOptions::Settings(), &options);
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
   options.priors = ResolvePriors(vm, rig);
+  options.encoder_sigma = vm["encoder-sigma-mrad"].as<double>() * 1e-3;
   options.Validate();
   return options;
 }
@@ -265,6 +266,10 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "a-posteriori estimate; a direction the readings cannot see is set by its prior")(
       "prior", po::bool_switch(),
       "use the robot file's tolerances: as priors (--prior-sigma entries replace the same keys)")(
+      "encoder-sigma-mrad", po::value<double>()->default_value(0),
+      "errors in variables: standard deviation of each recorded joint value (mrad; mm for a "
+      "prismatic joint), one error per configuration; weights, covariance, chi-squared and "
+      "accuracy account for it (needs --sigma-mm)")(
       "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
       "loss", po::value<std::string>()->default_value("none"),
       "robust loss: none, huber, cauchy (either solver)")(

@@ -164,10 +164,45 @@ bool ValidOptions(const IdentificationOptions& options, IdentificationSummary* s
 
 }  // namespace
 
+std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
+                                             const MeasuredValues& data, double sigma,
+                                             double joint_sigma) {
+  const int k = kind.rows_per_configuration(), m = data.size(), nj = data.configs.num_joints();
+  const std::vector<double> e(static_cast<std::size_t>(kind.num_parameters()), 0.0);
+  std::vector<double> gradient2(static_cast<std::size_t>(k) * m, 0.0), plus(k * m), minus(k * m);
+  constexpr double kStep = 1e-6;  // rad or m: truncation O(step²), rounding O(1e-16/step)
+  for (int j = 0; j < nj; ++j) {
+    ConfigurationSet up(nj), down(nj);
+    std::vector<double> q(nj);
+    for (int i = 0; i < m; ++i) {
+      std::copy(data.configs.q(i), data.configs.q(i) + nj, q.begin());
+      q[j] += kStep;
+      up.Add(q.data(), data.configs.plane(i));
+      q[j] -= 2 * kStep;
+      down.Add(q.data(), data.configs.plane(i));
+    }
+    kind.Bind(up)->Predict(e.data(), plus.data(), nullptr);
+    kind.Bind(down)->Predict(e.data(), minus.data(), nullptr);
+    for (int r = 0; r < k * m; ++r) {
+      const double g = (plus[r] - minus[r]) / (2 * kStep);
+      if (std::isfinite(g)) gradient2[r] += g * g;
+    }
+  }
+  std::vector<double> weights(static_cast<std::size_t>(k) * m);
+  for (int i = 0; i < m; ++i)
+    for (int c = 0; c < k; ++c) {
+      const double variance =
+          sigma * sigma / data.repetitions[i] + joint_sigma * joint_sigma * gradient2[i * k + c];
+      weights[i * k + c] = sigma * sigma / variance;
+    }
+  return weights;
+}
+
 IdentificationSummary Identify(const MeasurementModel& model_in, const MeasurementSet& data,
                                const IdentificationOptions& options) {
-  // The maximum a-posteriori estimate is the kind-neutral path's (prior.h).
-  if (!options.priors.empty())
+  // The maximum a-posteriori estimate and errors in variables are the kind-neutral path's
+  // (prior.h, ErrorsInVariablesWeights).
+  if (!options.priors.empty() || options.encoder_sigma > 0)
     return Identify(RangerMeasurement(model_in), ToMeasuredValues(data), options);
   IdentificationSummary s;
   DescribeSolver(options, &s);
@@ -342,9 +377,20 @@ void EstimateKindStatistics(MeasurementEvaluator& evaluator, const Rows& rows,
 
 IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredValues& data,
                                const IdentificationOptions& options) {
+  if (options.encoder_sigma > 0 && data.weights.empty() && options.sigma > 0 &&
+      static_cast<int>(data.y.size()) == kind_in.rows_per_configuration() * data.size() &&
+      static_cast<int>(data.repetitions.size()) == data.size()) {
+    MeasuredValues weighted = data;
+    weighted.weights =
+        ErrorsInVariablesWeights(kind_in, data, options.sigma, options.encoder_sigma);
+    return Identify(kind_in, weighted, options);
+  }
   IdentificationSummary s;
   DescribeSolver(options, &s);
   if (!options.priors.empty()) s.loss += " with priors";
+  if (options.encoder_sigma > 0)
+    s.loss +=
+        ", errors in variables (joint sigma " + Fixed(options.encoder_sigma * 1e3, 4) + " mrad)";
   s.num_configurations = data.size();
   if (!ValidOptions(options, &s) || !CheckMeasuredValues(kind_in, data, options, &s)) return s;
   std::unique_ptr<MeasurementKind> reduced;

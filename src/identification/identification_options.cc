@@ -39,6 +39,24 @@ const std::vector<SettingField<IdentificationOptions>>& IdentificationOptions::S
 
 void IdentificationOptions::Validate() const {
   CheckSettings(*this, Settings());
+  const SettingSpec encoder{"identification",
+                            "encoder_sigma",
+                            "encoder_sigma_mrad",
+                            "mrad",
+                            1e-3,
+                            "rad",
+                            0,
+                            std::numeric_limits<double>::infinity(),
+                            false,
+                            false,
+                            "",
+                            "",
+                            "standard deviation of each recorded joint value"};
+  if (!encoder.Allows(encoder_sigma)) throw SettingError(encoder, encoder_sigma);
+  if (encoder_sigma > 0 && !(sigma > 0))
+    throw SettingError(encoder,
+                       "errors in variables are weighed against the readings' noise: "
+                       "give the noise of one reading as well");
   if (!priors.empty() && !(sigma > 0))
     throw SettingError(SettingSpec::Named("identification", "priors", "prior_sigma"),
                        "priors are weighed against the readings' noise: give the noise of one "

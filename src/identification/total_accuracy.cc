@@ -87,8 +87,14 @@ UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
   const Eigen::MatrixXd G = Columns(G_all, est), Gu = Columns(G_all, held);
   // Weights R_i/σ² (σ cancels without priors) and the priors of the estimated terms.
   const double sigma = options.sigma > 0 ? options.sigma : 1.0;
+  // The readings' weights as the identification used them (errors in variables included).
+  const std::vector<double> rows =
+      options.encoder_sigma > 0 && options.sigma > 0
+          ? ErrorsInVariablesWeights(RangerMeasurement(solved), ToMeasuredValues(data),
+                                     options.sigma, options.encoder_sigma)
+          : std::vector<double>(data.repetitions.begin(), data.repetitions.end());
   Eigen::VectorXd w(data.size());
-  for (int i = 0; i < data.size(); ++i) w[i] = data.repetitions[i] / (sigma * sigma);
+  for (int i = 0; i < data.size(); ++i) w[i] = rows[i] / (sigma * sigma);
   Eigen::MatrixXd A = G.transpose() * w.asDiagonal() * G;
   for (int i = 0; i < n; ++i) {
     const double p = options.priors.SigmaOf(names[i]);

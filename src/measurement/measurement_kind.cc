@@ -25,6 +25,7 @@ void CheckNoiseFitsKind(const MeasurementKind& kind, const NoiseModel& noise) {
 }  // namespace
 
 std::vector<double> MeasuredValues::RowWeights(int rows_per_configuration) const {
+  if (!this->weights.empty()) return this->weights;
   std::vector<double> weights;
   weights.reserve(static_cast<std::size_t>(rows_per_configuration) * repetitions.size());
   for (int r : repetitions) weights.insert(weights.end(), rows_per_configuration, r);

@@ -401,9 +401,10 @@ struct IdentifyArgs {
   std::string solver, loss;
   double loss_scale_mm, sigma_mm;
   long long max_iterations;
-  py::object loss_scale, sigma;  // the earlier spellings, in m (None: not given)
-  std::string prior_sigma;       // as --prior-sigma; "" = no priors
-  bool prior = false;            // as --prior: the robot file's tolerances
+  py::object loss_scale, sigma;   // the earlier spellings, in m (None: not given)
+  std::string prior_sigma;        // as --prior-sigma; "" = no priors
+  bool prior = false;             // as --prior: the robot file's tolerances
+  double encoder_sigma_mrad = 0;  // as --encoder-sigma-mrad: errors in variables
 };
 
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
@@ -431,6 +432,7 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   options.max_iterations = static_cast<int>(a.max_iterations);
   options.fix_dependent_parameters = auto_fix;
   options.priors = PriorsFor(rig, a.prior, a.prior_sigma, "prior=", "prior_sigma=");
+  options.encoder_sigma = a.encoder_sigma_mrad * 1e-3;
   options.Validate();
   py::gil_scoped_release release;
   return Identify(model, data, options);
@@ -918,6 +920,8 @@ prior_sigma: prior standard deviations as `lrcal identify --prior-sigma` takes t
 maximum a-posteriori estimate (prior_sigma, posterior_to_prior and set_by_prior on the result).
 prior: True to use the robot file's tolerances: as priors (as --prior); prior_sigma's entries
 replace the same keys.
+encoder_sigma_mrad: errors in variables (as --encoder-sigma-mrad): the standard deviation of each
+recorded joint value (mrad; mm for a prismatic joint), one error per configuration; needs sigma_mm.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc";
 
 void DefineCalibration(py::module_& m) {
@@ -934,17 +938,17 @@ void DefineCalibration(py::module_& m) {
          const std::string& estimate_plane, const py::object& fix, bool auto_fix,
          const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
          long long max_iterations, const py::object& loss_scale, const py::object& sigma,
-         const std::string& prior_sigma, bool prior) {
+         const std::string& prior_sigma, bool prior, double encoder_sigma_mrad) {
         return IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
                           {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
-                           prior_sigma, prior});
+                           prior_sigma, prior, encoder_sigma_mrad});
       },
       py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
       py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
       setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
       py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", py::arg("prior") = false,
-      kIdentifyDoc);
+      py::arg("encoder_sigma_mrad") = 0.0, kIdentifyDoc);
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
         py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8, R"doc(

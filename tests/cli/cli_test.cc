@@ -742,6 +742,26 @@ TEST_F(CliTest, AFileSizeLimitIsAStorageErrorNotASignal) {
   EXPECT_FALSE(std::ifstream(Path("m.csv")).good());
 }
 
+// identify --encoder-sigma-mrad: readings whose recorded joint values are off by 0.1 mrad fail
+// the χ² check as plain least squares and pass it with errors in variables; without the
+// readings' noise the option is refused, named.
+TEST_F(CliTest, IdentifyWithErrorsInVariables) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv") +
+                    " --sigma-mm 0.05 --repetitions 1 --encoder-sigma-mrad 0.1 --seed 5",
+                &out),
+            0)
+      << out;
+  const std::string identify = "identify --data " + Path("m.csv") + " --sigma-mm 0.05";
+  EXPECT_EQ(Run(identify, &out), 4) << out;
+  ASSERT_EQ(Run(identify + " --encoder-sigma-mrad 0.1", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("errors in variables (joint sigma 0.1000 mrad)"));
+  EXPECT_THAT(out, ::testing::HasSubstr("consistent with the stated noise"));
+  EXPECT_EQ(Run("identify --data " + Path("m.csv") + " --encoder-sigma-mrad 0.1", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--encoder-sigma-mrad")) << out;
+}
+
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
   std::string out;
   ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E "

@@ -129,6 +129,25 @@ def test_identify_with_priors_matches_the_program_bit_for_bit(tmp_path, cli, pap
         lrcal.identify(paper, m[:, :6], m[:, header.index("h")], prior_sigma="d=1mm")
 
 
+def test_identify_with_errors_in_variables_matches_the_program(tmp_path, cli, paper):
+    """lrcal.identify(encoder_sigma_mrad=...) is `lrcal identify --encoder-sigma-mrad`, bit for
+    bit, and needs sigma_mm as the program does."""
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    cli("sample", "--robot", "paper", "--count", 40, "--seed", 4, "--out", configs)
+    cli("simulate", "--robot", "paper", "--configs", configs, "--seed", 5, "--repetitions", 1,
+        "--sigma-mm", 0.05, "--encoder-sigma-mrad", 0.1, "--out", data)
+    program = json.loads(cli("identify", "--robot", "paper", "--data", data, "--sigma-mm", 0.05,
+                             "--encoder-sigma-mrad", 0.1, "--format", "json").stdout)
+    header, m = read_csv(data)
+    result = lrcal.identify(paper, m[:, :6], m[:, header.index("h")], sigma_mm=0.05,
+                            encoder_sigma_mrad=0.1)
+    assert "errors in variables" in repr(result)
+    np.testing.assert_array_equal(result.estimate, [p["estimate"] for p in program["parameters"]])
+    np.testing.assert_array_equal(result.covariance_given, program["covariance_given_sigma"])
+    with pytest.raises(lrcal.InputError, match="encoder_sigma_mrad"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], encoder_sigma_mrad=0.1)
+
+
 def test_prior_information_matches_identifiability_with_priors(tmp_path, cli, paper):
     """lrcal.prior_information is `lrcal identifiability --prior-sigma`'s table, bit for bit."""
     configs = tmp_path / "c.csv"

@@ -59,6 +59,12 @@ struct IdentificationOptions {
   /// identifiability analysis' suggested parameters at nominal and identify the rest.
   bool fix_dependent_parameters = false;
   IdentifiabilityOptions identifiability;
+  /// Errors in variables: the standard deviation of each recorded joint value (rad; m for a
+  /// prismatic joint), one error per configuration. Each measured value's variance becomes
+  /// σ²/R + σ_q²·Σ_j (∂y/∂q_j)² (the joint gradient at the nominal model, by central
+  /// differences), so the weights, the covariance, the χ² check and every accuracy statement
+  /// account for it. Needs `sigma`. 0: exact joint values, bit for bit as without this field.
+  double encoder_sigma = 0;
   /// Prior standard deviations of the estimated terms (prior.h): when given, the maximum
   /// a-posteriori estimate around the nominal values, which needs `sigma` (the priors are weighed
   /// against the readings' noise). Empty: least squares, bit for bit as without this field.
@@ -193,6 +199,14 @@ IdentificationSummary Identify(const MeasurementModel& model, const MeasurementS
 /// rounding (its statistics come from the batch kernel instead of the per-configuration path).
 IdentificationSummary Identify(const MeasurementKind& kind, const MeasuredValues& data,
                                const IdentificationOptions& options = {});
+
+/// Errors in variables: each measured value's weight σ²/var (in units of single readings) for
+/// recorded joint values with standard deviation `joint_sigma` (rad, or m for a prismatic
+/// joint), one error per configuration: var = σ²/R + joint_sigma²·Σ_j (∂y/∂q_j)², the joint
+/// gradient at the nominal model by central differences (step 1e-6).
+std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
+                                             const MeasuredValues& data, double sigma,
+                                             double joint_sigma);
 
 /// The model Identify solved: `model`'s parameter set without the parameters it fixed for rank
 /// deficiency (s.delta is laid out for it).

@@ -82,8 +82,12 @@ struct MeasuredValues {
   std::vector<double> y;
   std::vector<int> repetitions;
   int size() const { return configs.size(); }
-  /// Each measured value's weight: its configuration's repetitions, on each of its
-  /// `rows_per_configuration` values (what the solvers weigh the residuals by).
+  /// Per measured value (rows_per_configuration per configuration), weights that replace the
+  /// repetitions when not empty: σ²/var_i for a value whose variance is var_i (errors in
+  /// variables, identification.h), in units of single readings.
+  std::vector<double> weights{};
+  /// Each measured value's weight: `weights` if given, else its configuration's repetitions on
+  /// each of its `rows_per_configuration` values (what the solvers weigh the residuals by).
   std::vector<double> RowWeights(int rows_per_configuration) const;
 };
 
