@@ -37,8 +37,9 @@ void AddCommonOptions(po::options_description& options) {
       "tool-link", po::value<std::string>(),
       "URDF robots: the link whose frame is the ranger's (default: the URDF's only end link)")(
       "plane", po::value<std::vector<std::string>>()->composing(),
-      "plane nx,ny,nz,f in the base frame (normalised); repeat for several planes (a CSV's "
-      "plane column numbers them from 1 in this order); default: the robot file's plane(s)")(
+      "plane n.p + f = 0 as nx,ny,nz,f: the normal in the base frame (normalised) and f in m; "
+      "repeat for several planes (a CSV's plane column numbers them from 1 in this order); "
+      "default: the robot file's plane(s)")(
       "format", po::value<std::string>()->default_value("text"), "output: text or json");
 }
 

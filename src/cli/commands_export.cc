@@ -15,9 +15,10 @@ int ExportCommand(const std::vector<std::string>& args) {
                   "written (a calibrated file's are the estimates)")(
       "tool-link", po::value<std::string>(), "URDF robots: the ranger's link")(
       "plane", po::value<std::vector<std::string>>()->composing(),
-      "yaml: plane(s) nx,ny,nz,f to write instead of the robot file's")(
-      "format", po::value<std::string>()->default_value("urdf"), "urdf, dh-table or yaml")(
-      "out", po::value<std::string>(), "file to write (default: standard output)");
+      "yaml: plane(s) n.p + f = 0 as nx,ny,nz,f (base frame, f in m) to write instead of the "
+      "robot file's")("format", po::value<std::string>()->default_value("urdf"),
+                      "urdf, dh-table or yaml")("out", po::value<std::string>(),
+                                                "file to write (default: standard output)");
   po::variables_map vm;
   if (!Parse("export", "--robot R --format urdf|dh-table|yaml [--out FILE]", o, args, &vm))
     return 0;

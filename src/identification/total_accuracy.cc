@@ -287,7 +287,8 @@ std::string AccuracyPredictionText(const AccuracyPrediction& p) {
     data_ms += a.position_std.squaredNorm();
   }
   const std::size_t m = p.poses.size();
-  std::string t = PoseTable(p);
+  // The answer first (a workspace of 500 poses would push it below 500 rows), the poses last.
+  std::string t;
   t += "over these " + std::to_string(m) + " poses: RMS position error " +
        Fixed(m ? std::sqrt(data_ms / m) * 1e3 : 0) + " mm from the reading noise alone, " +
        Fixed(p.rms_position_total * 1e3) +
@@ -305,7 +306,7 @@ std::string AccuracyPredictionText(const AccuracyPrediction& p) {
     t += "\n         give them when calibrating: the robot file's tolerances:, or identify "
          "--prior-sigma\n";
   }
-  return t;
+  return t + PoseTable(p);
 }
 
 }  // namespace lrcal

@@ -116,8 +116,9 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
                                         const UnestimatedTerms& held,
                                         const ConfigurationSet& configs);
 
-/// The statement as text: the per-pose table (data part and total, mm and mrad), the summary, the
-/// source table and, when defaults were used, a warning naming the terms.
+/// The statement as text: the summary, the σ used, the source table, a warning naming the terms
+/// that took a default tolerance (if any), then the per-pose table (data part and total, mm and
+/// mrad).
 std::string AccuracyPredictionText(const AccuracyPrediction& prediction);
 
 }  // namespace lrcal
