@@ -232,9 +232,9 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
 void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const RobotFile& rig, const MeasurementModel& model,
                             const MeasurementSet& data, const IdentificationSummary& s,
-                            const IdentificationOptions& options) {
+                            const IdentificationOptions& options, const UnestimatedTerms& held) {
   CalibrationReportInputs in{vm["data"].as<std::string>(), &rig, &model, &data, &s, options};
-  in.known = KnownTolerances(vm, rig);
+  in.held = held;
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
   WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
   if (s.IsSolutionUsable())
@@ -320,7 +320,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
     WriteRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig, model, s,
                options, held);
   if (vm.count("report"))
-    WriteCalibrationReport(vm["report"].as<std::string>(), vm, rig, model, data, s, options);
+    WriteCalibrationReport(vm["report"].as<std::string>(), vm, rig, model, data, s, options, held);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
               << " < 0.001); see the fit line above\n";

@@ -377,14 +377,6 @@ void EstimateKindStatistics(MeasurementEvaluator& evaluator, const Rows& rows,
 
 IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredValues& data,
                                const IdentificationOptions& options) {
-  if (options.encoder_sigma > 0 && data.weights.empty() && options.sigma > 0 &&
-      static_cast<int>(data.y.size()) == kind_in.rows_per_configuration() * data.size() &&
-      static_cast<int>(data.repetitions.size()) == data.size()) {
-    MeasuredValues weighted = data;
-    weighted.weights =
-        ErrorsInVariablesWeights(kind_in, data, options.sigma, options.encoder_sigma);
-    return Identify(kind_in, weighted, options);
-  }
   IdentificationSummary s;
   DescribeSolver(options, &s);
   if (!options.priors.empty()) s.loss += " with priors";
@@ -393,6 +385,12 @@ IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredVal
         ", errors in variables (joint sigma " + Fixed(options.encoder_sigma * 1e3, 4) + " mrad)";
   s.num_configurations = data.size();
   if (!ValidOptions(options, &s) || !CheckMeasuredValues(kind_in, data, options, &s)) return s;
+  if (options.encoder_sigma > 0 && data.weights.empty()) {  // valid options: sigma > 0
+    MeasuredValues weighted = data;
+    weighted.weights =
+        ErrorsInVariablesWeights(kind_in, data, options.sigma, options.encoder_sigma);
+    return Identify(kind_in, weighted, options);
+  }
   std::unique_ptr<MeasurementKind> reduced;
   const MeasurementKind* kind = CheckIdentifiable(
       kind_in, kind_in.parameter_names(), options,

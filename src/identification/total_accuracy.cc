@@ -98,7 +98,7 @@ UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
   Eigen::MatrixXd A = G.transpose() * w.asDiagonal() * G;
   for (int i = 0; i < n; ++i) {
     const double p = options.priors.SigmaOf(names[i]);
-    if (!options.priors.empty() && p > 0) A(i, i) += 1 / (p * p);
+    if (p > 0) A(i, i) += 1 / (p * p);  // SigmaOf: 0 without a prior
   }
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
   if (ldlt.info() != Eigen::Success)
@@ -190,7 +190,7 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
     const Eigen::Matrix<double, 6, Eigen::Dynamic> Mj = M.middleRows(6 * j, 6);
     const Eigen::Matrix<double, 6, 6> D = Pj * covariance * Pj.transpose();
     const Eigen::Matrix<double, 6, 6> T = D + Mj * Mj.transpose();
-    out.poses.push_back(PoseAccuracyFromCovariance(D, k > 0 ? T : D));
+    out.poses.push_back(PoseAccuracyFromCovariance(D, T));  // T == D when nothing is held
     pos_ms += Mj.topRows<3>().colwise().squaredNorm().transpose();
     ori_ms += Mj.bottomRows<3>().colwise().squaredNorm().transpose();
     data_pos += D.topLeftCorner<3, 3>().trace();

@@ -79,8 +79,12 @@ ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord
   return MakeParameterSet(robot, planes, fixed, source, ranger);
 }
 
-Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet& ps,
-                                 const std::string& source) {
+namespace {
+
+// Where each of `ps`'s names is among the record's parameters (InputError naming `source` when
+// the record names a parameter `ps` lacks or misses one).
+std::vector<int> RecordOrder(const CalibrationRecord& r, const ParameterSet& ps,
+                             const std::string& source) {
   const int n = ps.size();
   if (n != static_cast<int>(r.parameters.size()))
     throw InputError(source, "names a parameter this robot does not have");
@@ -91,6 +95,15 @@ Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet&
       if (r.parameters[i] == ps.names[k]) at[k] = i;
     if (at[k] < 0) throw InputError(source, "missing " + ps.names[k]);
   }
+  return at;
+}
+
+}  // namespace
+
+Eigen::MatrixXd RecordCovariance(const CalibrationRecord& r, const ParameterSet& ps,
+                                 const std::string& source) {
+  const int n = ps.size();
+  const std::vector<int> at = RecordOrder(r, ps, source);
   Eigen::MatrixXd C(n, n);
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) C(a, b) = r.covariance(at[a], at[b]);
@@ -122,11 +135,8 @@ AccuracyPrediction PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSe
                        "'" + name + "' is not a term this set-up holds at nominal");
   // The shift's rows follow the record's parameters; reorder them like the covariance.
   if (!held.empty()) {
-    const Eigen::MatrixXd shift = held.estimate_shift;
-    for (int a = 0; a < ps.size(); ++a) {
-      const auto it = std::find(r.parameters.begin(), r.parameters.end(), ps.names[a]);
-      held.estimate_shift.row(a) = shift.row(it - r.parameters.begin());
-    }
+    const std::vector<int> at = RecordOrder(r, ps, source);
+    for (int a = 0; a < ps.size(); ++a) held.estimate_shift.row(a) = r.estimate_shift.row(at[a]);
   }
   const std::vector<double> zero(ps.size(), 0.0);  // the file's nominal values are the estimates
   AccuracyPrediction p = PredictTotalAccuracy(model, zero.data(), C, held, poses);

@@ -16,8 +16,7 @@ namespace lrcal {
 namespace {
 
 // Cross-validation and the total accuracy map over the workspace, added to `j` for a usable fit.
-void AddPredictions(const CalibrationReportInputs& in, const UnestimatedTerms& held,
-                    ResultJson* j) {
+void AddPredictions(const CalibrationReportInputs& in, ResultJson* j) {
   const IdentificationSummary& s = *in.summary;
   const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
   if (folds >= 2)
@@ -28,7 +27,7 @@ void AddPredictions(const CalibrationReportInputs& in, const UnestimatedTerms& h
   const ConfigurationSet poses =
       WorkspacePoses(in.model->robot(), in.workspace_poses, in.workspace_seed);
   AccuracyPrediction p =
-      PredictTotalAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, held, poses);
+      PredictTotalAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, in.held, poses);
   p.sigma_used = used;
   (*j)["workspace_accuracy"] = PoseAccuracyJson(p, poses);
 }
@@ -65,11 +64,9 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
   j["sigma_given"] = in.options.sigma > 0 ? ResultJson(in.options.sigma) : ResultJson();
   j["identifiability"] = IdentifiabilityJson(s.identifiability);
   if (s.IsSolutionUsable()) {
-    const UnestimatedTerms held =
-        FindUnestimatedTerms(SolvedModel(*in.model, s), s, *in.data, in.options, in.known);
-    AddPredictions(in, held, &j);
+    AddPredictions(in, &j);
     WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_file, *in.rig, *in.model, s, in.options,
-                         held);
+                         in.held);
     j["calibrated_robot"] = "calibrated.yaml";
     // The same model as URDF, from the file just written (what lrcal export would write).
     const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");

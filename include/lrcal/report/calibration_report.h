@@ -8,6 +8,7 @@
 
 #include "lrcal/core/settings.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/robot_file.h"
 
 namespace lrcal {
@@ -20,9 +21,9 @@ struct CalibrationReportInputs {
   const MeasurementSet* data = nullptr;
   const IdentificationSummary* summary = nullptr;
   IdentificationOptions options;
-  /// What is known of the terms held at nominal (the robot file's tolerances, --prior-sigma):
-  /// the total accuracy statement propagates them (total_accuracy.h); defaults elsewhere.
-  PriorSigmas known{};
+  /// The terms the fit held at nominal (FindUnestimatedTerms, for a usable fit): the total
+  /// accuracy statement and the calibrated file's record propagate them (total_accuracy.h).
+  UnestimatedTerms held{};
   /// Cross-validation folds (2 or more); 0: min(5, configurations).
   int holdout = 0;
   int workspace_poses = 500;         ///< poses of the accuracy map over the joint ranges
