@@ -216,12 +216,19 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
   std::optional<CrossValidation> cv;
   if (vm.count("holdout") && s.IsSolutionUsable())
     cv = CrossValidate(model, data, vm["holdout"].as<int>(), options);
+  const std::string average = Averaging::Parse(vm["average"].as<std::string>()).Name();
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = IdentificationJson(s);
     if (!accuracy.is_null()) j["accuracy"] = accuracy;
     if (cv) j["holdout"] = CrossValidationJson(*cv);
+    j["average"] = average;
     std::cout << j.dump(2) << "\n";
   } else {
+    if (average != "mean" && data.size() > 0)
+      std::cout << "readings: the " << average
+                << " of each configuration's readings, weighted R/c (c = "
+                << Fixed(data.variance_factor.front(), 3) << " for " << data.repetitions.front()
+                << " readings: the variance of the " << average << " relative to a mean)\n";
     std::cout << s.FullReport();
     std::cout << accuracy_text << (cv ? cv->ToString() : "");
   }
@@ -247,8 +254,8 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
   std::cerr << "lrcal identify: calibration report written to " << dir << "/report.html\n";
 }
 
-int IdentifyCommand(const std::vector<std::string>& args) {
-  po::options_description o("lrcal identify options");
+// identify's options (its settings from the schema are added by the command).
+void AddIdentifyOptions(po::options_description& o) {
   AddCommonOptions(o);
   o.add_options()("data", po::value<std::string>()->required(),
                   "measurement CSV (q1..qN, h in m; rows with equal q are averaged)")(
@@ -273,6 +280,10 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "solver", po::value<std::string>()->default_value("lm"), "lm (lrcal's) or ceres")(
       "loss", po::value<std::string>()->default_value("none"),
       "robust loss: none, huber, cauchy (either solver)")(
+      "average", po::value<std::string>()->default_value("mean"),
+      "how a configuration's repeated readings become its value: mean, median or trimmed:F "
+      "(F in (0, 0.5) cut from each end); the weights account for the median's larger "
+      "variance")(
       "predict-at", po::value<std::string>(),
       "poses (a configurations CSV) to predict the calibrated arm's accuracy at, from the "
       "estimate's covariance (given sigma if --sigma-mm, else residual-based)")(
@@ -286,6 +297,11 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       "write a calibration report into this folder: report.html (fit check, residuals, "
       "parameters, correlation, identifiability, cross-validation, accuracy over the "
       "workspace), calibration.json and the calibrated robot file");
+}
+
+int IdentifyCommand(const std::vector<std::string>& args) {
+  po::options_description o("lrcal identify options");
+  AddIdentifyOptions(o);
   AddSettingOptions(o, IdentificationOptions::Settings(), {"loss_scale_mm", "sigma_mm"});
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
@@ -293,7 +309,9 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const PlaneSet& planes = setup.planes;
-  const MeasurementSet data = ReadRobotMeasurements(vm["data"].as<std::string>(), rig, &planes);
+  const MeasurementSet data =
+      ReadRobotMeasurements(vm["data"].as<std::string>(), rig, &planes,
+                            Averaging::Parse(vm["average"].as<std::string>()));
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
   const IdentificationSummary s = Identify(model, data, options);

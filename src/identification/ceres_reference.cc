@@ -18,7 +18,7 @@ bool WeightedResidual(const MeasurementModel& model, const ModelPoint& point,
   double h;
   const double nb = model.Evaluate(point, data.configs, i, &h, row);
   if (!(std::fabs(nb) > kParallelBeamThreshold)) return false;
-  const double w = std::sqrt(static_cast<double>(data.repetitions[i]));
+  const double w = std::sqrt(data.Weight(i));
   *residual = w * (data.mean_h[i] - h);
   if (row)
     for (int k = 0; k < model.num_parameters(); ++k) row[k] *= -w;

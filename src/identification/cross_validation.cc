@@ -48,6 +48,7 @@ MeasurementSet FoldData(const MeasurementSet& data, int folds, int fold, bool he
     out.configs.AddFrom(data.configs, i);
     out.mean_h.push_back(data.mean_h[i]);
     out.repetitions.push_back(data.repetitions[i]);
+    if (!data.variance_factor.empty()) out.variance_factor.push_back(data.variance_factor[i]);
   }
   return out;
 }
@@ -76,7 +77,7 @@ std::string PredictFold(const MeasurementModel& model, const MeasurementSet& dat
     r.configuration = i;
     r.fold = fold;
     r.error = data.mean_h[i] - h;
-    r.predicted_std = std::sqrt(sigma * sigma / data.repetitions[i] + g.dot(C * g));
+    r.predicted_std = std::sqrt(sigma * sigma / data.Weight(i) + g.dot(C * g));
     r.z = r.error / r.predicted_std;
     out->push_back(r);
   }

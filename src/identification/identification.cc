@@ -125,7 +125,7 @@ void EstimateStatistics(const MeasurementModel& model_ref, const MeasurementSet&
       model->Evaluate(point, data.configs, i, &h, nullptr);
       const double r = data.mean_h[i] - h;
       residuals[i] = r;
-      c += 0.5 * data.repetitions[i] * r * r;
+      c += 0.5 * data.Weight(i) * r * r;
       ss += r * r;
     }
     if (rms) *rms = std::sqrt(ss / m);
@@ -189,10 +189,11 @@ std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
     }
   }
   std::vector<double> weights(static_cast<std::size_t>(k) * m);
+  const std::vector<double> readings = data.RowWeights(k);  // R, or R/c for a median
   for (int i = 0; i < m; ++i)
     for (int c = 0; c < k; ++c) {
       const double variance =
-          sigma * sigma / data.repetitions[i] + joint_sigma * joint_sigma * gradient2[i * k + c];
+          sigma * sigma / readings[i * k + c] + joint_sigma * joint_sigma * gradient2[i * k + c];
       weights[i * k + c] = sigma * sigma / variance;
     }
   return weights;
@@ -244,7 +245,7 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
   if (!model) return s;
 
   s.names = model->parameters().names;
-  std::vector<double> weights(data.repetitions.begin(), data.repetitions.end());
+  std::vector<double> weights = data.Weights();
   Eigen::VectorXd e;
   LevenbergMarquardt lm;
   if (options.solver == IdentificationOptions::Solver::kCeres) {

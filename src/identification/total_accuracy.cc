@@ -92,7 +92,7 @@ UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
       options.encoder_sigma > 0 && options.sigma > 0
           ? ErrorsInVariablesWeights(RangerMeasurement(solved), ToMeasuredValues(data),
                                      options.sigma, options.encoder_sigma)
-          : std::vector<double>(data.repetitions.begin(), data.repetitions.end());
+          : data.Weights();
   Eigen::VectorXd w(data.size());
   for (int i = 0; i < data.size(); ++i) w[i] = rows[i] / (sigma * sigma);
   Eigen::MatrixXd A = G.transpose() * w.asDiagonal() * G;

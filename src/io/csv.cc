@@ -258,7 +258,7 @@ ConfigurationSet ReadPoses(const std::string& path, int num_joints) {
 }
 
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const RangerSpec* ranger,
-                                const PlaneSet* planes) {
+                                const PlaneSet* planes, const Averaging& average) {
   CsvTable t = ReadCsv(path);
   std::vector<int> cols = JointColumns(t, num_joints);
   const int hc = t.Column("h");
@@ -286,7 +286,7 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const R
   return GroupReadings(
       q, h, ranger,
       [&](int r) { return r < 0 ? path : Location(path, t.lines[r]) + " column 'h'"; },
-      cc >= 0 ? &labels : nullptr);
+      cc >= 0 ? &labels : nullptr, average);
 }
 
 // The file is written whole or not at all. A path that cannot be a file is bad input (exit 2);

@@ -31,8 +31,8 @@ ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotMod
 }
 
 MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
-                                     const PlaneSet* planes) {
-  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger, planes);
+                                     const PlaneSet* planes, const Averaging& average) {
+  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger, planes, average);
   CheckJointRanges(data.configs, rig.robot, path);
   return data;
 }

@@ -53,7 +53,9 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
     }
     data->configs.AddFrom(configs, i);
     data->repetitions.push_back(R);
-    if (noise.draw_mean) {
+    if (!noise.average.IsMean())
+      data->weights.insert(data->weights.end(), k, R / noise.average.VarianceFactor(R));
+    if (noise.DrawsMean()) {
       stream.Normals(static_cast<std::uint64_t>(i) * k, k, z.data());
       for (int c = 0; c < k; ++c)
         data->y.push_back(exact[static_cast<std::size_t>(i) * k + c] +
@@ -61,11 +63,12 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
       continue;
     }
     stream.Normals(static_cast<std::uint64_t>(i) * R * k, R * k, z.data());
+    std::vector<double> readings(static_cast<std::size_t>(R));
     for (int c = 0; c < k; ++c) {
-      double sum = 0;
       for (int r = 0; r < R; ++r)
-        sum += exact[static_cast<std::size_t>(i) * k + c] + noise.sigma * z[r * k + c];
-      data->y.push_back(sum / R);
+        readings[static_cast<std::size_t>(r)] =
+            exact[static_cast<std::size_t>(i) * k + c] + noise.sigma * z[r * k + c];
+      data->y.push_back(noise.average.Combine(readings.data(), R));
     }
   }
   return missed;

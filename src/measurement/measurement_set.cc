@@ -40,9 +40,32 @@ void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& grou
 
 }  // namespace
 
+namespace {
+
+// A median or trimmed mean of each configuration's readings (group[r]: reading r's configuration,
+// first[i]: configuration i's first reading) in place of their mean, with its variance factor.
+void CombineRobustly(const std::vector<double>& h, const std::vector<int>& group,
+                     const std::vector<int>& first, const Averaging& average,
+                     const std::function<std::string(int)>& where, MeasurementSet* data) {
+  std::vector<std::vector<double>> readings(first.size());
+  for (std::size_t r = 0; r < group.size(); ++r)
+    readings[static_cast<std::size_t>(group[r])].push_back(h[r]);
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    const int n = static_cast<int>(readings[i].size());
+    data->mean_h[i] = average.Combine(readings[i].data(), n);
+    try {
+      data->variance_factor.push_back(average.VarianceFactor(n));
+    } catch (const SettingError& e) {
+      throw InputError(where(first[i]), e.Problem());
+    }
+  }
+}
+
+}  // namespace
+
 MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
                              const RangerSpec* ranger, const std::function<std::string(int)>& where,
-                             const std::vector<std::string>* labels) {
+                             const std::vector<std::string>* labels, const Averaging& average) {
   if (static_cast<std::size_t>(q.size()) != h.size())
     throw InputError(where(-1), std::to_string(q.size()) + " joint rows but " +
                                     std::to_string(h.size()) + " readings; expected one each");
@@ -100,6 +123,7 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
     data.mean_h.push_back(sums[i] / counts[i]);
     data.repetitions.push_back(counts[i]);
   }
+  if (!average.IsMean()) CombineRobustly(h, group, first, average, where, &data);
   return data;
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "lrcal/core/error.h"
 
@@ -38,8 +39,19 @@ const std::vector<SettingField<NoiseModel>>& NoiseModel::Settings() {
   return fields;
 }
 
+double NoiseModel::EffectiveReadings() const {
+  if (average.IsMean()) return repetitions;
+  return repetitions / average.VarianceFactor(repetitions);
+}
+
 void NoiseModel::Validate() const {
   CheckSettings(*this, Settings());
+  if (!average.IsMean() && repetitions > Averaging::kMaxRobustReadings)
+    throw SettingError(Averaging::Spec(), "a " + average.Name() + " takes at most " +
+                                              std::to_string(Averaging::kMaxRobustReadings) +
+                                              " readings per configuration (noise.repetitions is " +
+                                              std::to_string(repetitions) +
+                                              "); use mean, or fewer repetitions");
   if (!std::isfinite(ranger_offset))
     throw InputError("noise.ranger_offset", "expected a finite offset (m)");
   if (!(std::fabs(ranger_scale) < 0.5))

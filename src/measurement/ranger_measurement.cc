@@ -72,7 +72,9 @@ std::unique_ptr<MeasurementKind> RangerMeasurement::Without(
 }
 
 MeasuredValues ToMeasuredValues(const MeasurementSet& data) {
-  return MeasuredValues{data.configs, data.mean_h, data.repetitions};
+  MeasuredValues values{data.configs, data.mean_h, data.repetitions};
+  if (!data.variance_factor.empty()) values.weights = data.Weights();  // one row each
+  return values;
 }
 
 }  // namespace lrcal

@@ -40,11 +40,11 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
                        const PlaneSet& planes, const ConfigurationSet& configs,
                        const NoiseModel& noise, const RandomStream& stream,
                        const std::vector<int>* noise_slots, std::vector<double>* out) {
-  const int R = noise.repetitions, per = noise.draw_mean ? 1 : R, nj = configs.num_joints();
+  const int R = noise.repetitions, per = noise.DrawsMean() ? 1 : R, nj = configs.num_joints();
   const RandomStream encoder = stream.WithPurpose(RandomPurpose::kEncoder);
   const RandomStream form = stream.WithPurpose(RandomPurpose::kPlaneForm);
-  const double sigma_q = noise.draw_mean ? noise.encoder_sigma / std::sqrt(static_cast<double>(R))
-                                         : noise.encoder_sigma;
+  const double sigma_q = noise.DrawsMean() ? noise.encoder_sigma / std::sqrt(static_cast<double>(R))
+                                           : noise.encoder_sigma;
   ConfigurationSet disturbed(nj);
   disturbed.Reserve(configs.size() * per);
   std::vector<double> q(nj);
@@ -77,7 +77,7 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
 double OutlierError(const NoiseModel& noise, const RandomStream& outliers, std::uint64_t slot,
                     int r) {
   const int R = noise.repetitions;
-  if (!noise.draw_mean) {
+  if (!noise.DrawsMean()) {
     const std::uint64_t k = slot * R + r;
     return outliers.Uniform(4 * k) <= noise.outlier_fraction
                ? noise.outlier_sigma * outliers.Normal(4 * k + 2)
@@ -91,22 +91,22 @@ double OutlierError(const NoiseModel& noise, const RandomStream& outliers, std::
                : 0.0;
 }
 
-// The mean of R single readings of a configuration (each appended to `raw`): the exact
-// reading (per reading when `per_reading`, else `exact`) through the ranger, noise, outliers.
+// The value (noise.average: mean, median, trimmed mean) of R single readings of a configuration
+// (each appended to `raw`): the exact reading (per reading when `per_reading`, else `exact`)
+// through the ranger, noise, outliers.
 double MeanOfReadings(const NoiseModel& noise, const RandomStream& stream,
                       const RandomStream& outliers, std::uint64_t slot, const double* per_reading,
                       double exact, std::vector<double>* z, std::vector<double>* raw) {
   const int R = noise.repetitions;
   stream.Normals(slot * R, R, z->data());
-  double sum = 0;
   for (int r = 0; r < R; ++r) {
     double reading = (1 + noise.ranger_scale) * (per_reading ? per_reading[r] : exact) +
                      noise.ranger_offset + noise.sigma * (*z)[r];
     if (noise.outlier_fraction > 0) reading += OutlierError(noise, outliers, slot, r);
-    sum += reading;
+    (*z)[r] = reading;
     if (raw) raw->push_back(reading);
   }
-  return sum / R;
+  return noise.average.Combine(z->data(), R);
 }
 
 }  // namespace
@@ -127,7 +127,7 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
   std::vector<double> disturbed;
   DisturbedReadings(robot, true_link_values, true_planes, configs, noise, stream, noise_slots,
                     &disturbed);
-  if (noise.draw_mean)
+  if (noise.DrawsMean())
     return AddNoise(disturbed, *m, configs, noise, stream, data, raw, noise_slots);
   return AddNoise(h, *m, configs, noise, stream, data, raw, noise_slots, &disturbed);
 }
@@ -143,9 +143,12 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
   data->configs.Reserve(configs.size());
   data->mean_h.clear();
   data->repetitions.clear();
+  data->variance_factor.clear();
+  const double factor =
+      noise.average.IsMean() ? 1 : noise.average.VarianceFactor(noise.repetitions);
   const int R = noise.repetitions;
   const double sigma_mean = noise.sigma / std::sqrt(static_cast<double>(R));
-  std::vector<double> z(noise.draw_mean ? 1 : R);
+  std::vector<double> z(noise.DrawsMean() ? 1 : R);
   if (raw) raw->clear();
   const bool outliers = noise.outlier_fraction > 0;
   const RandomStream outlier_stream = stream.WithPurpose(RandomPurpose::kOutlier);
@@ -157,7 +160,7 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
       continue;
     }
     double mean;
-    if (noise.draw_mean) {
+    if (noise.DrawsMean()) {
       mean =
           (1 + noise.ranger_scale) * h[i] + noise.ranger_offset + sigma_mean * stream.Normal(slot);
       if (outliers) mean += OutlierError(noise, outlier_stream, slot, 0);
@@ -168,6 +171,7 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
     data->configs.AddFrom(configs, i);
     data->mean_h.push_back(mean);
     data->repetitions.push_back(R);
+    if (!noise.average.IsMean()) data->variance_factor.push_back(factor);
   }
   return missed;
 }

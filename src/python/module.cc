@@ -405,6 +405,7 @@ struct IdentifyArgs {
   std::string prior_sigma;        // as --prior-sigma; "" = no priors
   bool prior = false;             // as --prior: the robot file's tolerances
   double encoder_sigma_mrad = 0;  // as --encoder-sigma-mrad: errors in variables
+  std::string average = "mean";   // as --average: mean, median or trimmed:F
 };
 
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
@@ -413,9 +414,10 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   const RobotModel& robot = rig.robot;
   const ConfigurationSet readings_q = ToConfigurations(q, robot.num_links(), "q");
   const std::vector<double> readings = ToVector(h, "h");
-  const MeasurementSet data = GroupReadings(readings_q, readings, &rig.ranger, [](int r) {
-    return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]";
-  });
+  const MeasurementSet data = GroupReadings(
+      readings_q, readings, &rig.ranger,
+      [](int r) { return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]"; }, nullptr,
+      Averaging::Parse(a.average));
   const Plane plane = ResolvePlane(rig, plane_arg);
   const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
   IdentificationOptions options;
@@ -824,6 +826,22 @@ str() gives the full text report; repr() the one-line summary.)doc")
       .def_readonly("prior_sigma", &S::prior_sigma)
       .def_readonly("posterior_to_prior", &S::posterior_to_prior)
       .def_property_readonly("set_by_prior", &S::SetByPrior)
+      .def_property_readonly(
+          "fit",
+          [](const S& s) {
+            py::dict d;
+            d["sigma_given"] = s.fit.sigma_given;
+            d["chi2"] = s.fit.chi2;
+            d["dof"] = s.fit.dof;
+            d["p_value"] = s.fit.p_value;
+            d["consistent"] = s.fit.consistent;
+            d["standardized"] = s.fit.standardized;
+            d["suspects"] = s.fit.suspects;
+            return d;
+          },
+          "The fit check, as identify's JSON 'fit': chi2 against the given sigma_mm, dof, "
+          "p_value, consistent (p >= 0.001), standardized residuals and suspects (0-based "
+          "configurations with |standardized| > 4).")
       .def("__str__", &S::FullReport)
       .def("__repr__", &S::BriefReport);
 }
@@ -922,6 +940,9 @@ prior: True to use the robot file's tolerances: as priors (as --prior); prior_si
 replace the same keys.
 encoder_sigma_mrad: errors in variables (as --encoder-sigma-mrad): the standard deviation of each
 recorded joint value (mrad; mm for a prismatic joint), one error per configuration; needs sigma_mm.
+average: how the readings at one configuration become its value (as --average): "mean",
+"median" or "trimmed:F" (F in (0, 0.5) cut from each end); the weights account for the median's
+larger variance under Gaussian noise.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc";
 
 void DefineCalibration(py::module_& m) {
@@ -938,17 +959,18 @@ void DefineCalibration(py::module_& m) {
          const std::string& estimate_plane, const py::object& fix, bool auto_fix,
          const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
          long long max_iterations, const py::object& loss_scale, const py::object& sigma,
-         const std::string& prior_sigma, bool prior, double encoder_sigma_mrad) {
+         const std::string& prior_sigma, bool prior, double encoder_sigma_mrad,
+         const std::string& average) {
         return IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
                           {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
-                           prior_sigma, prior, encoder_sigma_mrad});
+                           prior_sigma, prior, encoder_sigma_mrad, average});
       },
       py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
       py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
       setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
       py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", py::arg("prior") = false,
-      py::arg("encoder_sigma_mrad") = 0.0, kIdentifyDoc);
+      py::arg("encoder_sigma_mrad") = 0.0, py::arg("average") = Averaging{}.Name(), kIdentifyDoc);
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
         py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8, R"doc(

@@ -62,6 +62,7 @@ const Json& StudyDefaults() {
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
+    j["noise"]["average"] = Averaging{}.Name();
     j["identification"]["max_iterations"] = static_cast<long long>(
         FindSetting(IdentificationOptions::Settings(), "max_iterations")->Default());
     return j;
@@ -378,6 +379,13 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
     }
   }
   ReadSettings(s, where, NoiseModel::Settings(), &c->noise);
+  try {
+    if (!At(s, "noise.average").is_null())
+      c->noise.average = Averaging::Parse(Str(s, "noise.average", where));
+    c->noise.Validate();  // a median's count of readings
+  } catch (const SettingError& e) {
+    throw e.Respelled(Frontend::kStudyFile, where("noise.average"));
+  }
 }
 
 void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings* c) {
@@ -632,6 +640,10 @@ Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& 
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
   base.merge_patch(settings);
+  // noise.average came after studies were run: at its default (the mean) it is left out of the
+  // settings, so that earlier studies' tables stay as they were.
+  if (base["noise"].is_object() && base["noise"].value("average", Json()) == Averaging{}.Name())
+    base["noise"].erase("average");
   HashRobotFile(&base, where, folder);
   ParseCell(base, where);  // the base itself must be valid
   return base;
@@ -938,6 +950,7 @@ void DropNeutralKeys(Json* id) {
                                         {"truth", "ranger_scale_ppm", "robot_file", nullptr},
                                         {"noise", "encoder_sigma_mrad", 0, nullptr},
                                         {"noise", "form_sigma_mm", 0, nullptr},
+                                        {"noise", "average", "mean", nullptr},
                                         {"noise", "outlier_fraction", 0, "outlier_sigma_mm"},
                                         {"identification", "estimate_ranger", "none", nullptr},
                                         {"identification", "loss", "none", "loss_scale"}};

@@ -287,7 +287,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->model, c->design.configs);
   if (!c->rank_deficient && design_report.full_rank()) {
-    c->predicted_covariance = ParameterCovariance(s.noise.repetitions * GtG, s.noise.sigma);
+    c->predicted_covariance = ParameterCovariance(s.noise.EffectiveReadings() * GtG, s.noise.sigma);
     c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
   } else {
     if (!c->rank_deficient) c->rank_message = design_report.ToString();
@@ -315,7 +315,7 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
     const Eigen::MatrixXd Gt =
         IdentificationJacobian(*c->model, c->design.configs, c->fixed_truth.delta.data());
     c->predicted_std_truth =
-        ParameterCovariance(s.noise.repetitions * (Gt.transpose() * Gt), s.noise.sigma)
+        ParameterCovariance(s.noise.EffectiveReadings() * (Gt.transpose() * Gt), s.noise.sigma)
             .diagonal()
             .cwiseSqrt();
   }
@@ -454,7 +454,7 @@ SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspac
     ws->e = summary.delta;
     return out;
   }
-  ws->weights.assign(ws->data.repetitions.begin(), ws->data.repetitions.end());
+  ws->weights = ws->data.Weights();
   const LevenbergMarquardt::Result r =
       ws->solver.Solve(*c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(),
                        s.identification, &ws->e, cell_design ? &c.design_nominal : nullptr);
@@ -555,7 +555,8 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   const SolveOutcome r = IdentifyTrial(c, design == &c.design, ws);
   rec.iterations = r.iterations;
   const int m = ws->data.size(), n = c.model->num_parameters();
-  rec.residual_rms = std::sqrt(2 * r.final_cost / (m * s.noise.repetitions));  // per-config mean
+  rec.residual_rms =
+      std::sqrt(2 * r.final_cost / (m * s.noise.EffectiveReadings()));  // per-config mean
   rec.sigma_hat = m > n ? std::sqrt(2 * r.final_cost / (m - n)) : 0.0;
   if (StatusOf(r.termination) != TrialStatus::kOk) return finish(StatusOf(r.termination));
 

@@ -762,6 +762,31 @@ TEST_F(CliTest, IdentifyWithErrorsInVariables) {
   EXPECT_THAT(out, ::testing::HasSubstr("--encoder-sigma-mrad")) << out;
 }
 
+// --average median: gross errors in one reading of five no longer reject the fit, and the
+// weights carry the median's variance factor.
+TEST_F(CliTest, IdentifyWithAMedianOfTheReadings) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv") +
+                    " --sigma-mm 0.05 --repetitions 5 --outlier-fraction 0.05 --seed 5",
+                &out),
+            0)
+      << out;
+  const std::string identify = "identify --data " + Path("m.csv") + " --sigma-mm 0.05";
+  EXPECT_EQ(Run(identify, &out), 4) << out;  // the means carry the gross errors
+  ASSERT_EQ(Run(identify + " --average median", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("readings: the median of each configuration's readings, "
+                                        "weighted R/c (c = 1.4"));
+  EXPECT_THAT(out, ::testing::HasSubstr("consistent with the stated noise"));
+  ASSERT_EQ(Run(identify + " --average median --format json", &out), 0) << out;
+  EXPECT_EQ(Json::parse(out)["average"], "median");
+  for (const char* bad : {"mode", "trimmed:0.7"}) {
+    EXPECT_EQ(Run(identify + " --average " + bad, &out), 2) << bad;
+    EXPECT_THAT(out, ::testing::HasSubstr("--average")) << out;
+    EXPECT_THAT(out, ::testing::HasSubstr("expected")) << out;
+  }
+}
+
 TEST_F(CliTest, DesignChoosesKAndBeatsTheRandomBaseline) {
   std::string out;
   ASSERT_EQ(Run("design --generate 60 --seed 2 --select 30 --method exchange --criterion E "

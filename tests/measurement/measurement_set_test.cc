@@ -27,6 +27,21 @@ TEST(GroupReadings, AveragesIdenticalJointValuesInOrderOfFirstAppearance) {
   EXPECT_EQ(data.mean_h[1], 2.0);
 }
 
+// With a median, a configuration's value is its middle reading and its weight R/c.
+TEST(GroupReadings, AMedianTakesTheMiddleReadingAndItsVarianceFactor) {
+  ConfigurationSet q(2);
+  for (int r = 0; r < 5; ++r) q.Add({0.1, 0.2});
+  q.Add({0.3, 0.4});
+  const std::vector<double> h = {1.0, 1.2, 9.0, 1.1, 1.3, 2.0};
+  const Averaging median = Averaging::Parse("median");
+  const MeasurementSet data = GroupReadings(q, h, nullptr, Where, nullptr, median);
+  ASSERT_EQ(data.size(), 2);
+  EXPECT_EQ(data.mean_h[0], 1.2);  // the 9.0 no longer pulls it
+  EXPECT_EQ(data.mean_h[1], 2.0);
+  EXPECT_EQ(data.Weight(0), 5 / median.VarianceFactor(5));
+  EXPECT_EQ(data.Weight(1), 1.0);  // one reading: nothing cut
+}
+
 // With labels (a `configuration` column) readings group by label: jittering joint values of
 // one pose are one configuration at their mean; identical ones keep their bits.
 TEST(GroupReadings, LabelsGroupJitteringJointValues) {

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -140,6 +141,40 @@ TEST(Simulation, OutliersHitTheStatedShareOfReadingsAndAverageInTheMean) {
   // Heavy-tailed (a mixture): the variance's relative SE is ≈ √((κ−1)/N) ≈ 3 % here.
   EXPECT_NEAR(Variance(all) / predicted, 1.0, 0.12);
   EXPECT_NEAR((all.array().abs() > 1e-12).cast<double>().mean(), 1 - std::pow(0.9, 10), 0.015);
+}
+
+// noise.average: a configuration's value is the median of exactly the readings written to `raw`,
+// with its variance factor; draw_mean does not apply (every reading is drawn).
+TEST(Simulation, AMedianIsTheMiddleOfTheWrittenReadingsWithItsVarianceFactor) {
+  const RobotModel& robot = testing::PaperRobot();
+  const ConfigurationSet configs = testing::PaperHittingConfigurations(8, 3);
+  NoiseModel noise;
+  noise.repetitions = 5;
+  noise.outlier_fraction = 0.2;
+  noise.average = Averaging::Parse("median");
+  const RandomStream stream(5, 0, 0, RandomPurpose::kNoise);
+  MeasurementSet data, drawn;
+  std::vector<double> raw;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   configs, noise, stream, &data, nullptr, &raw);
+  ASSERT_EQ(data.size(), 8);
+  ASSERT_EQ(raw.size(), 40u);
+  for (int i = 0; i < data.size(); ++i) {
+    std::vector<double> r(raw.begin() + 5 * i, raw.begin() + 5 * i + 5);
+    std::sort(r.begin(), r.end());
+    EXPECT_EQ(data.mean_h[i], r[2]) << i;
+    EXPECT_EQ(data.Weight(i), 5 / noise.average.VarianceFactor(5));
+  }
+  noise.draw_mean = true;
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   configs, noise, stream, &drawn);
+  EXPECT_EQ(drawn.mean_h, data.mean_h);
+  // The mean keeps no factors: its weights are its counts.
+  noise.average = Averaging{};
+  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
+                   configs, noise, stream, &drawn);
+  EXPECT_TRUE(drawn.variance_factor.empty());
+  EXPECT_EQ(drawn.Weight(0), 5.0);
 }
 
 TEST(Simulation, DisturbancesAreValidated) {

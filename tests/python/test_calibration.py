@@ -129,6 +129,26 @@ def test_identify_with_priors_matches_the_program_bit_for_bit(tmp_path, cli, pap
         lrcal.identify(paper, m[:, :6], m[:, header.index("h")], prior_sigma="d=1mm")
 
 
+def test_identify_with_a_median_of_the_readings_matches_the_program(tmp_path, cli, paper):
+    """lrcal.identify(average="median") is `lrcal identify --average median`, bit for bit: gross
+    errors that reject the means' fit leave the medians' consistent."""
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    cli("sample", "--robot", "paper", "--count", 60, "--seed", 4, "--out", configs)
+    cli("simulate", "--robot", "paper", "--configs", configs, "--seed", 5, "--repetitions", 5,
+        "--sigma-mm", 0.05, "--outlier-fraction", 0.05, "--out", data)
+    program = json.loads(cli("identify", "--robot", "paper", "--data", data, "--sigma-mm", 0.05,
+                             "--average", "median", "--format", "json").stdout)
+    header, m = read_csv(data)
+    q, h = m[:, :6], m[:, header.index("h")]
+    result = lrcal.identify(paper, q, h, sigma_mm=0.05, average="median")
+    np.testing.assert_array_equal(result.estimate, [p["estimate"] for p in program["parameters"]])
+    np.testing.assert_array_equal(result.covariance_given, program["covariance_given_sigma"])
+    assert program["fit"]["consistent"]
+    assert not lrcal.identify(paper, q, h, sigma_mm=0.05).fit["consistent"]
+    with pytest.raises(lrcal.InputError, match="average=: expected mean, median or trimmed:F"):
+        lrcal.identify(paper, q, h, sigma_mm=0.05, average="mode")
+
+
 def test_identify_with_errors_in_variables_matches_the_program(tmp_path, cli, paper):
     """lrcal.identify(encoder_sigma_mrad=...) is `lrcal identify --encoder-sigma-mrad`, bit for
     bit, and needs sigma_mm as the program does."""

@@ -48,7 +48,9 @@ TEST(Settings, StudyDefaultsAreTheOptionStructsDefaults) {
     ASSERT_TRUE(defaults["noise"].contains(f.spec.name)) << f.spec.name;
     EXPECT_EQ(defaults["noise"][f.spec.name].get<double>(), f.Default()) << f.spec.name;
   }
-  EXPECT_EQ(defaults["noise"].size(), NoiseModel::Settings().size());
+  // Plus the one setting that is not a number: noise.average.
+  EXPECT_EQ(defaults["noise"].size(), NoiseModel::Settings().size() + 1);
+  EXPECT_EQ(defaults["noise"]["average"], Averaging{}.Name());
   EXPECT_EQ(defaults["noise"]["sigma_mm"].get<double>(), NoiseModel{}.sigma * 1e3);
   EXPECT_EQ(defaults["identification"]["max_iterations"].get<int>(),
             IdentificationOptions{}.max_iterations);

@@ -30,6 +30,7 @@ enum class RandomPurpose : std::uint32_t {
   kPlaneForm = 8,     ///< plane flatness deviation at a configuration's hit point: index = slot
   kOutlier = 9,       ///< gross errors: 2·(configuration·R + repetition) (+1 for the size)
   kSensitivity = 10,  ///< sensitivity plans (Saltelli's A, B; Morris' trajectories), bootstrap
+  kAveraging = 11,    ///< averaging.h's variance factors: trial = readings, index = set·n + r
 };
 
 class RandomStream {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "lrcal/identification/identification.h"
+#include "lrcal/measurement/averaging.h"
 #include "lrcal/measurement/measurement_model.h"
 
 namespace lrcal {
@@ -53,10 +54,11 @@ ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
 ConfigurationSet ReadPoses(const std::string& path, int num_joints);
 /// Readings grouped by configuration (and plane, as ReadConfigurations). With a `ranger`, a
 /// reading outside its range is an error naming the line (and suggesting the likely unit
-/// mistake: readings are in metres).
+/// mistake: readings are in metres). A configuration's readings become its value by `average`
+/// (their mean unless told otherwise; GroupReadings).
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints,
                                 const RangerSpec* ranger = nullptr,
-                                const PlaneSet* planes = nullptr);
+                                const PlaneSet* planes = nullptr, const Averaging& average = {});
 
 /// Refuses (InputError naming `option`) an output path that cannot be a file: empty, a folder,
 /// or in a folder that does not exist.

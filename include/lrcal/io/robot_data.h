@@ -23,8 +23,9 @@ ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotMod
                                          const PlaneSet* planes = nullptr);
 
 /// A measurement CSV for `rig` (its ranger's range and its robot's joint ranges checked; its
-/// `plane` column resolved against `planes`).
+/// `plane` column resolved against `planes`; each configuration's readings combined by `average`).
 MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
-                                     const PlaneSet* planes = nullptr);
+                                     const PlaneSet* planes = nullptr,
+                                     const Averaging& average = {});
 
 }  // namespace lrcal

@@ -94,7 +94,9 @@ struct MeasuredValues {
 /// Simulated measurements: `truth` (the kind built on the true geometry) predicts the exact
 /// values at e = 0; configurations it misses are left out (their reasons in `misses`, if
 /// given, one per configuration). Each component of each reading carries independent noise
-/// N(0, noise.sigma²); a configuration's value is the mean of noise.repetitions readings. Reading
+/// N(0, noise.sigma²); a configuration's value is the mean (or noise.average's median or trimmed
+/// mean, each component on its own, with weights R/VarianceFactor(R)) of noise.repetitions
+/// readings. Reading
 /// r of component c of configuration i draws the standard normal at index (i·R + r)·k + c of
 /// `stream` (R repetitions, k rows per configuration), so a configuration's noise does not depend
 /// on the others; with noise.draw_mean the mean's error is drawn directly as σ/√R·z, z at index

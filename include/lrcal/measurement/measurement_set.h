@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/averaging.h"
 #include "lrcal/measurement/plane.h"
 
 namespace lrcal {
@@ -14,8 +15,22 @@ namespace lrcal {
 struct MeasurementSet {
   ConfigurationSet configs;
   std::vector<double> mean_h;    ///< m, mean of the readings at each configuration
-  std::vector<int> repetitions;  ///< number of readings averaged (the residual weight)
+  std::vector<int> repetitions;  ///< number of readings averaged
+  /// Each configuration's variance factor c (averaging.h): its value's variance is c·σ²/R.
+  /// Empty for means (c = 1 everywhere).
+  std::vector<double> variance_factor;
   int size() const { return configs.size(); }
+  /// The residual weight of configuration i: R/c (exactly R for a mean).
+  double Weight(int i) const {
+    const double r = repetitions[static_cast<std::size_t>(i)];
+    return variance_factor.empty() ? r : r / variance_factor[static_cast<std::size_t>(i)];
+  }
+  /// Every configuration's Weight, in order.
+  std::vector<double> Weights() const {
+    std::vector<double> w(repetitions.size());
+    for (int i = 0; i < static_cast<int>(w.size()); ++i) w[static_cast<std::size_t>(i)] = Weight(i);
+    return w;
+  }
 };
 
 /// Groups individual readings into a MeasurementSet: reading r was taken at joint values
@@ -29,8 +44,12 @@ struct MeasurementSet {
 /// grouped by label instead: a configuration is the readings that share a label, whatever
 /// their recorded joint values (encoders that jitter between readings of one pose); its joint
 /// values are those of its first reading if all agree, else their mean.
+///
+/// With `average` other than the mean, each configuration's value is the median or trimmed mean
+/// of its readings and variance_factor holds the factor each count of readings implies.
 MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
                              const RangerSpec* ranger, const std::function<std::string(int)>& where,
-                             const std::vector<std::string>* labels = nullptr);
+                             const std::vector<std::string>* labels = nullptr,
+                             const Averaging& average = {});
 
 }  // namespace lrcal

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lrcal/core/settings.h"
+#include "lrcal/measurement/averaging.h"
 
 namespace lrcal {
 
@@ -25,6 +26,15 @@ struct NoiseModel {
   /// geometric distance h, before the random errors above.
   double ranger_offset = 0;
   double ranger_scale = 0;
+  /// How a configuration's R readings become its value (averaging.h): their mean (the default),
+  /// median or trimmed mean; not a numeric setting (noise.average, --average, average=). A
+  /// median or trimmed mean draws every reading even with draw_mean (its law is not normal).
+  Averaging average{};
+  /// Readings averaged per configuration as the identification weighs them: R for the mean,
+  /// R / average.VarianceFactor(R) otherwise (the averaged value's variance is σ²/this).
+  double EffectiveReadings() const;
+  /// draw_mean, where it applies (the mean of the readings).
+  bool DrawsMean() const { return draw_mean && average.IsMean(); }
   /// Encoder noise or form error: the readings need the kinematics, not only exact readings.
   bool DisturbsGeometry() const { return encoder_sigma > 0 || form_sigma > 0; }
   /// The user-facing settings (settings.h), in this order: sigma_mm (≥ 0), repetitions (1 to
@@ -33,7 +43,8 @@ struct NoiseModel {
   /// are the truth's (a study's truth.ranger_offset_mm, the robot file's), not settings here.
   static const std::vector<SettingField<NoiseModel>>& Settings();
   /// Throws SettingError naming the library field (noise.sigma, ...) unless every setting is
-  /// in range; InputError unless the ranger's offset is finite and |scale| < 0.5.
+  /// in range (a median or trimmed mean of at most Averaging::kMaxRobustReadings readings);
+  /// InputError unless the ranger's offset is finite and |scale| < 0.5.
   void Validate() const;
 };
 
