@@ -7,7 +7,7 @@
 #   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
 #   docs     the API reference (Doxygen) builds without a warning
 #   fuzz     libFuzzer on the CSV readers, robot files, URDFs, study files and the number parser
-#            (ASan + UBSan, 45 s each: scripts/fuzz.sh)
+#            (ASan + UBSan, 25 s each: scripts/fuzz.sh)
 # Usage: bash scripts/checks.sh [format|layers|tidy|docs|asan|tsan|fuzz ...]  (default: all, in order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -58,11 +58,16 @@ for s in "${stages[@]}"; do
     tsan)
       stage tsan
       sanitizer_build build-tsan thread lrcal_cli lrcal_study_tests
+      # The statistics and sensitivity tests that run dozens of whole studies (4 of the 88, half
+      # of this stage's time) repeat, on more trials, the threaded runner code that the
+      # MonteCarlo, StopWhen and Mpi tests already run under TSan; they run in the Release and
+      # ASan suites.
+      repeats='^(Statistics\.(P95IntervalsOfFortySeeds.*|StreamingSummaryHasTheBitsOfSortingEveryValue)|SensitivityStudy\.(ASingleTrialsFigureHasTheNoiseAsAnInput|PlanPointsAreCells.*))$'
       TSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/tsan.supp:halt_on_error=1" \
-        ctest --test-dir build-tsan -j2 --output-on-failure -L study ;;
+        ctest --test-dir build-tsan -j2 --output-on-failure -L study -E "$repeats" ;;
     fuzz)
       stage fuzz
-      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-45}" ;;
+      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-25}" ;;
     *) echo "unknown stage '$s' (format, layers, tidy, docs, asan, tsan, fuzz)" >&2; exit 2 ;;
   esac
 done

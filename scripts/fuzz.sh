@@ -3,10 +3,10 @@
 # UndefinedBehaviorSanitizer, and runs each for a bounded time on its checked-in corpus
 # (tests/fuzz/corpus/<target>). Any crash, sanitizer report, or reader answer other than a clear
 # InputError is a finding: the script fails and leaves the input in build-fuzz/findings/.
-#   bash scripts/fuzz.sh [seconds per target, default 60]
+#   bash scripts/fuzz.sh [seconds per target, default 25]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds="${1:-${LRCAL_FUZZ_SECONDS:-45}}"
+seconds="${1:-${LRCAL_FUZZ_SECONDS:-25}}"
 bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liburdfdom-dev libtinyxml-dev \
   nlohmann-json3-dev librandom123-dev libboost-dev
 out=build-fuzz
