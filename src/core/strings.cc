@@ -138,6 +138,13 @@ std::vector<std::string> SplitList(const std::string& text, char separator) {
   return out;
 }
 
+std::string CellExcerpt(const std::string& cell) {
+  constexpr std::size_t kShown = 40;
+  return cell.size() <= kShown
+             ? cell
+             : cell.substr(0, kShown) + "... (" + std::to_string(cell.size()) + " characters)";
+}
+
 std::string FormatExact(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);

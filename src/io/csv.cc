@@ -29,13 +29,6 @@ double CsvTable::Number(std::size_t row, int column) const {
   return value;
 }
 
-std::string CellExcerpt(const std::string& cell) {
-  constexpr std::size_t kShown = 40;
-  return cell.size() <= kShown
-             ? cell
-             : cell.substr(0, kShown) + "... (" + std::to_string(cell.size()) + " characters)";
-}
-
 namespace {
 
 std::string ReadWholeFile(const std::string& path) {

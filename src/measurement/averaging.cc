@@ -18,11 +18,6 @@ namespace {
 // relative standard error of about √(2/kFactorSamples) = 0.4 %.
 constexpr int kFactorSamples = 1 << 17;
 
-// At most 40 characters of a value, for messages.
-std::string Excerpt(const std::string& text) {
-  return text.size() <= 40 ? text : text.substr(0, 40) + "...";
-}
-
 // n·Var(T) for T = average.Combine of n standard normal readings. The mean X̄ is complete and
 // sufficient for the normal's location and T − X̄ is location-invariant, so by Basu's theorem they
 // are independent: Var(T) = 1/n + Var(T − X̄). Only the small second term is simulated (a fixed
@@ -70,10 +65,10 @@ Averaging Averaging::Parse(const std::string& text) {
     throw SettingError(Spec(),
                        "expected trimmed:F with F, the fraction cut from each end, in "
                        "(0, 0.5) (trimmed:0.1), got '" +
-                           Excerpt(text) + "'");
+                           CellExcerpt(text) + "'");
   }
-  throw SettingError(
-      Spec(), "expected mean, median or trimmed:F (F in (0, 0.5)), got '" + Excerpt(text) + "'");
+  throw SettingError(Spec(), "expected mean, median or trimmed:F (F in (0, 0.5)), got '" +
+                                 CellExcerpt(text) + "'");
 }
 
 std::string Averaging::Name() const {
@@ -123,14 +118,18 @@ double Averaging::Combine(const double* readings, int n) const {
   return sum / (n - 2 * g);
 }
 
-double Averaging::VarianceFactor(int n) const {
-  const int g = Cut(n);
-  if (g == 0) return 1;
-  if (n > kMaxRobustReadings)
+void Averaging::CheckCount(int n) const {
+  if (!IsMean() && n > kMaxRobustReadings)
     throw SettingError(Spec(), "a " + Name() + " takes at most " +
                                    std::to_string(kMaxRobustReadings) +
                                    " readings per configuration, got " + std::to_string(n) +
                                    " (use mean, or fewer repetitions)");
+}
+
+double Averaging::VarianceFactor(int n) const {
+  const int g = Cut(n);
+  if (g == 0) return 1;
+  CheckCount(n);
   static std::mutex mutex;
   static std::map<std::pair<int, int>, double> cache;
   {

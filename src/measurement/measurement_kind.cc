@@ -46,6 +46,8 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
   *data = MeasuredValues{ConfigurationSet(configs.num_joints()), {}, {}};
   int missed = 0;
   std::vector<double> z(static_cast<std::size_t>(R) * k);
+  std::vector<double> readings(static_cast<std::size_t>(R));  // one component's R readings
+  const double robust_weight = noise.average.IsMean() ? 0 : R / noise.average.VarianceFactor(R);
   for (int i = 0; i < configs.size(); ++i) {
     if (reasons[i] != "ok" || !std::isfinite(exact[static_cast<std::size_t>(i) * k])) {
       ++missed;
@@ -53,8 +55,7 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
     }
     data->configs.AddFrom(configs, i);
     data->repetitions.push_back(R);
-    if (!noise.average.IsMean())
-      data->weights.insert(data->weights.end(), k, R / noise.average.VarianceFactor(R));
+    if (!noise.average.IsMean()) data->weights.insert(data->weights.end(), k, robust_weight);
     if (noise.DrawsMean()) {
       stream.Normals(static_cast<std::uint64_t>(i) * k, k, z.data());
       for (int c = 0; c < k; ++c)
@@ -63,7 +64,6 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
       continue;
     }
     stream.Normals(static_cast<std::uint64_t>(i) * R * k, R * k, z.data());
-    std::vector<double> readings(static_cast<std::size_t>(R));
     for (int c = 0; c < k; ++c) {
       for (int r = 0; r < R; ++r)
         readings[static_cast<std::size_t>(r)] =

@@ -38,10 +38,6 @@ void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& grou
   }
 }
 
-}  // namespace
-
-namespace {
-
 // A median or trimmed mean of each configuration's readings (group[r]: reading r's configuration,
 // first[i]: configuration i's first reading) in place of their mean, with its variance factor.
 void CombineRobustly(const std::vector<double>& h, const std::vector<int>& group,

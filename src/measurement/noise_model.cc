@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <limits>
-#include <string>
 
 #include "lrcal/core/error.h"
 
@@ -46,12 +45,7 @@ double NoiseModel::EffectiveReadings() const {
 
 void NoiseModel::Validate() const {
   CheckSettings(*this, Settings());
-  if (!average.IsMean() && repetitions > Averaging::kMaxRobustReadings)
-    throw SettingError(Averaging::Spec(), "a " + average.Name() + " takes at most " +
-                                              std::to_string(Averaging::kMaxRobustReadings) +
-                                              " readings per configuration (noise.repetitions is " +
-                                              std::to_string(repetitions) +
-                                              "); use mean, or fewer repetitions");
+  average.CheckCount(repetitions);
   if (!std::isfinite(ranger_offset))
     throw InputError("noise.ranger_offset", "expected a finite offset (m)");
   if (!(std::fabs(ranger_scale) < 0.5))

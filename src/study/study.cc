@@ -382,7 +382,7 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
   try {
     if (!At(s, "noise.average").is_null())
       c->noise.average = Averaging::Parse(Str(s, "noise.average", where));
-    c->noise.Validate();  // a median's count of readings
+    c->noise.average.CheckCount(c->noise.repetitions);
   } catch (const SettingError& e) {
     throw e.Respelled(Frontend::kStudyFile, where("noise.average"));
   }

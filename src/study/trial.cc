@@ -454,7 +454,7 @@ SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspac
     ws->e = summary.delta;
     return out;
   }
-  ws->weights = ws->data.Weights();
+  ws->data.FillWeights(&ws->weights);
   const LevenbergMarquardt::Result r =
       ws->solver.Solve(*c.model, ws->data.configs, ws->data.mean_h.data(), ws->weights.data(),
                        s.identification, &ws->e, cell_design ? &c.design_nominal : nullptr);

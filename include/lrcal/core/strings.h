@@ -26,4 +26,8 @@ bool ParseAngleExpression(const std::string& text, double* value);
 /// Formats a double with 17 significant digits (reads back to the same bits).
 std::string FormatExact(double v);
 
+/// A value (a CSV cell, a setting's text) as error messages show it: at most 40 characters,
+/// longer ones cut with "..." and their length.
+std::string CellExcerpt(const std::string& cell);
+
 }  // namespace lrcal

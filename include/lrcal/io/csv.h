@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "lrcal/core/strings.h"  // CellExcerpt
 #include "lrcal/identification/identification.h"
 #include "lrcal/measurement/averaging.h"
 #include "lrcal/measurement/measurement_model.h"
@@ -35,8 +36,6 @@ struct CsvTable {
 /// a 7-joint arm, some 4 GB in memory. `lrcal simulate` writes no more rows than this.
 inline constexpr long long kMaxCsvBytes = 256LL << 20;
 inline constexpr long long kMaxCsvRows = 2000000;
-/// A cell as error messages show it: at most 40 characters, longer ones cut with "...".
-std::string CellExcerpt(const std::string& cell);
 
 /// Reads a CSV file with a header line (see the file comment). InputError naming the file and
 /// line for a folder, an empty file, a NUL byte, repeated column names, a ragged row, or a file

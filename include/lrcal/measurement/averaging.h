@@ -45,8 +45,11 @@ struct Averaging {
   /// same bits on every machine, a standard error of about 0.4 % of the factor's excess over 1
   /// (0.002 for a median's ≈ 1.5), computed once per (estimator, n) and cached. The median of 3
   /// has 3·(1 − √3/π) ≈ 1.346; the median's factor tends to π/2 as n grows. Throws SettingError
-  /// for n above kMaxRobustReadings when something is cut.
+  /// for n above kMaxRobustReadings when something is cut (CheckCount).
   double VarianceFactor(int n) const;
+  /// Throws SettingError (naming noise.average) unless this estimator takes `n` readings per
+  /// configuration: any count for the mean, at most kMaxRobustReadings for the others.
+  void CheckCount(int n) const;
 
   /// The largest count of readings a median or trimmed mean takes (the factor's simulation grows
   /// with the count).

@@ -25,10 +25,17 @@ struct MeasurementSet {
     const double r = repetitions[static_cast<std::size_t>(i)];
     return variance_factor.empty() ? r : r / variance_factor[static_cast<std::size_t>(i)];
   }
+  /// Every configuration's Weight, in order, into `w` (its buffer reused: the Monte-Carlo
+  /// workspace fills it once per trial).
+  void FillWeights(std::vector<double>* w) const {
+    w->resize(repetitions.size());
+    for (int i = 0; i < static_cast<int>(w->size()); ++i)
+      (*w)[static_cast<std::size_t>(i)] = Weight(i);
+  }
   /// Every configuration's Weight, in order.
   std::vector<double> Weights() const {
-    std::vector<double> w(repetitions.size());
-    for (int i = 0; i < static_cast<int>(w.size()); ++i) w[static_cast<std::size_t>(i)] = Weight(i);
+    std::vector<double> w;
+    FillWeights(&w);
     return w;
   }
 };
