@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 namespace lrcal {
 
@@ -23,6 +24,17 @@ std::size_t Width(const std::string& s) {
   return w;
 }
 }  // namespace
+
+void Table::AddRow(std::vector<std::string> row) {
+  if (row.size() != header_.size())
+    throw std::logic_error("table '" +
+                           (!title_.empty()   ? title_
+                            : header_.empty() ? std::string("?")
+                                              : header_.front()) +
+                           "': a row of " + std::to_string(row.size()) + " cells under " +
+                           std::to_string(header_.size()) + " columns");
+  rows_.push_back(std::move(row));
+}
 
 std::string Table::ToText() const {
   std::vector<std::size_t> w(header_.size());

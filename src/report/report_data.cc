@@ -62,6 +62,10 @@ void SnapshotAndTables(const std::string& run_dir, const Json& manifest, ReportD
   // Done and expected as the tables count them: up to each cell's stopping point under
   // stop_when, the maximum until it is decided.
   const StudyTablesResult tables = WriteStudyTables(snap, manifest["study"], data->dir);
+  // The summary as blocks (headings, paragraphs, tables) for the page: lrcal.report lays them
+  // out without parsing summary.md back.
+  WriteFileAtomically((fs::path(data->dir) / "document.json").string(),
+                      tables.document.ToJson().dump(1) + "\n");
   for (const CellSummary& s : tables.cells) {
     data->done += s.trials;
     data->expected += s.stop.trials_used;

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/text_document.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/measurement/parameter_set.h"
@@ -195,11 +196,12 @@ void SummarizeCells(const TrialStore& store, const std::vector<StoredCell>& cell
 // "1.23 %", or "—" when a precision cannot be stated yet.
 std::string Percent(double x) { return std::isfinite(x) ? Fixed(100 * x, 2) + " %" : "—"; }
 
-std::string Header(const Json& study, long long trials, const StopWhen& rule, bool complete) {
-  std::ostringstream md;
-  md << "# Study `" << study.value("name", std::string("?")) << "` — Monte-Carlo summary\n\n";
+TextDocument Header(const Json& study, long long trials, const StopWhen& rule, bool complete) {
+  TextDocument doc;
+  doc.AddTitle("Study `" + study.value("name", std::string("?")) + "` — Monte-Carlo summary");
   if (study.contains("description") && !study["description"].get<std::string>().empty())
-    md << study["description"].get<std::string>() << "\n\n";
+    doc.AddParagraph(study["description"].get<std::string>());
+  std::ostringstream md;
   md << "Seed " << study.value("seed", 0ULL) << ", ";
   if (rule.enabled()) {
     md << "up to " << trials << " trials per cell in blocks of " << rule.block
@@ -214,9 +216,10 @@ std::string Header(const Json& study, long long trials, const StopWhen& rule, bo
   } else {
     md << trials << " trials per cell";
   }
-  md << ". Lengths in mm, angles in mrad; 'mean ± SE [p5, p95]' over the trials of a cell.\n";
-  if (!complete) md << "\n**Partial run: some cells do not have all their trials yet.**\n";
-  return md.str();
+  md << ". Lengths in mm, angles in mrad; 'mean ± SE [p5, p95]' over the trials of a cell.";
+  doc.AddParagraph(md.str());
+  if (!complete) doc.AddNote("Partial run: some cells do not have all their trials yet.");
+  return doc;
 }
 
 // Under stop_when: where each cell stopped and the precision it reached (worst metric).
@@ -340,7 +343,7 @@ void ValidationTables(const std::vector<CellSummary>& cells, Table* md, Table* c
 
 // Empirical mean of each validation metric against its first-order prediction (the planner's
 // estimate), for cells that have one.
-std::string PredictionSection(const std::vector<CellSummary>& cells) {
+TextDocument PredictionSection(const std::vector<CellSummary>& cells) {
   Table t({"cell", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
   for (const auto& s : cells) {
     if (s.cell.predicted_validation.size() != 12 || s.ok == 0) continue;
@@ -354,20 +357,24 @@ std::string PredictionSection(const std::vector<CellSummary>& cells) {
       t.AddRow(row);
     }
   }
-  if (t.num_rows() == 0) return "";
-  return "\n## Validation errors against their first-order prediction\n\nEmpirical mean / "
-         "predicted mean (ratio) of each validation metric of the identified model (mm, mrad). "
-         "The prediction needs no trial: the covariance σ²·(GᵀWG)⁻¹ at the nominal model "
-         "propagated to the validation poses through their Jacobian, each metric averaged over "
-         "4000 draws of those linear errors (validation.csv: mean_predicted). A ratio near 1 says "
-         "the linear model explains the cell; above 1, non-linearity, the truth's distance from "
-         "the nominal model or failed fits add error.\n\n" +
-         t.ToMarkdown();
+  TextDocument doc;
+  if (t.num_rows() == 0) return doc;
+  doc.AddHeading("Validation errors against their first-order prediction");
+  doc.AddParagraph(
+      "Empirical mean / "
+      "predicted mean (ratio) of each validation metric of the identified model (mm, mrad). "
+      "The prediction needs no trial: the covariance σ²·(GᵀWG)⁻¹ at the nominal model "
+      "propagated to the validation poses through their Jacobian, each metric averaged over "
+      "4000 draws of those linear errors (validation.csv: mean_predicted). A ratio near 1 says "
+      "the linear model explains the cell; above 1, non-linearity, the truth's distance from "
+      "the nominal model or failed fits add error.");
+  doc.AddTable(std::move(t));
+  return doc;
 }
 
 // Identified parameters laid out like the paper's table: link × (Δθ, Δα, Δa, Δd, Δβ), the mean
 // identified Δ (truth + bias) ± the empirical std, for cells whose truth is fixed.
-std::string PaperLayoutSection(const std::vector<CellSummary>& cells) {
+TextDocument PaperLayoutSection(const std::vector<CellSummary>& cells) {
   Table t({"link", "cell", "Δθ (mrad)", "Δα (mrad)", "Δa (mm)", "Δd (mm)", "Δβ (mrad)"});
   bool any = false;
   for (const auto& s : cells) {
@@ -388,22 +395,29 @@ std::string PaperLayoutSection(const std::vector<CellSummary>& cells) {
       t.AddRow(row);
     }
   }
-  if (!any) return "";
-  return "\n## Identified parameters (the paper's layout)\n\nMean identified Δ ± empirical std "
-         "over the trials (mrad, mm); compare with the robot file's true errors.\n\n" +
-         t.ToMarkdown();
+  TextDocument doc;
+  if (!any) return doc;
+  doc.AddHeading("Identified parameters (the paper's layout)");
+  doc.AddParagraph(
+      "Mean identified Δ ± empirical std over the trials (mrad, mm); compare with the robot "
+      "file's true errors.");
+  doc.AddTable(std::move(t));
+  return doc;
 }
 
 // Parameter errors per cell: a Markdown table each, and the tidy CSV and LaTeX of all.
-std::string ParameterSections(const std::vector<CellSummary>& cells, Table* csv, Table* tex) {
-  std::ostringstream md;
-  md << "\n## Parameter errors (estimate − truth)\n\nBias = mean error ± its Monte-Carlo standard "
-        "error; empirical std ± its standard error; predicted std = σ·√diag(GᵀWG)⁻¹ at the "
-        "nominal model (what a planner can compute) and at the true parameters (the Cramér–Rao "
-        "bound of the simulated experiment; fixed truth and design only); ratio = empirical / "
-        "predicted ± its standard error.\n";
+TextDocument ParameterSections(const std::vector<CellSummary>& cells, Table* csv, Table* tex) {
+  TextDocument doc;
+  doc.AddHeading("Parameter errors (estimate − truth)");
+  doc.AddParagraph(
+      "Bias = mean error ± its Monte-Carlo standard "
+      "error; empirical std ± its standard error; predicted std = σ·√diag(GᵀWG)⁻¹ at the "
+      "nominal model (what a planner can compute) and at the true parameters (the Cramér–Rao "
+      "bound of the simulated experiment; fixed truth and design only); ratio = empirical / "
+      "predicted ± its standard error.");
   for (const auto& s : cells) {
-    Table t({"parameter", "unit", "bias ± SE", "empirical std ± SE", "predicted std", "ratio ± SE"},
+    Table t({"parameter", "unit", "bias ± SE", "empirical std ± SE", "predicted std", "ratio ± SE",
+             "predicted std at truth", "ratio at truth ± SE"},
             "Cell " + s.cell.label + " (" + std::to_string(s.ok) + " trials ok)");
     for (const auto& p : s.parameters) {
       const std::string unit = UnitOf(p.name);
@@ -425,11 +439,11 @@ std::string ParameterSections(const std::vector<CellSummary>& cells, Table* csv,
     if (!s.cell.fixed_for_rank.empty()) {
       std::string f;
       for (const auto& x : s.cell.fixed_for_rank) f += " " + x;
-      md << "\nFixed at nominal because of rank deficiency:" << f << "\n";
+      doc.AddParagraph("Fixed at nominal because of rank deficiency:" + f);
     }
-    md << "\n" << t.ToMarkdown();
+    doc.AddTable(std::move(t));
   }
-  return md.str();
+  return doc;
 }
 
 Json NullIfNan(double x) { return std::isnan(x) ? Json() : Json(x); }
@@ -502,8 +516,8 @@ Json SummaryJson(const Json& study, const StudyTablesResult& result, const Json&
 // variance over the plan.
 
 struct SensitivityOutput {
-  Json json;             // null without a sensitivity section
-  std::string markdown;  // the summary.md section
+  Json json;              // null without a sensitivity section
+  TextDocument document;  // the summary.md section
   Table csv{{"input", "min", "max", "method", "first", "first_low", "first_high", "total",
              "total_low", "total_high", "mu", "mu_star", "sigma"}};
 };
@@ -549,8 +563,8 @@ std::string InputBound(const Json& input, const char* key) {
 // Sobol indices with bootstrap intervals: the table, the CSV rows and the JSON inputs. `scale`
 // turns indices of the cell means into indices of a single trial's figure (1 for the cell
 // means; see SensitivityAnalysis).
-std::string SobolSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed,
-                         double scale, SensitivityOutput* out) {
+void SobolSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed, double scale,
+                  SensitivityOutput* out) {
   const int d = static_cast<int>(spec["inputs"].size()), bootstrap = spec["bootstrap"];
   const SaltelliPlan plan{spec["samples"].get<int>(), d, {}};
   SobolIndices s = EstimateSobolIndices(plan, values, bootstrap, 0.95, seed);
@@ -579,16 +593,18 @@ std::string SobolSection(const Json& spec, const Eigen::VectorXd& values, std::u
                       {"total", {s.total[i].estimate, s.total[i].low, s.total[i].high}}});
   }
   out->json["inputs"] = inputs;
-  return "Saltelli's plan, N = " + std::to_string(plan.base_samples) + " base samples, " +
-         std::to_string(d) +
-         " inputs; first-order by Saltelli et al. (2010), total by Jansen (1999), 95 % "
-         "percentile-bootstrap intervals (" +
-         std::to_string(bootstrap) + " resamples).\n\n" + table.ToMarkdown();
+  out->document.AddParagraph(
+      "Saltelli's plan, N = " + std::to_string(plan.base_samples) + " base samples, " +
+      std::to_string(d) +
+      " inputs; first-order by Saltelli et al. (2010), total by Jansen (1999), 95 % "
+      "percentile-bootstrap intervals (" +
+      std::to_string(bootstrap) + " resamples).");
+  out->document.AddTable(std::move(table));
 }
 
 // Morris elementary effects: the table, the CSV rows and the JSON inputs.
-std::string MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed,
-                          const std::string& unit, SensitivityOutput* out) {
+void MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::uint64_t seed,
+                   const std::string& unit, SensitivityOutput* out) {
   const int d = static_cast<int>(spec["inputs"].size()), levels = spec["levels"];
   const MorrisPlan plan = MakeMorrisPlan(spec["samples"].get<int>(), d, levels, seed);
   const MorrisEffects e = EstimateMorrisEffects(plan, values);
@@ -606,11 +622,12 @@ std::string MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::
         {{"key", key}, {"mu", e.mu[i]}, {"mu_star", e.mu_star[i]}, {"sigma", e.sigma[i]}});
   }
   out->json["inputs"] = inputs;
-  return "Morris' plan, " + std::to_string(plan.trajectories) + " trajectories on a " +
-         std::to_string(levels) +
-         "-level grid; elementary effects are the change of the quantity of interest across "
-         "each input's whole range (Δ of the unit cube scaled to 1).\n\n" +
-         table.ToMarkdown();
+  out->document.AddParagraph(
+      "Morris' plan, " + std::to_string(plan.trajectories) + " trajectories on a " +
+      std::to_string(levels) +
+      "-level grid; elementary effects are the change of the quantity of interest across "
+      "each input's whole range (Δ of the unit cube scaled to 1).");
+  out->document.AddTable(std::move(table));
 }
 
 // quantity: trial. A single calibration's figure Y = f(x) + ε, the noise ε one more input
@@ -620,22 +637,24 @@ std::string MorrisSection(const Json& spec, const Eigen::VectorXd& values, std::
 // times the same ratio (Jensen), so it is reported as a lower bound. Returns the ratio and adds
 // the JSON keys and the markdown paragraph.
 double TrialQuantity(const Eigen::VectorXd& within, double variance, double noise,
-                     const std::string& unit, SensitivityOutput* out, std::ostringstream* md) {
+                     const std::string& unit, SensitivityOutput* out) {
   const double var_f = std::max(variance - noise, 0.0), mean_within = within.mean();
   const double var_y = var_f + mean_within;
   const double share = var_y > 0 ? mean_within / var_y : NAN;
   out->json["quantity"] = "trial";
   out->json["trial_variance"] = var_y;
   out->json["noise_total"] = share;
-  *md << "Quantity of interest for the indices: a single calibration's figure (one trial), the "
-         "trial's randomness (reading noise, and whatever else the study draws per trial) one "
-         "more input (Marrel et al. 2012): its variance "
-      << Fixed(var_y, 6) << " " << unit << "² = the cell means' " << Fixed(var_f, 6)
-      << " (Monte-Carlo noise removed) + the mean within-cell variance " << Fixed(mean_within, 6)
-      << ". The noise's total index is " << Fixed(share, 3)
-      << "; the inputs' first-order indices are exact, their total indices lower bounds (the "
-         "noise's interactions with an input cannot be told from its own share; up to the cell "
-         "means' Monte-Carlo noise).\n\n";
+  std::ostringstream md;
+  md << "Quantity of interest for the indices: a single calibration's figure (one trial), the "
+        "trial's randomness (reading noise, and whatever else the study draws per trial) one "
+        "more input (Marrel et al. 2012): its variance "
+     << Fixed(var_y, 6) << " " << unit << "² = the cell means' " << Fixed(var_f, 6)
+     << " (Monte-Carlo noise removed) + the mean within-cell variance " << Fixed(mean_within, 6)
+     << ". The noise's total index is " << Fixed(share, 3)
+     << "; the inputs' first-order indices are exact, their total indices lower bounds (the "
+        "noise's interactions with an input cannot be told from its own share; up to the cell "
+        "means' Monte-Carlo noise).";
+  out->document.AddParagraph(md.str());
   return var_y > 0 ? variance / var_y : NAN;
 }
 
@@ -662,18 +681,19 @@ SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellS
   }
   const std::string unit = metric % 2 == 0 ? "mm" : "mrad";
   out.json = {{"method", method}, {"metric", metric_name}, {"unit", unit}};
+  out.document.AddHeading(std::string("Sensitivity (") +
+                          (method == "sobol" ? "Sobol indices" : "Morris effects") + ")");
   std::ostringstream md;
-  md << "\n## Sensitivity (" << (method == "sobol" ? "Sobol indices" : "Morris effects") << ")\n\n"
-     << (trial ? "Cell means" : "Quantity of interest")
+  md << (trial ? "Cell means" : "Quantity of interest")
      << ": each cell's mean over its trials of the identified model's " << metric_name << " ("
      << unit << "), averaged over x, y and z, at " << values.size() << " plan points ("
      << cells.size() << " cells).";
   out.json["available"] = values.allFinite() && (!trial || within.allFinite());
   if (!out.json["available"].get<bool>()) {
-    out.markdown = md.str() +
-                   (trial ? " Some cells have fewer than two successful trials"
-                          : " Some cells have no successful trial") +
-                   ": no indices.\n";
+    out.document.AddParagraph(md.str() +
+                              (trial ? " Some cells have fewer than two successful trials"
+                                     : " Some cells have no successful trial") +
+                              ": no indices.");
     return out;
   }
   const double variance = (values.array() - values.mean()).square().sum() /
@@ -682,14 +702,16 @@ SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellS
   out.json["noise_variance"] = noise;
   md << " Variance over the plan " << Fixed(variance, 6) << " " << unit << "²; the cell means' "
      << "Monte-Carlo noise is " << Percent(variance > 0 ? noise / variance : NAN)
-     << " of it (it adds to every total index and lowers the first-order ones).\n\n";
-  const double scale = trial ? TrialQuantity(within, variance, noise, unit, &out, &md) : 1.0;
-  md << (method == "sobol" ? SobolSection(spec, values, seed, scale, &out)
-                           : MorrisSection(spec, values, seed, unit, &out));
+     << " of it (it adds to every total index and lowers the first-order ones).";
+  out.document.AddParagraph(md.str());
+  const double scale = trial ? TrialQuantity(within, variance, noise, unit, &out) : 1.0;
+  if (method == "sobol")
+    SobolSection(spec, values, seed, scale, &out);
+  else
+    MorrisSection(spec, values, seed, unit, &out);
   if (trial)
     out.csv.AddRow({"noise (one trial)", "", "", "sobol", "", "", "",
                     CsvValue(out.json["noise_total"].get<double>()), "", "", "", "", ""});
-  out.markdown = md.str();
   return out;
 }
 
@@ -752,30 +774,38 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
                 "Parameter errors (estimate - truth), mm and mrad");
   const Table cells = CellsTable(result.cells, rule);
 
-  std::ostringstream md;
-  md << Header(study, trials, rule, result.complete) << "\n## Cells\n\n" << cells.ToMarkdown();
-  md << "\n## Validation errors\n\nOver the validation configurations, per base axis: mean ± its "
-        "standard error [p5, p95] over the trials (mm, mrad). validation.csv adds the std ± SE, "
-        "95 % distribution-free confidence intervals of p5, p50 and p95 (from order statistics; "
-        "empty where a cell has too few trials, e.g. below 72 for the upper end of p95), and the "
-        "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
-        "(Wilks: at least 95 % from N = 59).\n\n"
-     << val.ToMarkdown();
+  TextDocument& doc = result.document;
+  doc.Append(Header(study, trials, rule, result.complete));
+  doc.AddHeading("Cells");
+  doc.AddTable(cells);
+  doc.AddHeading("Validation errors");
+  doc.AddParagraph(
+      "Over the validation configurations, per base axis: mean ± its "
+      "standard error [p5, p95] over the trials (mm, mrad). validation.csv adds the std ± SE, "
+      "95 % distribution-free confidence intervals of p5, p50 and p95 (from order statistics; "
+      "empty where a cell has too few trials, e.g. below 72 for the upper end of p95), and the "
+      "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
+      "(Wilks: at least 95 % from N = 59).");
+  doc.AddTable(val);
   const SensitivityOutput sensitivity = SensitivityAnalysis(study, result.cells);
-  md << PredictionSection(result.cells) << PaperLayoutSection(result.cells) << sensitivity.markdown
-     << ParameterSections(result.cells, &par_csv, &par_tex);
-  if (any_paper)
-    md << "\n## The paper's published numbers in lrcal's distributions\n\nPercentile of the "
-          "published value among lrcal's trials (0 or 100: outside every trial). Identified "
-          "errors are the published Δ minus the paper's own true Δ.\n\n"
-       << place.ToMarkdown();
-  result.markdown = md.str();
+  doc.Append(PredictionSection(result.cells));
+  doc.Append(PaperLayoutSection(result.cells));
+  doc.Append(sensitivity.document);
+  doc.Append(ParameterSections(result.cells, &par_csv, &par_tex));
+  if (any_paper) {
+    doc.AddHeading("The paper's published numbers in lrcal's distributions");
+    doc.AddParagraph(
+        "Percentile of the "
+        "published value among lrcal's trials (0 or 100: outside every trial). Identified "
+        "errors are the published Δ minus the paper's own true Δ.");
+    doc.AddTable(place);
+  }
 
   // Each file is written whole or not at all (a temporary name, checked and renamed).
   const auto write = [&](const char* name, const std::string& text) {
     WriteFileAtomically((dir / name).string(), text);
   };
-  write("summary.md", result.markdown);
+  write("summary.md", doc.ToMarkdown());
   write("cells.csv", cells.ToCsv());
   write("validation.csv", val_csv.ToCsv());
   write("parameters.csv", par_csv.ToCsv());

@@ -11,9 +11,13 @@ class Table {
  public:
   explicit Table(std::vector<std::string> header, std::string title = "")
       : title_(std::move(title)), header_(std::move(header)) {}
-  void AddRow(std::vector<std::string> row) { rows_.push_back(std::move(row)); }
+  /// Adds a row of exactly one cell per header column (std::logic_error otherwise: a table
+  /// whose rows and header disagree is a programming error).
+  void AddRow(std::vector<std::string> row);
   int num_rows() const { return static_cast<int>(rows_.size()); }
   const std::string& title() const { return title_; }
+  const std::vector<std::string>& header() const { return header_; }
+  const std::vector<std::vector<std::string>>& rows() const { return rows_; }
   std::string ToText() const;
   std::string ToMarkdown() const;
   std::string ToCsv() const;

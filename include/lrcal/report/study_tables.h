@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "lrcal/core/text_document.h"
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
 
@@ -19,8 +20,8 @@ namespace lrcal {
 
 struct StudyTablesResult {
   std::vector<CellSummary> cells;
-  std::string markdown;  ///< the content of summary.md
-  bool complete = true;  ///< every cell has all its trials
+  TextDocument document;  ///< the content of summary.md (TextDocument::ToMarkdown)
+  bool complete = true;   ///< every cell has all its trials
 };
 
 /// Summarises every cell in `store` and writes RUN_DIR/tables/. `study` is the resolved study
