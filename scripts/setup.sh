@@ -34,6 +34,9 @@ case "$action" in
     "$prefix/consumer-build/lrcal_consumer" "$prefix/share/lrcal/studies/robots/paper.yaml"
     (cd "$prefix" && "$prefix/bin/lrcal" run quick --out "$prefix/quick" --quiet > /dev/null)
     cmp "$prefix/quick/tables/summary.md" tests/golden/quick/summary.md
+    # The installed program draws the report with the installed package (python3 -m lrcal.report).
+    (cd "$prefix" && env -u PYTHONPATH "$prefix/bin/lrcal" report "$prefix/quick" > /dev/null)
+    test -s "$prefix/quick/report/report.html"
     # The installed Python module: the documented import, pytest, and the example.
     site=$(find "$prefix" -path '*/lrcal/_lrcal*.so' -printf '%h\n' | head -1)
     [ -n "$site" ] || { echo "setup: the Python module was not installed" >&2; exit 1; }

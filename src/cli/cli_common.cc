@@ -109,18 +109,44 @@ std::string ShellQuote(const std::string& s) {
 
 }  // namespace
 
-int RunAnalysisScript(const std::string& relative, const std::string& argument) {
-  std::string script = std::filesystem::exists(relative) ? relative : FindDataFile(relative);
-  if (script.empty())
-    throw InputError(relative, "not found in the working directory nor in lrcal's data folder (" +
-                                   DataDirectory() + ")");
+namespace {
+
+// The folder that holds lrcal's Python package (lrcal/report/__main__.py), from this program's.
+std::string PythonPackageParent() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path bin = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  std::vector<fs::path> candidates = {bin / "python"};  // the build tree
+#ifdef LRCAL_PYTHON_DIR_FROM_BIN
+  candidates.insert(candidates.begin(), bin / LRCAL_PYTHON_DIR_FROM_BIN);  // installed
+#endif
+  std::string tried;
+  for (const fs::path& dir : candidates) {
+    if (fs::exists(dir / "lrcal" / "report" / "__main__.py", ec))
+      return fs::weakly_canonical(dir, ec).string();
+    tried += (tried.empty() ? "" : ", ") + dir.string();
+  }
+  throw InputError("lrcal.report",
+                   "lrcal's Python package is not next to this program (looked in " + tried +
+                       "); it is built and installed with lrcal when python3 is found");
+}
+
+}  // namespace
+
+int RunReportModule(const std::vector<std::string>& arguments) {
+  const std::string parent = PythonPackageParent();
   // Debian's interpreter, where python3-pandas and python3-matplotlib are installed (a python3
   // earlier on PATH, e.g. from pyenv, may not have them); LRCAL_PYTHON overrides.
   std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   if (const char* p = std::getenv("LRCAL_PYTHON")) python = p;
+  std::string path = parent;
+  if (const char* p = std::getenv("PYTHONPATH"); p != nullptr && *p != '\0')
+    path += ":" + std::string(p);
+  std::string command =
+      "PYTHONPATH=" + ShellQuote(path) + " " + ShellQuote(python) + " -m lrcal.report";
+  for (const std::string& a : arguments) command += " " + ShellQuote(a);
   std::cout.flush();
-  const int status = std::system(
-      (ShellQuote(python) + " " + ShellQuote(script) + " " + ShellQuote(argument)).c_str());
+  const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
 

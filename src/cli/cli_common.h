@@ -120,9 +120,10 @@ int AggregateCommand(const std::vector<std::string>& args);
 int TrialCommand(const std::vector<std::string>& args);
 int AccuracyCommand(const std::vector<std::string>& args);
 int ExportCommand(const std::vector<std::string>& args);
-/// Runs lrcal's Python script `relative` ("analysis/report.py": from the working directory, else
-/// lrcal's data folder) on `argument` with Debian's /usr/bin/python3 (where python3-pandas and
-/// python3-matplotlib are; LRCAL_PYTHON overrides). Returns the script's exit code (1 if it did
-/// not exit normally). Throws InputError when the script is not found.
-int RunAnalysisScript(const std::string& relative, const std::string& argument);
+/// Runs `python3 -m lrcal.report ARGUMENTS` (the report pages, src/python/lrcal/report) with
+/// Debian's /usr/bin/python3 (where python3-pandas and python3-matplotlib are; LRCAL_PYTHON
+/// overrides) and lrcal's own Python package first on its path: next to this program in the build
+/// tree (build/python), or where `cmake --install` put it. Returns the module's exit code (1 if
+/// it did not exit normally). Throws InputError when the package is not found.
+int RunReportModule(const std::vector<std::string>& arguments);
 }  // namespace lrcal::cli

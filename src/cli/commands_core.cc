@@ -235,7 +235,7 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
 }
 
 // identify --report DIR: calibration.json and the calibrated robot (report/calibration_report.h),
-// then report.html from analysis/calibration_report.py.
+// then report.html from python3 -m lrcal.report --calibration DIR.
 void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const RobotFile& rig, const MeasurementModel& model,
                             const MeasurementSet& data, const IdentificationSummary& s,
@@ -246,9 +246,9 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
   WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
   if (s.IsSolutionUsable())
     std::cerr << "lrcal identify: calibrated robot written to " << dir << "/calibrated.yaml\n";
-  const int code = RunAnalysisScript("analysis/calibration_report.py", dir);
+  const int code = RunReportModule({"--calibration", dir});
   if (code != 0)
-    throw StorageError(dir + "/report.html: analysis/calibration_report.py failed (exit " +
+    throw StorageError(dir + "/report.html: python3 -m lrcal.report --calibration failed (exit " +
                        std::to_string(code) +
                        "); calibration.json and the calibrated robot file are written");
   std::cerr << "lrcal identify: calibration report written to " << dir << "/report.html\n";

@@ -1,5 +1,5 @@
 // lrcal report RUN_DIR: tables and a one-realisation file from the run's records (C++), then the
-// figures and report.html (analysis/report.py, which only reads what lrcal wrote).
+// figures and report.html (python3 -m lrcal.report, which only reads what lrcal wrote).
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -21,12 +21,12 @@ int ReportCommand(const std::vector<std::string>& args) {
   const std::string dir = vm["dir"].as<std::string>();
   const auto t0 = std::chrono::steady_clock::now();
   const ReportData data = PrepareReportData(dir);
-  const int code = RunAnalysisScript("analysis/report.py", dir);
+  const int code = RunReportModule({dir});
   RemoveReportSnapshot(data);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (code != 0) {
-    std::cerr << "lrcal report: analysis/report.py failed (exit " << code << ")\n";
+    std::cerr << "lrcal report: python3 -m lrcal.report failed (exit " << code << ")\n";
     return code == 2 || code == 5 ? code : 1;
   }
   std::cout << "report: " << data.dir << "/report.html (" << data.done << "/" << data.expected

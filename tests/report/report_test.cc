@@ -173,13 +173,16 @@ TEST(Report, MissingOrMalformedRunDirectoriesAreClearErrors) {
   std::ofstream(dir + "/broken/manifest.json") << "{ not json";
   EXPECT_EQ(RunCommand(LrcalBinary() + " report " + dir + "/broken", &out), 2);
   EXPECT_THAT(out, ::testing::HasSubstr("broken/manifest.json: not valid JSON")) << out;
-  // The analysis script alone, on a directory lrcal report has not prepared.
+  // The page module alone, on a directory lrcal report has not prepared, and with bad usage.
   std::ofstream(dir + "/empty/manifest.json") << "{}";
-  EXPECT_EQ(RunCommand("/usr/bin/python3 " + testing::SourcePath("analysis/report.py") + " " + dir +
-                           "/empty",
-                       &out),
-            2);
+  const std::string module =
+      "PYTHONPATH=" + std::string(LRCAL_BINARY_DIR) + "/python /usr/bin/python3 -m lrcal.report ";
+  EXPECT_EQ(RunCommand(module + dir + "/empty", &out), 2);
   EXPECT_THAT(out, ::testing::HasSubstr("summary.json: missing")) << out;
+  EXPECT_EQ(RunCommand(module + "--calibration " + dir + "/empty", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("empty/calibration.json: expected the JSON")) << out;
+  EXPECT_EQ(RunCommand(module + dir + "/empty " + dir + "/nothing", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("expected one folder")) << out;
 }
 
 // identify --report DIR (issue 13 item 9): from a measured CSV to a page with the fit check,

@@ -1,8 +1,9 @@
-// What `lrcal report` prepares for the analysis scripts (analysis/report.py), in RUN_DIR/report/:
+// What `lrcal report` prepares for the report page (python3 -m lrcal.report), in RUN_DIR/report/:
 //   trials.snapshot.sqlite  a consistent copy of every store of the run (main and rank stores),
 //                           so a run still going, or interrupted, can be reported; removed once
 //                           the report is written (RemoveReportSnapshot)
 //   tables/                 the tables of study_report.h, from the snapshot
+//   document.json           summary.md as blocks (TextDocument::ToJson), for the page
 //   realisation.json        trial 0 of every cell in detail (TrialDetails): the paper's figures
 //   status.json             trials done / expected, and whether the run is complete
 #pragma once
@@ -22,7 +23,7 @@ struct ReportData {
 
 /// Prepares RUN_DIR/report. Throws InputError for a missing or malformed run directory.
 ReportData PrepareReportData(const std::string& run_dir);
-/// Removes the snapshot once the analysis scripts have read it (it is as large as the store).
+/// Removes the snapshot once the page has been drawn (it is as large as the store).
 void RemoveReportSnapshot(const ReportData& data);
 
 }  // namespace lrcal

@@ -1,6 +1,6 @@
 // The per-run trial store: one SQLite database (trials.sqlite) in the run directory.
 //
-// Tables (queryable from Python/pandas; analysis/ reads them):
+// Tables (queryable from Python/pandas; lrcal.load_run reads them):
 //   cells(cell_id, ord, label, settings JSON, parameter_names JSON, predicted_std JSON (SI),
 //         design_sigma_min, fixed_for_rank JSON, pool_report, truth_errors JSON (SI, 5N),
 //         predicted_std_truth JSON (SI), predicted_validation JSON (SI, 12 metrics),

@@ -27,7 +27,7 @@ _CELL_JSON = ("settings", "parameter_names", "predicted_std", "fixed_for_rank", 
 
 
 def _error(path, what):
-    from ._lrcal import InputError
+    from . import InputError  # the module's, or the pure-Python stand-in without it
     error = InputError(f"{path}: {what}")
     error.where = path
     return error
@@ -93,7 +93,9 @@ class Run:
     Tables are pandas DataFrames, or numpy structured arrays without pandas.
     """
 
-    def __init__(self, path, as_pandas):
+    def __init__(self, path, as_pandas, stores=None):
+        """`stores`: the trial stores to read instead of the run's own (lrcal.report reads the
+        consistent snapshot that `lrcal report` made of them)."""
         self.path = path
         self._as_pandas = as_pandas
         manifest = os.path.join(path, "manifest.json")
@@ -102,9 +104,10 @@ class Run:
                                "folder of lrcal run or lrcal.run_study")
         with open(manifest, encoding="utf-8") as f:
             self.manifest = json.load(f)
-        self._stores = [p for p in [os.path.join(path, "trials.sqlite")] +
-                        sorted(glob.glob(os.path.join(path, "trials.rank*.sqlite")))
-                        if os.path.isfile(p)]
+        if stores is None:
+            stores = [os.path.join(path, "trials.sqlite")] + \
+                sorted(glob.glob(os.path.join(path, "trials.rank*.sqlite")))
+        self._stores = [p for p in stores if os.path.isfile(p)]
         self._cells = self._read_cells()
         self.cells = _records(
             ["cell_id", "ord", "label"] + list(_CELL_JSON) + ["design_sigma_min", "pool_report"],

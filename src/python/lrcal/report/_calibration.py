@@ -1,10 +1,9 @@
-#!/usr/bin/env python3
-"""Writes DIR/report.html for `lrcal identify ... --report DIR`: a self-contained page (figures
+"""lrcal.report's calibration page: DIR/report.html for `lrcal identify ... --report DIR`: a self-contained page (figures
 embedded as PNG, also written as PNG and SVG in DIR/figures/) from what identify wrote in
 DIR/calibration.json (SI units; the page shows mm and mrad and says so). It never recomputes the
 calibration: every number comes from the JSON.
 
-    /usr/bin/python3 analysis/calibration_report.py DIR
+    python3 -m lrcal.report --calibration DIR
 
 Sections: the fit check, residuals per configuration, the parameters with their change and
 uncertainty, the correlation map, identifiability, cross-validation, the predicted accuracy over
@@ -14,7 +13,6 @@ missing or malformed calibration.json, 5 when the page cannot be written.
 import html
 import json
 import os
-import sys
 
 import matplotlib
 
@@ -22,8 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import CHECK, STYLE, figure_html, write_atomically  # noqa: E402
+from ._page import CHECK, STYLE, figure_html, write_atomically  # noqa: E402
 
 
 class CalibrationDataError(Exception):
@@ -310,23 +307,3 @@ def build(folder):
                      json.dumps({"figures": [os.path.basename(p) for p, _ in figures],
                                  "captions": [c for _, c in figures]}, indent=2))
     return path, figures
-
-
-def main(argv):
-    if len(argv) != 2:
-        print("usage: calibration_report.py DIR", file=sys.stderr)
-        return 2
-    try:
-        path, figures = build(argv[1])
-    except CalibrationDataError as e:
-        print(f"calibration_report.py: error: {e}", file=sys.stderr)
-        return 2
-    except OSError as e:
-        print(f"calibration_report.py: could not write the report: {e}", file=sys.stderr)
-        return 5
-    print(f"calibration_report.py: {len(figures)} figures, {path}", file=sys.stderr)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv))

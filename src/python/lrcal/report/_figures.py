@@ -1,13 +1,13 @@
-"""Figures of an lrcal run, from what `lrcal run` and `lrcal report` wrote (never recomputing the
-science): RUN_DIR/manifest.json and RUN_DIR/report/{tables/*, trials.snapshot.sqlite (removed by
-`lrcal report` once the figures are drawn), realisation.json, status.json}. Units as in the
-tables: mm and mrad, named on every axis.
+"""lrcal.report's figures of a study run, from what `lrcal run` and `lrcal report` wrote (never
+recomputing the science): RUN_DIR/manifest.json and RUN_DIR/report/{tables/*, document.json,
+trials.snapshot.sqlite (removed by `lrcal report` once the figures are drawn), realisation.json,
+status.json}. The trials are read by lrcal.load_run's reader (lrcal.Run), from the snapshot the
+tables were made of. Units as in the tables: mm and mrad, named on every axis.
 
 Uses Debian's python3-pandas, python3-numpy and python3-matplotlib.
 """
 import json
 import os
-import sqlite3
 
 import matplotlib
 
@@ -16,6 +16,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 import pandas as pd  # noqa: E402
+
+from .._run import Run as _StoredRun  # noqa: E402
 
 AXES = ("x", "y", "z")
 METRICS = (("rms_pos", "RMS position error (mm)"), ("rms_ori", "RMS orientation error (mrad)"),
@@ -28,7 +30,9 @@ class RunDataError(Exception):
 
 
 class Run:
-    """Everything a report needs, loaded from a run directory prepared by `lrcal report`."""
+    """Everything a report needs, loaded from a run directory prepared by `lrcal report`: the
+    manifest, report/tables/*, report/document.json (summary.md as blocks), report/status.json,
+    report/realisation.json and the trials of report/trials.snapshot.sqlite."""
 
     def __init__(self, run_dir):
         self.dir = run_dir
@@ -47,8 +51,9 @@ class Run:
         realisation = os.path.join(self.report_dir, "realisation.json")
         self.realisation = self._json(realisation) if os.path.exists(realisation) else None
         self.snapshot = os.path.join(self.report_dir, "trials.snapshot.sqlite")
-        with open(os.path.join(tables, "summary.md"), encoding="utf-8") as f:
-            self.summary_md = f.read()
+        self.document = self._json(os.path.join(self.report_dir, "document.json"))
+        if not isinstance(self.document.get("blocks"), list):
+            raise RunDataError(f"{self.report_dir}/document.json: 'blocks' should be a list")
         self.cells = self.summary.get("cells", [])
         if not isinstance(self.cells, list):
             raise RunDataError(f"{tables}/summary.json: 'cells' should be a list")
@@ -77,11 +82,13 @@ class Run:
         """One row per ok trial the tables use: cell_id, trial and the identified model's
         validation metrics (under stop_when, only the trials before each cell's stopping
         point)."""
-        columns = ", ".join(f"val_{m}_{a}" for m, _ in METRICS for a in AXES)
-        with sqlite3.connect(f"file:{self.snapshot}?mode=ro", uri=True) as db:
-            data = pd.read_sql_query(
-                f"SELECT cell_id, trial, {columns} FROM trials WHERE status = 'ok' "
-                "ORDER BY cell_id, trial", db)
+        if not os.path.isfile(self.snapshot):
+            raise RunDataError(f"{self.snapshot}: missing (run `lrcal report RUN_DIR`, which "
+                               "prepares it)")
+        trials = _StoredRun(self.dir, True, stores=[self.snapshot]).trials
+        columns = [f"val_{m}_{a}" for m, _ in METRICS for a in AXES]
+        data = trials.loc[trials["status"] == "ok", ["cell_id", "trial"] + columns]
+        data = data.sort_values(["cell_id", "trial"]).reset_index(drop=True)
         used = {c["id"]: c["stop"]["trials_used"] for c in self.cells if "stop" in c}
         if used:
             limit = data["cell_id"].map(used).fillna(np.inf)

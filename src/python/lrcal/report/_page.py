@@ -1,65 +1,51 @@
-#!/usr/bin/env python3
-"""Writes RUN_DIR/report/report.html: a single self-contained page (figures embedded as PNG,
-also written as PNG and SVG in RUN_DIR/report/figures/), the tables, the study settings, the
-manifest and the failures by reason. Run by `lrcal report RUN_DIR`, which first prepares the
-tables and the one-realisation data from the run's records.
-
-    /usr/bin/python3 analysis/report.py RUN_DIR
-
-Exit code 2, with a message naming the file, for a missing or malformed run directory.
+"""lrcal.report's page of a study run: RUN_DIR/report/report.html, a single self-contained page
+(figures embedded as PNG, also written as PNG and SVG in RUN_DIR/report/figures/), the tables,
+the study settings, the manifest and the failures by reason. `lrcal report RUN_DIR` first
+prepares the tables, the summary's blocks and the one-realisation data from the run's records,
+then runs `python3 -m lrcal.report RUN_DIR`.
 """
 import base64
 import html
 import json
 import os
-import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import lrcal_analysis as la  # noqa: E402
+from . import _figures
 
 
-def markdown_to_html(text):
-    """The subset of Markdown that lrcal's summary.md uses: headings, bold lines, paragraphs and
-    pipe tables."""
-    out, table, paragraph = [], [], []
+def _inline(text):
+    """Escaped text with `code` spans as <code>."""
+    parts = html.escape(text).split("`")
+    return "".join(f"<code>{p}</code>" if k % 2 else p for k, p in enumerate(parts))
 
-    def flush_table():
-        if not table:
-            return
-        rows = [r.strip().strip("|").split("|") for r in table if not set(r.strip()) <= set("|-: ")]
-        out.append("<table>")
-        for i, row in enumerate(rows):
-            tag = "th" if i == 0 else "td"
-            out.append("<tr>" + "".join(f"<{tag}>{html.escape(c.strip())}</{tag}>" for c in row) + "</tr>")
-        out.append("</table>")
-        table.clear()
 
-    def flush_paragraph():
-        if paragraph:
-            out.append("<p>" + html.escape(" ".join(paragraph)).replace("`", "") + "</p>")
-            paragraph.clear()
+def table_html(header, rows):
+    """A table of strings (lrcal formats every number; the header says its unit)."""
+    out = ["<table>", "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>"]
+    out.extend("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
+               for row in rows)
+    out.append("</table>")
+    return "\n".join(out)
 
-    for line in text.splitlines():
-        if line.startswith("|"):
-            flush_paragraph()
-            table.append(line)
-            continue
-        flush_table()
-        if not line.strip():
-            flush_paragraph()
-        elif line.startswith("## "):
-            flush_paragraph()
-            out.append(f"<h3>{html.escape(line[3:])}</h3>")
-        elif line.startswith("# "):
-            flush_paragraph()  # the page has its own title
-        elif line.startswith("**") and line.endswith("**"):
-            flush_paragraph()
-            out.append(f"<p class='caption'>{html.escape(line.strip('*'))}</p>")
-        else:
-            paragraph.append(line)
-    flush_table()
-    flush_paragraph()
+
+def document_html(blocks):
+    """The summary's blocks (report/document.json, what summary.md says) as HTML; the page has
+    its own title, so the document's is left out and its headings become h3."""
+    out = []
+    for b in blocks:
+        kind = b.get("kind")
+        if kind == "heading":
+            out.append(f"<h3>{_inline(b['text'])}</h3>")
+        elif kind == "paragraph":
+            out.append(f"<p>{_inline(b['text'])}</p>")
+        elif kind == "note":
+            out.append(f"<p class='partial'><b>{_inline(b['text'])}</b></p>")
+        elif kind == "table":
+            if b.get("title"):
+                out.append(f"<p class='caption'>{_inline(b['title'])}</p>")
+            out.append(table_html(b["header"], b["rows"]))
+        elif kind != "title":
+            raise _figures.RunDataError(f"document.json: unknown block kind {kind!r}")
     return "\n".join(out)
 
 
@@ -101,9 +87,9 @@ def figure_html(png, caption, base_dir):
 
 def build(run_dir):
     t0 = time.time()
-    run = la.Run(run_dir)
+    run = _figures.Run(run_dir)
     fig_dir = os.path.join(run.report_dir, "figures")
-    figures = la.all_figures(run, fig_dir)
+    figures = _figures.all_figures(run, fig_dir)
     study = run.manifest.get("study", {})
     status = run.status
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
@@ -123,7 +109,7 @@ def build(run_dir):
     parts.append("<h2>Figures</h2>")
     parts.extend(figure_html(png, caption, run.report_dir) for png, caption in figures)
     parts.append("<h2>Tables</h2>")
-    parts.append(markdown_to_html(run.summary_md))
+    parts.append(document_html(run.document["blocks"]))
     parts.append("<h2>Study settings</h2><pre>" + html.escape(json.dumps(study, indent=2)) + "</pre>")
     parts.append("<h2>Manifest</h2><details><summary>versions, commit, sessions</summary><pre>" +
                  html.escape(json.dumps(run.manifest, indent=2)) + "</pre></details>")
@@ -150,23 +136,3 @@ def write_atomically(path, text):
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
-
-
-def main(argv):
-    if len(argv) != 2:
-        print("usage: report.py RUN_DIR", file=sys.stderr)
-        return 2
-    try:
-        path, figures = build(argv[1])
-    except la.RunDataError as e:
-        print(f"report.py: error: {e}", file=sys.stderr)
-        return 2
-    except OSError as e:  # a full disk, a folder that cannot be written
-        print(f"report.py: could not write the report: {e}", file=sys.stderr)
-        return 5
-    print(f"report.py: {len(figures)} figures, {path}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv))
