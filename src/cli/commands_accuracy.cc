@@ -28,9 +28,8 @@ int AccuracyCommand(const std::vector<std::string>& args) {
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const ConfigurationSet configs =
-      vm.count("configs")
-          ? ReadRobotConfigurations(vm["configs"].as<std::string>(), rig.robot, &setup.planes)
-          : WorkspacePoses(rig.robot, vm["workspace"].as<int>(), ParseSeed(vm));
+      vm.count("configs") ? ReadRobotPoses(vm["configs"].as<std::string>(), rig.robot)
+                          : WorkspacePoses(rig.robot, vm["workspace"].as<int>(), ParseSeed(vm));
   const AccuracyPrediction poses = PredictCalibratedAccuracy(rig, setup.planes, configs);
   const CalibrationRecord& r = *rig.calibration;
   if (ResolveFormat(vm) == Format::kJson) {

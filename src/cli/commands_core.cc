@@ -189,19 +189,15 @@ void WriteRobot(const std::string& path, const std::string& data_file, const Rob
 void PredictAt(const std::string& file, const MeasurementModel& model,
                const IdentificationSummary& s, const IdentificationOptions& options,
                const UnestimatedTerms& held, Json* json, std::string* text) {
-  const ConfigurationSet poses =
-      ReadRobotConfigurations(file, model.robot(), &model.nominal_planes());
-  const SigmaUsed used = ChooseSigma(s, options);
-  const Eigen::MatrixXd& C = CovarianceFor(s, used);
-  if (!C.allFinite())
+  const ConfigurationSet poses = ReadRobotPoses(file, model.robot());
+  const std::optional<AccuracyPrediction> predicted =
+      PredictAccuracyAfterFit(model, s, options, held, poses);
+  if (!predicted)
     throw InputError("--predict-at",
                      "the covariance is undefined (as many configurations as parameters); "
                      "give --sigma-mm");
-  AccuracyPrediction predicted =
-      PredictTotalAccuracy(SolvedModel(model, s), s.delta.data(), C, held, poses);
-  predicted.sigma_used = used;
-  *json = PoseAccuracyJson(predicted, poses);
-  *text = AccuracyPredictionText(predicted);
+  *json = PoseAccuracyJson(*predicted, poses);
+  *text = AccuracyPredictionText(*predicted);
 }
 
 // identify's output: the fit, and what --predict-at and --holdout add, as text or JSON.

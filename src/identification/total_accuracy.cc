@@ -157,6 +157,20 @@ double Percentile95(std::vector<double> v) {
 
 }  // namespace
 
+std::optional<AccuracyPrediction> PredictAccuracyAfterFit(const MeasurementModel& model,
+                                                          const IdentificationSummary& s,
+                                                          const IdentificationOptions& options,
+                                                          const UnestimatedTerms& held,
+                                                          const ConfigurationSet& poses) {
+  const SigmaUsed used = ChooseSigma(s, options);
+  const Eigen::MatrixXd& C = CovarianceFor(s, used);
+  if (!C.allFinite()) return std::nullopt;
+  AccuracyPrediction p =
+      PredictTotalAccuracy(SolvedModel(model, s), s.delta.data(), C, held, poses);
+  p.sigma_used = used;
+  return p;
+}
+
 AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const double* e,
                                         const Eigen::MatrixXd& covariance,
                                         const UnestimatedTerms& held,

@@ -30,6 +30,12 @@ ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotMod
   return configs;
 }
 
+ConfigurationSet ReadRobotPoses(const std::string& path, const RobotModel& robot) {
+  ConfigurationSet poses = ReadPoses(path, robot.num_links());
+  CheckJointRanges(poses, robot, path);
+  return poses;
+}
+
 MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
                                      const PlaneSet* planes, const Averaging& average) {
   MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger, planes, average);

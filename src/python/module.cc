@@ -27,8 +27,10 @@
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/design_choice.h"
 #include "lrcal/design/experiment_design.h"
+#include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/calibration_record.h"
 #include "lrcal/io/kinematics_report.h"
 #include "lrcal/io/result_json.h"
@@ -401,25 +403,62 @@ struct IdentifyArgs {
   std::string solver, loss;
   double loss_scale_mm, sigma_mm;
   long long max_iterations;
-  py::object loss_scale, sigma;   // the earlier spellings, in m (None: not given)
-  std::string prior_sigma;        // as --prior-sigma; "" = no priors
-  bool prior = false;             // as --prior: the robot file's tolerances
-  double encoder_sigma_mrad = 0;  // as --encoder-sigma-mrad: errors in variables
-  std::string average = "mean";   // as --average: mean, median or trimmed:F
+  py::object loss_scale, sigma;          // the earlier spellings, in m (None: not given)
+  std::string prior_sigma;               // as --prior-sigma; "" = no priors
+  bool prior = false;                    // as --prior: the robot file's tolerances
+  double encoder_sigma_mrad = 0;         // as --encoder-sigma-mrad: errors in variables
+  std::string average = "mean";          // as --average: mean, median or trimmed:F
+  std::string estimate_ranger = "none";  // as --estimate-ranger
+  py::object plane_of = py::none();      // one plane number (from 1) per reading, or None
+  py::object holdout = py::none();       // as --holdout K, or None
+  py::object predict_at = py::none();    // as --predict-at: poses (M, joints), or None
 };
 
-IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
-                                 const py::object& plane_arg, const std::string& estimate_plane,
-                                 const py::object& fix, bool auto_fix, const IdentifyArgs& a) {
-  const RobotModel& robot = rig.robot;
-  const ConfigurationSet readings_q = ToConfigurations(q, robot.num_links(), "q");
-  const std::vector<double> readings = ToVector(h, "h");
-  const MeasurementSet data = GroupReadings(
-      readings_q, readings, &rig.ranger,
-      [](int r) { return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]"; }, nullptr,
-      Averaging::Parse(a.average));
-  const Plane plane = ResolvePlane(rig, plane_arg);
-  const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
+PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
+
+// A JSON text as Python objects (what the command prints with --format json).
+py::object FromJson(const std::string& json) {
+  return py::module_::import("json").attr("loads")(json);
+}
+
+// The readings' configurations with the plane each is aimed at: `plane_of` has one plane number
+// (from 1, in `planes`' order) per reading, as a measurement CSV's plane column; it may be left
+// out with one plane only.
+ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_of, int num_planes) {
+  if (plane_of.is_none()) {
+    if (num_planes > 1)
+      throw InputError("plane_of", std::to_string(num_planes) +
+                                       " planes: give the plane each reading's beam is aimed at, "
+                                       "a number from 1 to " +
+                                       std::to_string(num_planes) +
+                                       " per reading (as a measurement CSV's plane column)");
+    return q;
+  }
+  std::vector<double> tags;
+  try {
+    tags = plane_of.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw InputError("plane_of", "expected one plane number (from 1) per reading");
+  }
+  if (static_cast<int>(tags.size()) != q.size())
+    throw InputError("plane_of", "expected one plane number per reading (" +
+                                     std::to_string(q.size()) + "), got " +
+                                     std::to_string(tags.size()));
+  ConfigurationSet out(q.num_joints());
+  out.Reserve(q.size());
+  for (int i = 0; i < q.size(); ++i) {
+    const double t = tags[i];
+    if (!(t >= 1 && t <= num_planes && t == std::floor(t)))
+      throw InputError("plane_of[" + std::to_string(i) + "]", "expected a plane number from 1 to " +
+                                                                  std::to_string(num_planes) +
+                                                                  ", got " + FormatExact(t));
+    out.Add(q.q(i), static_cast<int>(t) - 1);
+  }
+  return out;
+}
+
+IdentificationOptions IdentifyOptionsPy(const RobotFile& rig, bool auto_fix,
+                                        const IdentifyArgs& a) {
   IdentificationOptions options;
   options.solver = ParseName(kSolverNames, a.solver, "solver", "solver");
   options.loss = ParseName(kRobustLossNames, a.loss, "loss", "loss");
@@ -436,8 +475,65 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   options.priors = PriorsFor(rig, a.prior, a.prior_sigma, "prior=", "prior_sigma=");
   options.encoder_sigma = a.encoder_sigma_mrad * 1e-3;
   options.Validate();
+  return options;
+}
+
+// What identify(holdout=, predict_at=) add to the result, as the command line's JSON has them.
+struct IdentifyExtras {
+  std::optional<CrossValidation> holdout;
+  std::optional<AccuracyPrediction> accuracy;
+  ConfigurationSet poses;
+};
+
+IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
+                                 const py::object& plane_arg, const std::string& estimate_plane,
+                                 const py::object& fix, bool auto_fix, const IdentifyArgs& a,
+                                 IdentifyExtras* extras) {
+  const RobotModel& robot = rig.robot;
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  const ConfigurationSet readings_q =
+      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), a.plane_of, planes.size());
+  CheckJointRanges(readings_q, robot, "q");
+  const std::vector<double> readings = ToVector(h, "h");
+  const MeasurementSet data = GroupReadings(
+      readings_q, readings, &rig.ranger,
+      [](int r) { return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]"; }, nullptr,
+      Averaging::Parse(a.average));
+  const ParameterSet ps = MakeParameterSet(
+      robot,
+      std::vector<PlaneTerms>(planes.size(), PlaneTerms::Parse(estimate_plane, "estimate_plane")),
+      ToNames(fix), "fix", RangerTerms::Parse(a.estimate_ranger, "estimate_ranger"));
+  const MeasurementModel model(robot, planes, ps);
+  const IdentificationOptions options = IdentifyOptionsPy(rig, auto_fix, a);
+  std::optional<int> folds;
+  if (!a.holdout.is_none()) folds = a.holdout.cast<int>();
+  const bool predict = !a.predict_at.is_none();
+  if (predict) {
+    extras->poses = ToConfigurations(a.predict_at.cast<Array>(), robot.num_links(), "predict_at");
+    CheckJointRanges(extras->poses, robot, "predict_at");
+  }
   py::gil_scoped_release release;
-  return Identify(model, data, options);
+  IdentificationSummary s = Identify(model, data, options);
+  if (!s.IsSolutionUsable()) return s;
+  if (folds) {
+    try {
+      extras->holdout = CrossValidate(model, data, *folds, options);
+    } catch (const SettingError& e) {
+      throw e.Respelled(Frontend::kPython);
+    }
+  }
+  if (predict) {
+    // What is known of the held terms: the robot file's tolerances, prior_sigma over them.
+    const UnestimatedTerms held = FindUnestimatedTerms(
+        SolvedModel(model, s), s, data, options,
+        PriorsFor(rig, !rig.tolerances.empty(), a.prior_sigma, "prior=", "prior_sigma="));
+    extras->accuracy = PredictAccuracyAfterFit(model, s, options, held, extras->poses);
+    if (!extras->accuracy)
+      throw InputError("predict_at",
+                       "the covariance is undefined (as many configurations as parameters); "
+                       "give sigma_mm");
+  }
+  return s;
 }
 
 IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
@@ -790,7 +886,7 @@ set, the candidate evaluations spent, and the pool rows rejected because their b
 
 void DefineIdentification(py::module_& m) {
   using S = IdentificationSummary;
-  py::class_<S>(m, "Identification", R"doc(
+  py::class_<S>(m, "Identification", py::dynamic_attr(), R"doc(
 The result of lrcal.identify. Arrays are SI (m, rad); index k belongs to names[k].
   names, nominal, estimate (= nominal + delta), delta
   std, covariance, correlation: from the residuals (σ̂²·(GᵀWG)⁻¹)
@@ -800,6 +896,8 @@ The result of lrcal.identify. Arrays are SI (m, rad); index k belongs to names[k
   'beam_missed', 'numerical_failure', 'invalid_input'), usable, message, fixed (parameters fixed
   for rank), identifiability, solver; with priors prior_sigma (SI, 0 where none),
   posterior_to_prior (NaN where no prior) and set_by_prior (posterior/prior above 0.9).
+holdout and accuracy: what identify(holdout=K) and identify(predict_at=poses) add, as dicts with
+the keys of `lrcal identify --holdout K --predict-at F --format json` (None when not asked for).
 str() gives the full text report; repr() the one-line summary.)doc")
       .def_readonly("names", &S::names)
       .def_readonly("nominal", &S::nominal)
@@ -924,8 +1022,12 @@ Identifies the geometric parameters (and plane terms) from laser readings.
 
 q (M, joints) rad and h (M,) m are single readings; readings at identical joint values are
 averaged (weight = their count), exactly as `lrcal identify --data` does with a CSV.
-plane: None (the robot file's), an lrcal.Plane or (nx, ny, nz, f), the nominal plane.
-estimate_plane: "none", "normal", "offset" or "normal,offset" (names plane_u1, plane_u2, plane_f).
+plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
+lrcal.Plane (several planes, as repeated --plane). plane_of: with several planes, the plane each
+reading's beam is aimed at, a number from 1 per reading (a measurement CSV's plane column).
+estimate_plane: "none", "normal", "offset" or "normal,offset", for every plane (names plane_u1,
+plane_u2, plane_f; with several planes plane1_u1, ...). estimate_ranger: "none", "offset",
+"scale" or "offset,scale" (as --estimate-ranger: reading = (1+s) h + o).
 fix: parameter names kept at nominal (a list or "a1,d2"). auto_fix: if the set is rank-deficient,
 fix the suggested parameters and go on (else termination is 'rank_deficient').
 solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (either solver) with scale
@@ -943,9 +1045,15 @@ recorded joint value (mrad; mm for a prismatic joint), one error per configurati
 average: how the readings at one configuration become its value (as --average): "mean",
 "median" or "trimmed:F" (F in (0, 0.5) cut from each end); the weights account for the median's
 larger variance under Gaussian noise.
+holdout: K-fold cross-validation over the configurations (as --holdout K): result.holdout.
+predict_at: poses (M, joints) rad to state the calibrated arm's accuracy at (as --predict-at: the
+data part and the total with its sources, the robot file's tolerances and prior_sigma for the
+held terms): result.accuracy.
+Joint values outside the robot's joint ranges are refused (degrees for rad?), as the command
+line refuses them in a CSV.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc";
 
-void DefineCalibration(py::module_& m) {
+void DefineIdentify(py::module_& m) {
   // The numeric settings' names and defaults are the schema's (IdentificationOptions::Settings()).
   const auto& fields = IdentificationOptions::Settings();
   const auto setting = [&](const char* name) {
@@ -960,17 +1068,35 @@ void DefineCalibration(py::module_& m) {
          const std::string& solver, const std::string& loss, double loss_scale_mm, double sigma_mm,
          long long max_iterations, const py::object& loss_scale, const py::object& sigma,
          const std::string& prior_sigma, bool prior, double encoder_sigma_mrad,
-         const std::string& average) {
-        return IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
-                          {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
-                           prior_sigma, prior, encoder_sigma_mrad, average});
+         const std::string& average, const py::object& plane_of, const std::string& estimate_ranger,
+         const py::object& holdout, const py::object& predict_at) {
+        IdentifyExtras extras;
+        py::object result = py::cast(IdentifyPy(
+            rig, q, h, plane, estimate_plane, fix, auto_fix,
+            {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma, prior_sigma,
+             prior, encoder_sigma_mrad, average, estimate_ranger, plane_of, holdout, predict_at},
+            &extras));
+        // As `lrcal identify --format json` has them: "holdout" and "accuracy" (None when not
+        // asked for, or when the fit is not usable).
+        result.attr("holdout") =
+            extras.holdout ? FromJson(CrossValidationJson(*extras.holdout).dump()) : py::none();
+        result.attr("accuracy") =
+            extras.accuracy ? FromJson(PoseAccuracyJson(*extras.accuracy, extras.poses).dump())
+                            : py::none();
+        return result;
       },
       py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
       py::arg("solver") = "lm", py::arg("loss") = "none", setting("loss_scale_mm"),
       setting("sigma_mm"), setting("max_iterations"), py::arg("loss_scale") = py::none(),
       py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", py::arg("prior") = false,
-      py::arg("encoder_sigma_mrad") = 0.0, py::arg("average") = Averaging{}.Name(), kIdentifyDoc);
+      py::arg("encoder_sigma_mrad") = 0.0, py::arg("average") = Averaging{}.Name(),
+      py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
+      py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(), kIdentifyDoc);
+}
+
+void DefineCalibration(py::module_& m) {
+  DefineIdentify(m);
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
         py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8, R"doc(
@@ -1082,10 +1208,6 @@ target's unit, meets_target, ...), study and run (the confirmation study file an
 }
 
 // --- one function per command (the command's library call, its JSON as Python objects) -------
-
-py::object FromJson(const std::string& json) {
-  return py::module_::import("json").attr("loads")(json);
-}
 
 // `planes`: None (the robot file's, one or several), an lrcal.Plane, four numbers, or a list of
 // planes.

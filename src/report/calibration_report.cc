@@ -21,15 +21,11 @@ void AddPredictions(const CalibrationReportInputs& in, ResultJson* j) {
   const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
   if (folds >= 2)
     (*j)["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
-  const SigmaUsed used = ChooseSigma(s, in.options);
-  const Eigen::MatrixXd& C = CovarianceFor(s, used);
-  if (!C.allFinite()) return;
   const ConfigurationSet poses =
       WorkspacePoses(in.model->robot(), in.workspace_poses, in.workspace_seed);
-  AccuracyPrediction p =
-      PredictTotalAccuracy(SolvedModel(*in.model, s), s.delta.data(), C, in.held, poses);
-  p.sigma_used = used;
-  (*j)["workspace_accuracy"] = PoseAccuracyJson(p, poses);
+  const std::optional<AccuracyPrediction> p =
+      PredictAccuracyAfterFit(*in.model, s, in.options, in.held, poses);
+  if (p) (*j)["workspace_accuracy"] = PoseAccuracyJson(*p, poses);
 }
 
 }  // namespace

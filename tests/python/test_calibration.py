@@ -338,3 +338,44 @@ def test_settings_have_the_command_lines_names_units_and_checks(tmp_path, cli, p
         lrcal.identify(paper, readings.q, readings.h, max_iterations=0)
     with pytest.raises(lrcal.InputError, match=r"threads=: expected 0 \(all cores\) to 4096"):
         lrcal.run_study("quick", str(tmp_path / "run"), threads=-1)
+
+
+def test_identify_with_several_planes_ranger_holdout_and_predict_at_is_the_programs(tmp_path, cli,
+                                                                                   paper):
+    # Three planes (the README's), the ranger's offset estimated, 5-fold cross-validation and the
+    # accuracy statement at poses: the numbers of `lrcal identify ... --format json`, bit for bit.
+    planes_args = ["--plane", "0,0,1,0.3", "--plane", "1,0,0,0.9", "--plane", "0,1,0,0.9"]
+    configs, data, poses = tmp_path / "c.csv", tmp_path / "m.csv", tmp_path / "p.csv"
+    cli("sample", *planes_args, "--count", 40, "--seed", 5, "--out", configs)
+    cli("simulate", *planes_args, "--configs", configs, "--seed", 5, "--out", data)
+    cli("sample", "--count", 7, "--seed", 9, "--validation", "--out", poses)
+    program = json.loads(cli("identify", *planes_args, "--data", data, "--sigma-mm", 0.2,
+                             "--estimate-ranger", "offset", "--fix", "d6", "--holdout", 5,
+                             "--predict-at", poses, "--format", "json").stdout)
+    header, m = read_csv(data)
+    planes = [lrcal.Plane((0, 0, 1), 0.3), lrcal.Plane((1, 0, 0), 0.9),
+              lrcal.Plane((0, 1, 0), 0.9)]
+    _, p = read_csv(poses)
+    result = lrcal.identify(paper, m[:, :6], m[:, header.index("h")], plane=planes,
+                            plane_of=m[:, header.index("plane")], sigma_mm=0.2,
+                            estimate_ranger="offset", fix="d6", holdout=5, predict_at=p)
+    assert result.names == [q["name"] for q in program["parameters"]]
+    assert "ranger_offset" in result.names and "d6" not in result.names
+    np.testing.assert_array_equal(result.estimate,
+                                  [q["estimate"] for q in program["parameters"]])
+    assert result.holdout == program["holdout"]
+    assert result.accuracy == program["accuracy"]
+    assert lrcal.identify(paper, m[:, :6], m[:, header.index("h")], plane=planes,
+                          plane_of=m[:, header.index("plane")]).holdout is None
+    with pytest.raises(lrcal.InputError, match="plane_of: 3 planes: give the plane each"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], plane=planes)
+    with pytest.raises(lrcal.InputError, match=r"plane_of\[0\]: expected a plane number from 1 "
+                                               "to 3, got 4"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], plane=planes,
+                       plane_of=np.full(len(m), 4))
+    with pytest.raises(lrcal.InputError, match="holdout=: expected 2 to 120 folds"):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")], plane=planes,
+                       plane_of=m[:, header.index("plane")], holdout=121)
+    with pytest.raises(lrcal.InputError, match="outside the joint's range"):
+        lrcal.identify(paper, np.degrees(m[:, :6]), m[:, header.index("h")], plane=planes,
+                       plane_of=m[:, header.index("plane")])

@@ -22,6 +22,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -115,6 +116,16 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
                                         const Eigen::MatrixXd& covariance,
                                         const UnestimatedTerms& held,
                                         const ConfigurationSet& configs);
+
+/// The statement at `poses` after the identification `s` on `model`, what `identify --predict-at`
+/// and the calibration report give: the σ ChooseSigma picks with its covariance, the estimate
+/// and the held terms `held` (FindUnestimatedTerms). Empty when that covariance is undefined (as
+/// many configurations as parameters and no σ given); each front end says so in its words.
+std::optional<AccuracyPrediction> PredictAccuracyAfterFit(const MeasurementModel& model,
+                                                          const IdentificationSummary& s,
+                                                          const IdentificationOptions& options,
+                                                          const UnestimatedTerms& held,
+                                                          const ConfigurationSet& poses);
 
 /// The statement as text: the summary, the σ used, the source table, a warning naming the terms
 /// that took a default tolerance (if any), then the per-pose table (data part and total, mm and

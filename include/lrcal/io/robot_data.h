@@ -22,6 +22,10 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
 ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
                                          const PlaneSet* planes = nullptr);
 
+/// Poses for `robot` (where to state an accuracy: no beam, so a `plane` column, if any, is not
+/// read), joint ranges checked.
+ConfigurationSet ReadRobotPoses(const std::string& path, const RobotModel& robot);
+
 /// A measurement CSV for `rig` (its ranger's range and its robot's joint ranges checked; its
 /// `plane` column resolved against `planes`; each configuration's readings combined by `average`).
 MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
