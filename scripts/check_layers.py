@@ -25,7 +25,6 @@ PRIVATE_ALLOWED = {
     ("study", "identification/levenberg_marquardt.h"):
         "the trial pipeline holds the solver's workspace (issue 25 item 4: a public trial API)",
     ("study", "io/yaml_util.h"): "the study reader uses the robot files' YAML helpers",
-    ("report", "study/trial_pipeline.h"): "the report replays a trial (issue 25 item 4)",
 }
 
 

@@ -13,9 +13,9 @@
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/report/run_tables.h"
+#include "lrcal/study/prepared_cell.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/trial_store.h"
-#include "study/trial_pipeline.h"
 
 namespace lrcal {
 
@@ -210,9 +210,9 @@ class Planner {
     CheckFolder();
     fs::create_directories(in_.out_dir);
     WriteFileAtomically(in_.out_dir + "/plan.json", PlanSettings(in_, study_).dump(2) + "\n");
-    const auto base_cell = PrepareCell(study_, study_.cells.at(0));
+    const PreparedCell base_cell = PreparedCell::Prepare(study_, study_.cells.at(0));
     validation_file_ = in_.out_dir + "/validation.csv";
-    WriteConfigurations(validation_file_, base_cell->validation);
+    WriteConfigurations(validation_file_, base_cell.validation());
     const Json& planes = study_.base["plane"];
     if (!planes.is_array() || planes.size() < 2) {
       if (!in_.planes.empty())
@@ -221,7 +221,7 @@ class Planner {
                "list of two or more planes");
       PlaneSubset all;
       all.pool_file = in_.out_dir + "/pool.csv";
-      AddSubset(std::move(all), *base_cell);
+      AddSubset(std::move(all), base_cell);
     } else {
       const int K = static_cast<int>(planes.size());
       const std::vector<int> sizes =
@@ -259,10 +259,10 @@ class Planner {
                  validation_file_);
       const Study search = LoadStudy(path);
       for (const Cell& cell : search.cells) {
-        const auto ctx = PrepareCell(search, cell);
-        AddSearchRow(
-            static_cast<int>(sub), cell.typed.select_count,
-            WorstAxisQuantile(LinearisedValidationDraws(*ctx, 4000), in_.target, in_.confidence));
+        const PreparedCell prepared = PreparedCell::Prepare(search, cell);
+        AddSearchRow(static_cast<int>(sub), cell.typed.select_count,
+                     WorstAxisQuantile(prepared.LinearisedValidationDraws(4000), in_.target,
+                                       in_.confidence));
       }
     }
     search_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -343,10 +343,10 @@ class Planner {
 
   // A subset: its pool (drawn for its planes, as a study of them would), the number of
   // parameters and the counts to consider.
-  void AddSubset(PlaneSubset subset, const CellContext& cell) {
-    WriteConfigurations(subset.pool_file, cell.pool);
-    const int n = cell.model->num_parameters(), pool = cell.pool.size();
-    subset.num_planes = cell.planes.size();
+  void AddSubset(PlaneSubset subset, const PreparedCell& cell) {
+    WriteConfigurations(subset.pool_file, cell.pool());
+    const int n = cell.num_parameters(), pool = cell.pool().size();
+    subset.num_planes = cell.num_planes();
     subset.counts = ParseRange(in_.configurations.empty()
                                    ? std::to_string(n + 1) + ":" + std::to_string(pool) + ":5"
                                    : in_.configurations,
@@ -386,7 +386,7 @@ class Planner {
     WriteFileAtomically(path, "# lrcal plan-accuracy: the set-up on planes " + subset.label +
                                   " (JSON is YAML)\n" + settings.dump(2) + "\n");
     const Study setup = LoadStudy(path);
-    AddSubset(std::move(subset), *PrepareCell(setup, setup.cells.at(0)));
+    AddSubset(std::move(subset), PreparedCell::Prepare(setup, setup.cells.at(0)));
   }
 
   void AddSearchRow(int sub, int k, double q1) {

@@ -5,10 +5,10 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/report/study_tables.h"
+#include "lrcal/study/prepared_cell.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
-#include "study/trial_pipeline.h"
 
 namespace lrcal {
 
@@ -82,10 +82,9 @@ Json PoseErrorsJson(const PoseErrors& nominal, const PoseErrors& identified) {
 
 // Trial 0 of a cell in detail, recomputed (it is a pure function of the settings).
 Json CellRealisation(const Study& study, const Cell& cell) {
-  auto context = PrepareCell(study, cell);
-  TrialWorkspace ws;
+  const PreparedCell prepared = PreparedCell::Prepare(study, cell);
   TrialDetails d;
-  const TrialRecord r = RunTrial(*context, 0, &ws, &d);
+  const TrialRecord r = prepared.Run(0, &d);
   Json cj = {{"id", cell.id},
              {"label", cell.label},
              {"status", TrialStatusName(r.status)},
