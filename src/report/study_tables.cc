@@ -1,5 +1,6 @@
 #include "lrcal/report/study_tables.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -273,6 +274,97 @@ Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
                                     DesignEfficiency(s)};
     if (rule.enabled())
       for (auto& c : StopColumns(s)) row.push_back(std::move(c));
+    t.AddRow(row);
+  }
+  return t;
+}
+
+// Every leaf under `value` as a dotted key below `prefix` ("selection.count"), once each.
+void AddLeafKeys(const Json& value, const std::string& prefix, std::vector<std::string>* keys) {
+  if (value.is_object() && !value.empty()) {
+    for (const auto& [k, v] : value.items())
+      AddLeafKeys(v, prefix.empty() || prefix == "." ? k : prefix + "." + k, keys);
+  } else if (std::find(keys->begin(), keys->end(), prefix) == keys->end()) {
+    keys->push_back(prefix);
+  }
+}
+
+// The settings a study varies, as dotted keys: every leaf of every sweep axis' values (an axis
+// on "." patches several settings at once) and every sensitivity input.
+std::vector<std::string> VariedKeys(const Json& study) {
+  std::vector<std::string> keys;
+  for (const Json& axis : study.value("/sweep/axes"_json_pointer, Json::array()))
+    for (const Json& v : axis.value("values", Json::array())) AddLeafKeys(v, axis["key"], &keys);
+  for (const Json& input : study.value("/sensitivity/inputs"_json_pointer, Json::array()))
+    AddLeafKeys(Json(), input["key"], &keys);
+  return keys;
+}
+
+// A cell's setting at a dotted key, for a CSV cell: numbers as JSON writes them, text as it is,
+// lists and mappings as compact JSON; empty when the cell does not have it.
+std::string SettingCsvValue(const Json& settings, const std::string& key) {
+  std::string pointer = "/" + key;
+  std::replace(pointer.begin(), pointer.end(), '.', '/');
+  const Json::json_pointer at(pointer);
+  if (!settings.contains(at)) return "";
+  const Json& v = settings.at(at);
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+// cells.csv: one row per cell, numbers as numbers (a fraction, not "99.7 % of the E bound"),
+// then one column per setting the study varies, so that pandas can group by them.
+Table CellsCsv(const std::vector<CellSummary>& cells, const StopWhen& rule, const Json& study) {
+  std::vector<std::string> columns = {"cell_id",
+                                      "cell_label",
+                                      "trials",
+                                      "ok",
+                                      "failed",
+                                      "failed_reasons",
+                                      "design_sigma_min",
+                                      "design_sigma_min_p5",
+                                      "design_sigma_min_p95",
+                                      "design_redrawn",
+                                      "design_efficiency",
+                                      "design_criterion"};
+  if (rule.enabled())
+    for (const char* c :
+         {"stop_state", "trials_used", "worst_relative_se", "worst_p95_relative_halfwidth"})
+      columns.emplace_back(c);
+  const std::vector<std::string> varied = VariedKeys(study);
+  columns.insert(columns.end(), varied.begin(), varied.end());
+  Table t(columns);
+  for (const auto& s : cells) {
+    long long failed = 0;
+    std::string reasons;
+    for (const auto& [reason, n] : s.failed) {
+      failed += n;
+      reasons += (reasons.empty() ? "" : "; ") + reason + " " + std::to_string(n);
+    }
+    const Json settings = Json::parse(s.cell.settings);
+    const bool redrawn = settings.value("/selection/redraw"_json_pointer, false) ||
+                         settings.value("/pool/redraw"_json_pointer, false);
+    const bool spread = redrawn && s.design_sigma_min.n > 0;
+    std::vector<std::string> row = {
+        s.cell.id,
+        s.cell.label,
+        std::to_string(s.trials),
+        std::to_string(s.ok),
+        std::to_string(failed),
+        reasons,
+        CsvValue(spread ? s.design_sigma_min.mean : s.cell.design_sigma_min),
+        spread ? CsvValue(s.design_sigma_min.p5) : "",
+        spread ? CsvValue(s.design_sigma_min.p95) : "",
+        redrawn ? "1" : "0",
+        CsvValue(s.cell.design_efficiency),
+        settings.value("/selection/criterion"_json_pointer, std::string("E"))};
+    if (rule.enabled()) {
+      const CellStop& stop = s.stop;
+      row.emplace_back(!stop.decided ? "running" : stop.precise ? "precision" : "maximum");
+      row.push_back(std::to_string(stop.trials_used));
+      row.push_back(CsvValue(stop.precision.relative_se));
+      row.push_back(CsvValue(stop.precision.p95_relative_halfwidth));
+    }
+    for (const std::string& key : varied) row.push_back(SettingCsvValue(settings, key));
     t.AddRow(row);
   }
   return t;
@@ -806,7 +898,7 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
     WriteFileAtomically((dir / name).string(), text);
   };
   write("summary.md", doc.ToMarkdown());
-  write("cells.csv", cells.ToCsv());
+  write("cells.csv", CellsCsv(result.cells, rule, study).ToCsv());
   write("validation.csv", val_csv.ToCsv());
   write("parameters.csv", par_csv.ToCsv());
   if (any_paper) write("paper_placement.csv", place.ToCsv());

@@ -6,8 +6,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 
 #include "test_util.h"
 
@@ -145,8 +147,50 @@ TEST(RunBookkeeping, RedrawnDesignsShowSigmaMinOverTheTrials) {
                                     "validation: {size: 5}\n";
   std::string out;
   ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
+  EXPECT_THAT(testing::ReadFile(dir + "/run/tables/summary.md"),
+              ::testing::HasSubstr("(redrawn per trial)"));
+  // cells.csv: numbers as numbers, the spread in columns of its own.
+  std::istringstream csv(testing::ReadFile(dir + "/run/tables/cells.csv"));
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  const auto split = [](const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream in(line);
+    for (std::string c; std::getline(in, c, ',');) cells.push_back(c);
+    return cells;
+  };
+  const std::vector<std::string> names = split(header), values = split(row);
+  ASSERT_EQ(names.size(), values.size()) << header << "\n" << row;
+  std::map<std::string, std::string> cell;
+  for (std::size_t i = 0; i < names.size(); ++i) cell[names[i]] = values[i];
+  EXPECT_EQ(cell["design_redrawn"], "1");
+  EXPECT_EQ(cell["design_efficiency"], "");  // no certificate for a design redrawn per trial
+  const double p5 = std::stod(cell["design_sigma_min_p5"]),
+               mean = std::stod(cell["design_sigma_min"]),
+               p95 = std::stod(cell["design_sigma_min_p95"]);
+  EXPECT_LT(p5, mean);
+  EXPECT_LT(mean, p95);
+}
+
+TEST(RunBookkeeping, CellsCsvHasOneNumericColumnPerVariedSetting) {
+  const std::string dir = testing::TempDir("cells_csv_columns");
+  std::ofstream(dir + "/s.yaml") << "name: sweep\nseed: 4\ntrials: 2\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 60}\nvalidation: {size: 5}\n"
+                                    "sweep:\n  axes:\n    - key: selection.count\n"
+                                    "      values: [30, 40]\n    - key: noise.sigma_mm\n"
+                                    "      values: [0.1]\n";
+  std::string out;
+  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
   const std::string cells = testing::ReadFile(dir + "/run/tables/cells.csv");
-  EXPECT_THAT(cells, ::testing::HasSubstr("(redrawn per trial)")) << cells;
+  EXPECT_THAT(cells, ::testing::StartsWith(
+                         "cell_id,cell_label,trials,ok,failed,failed_reasons,design_sigma_min,"
+                         "design_sigma_min_p5,design_sigma_min_p95,design_redrawn,"
+                         "design_efficiency,design_criterion,selection.count,noise.sigma_mm\n"));
+  EXPECT_THAT(cells,
+              ::testing::ContainsRegex(",2,2,0,,0\\.[0-9]{6},,,0,0\\.[0-9]{6},E,30,0\\.1\n"));
+  EXPECT_THAT(cells, ::testing::ContainsRegex(",E,40,0\\.1\n"));
 }
 
 }  // namespace

@@ -61,6 +61,14 @@ def test_run_study_gives_the_programs_tables_and_trials(tmp_path, cli):
     assert errors.dtypes.iloc[1] == np.float64
     assert set(py_run.tables) >= {"validation", "parameters", "cells"}
     assert py_run.summary is not None and py_run.manifest["study"]["name"] == "quick"
+    # One flat column per setting the study varies, in the cells frame and in cells.csv, with
+    # numbers as numbers.
+    cells = py_run.tables["cells"]
+    for key, values in (("paper_case", [1, 2]), ("selection.count", [50, 100]),
+                        ("selection.method", ["backward", "exhaustive"])):
+        assert list(py_run.cells[key]) == list(cells[key]) == values
+    assert cells["design_efficiency"].dtype == np.float64
+    assert ((cells["design_efficiency"] > 0.99) & (cells["design_efficiency"] <= 1)).all()
 
 
 def test_load_run_without_pandas_gives_numpy_structured_arrays(tmp_path):

@@ -75,6 +75,36 @@ def _read_csv(path, as_pandas):
     return _records(header, list(zip(*converted)) if rows else [], False)
 
 
+def _leaf_keys(value, prefix, keys):
+    """Every leaf under `value` as a dotted key below `prefix` ("selection.count"), once each."""
+    if isinstance(value, dict) and value:
+        for k, v in value.items():
+            _leaf_keys(v, k if prefix in ("", ".") else f"{prefix}.{k}", keys)
+    elif prefix not in keys:
+        keys.append(prefix)
+
+
+def varied_keys(study):
+    """The settings a study varies, as dotted keys (the columns cells.csv adds): every leaf of
+    every sweep axis' values and every sensitivity input."""
+    keys = []
+    for axis in (study.get("sweep") or {}).get("axes", []):
+        for v in axis.get("values", []):
+            _leaf_keys(v, axis["key"], keys)
+    for item in (study.get("sensitivity") or {}).get("inputs", []):
+        _leaf_keys(None, item["key"], keys)
+    return keys
+
+
+def _setting(settings, key):
+    value = settings
+    for part in key.split("."):
+        if not isinstance(value, dict) or part not in value:
+            return None
+        value = value[part]
+    return value
+
+
 class Run:
     """A run directory read back (lrcal.load_run).
 
@@ -83,7 +113,8 @@ class Run:
       manifest  manifest.json as a dict (study, seed, build, sessions)
       cells     one row per cell: cell_id, ord, label, settings (dict), parameter_names (list),
                 predicted_std (list, SI), design_sigma_min, fixed_for_rank, pool_report,
-                truth_errors (list, SI)
+                truth_errors (list, SI), then one column per setting the study varies, named by
+                its key ("selection.count", "noise.sigma_mm": varied_keys), as in cells.csv
       trials    one row per recorded trial: cell_id, trial, status, iterations, residual_rms (m),
                 sigma_hat (m), sigma_min, val_{rms,max}_{pos,ori}_{x,y,z} (validation errors of
                 the identified model, m or rad), nom_... (of the nominal model), seconds
@@ -109,9 +140,13 @@ class Run:
                 sorted(glob.glob(os.path.join(path, "trials.rank*.sqlite")))
         self._stores = [p for p in stores if os.path.isfile(p)]
         self._cells = self._read_cells()
+        varied = varied_keys(self.manifest.get("study", {}))
+        settings = 3 + _CELL_JSON.index("settings")
         self.cells = _records(
-            ["cell_id", "ord", "label"] + list(_CELL_JSON) + ["design_sigma_min", "pool_report"],
-            self._cells, as_pandas)
+            ["cell_id", "ord", "label"] + list(_CELL_JSON) + ["design_sigma_min", "pool_report"] +
+            varied,
+            [c + tuple(_setting(c[settings] or {}, k) for k in varied) for c in self._cells],
+            as_pandas)
         self.trials = _records(self._trial_columns(), self._read_trials(), as_pandas)
         tables = os.path.join(path, "tables")
         self.tables = {os.path.splitext(os.path.basename(p))[0]: _read_csv(p, as_pandas)
