@@ -311,6 +311,43 @@ std::string SettingCsvValue(const Json& settings, const std::string& key) {
   return v.is_string() ? v.get<std::string>() : v.dump();
 }
 
+// One row of cells.csv (CellsCsv).
+std::vector<std::string> CellsCsvRow(const CellSummary& s, const StopWhen& rule,
+                                     const std::vector<std::string>& varied) {
+  long long failed = 0;
+  std::string reasons;
+  for (const auto& [reason, n] : s.failed) {
+    failed += n;
+    reasons += (reasons.empty() ? "" : "; ") + reason + " " + std::to_string(n);
+  }
+  const Json settings = Json::parse(s.cell.settings);
+  const bool redrawn = settings.value("/selection/redraw"_json_pointer, false) ||
+                       settings.value("/pool/redraw"_json_pointer, false);
+  const bool spread = redrawn && s.design_sigma_min.n > 0;
+  std::vector<std::string> row = {
+      s.cell.id,
+      s.cell.label,
+      std::to_string(s.trials),
+      std::to_string(s.ok),
+      std::to_string(failed),
+      reasons,
+      CsvValue(spread ? s.design_sigma_min.mean : s.cell.design_sigma_min),
+      spread ? CsvValue(s.design_sigma_min.p5) : "",
+      spread ? CsvValue(s.design_sigma_min.p95) : "",
+      redrawn ? "1" : "0",
+      CsvValue(s.cell.design_efficiency),
+      settings.value("/selection/criterion"_json_pointer, std::string("E"))};
+  if (rule.enabled()) {
+    const CellStop& stop = s.stop;
+    row.emplace_back(!stop.decided ? "running" : stop.precise ? "precision" : "maximum");
+    row.push_back(std::to_string(stop.trials_used));
+    row.push_back(CsvValue(stop.precision.relative_se));
+    row.push_back(CsvValue(stop.precision.p95_relative_halfwidth));
+  }
+  for (const std::string& key : varied) row.push_back(SettingCsvValue(settings, key));
+  return row;
+}
+
 // cells.csv: one row per cell, numbers as numbers (a fraction, not "99.7 % of the E bound"),
 // then one column per setting the study varies, so that pandas can group by them.
 Table CellsCsv(const std::vector<CellSummary>& cells, const StopWhen& rule, const Json& study) {
@@ -333,40 +370,7 @@ Table CellsCsv(const std::vector<CellSummary>& cells, const StopWhen& rule, cons
   const std::vector<std::string> varied = VariedKeys(study);
   columns.insert(columns.end(), varied.begin(), varied.end());
   Table t(columns);
-  for (const auto& s : cells) {
-    long long failed = 0;
-    std::string reasons;
-    for (const auto& [reason, n] : s.failed) {
-      failed += n;
-      reasons += (reasons.empty() ? "" : "; ") + reason + " " + std::to_string(n);
-    }
-    const Json settings = Json::parse(s.cell.settings);
-    const bool redrawn = settings.value("/selection/redraw"_json_pointer, false) ||
-                         settings.value("/pool/redraw"_json_pointer, false);
-    const bool spread = redrawn && s.design_sigma_min.n > 0;
-    std::vector<std::string> row = {
-        s.cell.id,
-        s.cell.label,
-        std::to_string(s.trials),
-        std::to_string(s.ok),
-        std::to_string(failed),
-        reasons,
-        CsvValue(spread ? s.design_sigma_min.mean : s.cell.design_sigma_min),
-        spread ? CsvValue(s.design_sigma_min.p5) : "",
-        spread ? CsvValue(s.design_sigma_min.p95) : "",
-        redrawn ? "1" : "0",
-        CsvValue(s.cell.design_efficiency),
-        settings.value("/selection/criterion"_json_pointer, std::string("E"))};
-    if (rule.enabled()) {
-      const CellStop& stop = s.stop;
-      row.emplace_back(!stop.decided ? "running" : stop.precise ? "precision" : "maximum");
-      row.push_back(std::to_string(stop.trials_used));
-      row.push_back(CsvValue(stop.precision.relative_se));
-      row.push_back(CsvValue(stop.precision.p95_relative_halfwidth));
-    }
-    for (const std::string& key : varied) row.push_back(SettingCsvValue(settings, key));
-    t.AddRow(row);
-  }
+  for (const auto& s : cells) t.AddRow(CellsCsvRow(s, rule, varied));
   return t;
 }
 
