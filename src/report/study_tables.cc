@@ -614,6 +614,7 @@ Json SummaryJson(const Json& study, const StudyTablesResult& result, const Json&
 struct SensitivityOutput {
   Json json;              // null without a sensitivity section
   TextDocument document;  // the summary.md section
+  Table plan{{}};         // sensitivity_plan.csv: inputs and output per plan point
   Table csv{{"input", "min", "max", "method", "first", "first_low", "first_high", "total",
              "total_low", "total_high", "mu", "mu_star", "sigma"}};
 };
@@ -754,6 +755,37 @@ double TrialQuantity(const Eigen::VectorXd& within, double variance, double nois
   return var_y > 0 ? variance / var_y : NAN;
 }
 
+// sensitivity_plan.csv: per plan point its cell, the inputs' values and the quantity of interest
+// (the cell mean, averaged over x, y and z) with its Monte-Carlo standard error: what SALib or
+// pandas would take.
+Table SensitivityPlanTable(const Json& spec, const std::vector<CellSummary>& cells,
+                           const std::map<std::string, CellQuantity>& quantities,
+                           const std::string& metric, const std::string& unit) {
+  std::vector<std::string> columns = {"point", "cell_id"};
+  for (const Json& input : spec["inputs"]) columns.push_back(input["key"]);
+  for (const char* c : {"_mean_", "_se_"}) columns.push_back(metric + c + unit);
+  columns.emplace_back("ok");
+  Table t(columns);
+  std::map<std::string, const CellSummary*> by_id;
+  for (const CellSummary& s : cells) by_id[s.cell.id] = &s;
+  const Json& plan_cells = spec["plan_cells"];
+  for (std::size_t p = 0; p < plan_cells.size(); ++p) {
+    const std::string id = plan_cells[p];
+    std::vector<std::string> row = {std::to_string(p), id};
+    const auto cell = by_id.find(id);
+    const Json settings = cell == by_id.end() ? Json() : Json::parse(cell->second->cell.settings);
+    for (const Json& input : spec["inputs"])
+      row.push_back(settings.is_null() ? "" : SettingCsvValue(settings, input["key"]));
+    const auto q = quantities.find(id);
+    const bool known = q != quantities.end();
+    row.push_back(known ? CsvValue(q->second.mean) : "");
+    row.push_back(known && q->second.se2 > 0 ? CsvValue(std::sqrt(q->second.se2)) : "");
+    row.push_back(cell == by_id.end() ? "0" : std::to_string(cell->second->ok));
+    t.AddRow(row);
+  }
+  return t;
+}
+
 SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellSummary>& cells) {
   SensitivityOutput out;
   if (!study.contains("sensitivity")) return out;
@@ -776,6 +808,7 @@ SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellS
     noise += q.se2 / static_cast<double>(points);
   }
   const std::string unit = metric % 2 == 0 ? "mm" : "mrad";
+  out.plan = SensitivityPlanTable(spec, cells, quantities, metric_name, unit);
   out.json = {{"method", method}, {"metric", metric_name}, {"unit", unit}};
   out.document.AddHeading(std::string("Sensitivity (") +
                           (method == "sobol" ? "Sobol indices" : "Morris effects") + ")");
@@ -906,7 +939,10 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   write("validation.csv", val_csv.ToCsv());
   write("parameters.csv", par_csv.ToCsv());
   if (any_paper) write("paper_placement.csv", place.ToCsv());
-  if (!sensitivity.json.is_null()) write("sensitivity.csv", sensitivity.csv.ToCsv());
+  if (!sensitivity.json.is_null()) {
+    write("sensitivity.csv", sensitivity.csv.ToCsv());
+    write("sensitivity_plan.csv", sensitivity.plan.ToCsv());
+  }
   write("summary.json", SummaryJson(study, result, sensitivity.json).dump(1) + "\n");
   write("validation.tex", val.ToLatex());
   write("parameters.tex", par_tex.ToLatex());

@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "lrcal/core/error.h"
 #include "lrcal/study/sensitivity.h"
@@ -69,6 +71,35 @@ TEST(SensitivityStudy, MorrisScreensTheInputs) {
   EXPECT_GT(in[0]["mu_star"].get<double>(), 0.01);  // mm across σ's range
   EXPECT_EQ(in[1]["mu_star"].get<double>(), 0.0);
   EXPECT_EQ(in[1]["sigma"].get<double>(), 0.0);
+  // sensitivity_plan.csv: one row per plan point, its inputs as the cell's settings and the
+  // quantity of interest as the cell's validation means (summary.json, m) averaged over x, y, z.
+  std::map<std::string, double> cell_mean;
+  for (const auto& c : j["cells"]) {
+    double sum = 0;
+    for (const char* a : {"x", "y", "z"})
+      sum += c["validation"][std::string("rms_pos_") + a]["mean"].get<double>();
+    cell_mean[c["id"]] = sum / 3 * 1e3;
+  }
+  std::istringstream plan(testing::ReadFile(dir + "/run/tables/sensitivity_plan.csv"));
+  std::string line;
+  std::getline(plan, line);
+  EXPECT_EQ(line,
+            "point,cell_id,noise.sigma_mm,noise.outlier_sigma_mm,rms_pos_mean_mm,rms_pos_se_mm,ok");
+  int points = 0;
+  for (; std::getline(plan, line); ++points) {
+    std::vector<std::string> f;
+    std::stringstream in_line(line);
+    for (std::string c; std::getline(in_line, c, ',');) f.push_back(c);
+    ASSERT_EQ(f.size(), 7U) << line;
+    EXPECT_EQ(f[0], std::to_string(points));
+    EXPECT_EQ(f[1], study.sensitivity["plan_cells"][points].get<std::string>());
+    const double sigma = std::stod(f[2]);
+    EXPECT_GE(sigma, 0.1);
+    EXPECT_LE(sigma, 0.4);
+    EXPECT_NEAR(std::stod(f[4]), cell_mean.at(f[1]), 5e-7) << line;  // 6 decimals in the CSV
+    EXPECT_EQ(f[6], "20");
+  }
+  EXPECT_EQ(points, 18);
 }
 
 TEST(SensitivityStudy, NormalInputsFollowTheirLaw) {
