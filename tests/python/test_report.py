@@ -67,7 +67,7 @@ def test_figures_read_the_trials_through_load_runs_reader(reported_run, tmp_path
     stored = lrcal.load_run(reported_run).trials
     ok = stored[stored["status"] == "ok"]
     assert len(metrics) == len(ok) == 12
-    assert sorted(metrics["val_rms_pos_x"]) == sorted(ok["val_rms_pos_x"])
+    assert sorted(metrics["val_rms_pos_x_mm"]) == sorted(ok["val_rms_pos_x_mm"])
 
 
 def test_the_module_runs_as_the_program_runs_it(reported_run, tmp_path):

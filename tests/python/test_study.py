@@ -61,6 +61,17 @@ def test_run_study_gives_the_programs_tables_and_trials(tmp_path, cli):
     assert errors.dtypes.iloc[1] == np.float64
     assert set(py_run.tables) >= {"validation", "parameters", "cells"}
     assert py_run.summary is not None and py_run.manifest["study"]["name"] == "quick"
+    # The trials in the tables' units, each column naming its unit: the mean of a cell's
+    # val_rms_pos_x_mm is validation.csv's mean (6 decimals).
+    validation = py_run.tables["validation"]
+    for metric, unit in (("rms_pos", "mm"), ("max_ori", "mrad")):
+        row = validation[(validation["cell_label"] == "case 1") &
+                         (validation["model"] == "identified") &
+                         (validation["metric"] == metric) & (validation["axis"] == "x")]
+        assert row["unit"].item() == unit
+        case1 = py_run.trials[py_run.trials["cell_id"] == row["cell_id"].item()]
+        assert abs(case1[f"val_{metric}_x_{unit}"].mean() - row["mean"].item()) < 5e-7
+    assert {"residual_rms_mm", "sigma_hat_mm", "nom_rms_ori_z_mrad"} <= set(py_run.trials.columns)
     # One flat column per setting the study varies, in the cells frame and in cells.csv, with
     # numbers as numbers.
     cells = py_run.tables["cells"]
@@ -79,7 +90,7 @@ def test_load_run_without_pandas_gives_numpy_structured_arrays(tmp_path):
     run = lrcal.load_run(tmp_path / "r", as_pandas=False)
     assert isinstance(run.trials, np.ndarray) and run.trials.dtype.names[:3] == (
         "cell_id", "trial", "status")
-    assert run.trials["residual_rms"].dtype == np.float64 and len(run.trials) == 200
+    assert run.trials["residual_rms_mm"].dtype == np.float64 and len(run.trials) == 200
     assert run.tables["validation"]["n"].dtype == np.int64
     assert run.errors("case 1")["theta1"].shape == (100,)
     with pytest.raises(lrcal.InputError, match="no cell 'case 9'"):

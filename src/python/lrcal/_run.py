@@ -26,6 +26,17 @@ _CELL_JSON = ("settings", "parameter_names", "predicted_std", "fixed_for_rank", 
               "predicted_std_truth")
 
 
+def _display_column(name):
+    """The trial table's name for a store column, with the tables' unit (mm, mrad) appended to
+    every length and angle, and the factor from the store's SI value."""
+    if name in ("residual_rms", "sigma_hat") or (name.startswith(("val_", "nom_")) and
+                                                  "_pos_" in name):
+        return name + "_mm", 1e3
+    if name.startswith(("val_", "nom_")) and "_ori_" in name:
+        return name + "_mrad", 1e3
+    return name, None
+
+
 def _error(path, what):
     from . import InputError  # the module's, or the pure-Python stand-in without it
     error = InputError(f"{path}: {what}")
@@ -115,9 +126,11 @@ class Run:
                 predicted_std (list, SI), design_sigma_min, fixed_for_rank, pool_report,
                 truth_errors (list, SI), then one column per setting the study varies, named by
                 its key ("selection.count", "noise.sigma_mm": varied_keys), as in cells.csv
-      trials    one row per recorded trial: cell_id, trial, status, iterations, residual_rms (m),
-                sigma_hat (m), sigma_min, val_{rms,max}_{pos,ori}_{x,y,z} (validation errors of
-                the identified model, m or rad), nom_... (of the nominal model), seconds
+      trials    one row per recorded trial, in the tables' units, each named in the column:
+                cell_id, trial, status, iterations, residual_rms_mm, sigma_hat_mm, sigma_min
+                (σ_min of the design's G, SI), val_{rms,max}_pos_{x,y,z}_mm and
+                val_{rms,max}_ori_{x,y,z}_mrad (validation errors of the identified model),
+                nom_..._mm and nom_..._mrad (of the nominal model), seconds
       tables    {name: table} for every tables/<name>.csv (units as the CSV headers say;
                 empty until the run is complete)
       summary   tables/summary.json as a dict, or None
@@ -147,7 +160,13 @@ class Run:
             varied,
             [c + tuple(_setting(c[settings] or {}, k) for k in varied) for c in self._cells],
             as_pandas)
-        self.trials = _records(self._trial_columns(), self._read_trials(), as_pandas)
+        stored = self._trial_columns()
+        shown = [_display_column(c) for c in stored]
+        self.trials = _records(
+            [name for name, _ in shown],
+            [tuple(v * f if f is not None and v is not None else v
+                   for v, (_, f) in zip(r, shown)) for r in self._read_trials()],
+            as_pandas)
         tables = os.path.join(path, "tables")
         self.tables = {os.path.splitext(os.path.basename(p))[0]: _read_csv(p, as_pandas)
                        for p in sorted(glob.glob(os.path.join(tables, "*.csv")))}

@@ -25,6 +25,11 @@ METRICS = (("rms_pos", "RMS position error (mm)"), ("rms_ori", "RMS orientation 
 MAX_CELLS_PER_FIGURE = 12
 
 
+def _column(metric, axis):
+    """The trial table's column of a validation metric of the identified model (mm or mrad)."""
+    return f"val_{metric}_{axis}_{'mm' if metric.endswith('pos') else 'mrad'}"
+
+
 class RunDataError(Exception):
     """A run directory that is missing or malformed: the message says what was expected."""
 
@@ -86,7 +91,7 @@ class Run:
             raise RunDataError(f"{self.snapshot}: missing (run `lrcal report RUN_DIR`, which "
                                "prepares it)")
         trials = _StoredRun(self.dir, True, stores=[self.snapshot]).trials
-        columns = [f"val_{m}_{a}" for m, _ in METRICS for a in AXES]
+        columns = [_column(m, a) for m, _ in METRICS for a in AXES]
         data = trials.loc[trials["status"] == "ok", ["cell_id", "trial"] + columns]
         data = data.sort_values(["cell_id", "trial"]).reset_index(drop=True)
         used = {c["id"]: c["stop"]["trials_used"] for c in self.cells if "stop" in c}
@@ -208,7 +213,7 @@ def distribution_figure(run, out_dir):
         for i, cell in enumerate(cells):
             rows = data[data["cell_id"] == cell["id"]]
             for j, axis in enumerate(AXES):
-                boxes.append(rows[f"val_{metric}_{axis}"].to_numpy() * 1e3)
+                boxes.append(rows[_column(metric, axis)].to_numpy())
                 positions.append(i * 4 + j)
                 colors.append(f"C{j}")
                 paper = run.paper_value(cell, metric, axis)
@@ -462,7 +467,7 @@ def histogram_figures(run, out_dir, limit=4):
             unit = "mm" if metric.endswith("pos") else "mrad"
             for a, axis in enumerate(AXES):
                 ax = axes[m, a]
-                values = rows[f"val_{metric}_{axis}"].to_numpy() * 1e3
+                values = rows[_column(metric, axis)].to_numpy()
                 ax.hist(values, bins=min(60, max(10, len(values) // 20)), color=f"C{a}", alpha=0.6)
                 t = val[(val["cell_id"] == cell["id"]) & (val["metric"] == metric) &
                         (val["axis"] == axis)]
