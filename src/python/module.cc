@@ -16,6 +16,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -536,14 +537,41 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   return s;
 }
 
+// The configurations q (with the plane each is aimed at) and the model with its parameter set:
+// what identifiability and prior_information analyse, as the command line's --configs, --plane,
+// --estimate-plane, --estimate-ranger and --fix give them.
+struct ConfigsAndModel {
+  ConfigurationSet configs;
+  std::unique_ptr<MeasurementModel> model;
+};
+ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
+                                       const py::object& plane_arg, const py::object& plane_of,
+                                       const std::string& estimate_plane,
+                                       const std::string& estimate_ranger, const py::object& fix) {
+  const RobotModel& robot = rig.robot;
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  ConfigsAndModel out;
+  out.configs = WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
+  CheckJointRanges(out.configs, robot, "q");
+  out.model = std::make_unique<MeasurementModel>(
+      robot, planes,
+      MakeParameterSet(robot,
+                       std::vector<PlaneTerms>(planes.size(),
+                                               PlaneTerms::Parse(estimate_plane, "estimate_plane")),
+                       ToNames(fix), "fix",
+                       RangerTerms::Parse(estimate_ranger, "estimate_ranger")));
+  return out;
+}
+
 IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
                                         const py::object& plane_arg,
                                         const std::string& estimate_plane, const py::object& fix,
-                                        double rank_tolerance) {
-  const RobotModel& robot = rig.robot;
-  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
-  const MeasurementModel model(robot, ResolvePlane(rig, plane_arg),
-                               ResolveParameters(robot, estimate_plane, fix));
+                                        double rank_tolerance, const py::object& plane_of,
+                                        const std::string& estimate_ranger) {
+  const ConfigsAndModel set =
+      ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane, estimate_ranger, fix);
+  const ConfigurationSet& configs = set.configs;
+  const MeasurementModel& model = *set.model;
   IdentifiabilityOptions options;
   options.rank_tolerance = rank_tolerance;
   options.Validate("rank_tolerance");
@@ -554,11 +582,13 @@ IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
 PriorInformation PriorInformationPy(const RobotFile& rig, const Array& q,
                                     const std::string& prior_sigma, bool prior, double sigma_mm,
                                     long long repetitions, const py::object& plane_arg,
-                                    const std::string& estimate_plane, const py::object& fix) {
-  const RobotModel& robot = rig.robot;
-  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
-  const MeasurementModel model(robot, ResolvePlane(rig, plane_arg),
-                               ResolveParameters(robot, estimate_plane, fix));
+                                    const std::string& estimate_plane, const py::object& fix,
+                                    const py::object& plane_of,
+                                    const std::string& estimate_ranger) {
+  const ConfigsAndModel set =
+      ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane, estimate_ranger, fix);
+  const ConfigurationSet& configs = set.configs;
+  const MeasurementModel& model = *set.model;
   const PriorSigmas priors = PriorsFor(rig, prior, prior_sigma, "prior=", "prior_sigma=");
   if (priors.empty())
     throw InputError("prior_sigma=",
@@ -1099,9 +1129,10 @@ void DefineCalibration(py::module_& m) {
   DefineIdentify(m);
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8, R"doc(
-What the configurations q (N, joints) can identify of the parameter set (estimate_plane, fix as
-in identify), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
+        py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8,
+        py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none", R"doc(
+What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
+estimate_plane, estimate_ranger, fix as in identify: several planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
 `lrcal identifiability`.)doc");
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,
@@ -1109,9 +1140,11 @@ in identify), at the nominal model. Returns an lrcal.Identifiability; str() give
         py::arg("repetitions") =
             static_cast<long long>(FindSetting(NoiseModel::Settings(), "repetitions")->Default()),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(), R"doc(
+        py::arg("fix") = py::none(), py::arg("plane_of") = py::none(),
+        py::arg("estimate_ranger") = "none", R"doc(
 What readings at the configurations q (N, joints) would tell against priors, before any reading
-is taken: `lrcal identifiability --prior-sigma ... --sigma-mm S --repetitions R`'s table.
+is taken: `lrcal identifiability --prior-sigma ... --sigma-mm S --repetitions R`'s table (plane,
+plane_of, estimate_plane, estimate_ranger and fix as in identify).
 prior_sigma as in identify ("theta=1mrad,a=0.5mm"); prior=True uses the robot file's
 tolerances: (prior_sigma's entries replace the same keys). sigma_mm (> 0) and repetitions: the
 noise of one reading and the readings averaged per configuration. Returns an

@@ -379,3 +379,30 @@ def test_identify_with_several_planes_ranger_holdout_and_predict_at_is_the_progr
     with pytest.raises(lrcal.InputError, match="outside the joint's range"):
         lrcal.identify(paper, np.degrees(m[:, :6]), m[:, header.index("h")], plane=planes,
                        plane_of=m[:, header.index("plane")])
+
+
+def test_identifiability_with_several_planes_and_ranger_terms_is_the_programs(tmp_path, cli,
+                                                                              paper):
+    # With their offsets estimated, three planes still lose the ranger's offset against the tool
+    # length d6, the first plane's offset against d1 and, with the scale, the scale against the
+    # lengths and the other offsets: the same analysis as `lrcal identifiability`.
+    planes_args = ["--plane", "0,0,1,0.3", "--plane", "1,0,0,0.9", "--plane", "0,1,0,0.9"]
+    configs = tmp_path / "c.csv"
+    cli("sample", *planes_args, "--count", 30, "--seed", 6, "--out", configs)
+    header, c = read_csv(configs)
+    planes = [lrcal.Plane((0, 0, 1), 0.3), lrcal.Plane((1, 0, 0), 0.9),
+              lrcal.Plane((0, 1, 0), 0.9)]
+    for ranger in ("offset", "offset,scale"):
+        program = json.loads(cli("identifiability", *planes_args, "--configs", configs,
+                                 "--estimate-ranger", ranger, "--estimate-plane", "offset",
+                                 "--format", "json").stdout)
+        mine = lrcal.identifiability(paper, c[:, :6], plane=planes,
+                                     plane_of=c[:, header.index("plane")],
+                                     estimate_plane="offset", estimate_ranger=ranger)
+        assert mine.names == program["parameters"] and "ranger_offset" in mine.names
+        assert mine.rank == program["rank"]
+        np.testing.assert_array_equal(mine.singular_values, program["singular_values"])
+        assert mine.suggested_fixed == program["suggested_fixed"]
+        assert {"ranger_offset", "plane1_f"} <= set(mine.suggested_fixed)
+    with pytest.raises(lrcal.InputError, match="plane_of: 3 planes"):
+        lrcal.identifiability(paper, c[:, :6], plane=planes)
