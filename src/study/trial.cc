@@ -255,8 +255,6 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   if (!s.truth_random) c->fixed_truth.delta = DrawTruth(*c, 0).delta;
 }
 
-Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
-
 // The task criterion's selection matrix (selection.criterion: I), weighted by the validation
 // configurations (task_criterion.h).
 Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
@@ -323,22 +321,6 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
       ComparePoses(*c->robot, truth, c->robot->nominal_values(), c->validation).stats;
 }
 
-// The linearised validation errors: the Jacobian (6M × n, rows per configuration j: position
-// 3j..3j+2, then orientation 3M+3j..) of the validation poses with respect to the parameters at
-// the nominal model (PoseJacobian, regrouped; its sign is irrelevant here: the draws enter only
-// through squares and magnitudes).
-Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
-  const int n = c.model->num_parameters(), m = c.validation.size();
-  const std::vector<double> zero(n, 0.0);
-  const Eigen::MatrixXd J6 = PoseJacobian(*c.model, zero.data(), c.validation);
-  Eigen::MatrixXd J(6 * m, n);
-  for (int j = 0; j < m; ++j) {
-    J.middleRows(3 * j, 3) = J6.middleRows(6 * j, 3);
-    J.middleRows(3 * m + 3 * j, 3) = J6.middleRows(6 * j + 3, 3);
-  }
-  return J;
-}
-
 Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
   const Eigen::MatrixXd& C = c.predicted_covariance;
   const int n = c.model->num_parameters(), m = c.validation.size();
@@ -350,19 +332,31 @@ Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
   Eigen::MatrixXd Z(n, draws);
   const RandomStream stream(0, c.validation_stream, 0, RandomPurpose::kPrediction);
   stream.Normals(0, n * draws, Z.data());
-  const Eigen::MatrixXd E = ValidationPoseJacobian(c) * (L * Z);  // 6M × draws
-  for (int d = 0; d < draws; ++d)
-    for (int part = 0; part < 2; ++part)  // position, orientation
-      for (int a = 0; a < 3; ++a) {
-        double ss = 0, max = 0;
-        for (int j = 0; j < m; ++j) {
-          const double x = E(3 * m * part + 3 * j + a, d);
-          ss += x * x;
-          max = std::max(max, std::fabs(x));
+  const Eigen::MatrixXd LZ = L * Z;  // n × draws
+  // The poses' pose Jacobian (6 rows per pose: position, then orientation; its sign is
+  // irrelevant here, the draws enter through squares and magnitudes), applied to the draws a
+  // block of poses at a time: memory per validation pose stays about 1 KB, not 6 × draws
+  // doubles. Each draw's sums run over the poses in order, so the bits do not depend on the block.
+  const std::vector<double> zero(n, 0.0);
+  const Eigen::MatrixXd J6 = PoseJacobian(*c.model, zero.data(), c.validation);
+  constexpr int kPosesPerBlock = 256;
+  Eigen::MatrixXd ss = Eigen::MatrixXd::Zero(draws, 6), max = Eigen::MatrixXd::Zero(draws, 6);
+  for (int j0 = 0; j0 < m; j0 += kPosesPerBlock) {
+    const int mc = std::min(kPosesPerBlock, m - j0);
+    const Eigen::MatrixXd E = J6.middleRows(6 * j0, 6 * mc) * LZ;  // 6·mc × draws
+    for (int d = 0; d < draws; ++d)
+      for (int k = 0; k < 6; ++k)  // position xyz, orientation xyz
+        for (int j = 0; j < mc; ++j) {
+          const double x = E(6 * j + k, d);
+          ss(d, k) += x * x;
+          max(d, k) = std::max(max(d, k), std::fabs(x));
         }
-        out(d, 3 * part + a) = std::sqrt(ss / m);  // rms pos xyz, rms ori xyz
-        out(d, 6 + 3 * part + a) = max;            // max pos xyz, max ori xyz
-      }
+  }
+  for (int d = 0; d < draws; ++d)
+    for (int k = 0; k < 6; ++k) {
+      out(d, k) = std::sqrt(ss(d, k) / m);  // rms pos xyz, rms ori xyz
+      out(d, 6 + k) = max(d, k);            // max pos xyz, max ori xyz
+    }
   return out;
 }
 

@@ -11,6 +11,8 @@
 #include <list>
 #include <random>
 
+#include "lrcal/core/random.h"
+#include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/report/run_tables.h"
 #include "lrcal/study/runner.h"
@@ -27,6 +29,41 @@ std::string PredictionStudy(const std::string& dir, int trials) {
                       << "\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
                       << "\npool: {size: 60}\nselection: {count: 40}\nvalidation: {size: 15}\n";
   return path;
+}
+
+// Many validation poses are pushed through the Jacobian a block at a time (memory per pose stays
+// about 1 KB): the draws have the bits of the whole 6M × draws product, summed pose by pose.
+TEST(ValidationPrediction, BlocksOfPosesGiveTheBitsOfTheWholeProduct) {
+  const std::string dir = testing::TempDir("prediction_blocks");
+  std::ofstream(dir + "/s.yaml") << "name: blocks\nseed: 2\ntrials: 1\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 60}\nselection: {count: 40}\n"
+                                    "validation: {size: 700}\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  const auto c = PrepareCell(study, study.cells[0]);
+  constexpr int kDraws = 50;
+  const Eigen::MatrixXd blocked = LinearisedValidationDraws(*c, kDraws);
+  // The whole product, as lrcal computed it before the blocks.
+  const int n = c->model->num_parameters(), m = c->validation.size();
+  ASSERT_EQ(m, 700);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(c->predicted_covariance);
+  const Eigen::MatrixXd L =
+      eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  Eigen::MatrixXd Z(n, kDraws);
+  RandomStream(0, c->validation_stream, 0, RandomPurpose::kPrediction)
+      .Normals(0, n * kDraws, Z.data());
+  const std::vector<double> zero(n, 0.0);
+  const Eigen::MatrixXd E = PoseJacobian(*c->model, zero.data(), c->validation) * (L * Z);
+  for (int d = 0; d < kDraws; ++d)
+    for (int k = 0; k < 6; ++k) {
+      double ss = 0, max = 0;
+      for (int j = 0; j < m; ++j) {
+        ss += E(6 * j + k, d) * E(6 * j + k, d);
+        max = std::max(max, std::fabs(E(6 * j + k, d)));
+      }
+      EXPECT_EQ(blocked(d, k), std::sqrt(ss / m)) << d << " " << k;
+      EXPECT_EQ(blocked(d, 6 + k), max) << d << " " << k;
+    }
 }
 
 TEST(ValidationPrediction, LinearPropagationMatchesTheExactPoseErrorsOfGaussianParameterErrors) {
