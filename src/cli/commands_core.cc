@@ -301,6 +301,9 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   AddSettingOptions(o, IdentificationOptions::Settings(), {"loss_scale_mm", "sigma_mm"});
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
+  // A calibrated robot file that could not be written is refused before the fit, not after.
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;

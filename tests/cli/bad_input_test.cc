@@ -580,6 +580,12 @@ const std::vector<BadInput>& Cases() {
        2,
        {"--out", "does not exist"}},
       {"SampleEmptyOut", {}, "sample --out ''", 2, {"--out", "empty string"}},
+      // Refused before the fit (the readings here are valid: the path is what is wrong).
+      {"IdentifyWriteRobotInAMissingFolder",
+       {{"m.csv", "q1,q2,q3,q4,q5,q6,h\n0,0,0,0,0,0,1.5\n"}},
+       "identify --data m.csv --write-robot no/such/cal.yaml",
+       2,
+       {"--write-robot", "does not exist"}},
       {"SampleCountHuge",
        {},
        "sample --count 100000000 --out c.csv",
