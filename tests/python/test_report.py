@@ -84,6 +84,11 @@ def test_the_module_runs_as_the_program_runs_it(reported_run, tmp_path):
                            str(tmp_path)], env=env, capture_output=True, text=True, check=False)
     assert done.returncode == 2 and "calibration.json: expected the JSON" in done.stderr
     assert callable(lrcal.report)  # the function, not the package of the same name
+    # The drawing modules are imported when asked for: `import lrcal` needs no matplotlib.
+    done = subprocess.run([sys.executable, "-c",
+                           "import lrcal, sys; print('matplotlib' in sys.modules)"],
+                          env=env, capture_output=True, text=True, check=False)
+    assert done.stdout.split() == ["False"], done.stderr
 
 
 def test_without_the_compiled_module_the_python_part_still_works(reported_run, tmp_path):

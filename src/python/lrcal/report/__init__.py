@@ -8,15 +8,12 @@ then draws the page, as `lrcal report RUN_DIR` does. The drawing modules read on
 wrote, through lrcal.load_run's reader: `from lrcal.report import figures` gives the study
 figures (Run, all_figures, ...), `page` the study page, `calibration` the calibration page.
 They need pandas and matplotlib (Debian: python3-pandas, python3-matplotlib), not the compiled
-module, so they also run where only the Python files are installed.
+module, so they also run where only the Python files are installed; they are imported only when
+asked for, so `import lrcal` needs neither.
 """
 import os
 import subprocess
 import sys
-
-from . import _calibration as calibration
-from . import _figures as figures
-from . import _page as page
 
 
 def report(run_dir):
@@ -51,4 +48,4 @@ def report(run_dir):
     return dict(path=os.path.join(data["dir"], "report.html"), **data)
 
 
-__all__ = ["calibration", "figures", "page", "report"]
+__all__ = ["report"]

@@ -5,7 +5,9 @@ names the file); 5 the page could not be written (a full disk, a folder that can
 """
 import sys
 
-from . import _calibration, _figures, _page
+from . import calibration as _calibration
+from . import figures as _figures
+from . import page as _page
 
 USAGE = "usage: python3 -m lrcal.report RUN_DIR | python3 -m lrcal.report --calibration DIR"
 

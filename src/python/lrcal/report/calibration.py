@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ._page import CHECK, STYLE, figure_html, write_atomically  # noqa: E402
+from .page import CHECK, STYLE, figure_html, write_atomically  # noqa: E402
 
 
 class CalibrationDataError(Exception):

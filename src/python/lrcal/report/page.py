@@ -10,7 +10,7 @@ import json
 import os
 import time
 
-from . import _figures
+from . import figures as _figures
 
 
 def _inline(text):
