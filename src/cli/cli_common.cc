@@ -1,10 +1,16 @@
 #include "cli_common.h"
 
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <string_view>
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/io/csv.h"
@@ -101,16 +107,6 @@ Format ResolveFormat(const po::variables_map& vm) {
 
 namespace {
 
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-}  // namespace
-
-namespace {
-
 // The folder that holds lrcal's Python package (lrcal/report/__main__.py), from this program's.
 std::string PythonPackageParent() {
   namespace fs = std::filesystem;
@@ -142,11 +138,54 @@ int RunReportModule(const std::vector<std::string>& arguments) {
   std::string path = parent;
   if (const char* p = std::getenv("PYTHONPATH"); p != nullptr && *p != '\0')
     path += ":" + std::string(p);
-  std::string command =
-      "PYTHONPATH=" + ShellQuote(path) + " " + ShellQuote(python) + " -m lrcal.report";
-  for (const std::string& a : arguments) command += " " + ShellQuote(a);
+  // The interpreter is started directly (no shell, so no quoting), with this environment and
+  // lrcal's package first on PYTHONPATH.
+  std::vector<std::string> env;
+  for (char** e = environ; *e != nullptr; ++e)
+    if (std::string_view(*e).substr(0, 11) != "PYTHONPATH=") env.emplace_back(*e);
+  env.push_back("PYTHONPATH=" + path);
+  std::vector<std::string> args = {python, "-m", "lrcal.report"};
+  args.insert(args.end(), arguments.begin(), arguments.end());
+  const auto pointers = [](std::vector<std::string>& strings) {
+    std::vector<char*> p;
+    for (std::string& s : strings) p.push_back(s.data());
+    p.push_back(nullptr);
+    return p;
+  };
+  std::vector<char*> argv = pointers(args), envp = pointers(env);
+  // As system() does: Ctrl-C and Ctrl-\ reach the interpreter, while lrcal waits for it and then
+  // removes what it prepared; the child gets their default actions back.
+  struct sigaction ignore {
+  }, old_int{}, old_quit{};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGINT, &ignore, &old_int);
+  sigaction(SIGQUIT, &ignore, &old_quit);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGINT);
+  sigaddset(&defaults, SIGQUIT);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
   std::cout.flush();
-  const int status = std::system(command.c_str());
+  std::cerr.flush();
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, python.c_str(), nullptr, &attr, argv.data(), envp.data());
+  posix_spawnattr_destroy(&attr);
+  int status = -1;  // not an exit status: a failed wait reads as failure
+  if (spawned == 0) {
+    pid_t waited = 0;
+    do {
+      waited = waitpid(pid, &status, 0);
+    } while (waited < 0 && errno == EINTR);
+  }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGQUIT, &old_quit, nullptr);
+  if (spawned != 0)
+    throw InputError("LRCAL_PYTHON", "cannot run the Python interpreter '" + python +
+                                         "': " + std::strerror(spawned));
   return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
 

@@ -21,7 +21,13 @@ int ReportCommand(const std::vector<std::string>& args) {
   const std::string dir = vm["dir"].as<std::string>();
   const auto t0 = std::chrono::steady_clock::now();
   const ReportData data = PrepareReportData(dir);
-  const int code = RunReportModule({dir});
+  int code = 0;
+  try {
+    code = RunReportModule({dir});
+  } catch (...) {  // no interpreter: the snapshot goes all the same
+    RemoveReportSnapshot(data);
+    throw;
+  }
   RemoveReportSnapshot(data);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

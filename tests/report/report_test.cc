@@ -183,6 +183,16 @@ TEST(Report, MissingOrMalformedRunDirectoriesAreClearErrors) {
   EXPECT_THAT(out, ::testing::HasSubstr("empty/calibration.json: expected the JSON")) << out;
   EXPECT_EQ(RunCommand(module + dir + "/empty " + dir + "/nothing", &out), 2);
   EXPECT_THAT(out, ::testing::HasSubstr("expected one folder")) << out;
+  // An interpreter that cannot be started: exit 2 naming it, and the snapshot removed.
+  ASSERT_EQ(RunCommand(LrcalBinary() + " run quick --out " + dir + "/run --quiet", &out), 0) << out;
+  EXPECT_EQ(
+      RunCommand("LRCAL_PYTHON=/nonexistent/python3 " + LrcalBinary() + " report " + dir + "/run",
+                 &out),
+      2);
+  EXPECT_THAT(out, ::testing::HasSubstr("LRCAL_PYTHON: cannot run the Python interpreter "
+                                        "'/nonexistent/python3': No such file or directory"))
+      << out;
+  EXPECT_FALSE(fs::exists(dir + "/run/report/trials.snapshot.sqlite"));
 }
 
 // identify --report DIR (issue 13 item 9): from a measured CSV to a page with the fit check,
