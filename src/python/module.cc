@@ -183,6 +183,17 @@ ParameterSet ResolveParameters(const RobotModel& robot, const std::string& estim
                           "fix");
 }
 
+// The same for `num_planes` planes (estimate_plane for each) and the ranger's terms: what
+// --estimate-plane, --estimate-ranger and --fix give the command line.
+ParameterSet ResolveParameters(const RobotModel& robot, int num_planes,
+                               const std::string& estimate_plane,
+                               const std::string& estimate_ranger, const py::object& fix) {
+  return MakeParameterSet(
+      robot,
+      std::vector<PlaneTerms>(num_planes, PlaneTerms::Parse(estimate_plane, "estimate_plane")),
+      ToNames(fix), "fix", RangerTerms::Parse(estimate_ranger, "estimate_ranger"));
+}
+
 // The 5N link values of `model`: "nominal", "true", or an array of 5N values (SI).
 Eigen::VectorXd ResolveLinkValues(const RobotModel& robot, const py::object& model) {
   if (py::isinstance<py::str>(model)) {
@@ -486,25 +497,41 @@ struct IdentifyExtras {
   ConfigurationSet poses;
 };
 
+// The configurations q (with the plane each is aimed at) and the model with its parameter set:
+// what identify (one configuration per reading), identifiability and prior_information take, as
+// the command line's --data or --configs, --plane,
+// --estimate-plane, --estimate-ranger and --fix give them.
+struct ConfigsAndModel {
+  ConfigurationSet configs;
+  std::unique_ptr<MeasurementModel> model;
+};
+ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
+                                       const py::object& plane_arg, const py::object& plane_of,
+                                       const std::string& estimate_plane,
+                                       const std::string& estimate_ranger, const py::object& fix) {
+  const RobotModel& robot = rig.robot;
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  ConfigsAndModel out;
+  out.configs = WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
+  CheckJointRanges(out.configs, robot, "q");
+  out.model = std::make_unique<MeasurementModel>(
+      robot, planes, ResolveParameters(robot, planes.size(), estimate_plane, estimate_ranger, fix));
+  return out;
+}
+
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
                                  const py::object& plane_arg, const std::string& estimate_plane,
                                  const py::object& fix, bool auto_fix, const IdentifyArgs& a,
                                  IdentifyExtras* extras) {
   const RobotModel& robot = rig.robot;
-  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
-  const ConfigurationSet readings_q =
-      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), a.plane_of, planes.size());
-  CheckJointRanges(readings_q, robot, "q");
+  const ConfigsAndModel set =
+      ResolveConfigsAndModel(rig, q, plane_arg, a.plane_of, estimate_plane, a.estimate_ranger, fix);
   const std::vector<double> readings = ToVector(h, "h");
   const MeasurementSet data = GroupReadings(
-      readings_q, readings, &rig.ranger,
+      set.configs, readings, &rig.ranger,
       [](int r) { return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]"; }, nullptr,
       Averaging::Parse(a.average));
-  const ParameterSet ps = MakeParameterSet(
-      robot,
-      std::vector<PlaneTerms>(planes.size(), PlaneTerms::Parse(estimate_plane, "estimate_plane")),
-      ToNames(fix), "fix", RangerTerms::Parse(a.estimate_ranger, "estimate_ranger"));
-  const MeasurementModel model(robot, planes, ps);
+  const MeasurementModel& model = *set.model;
   const IdentificationOptions options = IdentifyOptionsPy(rig, auto_fix, a);
   std::optional<int> folds;
   if (!a.holdout.is_none()) folds = a.holdout.cast<int>();
@@ -535,32 +562,6 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
                        "give sigma_mm");
   }
   return s;
-}
-
-// The configurations q (with the plane each is aimed at) and the model with its parameter set:
-// what identifiability and prior_information analyse, as the command line's --configs, --plane,
-// --estimate-plane, --estimate-ranger and --fix give them.
-struct ConfigsAndModel {
-  ConfigurationSet configs;
-  std::unique_ptr<MeasurementModel> model;
-};
-ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
-                                       const py::object& plane_arg, const py::object& plane_of,
-                                       const std::string& estimate_plane,
-                                       const std::string& estimate_ranger, const py::object& fix) {
-  const RobotModel& robot = rig.robot;
-  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
-  ConfigsAndModel out;
-  out.configs = WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
-  CheckJointRanges(out.configs, robot, "q");
-  out.model = std::make_unique<MeasurementModel>(
-      robot, planes,
-      MakeParameterSet(robot,
-                       std::vector<PlaneTerms>(planes.size(),
-                                               PlaneTerms::Parse(estimate_plane, "estimate_plane")),
-                       ToNames(fix), "fix",
-                       RangerTerms::Parse(estimate_ranger, "estimate_ranger")));
-  return out;
 }
 
 IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
@@ -1267,10 +1268,8 @@ py::object KinematicsPy(const RobotFile& rig, const Array& q, const std::string&
   const PlaneSet planes = ResolvePlanes(rig, plane);
   const ConfigurationSet configs = ToConfigurations(q, rig.robot.num_links(), "q");
   CheckJointRanges(configs, rig.robot, "q");
-  const ParameterSet ps = MakeParameterSet(
-      rig.robot,
-      std::vector<PlaneTerms>(planes.size(), PlaneTerms::Parse(estimate_plane, "estimate_plane")),
-      ToNames(fix), "fix", RangerTerms::Parse(estimate_ranger, "estimate_ranger"));
+  const ParameterSet ps =
+      ResolveParameters(rig.robot, planes.size(), estimate_plane, estimate_ranger, fix);
   return FromJson(
       ReportKinematics(rig, planes, ps, which == "true", configs, jacobian).rows.dump());
 }
