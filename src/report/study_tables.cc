@@ -237,12 +237,22 @@ std::vector<std::string> StopColumns(const CellSummary& s) {
           Percent(stop.precision.p95_relative_halfwidth)};
 }
 
+// A cell's design criterion (E unless its settings say otherwise).
+std::string DesignCriterion(const Json& settings) {
+  return settings.value("/selection/criterion"_json_pointer, std::string("E"));
+}
+
+// True when the cell's design is drawn anew every trial (its pool or its selection).
+bool DesignRedrawn(const Json& settings) {
+  return settings.value("/selection/redraw"_json_pointer, false) ||
+         settings.value("/pool/redraw"_json_pointer, false);
+}
+
 // The certified share of the best possible criterion value the cell's design reaches.
 std::string DesignEfficiency(const CellSummary& s) {
   if (std::isnan(s.cell.design_efficiency)) return "—";
-  const std::string criterion =
-      Json::parse(s.cell.settings).value("/selection/criterion"_json_pointer, std::string("E"));
-  return Fixed(100 * s.cell.design_efficiency, 1) + " % of the " + criterion + " bound";
+  return Fixed(100 * s.cell.design_efficiency, 1) + " % of the " +
+         DesignCriterion(Json::parse(s.cell.settings)) + " bound";
 }
 
 Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
@@ -257,9 +267,7 @@ Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
     std::string failed;
     for (const auto& [reason, n] : s.failed)
       failed += (failed.empty() ? "" : ", ") + reason + " " + std::to_string(n);
-    const Json settings = Json::parse(s.cell.settings);
-    const bool redrawn = settings.value("/selection/redraw"_json_pointer, false) ||
-                         settings.value("/pool/redraw"_json_pointer, false);
+    const bool redrawn = DesignRedrawn(Json::parse(s.cell.settings));
     const std::string sigma_min =
         redrawn && s.design_sigma_min.n > 0
             ? Fixed(s.design_sigma_min.mean, 5) + " [" + Fixed(s.design_sigma_min.p5, 5) + ", " +
@@ -321,8 +329,7 @@ std::vector<std::string> CellsCsvRow(const CellSummary& s, const StopWhen& rule,
     reasons += (reasons.empty() ? "" : "; ") + reason + " " + std::to_string(n);
   }
   const Json settings = Json::parse(s.cell.settings);
-  const bool redrawn = settings.value("/selection/redraw"_json_pointer, false) ||
-                       settings.value("/pool/redraw"_json_pointer, false);
+  const bool redrawn = DesignRedrawn(settings);
   const bool spread = redrawn && s.design_sigma_min.n > 0;
   std::vector<std::string> row = {
       s.cell.id,
@@ -336,7 +343,7 @@ std::vector<std::string> CellsCsvRow(const CellSummary& s, const StopWhen& rule,
       spread ? CsvValue(s.design_sigma_min.p95) : "",
       redrawn ? "1" : "0",
       CsvValue(s.cell.design_efficiency),
-      settings.value("/selection/criterion"_json_pointer, std::string("E"))};
+      DesignCriterion(settings)};
   if (rule.enabled()) {
     const CellStop& stop = s.stop;
     row.emplace_back(!stop.decided ? "running" : stop.precise ? "precision" : "maximum");

@@ -18,6 +18,7 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from .._run import Run as _StoredRun  # noqa: E402
+from .._run import _display_column  # noqa: E402
 
 AXES = ("x", "y", "z")
 METRICS = (("rms_pos", "RMS position error (mm)"), ("rms_ori", "RMS orientation error (mrad)"),
@@ -26,8 +27,9 @@ MAX_CELLS_PER_FIGURE = 12
 
 
 def _column(metric, axis):
-    """The trial table's column of a validation metric of the identified model (mm or mrad)."""
-    return f"val_{metric}_{axis}_{'mm' if metric.endswith('pos') else 'mrad'}"
+    """The trial table's column of a validation metric of the identified model (mm or mrad):
+    load_run's name for the store's column."""
+    return _display_column(f"val_{metric}_{axis}")[0]
 
 
 class RunDataError(Exception):
