@@ -23,11 +23,12 @@
 namespace lrcal {
 namespace {
 
-std::string PredictionStudy(const std::string& dir, int trials) {
+std::string PredictionStudy(const std::string& dir, int trials, int validation_poses = 15) {
   const std::string path = dir + "/prediction.yaml";
   std::ofstream(path) << "name: prediction\nseed: 8\ntrials: " << trials
                       << "\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
-                      << "\npool: {size: 60}\nselection: {count: 40}\nvalidation: {size: 15}\n";
+                      << "\npool: {size: 60}\nselection: {count: 40}\nvalidation: {size: "
+                      << validation_poses << "}\n";
   return path;
 }
 
@@ -35,11 +36,7 @@ std::string PredictionStudy(const std::string& dir, int trials) {
 // about 1 KB): the draws have the bits of the whole 6M × draws product, summed pose by pose.
 TEST(ValidationPrediction, BlocksOfPosesGiveTheBitsOfTheWholeProduct) {
   const std::string dir = testing::TempDir("prediction_blocks");
-  std::ofstream(dir + "/s.yaml") << "name: blocks\nseed: 2\ntrials: 1\nrobot: "
-                                 << testing::SourcePath("studies/robots/paper.yaml")
-                                 << "\npool: {size: 60}\nselection: {count: 40}\n"
-                                    "validation: {size: 700}\n";
-  const Study study = LoadStudy(dir + "/s.yaml");
+  const Study study = LoadStudy(PredictionStudy(dir, 1, 700));
   const auto c = PrepareCell(study, study.cells[0]);
   constexpr int kDraws = 50;
   const Eigen::MatrixXd blocked = LinearisedValidationDraws(*c, kDraws);
