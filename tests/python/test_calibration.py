@@ -379,6 +379,17 @@ def test_identify_with_several_planes_ranger_holdout_and_predict_at_is_the_progr
     with pytest.raises(lrcal.InputError, match="outside the joint's range"):
         lrcal.identify(paper, np.degrees(m[:, :6]), m[:, header.index("h")], plane=planes,
                        plane_of=m[:, header.index("plane")])
+    q, h = m[:, :6], m[:, header.index("h")]
+    tags = m[:, header.index("plane")]
+    with pytest.raises(lrcal.InputError, match=r"predict_at: expected an array of shape \(N, 6\)"):
+        lrcal.identify(paper, q, h, plane=planes, plane_of=tags, predict_at=np.zeros((3, 5)))
+    with pytest.raises(lrcal.InputError, match="estimate_ranger: unknown ranger term 'offst'"):
+        lrcal.identify(paper, q, h, plane=planes, plane_of=tags, estimate_ranger="offst")
+    with pytest.raises(lrcal.InputError, match=r"plane_of: expected one plane number \(from 1\)"):
+        lrcal.identify(paper, q, h, plane=planes, plane_of=["a"] * len(q))
+    with pytest.raises(lrcal.InputError, match=r"plane_of: expected one plane number per reading "
+                                               r"\(1200\), got 3"):
+        lrcal.identify(paper, q, h, plane=planes, plane_of=[1, 2, 3])
 
 
 def test_identifiability_with_several_planes_and_ranger_terms_is_the_programs(tmp_path, cli,
