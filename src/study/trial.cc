@@ -543,12 +543,16 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   const TrialDesign* design = nullptr;
   if (!DesignOfTrial(c, trial, truth, &redrawn, &design)) return finish(TrialStatus::kBeamMissed);
   rec.sigma_min = design->sigma_min;
-  if (SimulateTrialReadings(c, trial, truth, *design, ws) > 0)
-    return finish(TrialStatus::kBeamMissed);
-
-  const SolveOutcome r = IdentifyTrial(c, design == &c.design, ws);
-  rec.iterations = r.iterations;
+  // A configuration whose true beam misses its plane has no reading: it is left out, and the
+  // trial goes on with the others unless fewer readings than parameters remain.
+  rec.missed_configurations = SimulateTrialReadings(c, trial, truth, *design, ws);
   const int m = ws->data.size(), n = c.model->num_parameters();
+  if (m < n) return finish(TrialStatus::kBeamMissed);
+
+  // The cell's cached nominal linearisation holds for its own design only when nothing is missing.
+  const SolveOutcome r =
+      IdentifyTrial(c, design == &c.design && rec.missed_configurations == 0, ws);
+  rec.iterations = r.iterations;
   rec.residual_rms =
       std::sqrt(2 * r.final_cost / (m * s.noise.EffectiveReadings()));  // per-config mean
   rec.sigma_hat = m > n ? std::sqrt(2 * r.final_cost / (m - n)) : 0.0;
@@ -577,8 +581,9 @@ const char* TrialStatusReason(TrialStatus s) {
     case TrialStatus::kNumericalFailure:
       return "a non-finite cost or a failed factorisation during the identification";
     case TrialStatus::kBeamMissed:
-      return "a beam missed its plane: the true arm's beam at a configuration of the design (no "
-             "reading), or the model's beam at an iterate of the identification";
+      return "a beam missed its plane: the true arm's beams at so many configurations of the "
+             "design that fewer readings than parameters remained, or the model's beam at an "
+             "iterate of the identification";
   }
   return "";
 }

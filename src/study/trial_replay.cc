@@ -29,6 +29,8 @@ std::vector<std::string> Differences(const TrialRecord& a, const TrialRecord& b)
   if (!SameBits(a.residual_rms, b.residual_rms)) out.emplace_back("residual_rms");
   if (!SameBits(a.sigma_hat, b.sigma_hat)) out.emplace_back("sigma_hat");
   if (!SameBits(a.sigma_min, b.sigma_min)) out.emplace_back("sigma_min");
+  if (a.missed_configurations != b.missed_configurations)
+    out.emplace_back("missed_configurations");
   if (a.errors.size() != b.errors.size() ||
       (!a.errors.empty() &&
        std::memcmp(a.errors.data(), b.errors.data(), a.errors.size() * sizeof(double)) != 0))
@@ -114,6 +116,7 @@ ResultJson RecordJson(const TrialRecord& r) {
   j["residual_rms"] = r.residual_rms;
   j["sigma_hat"] = r.sigma_hat;
   j["sigma_min"] = r.sigma_min;
+  j["missed_configurations"] = r.missed_configurations;
   j["errors"] = r.errors;
   // A failed trial identified no model: its validation is null (as the store has it).
   const bool ok = r.status == TrialStatus::kOk;
@@ -143,7 +146,11 @@ void PrintIdentifiedModel(const TrialReplay& t, std::ostream& out) {
               Fixed(t.recomputed.validation[3 * m + 2] * 1e3, 6)});
   out << v.ToText() << t.configurations.size()
       << " configurations read (--format json lists them with their readings and "
-         "residuals)\n";
+         "residuals)";
+  if (t.recomputed.missed_configurations > 0)
+    out << "; " << t.recomputed.missed_configurations
+        << " more of the design had no reading (the true beam missed its plane) and were left out";
+  out << "\n";
 }
 
 }  // namespace
@@ -197,7 +204,8 @@ std::string TrialReplay::ToText() const {
     // A failed trial identified no model: no parameter errors, no validation to show.
     out << "the trial failed (" << TrialStatusName(t.recomputed.status)
         << "): " << TrialStatusReason(t.recomputed.status) << "\n"
-        << t.configurations.size() << " configurations with readings\n";
+        << t.configurations.size() << " configurations with readings, "
+        << t.recomputed.missed_configurations << " without (the true beam missed its plane)\n";
   } else {
     PrintIdentifiedModel(t, out);
   }

@@ -93,7 +93,7 @@ std::string TrialColumns() {
   for (const char* prefix : {"val_", "nom_"})
     for (int k = 0; k < kNumValidationColumns; ++k)
       cols += std::string(", ") + prefix + ValidationColumnName(k);
-  return cols + ", errors, seconds";
+  return cols + ", errors, seconds, missed_configurations";
 }
 
 }  // namespace
@@ -144,8 +144,19 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
   for (const char* prefix : {"val_", "nom_"})
     for (int k = 0; k < kNumValidationColumns; ++k)
       trials += std::string(", ") + prefix + ValidationColumnName(k) + " REAL";
-  trials += ", errors BLOB, seconds REAL, PRIMARY KEY(cell_id, trial)) WITHOUT ROWID";
+  trials +=
+      ", errors BLOB, seconds REAL, missed_configurations INTEGER NOT NULL DEFAULT 0, "
+      "PRIMARY KEY(cell_id, trial)) WITHOUT ROWID";
   Exec(trials);
+  // Stores written before a missed beam dropped its configuration (every such trial failed):
+  // the column, 0 for every trial already recorded.
+  bool has_missed = false;
+  {
+    Statement info(db_, "PRAGMA table_info(trials)");
+    while (info.Step()) has_missed |= info.ColumnText(1) == "missed_configurations";
+  }
+  if (!has_missed)
+    Exec("ALTER TABLE trials ADD COLUMN missed_configurations INTEGER NOT NULL DEFAULT 0");
 }
 
 TrialStore::~TrialStore() { sqlite3_close(db_); }
@@ -245,7 +256,7 @@ void TrialStore::Insert(const std::vector<TrialRecord>& records) {
   Exec("BEGIN IMMEDIATE");
   try {
     std::string q = "INSERT OR IGNORE INTO trials(" + TrialColumns() + ") VALUES (?";
-    for (int i = 1; i < 7 + 24 + 2; ++i) q += ", ?";
+    for (int i = 1; i < 7 + 24 + 3; ++i) q += ", ?";
     q += ")";
     Statement st(db_, q);
     for (const TrialRecord& r : records) {
@@ -271,6 +282,7 @@ void TrialStore::Insert(const std::vector<TrialRecord>& records) {
       else
         sqlite3_bind_null(st.get(), 32);
       sqlite3_bind_double(st.get(), 33, r.seconds);
+      sqlite3_bind_int(st.get(), 34, r.missed_configurations);
       st.Step();
     }
     Exec("COMMIT");  // a full disk usually shows here: the batch is rolled back, nothing half-done
@@ -324,6 +336,7 @@ void ReadTrialRow(Statement& st, TrialRecord* r) {
   r->errors.resize(bytes / sizeof(double));
   if (bytes) std::memcpy(r->errors.data(), sqlite3_column_blob(st.get(), 31), bytes);
   r->seconds = sqlite3_column_double(st.get(), 32);
+  r->missed_configurations = sqlite3_column_int(st.get(), 33);
 }
 
 }  // namespace

@@ -132,5 +132,46 @@ TEST(TrialReplayOfFailedTrials, EachStatusReplaysAndMatchesItsRecord) {
   EXPECT_EQ(statuses, (std::set<std::string>{"ok", "not_converged", "beam_missed"}));
 }
 
+// Issue 31: a configuration whose true beam misses its plane has no reading and is left out;
+// the trial goes on with the others (recorded with the count), and fails as beam_missed only
+// when fewer readings than parameters remain.
+TEST(TrialReplayOfFailedTrials, AMissedBeamDropsItsConfigurationNotTheTrial) {
+  const std::string dir = testing::TempDir("trial_replay_missed");
+  std::ofstream(dir + "/s.yaml") << "name: missed\nseed: 3\ntrials: 8\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 60}\nselection: {count: 40}\n"
+                                    "validation: {size: 5}\n"
+                                    "truth: {mode: random, length_sigma_mm: 60, "
+                                    "angle_sigma_mrad: 60}\n";
+  std::string out;
+  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir + "/run/trials.sqlite").c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT trial, status, missed_configurations FROM trials "
+                               "ORDER BY missed_configurations DESC LIMIT 1",
+                               -1, &st, nullptr),
+            SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(st), SQLITE_ROW);
+  const long long trial = sqlite3_column_int64(st, 0);
+  const std::string status = reinterpret_cast<const char*>(sqlite3_column_text(st, 1));
+  const int missed = sqlite3_column_int(st, 2);
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  EXPECT_EQ(status, "ok");
+  ASSERT_GT(missed, 0) << "the study should make some true beams miss";
+  const std::string args = "trial " + dir + "/run --cell base --trial " + std::to_string(trial);
+  ASSERT_EQ(Lrcal(args + " --format json", &out), 0) << out;
+  const auto j = nlohmann::json::parse(out);
+  EXPECT_TRUE(j["identical"].get<bool>()) << out;
+  EXPECT_EQ(j["record"]["missed_configurations"], missed);
+  EXPECT_EQ(j["configurations"].size() + static_cast<std::size_t>(missed), 40u);
+  ASSERT_EQ(Lrcal(args, &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr(std::to_string(missed) +
+                                        " more of the design had no reading (the true beam "
+                                        "missed its plane) and were left out"));
+}
+
 }  // namespace
 }  // namespace lrcal

@@ -72,6 +72,7 @@ def test_run_study_gives_the_programs_tables_and_trials(tmp_path, cli):
         case1 = py_run.trials[py_run.trials["cell_id"] == row["cell_id"].item()]
         assert abs(case1[f"val_{metric}_x_{unit}"].mean() - row["mean"].item()) < 5e-7
     assert {"residual_rms_mm", "sigma_hat_mm", "nom_rms_ori_z_mrad"} <= set(py_run.trials.columns)
+    assert (py_run.trials["missed_configurations"] == 0).all()  # the paper's beams all hit
     # One flat column per setting the study varies, in the cells frame and in cells.csv, with
     # numbers as numbers.
     cells = py_run.tables["cells"]

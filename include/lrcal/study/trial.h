@@ -37,6 +37,10 @@ struct TrialRecord {
   /// The same for the nominal (uncalibrated) model.
   std::array<double, 12> nominal{};
   double seconds = 0;  ///< wall time of the trial (not part of any table)
+  /// Configurations of the design whose true beam missed its plane: they have no reading and are
+  /// left out of the fit (the trial fails as beam_missed only when fewer readings than
+  /// parameters remain).
+  int missed_configurations = 0;
 };
 
 /// One realisation in detail (the paper's figures): per measurement configuration the distance

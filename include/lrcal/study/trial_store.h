@@ -6,7 +6,8 @@
 //         predicted_std_truth JSON (SI), predicted_validation JSON (SI, 12 metrics),
 //         design_efficiency)
 //   trials(cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min,
-//          val_{rms,max}_{pos,ori}_{x,y,z}, nom_{...}, errors BLOB, seconds)
+//          val_{rms,max}_{pos,ori}_{x,y,z}, nom_{...}, errors BLOB, seconds,
+//          missed_configurations)
 //     errors: the parameter errors (estimate − truth, SI) as little-endian float64, in the order
 //     of cells.parameter_names; NULL unless status = 'ok'. Other lengths in m, angles in rad.
 //   meta(key, value)

@@ -130,7 +130,9 @@ class Run:
                 cell_id, trial, status, iterations, residual_rms_mm, sigma_hat_mm, sigma_min
                 (σ_min of the design's G, SI), val_{rms,max}_pos_{x,y,z}_mm and
                 val_{rms,max}_ori_{x,y,z}_mrad (validation errors of the identified model),
-                nom_..._mm and nom_..._mrad (of the nominal model), seconds
+                nom_..._mm and nom_..._mrad (of the nominal model), seconds,
+                missed_configurations (design configurations whose true beam missed its plane:
+                no reading, left out of the fit)
       tables    {name: table} for every tables/<name>.csv (units as the CSV headers say;
                 empty until the run is complete)
       summary   tables/summary.json as a dict, or None
@@ -196,14 +198,17 @@ class Run:
 
     def _trial_columns(self):
         """The trial table's columns as the run's store names them: the leading ones, the
-        validation metrics of the identified (val_*) and nominal (nom_*) models, seconds."""
+        validation metrics of the identified (val_*) and nominal (nom_*) models, seconds, and
+        missed_configurations where the store records it (stores written before lrcal kept a trial
+        whose beam missed at some configurations do not)."""
         present = []
         if self._stores:  # no store yet: no trials, no metric columns
             with self._connect(self._stores[0]) as db:
                 present = [c[1] for c in db.execute("PRAGMA table_info(trials)")]
         metrics = [c for c in present if c.startswith("val_")] + \
                   [c for c in present if c.startswith("nom_")]
-        return _TRIAL_LEADING + metrics + ["seconds"]
+        missed = ["missed_configurations"] if "missed_configurations" in present else []
+        return _TRIAL_LEADING + metrics + ["seconds"] + missed
 
     def _read_trials(self, with_errors=False):
         rows = {}
