@@ -53,7 +53,14 @@ RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_lin
   return LoadRobotFile(ResolveRobotPath(name_or_path), tool_link);
 }
 
+namespace {
+bool robot_defaulted = false;
+}  // namespace
+
+bool RobotWasDefaulted() { return robot_defaulted; }
+
 RobotFile LoadRobot(const po::variables_map& vm) {
+  robot_defaulted = vm["robot"].defaulted();
   return LoadRobot(vm["robot"].as<std::string>(),
                    vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "");
 }

@@ -42,6 +42,10 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
 /// --robot and --tool-link.
 RobotFile LoadRobot(const po::variables_map& vm);
+/// Whether the last LoadRobot(vm) used --robot's default (the paper's arm) because none was
+/// given: an input error then says so, since a forgotten --robot shows as joint values out of
+/// range or a wrong number of joints rather than as itself.
+bool RobotWasDefaulted();
 /// --plane (repeated: several planes, in order) if given, else the robot file's plane(s);
 /// InputError if neither.
 PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm);

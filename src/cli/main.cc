@@ -65,6 +65,14 @@ void PrintUsage(std::ostream& out) {
     out << "  " << c.name << std::string(18 - c.name.size(), ' ') << c.summary << "\n";
 }
 
+// After an input error: a note when the command ran on --robot's default because none was given.
+std::string DefaultRobotNote(const std::string& command) {
+  if (!lrcal::cli::RobotWasDefaulted()) return "";
+  return "lrcal " + command +
+         ": note: no --robot was given, so this used the paper's arm (the default); give --robot "
+         "FILE (YAML or URDF) for another arm\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -90,10 +98,12 @@ int main(int argc, char** argv) {
     } catch (const lrcal::SettingError& e) {  // a library check: in the option's words
       if (!OtherMpiRank())
         std::cerr << "lrcal " << name
-                  << ": error: " << e.Respelled(lrcal::Frontend::kCommandLine).what() << "\n";
+                  << ": error: " << e.Respelled(lrcal::Frontend::kCommandLine).what() << "\n"
+                  << DefaultRobotNote(name);
       return 2;
     } catch (const lrcal::InputError& e) {
-      if (!OtherMpiRank()) std::cerr << "lrcal " << name << ": error: " << e.what() << "\n";
+      if (!OtherMpiRank())
+        std::cerr << "lrcal " << name << ": error: " << e.what() << "\n" << DefaultRobotNote(name);
       return 2;
     } catch (const lrcal::StorageError& e) {
       std::cerr << "lrcal " << name << ": could not write results: " << e.what() << "\n";

@@ -198,7 +198,8 @@ const std::vector<BadInput>& Cases() {
        "kinematics --configs c.csv",
        2,
        {"c.csv configuration 2 column 'q1'", "outside the joint's range",
-        "were they written in degrees?"}},
+        "were they written in degrees?",
+        "note: no --robot was given, so this used the paper's arm (the default)"}},
       {"CsvMeasurementJointsInDegrees",
        {{"m.csv", "q1,q2,q3,q4,q5,q6,h\n0,0,0,-30,0,0,1\n"}},
        "identify --data m.csv",
@@ -845,6 +846,19 @@ INSTANTIATE_TEST_SUITE_P(Cases, BadInputTest, ::testing::ValuesIn(Cases()),
                          [](const ::testing::TestParamInfo<BadInput>& info) {
                            return info.param.name;
                          });
+
+// Issue 31: the note on --robot's default appears only when --robot was left out.
+TEST(BadInputDefaultRobot, NoNoteWhenTheRobotIsGiven) {
+  const std::string dir = testing::TempDir("bad_default_robot");
+  std::ofstream(dir + "/c.csv") << "q1,q2,q3,q4,q5,q6\n90,0,45,0,0,0\n";
+  std::string out;
+  EXPECT_EQ(testing::RunCommand("cd " + dir + " && " + testing::LrcalBinary() +
+                                    " kinematics --robot paper --configs c.csv",
+                                &out),
+            2);
+  EXPECT_THAT(out, ::testing::HasSubstr("were they written in degrees?"));
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("no --robot was given")));
+}
 
 TEST(BadInputTable, HasAtLeastEightyCasesOfBadInput) {
   int bad = 0;
