@@ -199,8 +199,11 @@ std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
   return weights;
 }
 
-IdentificationSummary Identify(const MeasurementModel& model_in, const MeasurementSet& data,
-                               const IdentificationOptions& options) {
+namespace {
+
+IdentificationSummary IdentifyReadings(const MeasurementModel& model_in,
+                                       const MeasurementSet& data,
+                                       const IdentificationOptions& options) {
   // The maximum a-posteriori estimate and errors in variables are the kind-neutral path's
   // (prior.h, ErrorsInVariablesWeights).
   if (!options.priors.empty() || options.encoder_sigma > 0)
@@ -259,6 +262,16 @@ IdentificationSummary Identify(const MeasurementModel& model_in, const Measureme
   }
 
   EstimateStatistics(*model, data, weights, e, options, &s);
+  return s;
+}
+
+}  // namespace
+
+IdentificationSummary Identify(const MeasurementModel& model, const MeasurementSet& data,
+                               const IdentificationOptions& options) {
+  IdentificationSummary s = IdentifyReadings(model, data, options);
+  if (data.labels.size() == static_cast<std::size_t>(data.size()))
+    s.fit.configuration_labels = data.labels;
   return s;
 }
 
@@ -438,6 +451,11 @@ Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double
   return sigma * sigma * normal_matrix.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
 }
 
+std::string FitCheck::LabelOf(int configuration) const {
+  const auto i = static_cast<std::size_t>(configuration);
+  return i < configuration_labels.size() ? configuration_labels[i] : std::string();
+}
+
 std::string FitCheck::Explain() const {
   std::ostringstream out;
   if (sigma_given) {
@@ -465,12 +483,15 @@ std::string FitCheck::Explain() const {
   if (!suspects.empty()) {
     out << "suspect readings (|residual| > 4 " << (sigma_given ? "sigma" : "sigma_hat")
         << "), configuration (1-based"
+        << (configuration_labels.empty() ? "" : ", with its label")
         << (rows_per_configuration > 1 ? ", then the value: .1 .. ." : "")
         << (rows_per_configuration > 1 ? std::to_string(rows_per_configuration) : "")
         << ") and standardised residual:";
     for (int i : suspects) {
       out << " " << i / rows_per_configuration + 1;
       if (rows_per_configuration > 1) out << "." << i % rows_per_configuration + 1;
+      const std::string label = LabelOf(i / rows_per_configuration);
+      if (!label.empty()) out << " '" << label << "'";
       out << " (" << standardized[i] << ")";
     }
     out << "\n";

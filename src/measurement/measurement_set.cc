@@ -118,6 +118,7 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
   for (std::size_t i = 0; i < first.size(); ++i) {
     data.mean_h.push_back(sums[i] / counts[i]);
     data.repetitions.push_back(counts[i]);
+    if (labels) data.labels.push_back((*labels)[static_cast<std::size_t>(first[i])]);
   }
   if (!average.IsMean()) CombineRobustly(h, group, first, average, where, &data);
   return data;

@@ -424,7 +424,26 @@ struct IdentifyArgs {
   py::object plane_of = py::none();      // one plane number (from 1) per reading, or None
   py::object holdout = py::none();       // as --holdout K, or None
   py::object predict_at = py::none();    // as --predict-at: poses (M, joints), or None
+  py::object configuration = py::none();  // one label per reading (a CSV's configuration column)
 };
+
+// identify's `configuration`: one label per reading (any value, as text), none empty.
+std::optional<std::vector<std::string>> ConfigurationLabels(const py::object& labels,
+                                                            std::size_t readings) {
+  if (labels.is_none()) return std::nullopt;
+  std::vector<std::string> out;
+  for (const py::handle item : labels) {
+    out.push_back(py::str(item).cast<std::string>());
+    if (out.back().empty())
+      throw InputError("configuration[" + std::to_string(out.size() - 1) + "]",
+                       "empty: expected the label of the configuration this reading was taken at");
+  }
+  if (out.size() != readings)
+    throw InputError("configuration", "expected one label per reading (" +
+                                          std::to_string(readings) + "), got " +
+                                          std::to_string(out.size()));
+  return out;
+}
 
 PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
 
@@ -527,10 +546,11 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   const ConfigsAndModel set =
       ResolveConfigsAndModel(rig, q, plane_arg, a.plane_of, estimate_plane, a.estimate_ranger, fix);
   const std::vector<double> readings = ToVector(h, "h");
+  const auto labels = ConfigurationLabels(a.configuration, readings.size());
   const MeasurementSet data = GroupReadings(
       set.configs, readings, &rig.ranger,
-      [](int r) { return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]"; }, nullptr,
-      Averaging::Parse(a.average));
+      [](int r) { return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]"; },
+      labels ? &*labels : nullptr, Averaging::Parse(a.average));
   const MeasurementModel& model = *set.model;
   const IdentificationOptions options = IdentifyOptionsPy(rig, auto_fix, a);
   std::optional<int> folds;
@@ -966,11 +986,17 @@ str() gives the full text report; repr() the one-line summary.)doc")
             d["consistent"] = s.fit.consistent;
             d["standardized"] = s.fit.standardized;
             d["suspects"] = s.fit.suspects;
+            if (!s.fit.configuration_labels.empty()) {
+              py::list labels;
+              for (int i : s.fit.suspects) labels.append(s.fit.LabelOf(i));
+              d["suspect_labels"] = labels;
+            }
             return d;
           },
           "The fit check, as identify's JSON 'fit': chi2 against the given sigma_mm, dof, "
           "p_value, consistent (p >= 0.001), standardized residuals and suspects (0-based "
-          "configurations with |standardized| > 4).")
+          "configurations with |standardized| > 4), with suspect_labels when the readings were "
+          "grouped by configuration labels.")
       .def("__str__", &S::FullReport)
       .def("__repr__", &S::BriefReport);
 }
@@ -1053,6 +1079,9 @@ Identifies the geometric parameters (and plane terms) from laser readings.
 
 q (M, joints) rad and h (M,) m are single readings; readings at identical joint values are
 averaged (weight = their count), exactly as `lrcal identify --data` does with a CSV.
+configuration: None, or one label per reading (a measurement CSV's configuration column): the
+readings that share a label are one configuration, whatever their recorded joint values, and the
+fit check names suspects by label (fit['suspect_labels']).
 plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
 lrcal.Plane (several planes, as repeated --plane). plane_of: with several planes, the plane each
 reading's beam is aimed at, a number from 1 per reading (a measurement CSV's plane column).
@@ -1100,12 +1129,14 @@ void DefineIdentify(py::module_& m) {
          long long max_iterations, const py::object& loss_scale, const py::object& sigma,
          const std::string& prior_sigma, bool prior, double encoder_sigma_mrad,
          const std::string& average, const py::object& plane_of, const std::string& estimate_ranger,
-         const py::object& holdout, const py::object& predict_at) {
+         const py::object& holdout, const py::object& predict_at,
+         const py::object& configuration) {
         IdentifyExtras extras;
         py::object result = py::cast(IdentifyPy(
             rig, q, h, plane, estimate_plane, fix, auto_fix,
             {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma, prior_sigma,
-             prior, encoder_sigma_mrad, average, estimate_ranger, plane_of, holdout, predict_at},
+             prior, encoder_sigma_mrad, average, estimate_ranger, plane_of, holdout, predict_at,
+             configuration},
             &extras));
         // As `lrcal identify --format json` has them: "holdout" and "accuracy" (None when not
         // asked for, or when the fit is not usable).
@@ -1123,7 +1154,8 @@ void DefineIdentify(py::module_& m) {
       py::arg("sigma") = py::none(), py::arg("prior_sigma") = "", py::arg("prior") = false,
       py::arg("encoder_sigma_mrad") = 0.0, py::arg("average") = Averaging{}.Name(),
       py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
-      py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(), kIdentifyDoc);
+      py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(),
+      py::arg("configuration") = py::none(), kIdentifyDoc);
 }
 
 void DefineCalibration(py::module_& m) {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -560,6 +561,39 @@ TEST_F(CliTest, IdentifyChecksTheFitAgainstTheStatedNoise) {
       << out;
   EXPECT_THAT(out, ::testing::HasSubstr("10 given")) << out;
   EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("dependence"))) << out;
+}
+
+// Issue 31: with a `configuration` column the suspects are named by their labels too.
+TEST_F(CliTest, IdentifyNamesSuspectsByTheirConfigurationLabels) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 60 --seed 4 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0);
+  std::ifstream in(Path("m.csv"));
+  std::string line, labelled;
+  std::getline(in, line);
+  labelled = line + ",configuration\n";
+  std::map<std::string, int> station;  // joint values → 1-based configuration
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells = SplitList(line);
+    std::string q;
+    for (int c = 0; c < 6; ++c) q += cells[static_cast<std::size_t>(c)] + ",";
+    const int k = station.emplace(q, static_cast<int>(station.size()) + 1).first->second;
+    if (k == 18) cells[6] = FormatExact(std::stod(cells[6]) + 0.5e-3);  // 0.5 mm off: 8 sigma
+    for (const std::string& cell : cells) labelled += cell + ",";
+    labelled += "station_" + std::to_string(k) + "\n";
+  }
+  Write("labelled.csv", labelled);
+  ASSERT_EQ(Run("identify --data " + Path("labelled.csv") + " --sigma-mm 0.2 --format json", &out),
+            4)
+      << out;
+  const Json fit = Json::parse(out.substr(0, out.rfind('}') + 1))["fit"];
+  EXPECT_EQ(fit["suspects"], Json::array({18}));
+  EXPECT_EQ(fit["suspect_labels"], Json::array({"station_18"}));
+  EXPECT_EQ(Run("identify --data " + Path("labelled.csv") + " --sigma-mm 0.2", &out), 4);
+  EXPECT_THAT(out, ::testing::HasSubstr("18 'station_18' (")) << out;
+  // Without labels, no suspect_labels.
+  ASSERT_EQ(Run("identify --data " + Path("m.csv") + " --sigma-mm 0.2 --format json", &out), 0);
+  EXPECT_FALSE(Json::parse(out)["fit"].contains("suspect_labels"));
 }
 
 // identify --write-robot: the calibrated model as a robot file whose nominal values are the

@@ -542,6 +542,13 @@ TEST(Identification, SuspectsAndTooFewConfigurations) {
   ASSERT_TRUE(s.IsSolutionUsable());
   EXPECT_EQ(s.fit.suspects, std::vector<int>{17});
   EXPECT_THAT(s.fit.Explain(), ::testing::HasSubstr("18 (")) << s.fit.Explain();
+  // Issue 31: with labels (a measurement file's configuration column) the suspect is named by
+  // its label as well.
+  for (int i = 0; i < data.size(); ++i) data.labels.push_back("pose_" + std::to_string(100 + i));
+  const IdentificationSummary labelled = Identify(model, data, o);
+  EXPECT_EQ(labelled.fit.suspects, std::vector<int>{17});
+  EXPECT_THAT(labelled.fit.Explain(), ::testing::HasSubstr("18 'pose_117' ("));
+  EXPECT_EQ(labelled.fit.LabelOf(17), "pose_117");
   MeasurementSet exact;
   SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
                    testing::PaperHittingConfigurations(25, 15), NoiseModel{0.2e-3, 10, true},

@@ -91,6 +91,31 @@ def test_sample_simulate_identify_match_the_program_bit_for_bit(tmp_path, cli, p
     assert result.usable and "converged" in repr(result) and "theta1" in str(result)
 
 
+def test_identify_names_suspects_by_configuration_label_as_the_program(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 60, seed=4)
+    readings = lrcal.simulate(paper, q, sigma_mm=0.2, repetitions=10, seed=4)
+    h = readings.h.copy()
+    h[readings.configuration == 17] += 0.5e-3  # 8 sigma on the mean of 10
+    labels = [f"station_{c + 1}" for c in readings.configuration]
+    data = tmp_path / "m.csv"
+    with open(data, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow([f"q{j + 1}" for j in range(6)] + ["h", "configuration"])
+        for row, value, label in zip(readings.q, h, labels):
+            w.writerow([repr(float(v)) for v in row] + [repr(float(value)), label])
+    done = cli("identify", "--robot", "paper", "--data", data, "--sigma-mm", 0.2, "--format",
+               "json", check=False)
+    program = json.loads(done.stdout)["fit"]
+    result = lrcal.identify(paper, readings.q, h, sigma_mm=0.2, configuration=labels)
+    assert result.fit["suspects"] == [s - 1 for s in program["suspects"]]
+    assert result.fit["suspect_labels"] == program["suspect_labels"] == ["station_18"]
+    assert "suspect_labels" not in lrcal.identify(paper, readings.q, h, sigma_mm=0.2).fit
+    with pytest.raises(lrcal.InputError, match="expected one label per reading"):
+        lrcal.identify(paper, readings.q, h, configuration=labels[:-1])
+    with pytest.raises(lrcal.InputError, match=r"configuration\[3\]: empty"):
+        lrcal.identify(paper, readings.q, h, configuration=labels[:3] + [""] + labels[4:])
+
+
 def test_identify_with_priors_matches_the_program_bit_for_bit(tmp_path, cli, paper):
     """lrcal.identify(prior_sigma=...) is `lrcal identify --prior-sigma`: the same maximum
     a-posteriori estimate, covariance and posterior/prior ratios, and the same refusals."""

@@ -122,6 +122,11 @@ struct FitCheck {
   std::vector<int> suspects;
   /// Measured values per configuration (measurement_kind.h): 1 for the ranger.
   int rows_per_configuration = 1;
+  /// The configurations' labels (MeasurementSet::labels) when the data has them: suspects are
+  /// then named by label as well as by number. Empty otherwise.
+  std::vector<std::string> configuration_labels{};
+  /// Configuration i's label, or "" without labels.
+  std::string LabelOf(int configuration) const;
   /// With priors (prior.h): how many terms have one, and their part of chi2, Σ e_k²/σ_k² (the
   /// rest is the readings'). A large part says the priors are tighter than the terms' true
   /// deviations. NaN without σ.
@@ -184,7 +189,8 @@ struct IdentificationSummary {
 /// and the Monte-Carlo prediction compute it.
 Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double sigma);
 
-/// Identifies the model's parameter set from `data`.
+/// Identifies the model's parameter set from `data` (its configuration labels, if any, go to the
+/// fit check).
 IdentificationSummary Identify(const MeasurementModel& model, const MeasurementSet& data,
                                const IdentificationOptions& options = {});
 

@@ -19,6 +19,9 @@ struct MeasurementSet {
   /// Each configuration's variance factor c (averaging.h): its value's variance is c·σ²/R.
   /// Empty for means (c = 1 everywhere).
   std::vector<double> variance_factor;
+  /// Each configuration's label (a measurement file's `configuration` column), in order; empty
+  /// when the readings were grouped by their joint values. Messages name configurations by it.
+  std::vector<std::string> labels{};
   int size() const { return configs.size(); }
   /// The residual weight of configuration i: R/c (exactly R for a mean).
   double Weight(int i) const {

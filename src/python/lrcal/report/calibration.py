@@ -179,8 +179,10 @@ def fit_text(data):
     elif data.get("sigma_hat") is not None:
         parts.append(f"No σ given: σ̂ per reading {data['sigma_hat'] * 1e3:.4f} mm.")
     if fit.get("suspects"):
-        parts.append("Suspect configurations (beyond 4 σ): "
-                     + ", ".join(str(i) for i in fit["suspects"]) + ".")
+        labels = fit.get("suspect_labels") or [None] * len(fit["suspects"])
+        parts.append("Suspect configurations (beyond 4 σ): " + ", ".join(
+            str(i) if label is None else f"{i} ({html.escape(label)})"
+            for i, label in zip(fit["suspects"], labels)) + ".")
     return "<p>" + "</p><p>".join(parts) + "</p>"
 
 
