@@ -1,7 +1,9 @@
 #include "lrcal/identification/identification.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <boost/math/special_functions/gamma.hpp>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -84,6 +86,49 @@ void CheckFit(const std::vector<double>& residuals, const std::vector<double>& w
   }
 }
 
+// 1.4826·median|z| over z's entries (the normal distribution's σ from its median absolute value).
+double RobustScale(std::vector<double> z) {
+  for (double& v : z) v = std::fabs(v);
+  const std::size_t k = z.size() / 2;
+  std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(k), z.end());
+  double median = z[k];
+  if (z.size() % 2 == 0) median = 0.5 * (median + *std::max_element(z.begin(), z.begin() + k));
+  return 1.4826 * median;
+}
+
+// The robust fit check (FitCheck::robust_*): the robust scale of the readings' standardised
+// residuals against its distribution under the linearised null, z* = (I − Q·Qᵀ)·ε with ε standard
+// normal and Q an orthonormal basis of W^½·G's columns (the fit's projection), drawn in blocks.
+void CheckRobustFit(const Eigen::MatrixXd& G, const std::vector<double>& weights, int data_rows,
+                    FitCheck* fit) {
+  const int m = static_cast<int>(G.rows()), n = static_cast<int>(G.cols());
+  fit->robust = true;
+  fit->robust_scale = RobustScale(fit->standardized);
+  if (fit->dof <= 0) return;
+  Eigen::MatrixXd Gw = G;
+  for (int i = 0; i < m; ++i) Gw.row(i) *= std::sqrt(weights[static_cast<std::size_t>(i)]);
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Gw);
+  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(m, n);
+  const RandomStream stream(0, 0, 0, RandomPurpose::kFitCheck);
+  constexpr int kBlock = 64;
+  int at_least = 0;
+  std::vector<double> z(static_cast<std::size_t>(data_rows));
+  for (int first = 0; first < FitCheck::kRobustCheckDraws; first += kBlock) {
+    const int count = std::min(kBlock, FitCheck::kRobustCheckDraws - first);
+    Eigen::MatrixXd E(m, count);
+    for (int b = 0; b < count; ++b)
+      stream.Normals(static_cast<std::uint64_t>(first + b) * static_cast<std::uint64_t>(m), m,
+                     E.col(b).data());
+    E -= Q * (Q.transpose() * E);
+    for (int b = 0; b < count; ++b) {
+      for (int i = 0; i < data_rows; ++i) z[static_cast<std::size_t>(i)] = E(i, b);
+      at_least += RobustScale(z) >= fit->robust_scale;
+    }
+  }
+  fit->robust_p_value = (1.0 + at_least) / (1.0 + FitCheck::kRobustCheckDraws);
+  fit->consistent = fit->robust_p_value > 1e-3;
+}
+
 // σ̂, the fit check and the covariances at the estimate, from the Jacobian G at e (rows: measured
 // values), the weights and the unweighted residuals; s->final_cost is set.
 void SummarizeFit(const Eigen::MatrixXd& G, const std::vector<double>& weights,
@@ -97,6 +142,8 @@ void SummarizeFit(const Eigen::MatrixXd& G, const std::vector<double>& weights,
   const Eigen::MatrixXd Ainv = ParameterCovariance(A, 1.0);
   s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : std::nan("");
   CheckFit(residuals, weights, n, rows_per_configuration, data_rows, options, &s);
+  if (options.loss != RobustLoss::kNone && s.fit.sigma_given)
+    CheckRobustFit(G, weights, data_rows, &s.fit);
   s.covariance_residual = s.sigma_hat * s.sigma_hat * Ainv;
   s.std_residual = s.covariance_residual.diagonal().cwiseSqrt();
   if (options.sigma > 0) {
@@ -458,7 +505,24 @@ std::string FitCheck::LabelOf(int configuration) const {
 
 std::string FitCheck::Explain() const {
   std::ostringstream out;
-  if (sigma_given) {
+  if (sigma_given && robust) {
+    out << "fit (robust loss): robust scale of the residuals " << robust_scale
+        << " of the stated sigma (1.4826 x median |standardised residual|)";
+    if (dof <= 0) {
+      out << " (as many configurations as parameters: no test)";
+    } else if (consistent) {
+      out << ", p = " << robust_p_value << ": consistent with the stated noise";
+    } else {
+      out << ", p = " << robust_p_value
+          << ": INCONSISTENT with the stated noise: the bulk of the residuals is " << robust_scale
+          << " times what sigma predicts, outliers aside. Likely causes: sigma too small for "
+             "these readings; an error the model does not have (a second plane, the ranger's "
+             "offset or scale, a fixed parameter that is not at its nominal value); wrong units "
+             "(readings in mm, joint angles in degrees)";
+    }
+    out << "; chi2 = " << chi2 << " on " << dof
+        << " degrees of freedom is not the test with a robust loss (outliers inflate it)\n";
+  } else if (sigma_given) {
     out << "fit: chi2 = " << chi2 << " on " << dof << " degrees of freedom";
     if (num_priors > 0)
       out << " (readings " << chi2 - chi2_priors << ", the " << num_priors << " priors "

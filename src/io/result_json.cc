@@ -94,6 +94,11 @@ ResultJson ParametersJson(const IdentificationSummary& s) {
 
 ResultJson FitJson(const FitCheck& f) {
   ResultJson fit = {{"dof", f.dof}, {"standardized_residuals", f.standardized}};
+  fit["test"] = !f.sigma_given ? "none" : f.robust ? "robust_scale" : "chi2";
+  if (f.robust) {
+    fit["robust_scale"] = OrNull(f.robust_scale);
+    fit["robust_p_value"] = OrNull(f.robust_p_value);
+  }
   ResultJson suspects = ResultJson::array();
   for (int i : f.suspects) suspects.push_back(i + 1);
   fit["suspects"] = suspects;  // 1-based configurations

@@ -986,6 +986,11 @@ str() gives the full text report; repr() the one-line summary.)doc")
             d["consistent"] = s.fit.consistent;
             d["standardized"] = s.fit.standardized;
             d["suspects"] = s.fit.suspects;
+            d["test"] = !s.fit.sigma_given ? "none" : s.fit.robust ? "robust_scale" : "chi2";
+            if (s.fit.robust) {
+              d["robust_scale"] = s.fit.robust_scale;
+              d["robust_p_value"] = s.fit.robust_p_value;
+            }
             if (!s.fit.configuration_labels.empty()) {
               py::list labels;
               for (int i : s.fit.suspects) labels.append(s.fit.LabelOf(i));
@@ -996,7 +1001,8 @@ str() gives the full text report; repr() the one-line summary.)doc")
           "The fit check, as identify's JSON 'fit': chi2 against the given sigma_mm, dof, "
           "p_value, consistent (p >= 0.001), standardized residuals and suspects (0-based "
           "configurations with |standardized| > 4), with suspect_labels when the readings were "
-          "grouped by configuration labels.")
+          "grouped by configuration labels; test says which check decided `consistent`: chi2, "
+          "or robust_scale with a robust loss (robust_scale and robust_p_value).")
       .def("__str__", &S::FullReport)
       .def("__repr__", &S::BriefReport);
 }

@@ -31,6 +31,7 @@ enum class RandomPurpose : std::uint32_t {
   kOutlier = 9,       ///< gross errors: 2·(configuration·R + repetition) (+1 for the size)
   kSensitivity = 10,  ///< sensitivity plans (Saltelli's A, B; Morris' trajectories), bootstrap
   kAveraging = 11,    ///< averaging.h's variance factors: trial = readings, index = set·n + r
+  kFitCheck = 12,     ///< the robust fit check's null draws: index = draw·rows + row
 };
 
 class RandomStream {

@@ -132,6 +132,17 @@ struct FitCheck {
   /// deviations. NaN without σ.
   int num_priors = 0;
   double chi2_priors = std::numeric_limits<double>::quiet_NaN();
+  /// A robust fit (IdentificationOptions::loss other than none) with σ given is judged by the
+  /// robust scale of its standardised residuals instead of χ² (which the outliers a robust loss
+  /// is meant for would fail): robust_scale = 1.4826·median|z_i| (1 for Gaussian residuals of
+  /// known σ), and robust_p_value = P(scale ≥ robust_scale) under the linearised null (Gaussian
+  /// readings of the stated σ, the fit's own projection of them), by kRobustCheckDraws
+  /// Monte-Carlo draws: (1 + #{draws ≥ observed})/(1 + draws), so the test has level 0.001 at
+  /// the threshold. `consistent` then means robust_p_value > 0.001. NaN otherwise.
+  bool robust = false;
+  double robust_scale = std::numeric_limits<double>::quiet_NaN();
+  double robust_p_value = std::numeric_limits<double>::quiet_NaN();
+  static constexpr int kRobustCheckDraws = 1999;
   /// The verdict in words, with the likely causes when the fit is inconsistent.
   std::string Explain() const;
 };

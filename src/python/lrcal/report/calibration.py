@@ -170,7 +170,15 @@ def fit_text(data):
              f"residual RMS {data.get('residual_rms', 0) * 1e3:.4f} mm."]
     if data.get("message"):
         parts.append(html.escape(data["message"]))
-    if fit.get("chi2") is not None:
+    if fit.get("test") == "robust_scale" and fit.get("robust_p_value") is not None:
+        verdict = ("consistent with the stated noise" if fit.get("consistent")
+                   else "<b>INCONSISTENT with the stated noise</b>: σ too small, an unmodelled "
+                   "error (a second plane, a ranger offset or scale) or wrong units")
+        parts.append(f"Robust fit check: the residuals' robust scale (1.4826 × median |z|) is "
+                     f"{fit['robust_scale']:.3f} of the stated σ, p = "
+                     f"{fit['robust_p_value']:.3g}: {verdict}. χ² = {fit['chi2']:.2f} on "
+                     f"{fit['dof']} degrees of freedom is not the test with a robust loss.")
+    elif fit.get("chi2") is not None:
         verdict = ("consistent with the stated noise" if fit.get("consistent")
                    else "<b>INCONSISTENT with the stated noise</b>: σ too small, an unmodelled "
                    "error (a second plane, a ranger offset or scale), wrong units or outliers")
