@@ -2,8 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
-#include <boost/math/special_functions/gamma.hpp>
 #include <algorithm>
+#include <boost/math/special_functions/gamma.hpp>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -248,8 +248,7 @@ std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
 
 namespace {
 
-IdentificationSummary IdentifyReadings(const MeasurementModel& model_in,
-                                       const MeasurementSet& data,
+IdentificationSummary IdentifyReadings(const MeasurementModel& model_in, const MeasurementSet& data,
                                        const IdentificationOptions& options) {
   // The maximum a-posteriori estimate and errors in variables are the kind-neutral path's
   // (prior.h, ErrorsInVariablesWeights).
@@ -546,8 +545,7 @@ std::string FitCheck::Explain() const {
   }
   if (!suspects.empty()) {
     out << "suspect readings (|residual| > 4 " << (sigma_given ? "sigma" : "sigma_hat")
-        << "), configuration (1-based"
-        << (configuration_labels.empty() ? "" : ", with its label")
+        << "), configuration (1-based" << (configuration_labels.empty() ? "" : ", with its label")
         << (rows_per_configuration > 1 ? ", then the value: .1 .. ." : "")
         << (rows_per_configuration > 1 ? std::to_string(rows_per_configuration) : "")
         << ") and standardised residual:";

@@ -101,13 +101,13 @@ ResultJson FitJson(const FitCheck& f) {
   }
   ResultJson suspects = ResultJson::array();
   for (int i : f.suspects) suspects.push_back(i + 1);
-  fit["suspects"] = suspects;  // 1-based configurations
+  fit["suspects"] = suspects;             // 1-based configurations
   if (!f.configuration_labels.empty()) {  // and by the labels of the measurement file
     ResultJson labels = ResultJson::array();
     for (int i : f.suspects) labels.push_back(f.LabelOf(i / f.rows_per_configuration));
     fit["suspect_labels"] = labels;
   }
-  if (f.num_priors > 0) {      // without priors the JSON is as before them
+  if (f.num_priors > 0) {  // without priors the JSON is as before them
     fit["num_priors"] = f.num_priors;
     fit["chi2_priors"] = OrNull(f.chi2_priors);
   }

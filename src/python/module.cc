@@ -415,15 +415,15 @@ struct IdentifyArgs {
   std::string solver, loss;
   double loss_scale_mm, sigma_mm;
   long long max_iterations;
-  py::object loss_scale, sigma;          // the earlier spellings, in m (None: not given)
-  std::string prior_sigma;               // as --prior-sigma; "" = no priors
-  bool prior = false;                    // as --prior: the robot file's tolerances
-  double encoder_sigma_mrad = 0;         // as --encoder-sigma-mrad: errors in variables
-  std::string average = "mean";          // as --average: mean, median or trimmed:F
-  std::string estimate_ranger = "none";  // as --estimate-ranger
-  py::object plane_of = py::none();      // one plane number (from 1) per reading, or None
-  py::object holdout = py::none();       // as --holdout K, or None
-  py::object predict_at = py::none();    // as --predict-at: poses (M, joints), or None
+  py::object loss_scale, sigma;           // the earlier spellings, in m (None: not given)
+  std::string prior_sigma;                // as --prior-sigma; "" = no priors
+  bool prior = false;                     // as --prior: the robot file's tolerances
+  double encoder_sigma_mrad = 0;          // as --encoder-sigma-mrad: errors in variables
+  std::string average = "mean";           // as --average: mean, median or trimmed:F
+  std::string estimate_ranger = "none";   // as --estimate-ranger
+  py::object plane_of = py::none();       // one plane number (from 1) per reading, or None
+  py::object holdout = py::none();        // as --holdout K, or None
+  py::object predict_at = py::none();     // as --predict-at: poses (M, joints), or None
   py::object configuration = py::none();  // one label per reading (a CSV's configuration column)
 };
 
@@ -1135,15 +1135,14 @@ void DefineIdentify(py::module_& m) {
          long long max_iterations, const py::object& loss_scale, const py::object& sigma,
          const std::string& prior_sigma, bool prior, double encoder_sigma_mrad,
          const std::string& average, const py::object& plane_of, const std::string& estimate_ranger,
-         const py::object& holdout, const py::object& predict_at,
-         const py::object& configuration) {
+         const py::object& holdout, const py::object& predict_at, const py::object& configuration) {
         IdentifyExtras extras;
-        py::object result = py::cast(IdentifyPy(
-            rig, q, h, plane, estimate_plane, fix, auto_fix,
-            {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma, prior_sigma,
-             prior, encoder_sigma_mrad, average, estimate_ranger, plane_of, holdout, predict_at,
-             configuration},
-            &extras));
+        py::object result =
+            py::cast(IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
+                                {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale,
+                                 sigma, prior_sigma, prior, encoder_sigma_mrad, average,
+                                 estimate_ranger, plane_of, holdout, predict_at, configuration},
+                                &extras));
         // As `lrcal identify --format json` has them: "holdout" and "accuracy" (None when not
         // asked for, or when the fit is not usable).
         result.attr("holdout") =

@@ -29,8 +29,7 @@ std::vector<std::string> Differences(const TrialRecord& a, const TrialRecord& b)
   if (!SameBits(a.residual_rms, b.residual_rms)) out.emplace_back("residual_rms");
   if (!SameBits(a.sigma_hat, b.sigma_hat)) out.emplace_back("sigma_hat");
   if (!SameBits(a.sigma_min, b.sigma_min)) out.emplace_back("sigma_min");
-  if (a.missed_configurations != b.missed_configurations)
-    out.emplace_back("missed_configurations");
+  if (a.missed_configurations != b.missed_configurations) out.emplace_back("missed_configurations");
   if (a.errors.size() != b.errors.size() ||
       (!a.errors.empty() &&
        std::memcmp(a.errors.data(), b.errors.data(), a.errors.size() * sizeof(double)) != 0))

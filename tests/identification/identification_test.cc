@@ -534,7 +534,8 @@ TEST(Identification, FitCheckAgainstTheStatedNoise) {
 //  - Gaussian readings of the stated σ: flagged at most as often as the level (0.1 %: at most 2
 //    of 200). The null is the least-squares projection; a robust fit fits the bulk of the
 //    readings more closely than least squares, so its residuals' median is smaller and the test
-//    is conservative: p-values lean high (mean 0.59 for Huber, 0.68 for Cauchy here; 0.5 would be exact);
+//    is conservative: p-values lean high (mean 0.59 for Huber, 0.68 for Cauchy here; 0.5 would be
+//    exact);
 //  - the same with 4 of 61 configurations 30 σ off: χ² flags every fit, the robust check about
 //    as rarely as without them (the median's bias at 7 % contamination is about 7 %);
 //  - a third of the true σ stated (the loss scale kept in mm, as --loss-scale-mm is): flagged
@@ -575,9 +576,9 @@ void ExpectRobustFitCheckHolds(RobustLoss loss, double scale_in_sigma, int seeds
       EXPECT_THAT(r.fit.Explain(), ::testing::HasSubstr("consistent with the stated noise"));
     }
   }
-  EXPECT_LE(flagged, 2);                       // at most the level: 0.2 of 200 expected
+  EXPECT_LE(flagged, 2);  // at most the level: 0.2 of 200 expected
   EXPECT_THAT(p_sum / seeds, ::testing::AllOf(::testing::Ge(0.45), ::testing::Le(0.75)));
-  EXPECT_EQ(flagged_outliers_chi2, seeds);     // what χ² would have said
+  EXPECT_EQ(flagged_outliers_chi2, seeds);  // what χ² would have said
   EXPECT_LE(flagged_outliers, 4);
   EXPECT_EQ(flagged_inflated, seeds);
 }
