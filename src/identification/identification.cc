@@ -502,62 +502,78 @@ std::string FitCheck::LabelOf(int configuration) const {
   return i < configuration_labels.size() ? configuration_labels[i] : std::string();
 }
 
+namespace {
+
+// The robust fit check's verdict (FitCheck::robust).
+void ExplainRobustCheck(const FitCheck& f, std::ostream& out) {
+  out << "fit (robust loss): robust scale of the residuals " << f.robust_scale
+      << " of the stated sigma (1.4826 x median |standardised residual|)";
+  if (f.dof <= 0) {
+    out << " (as many configurations as parameters: no test)";
+  } else if (f.consistent) {
+    out << ", p = " << f.robust_p_value << ": consistent with the stated noise";
+  } else {
+    out << ", p = " << f.robust_p_value
+        << ": INCONSISTENT with the stated noise: the bulk of the residuals is " << f.robust_scale
+        << " times what sigma predicts, outliers aside. Likely causes: sigma too small for "
+           "these readings; an error the model does not have (a second plane, the ranger's "
+           "offset or scale, a fixed parameter that is not at its nominal value); wrong units "
+           "(readings in mm, joint angles in degrees)";
+  }
+  out << "; chi2 = " << f.chi2 << " on " << f.dof
+      << " degrees of freedom is not the test with a robust loss (outliers inflate it)\n";
+}
+
+// The χ² test's verdict.
+void ExplainChiSquared(const FitCheck& f, std::ostream& out) {
+  out << "fit: chi2 = " << f.chi2 << " on " << f.dof << " degrees of freedom";
+  if (f.num_priors > 0)
+    out << " (readings " << f.chi2 - f.chi2_priors << ", the " << f.num_priors << " priors "
+        << f.chi2_priors << ")";
+  if (f.dof <= 0) {
+    out << " (as many configurations as parameters: no test)";
+  } else if (f.consistent) {
+    out << ", p = " << f.p_value << ": consistent with the stated noise";
+  } else {
+    out << ", p = " << f.p_value << ": INCONSISTENT with the stated noise: the residuals are "
+        << std::sqrt(f.chi2 / f.dof)
+        << " times what sigma predicts. Likely causes: sigma too small for these readings; an "
+           "error the model does not have (readings on a second plane, the ranger's offset or "
+           "scale, noisy joint encoders, a fixed parameter that is not at its nominal value); "
+           "wrong units (readings in mm, joint angles in degrees); outlying readings";
+    if (f.num_priors > 0)
+      out << "; priors tighter than the terms' true deviations (a large priors' part of chi2)";
+    if (!f.suspects.empty()) out << " (see the suspects below)";
+  }
+  out << "\n";
+}
+
+// The suspects, by number (and value, for several per configuration) and label.
+void ExplainSuspects(const FitCheck& f, std::ostream& out) {
+  const int k = f.rows_per_configuration;
+  out << "suspect readings (|residual| > 4 " << (f.sigma_given ? "sigma" : "sigma_hat")
+      << "), configuration (1-based" << (f.configuration_labels.empty() ? "" : ", with its label")
+      << (k > 1 ? ", then the value: .1 .. ." + std::to_string(k) : std::string())
+      << ") and standardised residual:";
+  for (int i : f.suspects) {
+    out << " " << i / k + 1;
+    if (k > 1) out << "." << i % k + 1;
+    const std::string label = f.LabelOf(i / k);
+    if (!label.empty()) out << " '" << label << "'";
+    out << " (" << f.standardized[static_cast<std::size_t>(i)] << ")";
+  }
+  out << "\n";
+}
+
+}  // namespace
+
 std::string FitCheck::Explain() const {
   std::ostringstream out;
-  if (sigma_given && robust) {
-    out << "fit (robust loss): robust scale of the residuals " << robust_scale
-        << " of the stated sigma (1.4826 x median |standardised residual|)";
-    if (dof <= 0) {
-      out << " (as many configurations as parameters: no test)";
-    } else if (consistent) {
-      out << ", p = " << robust_p_value << ": consistent with the stated noise";
-    } else {
-      out << ", p = " << robust_p_value
-          << ": INCONSISTENT with the stated noise: the bulk of the residuals is " << robust_scale
-          << " times what sigma predicts, outliers aside. Likely causes: sigma too small for "
-             "these readings; an error the model does not have (a second plane, the ranger's "
-             "offset or scale, a fixed parameter that is not at its nominal value); wrong units "
-             "(readings in mm, joint angles in degrees)";
-    }
-    out << "; chi2 = " << chi2 << " on " << dof
-        << " degrees of freedom is not the test with a robust loss (outliers inflate it)\n";
-  } else if (sigma_given) {
-    out << "fit: chi2 = " << chi2 << " on " << dof << " degrees of freedom";
-    if (num_priors > 0)
-      out << " (readings " << chi2 - chi2_priors << ", the " << num_priors << " priors "
-          << chi2_priors << ")";
-    if (dof <= 0) {
-      out << " (as many configurations as parameters: no test)";
-    } else if (consistent) {
-      out << ", p = " << p_value << ": consistent with the stated noise";
-    } else {
-      out << ", p = " << p_value << ": INCONSISTENT with the stated noise: the residuals are "
-          << std::sqrt(chi2 / dof)
-          << " times what sigma predicts. Likely causes: sigma too small for these readings; an "
-             "error the model does not have (readings on a second plane, the ranger's offset or "
-             "scale, noisy joint encoders, a fixed parameter that is not at its nominal value); "
-             "wrong units (readings in mm, joint angles in degrees); outlying readings";
-      if (num_priors > 0)
-        out << "; priors tighter than the terms' true deviations (a large priors' part of chi2)";
-      if (!suspects.empty()) out << " (see the suspects below)";
-    }
-    out << "\n";
-  }
-  if (!suspects.empty()) {
-    out << "suspect readings (|residual| > 4 " << (sigma_given ? "sigma" : "sigma_hat")
-        << "), configuration (1-based" << (configuration_labels.empty() ? "" : ", with its label")
-        << (rows_per_configuration > 1 ? ", then the value: .1 .. ." : "")
-        << (rows_per_configuration > 1 ? std::to_string(rows_per_configuration) : "")
-        << ") and standardised residual:";
-    for (int i : suspects) {
-      out << " " << i / rows_per_configuration + 1;
-      if (rows_per_configuration > 1) out << "." << i % rows_per_configuration + 1;
-      const std::string label = LabelOf(i / rows_per_configuration);
-      if (!label.empty()) out << " '" << label << "'";
-      out << " (" << standardized[i] << ")";
-    }
-    out << "\n";
-  }
+  if (sigma_given && robust)
+    ExplainRobustCheck(*this, out);
+  else if (sigma_given)
+    ExplainChiSquared(*this, out);
+  if (!suspects.empty()) ExplainSuspects(*this, out);
   return out.str();
 }
 

@@ -9,10 +9,12 @@ namespace lrcal {
 
 namespace {
 
-// The joint values of each labelled configuration: its first reading's if all its readings
-// agree, else their mean (summed in reading order).
+// The label and joint values of each labelled configuration: its first reading's joint values
+// if all its readings agree, else their mean (summed in reading order).
 void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& group,
-                         const std::vector<int>& first, MeasurementSet* data) {
+                         const std::vector<int>& first, const std::vector<std::string>& labels,
+                         MeasurementSet* data) {
+  for (int r : first) data->labels.push_back(labels[static_cast<std::size_t>(r)]);
   const int n = q.num_joints(), m = static_cast<int>(first.size());
   std::vector<double> sum(static_cast<std::size_t>(m) * n, 0.0);
   std::vector<int> count(m, 0);
@@ -109,7 +111,7 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
   }
   MeasurementSet data;
   if (labels) {
-    LabelledJointValues(q, group, first, &data);
+    LabelledJointValues(q, group, first, *labels, &data);
   } else {
     data.configs = ConfigurationSet(n);
     data.configs.Reserve(static_cast<int>(first.size()));
@@ -118,7 +120,6 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
   for (std::size_t i = 0; i < first.size(); ++i) {
     data.mean_h.push_back(sums[i] / counts[i]);
     data.repetitions.push_back(counts[i]);
-    if (labels) data.labels.push_back((*labels)[static_cast<std::size_t>(first[i])]);
   }
   if (!average.IsMean()) CombineRobustly(h, group, first, average, where, &data);
   return data;
