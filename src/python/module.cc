@@ -1013,6 +1013,10 @@ void DefineRun(py::module_& m) {
       .def_readonly("total", &RunProgress::total, "trials of the run (or shard)")
       .def_readonly("computed", &RunProgress::computed, "computed by this call so far")
       .def_readonly("seconds", &RunProgress::seconds, "since the call started")
+      .def_readonly("eta_seconds", &RunProgress::eta_seconds,
+                    "seconds left (nan until a trial has finished): each cell's remaining "
+                    "trials at its own measured cost, at the run's pace since its trials "
+                    "started")
       .def("__repr__", [](const RunProgress& p) {
         return "lrcal.RunProgress(" + std::to_string(p.done) + "/" + std::to_string(p.total) + ")";
       });

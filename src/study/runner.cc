@@ -8,8 +8,10 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <system_error>
@@ -17,6 +19,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/study/remaining_time.h"
 #include "lrcal/study/run_directory.h"
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/trial_store.h"
@@ -121,11 +124,15 @@ class RecordQueue {
   std::exception_ptr failure_;
 };
 
-// Progress on stderr: a bar on a terminal, periodic lines otherwise (rank 0 only).
+// Progress on stderr: a bar on a terminal, periodic lines otherwise (rank 0 only). The rate and
+// the ETA count from the start of the trials (`start`), not from the cells' preparation; the ETA
+// weighs each cell's remaining trials by its own cost (`eta`, remaining_time.h) unless the run
+// is adaptive (its total changes as cells stop: then remaining trials over the rate).
 class ProgressReporter {
  public:
   ProgressReporter(bool enabled, int ranks, long long total, long long done_before,
-                   long long expected_total, Clock::time_point start)
+                   long long expected_total, Clock::time_point start,
+                   const RemainingTimeEstimate* eta)
       : enabled_(enabled),
         tty_(::isatty(STDERR_FILENO) != 0),
         ranks_(ranks),
@@ -133,7 +140,8 @@ class ProgressReporter {
         done_before_(done_before),
         expected_total_(expected_total),
         start_(start),
-        last_(Clock::now()) {
+        last_(Clock::now()),
+        eta_(eta) {
     if (const char* e = std::getenv("LRCAL_PROGRESS_SECONDS")) line_every_ = std::atof(e);
   }
   void Tick(long long computed) {
@@ -148,12 +156,19 @@ class ProgressReporter {
     expected_total_ = expected_total;
     note_ = std::move(note);
   }
+  // The ETA (s; NaN while unknown) after `computed` trials of this process.
+  double SecondsLeft(long long computed) const {
+    const double elapsed = Seconds(start_, Clock::now());
+    if (eta_) return eta_->SecondsLeft(elapsed);
+    const double rate = elapsed > 0 ? computed * ranks_ / elapsed : 0;
+    return rate > 0 ? (expected_total_ - done_before_ - computed * ranks_) / rate : NAN;
+  }
   void Report(long long computed, bool final) const {
     if (!enabled_) return;
     const double elapsed = Seconds(start_, Clock::now());
     const long long done_now = done_before_ + computed * ranks_;
     const double rate = elapsed > 0 ? computed * ranks_ / elapsed : 0;
-    const double eta = rate > 0 ? (expected_total_ - done_now) / rate : NAN;
+    const double eta = SecondsLeft(computed);
     const long long shown = std::min(done_now, total_);
     char line[256];
     if (tty_) {
@@ -176,6 +191,7 @@ class ProgressReporter {
   int ranks_;
   long long total_, done_before_, expected_total_;
   Clock::time_point start_, last_;
+  const RemainingTimeEstimate* eta_;
   double line_every_ = 10.0;
   std::string note_;
 };
@@ -251,10 +267,24 @@ class StudyRunner {
       Preparing() { g_preparing.store(true); }
       ~Preparing() { g_preparing.store(false); }
     } preparing;
+    const bool show = options_.progress && root();
+    const bool tty = ::isatty(STDERR_FILENO) != 0;
+    double every = 10.0;  // s between lines on a log (as the trials' progress lines)
+    if (const char* e = std::getenv("LRCAL_PROGRESS_SECONDS")) every = std::atof(e);
+    auto last_line = start_;
     for (const Cell& cell : study_.cells) {
       if (stop_->stop_requested()) break;
       contexts_.push_back(PrepareCell(study_, cell));
+      cell_index_.emplace(cell.id, static_cast<int>(contexts_.size()) - 1);
+      const auto now = Clock::now();
+      if (show && (tty || Seconds(last_line, now) >= every)) {
+        std::cerr << (tty ? "\r" : "") << "lrcal run: preparing cells: " << contexts_.size() << "/"
+                  << study_.cells.size() << " done, " << Duration(Seconds(start_, now))
+                  << (tty ? " " : "\n") << std::flush;
+        last_line = now;
+      }
     }
+    if (show && tty && !study_.cells.empty()) std::cerr << "\n";
     result_.prepare_seconds = Seconds(start_, Clock::now());
   }
 
@@ -304,12 +334,18 @@ class StudyRunner {
   // behind; whatever they hold counts, with any number of ranks now).
   void FindMissingTrials() {
     done_ = dir_.ReadDone(study_, store_.get());
-    collective_->Barrier();  // nobody writes before every rank has read
-    for (const auto& cell : done_)
+    collective_->Barrier();          // nobody writes before every rank has read
+    std::vector<long long> missing;  // per cell, this process's share (for the ETA)
+    for (const auto& cell : done_) {
+      missing.push_back(0);
       for (long long t = options_.shard_index; t < study_.trials; t += options_.shard_count) {
         ++result_.total;
         if (cell[t]) ++result_.done_before;
+        missing.back() += !cell[t];
       }
+      missing.back() = (missing.back() + ranks_ - 1) / ranks_;
+    }
+    eta_ = std::make_unique<RemainingTimeEstimate>(std::move(missing));
     // stop_when needs every trial of a block to decide; a shard sees only its share, so shards
     // run to the maximum and the merge applies the rule (same tables).
     adaptive_ = study_.stop_when.enabled() && options_.shard_count == 1;
@@ -349,7 +385,11 @@ class StudyRunner {
   // Writes one batch of records (the writer's step).
   void Commit(std::vector<TrialRecord>* batch) {
     store_->Insert(*batch);
-    for (const auto& r : *batch) result_.trial_seconds += r.seconds;
+    for (const auto& r : *batch) {
+      result_.trial_seconds += r.seconds;
+      const auto cell = cell_index_.find(r.cell_id);
+      if (cell != cell_index_.end()) eta_->Record(cell->second, r.seconds);
+    }
     result_.computed += static_cast<long long>(batch->size());
     batch->clear();
   }
@@ -359,11 +399,14 @@ class StudyRunner {
   // the decisions.
   void RunTrials() {
     const auto t_run = Clock::now();
+    trials_start_ = t_run;
     const long long expected =
         result_.done_before +
         (adaptive_ ? result_.total - result_.done_before : work_->share() * ranks_);
-    ProgressReporter progress(options_.progress && root(), ranks_, result_.total,
-                              result_.done_before, expected, start_);
+    progress_ = std::make_unique<ProgressReporter>(options_.progress && root(), ranks_,
+                                                   result_.total, result_.done_before, expected,
+                                                   t_run, adaptive_ ? nullptr : eta_.get());
+    ProgressReporter& progress = *progress_;
     if (adaptive_) {
       RunRounds(&progress);
     } else {
@@ -491,6 +534,7 @@ class StudyRunner {
     p.computed = result_.computed;
     p.done = std::min(result_.total, result_.done_before + result_.computed * ranks_);
     p.seconds = Seconds(start_, Clock::now());
+    if (progress_) p.eta_seconds = progress_->SecondsLeft(result_.computed);
     options_.on_progress(p);
   }
 
@@ -581,6 +625,10 @@ class StudyRunner {
   std::string store_path_;
   std::unique_ptr<TrialStore> store_;
   DoneSet done_;
+  std::map<std::string, int> cell_index_;  // cell id → index in contexts_
+  std::unique_ptr<RemainingTimeEstimate> eta_;
+  std::unique_ptr<ProgressReporter> progress_;
+  Clock::time_point trials_start_;
   bool dynamic_ = false;
   std::unique_ptr<WorkSource> work_;
   // stop_when (single process or MPI, not shards): the rules' state (rank 0) and whether every

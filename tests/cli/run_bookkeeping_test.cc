@@ -75,6 +75,22 @@ TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
 
 // More trials later: every trial is a pure function of its index, so raising `trials` extends a
 // run (the tables equal a fresh run's with the new count, byte for byte); fewer is refused.
+// Issue 31: a progress line while the cells are prepared, and the trials' rate and ETA after
+// them (on a log: lines every LRCAL_PROGRESS_SECONDS).
+TEST(RunBookkeeping, ProgressLinesDuringPreparationAndTrials) {
+  const std::string dir = testing::TempDir("progress_lines");
+  std::string out;
+  ASSERT_EQ(RunCommand("LRCAL_PROGRESS_SECONDS=0 " + LrcalBinary() + " run quick --out " + dir +
+                           "/run --threads 1 2>&1 | cat",
+                       &out),
+            0)
+      << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("lrcal run: preparing cells: 1/2 done, ")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("lrcal run: preparing cells: 2/2 done, ")) << out;
+  EXPECT_THAT(out, ::testing::ContainsRegex("lrcal run: 200/200 trials, [0-9]+/s, ETA 0:00"))
+      << out;
+}
+
 TEST(RunBookkeeping, RaisingTrialsExtendsARunToTheTablesOfAFreshOne) {
   const std::string dir = testing::TempDir("extend_trials");
   std::string quick = testing::ReadFile(testing::SourcePath("studies/quick.yaml"));

@@ -49,6 +49,8 @@ def test_run_study_gives_the_programs_tables_and_trials(tmp_path, cli):
     result = lrcal.run_study("quick", str(tmp_path / "py"), threads=2, progress=seen.append)
     assert result.complete and result.tables_written and result.computed == result.total == 200
     assert seen and seen[-1].done == seen[-1].total == 200
+    assert seen[-1].eta_seconds == 0.0  # the ETA: nothing left at the end
+    assert all(np.isnan(p.eta_seconds) or p.eta_seconds >= 0 for p in seen)
     assert_same_tables(tmp_path / "cli", tmp_path / "py")
 
     py_run, cli_run = lrcal.load_run(tmp_path / "py"), lrcal.load_run(tmp_path / "cli")

@@ -21,6 +21,7 @@
 
 #include <atomic>
 #include <functional>
+#include <limits>
 #include <string>
 
 #include "lrcal/core/settings.h"
@@ -46,6 +47,9 @@ struct RunProgress {
   long long total = 0;     ///< trials of the run (or shard)
   long long computed = 0;  ///< computed by this call so far
   double seconds = 0;      ///< since the call started
+  /// Seconds left (NaN until a trial has finished): each cell's remaining trials at its own
+  /// measured cost, at the run's pace since its trials started (remaining_time.h).
+  double eta_seconds = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct RunOptions {
