@@ -139,6 +139,8 @@ ResultJson IdentificationJson(const IdentificationSummary& s) {
   j["usable"] = s.IsSolutionUsable();
   j["message"] = s.message;
   j["residual_rms"] = s.residual_rms;
+  j["initial_cost"] = s.initial_cost;  // ½Σ w·r² (m²) at the nominal model: before
+  j["final_cost"] = s.final_cost;      // and at the estimate: after
   j["sigma_hat"] = OrNull(s.sigma_hat);
   if (s.IsSolutionUsable()) j["fit"] = FitJson(s.fit);
   j["n_configurations"] = s.num_configurations;

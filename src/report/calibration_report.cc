@@ -15,17 +15,17 @@ namespace lrcal {
 
 namespace {
 
-// Cross-validation and the total accuracy map over the workspace, added to `j` for a usable fit.
-void AddPredictions(const CalibrationReportInputs& in, ResultJson* j) {
-  const IdentificationSummary& s = *in.summary;
-  const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
-  if (folds >= 2)
-    (*j)["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
+// The total accuracy map over the workspace, from the calibrated robot file just written: the
+// computation of `lrcal accuracy --robot calibrated.yaml --workspace N --seed S`, poses drawn over
+// the calibrated arm, so the report and the command agree to the bit.
+void AddWorkspaceAccuracy(const CalibrationReportInputs& in, const RobotFile& calibrated,
+                          ResultJson* j) {
+  if (!calibrated.calibration || calibrated.calibration->covariance.size() == 0) return;
   const ConfigurationSet poses =
-      WorkspacePoses(in.model->robot(), in.workspace_poses, in.workspace_seed);
-  const std::optional<AccuracyPrediction> p =
-      PredictAccuracyAfterFit(*in.model, s, in.options, in.held, poses);
-  if (p) (*j)["workspace_accuracy"] = PoseAccuracyJson(*p, poses);
+      WorkspacePoses(calibrated.robot, in.workspace_poses, in.workspace_seed);
+  const PlaneSet& planes = calibrated.planes ? *calibrated.planes : in.model->nominal_planes();
+  (*j)["workspace_accuracy"] =
+      PoseAccuracyJson(PredictCalibratedAccuracy(calibrated, planes, poses), poses);
 }
 
 }  // namespace
@@ -60,12 +60,15 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
   j["sigma_given"] = in.options.sigma > 0 ? ResultJson(in.options.sigma) : ResultJson();
   j["identifiability"] = IdentifiabilityJson(s.identifiability);
   if (s.IsSolutionUsable()) {
-    AddPredictions(in, &j);
+    const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
+    if (folds >= 2)
+      j["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
     WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_file, *in.rig, *in.model, s, in.options,
                          in.held);
+    const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
+    AddWorkspaceAccuracy(in, calibrated, &j);
     j["calibrated_robot"] = "calibrated.yaml";
     // The same model as URDF, from the file just written (what lrcal export would write).
-    const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
     WriteFileAtomically(dir + "/calibrated.urdf",
                         UrdfText(calibrated.robot, calibrated.robot.nominal_values()));
     j["calibrated_urdf"] = "calibrated.urdf";

@@ -230,10 +230,15 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
   EXPECT_EQ(plain["parameters"], j["parameters"]);
   EXPECT_EQ(plain["holdout"], j["holdout"]);
   const std::string html = Read(cal / "report.html");
-  for (const char* section : {"Fit check", "Parameters", "Identifiability", "Cross-validation",
+  for (const char* section : {"Fit check", "Before and after", "nominal (before)",
+                              "calibrated (after)", "Parameters", "Identifiability",
+                              "Cross-validation",
                               "Accuracy over the workspace", "Calibrated files",
                               "consistent with the stated noise", "calibrated.urdf"})
     EXPECT_THAT(html, ::testing::HasSubstr(section)) << section;
+  // Issue 31: nominal D-H angles in degrees, not "3141.5927 mrad".
+  EXPECT_THAT(html, ::testing::HasSubstr("<td>theta5</td><td>180.000000°</td>"));
+  EXPECT_THAT(html, ::testing::Not(::testing::HasSubstr("3141.5927")));
   EXPECT_EQ(RunCommand(LrcalBinary() + " accuracy --robot " + (cal / "calibrated.yaml").string() +
                            " --workspace 0",
                        &out),
@@ -257,6 +262,17 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
   EXPECT_NEAR(Json::parse(out)["rms_position"].get<double>(),
               j["workspace_accuracy"]["rms_position"].get<double>(),
               1e-9 * j["workspace_accuracy"]["rms_position"].get<double>());
+  // Issue 31: `lrcal accuracy --workspace 500` on the written file is the report's map, bit for
+  // bit (it drew its poses over the nominal arm and disagreed in the 4th digit).
+  ASSERT_EQ(RunCommand(LrcalBinary() + " accuracy --robot " + (cal / "calibrated.yaml").string() +
+                           " --workspace 500 --format json",
+                       &out),
+            0)
+      << out;
+  const Json workspace = Json::parse(out);
+  for (const char* key : {"rms_position", "rms_position_total", "p95_position_radius_95_total",
+                          "worst", "sources", "poses"})
+    EXPECT_EQ(workspace[key], j["workspace_accuracy"][key]) << key;
 
   if (RunCommand("command -v chromium", &out) != 0) GTEST_SKIP() << "chromium is not installed";
   ASSERT_EQ(RunCommand(Chromium(dir + "/chromium-profile") +

@@ -194,20 +194,49 @@ def fit_text(data):
     return "<p>" + "</p><p>".join(parts) + "</p>"
 
 
+def value_text(name, value):
+    """A nominal value or estimate as users read a D-H table: angles in degrees, lengths in mm,
+    the ranger's scale in ppm."""
+    if name == "ranger_scale":
+        return f"{value * 1e6:.4f} ppm"
+    if is_angular(name):
+        return f"{np.degrees(value):.6f}°"
+    return f"{value * 1e3:.4f} mm"
+
+
 def parameter_table(data):
-    rows = ["<table><tr><th>parameter</th><th>unit</th><th>nominal</th><th>change</th>"
-            "<th>std</th><th>estimate</th></tr>"]
+    rows = ["<table><tr><th>parameter</th><th>nominal</th><th>estimate</th>"
+            "<th>change</th><th>std</th><th>unit of change and std</th></tr>"]
     for p in data["parameters"]:
         std = p["std_given_sigma"] if p.get("std_given_sigma") is not None else p.get("std")
-        nominal, unit = display(p["name"], p["nominal"])
-        if p["name"] == "ranger_scale":
-            nominal = p["nominal"] * 1e6
+        delta, unit = display(p["name"], p["delta"])
         rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in (
-            html.escape(p["name"]), unit, f"{nominal:.4f}", f"{display(p['name'], p['delta'])[0]:.4f}",
-            "undefined" if std is None else f"{display(p['name'], std)[0]:.4f}",
-            f"{display(p['name'], p['estimate'])[0]:.4f}")) + "</tr>")
+            html.escape(p["name"]), value_text(p["name"], p["nominal"]),
+            value_text(p["name"], p["estimate"]), f"{delta:.4f}",
+            "undefined" if std is None else f"{display(p['name'], std)[0]:.4f}", unit)) + "</tr>")
     rows.append("</table>")
     return "".join(rows)
+
+
+def before_after_table(data):
+    """The readings against the nominal model (before) and the calibrated one (after): the RMS of
+    √R·(h̄ − h) over the configurations, about σ for a model that explains the readings."""
+    m = data.get("n_configurations") or 0
+    if not m or data.get("initial_cost") is None or data.get("final_cost") is None:
+        return ""
+    before = np.sqrt(2 * data["initial_cost"] / m) * 1e3
+    after = np.sqrt(2 * data["final_cost"] / m) * 1e3
+    sigma = data.get("sigma_given")
+    rows = ["<table><tr><th>model</th><th>RMS of √R·(h̄ − h) (mm)</th>"
+            + ("<th>over the stated σ</th>" if sigma else "") + "</tr>"]
+    for label, value in (("nominal (before)", before), ("calibrated (after)", after)):
+        rows.append(f"<tr><td>{label}</td><td>{value:.4f}</td>"
+                    + (f"<td>{value / (sigma * 1e3):.2f}</td>" if sigma else "") + "</tr>")
+    rows.append("</table>")
+    return ("<p>How well each model explains the readings (R readings averaged per configuration; "
+            "the calibrated model's value is about σ when it explains them). The arm's pose "
+            "accuracy before calibration is not known from these readings: the section "
+            "below states the calibrated arm's.</p>" + "".join(rows))
 
 
 def identifiability_text(data):
@@ -293,8 +322,10 @@ def build(folder):
              "<h1>Calibration report</h1>",
              f"<p>Robot <code>{html.escape(str(data.get('robot', '?')))}</code>, data "
              f"<code>{html.escape(str(data.get('data', {}).get('file', '?')))}</code>. Lengths "
-             "in mm, angles in mrad; calibration.json has every number in SI.</p>",
-             "<h2>Fit check</h2>", fit_text(data), "<h2>Parameters</h2>", parameter_table(data),
+             "in mm, angles in mrad (nominal values and estimates of angles in degrees); calibration.json has every number in SI.</p>",
+             "<h2>Fit check</h2>", fit_text(data),
+             "<h2>Before and after</h2>", before_after_table(data),
+             "<h2>Parameters</h2>", parameter_table(data),
              "<h2>Identifiability</h2>", identifiability_text(data),
              "<h2>Cross-validation</h2>", holdout_text(data),
              "<h2>Accuracy over the workspace</h2>", accuracy_text(data), "<h2>Figures</h2>"]
