@@ -322,7 +322,8 @@ def build(folder):
              "<h1>Calibration report</h1>",
              f"<p>Robot <code>{html.escape(str(data.get('robot', '?')))}</code>, data "
              f"<code>{html.escape(str(data.get('data', {}).get('file', '?')))}</code>. Lengths "
-             "in mm, angles in mrad (nominal values and estimates of angles in degrees); calibration.json has every number in SI.</p>",
+             "in mm, angles in mrad (nominal values and estimates of angles in degrees); "
+             "calibration.json has every number in SI.</p>",
              "<h2>Fit check</h2>", fit_text(data),
              "<h2>Before and after</h2>", before_after_table(data),
              "<h2>Parameters</h2>", parameter_table(data),
