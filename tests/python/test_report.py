@@ -118,3 +118,27 @@ def test_without_the_compiled_module_the_python_part_still_works(reported_run, t
     assert "pybind11-dev" in lines[1]
     assert lines[2].startswith("InputError: /nonexistent: not a run directory") and \
         lines[2].endswith("True")
+
+
+def test_calibration_parameter_names_stay_clear_of_the_next_panel(monkeypatch, tmp_path):
+    """Issue 31: with ranger terms the angle panel's rotated names ran into the panel below and
+    the last length name was cut at the figure's edge."""
+    from lrcal.report import calibration
+    captured = []
+    monkeypatch.setattr(calibration, "save", lambda fig, *args: captured.append(fig))
+    names = ["a1", "a3", "d3", "a4", "d4", "a5", "d5", "a6", "ranger_offset",
+             "theta1", "alpha1", "theta2", "alpha2", "beta2", "theta3", "alpha3", "theta4",
+             "alpha4", "theta5", "alpha5", "theta6", "alpha6", "beta6", "ranger_scale"]
+    params = [{"name": n, "delta": 1e-4 * (k - 10), "std": 1e-5} for k, n in enumerate(names)]
+    calibration.parameter_figure({"parameters": params}, str(tmp_path), [])
+    fig = captured[0]
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    width = fig.bbox.width
+    for upper, lower in zip(fig.axes, fig.axes[1:]):
+        labels = [t.get_window_extent(renderer) for t in upper.get_xticklabels() if t.get_text()]
+        assert min(b.y0 for b in labels) > lower.get_window_extent(renderer).y1
+    for ax in fig.axes:
+        for t in ax.get_xticklabels():
+            box = t.get_window_extent(renderer)
+            assert box.x0 >= 0 and box.x1 <= width, t.get_text()

@@ -92,14 +92,19 @@ def parameter_figure(data, fig_dir, out):
         err = display(p["name"], std)[0] if std is not None else 0.0
         rows.append((p["name"], value, err, unit))
     units = sorted({r[3] for r in rows})
-    fig, axes = plt.subplots(len(units), 1, figsize=(10, 2.8 * len(units)), squeeze=False)
+    # constrained layout keeps each panel's rotated names clear of the panel below; a panel with
+    # few parameters keeps them near its centre rather than spread over the whole width.
+    fig, axes = plt.subplots(len(units), 1, figsize=(10, 3.3 * len(units)), squeeze=False,
+                             layout="constrained")
     for ax, unit in zip(axes[:, 0], units):
         sel = [r for r in rows if r[3] == unit]
         x = np.arange(len(sel))
         ax.errorbar(x, [r[1] for r in sel], yerr=[2 * r[2] for r in sel], fmt="o", capsize=3)
         ax.axhline(0, color="#888", lw=0.8)
         ax.set_xticks(x)
-        ax.set_xticklabels([r[0] for r in sel], rotation=60, fontsize=8)
+        ax.set_xticklabels([r[0] for r in sel], rotation=60, fontsize=8, ha="right",
+                           rotation_mode="anchor")
+        ax.set_xlim(-0.5 - max(0, (8 - len(sel)) / 2), len(sel) - 0.5 + max(0, (8 - len(sel)) / 2))
         ax.set_ylabel(f"change ({unit})")
     save(fig, fig_dir, "parameters",
          "Identified change of each parameter from its nominal value, with ±2 standard "
