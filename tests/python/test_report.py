@@ -142,3 +142,33 @@ def test_calibration_parameter_names_stay_clear_of_the_next_panel(monkeypatch, t
         for t in ax.get_xticklabels():
             box = t.get_window_extent(renderer)
             assert box.x0 >= 0 and box.x1 <= width, t.get_text()
+
+
+def test_cell_tick_labels_are_short_values_with_their_keys_on_the_axis():
+    """Issue 31: sweep cells' labels ("noise.sigma_mm=0.30000000000000004, selection.count=30")
+    overlapped under the box plots; the ticks keep the values, to 4 digits, the axis the keys."""
+    cells = [{"label": f"noise.sigma_mm={s}, selection.count={k}"}
+             for s in (0.05, 0.30000000000000004) for k in (30, 60)]
+    ticks, xlabel = figures._cell_ticks(cells)
+    assert ticks == ["0.05, 30", "0.05, 60", "0.3, 30", "0.3, 60"]
+    assert xlabel == "noise.sigma_mm, selection.count"
+    ticks, xlabel = figures._cell_ticks([{"label": "case 1"}, {"label": "x" * 40}])
+    assert xlabel is None and ticks[0] == "case 1" and len(ticks[1]) == 28
+
+
+def test_distribution_legend_sits_above_the_panels(reported_run, tmp_path, monkeypatch):
+    """Issue 31: the legend inside each panel hid the paper's case-2 values; it is one legend
+    above the four panels, clear of them."""
+    captured = []
+    monkeypatch.setattr(figures, "_save", lambda fig, out_dir, name: captured.append(fig) or name)
+    report_copy = tmp_path / "run"
+    shutil.copytree(reported_run, report_copy)
+    shutil.copy(os.path.join(reported_run, "trials.sqlite"),
+                report_copy / "report" / "trials.snapshot.sqlite")
+    figures.distribution_figure(figures.Run(str(report_copy)), str(tmp_path))
+    fig = captured[0]
+    assert all(ax.get_legend() is None for ax in fig.axes) and len(fig.legends) == 1
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legend = fig.legends[0].get_window_extent(renderer)
+    assert all(legend.y0 > ax.get_window_extent(renderer).y1 for ax in fig.axes)

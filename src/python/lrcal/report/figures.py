@@ -199,6 +199,22 @@ def realisation_figures(run, out_dir):
     return out
 
 
+def _cell_ticks(cells):
+    """Tick labels for cells and the axis label that names them. Labels of the form
+    "key=value, key=value" with the same keys in every cell become their values alone (numbers
+    to 4 significant digits), the keys going to the axis label; other labels are shortened."""
+    parts = [[p.partition("=") for p in c["label"].split(", ")] for c in cells]
+    keys = [k for k, eq, _ in parts[0]] if parts and all(eq for _, eq, _ in parts[0]) else None
+    if keys and all([k for k, eq, _ in p] == keys and all(eq for _, eq, _ in p) for p in parts):
+        def value(text):
+            try:
+                return _short(float(text)) if not text.lstrip("-").isdigit() else text
+            except ValueError:
+                return _short(text, 16)
+        return [", ".join(value(v) for _, _, v in p) for p in parts], ", ".join(keys)
+    return [_short(c["label"]) for c in cells], None
+
+
 def distribution_figure(run, out_dir):
     """Box plots of the validation RMS and max errors per axis for each cell; the paper's
     published values marked for paper cells."""
@@ -211,7 +227,7 @@ def distribution_figure(run, out_dir):
     for ax, (metric, title) in zip(axes.flat, METRICS):
         boxes, positions, colors = [], [], []
         any_paper = False
-        ticks, ticklabels = [], []
+        ticks = []
         for i, cell in enumerate(cells):
             rows = data[data["cell_id"] == cell["id"]]
             for j, axis in enumerate(AXES):
@@ -225,26 +241,39 @@ def distribution_figure(run, out_dir):
                     any_paper = True
                     shown_paper.add(True)
             ticks.append(i * 4 + 1)
-            ticklabels.append(cell["label"])
         bp = ax.boxplot(boxes, positions=positions, widths=0.8, showfliers=False, patch_artist=True)
         for patch, color in zip(bp["boxes"], colors):
             patch.set_facecolor(color)
             patch.set_alpha(0.5)
+        ticklabels, xlabel = _cell_ticks(cells)
         ax.set_xticks(ticks)
         ax.set_xticklabels(ticklabels, rotation=30, ha="right", fontsize=8)
+        if xlabel:
+            ax.set_xlabel(xlabel, fontsize=8)
         ax.set_yscale("log")
         ax.set_ylabel(title)
-        handles = [plt.Rectangle((0, 0), 1, 1, color=f"C{j}", alpha=0.5) for j in range(3)]
-        labels = list(AXES)
-        h, l = ax.get_legend_handles_labels()
-        ax.legend(handles + h, labels + l, fontsize=7, loc="upper right")
+    # One legend for the four panels, above them: inside a panel it hid the paper's values.
+    handles = [plt.Rectangle((0, 0), 1, 1, color=f"C{j}", alpha=0.5) for j in range(3)]
+    labels = list(AXES)
+    h, l = axes.flat[0].get_legend_handles_labels()
+    fig.legend(handles + h, labels + l, fontsize=8, loc="upper center", ncol=len(labels + l),
+               bbox_to_anchor=(0.5, 0.955), frameon=False)
     fig.suptitle("Validation errors over the Monte-Carlo trials (boxes: p25–p75, whiskers 1.5 IQR"
                  + ("; red: the paper's published value)" if shown_paper else ")"), fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
     return [(_save(fig, out_dir, "distributions_validation"),
              "Distributions of the validation RMS and max errors per base axis over the trials of "
              "each cell." + (" Red diamonds: the paper's published values." if shown_paper else "")
              + run.left_out_note(cells))]
+
+
+def _short(value, width=28):
+    """A setting's value for a label: numbers to 4 significant digits (0.30000000000000004 is
+    0.3), text cut to `width` characters."""
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    text = str(value)
+    return text if len(text) <= width else text[:width - 1] + "…"
 
 
 def _axis_values(run, cell, axis_index, key, n_axes):
@@ -258,6 +287,18 @@ def _axis_values(run, cell, axis_index, key, n_axes):
         return value, True
     parts = cell["label"].split(", ")
     return (parts[axis_index] if len(parts) == n_axes else cell["label"]), False
+
+
+def _other_axes_label(run, cell, a, axes_spec):
+    """The cell's values of every sweep axis but `a`, each named by its key: a line's label."""
+    parts = []
+    for b, spec in enumerate(axes_spec):
+        if b == a:
+            continue
+        key = spec.get("key", "?")
+        value = _short(_axis_values(run, cell, b, key, len(axes_spec))[0])
+        parts.append(value if key == "." else f"{key}={value}")
+    return ", ".join(parts)
 
 
 def sensitivity_figures(run, out_dir):
@@ -274,8 +315,7 @@ def sensitivity_figures(run, out_dir):
         rows = []
         for cell in run.cells:
             x, numeric = _axis_values(run, cell, a, key, n_axes)
-            others = ", ".join(str(_axis_values(run, cell, b, axes_spec[b].get("key", "?"), n_axes)[0])
-                               for b in range(n_axes) if b != a)
+            others = _other_axes_label(run, cell, a, axes_spec)
             for metric in ("rms_pos", "rms_ori"):
                 r = val[(val["cell_id"] == cell["id"]) & (val["metric"] == metric)]
                 if r.empty:
@@ -288,9 +328,13 @@ def sensitivity_figures(run, out_dir):
         numeric = bool(df["numeric"].all())
         categories = list(dict.fromkeys(df["x"]))
         # "." sweeps whole settings: name the axis by its labels, not by the key.
-        name = key if key != "." else "the swept settings (" + ", ".join(map(str, categories)) + ")"
-        fig, axs = plt.subplots(1, 2, figsize=(12, 4.2))
+        name = key if key != "." else "the swept settings (" + ", ".join(
+            _short(c, 16) for c in categories) + ")"
         groups = df["group"].nunique()
+        # Several other axes: one legend beside the panels (inside, it covered the lines).
+        outside = groups > 1
+        fig, axs = plt.subplots(1, 2, figsize=(14 if outside else 12,
+                                               4.2 + 0.12 * max(0, groups - 12)))
         for ax, (metric, title) in zip(axs, (("rms_pos", "RMS position error (mm)"),
                                              ("rms_ori", "RMS orientation error (mrad)"))):
             for g, (group, sub) in enumerate(df[df["metric"] == metric].groupby("group", sort=False)):
@@ -316,19 +360,24 @@ def sensitivity_figures(run, out_dir):
                     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             else:
                 ax.set_xticks(range(len(categories)))
-                ax.set_xticklabels(categories, rotation=30 if len(categories) > 4 else 0,
+                ax.set_xticklabels([_short(c) for c in categories],
+                                   rotation=30 if len(categories) > 4 else 0,
                                    ha="right" if len(categories) > 4 else "center", fontsize=8)
                 ax.set_xlim(-0.5, len(categories) - 0.5)
             ax.set_yscale("log")
             ax.set_xlabel(key if key != "." else "swept settings")
             ax.set_ylabel(title)
             ax.grid(alpha=0.3)
-            if groups > 1 or not numeric:
+            if not outside and not numeric:
                 ax.legend(fontsize=7)
+        if outside:
+            h, l = axs[0].get_legend_handles_labels()
+            fig.legend(h, l, fontsize=7, loc="upper left", bbox_to_anchor=(0.80, 0.9),
+                       title="other settings", title_fontsize=7, frameon=False)
         band = "p5–p95 band" if numeric else "p5–p95 range"
         fig.suptitle(f"Sensitivity to {name}: mean over trials with the {band} "
                      "(averaged over the x, y, z axes)", fontsize=10)
-        fig.tight_layout()
+        fig.tight_layout(rect=(0, 0, 0.79 if outside else 1, 1))
         safe = "".join(ch if ch.isalnum() else "_" for ch in key).strip("_") or "settings"
         out.append((_save(fig, out_dir, f"sensitivity_{safe}"),
                     f"Validation accuracy against {name}" +
