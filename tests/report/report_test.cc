@@ -230,11 +230,10 @@ TEST(Report, CalibrationReportRendersInHeadlessChromium) {
   EXPECT_EQ(plain["parameters"], j["parameters"]);
   EXPECT_EQ(plain["holdout"], j["holdout"]);
   const std::string html = Read(cal / "report.html");
-  for (const char* section : {"Fit check", "Before and after", "nominal (before)",
-                              "calibrated (after)", "Parameters", "Identifiability",
-                              "Cross-validation",
-                              "Accuracy over the workspace", "Calibrated files",
-                              "consistent with the stated noise", "calibrated.urdf"})
+  for (const char* section :
+       {"Fit check", "Before and after", "nominal (before)", "calibrated (after)", "Parameters",
+        "Identifiability", "Cross-validation", "Accuracy over the workspace", "Calibrated files",
+        "consistent with the stated noise", "calibrated.urdf"})
     EXPECT_THAT(html, ::testing::HasSubstr(section)) << section;
   // Issue 31: nominal D-H angles in degrees, not "3141.5927 mrad".
   EXPECT_THAT(html, ::testing::HasSubstr("<td>theta5</td><td>180.000000°</td>"));
