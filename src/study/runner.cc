@@ -399,13 +399,13 @@ class StudyRunner {
   // the decisions.
   void RunTrials() {
     const auto t_run = Clock::now();
-    trials_start_ = t_run;
     const long long expected =
         result_.done_before +
         (adaptive_ ? result_.total - result_.done_before : work_->share() * ranks_);
-    progress_ = std::make_unique<ProgressReporter>(options_.progress && root(), ranks_,
-                                                   result_.total, result_.done_before, expected,
-                                                   t_run, adaptive_ ? nullptr : eta_.get());
+    progress_ = std::make_unique<ProgressReporter>(
+        options_.progress && root(), ranks_, result_.total, result_.done_before, expected, t_run,
+        // A run whose total changes as cells stop, or one cut at --max-trials: by the rate.
+        adaptive_ || options_.max_new_trials > 0 ? nullptr : eta_.get());
     ProgressReporter& progress = *progress_;
     if (adaptive_) {
       RunRounds(&progress);
@@ -628,7 +628,6 @@ class StudyRunner {
   std::map<std::string, int> cell_index_;  // cell id → index in contexts_
   std::unique_ptr<RemainingTimeEstimate> eta_;
   std::unique_ptr<ProgressReporter> progress_;
-  Clock::time_point trials_start_;
   bool dynamic_ = false;
   std::unique_ptr<WorkSource> work_;
   // stop_when (single process or MPI, not shards): the rules' state (rank 0) and whether every
