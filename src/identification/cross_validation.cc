@@ -58,7 +58,9 @@ MeasurementSet FoldData(const MeasurementSet& data, int folds, int fold, bool he
 std::string PredictFold(const MeasurementModel& model, const MeasurementSet& data, int folds,
                         int fold, const IdentificationOptions& options,
                         std::vector<HeldOutReading>* out) {
-  const IdentificationSummary s = Identify(model, FoldData(data, folds, fold, false), options);
+  IdentificationOptions fold_options = options;
+  fold_options.robust_fit_check = false;  // a fold's fit verdict is not used
+  const IdentificationSummary s = Identify(model, FoldData(data, folds, fold, false), fold_options);
   if (!s.IsSolutionUsable()) return s.message.empty() ? "the fit did not converge" : s.message;
   const bool given = options.sigma > 0;
   const Eigen::MatrixXd& C = given ? s.covariance_given : s.covariance_residual;

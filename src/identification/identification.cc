@@ -142,7 +142,7 @@ void SummarizeFit(const Eigen::MatrixXd& G, const std::vector<double>& weights,
   const Eigen::MatrixXd Ainv = ParameterCovariance(A, 1.0);
   s.sigma_hat = m > n ? std::sqrt(2 * s.final_cost / (m - n)) : std::nan("");
   CheckFit(residuals, weights, n, rows_per_configuration, data_rows, options, &s);
-  if (options.loss != RobustLoss::kNone && s.fit.sigma_given)
+  if (options.loss != RobustLoss::kNone && s.fit.sigma_given && options.robust_fit_check)
     CheckRobustFit(G, weights, data_rows, &s.fit);
   s.covariance_residual = s.sigma_hat * s.sigma_hat * Ainv;
   s.std_residual = s.covariance_residual.diagonal().cwiseSqrt();

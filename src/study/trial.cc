@@ -441,7 +441,9 @@ SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspac
   const CellSettings& s = c.cell->typed;
   SolveOutcome out;
   if (s.identification.solver == IdentificationOptions::Solver::kCeres) {
-    const IdentificationSummary summary = Identify(*c.model, ws->data, s.identification);
+    IdentificationOptions options = s.identification;
+    options.robust_fit_check = false;  // a trial records no fit verdict: no draws for it
+    const IdentificationSummary summary = Identify(*c.model, ws->data, options);
     out.termination = summary.termination;
     out.iterations = summary.iterations;
     out.final_cost = summary.final_cost;

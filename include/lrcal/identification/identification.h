@@ -69,6 +69,11 @@ struct IdentificationOptions {
   /// a-posteriori estimate around the nominal values, which needs `sigma` (the priors are weighed
   /// against the readings' noise). Empty: least squares, bit for bit as without this field.
   PriorSigmas priors;
+  /// With a robust loss and `sigma`, judge the fit by the robust scale of its residuals
+  /// (FitCheck::robust_*: 1999 Monte-Carlo draws of the statistic, a few ms for a hundred
+  /// configurations). Off where nothing reads the verdict (a study's trials); then the fit check
+  /// is χ²'s as without a robust loss.
+  bool robust_fit_check = true;
   /// The numeric settings (settings.h): max_iterations (1 to 10,000), max_robust_iterations (1
   /// to 1,000,000), parameter_tolerance and function_tolerance (≥ 0), sigma_mm (σ, ≥ 0 mm; the
   /// command line's --sigma-mm) and loss_scale_mm (> 0 mm; --loss-scale-mm). A study gives σ as
