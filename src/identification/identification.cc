@@ -11,6 +11,7 @@
 
 #include "identification/ceres_reference.h"
 #include "identification/levenberg_marquardt.h"
+#include "lrcal/core/descriptive_statistics.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/measurement/ranger_measurement.h"
 
@@ -89,11 +90,7 @@ void CheckFit(const std::vector<double>& residuals, const std::vector<double>& w
 // 1.4826·median|z| over z's entries (the normal distribution's σ from its median absolute value).
 double RobustScale(std::vector<double> z) {
   for (double& v : z) v = std::fabs(v);
-  const std::size_t k = z.size() / 2;
-  std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(k), z.end());
-  double median = z[k];
-  if (z.size() % 2 == 0) median = 0.5 * (median + *std::max_element(z.begin(), z.begin() + k));
-  return 1.4826 * median;
+  return 1.4826 * Quantile(&z, 50);
 }
 
 // The robust fit check (FitCheck::robust_*): the robust scale of the readings' standardised
@@ -500,6 +497,17 @@ Eigen::MatrixXd ParameterCovariance(const Eigen::MatrixXd& normal_matrix, double
 std::string FitCheck::LabelOf(int configuration) const {
   const auto i = static_cast<std::size_t>(configuration);
   return i < configuration_labels.size() ? configuration_labels[i] : std::string();
+}
+
+std::vector<std::string> FitCheck::SuspectLabels() const {
+  std::vector<std::string> out;
+  if (configuration_labels.empty()) return out;
+  for (int i : suspects) out.push_back(LabelOf(i / rows_per_configuration));
+  return out;
+}
+
+const char* FitCheck::TestName() const {
+  return !sigma_given ? "none" : robust ? "robust_scale" : "chi2";
 }
 
 namespace {

@@ -94,19 +94,16 @@ ResultJson ParametersJson(const IdentificationSummary& s) {
 
 ResultJson FitJson(const FitCheck& f) {
   ResultJson fit = {{"dof", f.dof}, {"standardized_residuals", f.standardized}};
-  fit["test"] = !f.sigma_given ? "none" : f.robust ? "robust_scale" : "chi2";
+  fit["test"] = f.TestName();
   if (f.robust) {
     fit["robust_scale"] = OrNull(f.robust_scale);
     fit["robust_p_value"] = OrNull(f.robust_p_value);
   }
   ResultJson suspects = ResultJson::array();
   for (int i : f.suspects) suspects.push_back(i + 1);
-  fit["suspects"] = suspects;             // 1-based configurations
-  if (!f.configuration_labels.empty()) {  // and by the labels of the measurement file
-    ResultJson labels = ResultJson::array();
-    for (int i : f.suspects) labels.push_back(f.LabelOf(i / f.rows_per_configuration));
-    fit["suspect_labels"] = labels;
-  }
+  fit["suspects"] = suspects;           // 1-based configurations
+  if (!f.configuration_labels.empty())  // and by the labels of the measurement file
+    fit["suspect_labels"] = f.SuspectLabels();
   if (f.num_priors > 0) {  // without priors the JSON is as before them
     fit["num_priors"] = f.num_priors;
     fit["chi2_priors"] = OrNull(f.chi2_priors);

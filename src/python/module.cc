@@ -177,13 +177,7 @@ std::vector<std::string> ToNames(const py::object& fix) {
   }
 }
 
-ParameterSet ResolveParameters(const RobotModel& robot, const std::string& estimate_plane,
-                               const py::object& fix) {
-  return MakeParameterSet(robot, PlaneTerms::Parse(estimate_plane, "estimate_plane"), ToNames(fix),
-                          "fix");
-}
-
-// The same for `num_planes` planes (estimate_plane for each) and the ranger's terms: what
+// The parameter set of `num_planes` planes (estimate_plane for each) and the ranger's terms: what
 // --estimate-plane, --estimate-ranger and --fix give the command line.
 ParameterSet ResolveParameters(const RobotModel& robot, int num_planes,
                                const std::string& estimate_plane,
@@ -672,7 +666,8 @@ Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const py::obje
                 const std::string& estimate_plane, const py::object& fix, const DesignArgs& a) {
   const RobotModel& robot = rig.robot;
   const Plane plane = ResolvePlane(rig, plane_arg);
-  const MeasurementModel model(robot, plane, ResolveParameters(robot, estimate_plane, fix));
+  const MeasurementModel model(robot, plane,
+                               ResolveParameters(robot, 1, estimate_plane, "none", fix));
   const DesignRequest request = ToDesignRequest(a, model, k);
   const CandidatePool pool = UsableCandidates(robot, plane, rig.ranger,
                                               ToConfigurations(pool_q, robot.num_links(), "pool"));
@@ -986,16 +981,12 @@ str() gives the full text report; repr() the one-line summary.)doc")
             d["consistent"] = s.fit.consistent;
             d["standardized"] = s.fit.standardized;
             d["suspects"] = s.fit.suspects;
-            d["test"] = !s.fit.sigma_given ? "none" : s.fit.robust ? "robust_scale" : "chi2";
+            d["test"] = s.fit.TestName();
             if (s.fit.robust) {
               d["robust_scale"] = s.fit.robust_scale;
               d["robust_p_value"] = s.fit.robust_p_value;
             }
-            if (!s.fit.configuration_labels.empty()) {
-              py::list labels;
-              for (int i : s.fit.suspects) labels.append(s.fit.LabelOf(i));
-              d["suspect_labels"] = labels;
-            }
+            if (!s.fit.configuration_labels.empty()) d["suspect_labels"] = s.fit.SuspectLabels();
             return d;
           },
           "The fit check, as identify's JSON 'fit': chi2 against the given sigma_mm, dof, "

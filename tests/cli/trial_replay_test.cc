@@ -7,6 +7,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "test_util.h"
 
@@ -18,6 +20,34 @@ using testing::RunCommand;
 
 int Lrcal(const std::string& args, std::string* out) {
   return RunCommand(LrcalBinary() + " " + args, out);
+}
+
+// Writes a study on the paper's arm into dir/s.yaml (`head` before the robot line, `body` after
+// it) and runs it into dir/run.
+void RunPaperStudy(const std::string& dir, const std::string& head, const std::string& body) {
+  std::ofstream(dir + "/s.yaml") << head
+                                 << "robot: " << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\n"
+                                 << body;
+  std::string out;
+  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
+}
+
+// The rows of `sql` on dir/run/trials.sqlite, every column as text.
+std::vector<std::vector<std::string>> StoreRows(const std::string& dir, const std::string& sql) {
+  std::vector<std::vector<std::string>> rows;
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open((dir + "/run/trials.sqlite").c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &st, nullptr), SQLITE_OK) << sql;
+  while (st != nullptr && sqlite3_step(st) == SQLITE_ROW) {
+    rows.emplace_back();
+    for (int c = 0; c < sqlite3_column_count(st); ++c)
+      rows.back().emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(st, c)));
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  return rows;
 }
 
 class TrialReplayTest : public ::testing::Test {
@@ -87,34 +117,25 @@ TEST_F(TrialReplayTest, BadRequestsAndAChangedStudyAreClearErrors) {
 // (the store keeps no validation for it), in text and JSON, for every status a study produces.
 TEST(TrialReplayOfFailedTrials, EachStatusReplaysAndMatchesItsRecord) {
   const std::string dir = testing::TempDir("trial_replay_statuses");
-  std::ofstream(dir + "/s.yaml")
-      << "name: statuses\nseed: 3\ntrials: 8\nrobot: "
-      << testing::SourcePath("studies/robots/paper.yaml")
-      << "\npool: {size: 40}\nselection: {count: 30}\nvalidation: {size: 5}\n"
-         "sweep:\n  axes:\n    - key: .\n      values:\n"
-         "        - {identification: {max_iterations: 100}}\n"
-         "        - {identification: {max_iterations: 1}}\n"
-         "        - {truth: {mode: random, length_sigma_mm: 150, angle_sigma_mrad: 150}}\n"
-         "      labels: [ok, one_iteration, wild_truth]\n";
-  std::string out;
-  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open((dir + "/run/trials.sqlite").c_str(), &db), SQLITE_OK);
-  sqlite3_stmt* st = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(db,
-                               "SELECT c.label, t.trial, t.status FROM trials t JOIN cells c "
-                               "USING (cell_id) GROUP BY t.status",
-                               -1, &st, nullptr),
-            SQLITE_OK);
+  ASSERT_NO_FATAL_FAILURE(RunPaperStudy(
+      dir, "name: statuses\nseed: 3\ntrials: 8\n",
+      "pool: {size: 40}\nselection: {count: 30}\nvalidation: {size: 5}\n"
+      "sweep:\n  axes:\n    - key: .\n      values:\n"
+      "        - {identification: {max_iterations: 100}}\n"
+      "        - {identification: {max_iterations: 1}}\n"
+      "        - {truth: {mode: random, length_sigma_mm: 150, angle_sigma_mrad: 150}}\n"
+      "      labels: [ok, one_iteration, wild_truth]\n"));
   std::set<std::string> statuses;
-  while (sqlite3_step(st) == SQLITE_ROW) {
-    const std::string label = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
-    const long long trial = sqlite3_column_int64(st, 1);
-    const std::string status = reinterpret_cast<const char*>(sqlite3_column_text(st, 2));
+  std::string out;
+  for (const auto& row : StoreRows(dir,
+                                   "SELECT c.label, t.trial, t.status FROM trials t JOIN cells c "
+                                   "USING (cell_id) GROUP BY t.status")) {
+    const std::string& label = row[0];
+    const std::string& trial = row[1];
+    const std::string& status = row[2];
     statuses.insert(status);
     SCOPED_TRACE(status + " in cell " + label);
-    const std::string args =
-        "trial " + dir + "/run --cell " + label + " --trial " + std::to_string(trial);
+    const std::string args = "trial " + dir + "/run --cell " + label + " --trial " + trial;
     ASSERT_EQ(Lrcal(args + " --format json", &out), 0) << out;
     const auto j = nlohmann::json::parse(out);
     EXPECT_TRUE(j["identical"].get<bool>()) << out;
@@ -127,8 +148,6 @@ TEST(TrialReplayOfFailedTrials, EachStatusReplaysAndMatchesItsRecord) {
       EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("Validation errors")));
     }
   }
-  sqlite3_finalize(st);
-  sqlite3_close(db);
   EXPECT_EQ(statuses, (std::set<std::string>{"ok", "not_converged", "beam_missed"}));
 }
 
@@ -137,31 +156,21 @@ TEST(TrialReplayOfFailedTrials, EachStatusReplaysAndMatchesItsRecord) {
 // when fewer readings than parameters remain.
 TEST(TrialReplayOfFailedTrials, AMissedBeamDropsItsConfigurationNotTheTrial) {
   const std::string dir = testing::TempDir("trial_replay_missed");
-  std::ofstream(dir + "/s.yaml") << "name: missed\nseed: 3\ntrials: 8\nrobot: "
-                                 << testing::SourcePath("studies/robots/paper.yaml")
-                                 << "\npool: {size: 60}\nselection: {count: 40}\n"
-                                    "validation: {size: 5}\n"
-                                    "truth: {mode: random, length_sigma_mm: 60, "
-                                    "angle_sigma_mrad: 60}\n";
+  ASSERT_NO_FATAL_FAILURE(
+      RunPaperStudy(dir, "name: missed\nseed: 3\ntrials: 8\n",
+                    "pool: {size: 60}\nselection: {count: 40}\nvalidation: {size: 5}\n"
+                    "truth: {mode: random, length_sigma_mm: 60, angle_sigma_mrad: 60}\n"));
+  const auto rows = StoreRows(dir,
+                              "SELECT trial, status, missed_configurations FROM trials "
+                              "ORDER BY missed_configurations DESC LIMIT 1");
+  ASSERT_EQ(rows.size(), 1u);
+  const std::string& trial = rows[0][0];
+  const std::string& status = rows[0][1];
+  const int missed = std::stoi(rows[0][2]);
   std::string out;
-  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open((dir + "/run/trials.sqlite").c_str(), &db), SQLITE_OK);
-  sqlite3_stmt* st = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(db,
-                               "SELECT trial, status, missed_configurations FROM trials "
-                               "ORDER BY missed_configurations DESC LIMIT 1",
-                               -1, &st, nullptr),
-            SQLITE_OK);
-  ASSERT_EQ(sqlite3_step(st), SQLITE_ROW);
-  const long long trial = sqlite3_column_int64(st, 0);
-  const std::string status = reinterpret_cast<const char*>(sqlite3_column_text(st, 1));
-  const int missed = sqlite3_column_int(st, 2);
-  sqlite3_finalize(st);
-  sqlite3_close(db);
   EXPECT_EQ(status, "ok");
   ASSERT_GT(missed, 0) << "the study should make some true beams miss";
-  const std::string args = "trial " + dir + "/run --cell base --trial " + std::to_string(trial);
+  const std::string args = "trial " + dir + "/run --cell base --trial " + trial;
   ASSERT_EQ(Lrcal(args + " --format json", &out), 0) << out;
   const auto j = nlohmann::json::parse(out);
   EXPECT_TRUE(j["identical"].get<bool>()) << out;

@@ -132,6 +132,8 @@ struct FitCheck {
   std::vector<std::string> configuration_labels{};
   /// Configuration i's label, or "" without labels.
   std::string LabelOf(int configuration) const;
+  /// The label of each suspect's configuration, in the order of `suspects`; empty without labels.
+  std::vector<std::string> SuspectLabels() const;
   /// With priors (prior.h): how many terms have one, and their part of chi2, Σ e_k²/σ_k² (the
   /// rest is the readings'). A large part says the priors are tighter than the terms' true
   /// deviations. NaN without σ.
@@ -148,6 +150,8 @@ struct FitCheck {
   double robust_scale = std::numeric_limits<double>::quiet_NaN();
   double robust_p_value = std::numeric_limits<double>::quiet_NaN();
   static constexpr int kRobustCheckDraws = 1999;
+  /// Which test decided `consistent`: "chi2", "robust_scale", or "none" without σ.
+  const char* TestName() const;
   /// The verdict in words, with the likely causes when the fit is inconsistent.
   std::string Explain() const;
 };
