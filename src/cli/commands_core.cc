@@ -49,6 +49,10 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm,
   options.solver = ParseName(kSolverNames, vm["solver"].as<std::string>(), "--solver", "solver");
   options.loss = ParseName(kRobustLossNames, vm["loss"].as<std::string>(), "--loss", "loss");
   ReadSettingOptions(vm, IdentificationOptions::Settings(), &options);
+  if (options.loss_scale_sigma > 0 && vm.count("loss-scale-mm") && !vm["loss-scale-mm"].defaulted())
+    throw InputError("--loss-scale-sigma",
+                     "give the loss scale once: in mm (--loss-scale-mm) or in multiples of "
+                     "--sigma-mm (--loss-scale-sigma), not both");
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
   options.priors = ResolvePriors(vm, rig);
   options.encoder_sigma = vm["encoder-sigma-mrad"].as<double>() * 1e-3;
@@ -298,7 +302,8 @@ void AddIdentifyOptions(po::options_description& o) {
 int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddIdentifyOptions(o);
-  AddSettingOptions(o, IdentificationOptions::Settings(), {"loss_scale_mm", "sigma_mm"});
+  AddSettingOptions(o, IdentificationOptions::Settings(),
+                    {"loss_scale_mm", "loss_scale_sigma", "sigma_mm"});
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   // A calibrated robot file that could not be written is refused before the fit, not after.

@@ -198,8 +198,8 @@ Termination SolveLeastSquaresThenRobust(int num_parameters, int num_configuratio
   for (int i = 0; i < num_configurations; ++i) {
     ceres::LossFunction* loss =
         options.loss == RobustLoss::kHuber
-            ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
-            : new ceres::CauchyLoss(options.loss_scale);
+            ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.LossScale()))
+            : new ceres::CauchyLoss(options.LossScale());
     robust.AddResidualBlock(one(i), loss, e->data());
   }
   if (!priors.terms.empty())

@@ -189,8 +189,9 @@ void DescribeSolver(const IdentificationOptions& options, IdentificationSummary*
   s->solver = options.solver == IdentificationOptions::Solver::kCeres ? "ceres" : "lrcal-lm";
   if (options.loss != RobustLoss::kNone) {
     std::ostringstream loss;
-    loss << NameOf(kRobustLossNames, options.loss) << " loss, scale " << options.loss_scale * 1e3
+    loss << NameOf(kRobustLossNames, options.loss) << " loss, scale " << options.LossScale() * 1e3
          << " mm";
+    if (options.loss_scale_sigma > 0) loss << " (" << options.loss_scale_sigma << " σ)";
     s->loss = loss.str();
   }
 }

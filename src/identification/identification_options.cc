@@ -33,6 +33,11 @@ const std::vector<SettingField<IdentificationOptions>>& IdentificationOptions::S
         "robust loss scale on each configuration's residual sqrt(R)*(mean h - h); e.g. 1.345 "
         "sigma for Huber, 2.385 sigma for Cauchy (95 % efficiency)"},
        &O::loss_scale},
+      {{"identification", "loss_scale_sigma", "loss_scale_sigma", "σ", 1, "σ", 0, kNoMax, false,
+        false, "", "not used: the scale is loss_scale_mm",
+        "the robust loss scale in multiples of one reading's sigma (which must be given), in "
+        "place of the scale in mm; 1.345 for Huber, 2.385 for Cauchy (95 % efficiency)"},
+       &O::loss_scale_sigma},
   };
   return fields;
 }
@@ -57,6 +62,10 @@ void IdentificationOptions::Validate() const {
     throw SettingError(encoder,
                        "errors in variables are weighed against the readings' noise: "
                        "give the noise of one reading as well");
+  if (loss_scale_sigma > 0 && !(sigma > 0))
+    throw SettingError(FindSetting(Settings(), "loss_scale_sigma")->spec,
+                       "a loss scale in multiples of sigma needs the readings' noise: give the "
+                       "noise of one reading as well, or the scale in mm");
   if (!priors.empty() && !(sigma > 0))
     throw SettingError(SettingSpec::Named("identification", "priors", "prior_sigma"),
                        "priors are weighed against the readings' noise: give the noise of one "

@@ -209,7 +209,7 @@ LevenbergMarquardt::Result LevenbergMarquardt::Solve(MeasurementEvaluator& model
 
 double LevenbergMarquardt::RobustCost(const IdentificationOptions& options,
                                       const Eigen::VectorXd& r, RobustWeights* weights) {
-  const double a = options.loss_scale, a2 = a * a;
+  const double a = options.LossScale(), a2 = a * a;
   if (weights) {
     weights->rho1.resize(r.size());
     weights->curvature.resize(r.size());

@@ -96,7 +96,7 @@ class LevenbergMarquardt {
   ///
   /// With a robust loss (options.loss) the least-squares estimate is then refined to the minimum
   /// of ½·Σ ρ(r_i²), r_i the weighted residual, ρ Ceres' HuberLoss / CauchyLoss of scale
-  /// options.loss_scale: the same cost, started from the same point, as the Ceres path (tested to
+  /// options.LossScale(): the same cost, started from the same point, as the Ceres path (tested to
   /// agree to 1e-8).
   Result Solve(const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
                const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,

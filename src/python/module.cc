@@ -419,6 +419,7 @@ struct IdentifyArgs {
   py::object holdout = py::none();        // as --holdout K, or None
   py::object predict_at = py::none();     // as --predict-at: poses (M, joints), or None
   py::object configuration = py::none();  // one label per reading (a CSV's configuration column)
+  double loss_scale_sigma = 0;            // as --loss-scale-sigma (0: loss_scale_mm is the scale)
 };
 
 // identify's `configuration`: one label per reading (any value, as text), none empty.
@@ -491,6 +492,16 @@ IdentificationOptions IdentifyOptionsPy(const RobotFile& rig, bool auto_fix,
   options.loss_scale = SettingValue(*FindSetting(fields, "loss_scale_mm"), a.loss_scale_mm,
                                     a.loss_scale, "loss_scale");
   options.sigma = SettingValue(*FindSetting(fields, "sigma_mm"), a.sigma_mm, a.sigma, "sigma");
+  const auto& in_sigmas = *FindSetting(fields, "loss_scale_sigma");
+  if (!in_sigmas.spec.Allows(a.loss_scale_sigma))
+    throw SettingError(in_sigmas.spec, a.loss_scale_sigma).Respelled(Frontend::kPython);
+  if (a.loss_scale_sigma > 0 &&
+      (a.loss_scale_mm != FindSetting(fields, "loss_scale_mm")->Default() ||
+       !a.loss_scale.is_none()))
+    throw InputError("loss_scale_sigma=",
+                     "give the loss scale once: in mm (loss_scale_mm=) or in multiples of sigma "
+                     "(loss_scale_sigma=), not both");
+  options.loss_scale_sigma = a.loss_scale_sigma;
   const auto& iterations = *FindSetting(fields, "max_iterations");
   const double max_iterations = static_cast<double>(a.max_iterations);
   if (!iterations.spec.Allows(max_iterations))
@@ -940,7 +951,8 @@ The result of lrcal.identify. Arrays are SI (m, rad); index k belongs to names[k
   sigma_hat (m), residual_rms (m), initial_cost, final_cost (½Σr², m²), iterations,
   num_configurations, termination ('converged', 'max_iterations', 'rank_deficient',
   'beam_missed', 'numerical_failure', 'invalid_input'), usable, message, fixed (parameters fixed
-  for rank), identifiability, solver; with priors prior_sigma (SI, 0 where none),
+  for rank), identifiability, solver, loss (in words: 'least squares', 'huber loss, scale 0.3 mm
+  (1.5 σ)'); with priors prior_sigma (SI, 0 where none),
   posterior_to_prior (NaN where no prior) and set_by_prior (posterior/prior above 0.9).
 holdout and accuracy: what identify(holdout=K) and identify(predict_at=poses) add, as dicts with
 the keys of `lrcal identify --holdout K --predict-at F --format json` (None when not asked for).
@@ -967,6 +979,7 @@ str() gives the full text report; repr() the one-line summary.)doc")
       .def_readonly("fixed", &S::fixed)
       .def_readonly("identifiability", &S::identifiability)
       .def_readonly("solver", &S::solver)
+      .def_readonly("loss", &S::loss)
       .def_readonly("prior_sigma", &S::prior_sigma)
       .def_readonly("posterior_to_prior", &S::posterior_to_prior)
       .def_property_readonly("set_by_prior", &S::SetByPrior)
@@ -1092,7 +1105,9 @@ plane_u2, plane_f; with several planes plane1_u1, ...). estimate_ranger: "none",
 fix: parameter names kept at nominal (a list or "a1,d2"). auto_fix: if the set is rank-deficient,
 fix the suggested parameters and go on (else termination is 'rank_deficient').
 solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (either solver) with scale
-loss_scale_mm (mm, as `lrcal identify --loss-scale-mm`) on each configuration's residual.
+loss_scale_mm (mm, as `lrcal identify --loss-scale-mm`) on each configuration's residual, or
+loss_scale_sigma (multiples of sigma_mm, as --loss-scale-sigma and a study's
+identification.loss_scale_sigma: 1.345 Huber, 2.385 Cauchy for 95 % efficiency) in its place.
 sigma_mm: the known σ of one reading (mm, as --sigma-mm) for covariance_given and the fit check;
 0 = unknown. loss_scale and sigma (m) are the earlier spellings of the two, still accepted.
 max_iterations: 1 to 10,000.
@@ -1130,14 +1145,15 @@ void DefineIdentify(py::module_& m) {
          long long max_iterations, const py::object& loss_scale, const py::object& sigma,
          const std::string& prior_sigma, bool prior, double encoder_sigma_mrad,
          const std::string& average, const py::object& plane_of, const std::string& estimate_ranger,
-         const py::object& holdout, const py::object& predict_at, const py::object& configuration) {
+         const py::object& holdout, const py::object& predict_at, const py::object& configuration,
+         double loss_scale_sigma) {
         IdentifyExtras extras;
-        py::object result =
-            py::cast(IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
-                                {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale,
-                                 sigma, prior_sigma, prior, encoder_sigma_mrad, average,
-                                 estimate_ranger, plane_of, holdout, predict_at, configuration},
-                                &extras));
+        py::object result = py::cast(
+            IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
+                       {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
+                        prior_sigma, prior, encoder_sigma_mrad, average, estimate_ranger, plane_of,
+                        holdout, predict_at, configuration, loss_scale_sigma},
+                       &extras));
         // As `lrcal identify --format json` has them: "holdout" and "accuracy" (None when not
         // asked for, or when the fit is not usable).
         result.attr("holdout") =
@@ -1155,7 +1171,7 @@ void DefineIdentify(py::module_& m) {
       py::arg("encoder_sigma_mrad") = 0.0, py::arg("average") = Averaging{}.Name(),
       py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
       py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(),
-      py::arg("configuration") = py::none(), kIdentifyDoc);
+      py::arg("configuration") = py::none(), setting("loss_scale_sigma"), kIdentifyDoc);
 }
 
 void DefineCalibration(py::module_& m) {

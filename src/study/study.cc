@@ -58,7 +58,7 @@ const Json& StudyDefaults() {
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
                        "on_rank_deficient": "fail",
-                       "loss": "none", "loss_scale": 1.345, "estimate_ranger": "none"},
+                       "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none"},
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
@@ -73,6 +73,11 @@ const Json& StudyDefaults() {
 namespace {
 
 using LineMap = std::map<std::string, int>;
+
+// The robust loss scale, given one way per cell: in mm, or in multiples of the reading's σ (the
+// default, 1.345). "identification.loss_scale" is the earlier spelling of the second.
+constexpr const char* kLossScaleMm = "identification.loss_scale_mm";
+constexpr const char* kLossScaleSigma = "identification.loss_scale_sigma";
 
 std::string Join(const std::string& prefix, const std::string& key) {
   if (key.empty()) return prefix;
@@ -134,6 +139,44 @@ Json ToJsonNode(const YAML::Node& node, const std::string& path, const std::stri
   return ToJsonScalar(node, path, file);
 }
 
+// identification.loss_scale, the earlier spelling of identification.loss_scale_sigma, renamed
+// wherever a study may write it (the identification mapping of the base or a sweep value, an axis
+// or a sensitivity input key); a mapping that gives the scale twice is refused.
+void RenameEarlierKeys(Json* j, const std::string& path, const std::string& file, LineMap* lines,
+                       bool identification = false) {
+  if (j->is_array()) {
+    for (std::size_t i = 0; i < j->size(); ++i)
+      RenameEarlierKeys(&(*j)[i], path + "[" + std::to_string(i) + "]", file, lines,
+                        identification);
+    return;
+  }
+  if (!j->is_object()) return;
+  if (identification) {
+    const auto twice = [&](const char* a, const char* b) {
+      if (!j->contains(a) || !j->contains(b)) return;
+      throw InputError(Location(file, (*lines)[Join(path, b)]) + " key '" + Join(path, b) + "'",
+                       std::string("the loss scale is given twice (also as ") + a +
+                           "): give loss_scale_mm (mm) or loss_scale_sigma (multiples of "
+                           "noise.sigma_mm), not both");
+    };
+    twice("loss_scale", "loss_scale_sigma");
+    twice("loss_scale_sigma", "loss_scale_mm");
+    twice("loss_scale", "loss_scale_mm");
+    if (j->contains("loss_scale")) {
+      (*j)["loss_scale_sigma"] = (*j)["loss_scale"];
+      j->erase("loss_scale");
+      (*lines)[Join(path, "loss_scale_sigma")] = (*lines)[Join(path, "loss_scale")];
+    }
+  }
+  const auto key = j->find("key");
+  const bool axis_of_identification = key != j->end() && *key == "identification";
+  if (key != j->end() && *key == "identification.loss_scale") *key = std::string(kLossScaleSigma);
+  for (auto it = j->begin(); it != j->end(); ++it)
+    RenameEarlierKeys(
+        &it.value(), Join(path, it.key()), file, lines,
+        it.key() == "identification" || (axis_of_identification && it.key() == "values"));
+}
+
 // Where a key path was written: "file:line key 'path'".
 struct KeyLocator {
   std::string file;
@@ -182,6 +225,8 @@ void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string
     if ((path == "pool" || path == "validation") &&
         (it.key() == "file" || it.key() == "file_fnv1a"))
       continue;
+    // identification.loss_scale_mm: the loss scale in mm, in place of loss_scale_sigma.
+    if (path == "identification" && it.key() == "loss_scale_mm") continue;
     if (!defaults.contains(it.key()))
       throw InputError(where(p), "unknown key; expected one of: " + KeyList(defaults));
     const Json& d = defaults[it.key()];
@@ -445,17 +490,27 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
                                        where("identification.estimate_ranger"));
   c->identification.loss = ParseName(kRobustLossNames, Str(s, "identification.loss", where),
                                      where("identification.loss"), "loss");
-  const double scale = Num(s, "identification.loss_scale", where);
-  if (!(scale > 0) || !std::isfinite(scale))
-    throw InputError(where("identification.loss_scale"),
-                     "expected a scale > 0 in units of the reading's standard deviation "
-                     "(Huber 1.345, Cauchy 2.385 for 95 % efficiency)");
-  if (c->identification.loss != RobustLoss::kNone && !(c->noise.sigma > 0))
-    throw InputError(where("identification.loss"),
-                     "a robust loss needs noise.sigma_mm > 0: its scale is in units of σ");
   // The scale applies to each configuration's weighted residual √R·(h̄ − h), whose standard
-  // deviation is that of one reading.
-  c->identification.loss_scale = c->noise.sigma > 0 ? scale * c->noise.sigma : 1e-3;
+  // deviation is that of one reading: in mm (loss_scale_mm) or in multiples of that σ.
+  if (At(s, kLossScaleMm).is_null()) {
+    const double scale = Num(s, kLossScaleSigma, where);
+    if (!(scale > 0) || !std::isfinite(scale))
+      throw InputError(where(kLossScaleSigma),
+                       "expected a scale > 0 in units of the reading's standard deviation "
+                       "(Huber 1.345, Cauchy 2.385 for 95 % efficiency), or the scale in mm "
+                       "as identification.loss_scale_mm");
+    if (c->identification.loss != RobustLoss::kNone && !(c->noise.sigma > 0))
+      throw InputError(where("identification.loss"),
+                       "a robust loss needs noise.sigma_mm > 0 for a scale in units of σ "
+                       "(identification.loss_scale_sigma); or give identification.loss_scale_mm");
+    c->identification.loss_scale = c->noise.sigma > 0 ? scale * c->noise.sigma : 1e-3;
+    return;
+  }
+  const auto& mm = *FindSetting(IdentificationOptions::Settings(), "loss_scale_mm");
+  const double scale = Num(s, kLossScaleMm, where) * mm.spec.to_si;
+  if (!mm.spec.Allows(scale))
+    throw SettingError(mm.spec, scale).Respelled(Frontend::kStudyFile, where(kLossScaleMm));
+  c->identification.loss_scale = scale;
 }
 
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
@@ -496,7 +551,7 @@ void Apply(Json* settings, const std::string& key, const Json& value) {
 }
 
 bool KeyExists(const Json& defaults, const std::string& key) {
-  if (key == "." || key == "plane") return true;
+  if (key == "." || key == "plane" || key == kLossScaleMm) return true;
   for (const char* k : {"normal", "offset", "tilt_deg", "azimuth_deg", "through"})
     if (key == std::string("plane.") + k) return true;
   if (key.rfind("plane.", 0) == 0) return false;
@@ -640,6 +695,7 @@ Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& 
   CheckUnknownKeys(settings, StudyDefaults(), "", where);
   Json base = StudyDefaults();
   base.merge_patch(settings);
+  if (!At(settings, kLossScaleMm).is_null()) base["identification"].erase("loss_scale_sigma");
   // noise.average came after studies were run: at its default (the mean) it is left out of the
   // settings, so that earlier studies' tables stay as they were.
   if (base["noise"].is_object() && base["noise"].value("average", Json()) == Averaging{}.Name())
@@ -756,6 +812,7 @@ void CheckSensitivityKey(const std::string& key, const Json& base, const std::st
                                   " (not the robot file's plane or a list of planes)");
     return;
   }
+  if (key == kLossScaleMm) return;
   if (!KeyExists(StudyDefaults(), key) ||
       !(At(StudyDefaults(), key).is_number() || At(StudyDefaults(), key) == "robot_file"))
     throw InputError(where, "'" + key +
@@ -901,6 +958,27 @@ void HashConfigurationFiles(Json* settings, const KeyLocator& where, const std::
   }
 }
 
+// True if an axis value at `key` sets the key path `path`.
+bool Sets(const std::string& key, const Json& value, const std::string& path) {
+  if (key == path) return true;
+  if (key == ".") return !At(value, path).is_null();
+  return path.rfind(key + ".", 0) == 0 && !At(value, path.substr(key.size() + 1)).is_null();
+}
+
+// A cell has its loss scale one way: a sweep value in one spelling replaces the base's in the
+// other (the base's default, 1.345 σ, included).
+void KeepOneLossScale(const std::vector<Axis>& axes, const std::vector<int>& combo,
+                      Json* settings) {
+  bool mm = false, sigma = false;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    mm = mm || Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleMm);
+    sigma = sigma || Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleSigma);
+  }
+  Json& id = (*settings)["identification"];
+  if (!id.is_object() || !id.contains("loss_scale_mm") || !id.contains("loss_scale_sigma")) return;
+  id.erase(sigma && !mm ? "loss_scale_mm" : "loss_scale_sigma");
+}
+
 Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector<int>& combo,
               const std::string& path, const LineMap& lines) {
   Cell cell;
@@ -922,6 +1000,7 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
                Location(path, line == lines.end() ? 0 : line->second);
   }
   if (cell.label.empty()) cell.label = "base";
+  KeepOneLossScale(axes, combo, &cell.settings);
   const std::string folder = std::filesystem::path(path).parent_path().string();
   HashRobotFile(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
   HashConfigurationFiles(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
@@ -973,6 +1052,16 @@ bool IsRobotFilePath(const std::string& robot) {
 
 Json CellIdentity(const Json& settings) {
   Json id = settings;
+  // loss_scale_sigma was loss_scale when the first robust studies were run: named so in the
+  // identity, and neither spelling counts without a robust loss.
+  if (id.contains("identification") && id["identification"].is_object()) {
+    Json& ident = id["identification"];
+    if (ident.contains("loss_scale_sigma")) {
+      ident["loss_scale"] = ident["loss_scale_sigma"];
+      ident.erase("loss_scale_sigma");
+    }
+    if (ident.value("loss", Json()) == "none") ident.erase("loss_scale_mm");
+  }
   DropNeutralKeys(&id);
   // tool_link came with URDF robots: left out when empty (as if not given).
   if (id.contains("tool_link") && id["tool_link"] == "") id.erase("tool_link");
@@ -989,7 +1078,8 @@ Study LoadStudy(const std::string& path) {
   yaml::RequireMap(root, path, "");
   LineMap lines;
   long budget = kMaxStudyValues;
-  const Json given = ToJsonNode(root, "", path, &lines, &budget);
+  Json given = ToJsonNode(root, "", path, &lines, &budget);
+  RenameEarlierKeys(&given, "", path, &lines);
   const KeyLocator where{path, &lines, "", ""};
   Study study;
   study.path = path;

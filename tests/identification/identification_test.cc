@@ -274,6 +274,19 @@ TEST(Identification, RobustLossesAgreeWithCeres) {
         EXPECT_LT((lm.delta - ceres.delta).cwiseAbs().maxCoeff(), 1e-8)
             << lm.loss << ", " << outliers << " outliers";
         EXPECT_THAT(lm.BriefReport(), ::testing::HasSubstr(NameOf(kRobustLossNames, loss)));
+        // The same scale in multiples of σ: the same fit, bit for bit, with either solver.
+        IdentificationOptions in_sigmas = o;
+        in_sigmas.loss_scale = 1e-3;  // unused
+        in_sigmas.loss_scale_sigma = scale_sigma;
+        in_sigmas.sigma = 0.2e-3;
+        in_sigmas.robust_fit_check = false;
+        o.sigma = 0.2e-3;
+        o.robust_fit_check = false;
+        for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
+                            IdentificationOptions::Solver::kCeres}) {
+          o.solver = in_sigmas.solver = solver;
+          EXPECT_EQ(Identify(model, data, in_sigmas).delta, Identify(model, data, o).delta);
+        }
       }
   }
 }
@@ -647,6 +660,20 @@ TEST(Identification, OptionsValidationNamesTheLibraryField) {
   EXPECT_THAT([&] { o.Validate(); },
               ThrowsMessage<SettingError>(HasSubstr("identification.loss_scale: expected a finite "
                                                     "value > 0 (m), got -0.001")));
+  // A scale in multiples of σ needs σ, and is that multiple of it.
+  o = IdentificationOptions{};
+  o.loss_scale_sigma = 1.345;
+  EXPECT_THAT([&] { o.Validate(); },
+              ThrowsMessage<SettingError>(HasSubstr("identification.loss_scale_sigma: a loss "
+                                                    "scale in multiples of sigma needs")));
+  o.sigma = 0.2e-3;
+  EXPECT_NO_THROW(o.Validate());
+  EXPECT_DOUBLE_EQ(o.LossScale(), 1.345 * 0.2e-3);
+  o.loss_scale_sigma = 0;
+  EXPECT_EQ(o.LossScale(), o.loss_scale);
+  o = IdentificationOptions{};
+  o.loss = RobustLoss::kHuber;
+  o.loss_scale = -1e-3;
   // Identify itself refuses bad options without throwing, naming the field.
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));

@@ -349,6 +349,19 @@ def test_settings_have_the_command_lines_names_units_and_checks(tmp_path, cli, p
     b = lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale=0.3e-3,
                        sigma=0.1e-3)
     np.testing.assert_array_equal(a.estimate, b.estimate)
+    # The scale in multiples of sigma_mm (as --loss-scale-sigma and a study's
+    # identification.loss_scale_sigma): the same fit as the product in mm (3 × 0.1e-3 m and
+    # 0.3e-3 m differ in the last bit, hence the tolerance).
+    c = lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_sigma=3.0,
+                       sigma_mm=0.1)
+    np.testing.assert_allclose(c.estimate, a.estimate, rtol=1e-9, atol=1e-14)
+    assert "(3 σ)" in c.loss
+    with pytest.raises(lrcal.InputError, match=r"^loss_scale_sigma=: .*not both"):
+        lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_sigma=3.0,
+                       loss_scale_mm=0.3, sigma_mm=0.1)
+    with pytest.raises(lrcal.InputError,
+                       match=r"^loss_scale_sigma=: a loss scale in multiples of sigma needs"):
+        lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_sigma=3.0)
 
     # Out of range: the command line's message in Python's words.
     with pytest.raises(lrcal.InputError, match=r"^sigma_mm=: expected a finite value >= 0 \(mm\)"):

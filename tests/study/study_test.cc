@@ -223,6 +223,70 @@ TEST(StudySchema, RobustLossScaleIsInSigmaAndLeavesOldCellsAlone) {
   EXPECT_THROW(LoadStudy(dir + "/bad.yaml"), InputError);
 }
 
+// The loss scale one way per cell, its unit in its name: loss_scale_sigma (multiples of σ; the
+// earlier spelling loss_scale reads as it, and a cell's name is what it was before the rename)
+// or loss_scale_mm (mm; no σ needed). A mapping that gives both is refused at its line.
+TEST(StudySchema, TheLossScaleIsGivenInMillimetresOrInSigmas) {
+  using ::testing::AllOf;
+  using ::testing::HasSubstr;
+  const std::string dir = testing::TempDir("study_loss_units");
+  const auto load = [&](const std::string& noise, const std::string& identification,
+                        const std::string& extra = "") {
+    std::ofstream(dir + "/s.yaml") << "name: s\nseed: 1\ntrials: 2\nnoise: " << noise
+                                   << "\nidentification: " << identification << "\n"
+                                   << extra;
+    return LoadStudy(dir + "/s.yaml");
+  };
+  const Study earlier = load("{sigma_mm: 0.2}", "{loss: cauchy, loss_scale: 2.385}");
+  const Study sigmas = load("{sigma_mm: 0.2}", "{loss: cauchy, loss_scale_sigma: 2.385}");
+  EXPECT_EQ(earlier.cells[0].id, sigmas.cells[0].id);
+  EXPECT_EQ(earlier.cells[0].settings["identification"]["loss_scale_sigma"], 2.385);
+  EXPECT_FALSE(earlier.cells[0].settings["identification"].contains("loss_scale"));
+  const Json identity = CellIdentity(sigmas.cells[0].settings);
+  EXPECT_EQ(identity["identification"]["loss_scale"], 2.385);
+  EXPECT_FALSE(identity["identification"].contains("loss_scale_sigma"));
+  EXPECT_DOUBLE_EQ(sigmas.cells[0].typed.identification.loss_scale, 2.385 * 0.2e-3);
+
+  // In mm: the default σ multiple leaves the cell; no noise is needed.
+  const Study mm = load("{sigma_mm: 0}", "{loss: huber, loss_scale_mm: 0.27}");
+  EXPECT_DOUBLE_EQ(mm.cells[0].typed.identification.loss_scale, 0.27e-3);
+  EXPECT_FALSE(mm.cells[0].settings["identification"].contains("loss_scale_sigma"));
+  EXPECT_NE(mm.cells[0].id, load("{sigma_mm: 0}", "{loss: huber, loss_scale_mm: 0.3}").cells[0].id);
+  // Without a loss neither spelling changes the cell's name.
+  EXPECT_EQ(load("{sigma_mm: 0.2}", "{loss_scale_mm: 0.3}").cells[0].id,
+            load("{sigma_mm: 0.2}", "{}").cells[0].id);
+
+  // A sweep in either spelling (the earlier one too) over the base's other one.
+  const Study swept =
+      load("{sigma_mm: 0.2}", "{loss: huber, loss_scale_mm: 0.3}",
+           "sweep:\n  axes:\n    - {key: identification.loss_scale, values: [1, 2]}\n");
+  ASSERT_EQ(swept.cells.size(), 2u);
+  EXPECT_EQ(swept.axis_keys[0], "identification.loss_scale_sigma");
+  EXPECT_DOUBLE_EQ(swept.cells[1].typed.identification.loss_scale, 2 * 0.2e-3);
+  EXPECT_FALSE(swept.cells[1].settings["identification"].contains("loss_scale_mm"));
+  const Study swept_mm =
+      load("{sigma_mm: 0.2}", "{loss: huber}",
+           "sweep:\n  axes:\n    - {key: ., values: [{identification: {loss_scale_mm: 0.5}}]}\n");
+  EXPECT_DOUBLE_EQ(swept_mm.cells[0].typed.identification.loss_scale, 0.5e-3);
+  EXPECT_FALSE(swept_mm.cells[0].settings["identification"].contains("loss_scale_sigma"));
+
+  const auto refused = [&](const std::string& noise, const std::string& identification) {
+    try {
+      load(noise, identification);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_THAT(
+      refused("{sigma_mm: 0.2}", "{loss: huber, loss_scale_sigma: 1, loss_scale_mm: 1}"),
+      AllOf(HasSubstr("s.yaml:5 key 'identification.loss_scale_mm'"), HasSubstr("given twice")));
+  EXPECT_THAT(refused("{sigma_mm: 0.2}", "{loss: huber, loss_scale: 1, loss_scale_sigma: 1}"),
+              HasSubstr("given twice"));
+  EXPECT_THAT(refused("{sigma_mm: 0.2}", "{loss: huber, loss_scale_mm: -1}"),
+              AllOf(HasSubstr("identification.loss_scale_mm"), HasSubstr("(mm), got -1")));
+}
+
 // noise.average: the mean leaves earlier cells alone; a median is its own cell, and with gross
 // errors in the readings its calibrations are far better than the mean's, with the predicted
 // accuracy (from the median's weights) still matching what the trials show.

@@ -40,8 +40,11 @@ struct IdentificationOptions {
   Solver solver = Solver::kLevenbergMarquardt;
   RobustLoss loss = RobustLoss::kNone;
   /// Scale of the robust loss (m), applied to each configuration's weighted residual
-  /// √R·(h̄ − h): residuals beyond it are down-weighted.
+  /// √R·(h̄ − h): residuals beyond it are down-weighted. Unused when loss_scale_sigma > 0.
   double loss_scale = 1e-3;
+  /// The same scale in multiples of one reading's σ (`sigma`, which it needs): 1.345 for Huber,
+  /// 2.385 for Cauchy give 95 % efficiency under Gaussian noise. 0: the scale is loss_scale.
+  double loss_scale_sigma = 0;
   int max_iterations = 100;
   /// Iterations of the robust refinement (after least squares). Its own budget: at loss scales
   /// far below the noise nearly every residual is in the loss' tail and the refinement
@@ -76,12 +79,17 @@ struct IdentificationOptions {
   bool robust_fit_check = true;
   /// The numeric settings (settings.h): max_iterations (1 to 10,000), max_robust_iterations (1
   /// to 1,000,000), parameter_tolerance and function_tolerance (≥ 0), sigma_mm (σ, ≥ 0 mm; the
-  /// command line's --sigma-mm) and loss_scale_mm (> 0 mm; --loss-scale-mm). A study gives σ as
-  /// noise.sigma_mm and the loss scale in multiples of σ (identification.loss_scale).
+  /// command line's --sigma-mm), loss_scale_mm (> 0 mm; --loss-scale-mm) and loss_scale_sigma
+  /// (≥ 0 multiples of σ; --loss-scale-sigma). Every front end spells the loss scale these two
+  /// ways, its unit in its name; a study gives σ as noise.sigma_mm.
   static const std::vector<SettingField<IdentificationOptions>>& Settings();
   /// Throws SettingError naming the library field (identification.sigma, ...) and the range;
-  /// with priors, naming identification.priors unless sigma > 0.
+  /// with priors, naming identification.priors unless sigma > 0; with loss_scale_sigma > 0,
+  /// naming it unless sigma > 0.
   void Validate() const;
+  /// The robust loss scale in metres: loss_scale_sigma · sigma if loss_scale_sigma > 0, else
+  /// loss_scale.
+  double LossScale() const { return loss_scale_sigma > 0 ? loss_scale_sigma * sigma : loss_scale; }
 };
 
 /// Solver names in study files and options.
