@@ -142,23 +142,16 @@ std::vector<double> ToVector(const Array& a, const char* name) {
   return std::vector<double>(data, data + b.shape[0]);
 }
 
-// `plane`: None (the robot file's), a Plane, or four numbers nx, ny, nz, f.
-Plane ResolvePlane(const RobotFile& rig, const py::object& plane) {
-  if (plane.is_none()) {
-    if (rig.planes && rig.planes->size() == 1) return (*rig.planes)[0];
-    if (rig.planes)
-      throw InputError("plane", "the robot file '" + rig.path +
-                                    "' has several planes; the Python module calibrates against "
-                                    "one: pass plane=lrcal.Plane((nx, ny, nz), f)");
-    throw InputError("plane", "the robot file '" + rig.path +
-                                  "' has no plane: pass plane=lrcal.Plane((nx, ny, nz), f)");
-  }
+// One plane given as an lrcal.Plane or four numbers (nx, ny, nz, f).
+Plane ToPlane(const py::object& plane) {
   if (py::isinstance<Plane>(plane)) return plane.cast<Plane>();
   std::vector<double> c;
   try {
     c = plane.cast<std::vector<double>>();
   } catch (const py::cast_error&) {
-    throw InputError("plane", "expected None, an lrcal.Plane or four numbers (nx, ny, nz, f)");
+    throw InputError("plane",
+                     "expected None, an lrcal.Plane, four numbers (nx, ny, nz, f) or a list of "
+                     "lrcal.Plane");
   }
   if (c.size() != 4)
     throw InputError("plane",
@@ -232,6 +225,7 @@ struct Readings {
   py::array_t<double> h;                             ///< M, m
   py::array_t<int> configuration;                    ///< M, 0-based index of the configuration read
   std::vector<std::pair<int, std::string>> skipped;  ///< (configuration, why) without a reading
+  py::object plane_of = py::none();  ///< M, the plane (from 1) each reading is of; None: one plane
 };
 
 /// A chosen design.
@@ -247,6 +241,18 @@ struct Design {
 
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link) {
   return LoadRobotFile(ResolveRobotPath(name_or_path), tool_link);
+}
+
+PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
+ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_of, int num_planes);
+
+// One plane number (from 1) per configuration, as a CSV's plane column; None with one plane.
+py::object PlaneNumbers(const ConfigurationSet& configs, int num_planes) {
+  if (num_planes < 2) return py::none();
+  py::array_t<int> out(configs.size());
+  auto w = out.mutable_unchecked<1>();
+  for (int i = 0; i < configs.size(); ++i) w(i) = configs.plane(i) + 1;
+  return std::move(out);
 }
 
 py::array_t<double> ForwardKinematicsPy(const RobotFile& rig, const Array& q,
@@ -270,14 +276,16 @@ py::array_t<double> ForwardKinematicsPy(const RobotFile& rig, const Array& q,
 }
 
 py::object LaserReadingsPy(const RobotFile& rig, const Array& q, const py::object& plane_arg,
-                           const py::object& model, bool return_status) {
+                           const py::object& model, bool return_status,
+                           const py::object& plane_of) {
   const RobotModel& robot = rig.robot;
-  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
-  const Plane plane = ResolvePlane(rig, plane_arg);
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  const ConfigurationSet configs =
+      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
   const Eigen::VectorXd values = ResolveLinkValues(robot, model);
   std::vector<double> h;
   std::vector<BeamMiss> misses;
-  ExactReadings(robot, values, plane, rig.ranger, configs, &h, &misses);
+  ExactReadings(robot, values, planes, rig.ranger, configs, &h, &misses);
   std::vector<std::string> status;
   for (std::size_t i = 0; i < h.size(); ++i) {
     if (misses[i] != BeamMiss::kNone) h[i] = std::numeric_limits<double>::quiet_NaN();
@@ -287,28 +295,38 @@ py::object LaserReadingsPy(const RobotFile& rig, const Array& q, const py::objec
   return py::make_tuple(ToArray(h), py::cast(status));
 }
 
-py::array_t<double> SampleConfigurationsPy(const RobotFile& rig, int count, long long seed,
-                                           const py::object& plane_arg, bool validation,
-                                           double min_singular_value) {
+py::object SampleConfigurationsPy(const RobotFile& rig, int count, long long seed,
+                                  const py::object& plane_arg, bool validation,
+                                  double min_singular_value, bool return_planes) {
   if (count < 1 || count > 1000000)
     throw InputError("count",
                      "expected 1 to 1,000,000 configurations, got " + std::to_string(count));
-  const Plane plane = ResolvePlane(rig, plane_arg);
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  if (planes.size() > 1 && !return_planes)
+    throw InputError("return_planes",
+                     std::to_string(planes.size()) +
+                         " planes: count configurations are drawn per plane; pass "
+                         "return_planes=True to receive (q, plane_of), the plane each is aimed "
+                         "at (as lrcal sample's plane column)");
   SamplingOptions options;
   options.ranger = rig.ranger;
   options.min_jacobian_singular_value = min_singular_value;
   options.require_beam_hit = !validation;
   options.Validate("min_singular_value");
+  const RandomStream stream(ToSeed(seed), 0, 0,
+                            validation ? RandomPurpose::kValidation : RandomPurpose::kPool);
   ConfigurationSet configs;
   {
     py::gil_scoped_release release;
-    configs = SampleConfigurations(
-        rig.robot, plane, count,
-        RandomStream(ToSeed(seed), 0, 0,
-                     validation ? RandomPurpose::kValidation : RandomPurpose::kPool),
-        options);
+    configs = planes.size() == 1
+                  ? SampleConfigurations(rig.robot, planes[0], count, stream, options)
+                  : SampleConfigurations(rig.robot, planes, std::vector<int>(planes.size(), count),
+                                         stream, options);
   }
-  return ToArray(configs);
+  if (!return_planes) return ToArray(configs);
+  py::object plane_numbers = PlaneNumbers(configs, planes.size());
+  if (plane_numbers.is_none()) plane_numbers = ToArray(std::vector<double>(configs.size(), 1.0));
+  return py::make_tuple(ToArray(configs), plane_numbers);
 }
 
 // The noise settings as simulate() takes them: sigma_mm, repetitions, encoder_sigma_mrad,
@@ -343,18 +361,24 @@ NoiseModel ToNoiseModel(const NoiseArgs& a, const py::object& sigma_m) {
 
 Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise_args,
                     long long seed, const py::object& plane_arg, const py::object& model,
-                    const py::object& sigma_m) {
+                    const py::object& sigma_m, const py::object& plane_of) {
   const RobotModel& robot = rig.robot;
-  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
-  const Plane plane = ResolvePlane(rig, plane_arg);
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  const ConfigurationSet configs =
+      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
   const Eigen::VectorXd values = ResolveLinkValues(robot, model);
-  const NoiseModel noise = ToNoiseModel(noise_args, sigma_m);
+  NoiseModel noise = ToNoiseModel(noise_args, sigma_m);
+  // The robot file's true ranger errors are part of its true model (as lrcal simulate reads).
+  if (py::isinstance<py::str>(model) && model.cast<std::string>() == "true") {
+    noise.ranger_offset = rig.ranger_offset;
+    noise.ranger_scale = rig.ranger_scale;
+  }
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
   {
     py::gil_scoped_release release;
-    SimulateReadings(robot, values, plane, rig.ranger, configs, noise,
+    SimulateReadings(robot, values, planes, rig.ranger, configs, noise,
                      RandomStream(ToSeed(seed), 0, 0, RandomPurpose::kNoise), &data, &misses, &raw);
   }
   // The kept configurations in order, `repetitions` readings each (as lrcal simulate writes).
@@ -378,6 +402,12 @@ Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise
     const int i = kept[static_cast<std::size_t>(r / noise.repetitions)];
     for (int j = 0; j < n; ++j) wq(r, j) = configs.q(i)[j];
     wc(r) = i;
+  }
+  if (planes.size() > 1) {
+    py::array_t<int> tags(m);
+    auto wt = tags.mutable_unchecked<1>();
+    for (py::ssize_t r = 0; r < m; ++r) wt(r) = configs.plane(wc(r)) + 1;
+    out.plane_of = std::move(tags);
   }
   return out;
 }
@@ -439,8 +469,6 @@ std::optional<std::vector<std::string>> ConfigurationLabels(const py::object& la
                                           std::to_string(out.size()));
   return out;
 }
-
-PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
 
 // A JSON text as Python objects (what the command prints with --format json).
 py::object FromJson(const std::string& json) {
@@ -639,6 +667,8 @@ struct DesignArgs {
   py::object poses;  // criterion I: the task poses (M, joints); None: `workspace` poses
   int workspace, baseline;
   double expected_angle_mrad, expected_length_mm;
+  py::object plane_of = py::none();      // with several planes, each candidate's plane (from 1)
+  std::string estimate_ranger = "none";  // as --estimate-ranger
 };
 
 DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model, int k) {
@@ -676,12 +706,14 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
 Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const py::object& plane_arg,
                 const std::string& estimate_plane, const py::object& fix, const DesignArgs& a) {
   const RobotModel& robot = rig.robot;
-  const Plane plane = ResolvePlane(rig, plane_arg);
-  const MeasurementModel model(robot, plane,
-                               ResolveParameters(robot, 1, estimate_plane, "none", fix));
+  const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+  const MeasurementModel model(
+      robot, planes,
+      ResolveParameters(robot, planes.size(), estimate_plane, a.estimate_ranger, fix));
   const DesignRequest request = ToDesignRequest(a, model, k);
-  const CandidatePool pool = UsableCandidates(robot, plane, rig.ranger,
-                                              ToConfigurations(pool_q, robot.num_links(), "pool"));
+  const CandidatePool pool = UsableCandidates(
+      robot, planes, rig.ranger,
+      WithPlanes(ToConfigurations(pool_q, robot.num_links(), "pool"), a.plane_of, planes.size()));
   if (pool.configs.size() == 0)
     throw InputError("pool", "no usable candidate configurations (every beam misses the plane)");
   Design out;
@@ -869,11 +901,13 @@ void DefineResults(py::module_& m) {
   py::class_<Readings>(m, "Readings", R"doc(
 Simulated single readings, one row per reading (as a measurement CSV holds them):
 q (M, joints) rad, h (M,) m, configuration (M,) the 0-based row of the q given,
-skipped: [(row, why)] for configurations whose beam missed (no reading).)doc")
+skipped: [(row, why)] for configurations whose beam missed (no reading); with several planes
+plane_of (M,) the plane each reading is of, from 1 (a measurement CSV's plane column), else None.)doc")
       .def_readonly("q", &Readings::q)
       .def_readonly("h", &Readings::h)
       .def_readonly("configuration", &Readings::configuration)
-      .def_readonly("skipped", &Readings::skipped);
+      .def_readonly("skipped", &Readings::skipped)
+      .def_readonly("plane_of", &Readings::plane_of);
 
   py::class_<Dependency>(m, "Dependency",
                          "Moving the parameters along these SI coefficients leaves every reading "
@@ -1049,18 +1083,24 @@ model: "nominal", "true" (nominal + the file's true errors) or an array of the 5
 (e.g. a calibrated model). The tool z axis (column 2) is the laser beam.)doc");
   m.def("laser_readings", &LaserReadingsPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("model") = "nominal",
-        py::arg("return_status") = false, R"doc(
+        py::arg("return_status") = false, py::arg("plane_of") = py::none(), R"doc(
 Exact laser readings h (N,) in m of q (N, joints): the distance along the beam to the plane.
 NaN where the ranger gives no reading (beam parallel, plane behind, out of range, grazing).
-plane: None (the robot file's), an lrcal.Plane or (nx, ny, nz, f). model: as forward_kinematics.
+plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
+lrcal.Plane; with several planes plane_of gives each configuration's plane (from 1).
+model: as forward_kinematics.
 With return_status=True: (h, status), status a list of 'ok' or the reason per configuration.)doc");
   m.def("sample_configurations", &SampleConfigurationsPy, py::arg("robot"), py::arg("count"),
         py::arg("seed") = 1, py::arg("plane") = py::none(), py::arg("validation") = false,
-        py::arg("min_singular_value") = 0.05, R"doc(
+        py::arg("min_singular_value") = 0.05, py::arg("return_planes") = false, R"doc(
 Draws count configurations (count, joints) uniformly within the joint limits whose nominal beam
 hits the plane within the ranger's limits and whose geometric Jacobian's smallest singular value
 is at least min_singular_value; validation=True drops the beam condition (validation poses).
-The same numbers as `lrcal sample --seed SEED [--validation]`.)doc");
+The same numbers as `lrcal sample --seed SEED [--validation]`.
+plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
+lrcal.Plane. With several planes count configurations are drawn per plane, plane 1's first (as
+`lrcal sample` with repeated --plane), and return_planes=True is needed: it returns (q, plane_of),
+plane_of (N,) the plane each configuration is aimed at, from 1 (the CSV's plane column).)doc");
   // The noise settings' names and defaults are the schema's (NoiseModel::Settings()).
   const auto& noise = NoiseModel::Settings();
   const auto setting = [&](int k) { return py::arg(noise[k].spec.name) = noise[k].Default(); };
@@ -1069,23 +1109,27 @@ The same numbers as `lrcal sample --seed SEED [--validation]`.)doc");
       [](const RobotFile& rig, const Array& q, double sigma_mm, long long repetitions,
          double encoder_sigma_mrad, double form_sigma_mm, double outlier_fraction,
          double outlier_sigma_mm, long long seed, const py::object& plane, const py::object& model,
-         const py::object& sigma) {
+         const py::object& sigma, const py::object& plane_of) {
         return SimulatePy(rig, q,
                           {sigma_mm, repetitions, encoder_sigma_mrad, form_sigma_mm,
                            outlier_fraction, outlier_sigma_mm},
-                          seed, plane, model, sigma);
+                          seed, plane, model, sigma, plane_of);
       },
       py::arg("robot"), py::arg("q"), setting(0),
       py::arg(noise[1].spec.name) = static_cast<long long>(noise[1].Default()), setting(2),
       setting(3), setting(4), setting(5), py::arg("seed") = 1, py::arg("plane") = py::none(),
-      py::arg("model") = "true", py::arg("sigma") = py::none(), R"doc(
-Simulated noisy readings of the arm `model` ("true" by default: nominal + the file's true errors)
-at the configurations q (N, joints): `repetitions` readings per configuration with Gaussian noise
+      py::arg("model") = "true", py::arg("sigma") = py::none(), py::arg("plane_of") = py::none(),
+      R"doc(
+Simulated noisy readings of the arm `model` ("true" by default: nominal + the file's true errors,
+its ranger's true offset and scale included) at the configurations q (N, joints): `repetitions` readings per configuration with Gaussian noise
 of standard deviation sigma_mm (mm), and a real rig's disturbances as `lrcal simulate` has them:
 encoder_sigma_mrad (joint-encoder noise, each joint and reading), form_sigma_mm (plane flatness),
 outlier_fraction and outlier_sigma_mm (gross errors). `sigma` (m) is the earlier spelling of
 sigma_mm. Returns an lrcal.Readings (q, h, configuration, skipped), the same numbers as
-`lrcal simulate --seed SEED` with the same settings.)doc");
+`lrcal simulate --seed SEED` with the same settings.
+plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
+lrcal.Plane; with several planes plane_of gives the plane each configuration is aimed at (from 1,
+as sample(..., return_planes=True) returns it).)doc");
 }
 
 constexpr const char* kIdentifyDoc = R"doc(
@@ -1206,11 +1250,13 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
          const py::object& expected_length, int restarts, int samples, long long seed,
          const py::object& plane, const std::string& estimate_plane, const py::object& fix,
          const py::object& poses, int workspace, int baseline, double expected_angle_mrad,
-         double expected_length_mm) {
-        return DesignPy(rig, pool, k, plane, estimate_plane, fix,
-                        DesignArgs{criterion, method, scaling, expected_angle, expected_length,
-                                   restarts, samples, seed, poses, workspace, baseline,
-                                   expected_angle_mrad, expected_length_mm});
+         double expected_length_mm, const py::object& plane_of,
+         const std::string& estimate_ranger) {
+        return DesignPy(
+            rig, pool, k, plane, estimate_plane, fix,
+            DesignArgs{criterion, method, scaling, expected_angle, expected_length, restarts,
+                       samples, seed, poses, workspace, baseline, expected_angle_mrad,
+                       expected_length_mm, plane_of, estimate_ranger});
       },
       py::arg("robot"), py::arg("pool"), py::arg("k"), py::arg("criterion") = "E",
       py::arg("method") = "exchange", py::arg("scaling") = "si",
@@ -1219,7 +1265,8 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
       py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
       py::arg("fix") = py::none(), py::arg("poses") = py::none(), py::arg("workspace") = 200,
       py::arg("baseline") = 1000, py::arg("expected_angle_mrad") = 1.0,
-      py::arg("expected_length_mm") = 1.0, R"doc(
+      py::arg("expected_length_mm") = 1.0, py::arg("plane_of") = py::none(),
+      py::arg("estimate_ranger") = "none", R"doc(
 Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
 identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
 (design/design_choice.h), numbers and checks.
@@ -1230,7 +1277,10 @@ paper), unit, expected (× expected_angle_mrad / expected_length_mm; expected_an
 expected_length in m are the earlier spellings). The choice is compared with `baseline` random
 designs (Design.baseline) and certified (Design.certificate, Design.efficiency). Candidates whose
 nominal beam misses the plane are left out (Design.rejected). Returns an lrcal.Design whose
-indices are rows of `pool`; Design.json holds `lrcal design --format json`'s fields.)doc");
+indices are rows of `pool`; Design.json holds `lrcal design --format json`'s fields.
+plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
+lrcal.Plane; with several planes plane_of gives each candidate's plane (from 1, the pool CSV's
+plane column). estimate_ranger: the ranger terms estimated (as --estimate-ranger).)doc");
 }
 
 void DefineStudy(py::module_& m) {
@@ -1305,7 +1355,7 @@ PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes) {
     for (const py::handle p : planes.cast<py::list>()) list.push_back(p.cast<Plane>());
     return PlaneSet(std::move(list), {}, "plane");
   }
-  return PlaneSet(ResolvePlane(rig, planes));
+  return PlaneSet(ToPlane(planes));
 }
 
 py::object KinematicsPy(const RobotFile& rig, const Array& q, const std::string& which,

@@ -455,3 +455,46 @@ def test_identifiability_with_several_planes_and_ranger_terms_is_the_programs(tm
         assert {"ranger_offset", "plane1_f"} <= set(mine.suggested_fixed)
     with pytest.raises(lrcal.InputError, match="plane_of: 3 planes"):
         lrcal.identifiability(paper, c[:, :6], plane=planes)
+
+
+def test_sample_simulate_readings_and_design_with_several_planes_are_the_programs(tmp_path, cli):
+    # A robot file with two planes and true ranger errors (examples/rigs): sample, simulate and
+    # design give the numbers of the commands, bit for bit; laser_readings reads each
+    # configuration on its own plane.
+    rig_path = pathlib.Path(__file__).parents[2] / "examples" / "rigs" / "seven_joint_ranger.yaml"
+    rig = lrcal.Robot.load(str(rig_path))
+    configs, data, chosen = tmp_path / "c.csv", tmp_path / "m.csv", tmp_path / "chosen.csv"
+    cli("sample", "--robot", rig_path, "--count", 25, "--seed", 3, "--out", configs)
+    cli("simulate", "--robot", rig_path, "--configs", configs, "--sigma-mm", 0.1,
+        "--repetitions", 3, "--seed", 4, "--out", data)
+    header, c = read_csv(configs)
+    q, plane_of = lrcal.sample(rig, 25, seed=3, return_planes=True)
+    np.testing.assert_array_equal(q, c[:, :7])
+    np.testing.assert_array_equal(plane_of, c[:, header.index("plane")])
+    assert sorted(set(plane_of)) == [1, 2]
+    with pytest.raises(lrcal.InputError, match=r"^return_planes: 2 planes: .*return_planes=True"):
+        lrcal.sample(rig, 25, seed=3)
+
+    readings = lrcal.simulate(rig, q, sigma_mm=0.1, repetitions=3, seed=4, plane_of=plane_of)
+    mheader, m = read_csv(data)
+    np.testing.assert_array_equal(readings.h, m[:, mheader.index("h")])
+    np.testing.assert_array_equal(readings.plane_of, m[:, mheader.index("plane")])
+    with pytest.raises(lrcal.InputError, match=r"^plane_of: 2 planes: give the plane each"):
+        lrcal.simulate(rig, q, seed=4)
+
+    # Each configuration read on its own plane: the one-plane call on that plane.
+    h = lrcal.laser_readings(rig, q, plane_of=plane_of)
+    planes = rig.planes
+    for k, plane in enumerate(planes, start=1):
+        mine = plane_of == k
+        np.testing.assert_array_equal(h[mine], lrcal.laser_readings(rig, q[mine], plane=plane))
+
+    program = json.loads(cli("design", "--robot", rig_path, "--pool", configs, "--select", 30,
+                             "--method", "greedy", "--format", "json", "--out", chosen).stdout)
+    design = lrcal.design(rig, q, 30, method="greedy", plane_of=plane_of)
+    mine = json.loads(design.json)
+    assert mine["score"] == program["score"]
+    assert mine["selected_per_plane"] == program["selected_per_plane"]
+    _, rows = read_csv(chosen)
+    np.testing.assert_array_equal(q[design.indices], rows[:, :7])
+    np.testing.assert_array_equal(plane_of[design.indices], rows[:, 7])
