@@ -184,7 +184,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
 void WriteRobot(const std::string& path, const std::string& data_file, const RobotFile& rig,
                 const MeasurementModel& model, const IdentificationSummary& s,
                 const IdentificationOptions& options, const UnestimatedTerms& held) {
-  WriteCalibratedRobot(path, data_file, rig, model, s, options, held);
+  WriteCalibratedRobot(path, DataSource::File(data_file), rig, model, s, options, held);
   std::cerr << "lrcal identify: calibrated robot written to " << path << "\n";
 }
 
@@ -240,7 +240,8 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const RobotFile& rig, const MeasurementModel& model,
                             const MeasurementSet& data, const IdentificationSummary& s,
                             const IdentificationOptions& options, const UnestimatedTerms& held) {
-  CalibrationReportInputs in{vm["data"].as<std::string>(), &rig, &model, &data, &s, options};
+  CalibrationReportInputs in{
+      DataSource::File(vm["data"].as<std::string>()), &rig, &model, &data, &s, options};
   in.held = held;
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
   WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)

@@ -13,16 +13,19 @@
 
 namespace lrcal {
 
-CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
-                                        const IdentificationSummary& s,
+DataSource DataSource::File(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return {path, HashHex(bytes.str())};
+}
+
+CalibrationRecord MakeCalibrationRecord(const DataSource& data, const IdentificationSummary& s,
                                         const IdentificationOptions& options,
                                         const UnestimatedTerms& held) {
   CalibrationRecord r;
-  r.data_file = data_file;
-  std::ifstream in(data_file, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  r.data_fnv1a = HashHex(bytes.str());
+  r.data_file = data.name;
+  r.data_fnv1a = data.fnv1a;
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   gmtime_r(&now, &utc);
@@ -46,14 +49,13 @@ CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
   return r;
 }
 
-void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
-                          const RobotFile& rig, const MeasurementModel& model,
-                          const IdentificationSummary& s, const IdentificationOptions& options,
-                          const UnestimatedTerms& held) {
+void WriteCalibratedRobot(const std::string& path, const DataSource& data, const RobotFile& rig,
+                          const MeasurementModel& model, const IdentificationSummary& s,
+                          const IdentificationOptions& options, const UnestimatedTerms& held) {
   const MeasurementModel solved = SolvedModel(model, s);
   WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
                            solved.PlanesAt(s.delta.data()),
-                           MakeCalibrationRecord(data_file, s, options, held));
+                           MakeCalibrationRecord(data, s, options, held));
 }
 
 ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord& r, int num_planes,

@@ -23,6 +23,7 @@
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/core/hash.h"
 #include "lrcal/core/random.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/design/configuration_sampling.h"
@@ -33,6 +34,7 @@
 #include "lrcal/identification/identification.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/calibration_record.h"
+#include "lrcal/io/csv.h"
 #include "lrcal/io/kinematics_report.h"
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_data.h"
@@ -44,6 +46,7 @@
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/report/accuracy_plan.h"
+#include "lrcal/report/calibration_report.h"
 #include "lrcal/report/report_data.h"
 #include "lrcal/report/run_tables.h"
 #include "lrcal/study/run_directory.h"
@@ -450,6 +453,9 @@ struct IdentifyArgs {
   py::object predict_at = py::none();     // as --predict-at: poses (M, joints), or None
   py::object configuration = py::none();  // one label per reading (a CSV's configuration column)
   double loss_scale_sigma = 0;            // as --loss-scale-sigma (0: loss_scale_mm is the scale)
+  py::object write_robot = py::none();    // as --write-robot: the calibrated robot file, or None
+  py::object report = py::none();         // as --report: the report's folder, or None
+  py::object data_file = py::none();      // the file q and h were read from, for the record
 };
 
 // identify's `configuration`: one label per reading (any value, as text), none empty.
@@ -571,6 +577,45 @@ ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
   return out;
 }
 
+// Where identify()'s readings came from, for the calibrated file's record: data_file= (hashed)
+// or the arrays themselves (described, and hashed as their float64 bytes).
+DataSource ReadingsSource(const py::object& data_file, const ConfigurationSet& configs,
+                          const std::vector<double>& h) {
+  if (!data_file.is_none()) return DataSource::File(py::str(data_file).cast<std::string>());
+  std::string bytes;
+  for (int i = 0; i < configs.size(); ++i)
+    bytes.append(reinterpret_cast<const char*>(configs.q(i)),
+                 sizeof(double) * static_cast<std::size_t>(configs.num_joints()));
+  bytes.append(reinterpret_cast<const char*>(h.data()), sizeof(double) * h.size());
+  return {"Python arrays: " + std::to_string(h.size()) + " readings (identify(q, h))",
+          HashHex(bytes)};
+}
+
+// identify(write_robot=, report=) as paths ("" when not asked for).
+struct IdentifyFiles {
+  std::string robot, report;
+  bool any() const { return !robot.empty() || !report.empty(); }
+};
+
+// What --write-robot and --report write (the report's HTML page is drawn by the caller, with the
+// GIL); runs without the GIL.
+void WriteIdentifyFiles(const IdentifyFiles& files, const RobotFile& rig,
+                        const MeasurementModel& model, const MeasurementSet& data,
+                        const IdentificationSummary& s, const IdentificationOptions& options,
+                        const UnestimatedTerms& held, const DataSource& source, int folds) {
+  if (!files.robot.empty() && s.IsSolutionUsable())
+    WriteCalibratedRobot(files.robot, source, rig, model, s, options, held);
+  if (files.report.empty()) return;
+  CalibrationReportInputs in{source, &rig, &model, &data, &s, options};
+  in.held = held;
+  in.holdout = folds;
+  try {
+    WriteCalibrationReportData(files.report, in);
+  } catch (const SettingError& e) {
+    throw e.Respelled(Frontend::kPython);
+  }
+}
+
 IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Array& h,
                                  const py::object& plane_arg, const std::string& estimate_plane,
                                  const py::object& fix, bool auto_fix, const IdentifyArgs& a,
@@ -593,8 +638,23 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
     extras->poses = ToConfigurations(a.predict_at.cast<Array>(), robot.num_links(), "predict_at");
     CheckJointRanges(extras->poses, robot, "predict_at");
   }
+  IdentifyFiles files;
+  if (!a.write_robot.is_none()) files.robot = py::str(a.write_robot).cast<std::string>();
+  if (!a.report.is_none()) files.report = py::str(a.report).cast<std::string>();
+  if (!a.write_robot.is_none()) CheckOutputFile(files.robot, "write_robot=");
+  const DataSource source =
+      files.any() ? ReadingsSource(a.data_file, set.configs, readings) : DataSource{};
   py::gil_scoped_release release;
   IdentificationSummary s = Identify(model, data, options);
+  // What is known of the held terms: the robot file's tolerances, prior_sigma over them.
+  const UnestimatedTerms held =
+      s.IsSolutionUsable() && (predict || files.any())
+          ? FindUnestimatedTerms(
+                SolvedModel(model, s), s, data, options,
+                PriorsFor(rig, !rig.tolerances.empty(), a.prior_sigma, "prior=", "prior_sigma="))
+          : UnestimatedTerms{};
+  if (files.any())
+    WriteIdentifyFiles(files, rig, model, data, s, options, held, source, folds.value_or(0));
   if (!s.IsSolutionUsable()) return s;
   if (folds) {
     try {
@@ -604,10 +664,6 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
     }
   }
   if (predict) {
-    // What is known of the held terms: the robot file's tolerances, prior_sigma over them.
-    const UnestimatedTerms held = FindUnestimatedTerms(
-        SolvedModel(model, s), s, data, options,
-        PriorsFor(rig, !rig.tolerances.empty(), a.prior_sigma, "prior=", "prior_sigma="));
     extras->accuracy = PredictAccuracyAfterFit(model, s, options, held, extras->poses);
     if (!extras->accuracy)
       throw InputError("predict_at",
@@ -1169,6 +1225,11 @@ holdout: K-fold cross-validation over the configurations (as --holdout K): resul
 predict_at: poses (M, joints) rad to state the calibrated arm's accuracy at (as --predict-at: the
 data part and the total with its sources, the robot file's tolerances and prior_sigma for the
 held terms): result.accuracy.
+write_robot: a path: the calibrated model written as a robot file with its record (as
+--write-robot; every function takes it as a robot). report: a folder: the calibration report (as
+--report: report.html, calibration.json, calibrated.yaml and .urdf); result.report is the page's
+path. data_file: the measurement file q and h were read from, named and hashed in the calibrated
+file's record (else the record names and hashes the arrays).
 Joint values outside the robot's joint ranges are refused (degrees for rad?), as the command
 line refuses them in a CSV.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc";
@@ -1190,14 +1251,37 @@ void DefineIdentify(py::module_& m) {
          const std::string& prior_sigma, bool prior, double encoder_sigma_mrad,
          const std::string& average, const py::object& plane_of, const std::string& estimate_ranger,
          const py::object& holdout, const py::object& predict_at, const py::object& configuration,
-         double loss_scale_sigma) {
+         double loss_scale_sigma, const py::object& write_robot, const py::object& report,
+         const py::object& data_file) {
         IdentifyExtras extras;
-        py::object result = py::cast(
-            IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
-                       {solver, loss, loss_scale_mm, sigma_mm, max_iterations, loss_scale, sigma,
-                        prior_sigma, prior, encoder_sigma_mrad, average, estimate_ranger, plane_of,
-                        holdout, predict_at, configuration, loss_scale_sigma},
-                       &extras));
+        py::object result = py::cast(IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
+                                                {solver,
+                                                 loss,
+                                                 loss_scale_mm,
+                                                 sigma_mm,
+                                                 max_iterations,
+                                                 loss_scale,
+                                                 sigma,
+                                                 prior_sigma,
+                                                 prior,
+                                                 encoder_sigma_mrad,
+                                                 average,
+                                                 estimate_ranger,
+                                                 plane_of,
+                                                 holdout,
+                                                 predict_at,
+                                                 configuration,
+                                                 loss_scale_sigma,
+                                                 write_robot,
+                                                 report,
+                                                 data_file},
+                                                &extras));
+        // report=: the page drawn from the files just written, as `lrcal identify --report`.
+        result.attr("report") = report.is_none()
+                                    ? py::object(py::none())
+                                    : py::object(py::module_::import("lrcal.report.calibration")
+                                                     .attr("build")(py::str(report))
+                                                     .cast<py::tuple>()[0]);
         // As `lrcal identify --format json` has them: "holdout" and "accuracy" (None when not
         // asked for, or when the fit is not usable).
         result.attr("holdout") =
@@ -1215,7 +1299,9 @@ void DefineIdentify(py::module_& m) {
       py::arg("encoder_sigma_mrad") = 0.0, py::arg("average") = Averaging{}.Name(),
       py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
       py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(),
-      py::arg("configuration") = py::none(), setting("loss_scale_sigma"), kIdentifyDoc);
+      py::arg("configuration") = py::none(), setting("loss_scale_sigma"),
+      py::arg("write_robot") = py::none(), py::arg("report") = py::none(),
+      py::arg("data_file") = py::none(), kIdentifyDoc);
 }
 
 void DefineCalibration(py::module_& m) {

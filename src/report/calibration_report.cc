@@ -55,7 +55,7 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
                        "cannot create the folder '" + dir + "': " + ec.message());
   const IdentificationSummary& s = *in.summary;
   ResultJson j = IdentificationJson(s);
-  j["data"] = {{"file", in.data_file}, {"configurations", in.data->size()}};
+  j["data"] = {{"file", in.data_source.name}, {"configurations", in.data->size()}};
   j["robot"] = in.rig->path;
   j["sigma_given"] = in.options.sigma > 0 ? ResultJson(in.options.sigma) : ResultJson();
   j["identifiability"] = IdentifiabilityJson(s.identifiability);
@@ -63,8 +63,8 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
     const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
     if (folds >= 2)
       j["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
-    WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_file, *in.rig, *in.model, s, in.options,
-                         in.held);
+    WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_source, *in.rig, *in.model, s,
+                         in.options, in.held);
     const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
     AddWorkspaceAccuracy(in, calibrated, &j);
     j["calibrated_robot"] = "calibrated.yaml";

@@ -25,11 +25,12 @@ TEST(CalibrationRecord, SaysWhichSigmaTheCovarianceAssumes) {
   std::ofstream(data) << "q1,h\n0,1\n";
   IdentificationOptions given;
   given.sigma = 2e-4;
-  const CalibrationRecord g = MakeCalibrationRecord(data, s, given);
+  const CalibrationRecord g = MakeCalibrationRecord(DataSource::File(data), s, given);
   EXPECT_EQ(g.sigma, 2e-4);
   EXPECT_EQ(g.sigma_source, "given (--sigma-mm)");
   EXPECT_THAT(g.covariance, testing::EigenNear(s.covariance_given, 0.0));
-  const CalibrationRecord r = MakeCalibrationRecord(data, s, IdentificationOptions{});
+  const CalibrationRecord r =
+      MakeCalibrationRecord(DataSource::File(data), s, IdentificationOptions{});
   EXPECT_EQ(r.sigma, 3e-4);
   EXPECT_EQ(r.sigma_source, "residual (sigma_hat)");
   EXPECT_THAT(r.covariance, testing::EigenNear(s.covariance_residual, 0.0));
@@ -68,7 +69,8 @@ TEST(CalibrationRecord, TheWrittenRobotIsTheSolvedModel) {
   s.covariance_residual = Eigen::MatrixXd::Identity(s.delta.size(), s.delta.size()) * 1e-8;
   const std::string dir = testing::TempDir("record_robot");
   std::ofstream(dir + "/m.csv") << "q1\n";
-  WriteCalibratedRobot(dir + "/cal.yaml", dir + "/m.csv", rig, model, s, IdentificationOptions{});
+  WriteCalibratedRobot(dir + "/cal.yaml", DataSource::File(dir + "/m.csv"), rig, model, s,
+                       IdentificationOptions{});
   const RobotFile back = LoadRobotFile(dir + "/cal.yaml");
   EXPECT_THAT(back.robot.nominal_values(),
               testing::EigenNear(model.LinkValues(s.delta.data()), 0.0));

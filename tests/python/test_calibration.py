@@ -498,3 +498,40 @@ def test_sample_simulate_readings_and_design_with_several_planes_are_the_program
     _, rows = read_csv(chosen)
     np.testing.assert_array_equal(q[design.indices], rows[:, :7])
     np.testing.assert_array_equal(plane_of[design.indices], rows[:, 7])
+
+
+def _without_date(text):
+    return "\n".join(line for line in text.splitlines()
+                     if not line.lstrip().startswith(("date:", "lrcal:")))
+
+
+def test_identify_writes_the_calibrated_robot_and_report_as_the_program_does(tmp_path, cli,
+                                                                             paper):
+    # identify(write_robot=, report=, data_file=) writes what --write-robot and --report write:
+    # the same calibrated robot file (but for its date), the same calibration.json and a page.
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    cli("sample", "--count", 40, "--seed", 5, "--out", configs)
+    cli("simulate", "--configs", configs, "--sigma-mm", 0.2, "--seed", 5, "--out", data)
+    cli("identify", "--data", data, "--sigma-mm", 0.2, "--write-robot", tmp_path / "cli.yaml",
+        "--report", tmp_path / "cli-report")
+    header, m = read_csv(data)
+    result = lrcal.identify(paper, m[:, :6], m[:, header.index("h")], sigma_mm=0.2,
+                            write_robot=tmp_path / "py.yaml", report=tmp_path / "py-report",
+                            data_file=data)
+    assert _without_date((tmp_path / "py.yaml").read_text()) == \
+        _without_date((tmp_path / "cli.yaml").read_text())
+    for name in ("calibration.json", "calibrated.urdf"):
+        assert (tmp_path / "py-report" / name).read_text() == \
+            (tmp_path / "cli-report" / name).read_text()
+    assert result.report == str(tmp_path / "py-report" / "report.html")
+    assert "Calibration report" in (tmp_path / "py-report" / "report.html").read_text()
+    calibrated = lrcal.Robot.load(str(tmp_path / "py.yaml"))
+    np.testing.assert_array_equal(calibrated.nominal_values, lrcal.Robot.load(
+        str(tmp_path / "cli.yaml")).nominal_values)
+
+    # Without data_file the record names and hashes the arrays; a bad place is refused first.
+    lrcal.identify(paper, m[:, :6], m[:, header.index("h")], write_robot=tmp_path / "arrays.yaml")
+    assert f'data: "Python arrays: {len(m)} readings' in (tmp_path / "arrays.yaml").read_text()
+    with pytest.raises(lrcal.InputError, match=r"^write_robot="):
+        lrcal.identify(paper, m[:, :6], m[:, header.index("h")],
+                       write_robot=tmp_path / "no" / "such" / "folder" / "x.yaml")

@@ -10,21 +10,28 @@
 
 namespace lrcal {
 
-/// The record of an identification of `data_file` (hashed, dated, with lrcal's version): σ and
-/// the covariance are ChooseSigma's (the given σ unless the χ² check rejects it, else σ̂; the
+/// Where a calibration's readings came from, for its record: a measurement file (its bytes
+/// hashed) or readings given as arrays (Python), described and hashed by the caller.
+struct DataSource {
+  std::string name;   ///< the file as given, or what the readings were ("Python arrays: ...")
+  std::string fnv1a;  ///< FNV-1a (hex) of the file's bytes, or of the arrays'
+  /// A measurement file: `path` and the hash of its bytes (of nothing if it cannot be read).
+  static DataSource File(const std::string& path);
+};
+
+/// The record of an identification of `data` (hashed, dated, with lrcal's version): σ and the
+/// covariance are ChooseSigma's (the given σ unless the χ² check rejects it, else σ̂; the
 /// covariance empty when undefined), with the terms `held` at nominal (total_accuracy.h).
-CalibrationRecord MakeCalibrationRecord(const std::string& data_file,
-                                        const IdentificationSummary& s,
+CalibrationRecord MakeCalibrationRecord(const DataSource& data, const IdentificationSummary& s,
                                         const IdentificationOptions& options,
                                         const UnestimatedTerms& held = {});
 
 /// The calibrated model of an identification (its solved model, SolvedModel) written as a robot
 /// file at `path` with its record (and the terms `held` at nominal); every command takes it as a
 /// robot. Throws StorageError.
-void WriteCalibratedRobot(const std::string& path, const std::string& data_file,
-                          const RobotFile& rig, const MeasurementModel& model,
-                          const IdentificationSummary& s, const IdentificationOptions& options,
-                          const UnestimatedTerms& held = {});
+void WriteCalibratedRobot(const std::string& path, const DataSource& data, const RobotFile& rig,
+                          const MeasurementModel& model, const IdentificationSummary& s,
+                          const IdentificationOptions& options, const UnestimatedTerms& held = {});
 
 /// The parameter set the calibration record `r` names: plane and ranger terms from their names,
 /// robot parameters not named are fixed, in MakeParameterSet's order. `source` names the record in

@@ -9,13 +9,14 @@
 #include "lrcal/core/settings.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/identification/total_accuracy.h"
+#include "lrcal/io/calibration_record.h"
 #include "lrcal/io/robot_file.h"
 
 namespace lrcal {
 
 /// What the report covers.
 struct CalibrationReportInputs {
-  std::string data_file;  ///< the measurement CSV the fit used, as given
+  DataSource data_source;  ///< the measurement CSV the fit used (or the arrays, from Python)
   const RobotFile* rig = nullptr;
   const MeasurementModel* model = nullptr;  ///< the model identified (before any rank fixes)
   const MeasurementSet* data = nullptr;
