@@ -105,9 +105,8 @@ int SampleCommand(const std::vector<std::string>& args) {
                   "configurations to draw (per plane when several planes are given)")(
       "seed", po::value<long long>()->default_value(1), "random seed")(
       "validation", po::bool_switch(), "validation set: anywhere in the workspace, no beam needed")(
-      "min-singular-value", po::value<double>()->default_value(0.05),
-      "reject arm configurations whose geometric Jacobian has a smaller singular value")(
       "out", po::value<std::string>()->required(), "output CSV (q1..qN)");
+  AddSettingOptions(o, SamplingOptions::Settings(), {"min_singular_value"});
   po::variables_map vm;
   if (!Parse("sample", "--out C.csv [options]", o, args, &vm)) return 0;
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
@@ -121,9 +120,9 @@ int SampleCommand(const std::vector<std::string>& args) {
                      "expected 1 to 1,000,000 configurations, got " + std::to_string(count));
   SamplingOptions options;
   options.ranger = rig.ranger;
-  options.min_jacobian_singular_value = vm["min-singular-value"].as<double>();
+  ReadSettingOptions(vm, SamplingOptions::Settings(), &options);
   options.require_beam_hit = !vm["validation"].as<bool>();
-  options.Validate("--min-singular-value");
+  options.Validate();
   SamplingReport report;
   const bool validation = vm["validation"].as<bool>();
   ConfigurationSet configs = SampleConfigurations(
@@ -378,8 +377,6 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "estimate-plane", po::value<std::string>()->default_value("none"),
       "plane terms in the set: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters to leave out, comma-separated")(
-      "rank-tolerance", po::value<double>()->default_value(1e-8),
-      "relative singular value below which a direction is unobservable")(
       "prior-sigma", po::value<std::string>(),
       "prior standard deviations as identify takes them (theta=1mrad,a=0.5mm,...): also say, "
       "per term, how much readings with --sigma-mm and --repetitions would inform it against "
@@ -387,6 +384,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "prior", po::bool_switch(),
       "the same with the robot file's tolerances: (--prior-sigma entries replace the same keys)");
   AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
+  AddSettingOptions(o, IdentifiabilityOptions::Settings(), {"rank_tolerance"});
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -397,8 +395,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   IdentifiabilityOptions options;
-  options.rank_tolerance = vm["rank-tolerance"].as<double>();
-  options.Validate("--rank-tolerance");
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
   const IdentifiabilityReport r = AnalyzeIdentifiability(model, configs, nullptr, options);
   RemedyOptions remedy_options;
   remedy_options.ranger = rig.ranger;
@@ -424,8 +421,8 @@ int PaperCommand(const std::vector<std::string>& args) {
       "seed", po::value<long long>()->default_value(1), "random seed of the realisation")(
       "case1-selection", po::value<std::string>()->default_value("backward"),
       "how case 1 picks 50 of 101: backward, exchange, greedy, sampled (the paper's), random")(
-      "samples", po::value<int>()->default_value(1000), "subsets tried by 'sampled'")(
       "format", po::value<std::string>()->default_value("text"), "text or json");
+  AddSettingOptions(o, SelectionOptions::Settings(), {"samples"});
   po::variables_map vm;
   if (!Parse("paper", "[--seed K] [options]", o, args, &vm)) return 0;
   const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
@@ -438,8 +435,7 @@ int PaperCommand(const std::vector<std::string>& args) {
   options.seed = ParseSeed(vm);
   options.case1_selection.method =
       ParseSelectionMethod(vm["case1-selection"].as<std::string>(), "--case1-selection");
-  options.case1_selection.samples = vm["samples"].as<int>();
-  options.case1_selection.Validate("--samples");
+  ReadSettingOptions(vm, SelectionOptions::Settings(), &options.case1_selection);
   const PaperCasesResult r = RunPaperCases(robot, (*rig.planes)[0], options);
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << PaperCasesJson(r, options).dump(2) << "\n";

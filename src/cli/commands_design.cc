@@ -33,15 +33,13 @@ void AddDesignOptions(po::options_description& o) {
       "expected-angle-mrad", po::value<double>()->default_value(1.0),
       "expected angle error (mrad)")("expected-length-mm", po::value<double>()->default_value(1.0),
                                      "expected length error (mm)")(
-      "restarts", po::value<int>()->default_value(4),
-      "exchange: starts (backward design + random)")(
-      "samples", po::value<int>()->default_value(1000), "sampled: random subsets tried")(
       "baseline", po::value<int>()->default_value(1000), "random designs for the baseline")(
       "estimate-ranger", po::value<std::string>()->default_value("none"),
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
       "fix", po::value<std::string>(), "parameters left out, comma-separated")(
       "out", po::value<std::string>(), "write the chosen configurations (CSV)");
+  AddSettingOptions(o, SelectionOptions::Settings(), {"samples", "restarts"});
 }
 
 struct ResolvedPool {
@@ -106,10 +104,7 @@ DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel
         model, WorkspacePoses(model.robot(), vm["workspace"].as<int>(), seed), "workspace");
   }
   request.selection.method = ParseSelectionMethod(vm["method"].as<std::string>(), "--method");
-  request.selection.restarts = vm["restarts"].as<int>();
-  request.selection.samples = vm["samples"].as<int>();
-  if (request.selection.restarts < 1) throw InputError("--restarts", "expected at least 1");
-  if (request.selection.samples < 1) throw InputError("--samples", "expected at least 1");
+  ReadSettingOptions(vm, SelectionOptions::Settings(), &request.selection);
   request.scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
   request.expected_angle = vm["expected-angle-mrad"].as<double>() * 1e-3;
   request.expected_length = vm["expected-length-mm"].as<double>() * 1e-3;

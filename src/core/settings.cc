@@ -55,7 +55,9 @@ std::string SettingSpec::Expected(bool si) const {
     if (bounded) return "expected " + low + " to " + Number(hi) + what;
     return "expected " + low + " or more" + what;
   }
-  if (bounded) return "expected a value in [" + Number(lo) + ", " + Number(hi) + "]" + Unit(u);
+  if (bounded)
+    return std::string("expected a value in ") + (min_exclusive ? "(" : "[") + Number(lo) + ", " +
+           Number(hi) + (max_exclusive ? ")" : "]") + Unit(u);
   return std::string("expected a finite value ") + (min_exclusive ? "> " : ">= ") + Number(lo) +
          Unit(u);
 }
@@ -65,7 +67,8 @@ bool SettingSpec::Allows(double value_si) const {
   const double v = value_si / to_si;
   if (integer && v != std::floor(v)) return false;
   const double lo = min * to_si, hi = max * to_si;
-  return (min_exclusive ? value_si > lo : value_si >= lo) && value_si <= hi;
+  return (min_exclusive ? value_si > lo : value_si >= lo) &&
+         (max_exclusive ? value_si < hi : value_si <= hi);
 }
 
 void SettingSpec::Check(double value_si) const {

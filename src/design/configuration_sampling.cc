@@ -1,6 +1,7 @@
 #include "lrcal/design/configuration_sampling.h"
 
 #include <Eigen/SVD>
+#include <limits>
 #include <sstream>
 
 #include "lrcal/core/error.h"
@@ -58,12 +59,25 @@ std::string RejectionOf(const RobotModel& robot, const ModelPoint& nominal, cons
 
 }  // namespace
 
-void SamplingOptions::Validate(const std::string& source) const {
-  if (!(std::isfinite(min_jacobian_singular_value) && min_jacobian_singular_value >= 0))
-    throw InputError(source, "min_jacobian_singular_value: expected a finite value >= 0");
-  if (max_attempts_per_configuration < 1)
-    throw InputError(source, "max_attempts_per_configuration: expected at least 1");
-  ranger.Validate(source + " ranger");
+const std::vector<SettingField<SamplingOptions>>& SamplingOptions::Settings() {
+  using O = SamplingOptions;
+  static const std::vector<SettingField<O>> fields = {
+      {{"pool", "min_jacobian_singular_value", "min_singular_value", "", 1, "", 0,
+        std::numeric_limits<double>::infinity(), false, false, "", "",
+        "reject arm configurations whose geometric Jacobian has a smaller singular value"},
+       &O::min_jacobian_singular_value},
+      {{"pool", "max_attempts_per_configuration", "max_attempts", "", 1, "", 1, 1e9, false, true,
+        "attempts per configuration", "",
+        "give up after this many attempts per requested configuration"},
+       nullptr,
+       &O::max_attempts_per_configuration},
+  };
+  return fields;
+}
+
+void SamplingOptions::Validate() const {
+  CheckSettings(*this, Settings());
+  ranger.Validate();
 }
 
 ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,

@@ -63,18 +63,28 @@ Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
   return G;
 }
 
-void IdentifiabilityOptions::Validate(const std::string& source) const {
-  const auto check = [&](double v, const char* name) {
-    if (!(v >= 0 && v < 1))
-      throw InputError(source, std::string(name) +
-                                   ": expected a relative tolerance in [0, 1), "
-                                   "got " +
-                                   std::to_string(v));
+const std::vector<SettingField<IdentifiabilityOptions>>& IdentifiabilityOptions::Settings() {
+  using O = IdentifiabilityOptions;
+  const auto tolerance = [](const char* field, const char* help) {
+    SettingSpec spec{"identifiability", field, field, "", 1, "", 0, 1, false, false, "", "", help};
+    spec.max_exclusive = true;
+    return spec;
   };
-  check(rank_tolerance, "rank tolerance");
-  check(zero_column_tolerance, "zero-column tolerance");
-  check(coefficient_tolerance, "coefficient tolerance");
+  static const std::vector<SettingField<O>> fields = {
+      {tolerance("rank_tolerance",
+                 "relative singular value (of the unit-column Jacobian) below which a direction "
+                 "is unobservable"),
+       &O::rank_tolerance},
+      {tolerance("zero_column_tolerance",
+                 "relative column norm below which a parameter has no effect"),
+       &O::zero_column_tolerance},
+      {tolerance("coefficient_tolerance", "smallest coefficient of a dependence kept"),
+       &O::coefficient_tolerance},
+  };
+  return fields;
 }
+
+void IdentifiabilityOptions::Validate() const { CheckSettings(*this, Settings()); }
 
 namespace {
 

@@ -216,7 +216,13 @@ RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
   if (rg["max_incidence_deg"])
     ranger.max_incidence =
         Number(rg["max_incidence_deg"], path, "ranger.max_incidence_deg") * M_PI / 180.0;
-  ranger.Validate(Where(path, rg, "ranger"));
+  try {
+    ranger.Validate();
+  } catch (const SettingError& e) {  // in the file's words: its line and key, its unit
+    const char* key = e.spec().name;
+    throw InputError(Where(path, rg[key] ? rg[key] : rg, std::string("ranger.") + key),
+                     e.Problem());
+  }
   return ranger;
 }
 

@@ -104,11 +104,28 @@ void NormalChart::NormalAndJacobian(double u1, double u2, Eigen::Vector3d* n,
   dn_du->col(1) = P * t2;
 }
 
-void RangerSpec::Validate(const std::string& source) const {
-  if (!(min_range >= 0 && min_range < max_range && std::isfinite(max_range)))
-    throw InputError(source, "expected 0 <= min_range < max_range (finite, m)");
-  if (!(max_incidence > 0 && max_incidence <= M_PI / 2))
-    throw InputError(source, "max_incidence: expected an angle in (0, 90] degrees");
+const std::vector<SettingField<RangerSpec>>& RangerSpec::Settings() {
+  using R = RangerSpec;
+  static const std::vector<SettingField<R>> fields = {
+      {{"ranger", "min_range", "min_range", "m", 1, "m", 0, 1e6, false, false, "", "",
+        "shortest usable reading"},
+       &R::min_range},
+      {{"ranger", "max_range", "max_range", "m", 1, "m", 0, 1e6, true, false, "", "",
+        "longest usable reading"},
+       &R::max_range},
+      {{"ranger", "max_incidence", "max_incidence_deg", "deg", M_PI / 180, "rad", 0, 90, true,
+        false, "", "", "largest angle between the beam and the plane normal"},
+       &R::max_incidence},
+  };
+  return fields;
+}
+
+void RangerSpec::Validate() const {
+  CheckSettings(*this, Settings());
+  if (!(min_range < max_range))
+    throw SettingError(Settings()[1].spec, "expected a value above min_range (" +
+                                               FormatExact(min_range) + " m), got " +
+                                               FormatExact(max_range));
 }
 
 BeamMiss ClassifyReading(double h, double n_dot_b, const RangerSpec& ranger) {

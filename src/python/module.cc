@@ -315,7 +315,7 @@ py::object SampleConfigurationsPy(const RobotFile& rig, int count, long long see
   options.ranger = rig.ranger;
   options.min_jacobian_singular_value = min_singular_value;
   options.require_beam_hit = !validation;
-  options.Validate("min_singular_value");
+  options.Validate();
   const RandomStream stream(ToSeed(seed), 0, 0,
                             validation ? RandomPurpose::kValidation : RandomPurpose::kPool);
   ConfigurationSet configs;
@@ -684,7 +684,7 @@ IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
   const MeasurementModel& model = *set.model;
   IdentifiabilityOptions options;
   options.rank_tolerance = rank_tolerance;
-  options.Validate("rank_tolerance");
+  options.Validate();
   py::gil_scoped_release release;
   return AnalyzeIdentifiability(model, configs, nullptr, options);
 }
@@ -746,7 +746,7 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
   request.selection.method = ParseSelectionMethod(a.method, "method");
   request.selection.restarts = a.restarts;
   request.selection.samples = a.samples;
-  request.selection.Validate("design");
+  request.selection.Validate();
   request.scaling = ParseDesignScaling(a.scaling, "scaling");
   const auto& specs = DesignRequest::Settings();
   const DesignRequest defaults;
@@ -1148,7 +1148,9 @@ model: as forward_kinematics.
 With return_status=True: (h, status), status a list of 'ok' or the reason per configuration.)doc");
   m.def("sample_configurations", &SampleConfigurationsPy, py::arg("robot"), py::arg("count"),
         py::arg("seed") = 1, py::arg("plane") = py::none(), py::arg("validation") = false,
-        py::arg("min_singular_value") = 0.05, py::arg("return_planes") = false, R"doc(
+        py::arg("min_singular_value") =
+            FindSetting(SamplingOptions::Settings(), "min_singular_value")->Default(),
+        py::arg("return_planes") = false, R"doc(
 Draws count configurations (count, joints) uniformly within the joint limits whose nominal beam
 hits the plane within the ranger's limits and whose geometric Jacobian's smallest singular value
 is at least min_singular_value; validation=True drops the beam condition (validation poses).
@@ -1308,7 +1310,9 @@ void DefineCalibration(py::module_& m) {
   DefineIdentify(m);
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(), py::arg("rank_tolerance") = 1e-8,
+        py::arg("fix") = py::none(),
+        py::arg("rank_tolerance") =
+            FindSetting(IdentifiabilityOptions::Settings(), "rank_tolerance")->Default(),
         py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none", R"doc(
 What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
 estimate_plane, estimate_ranger, fix as in identify: several planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
@@ -1347,8 +1351,11 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
       py::arg("robot"), py::arg("pool"), py::arg("k"), py::arg("criterion") = "E",
       py::arg("method") = "exchange", py::arg("scaling") = "si",
       py::arg("expected_angle") = py::none(), py::arg("expected_length") = py::none(),
-      py::arg("restarts") = 4, py::arg("samples") = 1000, py::arg("seed") = 1,
-      py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+      py::arg("restarts") =
+          static_cast<int>(FindSetting(SelectionOptions::Settings(), "restarts")->Default()),
+      py::arg("samples") =
+          static_cast<int>(FindSetting(SelectionOptions::Settings(), "samples")->Default()),
+      py::arg("seed") = 1, py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
       py::arg("fix") = py::none(), py::arg("poses") = py::none(), py::arg("workspace") = 200,
       py::arg("baseline") = 1000, py::arg("expected_angle_mrad") = 1.0,
       py::arg("expected_length_mm") = 1.0, py::arg("plane_of") = py::none(),

@@ -12,6 +12,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/design/configuration_sampling.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/validation_metric.h"
@@ -52,9 +53,9 @@ const Json& StudyDefaults() {
     "plane": "robot",
     "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0,
               "ranger_offset_mm": "robot_file", "ranger_scale_ppm": "robot_file"},
-    "pool": {"size": 101, "redraw": false, "min_singular_value": 0.05},
-    "selection": {"count": 50, "method": "backward", "criterion": "E", "samples": 1000,
-                  "scaling": "si", "restarts": 4, "redraw": false},
+    "pool": {"size": 101, "redraw": false},
+    "selection": {"count": 50, "method": "backward", "criterion": "E", "scaling": "si",
+                  "redraw": false},
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
                        "on_rank_deficient": "fail",
@@ -62,9 +63,16 @@ const Json& StudyDefaults() {
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
+    const auto setting = [](const auto& fields, const char* name) {
+      const auto& f = *FindSetting(fields, name);
+      return f.spec.integer ? Json(static_cast<long long>(f.Default())) : Json(f.Default());
+    };
+    j["pool"]["min_singular_value"] = setting(SamplingOptions::Settings(), "min_singular_value");
+    j["selection"]["samples"] = setting(SelectionOptions::Settings(), "samples");
+    j["selection"]["restarts"] = setting(SelectionOptions::Settings(), "restarts");
     j["noise"]["average"] = Averaging{}.Name();
-    j["identification"]["max_iterations"] = static_cast<long long>(
-        FindSetting(IdentificationOptions::Settings(), "max_iterations")->Default());
+    j["identification"]["max_iterations"] =
+        setting(IdentificationOptions::Settings(), "max_iterations");
     return j;
   }();
   return d;
@@ -436,7 +444,9 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
 void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings* c) {
   c->pool_size = Int(s, "pool.size", where, 1, 100000);
   c->pool_redraw = Bool(s, "pool.redraw", where);
-  c->min_singular_value = NonNegative(s, "pool.min_singular_value", where);
+  SamplingOptions sampling;
+  ReadSetting(s, where, *FindSetting(SamplingOptions::Settings(), "min_singular_value"), &sampling);
+  c->min_singular_value = sampling.min_jacobian_singular_value;
   if (!At(s, "pool.file").is_null()) {
     c->pool_file = Str(s, "pool.file", where);
     if (c->pool_redraw)
@@ -458,8 +468,8 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
   c->selection.criterion = c->task_criterion
                                ? DesignCriterion::kA
                                : ParseDesignCriterion(criterion, where("selection.criterion"));
-  c->selection.samples = Int(s, "selection.samples", where, 1, 1000000);
-  c->selection.restarts = Int(s, "selection.restarts", where, 1, 1000);
+  for (const char* name : {"samples", "restarts"})
+    ReadSetting(s, where, *FindSetting(SelectionOptions::Settings(), name), &c->selection);
   c->selection_redraw = Bool(s, "selection.redraw", where);
   c->scaling = ParseDesignScaling(Str(s, "selection.scaling", where), where("selection.scaling"));
   c->validation_size = Int(s, "validation.size", where, 1, 100000);

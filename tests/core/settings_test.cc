@@ -57,6 +57,21 @@ TEST(Settings, RangesHoldAtTheirEdges) {
   EXPECT_FALSE(kCount.Allows(2.5));  // whole numbers only
 }
 
+// Open ends: a relative tolerance in [0, 1), an angle in (0, 90] degrees; each says which ends
+// it excludes.
+TEST(Settings, ExclusiveEndsAreRefusedAndSaidSo) {
+  SettingSpec tolerance{"t", "tol", "tol", "", 1, "", 0, 1};
+  tolerance.max_exclusive = true;
+  EXPECT_TRUE(tolerance.Allows(0));
+  EXPECT_TRUE(tolerance.Allows(std::nextafter(1.0, 0.0)));
+  EXPECT_FALSE(tolerance.Allows(1));
+  EXPECT_EQ(tolerance.Expected(), "expected a value in [0, 1)");
+  const SettingSpec angle{"r", "a", "a_deg", "deg", M_PI / 180, "rad", 0, 90, true};
+  EXPECT_FALSE(angle.Allows(0));
+  EXPECT_TRUE(angle.Allows(90 * (M_PI / 180)));
+  EXPECT_EQ(angle.Expected(), "expected a value in (0, 90] (deg)");
+}
+
 TEST(Settings, TheLibraryNamesItsFieldInSiAndFrontEndsRespellIt) {
   EXPECT_THAT([] { kSigma.Check(-2e-4); },
               ThrowsMessage<SettingError>(

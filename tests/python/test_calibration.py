@@ -374,6 +374,17 @@ def test_settings_have_the_command_lines_names_units_and_checks(tmp_path, cli, p
         lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_mm=0)
     with pytest.raises(lrcal.InputError, match=r"max_iterations=: expected 1 to 10,000"):
         lrcal.identify(paper, readings.q, readings.h, max_iterations=0)
+    # Sampling, selection and identifiability settings: the same schema, Python's names.
+    with pytest.raises(lrcal.InputError,
+                       match=r"^min_singular_value=: expected a finite value >= 0, got -1"):
+        lrcal.sample(paper, 5, min_singular_value=-1)
+    with pytest.raises(lrcal.InputError,
+                       match=r"^samples=: expected 1 to 1,000,000 random subsets, got 0"):
+        lrcal.design(paper, q, 26, method="sampled", samples=0)
+    with pytest.raises(lrcal.InputError, match=r"^restarts=: expected 1 to 1000 starts, got 0"):
+        lrcal.design(paper, q, 26, restarts=0)
+    with pytest.raises(lrcal.InputError, match=r"^rank_tolerance=: expected a value in \[0, 1\)"):
+        lrcal.identifiability(paper, q, rank_tolerance=1)
     with pytest.raises(lrcal.InputError, match=r"threads=: expected 0 \(all cores\) to 4096"):
         lrcal.run_study("quick", str(tmp_path / "run"), threads=-1)
 

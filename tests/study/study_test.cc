@@ -13,6 +13,8 @@
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/core/error.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/io/robot_file.h"
@@ -55,6 +57,31 @@ TEST(StudySchema, DocumentedDefaultsAreTheSchemasDefaults) {
   const auto end = text.find("```", begin + 8);
   const YAML::Node doc = YAML::Load(text.substr(begin + 8, end - begin - 8));
   ExpectDocumented(StudyDefaults(), doc, "");
+}
+
+// The study's defaults of the option structs' settings are the structs' own (settings.h): one
+// default per knob, whichever front end reads it.
+template <class Options>
+void ExpectStudyDefaults(const std::vector<SettingField<Options>>& fields,
+                         const std::vector<std::string>& names) {
+  for (const std::string& name : names) {
+    const SettingField<Options>& f = *FindSetting(fields, name);
+    const std::string key = f.spec.Spelling(Frontend::kStudyFile);
+    const Json* j = &StudyDefaults();
+    for (std::size_t at = 0, dot = 0; dot != std::string::npos; at = dot + 1) {
+      dot = key.find('.', at);
+      j = &(*j)[key.substr(at, dot == std::string::npos ? dot : dot - at)];
+    }
+    EXPECT_EQ(j->get<double>(), f.Default()) << key;
+  }
+}
+
+TEST(StudySchema, StudyDefaultsAreTheOptionStructsOwn) {
+  ExpectStudyDefaults(NoiseModel::Settings(), {"sigma_mm", "repetitions", "encoder_sigma_mrad",
+                                               "form_sigma_mm", "outlier_fraction"});
+  ExpectStudyDefaults(IdentificationOptions::Settings(), {"max_iterations"});
+  ExpectStudyDefaults(SamplingOptions::Settings(), {"min_singular_value"});
+  ExpectStudyDefaults(SelectionOptions::Settings(), {"samples", "restarts"});
 }
 
 // Every study shipped in studies/ loads (the README and docs run them by name).

@@ -43,6 +43,7 @@ struct SettingSpec {
   /// Python's name where it differs from `name` (a keyword that names a value, not an option:
   /// out_dir= for --out); null: `name`.
   const char* python_name = nullptr;
+  bool max_exclusive = false;  ///< max itself is not allowed (a relative tolerance < 1)
 
   /// The setting as `frontend` spells it (see the file comment).
   std::string Spelling(Frontend frontend) const;

@@ -33,8 +33,13 @@ struct SamplingOptions {
   RangerSpec ranger;
   /// Give up after this many attempts per requested configuration.
   int max_attempts_per_configuration = 10000;
-  /// Throws InputError (where = `source`) naming the field and the range expected.
-  void Validate(const std::string& source = "sampling") const;
+  /// The numeric settings (settings.h): min_singular_value (≥ 0; a study's
+  /// pool.min_singular_value, --min-singular-value, min_singular_value=) and max_attempts (at
+  /// least 1 per configuration; the library's only).
+  static const std::vector<SettingField<SamplingOptions>>& Settings();
+  /// Throws SettingError naming the library field (pool.min_jacobian_singular_value, ...) and the
+  /// range, or the ranger's (RangerSpec::Validate).
+  void Validate() const;
 };
 
 struct SamplingReport {

@@ -28,6 +28,7 @@
 
 #include "lrcal/core/enum_names.h"
 #include "lrcal/core/random.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/measurement/measurement_model.h"
 
@@ -88,8 +89,12 @@ struct SelectionOptions {
   /// end wins.
   int restarts = 4;
   double exhaustive_limit = 5e6;  ///< most subsets kExhaustive will enumerate
-  /// Throws InputError (where = `source`) naming the field and the range expected.
-  void Validate(const std::string& source = "selection") const;
+  /// The numeric settings (settings.h): samples (1 to 1,000,000 random subsets; a study's
+  /// selection.samples, --samples, samples=), restarts (1 to 1000 starts; selection.restarts,
+  /// --restarts, restarts=) and exhaustive_limit (at least 1 subset; the library's only).
+  static const std::vector<SettingField<SelectionOptions>>& Settings();
+  /// Throws SettingError naming the library field (selection.samples, ...) and the range.
+  void Validate() const;
 };
 
 struct SelectionResult {

@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "lrcal/core/settings.h"
 #include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/measurement_model.h"
 
@@ -34,8 +35,11 @@ struct IdentifiabilityOptions {
   double zero_column_tolerance = 1e-10;
   /// Coefficients of a dependence smaller than this (in the scaled problem) are dropped.
   double coefficient_tolerance = 1e-7;
-  /// Throws InputError (where = `source`) unless every tolerance is finite and in [0, 1).
-  void Validate(const std::string& source = "identifiability options") const;
+  /// The settings (settings.h): rank_tolerance (--rank-tolerance, rank_tolerance=),
+  /// zero_column_tolerance and coefficient_tolerance, each a relative tolerance in [0, 1).
+  static const std::vector<SettingField<IdentifiabilityOptions>>& Settings();
+  /// Throws SettingError naming the library field (identifiability.rank_tolerance, ...).
+  void Validate() const;
 };
 
 /// One exact dependence among parameters: moving the parameters along the direction whose

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "lrcal/core/enum_names.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 
 namespace lrcal {
@@ -112,9 +113,12 @@ struct RangerSpec {
   double min_range = 0.05;        ///< m; shorter readings are rejected
   double max_range = 3.0;         ///< m; longer readings are out of range
   double max_incidence = 1.2217;  ///< rad (70°); angle between the beam and the plane normal
-  /// Throws InputError (where = `source`) unless 0 ≤ min_range < max_range (finite) and the
-  /// incidence limit is in (0, π/2].
-  void Validate(const std::string& source = "ranger") const;
+  /// The settings (settings.h), as a robot file's `ranger:` section spells them: min_range (≥ 0
+  /// m), max_range (> 0 m, finite) and max_incidence_deg (in (0, 90] degrees).
+  static const std::vector<SettingField<RangerSpec>>& Settings();
+  /// Throws SettingError naming the library field (ranger.min_range, ...) unless each is in its
+  /// range and min_range < max_range.
+  void Validate() const;
 };
 
 /// Numerically parallel beam: |n·b| at or below this, the beam runs along the plane and h is not
