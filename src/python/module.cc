@@ -249,13 +249,12 @@ RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_lin
 PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
 ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_of, int num_planes);
 
-// One plane number (from 1) per configuration, as a CSV's plane column; None with one plane.
-py::object PlaneNumbers(const ConfigurationSet& configs, int num_planes) {
-  if (num_planes < 2) return py::none();
+// One plane number (from 1) per configuration, as a CSV's plane column.
+py::array_t<int> PlaneNumbers(const ConfigurationSet& configs) {
   py::array_t<int> out(configs.size());
   auto w = out.mutable_unchecked<1>();
   for (int i = 0; i < configs.size(); ++i) w(i) = configs.plane(i) + 1;
-  return std::move(out);
+  return out;
 }
 
 py::array_t<double> ForwardKinematicsPy(const RobotFile& rig, const Array& q,
@@ -327,9 +326,7 @@ py::object SampleConfigurationsPy(const RobotFile& rig, int count, long long see
                                          stream, options);
   }
   if (!return_planes) return ToArray(configs);
-  py::object plane_numbers = PlaneNumbers(configs, planes.size());
-  if (plane_numbers.is_none()) plane_numbers = ToArray(std::vector<double>(configs.size(), 1.0));
-  return py::make_tuple(ToArray(configs), plane_numbers);
+  return py::make_tuple(ToArray(configs), PlaneNumbers(configs));
 }
 
 // The noise settings as simulate() takes them: sigma_mm, repetitions, encoder_sigma_mrad,

@@ -482,7 +482,10 @@ def test_sample_simulate_readings_and_design_with_several_planes_are_the_program
     q, plane_of = lrcal.sample(rig, 25, seed=3, return_planes=True)
     np.testing.assert_array_equal(q, c[:, :7])
     np.testing.assert_array_equal(plane_of, c[:, header.index("plane")])
-    assert sorted(set(plane_of)) == [1, 2]
+    assert sorted(set(plane_of)) == [1, 2] and plane_of.dtype.kind == "i"
+    one, ones = lrcal.sample(rig, 5, seed=3, plane=rig.planes[0], return_planes=True)
+    np.testing.assert_array_equal(one, lrcal.sample(rig, 5, seed=3, plane=rig.planes[0]))
+    np.testing.assert_array_equal(ones, np.ones(5, dtype=int))
     with pytest.raises(lrcal.InputError, match=r"^return_planes: 2 planes: .*return_planes=True"):
         lrcal.sample(rig, 25, seed=3)
 
