@@ -1,7 +1,6 @@
 #include "lrcal/design/configuration_sampling.h"
 
 #include <Eigen/SVD>
-#include <limits>
 #include <sstream>
 
 #include "lrcal/core/error.h"
@@ -58,27 +57,6 @@ std::string RejectionOf(const RobotModel& robot, const ModelPoint& nominal, cons
 }
 
 }  // namespace
-
-const std::vector<SettingField<SamplingOptions>>& SamplingOptions::Settings() {
-  using O = SamplingOptions;
-  static const std::vector<SettingField<O>> fields = {
-      {{"pool", "min_jacobian_singular_value", "min_singular_value", "", 1, "", 0,
-        std::numeric_limits<double>::infinity(), false, false, "", "",
-        "reject arm configurations whose geometric Jacobian has a smaller singular value"},
-       &O::min_jacobian_singular_value},
-      {{"pool", "max_attempts_per_configuration", "max_attempts", "", 1, "", 1, 1e9, false, true,
-        "attempts per configuration", "",
-        "give up after this many attempts per requested configuration"},
-       nullptr,
-       &O::max_attempts_per_configuration},
-  };
-  return fields;
-}
-
-void SamplingOptions::Validate() const {
-  CheckSettings(*this, Settings());
-  ranger.Validate();
-}
 
 ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
                                       const RandomStream& stream, const SamplingOptions& options,

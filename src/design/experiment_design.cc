@@ -752,27 +752,6 @@ Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
   return G;
 }
 
-const std::vector<SettingField<SelectionOptions>>& SelectionOptions::Settings() {
-  using O = SelectionOptions;
-  static const std::vector<SettingField<O>> fields = {
-      {{"selection", "samples", "samples", "", 1, "", 1, 1e6, false, true, "random subsets", "",
-        "random subsets tried by the sampled method (the paper's case 1)"},
-       nullptr,
-       &O::samples},
-      {{"selection", "restarts", "restarts", "", 1, "", 1, 1000, false, true, "starts", "",
-        "exchange: starts (the greedy designs, the relaxation's, then kicks of the best)"},
-       nullptr,
-       &O::restarts},
-      {{"selection", "exhaustive_limit", "exhaustive_limit", "", 1, "", 1,
-        std::numeric_limits<double>::infinity(), false, false, "", "",
-        "most subsets the exhaustive method will enumerate"},
-       &O::exhaustive_limit},
-  };
-  return fields;
-}
-
-void SelectionOptions::Validate() const { CheckSettings(*this, Settings()); }
-
 namespace {
 
 void CheckSelectionSize(int N, int n, int k) {

@@ -984,9 +984,13 @@ void KeepOneLossScale(const std::vector<Axis>& axes, const std::vector<int>& com
     mm = mm || Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleMm);
     sigma = sigma || Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleSigma);
   }
-  Json& id = (*settings)["identification"];
-  if (!id.is_object() || !id.contains("loss_scale_mm") || !id.contains("loss_scale_sigma")) return;
-  id.erase(sigma && !mm ? "loss_scale_mm" : "loss_scale_sigma");
+  // A sweep value may have replaced the settings by a non-mapping: the checks after this say so.
+  if (!settings->is_object()) return;
+  const auto id = settings->find("identification");
+  if (id == settings->end() || !id->is_object() || !id->contains("loss_scale_mm") ||
+      !id->contains("loss_scale_sigma"))
+    return;
+  id->erase(sigma && !mm ? "loss_scale_mm" : "loss_scale_sigma");
 }
 
 Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector<int>& combo,
