@@ -523,9 +523,7 @@ IdentificationOptions IdentifyOptionsPy(const RobotFile& rig, bool auto_fix,
   options.loss_scale = SettingValue(*FindSetting(fields, "loss_scale_mm"), a.loss_scale_mm,
                                     a.loss_scale, "loss_scale");
   options.sigma = SettingValue(*FindSetting(fields, "sigma_mm"), a.sigma_mm, a.sigma, "sigma");
-  const auto& in_sigmas = *FindSetting(fields, "loss_scale_sigma");
-  if (!in_sigmas.spec.Allows(a.loss_scale_sigma))
-    throw SettingError(in_sigmas.spec, a.loss_scale_sigma).Respelled(Frontend::kPython);
+  // Its range is checked by Validate() below (a SettingError, in Python's words).
   if (a.loss_scale_sigma > 0 &&
       (a.loss_scale_mm != FindSetting(fields, "loss_scale_mm")->Default() ||
        !a.loss_scale.is_none()))

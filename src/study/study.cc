@@ -1,9 +1,11 @@
 #include "lrcal/study/study.h"
 
+#include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <sstream>
 
@@ -34,12 +36,19 @@ std::string ResolveStudyPath(const std::string& name_or_path) {
 
 // The defaults of an option struct's settings (settings.h) as a study section: each setting's
 // study name with the struct's initial value in the setting's unit.
+// `names`: only these settings (empty: every one).
 template <class Options>
-Json SettingDefaults(const std::vector<SettingField<Options>>& fields) {
+Json SettingDefaults(const std::vector<SettingField<Options>>& fields,
+                     std::initializer_list<const char*> names = {}) {
   Json section = Json::object();
-  for (const SettingField<Options>& f : fields)
+  for (const SettingField<Options>& f : fields) {
+    if (names.size() > 0 && std::find_if(names.begin(), names.end(), [&](const char* n) {
+                              return f.spec.name == std::string(n);
+                            }) == names.end())
+      continue;
     section[f.spec.name] =
         f.spec.integer ? Json(static_cast<long long>(f.Default())) : Json(f.Default());
+  }
   return section;
 }
 
@@ -63,16 +72,12 @@ const Json& StudyDefaults() {
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
-    const auto setting = [](const auto& fields, const char* name) {
-      const auto& f = *FindSetting(fields, name);
-      return f.spec.integer ? Json(static_cast<long long>(f.Default())) : Json(f.Default());
-    };
-    j["pool"]["min_singular_value"] = setting(SamplingOptions::Settings(), "min_singular_value");
-    j["selection"]["samples"] = setting(SelectionOptions::Settings(), "samples");
-    j["selection"]["restarts"] = setting(SelectionOptions::Settings(), "restarts");
+    j["pool"].merge_patch(SettingDefaults(SamplingOptions::Settings(), {"min_singular_value"}));
+    j["selection"].merge_patch(
+        SettingDefaults(SelectionOptions::Settings(), {"samples", "restarts"}));
     j["noise"]["average"] = Averaging{}.Name();
-    j["identification"]["max_iterations"] =
-        setting(IdentificationOptions::Settings(), "max_iterations");
+    j["identification"].merge_patch(
+        SettingDefaults(IdentificationOptions::Settings(), {"max_iterations"}));
     return j;
   }();
   return d;
@@ -977,12 +982,29 @@ bool Sets(const std::string& key, const Json& value, const std::string& path) {
 
 // A cell has its loss scale one way: a sweep value in one spelling replaces the base's in the
 // other (the base's default, 1.345 σ, included).
+// Two axes of one cell giving the scale in both spellings are refused, naming both values.
 void KeepOneLossScale(const std::vector<Axis>& axes, const std::vector<int>& combo,
-                      Json* settings) {
-  bool mm = false, sigma = false;
+                      const std::string& path, const LineMap& lines, Json* settings) {
+  int mm_axis = -1, sigma_axis = -1;
   for (std::size_t a = 0; a < axes.size(); ++a) {
-    mm = mm || Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleMm);
-    sigma = sigma || Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleSigma);
+    if (mm_axis < 0 && Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleMm))
+      mm_axis = static_cast<int>(a);
+    if (sigma_axis < 0 && Sets(axes[a].key, axes[a].values[combo[a]], kLossScaleSigma))
+      sigma_axis = static_cast<int>(a);
+  }
+  const bool mm = mm_axis >= 0, sigma = sigma_axis >= 0;
+  if (mm && sigma && mm_axis != sigma_axis) {
+    const auto line_of = [&](int a) {
+      const auto it = lines.find(axes[a].value_paths[combo[a]]);
+      return std::to_string(it == lines.end() ? 0 : it->second);
+    };
+    const int later = std::max(mm_axis, sigma_axis);
+    throw InputError(KeyLocator{path, &lines, "", ""}(axes[later].value_paths[combo[later]]),
+                     "this cell is given the robust loss scale twice: in mm by the sweep value "
+                     "at line " +
+                         line_of(mm_axis) + " (" + kLossScaleMm +
+                         ") and in multiples of sigma by the one at line " + line_of(sigma_axis) +
+                         " (" + kLossScaleSigma + "); give it one way");
   }
   // A sweep value may have replaced the settings by a non-mapping: the checks after this say so.
   if (!settings->is_object()) return;
@@ -1014,7 +1036,7 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
                Location(path, line == lines.end() ? 0 : line->second);
   }
   if (cell.label.empty()) cell.label = "base";
-  KeepOneLossScale(axes, combo, &cell.settings);
+  KeepOneLossScale(axes, combo, path, lines, &cell.settings);
   const std::string folder = std::filesystem::path(path).parent_path().string();
   HashRobotFile(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
   HashConfigurationFiles(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);

@@ -372,6 +372,9 @@ def test_settings_have_the_command_lines_names_units_and_checks(tmp_path, cli, p
         lrcal.simulate(paper, q, outlier_fraction=1.5)
     with pytest.raises(lrcal.InputError, match=r"loss_scale_mm=: expected a finite value > 0"):
         lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_mm=0)
+    with pytest.raises(lrcal.InputError, match=r"^loss_scale_sigma=: expected a finite value >= 0"):
+        lrcal.identify(paper, readings.q, readings.h, loss="huber", loss_scale_sigma=-1,
+                       sigma_mm=0.1)
     with pytest.raises(lrcal.InputError, match=r"max_iterations=: expected 1 to 10,000"):
         lrcal.identify(paper, readings.q, readings.h, max_iterations=0)
     # Sampling, selection and identifiability settings: the same schema, Python's names.

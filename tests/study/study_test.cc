@@ -312,6 +312,18 @@ TEST(StudySchema, TheLossScaleIsGivenInMillimetresOrInSigmas) {
               HasSubstr("given twice"));
   EXPECT_THAT(refused("{sigma_mm: 0.2}", "{loss: huber, loss_scale_mm: -1}"),
               AllOf(HasSubstr("identification.loss_scale_mm"), HasSubstr("(mm), got -1")));
+  // Two axes of one cell, one spelling each: refused, naming both values' lines.
+  try {
+    load("{sigma_mm: 0.2}", "{loss: huber}",
+         "sweep:\n  combine: product\n  axes:\n"
+         "    - {key: identification.loss_scale_mm, values: [0.3]}\n"
+         "    - {key: identification.loss_scale_sigma, values: [2]}\n");
+    ADD_FAILURE() << "two spellings from two axes were accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("s.yaml:10"), HasSubstr("twice"),
+                                HasSubstr("at line 9 (identification.loss_scale_mm)"),
+                                HasSubstr("at line 10 (identification.loss_scale_sigma)")));
+  }
 }
 
 // noise.average: the mean leaves earlier cells alone; a median is its own cell, and with gross
