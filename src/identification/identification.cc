@@ -433,22 +433,13 @@ void EstimateKindStatistics(MeasurementEvaluator& evaluator, const Rows& rows,
 
 }  // namespace
 
-IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredValues& data,
-                               const IdentificationOptions& options) {
-  IdentificationSummary s;
-  DescribeSolver(options, &s);
-  if (!options.priors.empty()) s.loss += " with priors";
-  if (options.encoder_sigma > 0)
-    s.loss +=
-        ", errors in variables (joint sigma " + Fixed(options.encoder_sigma * 1e3, 4) + " mrad)";
-  s.num_configurations = data.size();
-  if (!ValidOptions(options, &s) || !CheckMeasuredValues(kind_in, data, options, &s)) return s;
-  if (options.encoder_sigma > 0 && data.weights.empty()) {  // valid options: sigma > 0
-    MeasuredValues weighted = data;
-    weighted.weights =
-        ErrorsInVariablesWeights(kind_in, data, options.sigma, options.encoder_sigma);
-    return Identify(kind_in, weighted, options);
-  }
+namespace {
+
+// Identify() once the options and values are checked and the weights are final (errors in
+// variables applied): `s` has its description already.
+IdentificationSummary IdentifyWeighted(const MeasurementKind& kind_in, const MeasuredValues& data,
+                                       const IdentificationOptions& options,
+                                       IdentificationSummary s) {
   std::unique_ptr<MeasurementKind> reduced;
   const MeasurementKind* kind = CheckIdentifiable(
       kind_in, kind_in.parameter_names(), options,
@@ -481,6 +472,26 @@ IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredVal
   EstimateKindStatistics(evaluator, rows, kind->NominalValues(), e, kind->rows_per_configuration(),
                          options, &s);
   return s;
+}
+
+}  // namespace
+
+IdentificationSummary Identify(const MeasurementKind& kind_in, const MeasuredValues& data,
+                               const IdentificationOptions& options) {
+  IdentificationSummary s;
+  DescribeSolver(options, &s);
+  if (!options.priors.empty()) s.loss += " with priors";
+  if (options.encoder_sigma > 0)
+    s.loss +=
+        ", errors in variables (joint sigma " + Fixed(options.encoder_sigma * 1e3, 4) + " mrad)";
+  s.num_configurations = data.size();
+  if (!ValidOptions(options, &s) || !CheckMeasuredValues(kind_in, data, options, &s)) return s;
+  if (options.encoder_sigma == 0) return IdentifyWeighted(kind_in, data, options, std::move(s));
+  // Errors in variables on top of the values' own weights (repetitions, or a median's R/c):
+  // valid options have sigma > 0.
+  MeasuredValues weighted = data;
+  weighted.weights = ErrorsInVariablesWeights(kind_in, data, options.sigma, options.encoder_sigma);
+  return IdentifyWeighted(kind_in, weighted, options, std::move(s));
 }
 
 std::vector<std::string> IdentificationSummary::SetByPrior() const {

@@ -93,6 +93,41 @@ TEST(ErrorsInVariables, ChiSquaredAndCovarianceHoldWithNoisyJointValues) {
   ::testing::Test::RecordProperty("rejected_without", rejected_plain);
 }
 
+// A median's values carry weights R/c of their own (averaging.h): errors in variables add the
+// joint term to those, as they do to the repetitions of a mean (the joint term was once dropped
+// when the values had weights: a median fit then ignored encoder_sigma).
+TEST(ErrorsInVariables, ApplyOnTopOfAMediansWeights) {
+  const RobotModel& robot = testing::PaperRobot();
+  const ConfigurationSet configs = testing::PaperHittingConfigurations(40, 4);
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  const RangerMeasurement kind(model);
+  MeasuredValues median;
+  median.configs = configs;
+  median.repetitions.assign(configs.size(), 5);
+  median.weights.assign(configs.size(), 5 / 1.5);  // R/c
+  median.y.resize(configs.size());
+  kind.Bind(configs)->Predict(std::vector<double>(model.num_parameters(), 0.0).data(),
+                              median.y.data(), nullptr);
+  IdentificationOptions eiv;
+  eiv.sigma = kSigma;
+  eiv.encoder_sigma = kJointSigma;
+  IdentificationOptions plain;
+  plain.sigma = kSigma;
+  MeasuredValues weighted = median;
+  weighted.weights = ErrorsInVariablesWeights(kind, median, kSigma, kJointSigma);
+  for (int i = 0; i < configs.size(); ++i) {
+    EXPECT_GT(weighted.weights[i], 0.0);
+    EXPECT_LT(weighted.weights[i], median.weights[i]);
+  }
+  const IdentificationSummary with = Identify(kind, median, eiv);
+  const IdentificationSummary reference = Identify(kind, weighted, plain);
+  const IdentificationSummary without = Identify(kind, median, plain);
+  ASSERT_TRUE(with.IsSolutionUsable()) << with.FullReport();
+  constexpr double kSameSolve = 1e-12;  // the same weights, the same normal equations
+  EXPECT_THAT(with.std_given, testing::EigenNear(reference.std_given, kSameSolve * 1e-3));
+  EXPECT_GT((with.std_given - without.std_given).minCoeff(), 0.0);
+}
+
 TEST(ErrorsInVariables, NeedTheReadingNoise) {
   IdentificationOptions options;
   options.encoder_sigma = 1e-4;

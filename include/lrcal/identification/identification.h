@@ -236,8 +236,9 @@ IdentificationSummary Identify(const MeasurementKind& kind, const MeasuredValues
 
 /// Errors in variables: each measured value's weight σ²/var (in units of single readings) for
 /// recorded joint values with standard deviation `joint_sigma` (rad, or m for a prismatic
-/// joint), one error per configuration: var = σ²/R + joint_sigma²·Σ_j (∂y/∂q_j)², the joint
-/// gradient at the nominal model by central differences (step 1e-6).
+/// joint), one error per configuration: var = σ²/R + joint_sigma²·Σ_j (∂y/∂q_j)², R the value's
+/// own weight (data.RowWeights: its repetitions, or R/c for a median), the joint gradient at the
+/// nominal model by central differences (step 1e-6).
 std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
                                              const MeasuredValues& data, double sigma,
                                              double joint_sigma);
