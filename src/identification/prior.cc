@@ -168,8 +168,10 @@ PriorInformation InformationFromPriors(const Eigen::MatrixXd& G, const std::vect
                                      .eigenvalues();
   info.defined = n > 0 && lambda[0] > 1e-16 * lambda[n - 1];
   info.posterior_sigma = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
-  if (info.defined)
-    info.posterior_sigma = A.ldlt().solve(Eigen::MatrixXd::Identity(n, n)).diagonal().cwiseSqrt();
+  if (info.defined) {
+    info.posterior_covariance = A.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
+    info.posterior_sigma = info.posterior_covariance.diagonal().cwiseSqrt();
+  }
   // Undefined, no ratio means anything: the unbounded direction is the message.
   info.posterior_to_prior.resize(n);
   for (Eigen::Index k = 0; k < n; ++k)

@@ -68,7 +68,8 @@ const Json& StudyDefaults() {
     "validation": {"size": 20},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
                        "on_rank_deficient": "fail",
-                       "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none"},
+                       "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none",
+                       "prior_sigma": "none", "errors_in_variables": false},
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
@@ -528,6 +529,51 @@ void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c
   c->identification.loss_scale = scale;
 }
 
+// identification.prior_sigma: "none", "truth" (the truth's error magnitudes by class:
+// truth.angle_sigma_mrad for θ, α, β and truth.length_sigma_mm for a, d), priors as the command
+// line's --prior-sigma gives them ("theta=1mrad,d6=0.2mm"), or "truth" followed by such items,
+// which take the place of the truth's for their keys.
+PriorSigmas StudyPriors(const std::string& text, const CellSettings& c, const std::string& where) {
+  std::string rest = text;
+  PriorSigmas priors;
+  const std::string truth = "truth";
+  if (rest.compare(0, truth.size(), truth) == 0 &&
+      (rest.size() == truth.size() || rest[truth.size()] == ',')) {
+    if (!(c.truth_angle_sigma > 0) || !(c.truth_length_sigma > 0))
+      throw InputError(where,
+                       "priors from the truth need truth.angle_sigma_mrad and "
+                       "truth.length_sigma_mm > 0");
+    for (const char* angle : {"theta", "alpha", "beta"})
+      priors.entries.push_back({angle, c.truth_angle_sigma});
+    for (const char* length : {"a", "d"}) priors.entries.push_back({length, c.truth_length_sigma});
+    rest = rest.size() == truth.size() ? "" : rest.substr(truth.size() + 1);
+  }
+  if (rest.empty()) return priors;
+  return priors.OverriddenBy(PriorSigmas::Parse(rest, where));
+}
+
+// What the identification is told of the uncertainty it does not estimate: priors on the terms
+// (maximum a-posteriori) and the recorded joint values' noise (errors in variables). Either
+// weighs against the reading noise, so needs noise.sigma_mm > 0. A study's encoder noise is per
+// reading (noise.encoder_sigma_mrad), so a configuration's averaged value carries the joint
+// error of R_eff readings: errors in variables are given σ_q/√R_eff (R_eff = R for a mean).
+void ParsePriorsAndErrorsInVariables(const Json& s, const KeyLocator& where, CellSettings* c) {
+  const std::string prior = Str(s, "identification.prior_sigma", where);
+  if (prior != "none")
+    c->identification.priors = StudyPriors(prior, *c, where("identification.prior_sigma"));
+  const bool eiv = Bool(s, "identification.errors_in_variables", where);
+  if (c->identification.priors.empty() && !eiv) return;
+  if (!(c->noise.sigma > 0))
+    throw InputError(
+        where(eiv ? "identification.errors_in_variables" : "identification.prior_sigma"),
+        std::string(eiv ? "errors in variables" : "priors") +
+            " are weighed against the reading noise: needs noise.sigma_mm > 0");
+  c->identification.sigma = c->noise.sigma;
+  if (eiv)
+    c->identification.encoder_sigma =
+        c->noise.encoder_sigma / std::sqrt(c->noise.EffectiveReadings());
+}
+
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   CellSettings c;
   c.robot = Str(s, "robot", where);
@@ -539,6 +585,7 @@ CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   ParseTruthAndNoise(s, where, &c);
   ParsePoolAndSelection(s, where, &c);
   ParseIdentification(s, where, &c);
+  ParsePriorsAndErrorsInVariables(s, where, &c);
   c.paper_case = Int(s, "paper_case", where, 0);
   if (c.paper_case > 2) throw InputError(where("paper_case"), "expected 0 (none), 1 or 2");
   return c;
@@ -1068,7 +1115,9 @@ void DropNeutralKeys(Json* id) {
                                         {"noise", "average", "mean", nullptr},
                                         {"noise", "outlier_fraction", 0, "outlier_sigma_mm"},
                                         {"identification", "estimate_ranger", "none", nullptr},
-                                        {"identification", "loss", "none", "loss_scale"}};
+                                        {"identification", "loss", "none", "loss_scale"},
+                                        {"identification", "prior_sigma", "none", nullptr},
+                                        {"identification", "errors_in_variables", false, nullptr}};
   for (const NeutralKey& k : kNeutral) {
     const auto section = id->find(k.section);
     if (section == id->end() || !section->is_object()) continue;

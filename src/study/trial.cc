@@ -7,8 +7,10 @@
 #include "lrcal/design/design_certificate.h"
 #include "lrcal/design/task_criterion.h"
 #include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/identification/prior.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "study/trial_pipeline.h"
 
@@ -240,9 +242,33 @@ void DrawCellConfigurations(const Study& study, const CellSettings& s, CellConte
 }
 
 // Identifiability of the parameter set on the whole pool (the design is checked later).
+// Priors or errors in variables (identification.prior_sigma, errors_in_variables): the trials
+// solve with Identify()'s kind-neutral path and the prediction is the posterior covariance.
+bool ModelledUncertainty(const CellSettings& s) {
+  return !s.identification.priors.empty() || s.identification.encoder_sigma > 0;
+}
+
+// The posterior information of the cell's parameters on `configs`: each configuration's weight
+// its effective readings, with errors in variables their weights (identification.h).
+PriorInformation PosteriorOn(const CellSettings& s, const CellContext& c,
+                             const ConfigurationSet& configs) {
+  const Eigen::MatrixXd G = IdentificationJacobian(*c.model, configs);
+  std::vector<double> w(static_cast<std::size_t>(configs.size()), s.noise.EffectiveReadings());
+  if (s.identification.encoder_sigma > 0) {
+    MeasuredValues values{configs, std::vector<double>(w.size(), 0.0),
+                          std::vector<int>(w.size(), s.noise.repetitions), w};
+    w = ErrorsInVariablesWeights(RangerMeasurement(*c.model), values, s.identification.sigma,
+                                 s.identification.encoder_sigma);
+  }
+  return InformationFromPriors(G, w, s.identification.sigma, s.identification.priors,
+                               c.model->parameters().names);
+}
+
 void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   const IdentifiabilityReport rep = AnalyzeIdentifiability(*c->model, c->pool);
   if (rep.full_rank()) return;
+  // Priors that set every direction the readings cannot see: nothing to fix.
+  if (!s.identification.priors.empty() && PosteriorOn(s, *c, c->pool).defined) return;
   if (!s.fix_dependent) {
     c->rank_deficient = true;
     c->rank_message = rep.ToString();
@@ -284,7 +310,13 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
   const IdentifiabilityReport design_report =
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->model, c->design.configs);
-  if (!c->rank_deficient && design_report.full_rank()) {
+  const PriorInformation posterior = !c->rank_deficient && ModelledUncertainty(s)
+                                         ? PosteriorOn(s, *c, c->design.configs)
+                                         : PriorInformation{};
+  if (posterior.defined) {
+    c->predicted_covariance = posterior.posterior_covariance;
+    c->predicted_std = posterior.posterior_sigma;
+  } else if (!c->rank_deficient && !ModelledUncertainty(s) && design_report.full_rank()) {
     c->predicted_covariance = ParameterCovariance(s.noise.EffectiveReadings() * GtG, s.noise.sigma);
     c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
   } else {
@@ -309,7 +341,8 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
     ExactReadings(*c->robot, truth, c->planes, c->ranger, c->pool, &c->pool_true_h,
                   &c->pool_true_miss);
   c->validation_true_poses = ToolPoses(*c->robot, truth, c->validation);
-  if (!c->rank_deficient && !s.selection_redraw && !s.pool_redraw) {
+  // The Cramér–Rao bound of least squares (not of a posterior or errors in variables).
+  if (!c->rank_deficient && !s.selection_redraw && !s.pool_redraw && !ModelledUncertainty(s)) {
     const Eigen::MatrixXd Gt =
         IdentificationJacobian(*c->model, c->design.configs, c->fixed_truth.delta.data());
     c->predicted_std_truth =
@@ -440,7 +473,7 @@ struct SolveOutcome {
 SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspace* ws) {
   const CellSettings& s = c.cell->typed;
   SolveOutcome out;
-  if (s.identification.solver == IdentificationOptions::Solver::kCeres) {
+  if (s.identification.solver == IdentificationOptions::Solver::kCeres || ModelledUncertainty(s)) {
     IdentificationOptions options = s.identification;
     options.robust_fit_check = false;  // a trial records no fit verdict: no draws for it
     const IdentificationSummary summary = Identify(*c.model, ws->data, options);

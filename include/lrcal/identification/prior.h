@@ -61,9 +61,11 @@ struct PriorSigmas {
 /// one reading and the priors σ_k, the posterior covariance is (GᵀWG/σ² + diag(1/σ_k²))⁻¹.
 struct PriorInformation {
   std::vector<std::string> names;
-  double sigma = 0;                    ///< m, the noise of one reading assumed
-  Eigen::VectorXd prior_sigma;         ///< SI, 0 where a term has no prior
-  Eigen::VectorXd posterior_sigma;     ///< SI; infinite where neither readings nor priors see
+  double sigma = 0;                 ///< m, the noise of one reading assumed
+  Eigen::VectorXd prior_sigma;      ///< SI, 0 where a term has no prior
+  Eigen::VectorXd posterior_sigma;  ///< SI; infinite where neither readings nor priors see
+  /// (GᵀWG/σ² + diag(1/σ_k²))⁻¹ (SI) when `defined`; empty otherwise.
+  Eigen::MatrixXd posterior_covariance;
   Eigen::VectorXd posterior_to_prior;  ///< NaN where a term has no prior, or !defined
   /// Every direction is seen by the readings or set by a prior (the posterior is proper).
   bool defined = false;
