@@ -359,8 +359,8 @@ void ReadInBlocks(const TrialStore& store, const std::string& cell_id, long long
 }
 
 // The series of a cell, in one layout: validation (12, ok trials), nominal (12, every trial),
-// iterations, σ̂, σ_min, the 4 axis means of the validation metrics (ok trials), then the
-// parameter errors (ok trials).
+// iterations, σ̂, σ_min, the 4 axis means of the validation metrics (ok trials), the coverage
+// shares (ok trials that have them), then the parameter errors (ok trials).
 enum : int {
   kValidation = 0,
   kNominal = 12,
@@ -368,7 +368,9 @@ enum : int {
   kSigmaHat,
   kSigmaMin,
   kAxisMean,
-  kErrors = kAxisMean + 4
+  kCoverage = kAxisMean + 4,
+  kCoverageTotal,
+  kErrors
 };
 
 class CellPasses {
@@ -379,6 +381,7 @@ class CellPasses {
     num_params_ = static_cast<int>(cell.parameter_names.size());
     series_.resize(kErrors + num_params_);
     for (int k = 0; k < kAxisMean; ++k) series_[k].quantiles = true;
+    series_[kCoverage].quantiles = series_[kCoverageTotal].quantiles = true;
     if (probes) {
       for (int k = 0; k < 12; ++k) series_[kValidation + k].probe = probes->validation[k];
       for (int k = 0; k < num_params_ && k < static_cast<int>(probes->errors.size()); ++k)
@@ -433,13 +436,16 @@ class CellPasses {
     return b;
   }
 
-  // An ok record's validation metrics, and their means over x, y, z (a single trial's figure).
+  // An ok record's validation metrics, their means over x, y, z (a single trial's figure) and
+  // its coverage shares where it has them.
   template <typename Visit>
   static void VisitValidation(Visit& visit, const TrialRecord& r) {
     for (int k = 0; k < 12; ++k) visit(kValidation + k, r.validation[k]);
     for (int m = 0; m < 4; ++m)
       visit(kAxisMean + m,
             (r.validation[3 * m] + r.validation[3 * m + 1] + r.validation[3 * m + 2]) / 3);
+    if (!std::isnan(r.coverage)) visit(kCoverage, r.coverage);
+    if (!std::isnan(r.coverage_total)) visit(kCoverageTotal, r.coverage_total);
   }
 
   // One pass over the records in canonical order; `count` also counts trials and statuses,
@@ -512,6 +518,8 @@ class CellPasses {
     s_->sigma_hat = SeriesDistribution(series_[kSigmaHat]);
     s_->design_sigma_min = SeriesDistribution(series_[kSigmaMin]);
     for (int m = 0; m < 4; ++m) s_->axis_mean[m] = SeriesDistribution(series_[kAxisMean + m]);
+    s_->coverage = SeriesDistribution(series_[kCoverage]);
+    s_->coverage_total = SeriesDistribution(series_[kCoverageTotal]);
     const auto rank = [](const Series& x) {
       if (x.n == 0 || std::isnan(x.probe)) return kNan;
       return 100.0 * (x.probe_below + 0.5 * x.probe_equal) / x.n;

@@ -65,7 +65,7 @@ const Json& StudyDefaults() {
     "pool": {"size": 101, "redraw": false},
     "selection": {"count": 50, "method": "backward", "criterion": "E", "scaling": "si",
                   "redraw": false},
-    "validation": {"size": 20},
+    "validation": {"size": 20, "coverage": false},
     "identification": {"estimate_plane": "none", "fix": [], "solver": "lm",
                        "on_rank_deficient": "fail",
                        "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none",
@@ -479,6 +479,11 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
   c->selection_redraw = Bool(s, "selection.redraw", where);
   c->scaling = ParseDesignScaling(Str(s, "selection.scaling", where), where("selection.scaling"));
   c->validation_size = Int(s, "validation.size", where, 1, 100000);
+  c->coverage = Bool(s, "validation.coverage", where);
+  if (c->coverage && (c->pool_redraw || c->selection_redraw))
+    throw InputError(where("validation.coverage"),
+                     "coverage is of the radius a cell's one design states: it needs the pool and "
+                     "the selection kept for every trial (drop pool.redraw and selection.redraw)");
 }
 
 void ParseIdentification(const Json& s, const KeyLocator& where, CellSettings* c) {
@@ -1117,6 +1122,7 @@ void DropNeutralKeys(Json* id) {
                                         {"identification", "estimate_ranger", "none", nullptr},
                                         {"identification", "loss", "none", "loss_scale"},
                                         {"identification", "prior_sigma", "none", nullptr},
+                                        {"validation", "coverage", false, nullptr},
                                         {"identification", "errors_in_variables", false, nullptr}};
   for (const NeutralKey& k : kNeutral) {
     const auto section = id->find(k.section);

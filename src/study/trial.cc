@@ -8,6 +8,7 @@
 #include "lrcal/design/task_criterion.h"
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/identification/prior.h"
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/ranger_measurement.h"
@@ -407,6 +408,49 @@ void PredictValidation(CellContext* c) {
   for (int k = 0; k < 12; ++k) c->predicted_validation[k] = sum[k] / kDraws;
 }
 
+// validation.coverage: what a calibration of this cell would state at each validation pose, at
+// the nominal model: the 95 % position radius of the predicted covariance (the data part) and of
+// the total, with every term the cell holds at nominal (plane and ranger terms, fixed
+// parameters) at the identification's prior or lrcal's default tolerance, as `identify
+// --predict-at` states them.
+void StateCoverageRadii(const CellSettings& s, CellContext* c) {
+  if (!s.coverage || c->rank_deficient || c->predicted_covariance.size() == 0) return;
+  const int n = c->model->num_parameters(), m = c->design.configs.size();
+  IdentificationSummary at_nominal;
+  at_nominal.delta = Eigen::VectorXd::Zero(n);
+  MeasurementSet design;
+  design.configs = c->design.configs;
+  design.mean_h.assign(static_cast<std::size_t>(m), 0.0);
+  design.repetitions.assign(static_cast<std::size_t>(m), s.noise.repetitions);
+  if (!s.noise.average.IsMean())
+    design.variance_factor.assign(static_cast<std::size_t>(m),
+                                  s.noise.repetitions / s.noise.EffectiveReadings());
+  const UnestimatedTerms held = FindUnestimatedTerms(*c->model, at_nominal, design,
+                                                     s.identification, s.identification.priors);
+  const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
+  const AccuracyPrediction stated =
+      PredictTotalAccuracy(*c->model, zero.data(), c->predicted_covariance, held, c->validation);
+  for (const PoseAccuracy& pose : stated.poses) {
+    c->coverage_radius.push_back(pose.position_radius_95);
+    c->coverage_radius_total.push_back(pose.position_radius_95_total);
+  }
+  c->coverage_defaulted = held.defaulted;
+}
+
+// The share of the validation poses whose position error lies within each stated radius.
+void RecordCoverage(const CellContext& c, const PoseErrors& errors, TrialRecord* rec) {
+  if (c.coverage_radius.empty()) return;
+  const auto m = static_cast<Eigen::Index>(c.coverage_radius.size());
+  int inside = 0, inside_total = 0;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const double error = errors.position.col(j).norm();
+    inside += error <= c.coverage_radius[j];
+    inside_total += error <= c.coverage_radius_total[j];
+  }
+  rec->coverage = static_cast<double>(inside) / static_cast<double>(m);
+  rec->coverage_total = static_cast<double>(inside_total) / static_cast<double>(m);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The trial's steps.
 
@@ -548,6 +592,7 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
     SelectCellDesign(s, c.get());
     CacheTruth(s, c.get());
     PredictValidation(c.get());
+    StateCoverageRadii(s, c.get());
   } catch (const InputError& e) {
     throw InputError(study.path + " cell '" + cell.label + "' (" + cell.id + ")", e.what());
   }
@@ -596,10 +641,11 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   rec.errors.resize(n);
   for (int k = 0; k < n; ++k) rec.errors[k] = ws->e[k] - truth.delta[k];
   const Eigen::VectorXd identified = c.model->LinkValues(ws->e.data());
-  rec.validation = Flatten(
-      (s.truth_random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
-                      : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation))
-          .stats);
+  const PoseErrors validation =
+      s.truth_random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
+                     : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation);
+  rec.validation = Flatten(validation.stats);
+  RecordCoverage(c, validation, &rec);
   if (details) FillDetails(c, truth, identified, *ws, details);
   return finish(TrialStatus::kOk);
 }

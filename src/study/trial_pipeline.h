@@ -99,6 +99,11 @@ struct CellContext {
   /// First-order prediction of the mean of each validation metric of the identified model
   /// (layout of TrialRecord::validation, SI); NaN where the covariance cannot be predicted.
   std::array<double, 12> predicted_validation{};
+  /// validation.coverage: the 95 % position radius stated at each validation pose (m; the data
+  /// part from predicted_covariance, the total with the held terms: total_accuracy.h), and the
+  /// held terms that took a default tolerance. Empty unless the cell asks for coverage.
+  std::vector<double> coverage_radius, coverage_radius_total;
+  std::vector<std::string> coverage_defaulted;
   TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;

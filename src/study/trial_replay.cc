@@ -37,6 +37,13 @@ std::vector<std::string> Differences(const TrialRecord& a, const TrialRecord& b)
   // A failed trial has no validation of an identified model: the store keeps none (NULL), so
   // there is nothing to compare unless both succeeded.
   const bool both_ok = a.status == TrialStatus::kOk && b.status == TrialStatus::kOk;
+  // Coverage: NULL in the store where there is none (NaN either way).
+  const auto same_share = [](double x, double y) {
+    return (std::isnan(x) && std::isnan(y)) || SameBits(x, y);
+  };
+  if (both_ok && !same_share(a.coverage, b.coverage)) out.emplace_back("coverage");
+  if (both_ok && !same_share(a.coverage_total, b.coverage_total))
+    out.emplace_back("coverage_total");
   for (int k = 0; k < kNumValidationColumns; ++k) {
     if (both_ok && !SameBits(a.validation[k], b.validation[k]))
       out.push_back(std::string("val_") + ValidationColumnName(k));
@@ -116,6 +123,8 @@ ResultJson RecordJson(const TrialRecord& r) {
   j["sigma_hat"] = r.sigma_hat;
   j["sigma_min"] = r.sigma_min;
   j["missed_configurations"] = r.missed_configurations;
+  j["coverage"] = std::isnan(r.coverage) ? ResultJson() : ResultJson(r.coverage);
+  j["coverage_total"] = std::isnan(r.coverage_total) ? ResultJson() : ResultJson(r.coverage_total);
   j["errors"] = r.errors;
   // A failed trial identified no model: its validation is null (as the store has it).
   const bool ok = r.status == TrialStatus::kOk;

@@ -93,7 +93,7 @@ std::string TrialColumns() {
   for (const char* prefix : {"val_", "nom_"})
     for (int k = 0; k < kNumValidationColumns; ++k)
       cols += std::string(", ") + prefix + ValidationColumnName(k);
-  return cols + ", errors, seconds, missed_configurations";
+  return cols + ", errors, seconds, missed_configurations, coverage, coverage_total";
 }
 
 }  // namespace
@@ -146,17 +146,24 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
       trials += std::string(", ") + prefix + ValidationColumnName(k) + " REAL";
   trials +=
       ", errors BLOB, seconds REAL, missed_configurations INTEGER NOT NULL DEFAULT 0, "
-      "PRIMARY KEY(cell_id, trial)) WITHOUT ROWID";
+      "coverage REAL, coverage_total REAL, PRIMARY KEY(cell_id, trial)) WITHOUT ROWID";
   Exec(trials);
   // Stores written before a missed beam dropped its configuration (every such trial failed):
-  // the column, 0 for every trial already recorded.
-  bool has_missed = false;
+  // the column, 0 for every trial already recorded; before validation.coverage: NULL.
+  bool has_missed = false, has_coverage = false;
   {
     Statement info(db_, "PRAGMA table_info(trials)");
-    while (info.Step()) has_missed |= info.ColumnText(1) == "missed_configurations";
+    while (info.Step()) {
+      has_missed |= info.ColumnText(1) == "missed_configurations";
+      has_coverage |= info.ColumnText(1) == "coverage";
+    }
   }
   if (!has_missed)
     Exec("ALTER TABLE trials ADD COLUMN missed_configurations INTEGER NOT NULL DEFAULT 0");
+  if (!has_coverage) {
+    Exec("ALTER TABLE trials ADD COLUMN coverage REAL");
+    Exec("ALTER TABLE trials ADD COLUMN coverage_total REAL");
+  }
 }
 
 TrialStore::~TrialStore() { sqlite3_close(db_); }
@@ -256,7 +263,7 @@ void TrialStore::Insert(const std::vector<TrialRecord>& records) {
   Exec("BEGIN IMMEDIATE");
   try {
     std::string q = "INSERT OR IGNORE INTO trials(" + TrialColumns() + ") VALUES (?";
-    for (int i = 1; i < 7 + 24 + 3; ++i) q += ", ?";
+    for (int i = 1; i < 7 + 24 + 3 + 2; ++i) q += ", ?";
     q += ")";
     Statement st(db_, q);
     for (const TrialRecord& r : records) {
@@ -283,6 +290,13 @@ void TrialStore::Insert(const std::vector<TrialRecord>& records) {
         sqlite3_bind_null(st.get(), 32);
       sqlite3_bind_double(st.get(), 33, r.seconds);
       sqlite3_bind_int(st.get(), 34, r.missed_configurations);
+      for (int k = 0; k < 2; ++k) {
+        const double share = k == 0 ? r.coverage : r.coverage_total;
+        if (ok && std::isfinite(share))
+          sqlite3_bind_double(st.get(), 35 + k, share);
+        else
+          sqlite3_bind_null(st.get(), 35 + k);
+      }
       st.Step();
     }
     Exec("COMMIT");  // a full disk usually shows here: the batch is rolled back, nothing half-done
@@ -337,6 +351,11 @@ void ReadTrialRow(Statement& st, TrialRecord* r) {
   if (bytes) std::memcpy(r->errors.data(), sqlite3_column_blob(st.get(), 31), bytes);
   r->seconds = sqlite3_column_double(st.get(), 32);
   r->missed_configurations = sqlite3_column_int(st.get(), 33);
+  for (int k = 0; k < 2; ++k)
+    (k == 0 ? r->coverage : r->coverage_total) =
+        sqlite3_column_type(st.get(), 34 + k) == SQLITE_NULL
+            ? std::nan("")
+            : sqlite3_column_double(st.get(), 34 + k);
 }
 
 }  // namespace

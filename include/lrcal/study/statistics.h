@@ -65,6 +65,9 @@ struct CellSummary {
   /// (rms_pos, rms_ori, max_pos, max_ori; SI): a single calibration's figure. Mean, std and their
   /// standard errors only (no quantiles).
   std::array<Distribution, 4> axis_mean;
+  /// validation.coverage: per ok trial, the share of the validation poses within the stated 95 %
+  /// radius, the data part and the total (TrialRecord::coverage); n = 0 without it.
+  Distribution coverage, coverage_total;
 };
 
 /// Values to place among a cell's trials while it is summarised (the paper's published numbers):

@@ -76,6 +76,10 @@ struct CellSettings {
   int validation_size = 0;
   /// validation.file: the validation configurations from a CSV (as pool_file); empty: drawn.
   std::string validation_file;
+  /// validation.coverage: record in every trial the share of the validation poses whose true
+  /// position error lies within the 95 % radius the cell's prediction states, the data part and
+  /// the total (TrialRecord::coverage). Needs the cell's one design (no pool or selection redraw).
+  bool coverage = false;
   // Identification.
   PlaneTerms plane_terms;
   RangerTerms ranger_terms;  ///< identification.estimate_ranger

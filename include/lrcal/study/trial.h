@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,12 @@ struct TrialRecord {
   /// left out of the fit (the trial fails as beam_missed only when fewer readings than
   /// parameters remain).
   int missed_configurations = 0;
+  /// validation.coverage: the share of the validation poses whose true position error lies
+  /// within the cell's stated 95 % radius, the data part (`coverage`) and the total with the
+  /// terms the calibration holds at nominal (`coverage_total`; total_accuracy.h). NaN unless
+  /// the cell asks for it and the trial identified.
+  double coverage = std::numeric_limits<double>::quiet_NaN();
+  double coverage_total = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One realisation in detail (the paper's figures): per measurement configuration the distance

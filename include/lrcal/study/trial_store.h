@@ -7,7 +7,8 @@
 //         design_efficiency)
 //   trials(cell_id, trial, status, iterations, residual_rms, sigma_hat, sigma_min,
 //          val_{rms,max}_{pos,ori}_{x,y,z}, nom_{...}, errors BLOB, seconds,
-//          missed_configurations)
+//          missed_configurations, coverage, coverage_total)
+//     coverage, coverage_total: TrialRecord's (a share, 0..1); NULL where there is none.
 //     errors: the parameter errors (estimate − truth, SI) as little-endian float64, in the order
 //     of cells.parameter_names; NULL unless status = 'ok'. Other lengths in m, angles in rad.
 //   meta(key, value)

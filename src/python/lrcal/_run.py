@@ -34,6 +34,8 @@ def _display_column(name):
         return name + "_mm", 1e3
     if name.startswith(("val_", "nom_")) and "_ori_" in name:
         return name + "_mrad", 1e3
+    if name in ("coverage", "coverage_total"):
+        return name + "_pct", 100.0
     return name, None
 
 
@@ -132,7 +134,9 @@ class Run:
                 val_{rms,max}_ori_{x,y,z}_mrad (validation errors of the identified model),
                 nom_..._mm and nom_..._mrad (of the nominal model), seconds,
                 missed_configurations (design configurations whose true beam missed its plane:
-                no reading, left out of the fit)
+                no reading, left out of the fit), and with validation.coverage coverage_pct and
+                coverage_total_pct (% of the validation poses within the stated 95 % radius,
+                the data part and the total; NaN where a trial has none)
       tables    {name: table} for every tables/<name>.csv (units as the CSV headers say;
                 empty until the run is complete)
       summary   tables/summary.json as a dict, or None
@@ -208,7 +212,8 @@ class Run:
         metrics = [c for c in present if c.startswith("val_")] + \
                   [c for c in present if c.startswith("nom_")]
         missed = ["missed_configurations"] if "missed_configurations" in present else []
-        return _TRIAL_LEADING + metrics + ["seconds"] + missed
+        coverage = [c for c in ("coverage", "coverage_total") if c in present]
+        return _TRIAL_LEADING + metrics + ["seconds"] + missed + coverage
 
     def _read_trials(self, with_errors=False):
         rows = {}
