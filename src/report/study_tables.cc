@@ -481,8 +481,9 @@ TextDocument CoverageSection(const std::vector<CellSummary>& cells) {
       "calibration of the cell states there (mean ± its standard error over the trials, %): "
       "the data part, from the predicted covariance at the nominal model, and the total, which "
       "adds every term the cell holds at nominal (plane and ranger terms not estimated, fixed "
-      "parameters) at the identification's prior, or lrcal's default tolerance where it has "
-      "none (1 mm, 1 mrad, 0.5 mm for a ranger offset, 200 ppm for a scale), as identify "
+      "parameters) at the identification's prior, else the robot file's tolerance, else "
+      "lrcal's default (1 mm, 1 mrad, 0.5 mm for a ranger offset, 200 ppm for a scale), as "
+      "identify "
       "--predict-at states them. An honest statement covers about 95 %; far below, the "
       "calibration cannot see an error the truth has (validation.csv: metric coverage, "
       "coverage_total).");

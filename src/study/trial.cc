@@ -140,6 +140,9 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   const double scale = s.truth_random ? 1.0 : s.truth_scale;
   c->ranger_offset = s.ranger_offset ? *s.ranger_offset : file.ranger_offset * scale;
   c->ranger_scale = s.ranger_scale ? *s.ranger_scale : file.ranger_scale * scale;
+  for (const PriorSigmas::Entry& e : file.tolerances.entries)
+    if (s.plane_from_robot || TermClass(e.key).rfind("plane", 0) != 0)
+      c->tolerances.entries.push_back(e);
   if (!s.plane_from_robot) {
     c->planes = s.planes;
   } else if (file.planes) {
@@ -411,8 +414,8 @@ void PredictValidation(CellContext* c) {
 // validation.coverage: what a calibration of this cell would state at each validation pose, at
 // the nominal model: the 95 % position radius of the predicted covariance (the data part) and of
 // the total, with every term the cell holds at nominal (plane and ranger terms, fixed
-// parameters) at the identification's prior or lrcal's default tolerance, as `identify
-// --predict-at` states them.
+// parameters) at the identification's prior, else the robot file's tolerance, else lrcal's
+// default, as `identify --predict-at` states them.
 void StateCoverageRadii(const CellSettings& s, CellContext* c) {
   if (!s.coverage || c->rank_deficient || c->predicted_covariance.size() == 0) return;
   const int n = c->model->num_parameters(), m = c->design.configs.size();
@@ -425,8 +428,9 @@ void StateCoverageRadii(const CellSettings& s, CellContext* c) {
   if (!s.noise.average.IsMean())
     design.variance_factor.assign(static_cast<std::size_t>(m),
                                   s.noise.repetitions / s.noise.EffectiveReadings());
-  const UnestimatedTerms held = FindUnestimatedTerms(*c->model, at_nominal, design,
-                                                     s.identification, s.identification.priors);
+  const UnestimatedTerms held =
+      FindUnestimatedTerms(*c->model, at_nominal, design, s.identification,
+                           c->tolerances.OverriddenBy(s.identification.priors));
   const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
   const AccuracyPrediction stated =
       PredictTotalAccuracy(*c->model, zero.data(), c->predicted_covariance, held, c->validation);

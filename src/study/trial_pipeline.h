@@ -29,6 +29,7 @@
 #include "identification/levenberg_marquardt.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/prior.h"
 #include "lrcal/kinematics/pose_errors.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial.h"
@@ -104,6 +105,9 @@ struct CellContext {
   /// held terms that took a default tolerance. Empty unless the cell asks for coverage.
   std::vector<double> coverage_radius, coverage_radius_total;
   std::vector<std::string> coverage_defaulted;
+  /// The robot file's `tolerances:` (robot_file.h), its planes' only when the cell's planes are
+  /// the file's: the held terms' σ in the stated total, as `identify` uses them.
+  PriorSigmas tolerances;
   TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;
