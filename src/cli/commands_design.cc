@@ -24,22 +24,17 @@ void AddDesignOptions(po::options_description& o) {
       "or at --workspace poses)")(
       "poses", po::value<std::string>(),
       "criterion I: the poses where accuracy matters (a configurations CSV)")(
-      "workspace", po::value<int>()->default_value(200),
-      "criterion I without --poses: this many poses drawn over the joint ranges (--seed)")(
       "method", po::value<std::string>()->default_value("exchange"),
       "exhaustive, greedy (forward), backward, exchange, sampled, random")(
       "scaling", po::value<std::string>()->default_value("si"),
       "columns of G: si (the paper), unit (unit-norm), expected (× expected error)")(
-      "expected-angle-mrad", po::value<double>()->default_value(1.0),
-      "expected angle error (mrad)")("expected-length-mm", po::value<double>()->default_value(1.0),
-                                     "expected length error (mm)")(
-      "baseline", po::value<int>()->default_value(1000), "random designs for the baseline")(
       "estimate-ranger", po::value<std::string>()->default_value("none"),
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
       "fix", po::value<std::string>(), "parameters left out, comma-separated")(
       "out", po::value<std::string>(), "write the chosen configurations (CSV)");
   AddSettingOptions(o, SelectionOptions::Settings(), {"samples", "restarts"});
+  AddSettingOptions(o, DesignRequest::Settings());
 }
 
 struct ResolvedPool {
@@ -87,6 +82,7 @@ DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel
   DesignRequest request;
   request.count = vm["select"].as<int>();
   request.seed = seed;
+  ReadSettingOptions(vm, DesignRequest::Settings(), &request);  // --workspace first: the task
   const std::string criterion = vm["criterion"].as<std::string>();
   if (criterion != "I") {
     try {
@@ -100,15 +96,12 @@ DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel
     request.task = TaskPosesAt(
         model, ReadRobotConfigurations(file, model.robot(), &model.nominal_planes()), file);
   } else {
-    request.task = TaskPosesAt(
-        model, WorkspacePoses(model.robot(), vm["workspace"].as<int>(), seed), "workspace");
+    request.task =
+        TaskPosesAt(model, WorkspacePoses(model.robot(), request.workspace, seed), "workspace");
   }
   request.selection.method = ParseSelectionMethod(vm["method"].as<std::string>(), "--method");
   ReadSettingOptions(vm, SelectionOptions::Settings(), &request.selection);
   request.scaling = ParseDesignScaling(vm["scaling"].as<std::string>(), "--scaling");
-  request.expected_angle = vm["expected-angle-mrad"].as<double>() * 1e-3;
-  request.expected_length = vm["expected-length-mm"].as<double>() * 1e-3;
-  request.baseline = vm["baseline"].as<int>();
   return request;
 }
 

@@ -7,6 +7,8 @@
 
 #include "lrcal/core/random.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/design/configuration_sampling.h"
+#include "lrcal/design/random_baseline.h"
 
 namespace lrcal {
 
@@ -18,20 +20,23 @@ std::string DesignRequest::CriterionName() const {
   return task.count > 0 ? "I" : DesignCriterionName(selection.criterion);
 }
 
-const std::vector<SettingSpec>& DesignRequest::Settings() {
-  static const std::vector<SettingSpec> specs = {
-      {"design", "expected_angle", "expected_angle_mrad", "mrad", 1e-3, "rad", 0, kInf, true, false,
-       "", "", "expected angle error (scaling: expected)"},
-      {"design", "expected_length", "expected_length_mm", "mm", 1e-3, "m", 0, kInf, true, false, "",
-       "", "expected length error (scaling: expected)"},
+const std::vector<SettingField<DesignRequest>>& DesignRequest::Settings() {
+  using R = DesignRequest;
+  static const std::vector<SettingField<R>> fields = {
+      {{"design", "expected_angle", "expected_angle_mrad", "mrad", 1e-3, "rad", 0, kInf, true,
+        false, "", "", "expected angle error (scaling: expected)"},
+       &R::expected_angle},
+      {{"design", "expected_length", "expected_length_mm", "mm", 1e-3, "m", 0, kInf, true, false,
+        "", "", "expected length error (scaling: expected)"},
+       &R::expected_length},
+      {RandomBaselineSetting(), nullptr, &R::baseline},
+      {WorkspacePosesSetting(), nullptr, &R::workspace},
   };
-  return specs;
+  return fields;
 }
 
 void DesignRequest::Validate() const {
-  Settings()[0].Check(expected_angle);
-  Settings()[1].Check(expected_length);
-  RandomBaselineSetting().Check(baseline);
+  CheckSettings(*this, Settings());
   selection.Validate();
 }
 

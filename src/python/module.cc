@@ -726,10 +726,11 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
   DesignRequest request;
   request.count = k;
   request.seed = ToSeed(a.seed);
+  request.workspace = a.workspace;  // its range: WorkspacePoses' check, in Python's words
   if (a.criterion == "I") {
     request.task =
         a.poses.is_none()
-            ? TaskPosesAt(model, WorkspacePoses(model.robot(), a.workspace, request.seed),
+            ? TaskPosesAt(model, WorkspacePoses(model.robot(), request.workspace, request.seed),
                           "workspace")
             : TaskPosesAt(
                   model,
@@ -743,14 +744,14 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
   request.selection.samples = a.samples;
   request.selection.Validate();
   request.scaling = ParseDesignScaling(a.scaling, "scaling");
-  const auto& specs = DesignRequest::Settings();
-  const DesignRequest defaults;
-  request.expected_angle = SettingValue(specs[0], specs[0].FromSi(defaults.expected_angle),
-                                        a.expected_angle_mrad, a.expected_angle, "expected_angle");
-  request.expected_length =
-      SettingValue(specs[1], specs[1].FromSi(defaults.expected_length), a.expected_length_mm,
-                   a.expected_length, "expected_length");
-  request.baseline = a.baseline;
+  const auto& fields = DesignRequest::Settings();
+  const auto& angle = *FindSetting(fields, "expected_angle_mrad");
+  const auto& length = *FindSetting(fields, "expected_length_mm");
+  request.expected_angle = SettingValue(angle.spec, angle.Default(), a.expected_angle_mrad,
+                                        a.expected_angle, "expected_angle");
+  request.expected_length = SettingValue(length.spec, length.Default(), a.expected_length_mm,
+                                         a.expected_length, "expected_length");
+  request.baseline = a.baseline;  // checked by Validate() (a SettingError in Python's words)
   return request;
 }
 
@@ -1351,10 +1352,16 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
       py::arg("samples") =
           static_cast<int>(FindSetting(SelectionOptions::Settings(), "samples")->Default()),
       py::arg("seed") = 1, py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-      py::arg("fix") = py::none(), py::arg("poses") = py::none(), py::arg("workspace") = 200,
-      py::arg("baseline") = 1000, py::arg("expected_angle_mrad") = 1.0,
-      py::arg("expected_length_mm") = 1.0, py::arg("plane_of") = py::none(),
-      py::arg("estimate_ranger") = "none", R"doc(
+      py::arg("fix") = py::none(), py::arg("poses") = py::none(),
+      py::arg("workspace") =
+          static_cast<int>(FindSetting(DesignRequest::Settings(), "workspace")->Default()),
+      py::arg("baseline") =
+          static_cast<int>(FindSetting(DesignRequest::Settings(), "baseline")->Default()),
+      py::arg("expected_angle_mrad") =
+          FindSetting(DesignRequest::Settings(), "expected_angle_mrad")->Default(),
+      py::arg("expected_length_mm") =
+          FindSetting(DesignRequest::Settings(), "expected_length_mm")->Default(),
+      py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none", R"doc(
 Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
 identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
 (design/design_choice.h), numbers and checks.

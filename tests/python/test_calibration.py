@@ -295,6 +295,11 @@ def test_design_indices_are_rows_of_the_pool_given(paper):
     assert rejected and not rejected & set(design.indices)
     h = lrcal.laser_readings(paper, anywhere[design.indices])
     assert not np.isnan(h).any()
+    # The settings' ranges are the library's (DesignRequest::Settings), in Python's words.
+    with pytest.raises(lrcal.InputError, match=r"^baseline=: expected 1 to 1,000,000"):
+        lrcal.design(paper, anywhere, 30, baseline=0)
+    with pytest.raises(lrcal.InputError, match=r"^expected_angle_mrad=: expected a finite value > 0"):
+        lrcal.design(paper, anywhere, 30, scaling="expected", expected_angle_mrad=0)
 
 
 def test_docstrings_say_what_the_arguments_are():

@@ -27,12 +27,18 @@ struct DesignRequest {
   int baseline = 1000;            ///< random designs to compare with (RandomBaselineSetting)
   std::uint64_t seed = 1;         ///< exchange kicks (stream 1) and the baseline (stream 2)
   TaskPoses task;                 ///< criterion I's poses; count 0 for the other criteria
+  /// Criterion I without poses of the user's: the front ends draw this many workspace poses
+  /// (WorkspacePoses, with `seed`) to build `task` from.
+  int workspace = 200;
 
   /// "I" for the task criterion, else the criterion's name.
   std::string CriterionName() const;
-  /// The expected errors' settings (`design.expected_angle`: mrad > 0, `design.expected_length`:
-  /// mm > 0).
-  static const std::vector<SettingSpec>& Settings();
+  /// The numeric settings (settings.h), their defaults this struct's: expected_angle_mrad
+  /// (`design.expected_angle`, > 0 mrad), expected_length_mm (`design.expected_length`, > 0 mm)
+  /// baseline (1 to 1,000,000 random designs; RandomBaselineSetting) and workspace (1 to
+  /// 100,000 poses; WorkspacePosesSetting). The command line and Python take them as
+  /// --expected-angle-mrad, expected_angle_mrad=, ...
+  static const std::vector<SettingField<DesignRequest>>& Settings();
   /// Throws SettingError or InputError naming the field and what was expected.
   void Validate() const;
 };
