@@ -245,7 +245,6 @@ void DrawCellConfigurations(const Study& study, const CellSettings& s, CellConte
       RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), vo);
 }
 
-// Identifiability of the parameter set on the whole pool (the design is checked later).
 // Priors or errors in variables (identification.prior_sigma, errors_in_variables): the trials
 // solve with Identify()'s kind-neutral path and the prediction is the posterior covariance.
 bool ModelledUncertainty(const CellSettings& s) {
@@ -268,6 +267,7 @@ PriorInformation PosteriorOn(const CellSettings& s, const CellContext& c,
                                c.model->parameters().names);
 }
 
+// Identifiability of the parameter set on the whole pool (the design is checked later).
 void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   const IdentifiabilityReport rep = AnalyzeIdentifiability(*c->model, c->pool);
   if (rep.full_rank()) return;
@@ -438,7 +438,6 @@ void StateCoverageRadii(const CellSettings& s, CellContext* c) {
     c->coverage_radius.push_back(pose.position_radius_95);
     c->coverage_radius_total.push_back(pose.position_radius_95_total);
   }
-  c->coverage_defaulted = held.defaulted;
 }
 
 // The share of the validation poses whose position error lies within each stated radius.
@@ -514,6 +513,9 @@ struct SolveOutcome {
   Termination termination = Termination::kInvalidInput;
   int iterations = 0;
   double final_cost = 0;
+  /// With priors or errors in variables the cost is not Σ R·r² of the readings alone (prior
+  /// rows, errors-in-variables weights): the summary's residual RMS and σ̂ (m), NaN otherwise.
+  double residual_rms = std::nan(""), sigma_hat = std::nan("");
 };
 
 // Identifies from ws->data into ws->e with the cell's solver. lrcal's LM starts from the cell's
@@ -525,6 +527,10 @@ SolveOutcome IdentifyTrial(const CellContext& c, bool cell_design, TrialWorkspac
     IdentificationOptions options = s.identification;
     options.robust_fit_check = false;  // a trial records no fit verdict: no draws for it
     const IdentificationSummary summary = Identify(*c.model, ws->data, options);
+    if (ModelledUncertainty(s)) {
+      out.residual_rms = summary.residual_rms;
+      out.sigma_hat = std::isfinite(summary.sigma_hat) ? summary.sigma_hat : 0.0;
+    }
     out.termination = summary.termination;
     out.iterations = summary.iterations;
     out.final_cost = summary.final_cost;
@@ -638,8 +644,11 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
       IdentifyTrial(c, design == &c.design && rec.missed_configurations == 0, ws);
   rec.iterations = r.iterations;
   rec.residual_rms =
-      std::sqrt(2 * r.final_cost / (m * s.noise.EffectiveReadings()));  // per-config mean
-  rec.sigma_hat = m > n ? std::sqrt(2 * r.final_cost / (m - n)) : 0.0;
+      std::isnan(r.residual_rms)
+          ? std::sqrt(2 * r.final_cost / (m * s.noise.EffectiveReadings()))  // per-config mean
+          : r.residual_rms;
+  rec.sigma_hat =
+      std::isnan(r.sigma_hat) ? (m > n ? std::sqrt(2 * r.final_cost / (m - n)) : 0.0) : r.sigma_hat;
   if (StatusOf(r.termination) != TrialStatus::kOk) return finish(StatusOf(r.termination));
 
   rec.errors.resize(n);

@@ -101,10 +101,9 @@ struct CellContext {
   /// (layout of TrialRecord::validation, SI); NaN where the covariance cannot be predicted.
   std::array<double, 12> predicted_validation{};
   /// validation.coverage: the 95 % position radius stated at each validation pose (m; the data
-  /// part from predicted_covariance, the total with the held terms: total_accuracy.h), and the
-  /// held terms that took a default tolerance. Empty unless the cell asks for coverage.
+  /// part from predicted_covariance, the total with the held terms: total_accuracy.h). Empty
+  /// unless the cell asks for coverage.
   std::vector<double> coverage_radius, coverage_radius_total;
-  std::vector<std::string> coverage_defaulted;
   /// The robot file's `tolerances:` (robot_file.h), its planes' only when the cell's planes are
   /// the file's: the held terms' σ in the stated total, as `identify` uses them.
   PriorSigmas tolerances;

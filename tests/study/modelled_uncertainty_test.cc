@@ -69,7 +69,12 @@ TEST(ModelledUncertainty, ErrorsInVariablesPredictTheSpreadUnderEncoderNoise) {
   // Each parameter within 4 standard errors of its prediction, and a linearisation margin.
   for (const ParameterStats& p : cells[1].parameters)
     EXPECT_NEAR(p.ratio, 1.0, 4 * p.ratio_se + 0.03) << p.name;
-  // The identity of a study without the keys is kept: false is the neutral value.
+  // σ̂ of the weighted residuals estimates one reading's σ (0.05 mm) with errors in variables;
+  // least squares' residuals carry the encoder noise too.
+  EXPECT_NEAR(cells[1].sigma_hat.mean / 0.05e-3, 1.0, 0.05);
+  EXPECT_GT(cells[0].sigma_hat.mean / 0.05e-3, 2.0);
+  std::cout << "sigma_hat/sigma: least squares " << cells[0].sigma_hat.mean / 0.05e-3
+            << ", errors in variables " << cells[1].sigma_hat.mean / 0.05e-3 << "\n";
   std::cout << "empirical/predicted std: least squares " << plain << " ± " << plain_se
             << ", errors in variables " << eiv << " ± " << eiv_se << "\n";
 }
