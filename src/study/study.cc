@@ -60,8 +60,8 @@ const Json& StudyDefaults() {
     Json j = Json::parse(R"({
     "robot": "paper",
     "plane": "robot",
-    "truth": {"mode": "robot_file", "scale": 1.0, "angle_sigma_mrad": 1.0, "length_sigma_mm": 1.0,
-              "ranger_offset_mm": "robot_file", "ranger_scale_ppm": "robot_file"},
+    "truth": {"mode": "robot_file", "ranger_offset_mm": "robot_file",
+              "ranger_scale_ppm": "robot_file"},
     "pool": {"size": 101, "redraw": false},
     "selection": {"count": 50, "method": "backward", "criterion": "E", "scaling": "si",
                   "redraw": false},
@@ -73,6 +73,7 @@ const Json& StudyDefaults() {
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
+    j["truth"].merge_patch(SettingDefaults(TruthOptions::Settings()));
     j["pool"].merge_patch(SettingDefaults(SamplingOptions::Settings(), {"min_singular_value"}));
     j["selection"].merge_patch(
         SettingDefaults(SelectionOptions::Settings(), {"samples", "restarts"}));
@@ -286,12 +287,6 @@ int Int(const Json& s, const std::string& path, const KeyLocator& where, int min
   return static_cast<int>(v);
 }
 
-double NonNegative(const Json& s, const std::string& path, const KeyLocator& where) {
-  const double v = Num(s, path, where);
-  if (!(v >= 0)) throw InputError(where(path), "expected a value >= 0, got " + Json(v).dump());
-  return v;
-}
-
 std::string Str(const Json& s, const std::string& path, const KeyLocator& where) {
   const Json& j = At(s, path);
   if (!j.is_string()) throw InputError(where(path), "expected a string, got " + j.dump());
@@ -419,23 +414,21 @@ void ParseTruthAndNoise(const Json& s, const KeyLocator& where, CellSettings* c)
   const std::string mode = Str(s, "truth.mode", where);
   if (mode != "robot_file" && mode != "random")
     throw InputError(where("truth.mode"), "expected robot_file or random, got '" + mode + "'");
-  c->truth_random = mode == "random";
-  c->truth_scale = NonNegative(s, "truth.scale", where);
-  c->truth_angle_sigma = NonNegative(s, "truth.angle_sigma_mrad", where) * 1e-3;
-  c->truth_length_sigma = NonNegative(s, "truth.length_sigma_mm", where) * 1e-3;
+  c->truth.random = mode == "random";
+  ReadSettings(s, where, TruthOptions::Settings(), &c->truth);
   for (const char* key : {"truth.ranger_offset_mm", "truth.ranger_scale_ppm"}) {
     const Json& v = At(s, key);
     if (v == "robot_file") continue;
     if (!v.is_number() || !std::isfinite(v.get<double>()))
       throw InputError(where(key), "expected a number, or robot_file (the robot file's value)");
-    const double x = v.get<double>();
-    if (std::string(key) == "truth.ranger_offset_mm") {
-      c->ranger_offset = x * 1e-3;
-    } else {
-      if (!(std::fabs(x) < 5e5))
-        throw InputError(where(key), "expected a scale error in ppm, below 500,000 in magnitude");
-      c->ranger_scale = x * 1e-6;
-    }
+    const bool offset = std::string(key) == "truth.ranger_offset_mm";
+    (offset ? c->truth.ranger_offset : c->truth.ranger_scale) =
+        v.get<double>() * (offset ? 1e-3 : 1e-6);
+  }
+  try {
+    c->truth.Validate();
+  } catch (const SettingError& e) {
+    throw e.Respelled(Frontend::kStudyFile, where("truth.ranger_scale_ppm"));
   }
   ReadSettings(s, where, NoiseModel::Settings(), &c->noise);
   try {
@@ -544,13 +537,13 @@ PriorSigmas StudyPriors(const std::string& text, const CellSettings& c, const st
   const std::string truth = "truth";
   if (rest.compare(0, truth.size(), truth) == 0 &&
       (rest.size() == truth.size() || rest[truth.size()] == ',')) {
-    if (!(c.truth_angle_sigma > 0) || !(c.truth_length_sigma > 0))
+    if (!(c.truth.angle_sigma > 0) || !(c.truth.length_sigma > 0))
       throw InputError(where,
                        "priors from the truth need truth.angle_sigma_mrad and "
                        "truth.length_sigma_mm > 0");
     for (const char* angle : {"theta", "alpha", "beta"})
-      priors.entries.push_back({angle, c.truth_angle_sigma});
-    for (const char* length : {"a", "d"}) priors.entries.push_back({length, c.truth_length_sigma});
+      priors.entries.push_back({angle, c.truth.angle_sigma});
+    for (const char* length : {"a", "d"}) priors.entries.push_back({length, c.truth.length_sigma});
     rest = rest.size() == truth.size() ? "" : rest.substr(truth.size() + 1);
   }
   if (rest.empty()) return priors;

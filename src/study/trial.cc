@@ -51,15 +51,15 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
   const RobotModel& robot = *c.robot;
   TrialTruth truth;
   truth.errors.resize(robot.num_values());
-  if (s.truth_random) {
+  if (s.truth.random) {
     RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kTruth);
     for (int k = 0; k < robot.num_values(); ++k) {
       const bool is_param = robot.links()[k / kValuesPerLink].is_parameter[k % kValuesPerLink];
-      const double sigma = IsAngle(k % kValuesPerLink) ? s.truth_angle_sigma : s.truth_length_sigma;
+      const double sigma = IsAngle(k % kValuesPerLink) ? s.truth.angle_sigma : s.truth.length_sigma;
       truth.errors[k] = is_param ? stream.Normal(k) * sigma : 0.0;
     }
   } else {
-    truth.errors = robot.true_errors() * s.truth_scale;
+    truth.errors = robot.true_errors() * s.truth.scale;
   }
   truth.values = robot.nominal_values() + truth.errors;
   const ParameterSet& ps = c.model->parameters();
@@ -75,7 +75,7 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
 // truth.length_sigma_mm) for robot parameters and plane terms alike.
 Eigen::MatrixXd CellDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
   const CellSettings& s = c.cell->typed;
-  return DesignJacobian(*c.model, pool, s.scaling, s.truth_angle_sigma, s.truth_length_sigma);
+  return DesignJacobian(*c.model, pool, s.scaling, s.truth.angle_sigma, s.truth.length_sigma);
 }
 
 // `total` configurations split over the planes by their shares (largest remainders, ties to the
@@ -137,9 +137,9 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   RobotFile file = LoadRobotFile(ResolveRobotPath(s.robot, study.folder()), s.tool_link);
   c->robot = std::make_shared<RobotModel>(std::move(file.robot));
   c->ranger = file.ranger;
-  const double scale = s.truth_random ? 1.0 : s.truth_scale;
-  c->ranger_offset = s.ranger_offset ? *s.ranger_offset : file.ranger_offset * scale;
-  c->ranger_scale = s.ranger_scale ? *s.ranger_scale : file.ranger_scale * scale;
+  const double scale = s.truth.random ? 1.0 : s.truth.scale;
+  c->ranger_offset = s.truth.ranger_offset ? *s.truth.ranger_offset : file.ranger_offset * scale;
+  c->ranger_scale = s.truth.ranger_scale ? *s.truth.ranger_scale : file.ranger_scale * scale;
   for (const PriorSigmas::Entry& e : file.tolerances.entries)
     if (s.plane_from_robot || TermClass(e.key).rfind("plane", 0) != 0)
       c->tolerances.entries.push_back(e);
@@ -186,7 +186,7 @@ ConfigurationSet UsablePoolFromFile(const Study& study, const CellSettings& s, C
   const ConfigurationSet given =
       ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, &c->planes);
   CandidatePool usable = UsableCandidates(*c->robot, c->planes, c->ranger, given);
-  if (!s.truth_random) {  // the true beam must hit too
+  if (!s.truth.random) {  // the true beam must hit too
     std::vector<double> h;
     std::vector<BeamMiss> misses;
     ExactReadings(*c->robot, c->fixed_truth.values, c->planes, c->ranger, usable.configs, &h,
@@ -224,11 +224,11 @@ void DrawCellConfigurations(const Study& study, const CellSettings& s, CellConte
   // noise (and a drawn truth).
   c->selection_seed = s.pool_file.empty() ? study.seed : 0;
   // The pool must give readings on the nominal model and, for a fixed truth, on the true one.
-  if (!s.truth_random) c->fixed_truth = DrawTruth(*c, 0);
+  if (!s.truth.random) c->fixed_truth = DrawTruth(*c, 0);
   if (!s.pool_file.empty()) {
     c->pool = UsablePoolFromFile(study, s, c);
   } else {
-    c->pool = SamplePool(*c, 0, s.truth_random ? c->robot->nominal_values() : c->fixed_truth.values,
+    c->pool = SamplePool(*c, 0, s.truth.random ? c->robot->nominal_values() : c->fixed_truth.values,
                          &c->pool_report);
   }
   if (!s.validation_file.empty()) {
@@ -282,7 +282,7 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   c->model = std::make_unique<MeasurementModel>(
       *c->robot, c->planes,
       WithoutParameters(*c->robot, c->model->parameters(), rep.suggested_fixed));
-  if (!s.truth_random) c->fixed_truth.delta = DrawTruth(*c, 0).delta;
+  if (!s.truth.random) c->fixed_truth.delta = DrawTruth(*c, 0).delta;
 }
 
 // The task criterion's selection matrix (selection.criterion: I), weighted by the validation
@@ -337,7 +337,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
 
 // For a fixed truth: exact true readings and poses, once per cell.
 void CacheTruth(const CellSettings& s, CellContext* c) {
-  if (s.truth_random) return;
+  if (s.truth.random) return;
   const Eigen::VectorXd& truth = c->fixed_truth.values;
   ExactReadings(*c->robot, truth, c->planes, c->ranger, c->design.configs, &c->design_true_h,
                 &c->design_true_miss);
@@ -493,7 +493,7 @@ int SimulateTrialReadings(const CellContext& c, long long trial, const TrialTrut
   noise.ranger_offset = c.ranger_offset;
   noise.ranger_scale = c.ranger_scale;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
-  if (s.truth_random || s.pool_redraw || noise.DisturbsGeometry())
+  if (s.truth.random || s.pool_redraw || noise.DisturbsGeometry())
     return SimulateReadings(*c.robot, truth.values, c.planes, c.ranger, design.configs, noise,
                             stream, &ws->data, nullptr, nullptr, &design.slots);
   if (!s.selection_redraw)
@@ -622,9 +622,9 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
     rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return rec;
   };
-  const TrialTruth truth = s.truth_random ? DrawTruth(c, trial) : c.fixed_truth;
+  const TrialTruth truth = s.truth.random ? DrawTruth(c, trial) : c.fixed_truth;
   rec.nominal = Flatten(
-      s.truth_random
+      s.truth.random
           ? ComparePoses(*c.robot, truth.values, c.robot->nominal_values(), c.validation).stats
           : c.nominal_validation);
   if (c.rank_deficient) return finish(TrialStatus::kRankDeficient);
@@ -655,7 +655,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   for (int k = 0; k < n; ++k) rec.errors[k] = ws->e[k] - truth.delta[k];
   const Eigen::VectorXd identified = c.model->LinkValues(ws->e.data());
   const PoseErrors validation =
-      s.truth_random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
+      s.truth.random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
                      : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation);
   rec.validation = Flatten(validation.stats);
   RecordCoverage(c, validation, &rec);

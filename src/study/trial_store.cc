@@ -189,7 +189,7 @@ StoredCell ToStoredCell(const CellContext& c) {
   s.design_sigma_min = c.design.sigma_min;
   s.fixed_for_rank = c.fixed_for_rank;
   s.pool_report = c.pool_report.ToString();
-  if (!c.cell->typed.truth_random)
+  if (!c.cell->typed.truth.random)
     s.truth_errors.assign(c.fixed_truth.errors.data(),
                           c.fixed_truth.errors.data() + c.fixed_truth.errors.size());
   s.predicted_std_truth.assign(c.predicted_std_truth.data(),

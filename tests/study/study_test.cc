@@ -82,6 +82,30 @@ TEST(StudySchema, StudyDefaultsAreTheOptionStructsOwn) {
   ExpectStudyDefaults(IdentificationOptions::Settings(), {"max_iterations"});
   ExpectStudyDefaults(SamplingOptions::Settings(), {"min_singular_value"});
   ExpectStudyDefaults(SelectionOptions::Settings(), {"samples", "restarts"});
+  ExpectStudyDefaults(TruthOptions::Settings(), {"scale", "angle_sigma_mrad", "length_sigma_mm"});
+}
+
+// The truth's settings are checked where they are written, in the study's words.
+TEST(StudySchema, TheTruthsSettingsAreCheckedAtTheirLine) {
+  const std::string dir = testing::TempDir("study_truth");
+  const auto refused = [&](const std::string& truth) {
+    std::ofstream(dir + "/s.yaml") << "name: s\nseed: 1\ntrials: 2\ntruth: " << truth << "\n";
+    try {
+      LoadStudy(dir + "/s.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  using ::testing::AllOf;
+  using ::testing::HasSubstr;
+  EXPECT_THAT(refused("{scale: -1}"), AllOf(HasSubstr("s.yaml:4 key 'truth.scale'"),
+                                            HasSubstr("expected a finite value >= 0")));
+  EXPECT_THAT(refused("{mode: random, angle_sigma_mrad: -0.1}"),
+              AllOf(HasSubstr("truth.angle_sigma_mrad"), HasSubstr("(mrad)")));
+  EXPECT_THAT(refused("{ranger_scale_ppm: 600000}"),
+              AllOf(HasSubstr("truth.ranger_scale_ppm"), HasSubstr("below 500,000")));
+  EXPECT_EQ(refused("{mode: random, angle_sigma_mrad: 0.5}"), "accepted");
 }
 
 // Every study shipped in studies/ loads (the README and docs run them by name).

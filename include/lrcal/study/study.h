@@ -25,6 +25,7 @@
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
 #include "lrcal/study/stopping.h"
+#include "lrcal/study/truth_options.h"
 
 namespace lrcal {
 
@@ -40,17 +41,11 @@ struct CellSettings {
   std::vector<double> plane_shares;
   /// Several planes: each one's estimated terms ("" = identification.estimate_plane).
   std::vector<std::string> plane_estimate;
-  // Truth: the robot file's errors × scale, or errors drawn per trial.
-  bool truth_random = false;
-  double truth_scale = 0;
-  double truth_angle_sigma = 0;   ///< rad, per-parameter σ of drawn angle errors
-  double truth_length_sigma = 0;  ///< m, per-parameter σ of drawn length errors
-  /// truth.ranger_offset_mm / ranger_scale_ppm: the true ranger's errors (m, dimensionless);
-  /// empty: the robot file's (× truth.scale for a robot_file truth).
-  std::optional<double> ranger_offset, ranger_scale;
+  /// truth: the simulated arm and ranger (truth_options.h).
+  TruthOptions truth;
   /// noise: the reading noise and a real rig's disturbances (noise_model.h; its settings, their
   /// units, defaults and ranges are NoiseModel::Settings()). The ranger's errors are the
-  /// truth's (ranger_offset, ranger_scale above).
+  /// truth's (TruthOptions::ranger_offset, ranger_scale).
   NoiseModel noise;
   // Candidate pool.
   int pool_size = 0;
