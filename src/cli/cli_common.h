@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <boost/program_options.hpp>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -70,6 +72,14 @@ Format ResolveFormat(const po::variables_map& vm);
 /// takes).
 void AddCommonOptions(po::options_description& options);
 
+/// A setting's value as its option's default shows it: 12 significant digits, as
+/// SettingSpec::FromSi rounds it.
+inline std::string ShortNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(12) << value;
+  return out.str();
+}
+
 /// Adds one option per setting of an option struct (settings.h): --NAME with the struct's
 /// default in the setting's unit and its help line, the unit and range appended. `only`, if not
 /// empty, names the settings to add (the others are not options of this command).
@@ -85,9 +95,10 @@ void AddSettingOptions(po::options_description& options,
       options.add_options()(
           option.c_str(),
           po::value<long long>()->default_value(static_cast<long long>(f.Default())), help.c_str());
-    else
-      options.add_options()(option.c_str(), po::value<double>()->default_value(f.Default()),
-                            help.c_str());
+    else  // shown as the schema rounds it (0.2, not 0.20000000000000001)
+      options.add_options()(
+          option.c_str(), po::value<double>()->default_value(f.Default(), ShortNumber(f.Default())),
+          help.c_str());
   }
 }
 

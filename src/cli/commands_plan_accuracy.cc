@@ -11,13 +11,11 @@ namespace {
 AccuracyPlanOptions ReadOptions(const po::variables_map& vm) {
   AccuracyPlanOptions o;
   o.target = AccuracyTarget::Parse(vm["target"].as<std::string>());
-  o.confidence = vm["confidence"].as<double>();
+  ReadSettingOptions(vm, AccuracyPlanOptions::NumericSettings(), &o);
   o.cost = CampaignCosts::Parse(vm["cost"].as<std::string>());
   if (vm.count("planes")) o.planes = vm["planes"].as<std::string>();
   if (vm.count("configurations")) o.configurations = vm["configurations"].as<std::string>();
   o.repetitions = vm["repetitions"].as<std::string>();
-  o.trials = vm["trials"].as<int>();
-  o.stop_precision = vm["stop-precision"].as<double>();
   if (vm.count("seed")) o.seed = ParseSeed(vm);
   if (vm.count("out")) o.out_dir = vm["out"].as<std::string>();
   o.threads = vm["threads"].as<int>();
@@ -33,26 +31,22 @@ int PlanAccuracyCommand(const std::vector<std::string>& args) {
       "target", po::value<std::string>()->required(),
       "e.g. rms_pos=0.05mm: the quantile at --confidence of the largest per-axis RMS position "
       "error over the validation poses must not exceed it (also rms_ori, max_pos, max_ori)")(
-      "confidence", po::value<double>()->default_value(0.95), "share of calibrations that meet it")(
       "configurations", po::value<std::string>(),
       "FIRST:LAST[:STEP] configurations to consider (default: parameters+1 to the pool size, "
-      "step 5)")("repetitions", po::value<std::string>()->default_value("1:100"),
+      "step 5)")("repetitions",
+                 po::value<std::string>()->default_value(AccuracyPlanOptions{}.repetitions),
                  "FIRST:LAST readings per configuration to consider")(
-      "cost", po::value<std::string>()->default_value("configuration=30s,reading=1s"),
+      "cost", po::value<std::string>()->default_value(CampaignCosts{}.ToString()),
       "time per configuration (move) and per reading, and per plane set up (plane=600s)")(
       "planes", po::value<std::string>(),
       "FIRST:LAST candidate planes a campaign may use, when the study's plane is a list of two "
       "or more (default: 1 to all; every subset of those sizes is considered)")(
-      "trials", po::value<int>()->default_value(10000),
-      "Monte-Carlo trials per confirmed campaign")(
-      "stop-precision", po::value<double>()->default_value(0.0),
-      "stop each confirmed campaign once its validation means (SE) and p95s (95 % interval "
-      "half-width) are known to this relative precision; --trials is then the maximum")(
       "seed", po::value<long long>(), "seed of the confirmation runs (default: the study's)")(
       "out", po::value<std::string>(),
       "folder for the confirmation study and run (default: output/STUDY-plan-HASH, named by the "
       "plan's settings)")("threads", po::value<int>()->default_value(0), "threads (0: all cores)")(
       "format", po::value<std::string>()->default_value("text"), "text or json");
+  AddSettingOptions(o, AccuracyPlanOptions::NumericSettings());
   po::positional_options_description pos;
   pos.add("study", 1);
   po::variables_map vm;

@@ -1420,11 +1420,16 @@ Returns an lrcal.RunResult. Read the results with lrcal.load_run(out_dir).)doc")
         }
         return py::module_::import("json").attr("loads")(json);
       },
-      py::arg("study"), py::arg("target"), py::arg("confidence") = 0.95,
-      py::arg("cost") = "configuration=30s,reading=1s", py::arg("configurations") = py::none(),
-      py::arg("repetitions") = "1:100", py::arg("planes") = py::none(), py::arg("trials") = 10000,
-      py::arg("stop_precision") = 0.0, py::arg("seed") = py::none(),
-      py::arg("out_dir") = py::none(), py::arg("threads") = 0, R"doc(
+      py::arg("study"), py::arg("target"),
+      py::arg("confidence") =
+          FindSetting(AccuracyPlanOptions::NumericSettings(), "confidence")->Default(),
+      py::arg("cost") = CampaignCosts{}.ToString(), py::arg("configurations") = py::none(),
+      py::arg("repetitions") = AccuracyPlanOptions{}.repetitions, py::arg("planes") = py::none(),
+      py::arg("trials") = static_cast<int>(
+          FindSetting(AccuracyPlanOptions::NumericSettings(), "trials")->Default()),
+      py::arg("stop_precision") =
+          FindSetting(AccuracyPlanOptions::NumericSettings(), "stop_precision")->Default(),
+      py::arg("seed") = py::none(), py::arg("out_dir") = py::none(), py::arg("threads") = 0, R"doc(
 The cheapest campaign that meets an accuracy target, as `lrcal plan-accuracy STUDY --target ...`
 (report/accuracy_plan.h: the same search, confirmation run and numbers). target: e.g.
 "rms_pos=0.05mm" (also rms_ori, max_pos, max_ori, with mm or mrad); cost:

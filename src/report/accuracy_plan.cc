@@ -430,7 +430,7 @@ const std::vector<SettingSpec>& AccuracyPlanOptions::Settings() {
       {"plan", "target", "target", "", 1, "", 0, kInf, false, false, "", "",
        "e.g. rms_pos=0.05mm: the quantile at the confidence of the worst axis must not exceed it"},
       {"plan", "confidence", "confidence", "", 1, "", 0, 1, true, false, "", "",
-       "share of calibrations that meet the target"},
+       "share of calibrations that meet the target", nullptr, true},
       {"plan", "cost", "cost", "", 1, "", 0, kInf, false, false, "", "",
        "time per configuration, per reading and per plane set up"},
       {"plan", "configurations", "configurations", "", 1, "", 0, kInf, false, false, "", "",
@@ -442,22 +442,30 @@ const std::vector<SettingSpec>& AccuracyPlanOptions::Settings() {
       {"plan", "trials", "trials", "", 1, "", 100, 1e7, false, true, "trials per campaign", "",
        "Monte-Carlo trials per confirmed campaign"},
       {"plan", "stop_precision", "stop_precision", "", 1, "", 0, 1, false, false, "", "",
-       "stop each confirmed campaign at this relative precision (0: run every trial)"},
+       "stop each confirmed campaign once its validation means (SE) and p95s (95 % interval "
+       "half-width) are known to this relative precision (0: run every trial; trials is then "
+       "the maximum)",
+       nullptr, true},
       {"plan", "out_dir", "out", "", 1, "", 0, kInf, false, false, "", "",
        "folder for the confirmation study and run", "out_dir"},
   };
   return specs;
 }
 
+const std::vector<SettingField<AccuracyPlanOptions>>& AccuracyPlanOptions::NumericSettings() {
+  using O = AccuracyPlanOptions;
+  static const std::vector<SettingField<O>> fields = {
+      {Spec("confidence"), &O::confidence},
+      {Spec("trials"), nullptr, &O::trials},
+      {Spec("stop_precision"), &O::stop_precision},
+  };
+  return fields;
+}
+
 void AccuracyPlanOptions::Validate() const {
   if (!(target.value > 0) || !std::isfinite(target.value))
     Refuse("target", "expected a target > 0 with its unit, e.g. rms_pos=0.05mm");
-  if (!(confidence > 0 && confidence < 1))
-    Refuse("confidence", "expected a share in (0, 1), e.g. 0.95");
-  Spec("trials").Check(trials);
-  if (!(stop_precision >= 0 && stop_precision < 1))
-    Refuse("stop_precision",
-           "expected 0 (run every trial) or a relative precision in (0, 1), e.g. 0.05");
+  CheckSettings(*this, NumericSettings());
   for (double c : {cost.per_configuration, cost.per_reading, cost.per_plane})
     if (!(c >= 0) || !std::isfinite(c)) Refuse("cost", "expected costs >= 0 (s)");
   ParseRange(repetitions, "repetitions", 1);
@@ -519,6 +527,13 @@ CampaignCosts CampaignCosts::Parse(const std::string& text) {
   }
   if (!got_c || !got_r) Refuse("cost", expected);
   return costs;
+}
+
+std::string CampaignCosts::ToString() const {
+  std::ostringstream out;
+  out << "configuration=" << per_configuration << "s,reading=" << per_reading << "s";
+  if (per_plane > 0) out << ",plane=" << per_plane << "s";
+  return out.str();
 }
 
 // Met when the quantile's whole 95 % interval is at or below the target; not met when the

@@ -167,9 +167,7 @@ TEST(PlanAccuracy, ConfirmationStopsWhenPreciseEnough) {
   EXPECT_TRUE(s.stop_when.enabled());
   EXPECT_EQ(s.stop_when.block, 500);
   EXPECT_EQ(testing::RunCommand(plan + " --stop-precision 1.5", &out), 2);
-  EXPECT_THAT(out, ::testing::HasSubstr(
-                       "--stop-precision: expected 0 (run every trial) or a relative precision"))
-      << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--stop-precision: expected a value in [0, 1)")) << out;
 }
 
 // Another seed or cost is another plan: by default in a folder named by its settings; in a

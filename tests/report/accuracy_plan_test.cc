@@ -59,13 +59,20 @@ TEST(AccuracyPlanOptions, ValidateNamesTheSettingInEachFrontEndsWords) {
   o.target = AccuracyTarget::Parse("rms_pos=0.05mm");
   EXPECT_NO_THROW(o.Validate());
   o.confidence = 1;
-  EXPECT_THAT(CliMessage([&] { o.Validate(); }), HasSubstr("--confidence: expected a share"));
+  EXPECT_THAT(CliMessage([&] { o.Validate(); }),
+              HasSubstr("--confidence: expected a value in (0, 1)"));
   o.confidence = 0.9;
   o.trials = 99;
   EXPECT_THAT(CliMessage([&] { o.Validate(); }), HasSubstr("--trials: expected 100 to"));
   o.trials = 1000;
   o.stop_precision = 1;
-  EXPECT_THAT(CliMessage([&] { o.Validate(); }), HasSubstr("--stop-precision"));
+  EXPECT_THAT(CliMessage([&] { o.Validate(); }),
+              HasSubstr("--stop-precision: expected a value in [0, 1)"));
+  o.stop_precision = 0;
+  // The command line's and Python's defaults are the struct's, through its schema.
+  EXPECT_EQ(CampaignCosts{}.ToString(), "configuration=30s,reading=1s");
+  EXPECT_EQ(CampaignCosts::Parse(CampaignCosts{}.ToString()).per_configuration, 30.0);
+  EXPECT_EQ(FindSetting(AccuracyPlanOptions::NumericSettings(), "trials")->Default(), 10000.0);
   o.stop_precision = 0;
   o.repetitions = "5:2";
   EXPECT_THAT(CliMessage([&] { o.Validate(); }),

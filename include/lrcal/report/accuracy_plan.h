@@ -61,6 +61,8 @@ struct CampaignCosts {
   double per_plane = 0;           ///< s, setting one plane up
   /// "configuration=30s,reading=1s[,plane=600s]". Throws SettingError (`cost`).
   static CampaignCosts Parse(const std::string& text);
+  /// The text Parse reads back: "configuration=30s,reading=1s" (plane= when per_plane > 0).
+  std::string ToString() const;
 };
 
 /// The planner's settings (see the file comment).
@@ -86,6 +88,10 @@ struct AccuracyPlanOptions {
   /// Every setting's name at the interfaces (target, confidence, cost, configurations,
   /// repetitions, planes, trials, stop_precision, seed, out), for SettingError.
   static const std::vector<SettingSpec>& Settings();
+  /// The numeric ones bound to their members, their defaults this struct's: confidence (a share
+  /// in (0, 1)), trials (100 to 10,000,000), stop_precision ([0, 1): 0 runs every trial). The
+  /// command line and Python take their options and defaults from it.
+  static const std::vector<SettingField<AccuracyPlanOptions>>& NumericSettings();
   /// Throws SettingError naming the setting and what was expected.
   void Validate() const;
 };
