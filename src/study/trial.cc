@@ -251,11 +251,11 @@ bool ModelledUncertainty(const CellSettings& s) {
   return !s.identification.priors.empty() || s.identification.encoder_sigma > 0;
 }
 
-// The posterior information of the cell's parameters on `configs`: each configuration's weight
-// its effective readings, with errors in variables their weights (identification.h).
+// The posterior information of the cell's parameters on `configs`, whose identification
+// Jacobian is G: each configuration's weight its effective readings, with errors in variables
+// their weights (identification.h).
 PriorInformation PosteriorOn(const CellSettings& s, const CellContext& c,
-                             const ConfigurationSet& configs) {
-  const Eigen::MatrixXd G = IdentificationJacobian(*c.model, configs);
+                             const ConfigurationSet& configs, const Eigen::MatrixXd& G) {
   std::vector<double> w(static_cast<std::size_t>(configs.size()), s.noise.EffectiveReadings());
   if (s.identification.encoder_sigma > 0) {
     MeasuredValues values{configs, std::vector<double>(w.size(), 0.0),
@@ -272,7 +272,9 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   const IdentifiabilityReport rep = AnalyzeIdentifiability(*c->model, c->pool);
   if (rep.full_rank()) return;
   // Priors that set every direction the readings cannot see: nothing to fix.
-  if (!s.identification.priors.empty() && PosteriorOn(s, *c, c->pool).defined) return;
+  if (!s.identification.priors.empty() &&
+      PosteriorOn(s, *c, c->pool, IdentificationJacobian(*c->model, c->pool)).defined)
+    return;
   if (!s.fix_dependent) {
     c->rank_deficient = true;
     c->rank_message = rep.ToString();
@@ -315,7 +317,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->model, c->design.configs);
   const PriorInformation posterior = !c->rank_deficient && ModelledUncertainty(s)
-                                         ? PosteriorOn(s, *c, c->design.configs)
+                                         ? PosteriorOn(s, *c, c->design.configs, Gd)
                                          : PriorInformation{};
   if (posterior.defined) {
     c->predicted_covariance = posterior.posterior_covariance;
