@@ -14,6 +14,7 @@
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
+#include "run_summaries.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -29,12 +30,8 @@ std::vector<CellSummary> RunCoverage(const std::string& dir, const std::string& 
                                     "validation: {size: 20, coverage: true}\n"
                                     "noise: {sigma_mm: 0.1}\n"
                                  << body;
-  const RunResult r = testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2);
-  EXPECT_TRUE(r.complete);
-  TrialStore store(dir + "/run/trials.sqlite");
-  std::vector<CellSummary> out;
-  for (const StoredCell& cell : store.Cells()) out.push_back(SummarizeCell(store, cell));
-  return out;
+  EXPECT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
+  return testing::SummarizeRun(dir + "/run");
 }
 
 // The paper's case: every term with a true error is estimated (the plane is known exactly), so

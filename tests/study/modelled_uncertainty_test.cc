@@ -15,6 +15,7 @@
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
+#include "run_summaries.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -30,12 +31,8 @@ std::vector<CellSummary> RunCells(const std::string& dir, const std::string& bod
                                  << "\npool: {size: 80}\nselection: {count: " << count
                                  << "}\nvalidation: {size: 10}\n"
                                  << body;
-  const RunResult r = testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2);
-  EXPECT_TRUE(r.complete);
-  TrialStore store(dir + "/run/trials.sqlite");
-  std::vector<CellSummary> out;
-  for (const StoredCell& cell : store.Cells()) out.push_back(SummarizeCell(store, cell));
-  return out;
+  EXPECT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
+  return testing::SummarizeRun(dir + "/run");
 }
 
 // The mean over parameters of the empirical std's ratio to the predicted std, and its standard

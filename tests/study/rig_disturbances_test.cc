@@ -13,6 +13,7 @@
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial_store.h"
+#include "run_summaries.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
 
@@ -26,12 +27,9 @@ std::vector<std::pair<double, double>> RmsPosition(const std::string& dir, const
                                  << "\npool: {size: 60}\nselection: {count: 40}\n"
                                     "validation: {size: 10}\n"
                                  << body;
-  const RunResult r = testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2);
-  EXPECT_TRUE(r.complete);
-  TrialStore store(dir + "/run/trials.sqlite");
+  EXPECT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
   std::vector<std::pair<double, double>> out;
-  for (const StoredCell& cell : store.Cells()) {
-    const CellSummary s = SummarizeCell(store, cell);
+  for (const CellSummary& s : testing::SummarizeRun(dir + "/run")) {
     double mean = 0, var = 0;
     for (int a = 0; a < 3; ++a) {
       mean += s.validation[a].mean / 3;
