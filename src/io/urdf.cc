@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <set>
 #include <utility>
@@ -124,12 +125,26 @@ void CheckNoCycle(const std::map<std::string, std::string>& parent_of, const std
   }
 }
 
+// A URDF must be UTF-8 text: TinyXML (2.6.2, under urdfdom too) reads past the end of its buffer
+// on a truncated multi-byte sequence (found by fuzzing, tests/fuzz/corpus/urdf), so the bytes are
+// checked first, line by line, and the first bad line named.
+void CheckUtf8Text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number)
+    if (!IsValidUtf8(line))
+      throw InputError(Location(path, number),
+                       "not UTF-8 text (an invalid or truncated byte sequence on this line): a "
+                       "URDF is read as UTF-8 XML");
+}
+
 // A URDF's tree checked before urdfdom builds it: urdfdom walks the tree by recursion (a very
 // deep chain overflows the stack) and lrcal walks from the tool link to the root (a cycle would
 // never end). Read with TinyXML (urdfdom's own XML reader), iteratively: at most kMaxUrdfLinks
 // links, no joint whose parent is its child, no cycle. Anything else (a malformed file, a link
 // with two parents) is left to urdfdom's own checks.
 void CheckUrdfTree(const std::string& path) {
+  CheckUtf8Text(path);
   TiXmlDocument doc(path.c_str());
   if (!doc.LoadFile()) return;  // urdfdom reports the XML error
   const TiXmlElement* robot = doc.FirstChildElement("robot");

@@ -243,6 +243,27 @@ TEST(Urdf, CyclesOwnParentsAndVeryDeepTreesAreRefused) {
   ExpectInputError(deep, "l1000", "the URDF has 1001 links; lrcal reads at most 1000");
 }
 
+// Found by fuzzing: a truncated UTF-8 sequence at the end of a file made TinyXML (urdfdom's XML
+// reader) read past its buffer. Bytes that are not UTF-8 are refused first, naming the line.
+TEST(Urdf, BytesThatAreNotUtf8AreRefusedNamingTheLine) {
+  ExpectInputError(kTwoLinks + std::string("<!-- \xc4 -->\n"), "",
+                   "bad.urdf:4: not UTF-8 text (an invalid or truncated byte sequence");
+  const std::string path = testing::TempDir("urdf_utf8") + "/end.urdf";
+  std::ofstream(path, std::ios::binary)
+      << "<?xml version=\"1.0\"?>\n<robot name=\"r\">" << kTwoLinks << "</robot>\xeb";
+  try {
+    LoadRobotFile(path, "");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(path + ":3: not UTF-8 text"));
+  }
+  // UTF-8 text is read as before (a comment in Chinese).
+  ExpectInputError(kTwoLinks + std::string("<!-- \xe6\x9c\xba\xe5\x99\xa8 -->\n") +
+                       "<joint name=\"j\" type=\"fixed\"><parent link=\"a\"/>"
+                       "<child link=\"b\"/></joint>\n",
+                   "", "no movable joint between the root link 'a'");
+}
+
 TEST(Urdf, ToolLinkIsForUrdfsOnly) {
   try {
     LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"), "ranger");
