@@ -95,8 +95,23 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
   RangerTerms ranger;
   if (vm.count("estimate-ranger"))
     ranger = RangerTerms::Parse(vm["estimate-ranger"].as<std::string>(), "--estimate-ranger");
-  return MakeParameterSet(robot, std::vector<PlaneTerms>(num_planes, terms), fixed, "--fix",
-                          ranger);
+  FrameTerms frames[2];
+  for (int f = 0; f < 2; ++f) {
+    const std::string option = std::string("estimate-") + kFrameNames[f];
+    if (vm.count(option))
+      frames[f] = FrameTerms::Parse(vm[option].as<std::string>(), "--" + option);
+  }
+  return MakeParameterSet(robot, std::vector<PlaneTerms>(num_planes, terms), fixed, "--fix", ranger,
+                          frames[0], frames[1]);
+}
+
+void AddFrameTermOptions(po::options_description& o) {
+  o.add_options()("estimate-base", po::value<std::string>()->default_value("none"),
+                  "base transform terms to estimate: none, all, xyz, rpy, or a list of x, y, z, "
+                  "roll, pitch, yaw (frame 0 in the base frame: p0 + xyz, R0 Rz Ry Rx)")(
+      "estimate-tool", po::value<std::string>()->default_value("none"),
+      "tool transform terms to estimate, as --estimate-base (the ranger's frame in the last "
+      "link's frame)");
 }
 
 std::uint64_t ParseSeed(const po::variables_map& vm) {

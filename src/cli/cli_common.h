@@ -58,9 +58,12 @@ struct Setup {
   PlaneSet planes;
 };
 Setup ResolveSetup(const po::variables_map& vm);
-/// --estimate-plane (for every plane), --estimate-ranger and --fix, for `num_planes` planes.
+/// --estimate-plane (for every plane), --estimate-ranger, --estimate-base, --estimate-tool and
+/// --fix, for `num_planes` planes.
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
                                  int num_planes = 1);
+/// --estimate-base and --estimate-tool (parameter_set.h FrameTerms), read by ResolveParameterSet.
+void AddFrameTermOptions(po::options_description& o);
 
 /// --seed: a non-negative integer.
 std::uint64_t ParseSeed(const po::variables_map& vm);

@@ -76,6 +76,7 @@ int KinematicsCommand(const std::vector<std::string>& args) {
       "estimate-plane", po::value<std::string>()->default_value("none"),
       "plane terms in the Jacobian: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters left out of the Jacobian, comma-separated");
+  AddFrameTermOptions(o);
   po::variables_map vm;
   if (!Parse("kinematics", "--configs C.csv [options]", o, args, &vm)) return 0;
   const Setup setup = ResolveSetup(vm);
@@ -297,6 +298,7 @@ void AddIdentifyOptions(po::options_description& o) {
       "write a calibration report into this folder: report.html (fit check, residuals, "
       "parameters, correlation, identifiability, cross-validation, accuracy over the "
       "workspace), calibration.json and the calibrated robot file");
+  AddFrameTermOptions(o);
 }
 
 int IdentifyCommand(const std::vector<std::string>& args) {
@@ -383,6 +385,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "its prior (posterior/prior std; above 0.9 the prior alone sets it)")(
       "prior", po::bool_switch(),
       "the same with the robot file's tolerances: (--prior-sigma entries replace the same keys)");
+  AddFrameTermOptions(o);
   AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
   AddSettingOptions(o, IdentifiabilityOptions::Settings(), {"rank_tolerance"});
   po::variables_map vm;

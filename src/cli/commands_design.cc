@@ -33,6 +33,7 @@ void AddDesignOptions(po::options_description& o) {
       "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
       "fix", po::value<std::string>(), "parameters left out, comma-separated")(
       "out", po::value<std::string>(), "write the chosen configurations (CSV)");
+  AddFrameTermOptions(o);
   AddSettingOptions(o, SelectionOptions::Settings(), {"samples", "restarts"});
   AddSettingOptions(o, DesignRequest::Settings());
 }

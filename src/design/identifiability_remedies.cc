@@ -86,6 +86,27 @@ std::vector<int> RecoveredByFixing(const Context& c, int k) {
   return Recovered(c, N);
 }
 
+// After the planes: `in`'s ranger and frame terms, in their order, at the end of `out`.
+void AppendRangerAndFrameTerms(const ParameterSet& in, ParameterSet* out,
+                               std::vector<int>* old_to_new) {
+  const auto append = [&](int old_index, const std::string& name) {
+    (*old_to_new)[old_index] = out->size();
+    out->names.push_back(name);
+    return out->size() - 1;
+  };
+  out->ranger = in.ranger;
+  if (in.ranger_offset_index >= 0)
+    out->ranger_offset_index = append(in.ranger_offset_index, "ranger_offset");
+  if (in.ranger_scale_index >= 0)
+    out->ranger_scale_index = append(in.ranger_scale_index, "ranger_scale");
+  for (int f = 0; f < 2; ++f) {
+    out->frames[f] = in.frames[f];
+    for (int k = 0; k < 6; ++k)
+      if (in.frame_columns[f][k] >= 0)
+        out->frame_columns[f][k] = append(in.frame_columns[f][k], FrameTermName(f, k));
+  }
+}
+
 // The parameter set with one more plane (terms `terms`) after the existing ones, and where each
 // old entry went.
 ParameterSet WithAddedPlane(const ParameterSet& in, PlaneTerms terms,
@@ -115,17 +136,7 @@ ParameterSet WithAddedPlane(const ParameterSet& in, PlaneTerms terms,
         out.plane_columns[p].u[u] = add(p, old.u[u], u == 0 ? "u1" : "u2");
     if (added ? terms.offset : old.f >= 0) out.plane_columns[p].f = add(p, old.f, "f");
   }
-  out.ranger = in.ranger;
-  if (in.ranger_offset_index >= 0) {
-    out.ranger_offset_index = out.size();
-    (*old_to_new)[in.ranger_offset_index] = out.size();
-    out.names.push_back("ranger_offset");
-  }
-  if (in.ranger_scale_index >= 0) {
-    out.ranger_scale_index = out.size();
-    (*old_to_new)[in.ranger_scale_index] = out.size();
-    out.names.push_back("ranger_scale");
-  }
+  AppendRangerAndFrameTerms(in, &out, old_to_new);
   return out;
 }
 

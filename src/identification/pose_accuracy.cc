@@ -15,17 +15,23 @@ Eigen::MatrixXd PoseJacobian(const MeasurementModel& model, const double* e,
                              const ConfigurationSet& configs) {
   const int n = model.num_parameters(), m = configs.size();
   Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(e, n);
-  const std::vector<Pose<double>> poses =
-      ToolPoses(model.robot(), model.LinkValues(x.data()), configs);
+  // The poses of the model at x: its link values and, where estimated, its base and tool.
+  const bool frames = model.parameters().EstimatesFrames();
+  const auto compare = [&](const std::vector<Pose<double>>& reference) {
+    return frames ? ComparePoses(model.RobotAt(x.data()), reference, model.LinkValues(x.data()),
+                                 configs)
+                  : ComparePoses(model.robot(), reference, model.LinkValues(x.data()), configs);
+  };
+  const std::vector<Pose<double>> poses = ToolPoses(
+      frames ? model.RobotAt(x.data()) : model.robot(), model.LinkValues(x.data()), configs);
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6 * m, n);
   constexpr double kStep = 1e-6;  // m or rad: truncation O(step²), rounding O(1e-16/step)
   for (int k = 0; k < n; ++k) {
     const double x0 = x[k];
     x[k] = x0 + kStep;
-    const PoseErrors plus = ComparePoses(model.robot(), poses, model.LinkValues(x.data()), configs);
+    const PoseErrors plus = compare(poses);
     x[k] = x0 - kStep;
-    const PoseErrors minus =
-        ComparePoses(model.robot(), poses, model.LinkValues(x.data()), configs);
+    const PoseErrors minus = compare(poses);
     x[k] = x0;
     // ComparePoses gives reference − model: the pose moves by minus that.
     for (int j = 0; j < m; ++j)

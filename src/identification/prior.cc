@@ -34,7 +34,19 @@ constexpr const char* kClasses[] = {"theta",
                                     "instrument_yaw",
                                     "target_x",
                                     "target_y",
-                                    "target_z"};
+                                    "target_z",
+                                    "base_x",
+                                    "base_y",
+                                    "base_z",
+                                    "base_roll",
+                                    "base_pitch",
+                                    "base_yaw",
+                                    "tool_x",
+                                    "tool_y",
+                                    "tool_z",
+                                    "tool_roll",
+                                    "tool_pitch",
+                                    "tool_yaw"};
 
 struct Unit {
   const char* name;

@@ -24,8 +24,17 @@ std::string DefaultTolerances::ToString() const {
 }
 
 ParameterSet CompleteParameterSet(const RobotModel& robot, int num_planes) {
+  FrameTerms all;
+  all.estimated.fill(true);
   return MakeParameterSet(robot, std::vector<PlaneTerms>(num_planes, PlaneTerms{true, true}), {},
-                          "complete parameter set", RangerTerms{true, true});
+                          "complete parameter set", RangerTerms{true, true}, all, all);
+}
+
+bool IsFrameTermName(const std::string& name) {
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 6; ++k)
+      if (name == FrameTermName(f, k)) return true;
+  return false;
 }
 
 namespace {
@@ -65,8 +74,17 @@ UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
                                       const PriorSigmas& known, const DefaultTolerances& defaults) {
   const ParameterSet all = CompleteParameterSet(solved.robot(), solved.num_planes());
   const std::vector<std::string>& names = solved.parameters().names;
-  const std::vector<int> est = IndicesIn(all, names), held = HeldIndices(all, names);
+  const std::vector<int> est = IndicesIn(all, names);
+  std::vector<int> held;
   UnestimatedTerms out;
+  // A frame term with no tolerance is exact by definition (the header's comment).
+  for (int c : HeldIndices(all, names)) {
+    if (IsFrameTermName(all.names[c]) && !(known.SigmaOf(all.names[c]) > 0)) {
+      out.exact.push_back(all.names[c]);
+      continue;
+    }
+    held.push_back(c);
+  }
   const int k = static_cast<int>(held.size()), n = static_cast<int>(est.size());
   out.sigma.resize(k);
   for (int c = 0; c < k; ++c) {
@@ -105,6 +123,24 @@ UnestimatedTerms FindUnestimatedTerms(const MeasurementModel& solved,
     throw std::logic_error("total accuracy: the estimated terms' normal matrix is singular");
   out.estimate_shift = ldlt.solve(G.transpose() * w.asDiagonal() * Gu);
   return out;
+}
+
+std::string ExactFramesText(const std::vector<std::string>& exact) {
+  std::string t;
+  for (int f = 0; f < 2; ++f) {
+    std::vector<std::string> names;
+    for (int k = 0; k < 6; ++k)
+      if (std::find(exact.begin(), exact.end(), FrameTermName(f, k)) != exact.end())
+        names.push_back(FrameTermName(f, k));
+    if (names.empty()) continue;
+    if (!t.empty()) t += ", ";
+    if (names.size() == 6) {
+      t += std::string("the ") + kFrameNames[f] + " transform";
+      continue;
+    }
+    for (std::size_t i = 0; i < names.size(); ++i) t += (i ? " " : "") + names[i];
+  }
+  return t;
 }
 
 SigmaUsed ChooseSigma(const IdentificationSummary& s, const IdentificationOptions& options) {
@@ -195,6 +231,7 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
 
   AccuracyPrediction out;
   out.defaulted = held.defaulted;
+  out.exact = held.exact;
   const int m = configs.size();
   Eigen::VectorXd pos_ms = Eigen::VectorXd::Zero(k), ori_ms = Eigen::VectorXd::Zero(k);
   double data_pos = 0, data_ori = 0, total_pos = 0;
@@ -320,6 +357,10 @@ std::string AccuracyPredictionText(const AccuracyPrediction& p) {
     t += "\n         give them when calibrating: the robot file's tolerances:, or identify "
          "--prior-sigma\n";
   }
+  if (!p.exact.empty())
+    t += "note: taken as exact (no tolerance given, not estimated): " + ExactFramesText(p.exact) +
+         "; give tolerances.base/tool in the robot file (or --prior-sigma base_x=...) if the "
+         "base frame is not the robot's own\n";
   return t + PoseTable(p);
 }
 

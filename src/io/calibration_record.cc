@@ -53,7 +53,10 @@ void WriteCalibratedRobot(const std::string& path, const DataSource& data, const
                           const MeasurementModel& model, const IdentificationSummary& s,
                           const IdentificationOptions& options, const UnestimatedTerms& held) {
   const MeasurementModel solved = SolvedModel(model, s);
-  WriteCalibratedRobotFile(path, rig, solved.LinkValues(s.delta.data()),
+  // Estimated base and tool terms become the calibrated file's base: and tool: transforms.
+  RobotFile calibrated = rig;
+  if (solved.parameters().EstimatesFrames()) calibrated.robot = solved.RobotAt(s.delta.data());
+  WriteCalibratedRobotFile(path, calibrated, solved.LinkValues(s.delta.data()),
                            solved.PlanesAt(s.delta.data()),
                            MakeCalibrationRecord(data, s, options, held));
 }
@@ -78,7 +81,10 @@ ParameterSet RecordParameterSet(const RobotModel& robot, const CalibrationRecord
   ranger.scale = named("ranger_scale");
   for (int k : robot.parameter_indices())
     if (!named(robot.ValueName(k))) fixed.push_back(robot.ValueName(k));
-  return MakeParameterSet(robot, planes, fixed, source, ranger);
+  FrameTerms frames[2];
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 6; ++k) frames[f].estimated[k] = named(FrameTermName(f, k));
+  return MakeParameterSet(robot, planes, fixed, source, ranger, frames[0], frames[1]);
 }
 
 namespace {
@@ -131,6 +137,10 @@ AccuracyPrediction PredictCalibratedAccuracy(const RobotFile& rig, const PlaneSe
   held.defaulted = r.held_defaulted;
   held.estimate_shift = r.held.empty() ? Eigen::MatrixXd(ps.size(), 0) : r.estimate_shift;
   const ParameterSet all = CompleteParameterSet(rig.robot, planes.size());
+  for (const std::string& name : all.names)  // neither estimated nor held: taken as exact
+    if (IsFrameTermName(name) && ps.Find(name) < 0 &&
+        std::find(held.names.begin(), held.names.end(), name) == held.names.end())
+      held.exact.push_back(name);
   for (const std::string& name : held.names)
     if (all.Find(name) < 0 || ps.Find(name) >= 0)
       throw InputError(rig.path + " calibration.held",

@@ -226,6 +226,7 @@ ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction, const Configur
           {"worst", s.worst + 1},
           {"sources", sources},
           {"defaulted", prediction.defaulted},
+          {"taken_as_exact", prediction.exact},
           {"defaults", prediction.defaults.ToString()},
           {"sigma_used",
            {{"sigma", prediction.sigma_used.sigma},

@@ -413,6 +413,18 @@ void ParsePlaneTolerances(const YAML::Node& tp, const std::string& path, int num
   }
 }
 
+// tolerances.base / tolerances.tool: {x, y, z (lengths), roll, pitch, yaw (angles)}.
+void ParseFrameTolerances(const YAML::Node& node, const std::string& path, int frame, double as,
+                          double ls, PriorSigmas* priors) {
+  const std::string ctx = std::string("tolerances.") + kFrameNames[frame];
+  yaml::CheckKeys(node, {"x", "y", "z", "roll", "pitch", "yaw"}, path, ctx);
+  for (int k = 0; k < 6; ++k)
+    if (const YAML::Node value = node[kFrameTermNames[k]])
+      priors->entries.push_back(
+          {FrameTermName(frame, k),
+           Tolerance(value, path, ctx + "." + kFrameTermNames[k], k < 3 ? ls : as)});
+}
+
 // tolerances: the prior standard deviations `identify --prior` uses (identification/prior.h).
 PriorSigmas ParseTolerances(const YAML::Node& root, const std::string& path,
                             const std::vector<Link>& links, int num_planes) {
@@ -422,7 +434,7 @@ PriorSigmas ParseTolerances(const YAML::Node& root, const std::string& path,
   if (!t) return priors;
   CheckKeys(t,
             {"angle_unit", "length_unit", "every_link", "links", "planes", "ranger_offset_mm",
-             "ranger_scale_ppm"},
+             "ranger_scale_ppm", "base", "tool"},
             path, "tolerances");
   const double as =
       AngleScale(t["angle_unit"] ? String(t["angle_unit"], path, "tolerances.angle_unit") : "rad",
@@ -442,6 +454,8 @@ PriorSigmas ParseTolerances(const YAML::Node& root, const std::string& path,
                           static_cast<int>(i) + 1, as, ls, &priors);
   }
   if (t["planes"]) ParsePlaneTolerances(t["planes"], path, num_planes, as, ls, &priors);
+  for (int f = 0; f < 2; ++f)
+    if (t[kFrameNames[f]]) ParseFrameTolerances(t[kFrameNames[f]], path, f, as, ls, &priors);
   if (t["ranger_offset_mm"])
     priors.entries.push_back({"ranger_offset", Tolerance(t["ranger_offset_mm"], path,
                                                          "tolerances.ranger_offset_mm", 1e-3)});

@@ -40,6 +40,15 @@ RobotModel::RobotModel(std::string name, std::vector<Link> links, Eigen::VectorX
   true_errors_ = true_errors;
 }
 
+RobotModel RobotModel::WithFrames(const RigidTransform& base, const RigidTransform& tool) const {
+  base.Validate(source + ": base");
+  tool.Validate(source + ": tool");
+  RobotModel out = *this;
+  out.base_ = base;
+  out.tool_ = tool;
+  return out;
+}
+
 std::string LinkValueFullName(int index) {
   return std::string(LinkValueName(index % kValuesPerLink)) +
          std::to_string(index / kValuesPerLink + 1);

@@ -388,6 +388,59 @@ template <bool kSeveralPlanes>
   }
 }
 
+// One Jacobian column of an estimated base or tool term (measurement_model.h): a shift moves the
+// hit point along a direction v (n·v/(−n·b)), a rotation turns it about an axis v through a point
+// ((r × n)·v/(−n·b)). The base's v and point are fixed in B; the tool's v turns with the tool
+// (R_BT·v, from the state's axes) and its point is the beam's origin.
+template <bool kSeveralPlanes, bool kTool, bool kShift>
+[[gnu::always_inline]] inline void FrameColumn(const KernelArgs& args, const FrameArrays& s,
+                                               const ReadingArrays& r,
+                                               const PlaneAt<kSeveralPlanes>& n,
+                                               const Eigen::Vector3d& v, double* __restrict col) {
+  const Eigen::Vector3d& pb = args.point->base.translation;
+  for (int i = 0; i < args.m; ++i) {
+    double w0 = v[0], w1 = v[1], w2 = v[2];
+    if constexpr (kTool) {
+      w0 = s.x0[i] * v[0] + s.y0[i] * v[1] + s.z0[i] * v[2];
+      w1 = s.x1[i] * v[0] + s.y1[i] * v[1] + s.z1[i] * v[2];
+      w2 = s.x2[i] * v[0] + s.y2[i] * v[1] + s.z2[i] * v[2];
+    }
+    double g;
+    if constexpr (kShift) {
+      g = n.n0(i) * w0 + n.n1(i) * w1 + n.n2(i) * w2;
+    } else {
+      const double r0 = r.ph0[i] - (kTool ? s.o0[i] : pb[0]);
+      const double r1 = r.ph1[i] - (kTool ? s.o1[i] : pb[1]);
+      const double r2 = r.ph2[i] - (kTool ? s.o2[i] : pb[2]);
+      g = (r1 * n.n2(i) - r2 * n.n1(i)) * w0 + (r2 * n.n0(i) - r0 * n.n2(i)) * w1 +
+          (r0 * n.n1(i) - r1 * n.n0(i)) * w2;
+    }
+    col[i] = g * r.inv[i];
+  }
+}
+
+// Every estimated base and tool term's column.
+template <bool kSeveralPlanes>
+[[gnu::always_inline]] inline void FrameColumnsOf(const KernelArgs& args, const FrameArrays& s,
+                                                  const ReadingArrays& r,
+                                                  const PlaneAt<kSeveralPlanes>& n) {
+  const ModelPoint& point = *args.point;
+  const auto column = [&](int f, int k) {
+    const int c = args.parameters->frame_columns[f][k];
+    return c < 0 ? nullptr : args.J + static_cast<std::size_t>(c) * args.m;
+  };
+  for (int k = 0; k < 3; ++k) {
+    if (double* col = column(0, k))
+      FrameColumn<kSeveralPlanes, false, true>(args, s, r, n, Eigen::Vector3d::Unit(k), col);
+    if (double* col = column(0, 3 + k))
+      FrameColumn<kSeveralPlanes, false, false>(args, s, r, n, point.base_axes.col(k), col);
+    if (double* col = column(1, k))
+      FrameColumn<kSeveralPlanes, true, true>(args, s, r, n, point.tool_shifts_T.col(k), col);
+    if (double* col = column(1, 3 + k))
+      FrameColumn<kSeveralPlanes, true, false>(args, s, r, n, point.tool_axes_T.col(k), col);
+  }
+}
+
 // The kernel: frames through the chain, the readings and (kJacobian) the Jacobian's columns.
 template <bool kJacobian, bool kSeveralPlanes>
 [[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
@@ -406,6 +459,7 @@ template <bool kJacobian, bool kSeveralPlanes>
     LinkColumn<kSeveralPlanes>(args, ps.robot_values[k], r, n,
                                args.J + static_cast<std::size_t>(k) * m);
   for (int p = 0; p < ps.num_planes(); ++p) PlaneColumnsOf<kSeveralPlanes>(args, p, r);
+  if (ps.EstimatesFrames()) FrameColumnsOf<kSeveralPlanes>(args, s, r, n);
   return parallel == 0;
 }
 

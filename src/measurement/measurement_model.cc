@@ -1,5 +1,6 @@
 #include "lrcal/measurement/measurement_model.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "lrcal/core/error.h"
@@ -73,6 +74,60 @@ void MeasurementModel::Prepare(const double* e, ModelPoint* point) const {
       parameters_.ranger_offset_index >= 0 ? e[parameters_.ranger_offset_index] : 0.0;
   point->ranger_scale =
       parameters_.ranger_scale_index >= 0 ? e[parameters_.ranger_scale_index] : 0.0;
+  if (!parameters_.EstimatesFrames()) return;
+  point->base = FrameAt(0, e, &point->base_axes);
+  Eigen::Matrix3d tool_axes_N;
+  point->tool = FrameAt(1, e, &tool_axes_N);
+  point->has_base = point->has_tool = true;
+  point->tool_shifts_T = point->tool.rotation.transpose();
+  point->tool_axes_T = point->tool.rotation.transpose() * tool_axes_N;
+}
+
+RigidTransform MeasurementModel::FrameAt(int f, const double* e, Eigen::Matrix3d* axes) const {
+  const RigidTransform& nominal = f == 0 ? robot_->base() : robot_->tool();
+  double d[6];
+  for (int k = 0; k < 6; ++k) {
+    const int c = parameters_.frame_columns[f][k];
+    d[k] = c >= 0 ? e[c] : 0.0;
+  }
+  const Eigen::Matrix4d X = MovedTransformMatrix<double>(nominal, d);
+  RigidTransform out;
+  out.rotation = X.block<3, 3>(0, 0);
+  out.translation = X.block<3, 1>(0, 3);
+  if (axes) {
+    // d(R0·Rz·Ry·Rx)/dφ = [w]×·R: w = R0·Rz·Ry·e_x (roll), R0·Rz·e_y (pitch), R0·e_z (yaw).
+    const Eigen::Matrix3d Rz = Eigen::AngleAxisd(d[5], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d Ry = Eigen::AngleAxisd(d[4], Eigen::Vector3d::UnitY()).toRotationMatrix();
+    axes->col(2) = nominal.rotation.col(2);
+    axes->col(1) = nominal.rotation * Rz.col(1);
+    axes->col(0) = nominal.rotation * Rz * Ry.col(0);
+  }
+  return out;
+}
+
+RigidTransform MeasurementModel::BaseAt(const double* e) const { return FrameAt(0, e, nullptr); }
+
+RigidTransform MeasurementModel::ToolAt(const double* e) const { return FrameAt(1, e, nullptr); }
+
+RobotModel MeasurementModel::RobotAt(const double* e) const {
+  return robot_->WithFrames(BaseAt(e), ToolAt(e));
+}
+
+void MeasurementModel::FrameColumns(const ModelPoint& point, const Pose<double>& pose,
+                                    const Eigen::Vector3d& p_hit, const Eigen::Vector3d& n,
+                                    double inv, double* row) const {
+  const auto put = [&](int f, int k, double g) {
+    const int c = parameters_.frame_columns[f][k];
+    if (c >= 0) row[c] = g * inv;
+  };
+  const Eigen::Vector3d from_base = p_hit - point.base.translation;
+  const Eigen::Vector3d from_tool = p_hit - pose.p_BT;
+  for (int k = 0; k < 3; ++k) {
+    put(0, k, n[k]);
+    put(0, 3 + k, from_base.cross(n).dot(point.base_axes.col(k)));
+    put(1, k, n.dot(pose.R_BT * point.tool_shifts_T.col(k)));
+    put(1, 3 + k, from_tool.cross(n).dot(pose.R_BT * point.tool_axes_T.col(k)));
+  }
 }
 
 void MeasurementModel::ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const {
@@ -141,6 +196,7 @@ double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSe
       if (c.u[k] >= 0) row[c.u[k]] = own ? inv * p_hit.dot(point.dn_du[p].col(k)) : 0.0;
     if (c.f >= 0) row[c.f] = own ? inv : 0.0;
   }
+  if (parameters_.EstimatesFrames()) FrameColumns(point, pose, p_hit, n, inv, row);
   // One configuration: a 1×n row is a column-major matrix with leading dimension 1.
   ApplyRanger(point, 1, h, row);
   return nb;

@@ -53,6 +53,55 @@ std::string RangerTerms::ToString() const {
   return "none";
 }
 
+FrameTerms FrameTerms::Parse(const std::string& text, const std::string& source) {
+  FrameTerms t;
+  if (text == "none" || text.empty()) return t;
+  for (const std::string& s : SplitList(text)) {
+    if (s == "all" || s == "xyz" || s == "rpy") {
+      for (int k = 0; k < 6; ++k)
+        if (s == "all" || (s == "xyz") == (k < 3)) t.estimated[k] = true;
+      continue;
+    }
+    const auto* it = std::find_if(std::begin(kFrameTermNames), std::end(kFrameTermNames),
+                                  [&](const char* name) { return s == name; });
+    if (it == std::end(kFrameTermNames))
+      throw InputError(source, "unknown frame term '" + s +
+                                   "'; expected none, all, xyz, rpy or a list of x, y, z, roll, "
+                                   "pitch, yaw");
+    t.estimated[it - std::begin(kFrameTermNames)] = true;
+  }
+  return t;
+}
+
+std::string FrameTerms::ToString() const {
+  const bool shifts = estimated[0] && estimated[1] && estimated[2];
+  const bool turns = estimated[3] && estimated[4] && estimated[5];
+  if (shifts && turns) return "all";
+  std::string out;
+  const auto add = [&](const std::string& item) { out += (out.empty() ? "" : ",") + item; };
+  for (int k = 0; k < 6; ++k) {
+    if (k == 0 && shifts) add("xyz");
+    if (k == 3 && turns) add("rpy");
+    if (estimated[k] && !(k < 3 ? shifts : turns)) add(kFrameTermNames[k]);
+  }
+  return out.empty() ? "none" : out;
+}
+
+bool FrameTerms::any() const {
+  return std::find(estimated.begin(), estimated.end(), true) != estimated.end();
+}
+
+std::string FrameTermName(int frame, int k) {
+  return std::string(kFrameNames[frame]) + "_" + kFrameTermNames[k];
+}
+
+bool ParameterSet::EstimatesFrames() const {
+  for (const auto& columns : frame_columns)
+    for (int c : columns)
+      if (c >= 0) return true;
+  return false;
+}
+
 DisplayUnit DisplayUnitOf(const std::string& name) {
   if (name == "ranger_scale") return {"ppm", 1e6};
   return IsAngularName(name) ? DisplayUnit{"mrad", 1e3} : DisplayUnit{"mm", 1e3};
@@ -85,7 +134,12 @@ ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
   }
   if (in.ranger.offset && in.ranger_offset_index < 0) fixed.push_back("ranger_offset");
   if (in.ranger.scale && in.ranger_scale_index < 0) fixed.push_back("ranger_scale");
-  return MakeParameterSet(robot, in.plane_terms, fixed, "fix", in.ranger);
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 6; ++k)
+      if (in.frames[f].estimated[k] && in.frame_columns[f][k] < 0)
+        fixed.push_back(FrameTermName(f, k));
+  return MakeParameterSet(robot, in.plane_terms, fixed, "fix", in.ranger, in.frames[0],
+                          in.frames[1]);
 }
 
 namespace {
@@ -137,7 +191,20 @@ struct FixedNames {
   std::vector<int> values;
   std::vector<PlaneFixed> planes;
   bool ranger_offset = false, ranger_scale = false;
+  bool frames[2][6] = {};
 };
+
+// "base_roll" → (0, 3); "tool_x" → (1, 0); else false.
+bool ParseFrameTermName(const std::string& name, int* frame, int* term) {
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 6; ++k)
+      if (name == FrameTermName(f, k)) {
+        *frame = f;
+        *term = k;
+        return true;
+      }
+  return false;
+}
 
 FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& fixed,
                       int num_planes, const std::string& source) {
@@ -161,10 +228,17 @@ FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& f
       (name == "ranger_offset" ? out.ranger_offset : out.ranger_scale) = true;
       continue;
     }
+    int frame, frame_term;
+    if (ParseFrameTermName(name, &frame, &frame_term)) {
+      out.frames[frame][frame_term] = true;
+      continue;
+    }
     const int k = robot.FindValue(name);
     if (k < 0)
-      throw InputError(source, "unknown parameter '" + name +
-                                   "'; expected a name like theta1, alpha2, a3, d4, beta6");
+      throw InputError(
+          source, "unknown parameter '" + name +
+                      "'; expected a name like theta1, alpha2, a3, d4, beta6, a plane or ranger "
+                      "term, or base_x ... base_yaw, tool_x ... tool_yaw");
     const auto& ids = robot.parameter_indices();
     if (std::find(ids.begin(), ids.end(), k) == ids.end())
       throw InputError(source, "'" + name + "' is fixed on this robot already (not a parameter)");
@@ -173,17 +247,39 @@ FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& f
   return out;
 }
 
+// The ranger's and the frames' terms asked for and not fixed, at the end of `set`.
+void AppendRangerAndFrameTerms(const FixedNames& f, RangerTerms ranger, FrameTerms base,
+                               FrameTerms tool, ParameterSet* set) {
+  set->ranger = ranger;
+  if (ranger.offset && !f.ranger_offset) {
+    set->ranger_offset_index = set->size();
+    set->names.push_back("ranger_offset");
+  }
+  if (ranger.scale && !f.ranger_scale) {
+    set->ranger_scale_index = set->size();
+    set->names.push_back("ranger_scale");
+  }
+  set->frames[0] = base;
+  set->frames[1] = tool;
+  for (int fr = 0; fr < 2; ++fr)
+    for (int k = 0; k < 6; ++k) {
+      if (!set->frames[fr].estimated[k] || f.frames[fr][k]) continue;
+      set->frame_columns[fr][k] = set->size();
+      set->names.push_back(FrameTermName(fr, k));
+    }
+}
+
 }  // namespace
 
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed, const std::string& source,
-                              RangerTerms ranger) {
-  return MakeParameterSet(robot, std::vector<PlaneTerms>{plane}, fixed, source, ranger);
+                              RangerTerms ranger, FrameTerms base, FrameTerms tool) {
+  return MakeParameterSet(robot, std::vector<PlaneTerms>{plane}, fixed, source, ranger, base, tool);
 }
 
 ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTerms>& planes,
                               const std::vector<std::string>& fixed, const std::string& source,
-                              RangerTerms ranger) {
+                              RangerTerms ranger, FrameTerms base, FrameTerms tool) {
   const int np = static_cast<int>(planes.size());
   if (np < 1 || np > kMaxPlanes)
     throw InputError(source, "expected 1 to " + std::to_string(kMaxPlanes) + " planes, got " +
@@ -210,15 +306,7 @@ ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTe
       set.names.push_back(PlaneTermName(p, np, "f"));
     }
   }
-  set.ranger = ranger;
-  if (ranger.offset && !f.ranger_offset) {
-    set.ranger_offset_index = set.size();
-    set.names.push_back("ranger_offset");
-  }
-  if (ranger.scale && !f.ranger_scale) {
-    set.ranger_scale_index = set.size();
-    set.names.push_back("ranger_scale");
-  }
+  AppendRangerAndFrameTerms(f, ranger, base, tool, &set);
   if (set.size() == 0)
     throw InputError(source,
                      "nothing left to estimate: the robot file marks no link value as a "

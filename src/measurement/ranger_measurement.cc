@@ -34,6 +34,12 @@ Eigen::VectorXd RangerMeasurement::NominalValues() const {
   for (int p = 0; p < ps.num_planes(); ++p)
     if (ps.plane_columns[p].f >= 0)
       nominal[ps.plane_columns[p].f] = model_.nominal_planes()[p].offset;
+  // A frame's shifts start at its translation, its rotations at 0 (parameter_set.h FrameTerms).
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (ps.frame_columns[f][k] >= 0)
+        nominal[ps.frame_columns[f][k]] =
+            (f == 0 ? model_.robot().base() : model_.robot().tool()).translation[k];
   return nominal;
 }
 
@@ -55,8 +61,8 @@ std::vector<std::string> RangerMeasurement::MissReasons(const ConfigurationSet& 
   const double* at = e ? e : zero.data();
   std::vector<double> h;
   std::vector<BeamMiss> misses;
-  ExactReadings(model_.robot(), model_.LinkValues(at), model_.PlanesAt(at), ranger_, configs, &h,
-                &misses);
+  ExactReadings(model_.parameters().EstimatesFrames() ? model_.RobotAt(at) : model_.robot(),
+                model_.LinkValues(at), model_.PlanesAt(at), ranger_, configs, &h, &misses);
   std::vector<std::string> reasons;
   reasons.reserve(misses.size());
   for (BeamMiss miss : misses) reasons.emplace_back(BeamMissName(miss));

@@ -173,15 +173,27 @@ std::vector<std::string> ToNames(const py::object& fix) {
   }
 }
 
-// The parameter set of `num_planes` planes (estimate_plane for each) and the ranger's terms: what
-// --estimate-plane, --estimate-ranger and --fix give the command line.
+// The ranger's and the frames' terms asked for (estimate_ranger=, estimate_base=,
+// estimate_tool=); a text alone is the ranger's (the functions without frame terms).
+struct OtherTerms {
+  OtherTerms(std::string ranger_terms) : ranger(std::move(ranger_terms)) {}  // NOLINT: implicit
+  OtherTerms(std::string ranger_terms, std::string base_terms, std::string tool_terms)
+      : ranger(std::move(ranger_terms)), base(std::move(base_terms)), tool(std::move(tool_terms)) {}
+  std::string ranger, base = "none", tool = "none";
+};
+
+// The parameter set of `num_planes` planes (estimate_plane for each), the ranger's and the
+// frames' terms: what --estimate-plane, --estimate-ranger, --estimate-base, --estimate-tool and
+// --fix give the command line.
 ParameterSet ResolveParameters(const RobotModel& robot, int num_planes,
-                               const std::string& estimate_plane,
-                               const std::string& estimate_ranger, const py::object& fix) {
+                               const std::string& estimate_plane, const OtherTerms& other,
+                               const py::object& fix) {
   return MakeParameterSet(
       robot,
       std::vector<PlaneTerms>(num_planes, PlaneTerms::Parse(estimate_plane, "estimate_plane")),
-      ToNames(fix), "fix", RangerTerms::Parse(estimate_ranger, "estimate_ranger"));
+      ToNames(fix), "fix", RangerTerms::Parse(other.ranger, "estimate_ranger"),
+      FrameTerms::Parse(other.base, "estimate_base"),
+      FrameTerms::Parse(other.tool, "estimate_tool"));
 }
 
 // The 5N link values of `model`: "nominal", "true", or an array of 5N values (SI).
@@ -445,6 +457,8 @@ struct IdentifyArgs {
   double encoder_sigma_mrad = 0;          // as --encoder-sigma-mrad: errors in variables
   std::string average = "mean";           // as --average: mean, median or trimmed:F
   std::string estimate_ranger = "none";   // as --estimate-ranger
+  std::string estimate_base = "none";     // as --estimate-base
+  std::string estimate_tool = "none";     // as --estimate-tool
   py::object plane_of = py::none();       // one plane number (from 1) per reading, or None
   py::object holdout = py::none();        // as --holdout K, or None
   py::object predict_at = py::none();     // as --predict-at: poses (M, joints), or None
@@ -561,7 +575,7 @@ struct ConfigsAndModel {
 ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
                                        const py::object& plane_arg, const py::object& plane_of,
                                        const std::string& estimate_plane,
-                                       const std::string& estimate_ranger, const py::object& fix) {
+                                       const OtherTerms& estimate_ranger, const py::object& fix) {
   const RobotModel& robot = rig.robot;
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
   ConfigsAndModel out;
@@ -617,7 +631,8 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
                                  IdentifyExtras* extras) {
   const RobotModel& robot = rig.robot;
   const ConfigsAndModel set =
-      ResolveConfigsAndModel(rig, q, plane_arg, a.plane_of, estimate_plane, a.estimate_ranger, fix);
+      ResolveConfigsAndModel(rig, q, plane_arg, a.plane_of, estimate_plane,
+                             {a.estimate_ranger, a.estimate_base, a.estimate_tool}, fix);
   const std::vector<double> readings = ToVector(h, "h");
   const auto labels = ConfigurationLabels(a.configuration, readings.size());
   const MeasurementSet data = GroupReadings(
@@ -672,9 +687,12 @@ IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
                                         const py::object& plane_arg,
                                         const std::string& estimate_plane, const py::object& fix,
                                         double rank_tolerance, const py::object& plane_of,
-                                        const std::string& estimate_ranger) {
+                                        const std::string& estimate_ranger,
+                                        const std::string& estimate_base,
+                                        const std::string& estimate_tool) {
   const ConfigsAndModel set =
-      ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane, estimate_ranger, fix);
+      ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane,
+                             {estimate_ranger, estimate_base, estimate_tool}, fix);
   const ConfigurationSet& configs = set.configs;
   const MeasurementModel& model = *set.model;
   IdentifiabilityOptions options;
@@ -1199,7 +1217,9 @@ lrcal.Plane (several planes, as repeated --plane). plane_of: with several planes
 reading's beam is aimed at, a number from 1 per reading (a measurement CSV's plane column).
 estimate_plane: "none", "normal", "offset" or "normal,offset", for every plane (names plane_u1,
 plane_u2, plane_f; with several planes plane1_u1, ...). estimate_ranger: "none", "offset",
-"scale" or "offset,scale" (as --estimate-ranger: reading = (1+s) h + o).
+"scale" or "offset,scale" (as --estimate-ranger: reading = (1+s) h + o). estimate_base,
+estimate_tool: the base's and the tool's transform terms, "none", "all", "xyz", "rpy" or a list
+of x, y, z, roll, pitch, yaw (as --estimate-base, --estimate-tool; names base_x ... tool_yaw).
 fix: parameter names kept at nominal (a list or "a1,d2"). auto_fix: if the set is rank-deficient,
 fix the suggested parameters and go on (else termination is 'rank_deficient').
 solver: "lm" (lrcal's) or "ceres"; loss: "none", "huber", "cauchy" (either solver) with scale
@@ -1250,7 +1270,8 @@ void DefineIdentify(py::module_& m) {
          const std::string& average, const py::object& plane_of, const std::string& estimate_ranger,
          const py::object& holdout, const py::object& predict_at, const py::object& configuration,
          double loss_scale_sigma, const py::object& write_robot, const py::object& report,
-         const py::object& data_file) {
+         const py::object& data_file, const std::string& estimate_base,
+         const std::string& estimate_tool) {
         IdentifyExtras extras;
         py::object result = py::cast(IdentifyPy(rig, q, h, plane, estimate_plane, fix, auto_fix,
                                                 {solver,
@@ -1265,6 +1286,8 @@ void DefineIdentify(py::module_& m) {
                                                  encoder_sigma_mrad,
                                                  average,
                                                  estimate_ranger,
+                                                 estimate_base,
+                                                 estimate_tool,
                                                  plane_of,
                                                  holdout,
                                                  predict_at,
@@ -1299,7 +1322,8 @@ void DefineIdentify(py::module_& m) {
       py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(),
       py::arg("configuration") = py::none(), setting("loss_scale_sigma"),
       py::arg("write_robot") = py::none(), py::arg("report") = py::none(),
-      py::arg("data_file") = py::none(), kIdentifyDoc);
+      py::arg("data_file") = py::none(), py::arg("estimate_base") = "none",
+      py::arg("estimate_tool") = "none", kIdentifyDoc);
 }
 
 void DefineCalibration(py::module_& m) {
@@ -1309,9 +1333,11 @@ void DefineCalibration(py::module_& m) {
         py::arg("fix") = py::none(),
         py::arg("rank_tolerance") =
             FindSetting(IdentifiabilityOptions::Settings(), "rank_tolerance")->Default(),
-        py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none", R"doc(
+        py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
+        py::arg("estimate_base") = "none", py::arg("estimate_tool") = "none", R"doc(
 What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
-estimate_plane, estimate_ranger, fix as in identify: several planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
+estimate_plane, estimate_ranger, estimate_base, estimate_tool, fix as in identify: several
+planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
 `lrcal identifiability`.)doc");
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

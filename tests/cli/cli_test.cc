@@ -678,6 +678,9 @@ TEST_F(CliTest, AccuracyAtPosesFromTheFitAndFromTheCalibratedFile) {
   // plane and ranger terms at lrcal's defaults and names them.
   EXPECT_EQ(file["defaulted"],
             Json({"plane_u1", "plane_u2", "plane_f", "ranger_offset", "ranger_scale"}));
+  // The base and tool transforms have no tolerance and were not estimated: exact, and said so.
+  EXPECT_EQ(file["taken_as_exact"].size(), 12u);
+  EXPECT_EQ(fit["taken_as_exact"], file["taken_as_exact"]);
   ASSERT_EQ(fit["sources"].size(), file["sources"].size());
   for (std::size_t k = 0; k < file["sources"].size(); ++k) {
     EXPECT_EQ(fit["sources"][k]["name"], file["sources"][k]["name"]);

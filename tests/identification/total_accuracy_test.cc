@@ -32,8 +32,9 @@ MeasurementSet ReadingsOfTruth(const Eigen::VectorXd& e_all, const Configuration
   noise.ranger_offset = e_all[complete.parameters().ranger_offset_index];
   noise.ranger_scale = e_all[complete.parameters().ranger_scale_index];
   MeasurementSet data;
-  SimulateReadings(robot, complete.LinkValues(e_all.data()), complete.PlanesAt(e_all.data()),
-                   testing::PaperRig().ranger, configs, noise,
+  // The truth's base and tool are moved by e_all's frame terms.
+  SimulateReadings(complete.RobotAt(e_all.data()), complete.LinkValues(e_all.data()),
+                   complete.PlanesAt(e_all.data()), testing::PaperRig().ranger, configs, noise,
                    RandomStream(seed, 0, 0, RandomPurpose::kNoise), &data);
   return data;
 }
@@ -166,7 +167,8 @@ TEST(ChooseSigma, UsesTheResidualsWhenTheGivenSigmaIsRejected) {
 }
 
 // Coverage, by Monte Carlo: every term — estimated, fixed (θ1, a1, d3, which a horizontal plane
-// cannot see), the plane's offset and the ranger's terms — drawn from its prior; the calibration
+// cannot see), the plane's offset, the ranger's terms and the base's and tool's transforms —
+// drawn from its prior; the calibration
 // estimates 22 robot terms and the plane's normal. At one pose per trial the true
 // position error falls inside the stated total 95 % radius at 95 % within a 4-standard-error band
 // of the binomial count, and inside the data-only radius below that band.
@@ -179,7 +181,9 @@ TEST(AccuracyPrediction, TotalRadiusCoversTruthsDrawnFromThePriors) {
       robot, horizontal, MakeParameterSet(robot, PlaneTerms{true, false}, {"theta1", "a1", "d3"}));
   const PriorSigmas known = PriorSigmas::Parse(
       "theta=1mrad,alpha=1mrad,beta=1mrad,a=0.5mm,d=0.5mm,plane_u=0.5mrad,plane_f=0.3mm,"
-      "ranger_offset=0.2mm,ranger_scale=100ppm");
+      "ranger_offset=0.2mm,ranger_scale=100ppm,base_x=0.3mm,base_y=0.3mm,base_z=0.3mm,"
+      "base_roll=0.3mrad,base_pitch=0.3mrad,base_yaw=0.3mrad,tool_x=0.2mm,tool_y=0.2mm,"
+      "tool_z=0.2mm,tool_roll=0.5mrad,tool_pitch=0.5mrad,tool_yaw=0.5mrad");
   const ParameterSet all = CompleteParameterSet(robot, 1);
   const MeasurementModel complete(robot, horizontal, all);
   const Eigen::VectorXd prior = known.SigmasOf(all.names);
@@ -201,8 +205,9 @@ TEST(AccuracyPrediction, TotalRadiusCoversTruthsDrawnFromThePriors) {
     pose.Add(pool.q(t));
     const AccuracyPrediction p = PredictTotalAccuracy(
         solved, s.delta.data(), CovarianceFor(s, ChooseSigma(s, GivenSigma())), held, pose);
-    const double error = ComparePoses(robot, complete.LinkValues(truth.data()),
-                                      solved.LinkValues(s.delta.data()), pose)
+    const std::vector<Pose<double>> true_pose =
+        ToolPoses(complete.RobotAt(truth.data()), complete.LinkValues(truth.data()), pose);
+    const double error = ComparePoses(robot, true_pose, solved.LinkValues(s.delta.data()), pose)
                              .position.col(0)
                              .norm();
     inside_total += error <= p.poses[0].position_radius_95_total;

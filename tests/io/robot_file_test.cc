@@ -194,7 +194,11 @@ TEST(RobotFile, TolerancesAreThePriorsByClassAndByName) {
               ::testing::HasSubstr("'tolerances.planes': expected a list of 2 entries"));
   EXPECT_THAT(message("tolerances:\n  links:\n    - {}\n"),
               ::testing::HasSubstr("'tolerances.links': expected a list of 2 entries"));
-  EXPECT_THAT(message("tolerances:\n  base: {x: 1}\n"), ::testing::HasSubstr("unknown key"));
+  EXPECT_THAT(message("tolerances:\n  base: {x: 1, twist: 2}\n"),
+              ::testing::HasSubstr("key 'tolerances.base.twist': unknown key"));
+  EXPECT_THAT(
+      message("tolerances:\n  tool: {roll: 0}\n"),
+      ::testing::HasSubstr("key 'tolerances.tool.roll': expected a standard deviation > 0"));
 }
 
 }  // namespace

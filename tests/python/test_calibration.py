@@ -476,6 +476,39 @@ def test_identifiability_with_several_planes_and_ranger_terms_is_the_programs(tm
         lrcal.identifiability(paper, c[:, :6], plane=planes)
 
 
+def test_identify_and_identifiability_with_base_and_tool_terms_are_the_programs(tmp_path, cli,
+                                                                             paper):
+    # The base's and the tool's terms asked for, the rank-deficient ones fixed (--auto-fix): the
+    # same estimate and the same analysis as the program's, and the names it gives them.
+    planes_args = ["--plane", "0,0,1,0.3", "--plane", "1,0,0,0.9", "--plane", "0,1,0,0.9"]
+    configs, data = tmp_path / "c.csv", tmp_path / "m.csv"
+    cli("sample", *planes_args, "--count", 30, "--seed", 7, "--out", configs)
+    cli("simulate", *planes_args, "--configs", configs, "--seed", 7, "--out", data)
+    program = json.loads(cli("identify", *planes_args, "--data", data, "--sigma-mm", 0.2,
+                             "--estimate-base", "rpy", "--estimate-tool", "x,z,roll",
+                             "--auto-fix", "--format", "json").stdout)
+    header, m = read_csv(data)
+    planes = [lrcal.Plane((0, 0, 1), 0.3), lrcal.Plane((1, 0, 0), 0.9),
+              lrcal.Plane((0, 1, 0), 0.9)]
+    q, h, tags = m[:, :6], m[:, header.index("h")], m[:, header.index("plane")]
+    result = lrcal.identify(paper, q, h, plane=planes, plane_of=tags, sigma_mm=0.2,
+                            estimate_base="rpy", estimate_tool="x,z,roll", auto_fix=True)
+    assert result.names == [p["name"] for p in program["parameters"]]
+    assert {"base_roll", "base_pitch"} <= set(result.names)
+    np.testing.assert_array_equal(result.estimate, [p["estimate"] for p in program["parameters"]])
+    mine = lrcal.identifiability(paper, q, plane=planes, plane_of=tags, estimate_base="rpy",
+                                 estimate_tool="x,z,roll")
+    analysis = json.loads(cli("identifiability", *planes_args, "--configs", configs,
+                              "--estimate-base", "rpy", "--estimate-tool", "x,z,roll",
+                              "--format", "json").stdout)
+    assert mine.names == analysis["parameters"] and mine.names[-6:] == [
+        "base_roll", "base_pitch", "base_yaw", "tool_x", "tool_z", "tool_roll"]
+    assert mine.suggested_fixed == analysis["suggested_fixed"]
+    assert "base_yaw" in mine.suggested_fixed or "theta1" in mine.suggested_fixed
+    with pytest.raises(lrcal.InputError, match="estimate_tool: unknown frame term 'twist'"):
+        lrcal.identify(paper, q, h, plane=planes, plane_of=tags, estimate_tool="x,twist")
+
+
 def test_sample_simulate_readings_and_design_with_several_planes_are_the_programs(tmp_path, cli):
     # A robot file with two planes and true ranger errors (examples/rigs): sample, simulate and
     # design give the numbers of the commands, bit for bit; laser_readings reads each

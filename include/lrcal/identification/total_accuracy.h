@@ -18,7 +18,12 @@
 // estimated parameters' share is the data part. A robust loss is linearised with unit weights.
 //
 // Where no tolerance is known for a held term the stated defaults below apply, and the terms
-// they applied to are listed so every statement can warn about them.
+// they applied to are listed so every statement can warn about them. The base and tool
+// transforms are the exception: without a tolerance (the robot file's tolerances.base and
+// tolerances.tool, or --prior-sigma base_x=...) they are exact by definition, because lrcal
+// cannot tell whether the base frame B is the robot's own (then its base transform has no error)
+// or a frame outside it (the planes', the cell's), nor whether the tool frame is the ranger's
+// by definition; the statements name them as taken as exact.
 #pragma once
 
 #include <Eigen/Core>
@@ -52,12 +57,20 @@ struct UnestimatedTerms {
   Eigen::VectorXd sigma;               ///< their prior σ (SI)
   std::vector<std::string> defaulted;  ///< the held terms whose σ is DefaultTolerances'
   Eigen::MatrixXd estimate_shift;      ///< S: estimated terms × held terms, ∂ê/∂u
+  /// Base and tool terms neither estimated nor given a tolerance: taken as exact (not sources).
+  std::vector<std::string> exact;
   bool empty() const { return names.empty(); }
 };
 
 /// Every term a ranger set-up could estimate on `robot` with `num_planes` planes: each robot
-/// parameter, each plane's u1, u2 and f, the ranger's offset and scale (MakeParameterSet's order).
+/// parameter, each plane's u1, u2 and f, the ranger's offset and scale, the base's and the tool's
+/// six terms (MakeParameterSet's order).
 ParameterSet CompleteParameterSet(const RobotModel& robot, int num_planes);
+/// True for "base_x" ... "tool_yaw".
+bool IsFrameTermName(const std::string& name);
+/// "the base transform, tool_x tool_y": the frames whose six terms are all in `exact`, then the
+/// other frame terms in `exact` by name.
+std::string ExactFramesText(const std::vector<std::string>& exact);
 
 /// The held terms of the identification `s` of `data` on `model` (SolvedModel's parameter set:
 /// the requested set without the terms fixed for rank deficiency): their σ from `known` (the
@@ -101,6 +114,7 @@ struct AccuracyPrediction {
   std::vector<PoseAccuracy> poses;
   std::vector<AccuracySource> sources;
   std::vector<std::string> defaulted;  ///< held terms with the default σ
+  std::vector<std::string> exact;      ///< base and tool terms taken as exact (UnestimatedTerms)
   DefaultTolerances defaults;
   SigmaUsed sigma_used;
   /// RMS over the poses of the total position error (m), and the 95th percentile of the total

@@ -67,12 +67,41 @@ Eigen::Matrix<T, 4, 4> FixedTransformMatrix(const RigidTransform& t) {
   return X;
 }
 
-/// Forward kinematics: base · A_1 ··· A_N · tool (robot_model.h). `link_values` holds the
-/// robot's 5N link values (robot_model.h order, SI), `q` its N joint coordinates (rad, or m for
-/// prismatic joints).
+/// The homogeneous matrix of `nominal` moved by six terms d = (x, y, z, roll, pitch, yaw) (m,
+/// rad): translation p0 + (x, y, z) in the parent frame, rotation R0·Rz(yaw)·Ry(pitch)·Rx(roll)
+/// (about the frame's own axes, URDF's order). How an estimate moves the base and the tool
+/// (measurement/parameter_set.h, FrameTerms).
 template <typename T>
-Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const double* q) {
-  Eigen::Matrix<T, 4, 4> X = FixedTransformMatrix<T>(model.base());
+Eigen::Matrix<T, 4, 4> MovedTransformMatrix(const RigidTransform& nominal, const T* d) {
+  using std::cos;
+  using std::sin;
+  Eigen::Matrix<T, 3, 3> rz = Eigen::Matrix<T, 3, 3>::Identity();
+  rz(0, 0) = cos(d[5]);
+  rz(0, 1) = -sin(d[5]);
+  rz(1, 0) = sin(d[5]);
+  rz(1, 1) = cos(d[5]);
+  Eigen::Matrix<T, 3, 3> ry = Eigen::Matrix<T, 3, 3>::Identity();
+  ry(0, 0) = cos(d[4]);
+  ry(0, 2) = sin(d[4]);
+  ry(2, 0) = -sin(d[4]);
+  ry(2, 2) = cos(d[4]);
+  Eigen::Matrix<T, 3, 3> rx = Eigen::Matrix<T, 3, 3>::Identity();
+  rx(1, 1) = cos(d[3]);
+  rx(1, 2) = -sin(d[3]);
+  rx(2, 1) = sin(d[3]);
+  rx(2, 2) = cos(d[3]);
+  Eigen::Matrix<T, 4, 4> X = Eigen::Matrix<T, 4, 4>::Identity();
+  X.template block<3, 3>(0, 0) = nominal.rotation.cast<T>() * rz * ry * rx;
+  for (int c = 0; c < 3; ++c) X(c, 3) = T(nominal.translation[c]) + d[c];
+  return X;
+}
+
+/// Forward kinematics: base · A_1 ··· A_N · tool (robot_model.h) with the base and tool given
+/// as homogeneous matrices in the scalar T (for estimated frames; MovedTransformMatrix).
+template <typename T>
+Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const double* q,
+                          const Eigen::Matrix<T, 4, 4>& base, const Eigen::Matrix<T, 4, 4>& tool) {
+  Eigen::Matrix<T, 4, 4> X = base;
   for (int i = 0; i < model.num_links(); ++i) {
     const T* v = link_values + kValuesPerLink * i;
     T theta = v[kTheta];
@@ -84,11 +113,20 @@ Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const d
     }
     X = X * LinkTransform<T>(theta, d, v[kA], v[kAlpha], v[kBeta]);
   }
-  X = X * FixedTransformMatrix<T>(model.tool());
+  X = X * tool;
   Pose<T> pose;
   pose.R_BT = X.template block<3, 3>(0, 0);
   pose.p_BT = X.template block<3, 1>(0, 3);
   return pose;
+}
+
+/// Forward kinematics: base · A_1 ··· A_N · tool (robot_model.h). `link_values` holds the
+/// robot's 5N link values (robot_model.h order, SI), `q` its N joint coordinates (rad, or m for
+/// prismatic joints).
+template <typename T>
+Pose<T> ForwardKinematics(const RobotModel& model, const T* link_values, const double* q) {
+  return ForwardKinematics<T>(model, link_values, q, FixedTransformMatrix<T>(model.base()),
+                              FixedTransformMatrix<T>(model.tool()));
 }
 
 }  // namespace lrcal

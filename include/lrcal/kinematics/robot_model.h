@@ -69,10 +69,14 @@ class RobotModel {
   int num_links() const { return static_cast<int>(links_.size()); }
   int num_values() const { return kValuesPerLink * num_links(); }
   const std::vector<Link>& links() const { return links_; }
-  /// The chain's frame 0 in the robot's base frame B (fixed, not identified).
+  /// The chain's frame 0 in the robot's base frame B (the robot file's `base:`; estimated only
+  /// when a parameter set asks for its terms, parameter_set.h FrameTerms).
   const RigidTransform& base() const { return base_; }
-  /// The tool (ranger) frame T in the chain's last frame N (fixed, not identified).
+  /// The tool (ranger) frame T in the chain's last frame N (the robot file's `tool:`).
   const RigidTransform& tool() const { return tool_; }
+  /// The same robot with other base and tool transforms (each must be a rotation and a
+  /// translation: RigidTransform::Validate).
+  RobotModel WithFrames(const RigidTransform& base, const RigidTransform& tool) const;
 
   /// All 5N nominal link values (SI).
   const Eigen::VectorXd& nominal_values() const { return nominal_values_; }

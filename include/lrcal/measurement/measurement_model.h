@@ -13,6 +13,12 @@
 //     (n·b) ∂h/∂u   = -p_J·∂n/∂u / (n·b)                          ∂h/∂f   = -1 / (n·b)
 // (differentiate h = -(n·p + f)/(n·b) and use n·p + f = -h·n·b: a motion of the tool moves the
 // hit point, held fixed on the beam, and h changes by minus its normal component over n·b).
+// The frame terms (parameter_set.h FrameTerms) are motions of the same kind: the base's shift c
+// moves the whole arm along e_c of B, its roll, pitch and yaw turn it about the axes w =
+// R0·Rz·Ry·e_x, R0·Rz·e_y, R0·e_z through the base origin p_B0; the tool's shift c moves the beam
+// origin along R_BN·e_c, its rotations turn the beam about R_BN·w_N through p_BT:
+//     ∂h/∂base_c = -n_c / (n·b)           ∂h/∂base_rot = -n·(w × (p_J - p_B0)) / (n·b)
+//     ∂h/∂tool_c = -n·R_BN·e_c / (n·b)    ∂h/∂tool_rot = -n·(R_BN·w_N × (p_J - p_BT)) / (n·b)
 // Tests check this against Ceres autodiff through kinematics.h and against central differences.
 //
 // Speed: joint angles enter only through cos q, sin q, precomputed once per configuration
@@ -42,6 +48,10 @@ struct ModelPoint : ChainPoint {
   /// geometric distance h. Zero unless the parameter set estimates them.
   double ranger_offset = 0;
   double ranger_scale = 0;
+  /// For estimated frame terms (else unused): the base's rotation axes (columns: roll, pitch,
+  /// yaw) in B, turning about base.translation; the tool's shift directions (columns: x, y, z of
+  /// frame N) and rotation axes (roll, pitch, yaw), both in the tool frame T.
+  Eigen::Matrix3d base_axes, tool_shifts_T, tool_axes_T;
 };
 
 /// Prepares a ModelPoint from explicit link values (5N, SI) and planes (a perfect ranger).
@@ -68,6 +78,12 @@ class MeasurementModel {
   PlaneSet PlanesAt(const double* e) const;
   /// Prepares `point` at estimate e (size num_parameters()).
   void Prepare(const double* e, ModelPoint* point) const;
+  /// The base and tool transforms at estimate e: the robot's, moved by the estimated frame
+  /// terms (parameter_set.h FrameTerms).
+  RigidTransform BaseAt(const double* e) const;
+  RigidTransform ToolAt(const double* e) const;
+  /// The robot with its base and tool at estimate e (its link values stay nominal: LinkValues).
+  RobotModel RobotAt(const double* e) const;
 
   /// Reading h (m) for configuration i (on its plane, configs.plane(i)) at `point`, and (if
   /// jacobian_row is not null) the num_parameters() entries of ∂h/∂e: the columns of other
@@ -85,7 +101,20 @@ class MeasurementModel {
     std::vector<T> values(robot_->num_values());
     for (int k = 0; k < robot_->num_values(); ++k) values[k] = T(robot_->nominal_values()[k]);
     for (int k = 0; k < parameters_.num_robot(); ++k) values[parameters_.robot_values[k]] += e[k];
-    Pose<T> pose = ForwardKinematics<T>(*robot_, values.data(), q);
+    Pose<T> pose;
+    if (parameters_.EstimatesFrames()) {
+      T d[2][6];
+      for (int f = 0; f < 2; ++f)
+        for (int k = 0; k < 6; ++k) {
+          const int c = parameters_.frame_columns[f][k];
+          d[f][k] = c >= 0 ? e[c] : T(0);
+        }
+      pose = ForwardKinematics<T>(*robot_, values.data(), q,
+                                  MovedTransformMatrix<T>(robot_->base(), d[0]),
+                                  MovedTransformMatrix<T>(robot_->tool(), d[1]));
+    } else {
+      pose = ForwardKinematics<T>(*robot_, values.data(), q);
+    }
     Eigen::Matrix<T, 3, 1> n = nominal_planes_[plane].normal.cast<T>();
     T f = T(nominal_planes_[plane].offset);
     const PlaneColumns& c = parameters_.plane_columns[plane];
@@ -104,6 +133,13 @@ class MeasurementModel {
   void ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const;
 
  private:
+  // Frame f's transform at estimate e (0 base, 1 tool) and its rotation axes in the parent frame.
+  RigidTransform FrameAt(int f, const double* e, Eigen::Matrix3d* axes) const;
+  // The frame terms' entries of one configuration's row (before the ranger's scale): the file
+  // comment's formulas, inv = -1/(n·b).
+  void FrameColumns(const ModelPoint& point, const Pose<double>& pose, const Eigen::Vector3d& p_hit,
+                    const Eigen::Vector3d& n, double inv, double* row) const;
+
   const RobotModel* robot_;
   PlaneSet nominal_planes_;
   ParameterSet parameters_;

@@ -4,15 +4,18 @@
 // The estimate vector e is laid out as
 //   [Δ(robot link values, robot file order)
 //    | for each plane p: u1, u2 (if its normal) | Δf (if its offset)
-//    | ranger offset o | ranger scale s]
+//    | ranger offset o | ranger scale s
+//    | base x, y, z, roll, pitch, yaw | tool x, y, z, roll, pitch, yaw]
 // in SI units (rad, m; u and s are dimensionless, u ≈ rad). Its names are the link value names
-// ("theta1", ...), then the plane terms, then "ranger_offset", "ranger_scale". With one plane
+// ("theta1", ...), then the plane terms, then "ranger_offset", "ranger_scale", then the frame
+// terms "base_x" ... "base_yaw", "tool_x" ... "tool_yaw" (FrameTerms). With one plane
 // the plane terms are "plane_u1", "plane_u2", "plane_f"; with several they are numbered from 1:
 // "plane1_u1", "plane1_u2", "plane1_f", "plane2_u1", ... (PlaneTermName).
 // The ranger reads (1 + s)·h + o for a geometric distance h (measurement_model.h); nominally
 // o = s = 0.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -38,6 +41,29 @@ struct RangerTerms {
                            const std::string& source = "--estimate-ranger");
   std::string ToString() const;
 };
+
+/// Which terms of one of the fixed transforms around the chain (robot_model.h) are estimated:
+/// the base (frame 0 in B) or the tool (T in the last frame N). A frame's estimate moves its
+/// nominal transform (R0, p0) to
+///   p = p0 + (x, y, z)   (m, in the parent frame: B for the base, N for the tool)
+///   R = R0·Rz(yaw)·Ry(pitch)·Rx(roll)   (rad: about the frame's own axes, URDF's order)
+/// so the calibrated robot file simply gets the new transform (written as xyz/rpy).
+struct FrameTerms {
+  /// x, y, z, roll, pitch, yaw (kFrameTermNames' order).
+  std::array<bool, 6> estimated{};
+  /// Parses "none", "all", or a comma list of x, y, z, roll, pitch, yaw, "xyz" (the three
+  /// shifts) and "rpy" (the three rotations). Throws InputError naming `source`.
+  static FrameTerms Parse(const std::string& text, const std::string& source);
+  /// The canonical text: "none", "all", "xyz", "rpy" or the list (Parse's inverse).
+  std::string ToString() const;
+  bool any() const;
+};
+/// "x", "y", "z", "roll", "pitch", "yaw".
+inline constexpr const char* kFrameTermNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+/// The frames whose terms can be estimated: "base" and "tool".
+inline constexpr const char* kFrameNames[2] = {"base", "tool"};
+/// "base_x", "tool_yaw", ...: frame f (0 base, 1 tool), term k (kFrameTermNames).
+std::string FrameTermName(int frame, int k);
 
 /// Where one plane's terms are in e.
 struct PlaneColumns {
@@ -70,6 +96,12 @@ struct ParameterSet {
   /// Indices in e of the ranger's offset o and scale s, or -1 when not estimated.
   int ranger_offset_index = -1;
   int ranger_scale_index = -1;
+  /// The frame terms asked for: [0] the base, [1] the tool.
+  FrameTerms frames[2];
+  /// Index in e of frame f's term k (kFrameTermNames), or -1 when it is not estimated.
+  int frame_columns[2][6] = {{-1, -1, -1, -1, -1, -1}, {-1, -1, -1, -1, -1, -1}};
+  /// True if any base or tool term is estimated.
+  bool EstimatesFrames() const;
   /// True for the entries measured in rad (angles, chart coordinates); false for metres.
   bool IsAngular(int k) const;
   /// Index of a name, or -1.
@@ -80,12 +112,14 @@ struct ParameterSet {
 /// plane). Throws InputError (where = `source`) for an unknown or non-parameter name in `fixed`.
 ParameterSet MakeParameterSet(const RobotModel& robot, PlaneTerms plane,
                               const std::vector<std::string>& fixed = {},
-                              const std::string& source = "fix", RangerTerms ranger = {});
+                              const std::string& source = "fix", RangerTerms ranger = {},
+                              FrameTerms base = {}, FrameTerms tool = {});
 
 /// The same with several planes: `planes` has one entry per plane (1 ≤ size ≤ kMaxPlanes).
 ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTerms>& planes,
                               const std::vector<std::string>& fixed,
-                              const std::string& source = "fix", RangerTerms ranger = {});
+                              const std::string& source = "fix", RangerTerms ranger = {},
+                              FrameTerms base = {}, FrameTerms tool = {});
 
 /// `in` without the parameters `names` (robot parameters or plane terms): what remains when
 /// an identifiability analysis says to fix them. Throws InputError for an unknown name.

@@ -55,7 +55,8 @@ class RangerMeasurement : public MeasurementKind {
   const std::vector<std::string>& parameter_names() const override {
     return model_.parameters().names;
   }
-  /// Link values at nominal, each plane's offset f0 for plane_f, 0 for chart and ranger terms.
+  /// Link values at nominal, each plane's offset f0 for plane_f, the base's and tool's translation
+  /// for their shifts, 0 for chart, ranger and frame rotation terms.
   Eigen::VectorXd NominalValues() const override;
   std::unique_ptr<MeasurementEvaluator> Bind(const ConfigurationSet& configs) const override;
   std::vector<std::string> MissReasons(const ConfigurationSet& configs,

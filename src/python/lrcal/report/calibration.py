@@ -301,6 +301,11 @@ def accuracy_text(data):
                  + html.escape(", ".join(acc["defaulted"]))
                  + "; lrcal's stated defaults (" + html.escape(acc.get("defaults", ""))
                  + ") were used. Give them in the robot file's <code>tolerances:</code>.</p>")
+    if acc.get("taken_as_exact"):
+        text += ("<p><b>Taken as exact</b> (not estimated, no tolerance given): "
+                 + html.escape(", ".join(acc["taken_as_exact"]))
+                 + ". Give <code>tolerances.base</code> / <code>tolerances.tool</code> in the "
+                 "robot file if the base frame is not the robot's own.</p>")
     return text
 
 
