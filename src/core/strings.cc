@@ -151,4 +151,6 @@ std::string FormatExact(double v) {
   return buf;
 }
 
+std::string FileNumber(double v) { return FormatExact(v == 0 ? 0.0 : v); }
+
 }  // namespace lrcal

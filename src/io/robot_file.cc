@@ -529,9 +529,6 @@ RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
 
 namespace {
 
-// 17 significant digits (FormatExact), without "-0".
-std::string Num(double x) { return FormatExact(x == 0 ? 0.0 : x); }
-
 std::string Quoted(const std::string& text) {
   std::string out = "\"";
   for (char c : text) {
@@ -545,7 +542,7 @@ std::string LinkLine(const Link& link, const double* values) {
   std::string line = "  - {";
   if (link.joint == JointType::kPrismatic) line += "joint: prismatic, ";
   for (int v = 0; v < kValuesPerLink; ++v)
-    line += std::string(LinkValueName(v)) + ": " + Num(values[v]) + ", ";
+    line += std::string(LinkValueName(v)) + ": " + FileNumber(values[v]) + ", ";
   line += "parameters: [";
   bool first = true;
   for (int v = 0; v < kValuesPerLink; ++v)
@@ -553,7 +550,8 @@ std::string LinkLine(const Link& link, const double* values) {
       line += std::string(first ? "" : ", ") + LinkValueName(v);
       first = false;
     }
-  return line + "], q_min: " + Num(link.q_min) + ", q_max: " + Num(link.q_max) + "}\n";
+  return line + "], q_min: " + FileNumber(link.q_min) + ", q_max: " + FileNumber(link.q_max) +
+         "}\n";
 }
 
 // base: / tool: lines for the transforms that are not the identity (m, rad).
@@ -564,8 +562,9 @@ std::string FixedTransformText(const RobotModel& robot) {
   for (const auto& [key, transform] : frames) {
     if (transform->IsIdentity()) continue;
     const Eigen::Vector3d xyz = transform->translation, rpy = transform->Rpy();
-    t += std::string(key) + ": {xyz: [" + Num(xyz.x()) + ", " + Num(xyz.y()) + ", " + Num(xyz.z()) +
-         "], rpy: [" + Num(rpy.x()) + ", " + Num(rpy.y()) + ", " + Num(rpy.z()) + "]}  # m, rad\n";
+    t += std::string(key) + ": {xyz: [" + FileNumber(xyz.x()) + ", " + FileNumber(xyz.y()) + ", " +
+         FileNumber(xyz.z()) + "], rpy: [" + FileNumber(rpy.x()) + ", " + FileNumber(rpy.y()) +
+         ", " + FileNumber(rpy.z()) + "]}  # m, rad\n";
   }
   return t;
 }
@@ -580,7 +579,7 @@ std::string MatrixRows(const Eigen::MatrixXd& m) {
   std::string t;
   for (Eigen::Index i = 0; i < m.rows(); ++i) {
     t += "    - [";
-    for (Eigen::Index j = 0; j < m.cols(); ++j) t += (j ? ", " : "") + Num(m(i, j));
+    for (Eigen::Index j = 0; j < m.cols(); ++j) t += (j ? ", " : "") + FileNumber(m(i, j));
     t += "]\n";
   }
   return t;
@@ -590,12 +589,13 @@ std::string RecordText(const CalibrationRecord& r) {
   std::string t = "calibration:\n";
   t += "  data: " + Quoted(r.data_file) + "\n  data_fnv1a: " + Quoted(r.data_fnv1a) +
        "\n  date: " + Quoted(r.date) + "\n  lrcal: " + Quoted(r.lrcal) + "\n";
-  t += "  sigma: " + Num(r.sigma) + "  # m, one reading\n";
+  t += "  sigma: " + FileNumber(r.sigma) + "  # m, one reading\n";
   t += "  sigma_source: " + Quoted(r.sigma_source) + "\n";
   t += "  parameters: [";
   for (std::size_t k = 0; k < r.parameters.size(); ++k) t += (k ? ", " : "") + r.parameters[k];
   t += "]\n  estimate: [";  // SI
-  for (Eigen::Index k = 0; k < r.estimate.size(); ++k) t += (k ? ", " : "") + Num(r.estimate[k]);
+  for (Eigen::Index k = 0; k < r.estimate.size(); ++k)
+    t += (k ? ", " : "") + FileNumber(r.estimate[k]);
   t += "]\n  covariance:";
   if (r.covariance.size() == 0) {
     t += " null  # undefined: no residual degrees of freedom\n";
@@ -606,7 +606,7 @@ std::string RecordText(const CalibrationRecord& r) {
   if (r.held.empty()) return t;
   t += "  held: [" + Joined(r.held) + "]  # terms held at nominal\n  held_sigma: [";
   for (Eigen::Index k = 0; k < r.held_sigma.size(); ++k)
-    t += (k ? ", " : "") + Num(r.held_sigma[k]);
+    t += (k ? ", " : "") + FileNumber(r.held_sigma[k]);
   t += "]  # SI, their prior standard deviations\n";
   t += "  held_defaulted: [" + Joined(r.held_defaulted) + "]  # sigma is lrcal's default\n";
   t += "  estimate_shift:  # d(estimate)/d(held term): rows parameters, columns held\n";
@@ -624,8 +624,8 @@ std::string RobotFileText(const RobotFile& rig, const Eigen::VectorXd& link_valu
     t += LinkLine(robot.links()[i], link_values.data() + kValuesPerLink * i);
   t += FixedTransformText(robot);
   const auto plane_text = [](const Plane& plane) {
-    return "{normal: [" + Num(plane.normal.x()) + ", " + Num(plane.normal.y()) + ", " +
-           Num(plane.normal.z()) + "], offset: " + Num(plane.offset);
+    return "{normal: [" + FileNumber(plane.normal.x()) + ", " + FileNumber(plane.normal.y()) +
+           ", " + FileNumber(plane.normal.z()) + "], offset: " + FileNumber(plane.offset);
   };
   if (planes && planes->size() == 1) {
     t += "plane: " + plane_text((*planes)[0]) + "}\n";
@@ -635,9 +635,9 @@ std::string RobotFileText(const RobotFile& rig, const Eigen::VectorXd& link_valu
       t += "  - " + plane_text((*planes)[p]) +
            (planes->name(p).empty() ? "" : ", name: " + Quoted(planes->name(p))) + "}\n";
   }
-  t += "ranger: {min_range: " + Num(rig.ranger.min_range) +
-       ", max_range: " + Num(rig.ranger.max_range) +
-       ", max_incidence_deg: " + Num(rig.ranger.max_incidence * 180.0 / M_PI) + "}\n";
+  t += "ranger: {min_range: " + FileNumber(rig.ranger.min_range) +
+       ", max_range: " + FileNumber(rig.ranger.max_range) +
+       ", max_incidence_deg: " + FileNumber(rig.ranger.max_incidence * 180.0 / M_PI) + "}\n";
   return record ? t + RecordText(*record) : t;
 }
 

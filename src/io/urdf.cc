@@ -224,14 +224,11 @@ RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_lin
 
 namespace {
 
-// 17 significant digits (FormatExact), without "-0".
-std::string Num(double x) { return FormatExact(x == 0 ? 0.0 : x); }
-
 std::string Origin(const RigidTransform& t) {
   const Eigen::Vector3d rpy = t.Rpy();
-  return "<origin xyz=\"" + Num(t.translation.x()) + " " + Num(t.translation.y()) + " " +
-         Num(t.translation.z()) + "\" rpy=\"" + Num(rpy.x()) + " " + Num(rpy.y()) + " " +
-         Num(rpy.z()) + "\"/>";
+  return "<origin xyz=\"" + FileNumber(t.translation.x()) + " " + FileNumber(t.translation.y()) +
+         " " + FileNumber(t.translation.z()) + "\" rpy=\"" + FileNumber(rpy.x()) + " " +
+         FileNumber(rpy.y()) + " " + FileNumber(rpy.z()) + "\"/>";
 }
 
 std::string XmlEscaped(const std::string& text) {
@@ -266,8 +263,9 @@ std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& values) {
     t += "  <link name=\"" + child + "\"/>\n  <joint name=\"joint" + std::to_string(i + 1) +
          "\" type=\"" + (link.joint == JointType::kPrismatic ? "prismatic" : "revolute") +
          "\">\n    <parent link=\"" + parent + "\"/>\n    <child link=\"" + child + "\"/>\n    " +
-         Origin(origin) + "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" + Num(link.q_min) +
-         "\" upper=\"" + Num(link.q_max) + "\" effort=\"0\" velocity=\"0\"/>\n  </joint>\n";
+         Origin(origin) + "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" +
+         FileNumber(link.q_min) + "\" upper=\"" + FileNumber(link.q_max) +
+         "\" effort=\"0\" velocity=\"0\"/>\n  </joint>\n";
     origin = LinkRigidTransform(values.data() + kValuesPerLink * i);
   }
   t += "  <link name=\"tool\"/>\n  <joint name=\"tool_joint\" type=\"fixed\">\n    <parent "
@@ -284,9 +282,9 @@ std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& values) 
                                                                   {"tool", &robot.tool()}};
   for (const auto& [key, transform] : frames) {
     const Eigen::Vector3d xyz = transform->translation, rpy = transform->Rpy();
-    t += std::string("# ") + key + " xyz_m: " + Num(xyz.x()) + " " + Num(xyz.y()) + " " +
-         Num(xyz.z()) + " rpy_rad: " + Num(rpy.x()) + " " + Num(rpy.y()) + " " + Num(rpy.z()) +
-         "\n";
+    t += std::string("# ") + key + " xyz_m: " + FileNumber(xyz.x()) + " " + FileNumber(xyz.y()) +
+         " " + FileNumber(xyz.z()) + " rpy_rad: " + FileNumber(rpy.x()) + " " +
+         FileNumber(rpy.y()) + " " + FileNumber(rpy.z()) + "\n";
   }
   t += "link,joint,theta0_rad,d_m,a_m,alpha_rad,beta_rad,q_min,q_max,parameters\n";
   for (int i = 0; i < robot.num_links(); ++i) {
@@ -298,9 +296,10 @@ std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& values) 
     std::string list;
     for (const std::string& p : parameters) list += (list.empty() ? "" : " ") + p;
     t += std::to_string(i + 1) + "," +
-         (link.joint == JointType::kPrismatic ? "prismatic" : "revolute") + "," + Num(v[kTheta]) +
-         "," + Num(v[kD]) + "," + Num(v[kA]) + "," + Num(v[kAlpha]) + "," + Num(v[kBeta]) + "," +
-         Num(link.q_min) + "," + Num(link.q_max) + "," + list + "\n";
+         (link.joint == JointType::kPrismatic ? "prismatic" : "revolute") + "," +
+         FileNumber(v[kTheta]) + "," + FileNumber(v[kD]) + "," + FileNumber(v[kA]) + "," +
+         FileNumber(v[kAlpha]) + "," + FileNumber(v[kBeta]) + "," + FileNumber(link.q_min) + "," +
+         FileNumber(link.q_max) + "," + list + "\n";
   }
   return t;
 }

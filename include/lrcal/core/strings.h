@@ -25,6 +25,9 @@ bool ParseAngleExpression(const std::string& text, double* value);
 
 /// Formats a double with 17 significant digits (reads back to the same bits).
 std::string FormatExact(double v);
+/// FormatExact without a negative zero (-0 is written as 0): how numbers go into the files lrcal
+/// writes (robot files, URDFs).
+std::string FileNumber(double v);
 
 /// A value (a CSV cell, a setting's text) as error messages show it: at most 40 characters,
 /// longer ones cut with "..." and their length.
