@@ -14,7 +14,8 @@ namespace {
 // Same formulas, different order of operations: agreement to a few ulps of O(1) values.
 constexpr double kTolerance = 1e-13;
 
-void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs) {
+void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs,
+                Isa isa = ActiveIsa()) {
   const int n = model.num_parameters(), m = configs.size();
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> ue(-0.01, 0.01);
@@ -25,8 +26,8 @@ void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs) 
   BatchEvaluator batch;
   batch.SetConfigurations(configs);
   std::vector<double> h(m), J(static_cast<std::size_t>(m) * n), h_only(m);
-  batch.Evaluate(model, point, h.data(), J.data());
-  batch.Evaluate(model, point, h_only.data(), nullptr);
+  batch.Evaluate(model, point, h.data(), J.data(), isa);
+  batch.Evaluate(model, point, h_only.data(), nullptr, isa);
   std::vector<double> row(n);
   for (int i = 0; i < m; ++i) {
     double hi;
@@ -35,7 +36,7 @@ void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs) 
     EXPECT_EQ(h[i], h_only[i]);
     for (int k = 0; k < n; ++k)
       EXPECT_NEAR(J[static_cast<std::size_t>(k) * m + i], row[k], kTolerance)
-          << model.parameters().names[k] << " at configuration " << i;
+          << model.parameters().names[k] << " at configuration " << i << ", " << IsaName(isa);
   }
 }
 
@@ -114,6 +115,33 @@ TEST(BatchEvaluator, MatchesWithBaseAndToolTransforms) {
   const Plane plane = Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8);
   MeasurementModel model(robot, plane, MakeParameterSet(robot, PlaneTerms{true, true}));
   ExpectSame(model, testing::ConfigurationsFacing(robot, plane, 40, 4));
+}
+
+// The base's and the tool's terms estimated (parameter_set.h FrameTerms): the kernel computes
+// their columns from its own arrays, on one plane and on three, on every instruction set.
+TEST(BatchEvaluator, MatchesWithEstimatedBaseAndToolTermsOnEveryVariant) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PlaneSet planes(
+      {Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8), Plane::FromCoefficients(1, 0.1, 0, 0.9),
+       Plane::FromCoefficients(0, 1, 0.2, 0.9)},
+      {});
+  ConfigurationSet mixed(robot.num_links());
+  for (int p = 0; p < planes.size(); ++p) {
+    const ConfigurationSet facing = testing::ConfigurationsFacing(robot, planes[p], 13, 3 + p);
+    for (int i = 0; i < facing.size(); ++i) mixed.Add(facing.q(i), p);
+  }
+  const FrameTerms all = FrameTerms::Parse("all", "base"), some = FrameTerms::Parse("x,z,rpy", "t");
+  const MeasurementModel one(robot, PlaneSet({planes[0]}, {}),
+                             MakeParameterSet(robot, PlaneTerms{true, true}, {}, "--fix",
+                                              RangerTerms{true, true}, all, some));
+  const MeasurementModel three(
+      robot, planes,
+      MakeParameterSet(robot, std::vector<PlaneTerms>(3, PlaneTerms{true, true}), {}, "--fix",
+                       RangerTerms{true, true}, some, all));
+  for (Isa isa : SupportedIsas()) {
+    ExpectSame(one, testing::ConfigurationsFacing(robot, planes[0], 30, 3), isa);
+    ExpectSame(three, mixed, isa);
+  }
 }
 
 }  // namespace

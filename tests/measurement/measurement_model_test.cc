@@ -20,6 +20,8 @@ constexpr double kAutodiffTolerance = 1e-11;
 constexpr double kFiniteDifferenceTolerance = 1e-8;
 constexpr int kMaxParams = 30;
 using Jet = ceres::Jet<double, kMaxParams>;
+// Every link value, plane and ranger term and both frames' twelve terms (42) fit in 48.
+using WideJet = ceres::Jet<double, 48>;
 
 struct Case {
   PlaneTerms terms;
@@ -124,6 +126,50 @@ TEST(JacobianWithFrames, AnalyticMatchesAutodiffAndCentralDifferences) {
   ModelPoint point;
   model.Prepare(e.data(), &point);
   for (int i = 0; i < configs.size(); ++i) ExpectRowMatches<Jet>(model, point, e, configs, i);
+}
+
+// A tilted, shifted base and a ranger off the flange, every term estimated (25 link values,
+// the plane's three, the ranger's two and both frames' twelve: 42), at the nominal estimate and
+// away from it.
+TEST(JacobianWithFrameTerms, AnalyticMatchesAutodiffAndCentralDifferences) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const Plane plane = Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8);
+  const MeasurementModel model(
+      robot, plane,
+      MakeParameterSet(robot, PlaneTerms{true, true}, {}, "--fix", RangerTerms{true, true},
+                       FrameTerms::Parse("all", "b"), FrameTerms::Parse("all", "t")));
+  const int n = model.num_parameters();
+  ASSERT_EQ(n, 42);
+  ASSERT_LE(n, 48);
+  const ConfigurationSet configs = testing::ConfigurationsFacing(robot, plane, 25, 5);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> ue(-0.02, 0.02);
+  for (int at = 0; at < 2; ++at) {
+    std::vector<double> e(n, 0.0);
+    if (at == 1)
+      for (double& v : e) v = ue(rng);
+    ModelPoint point;
+    model.Prepare(e.data(), &point);
+    for (int i = 0; i < configs.size(); ++i) ExpectRowMatches<WideJet>(model, point, e, configs, i);
+  }
+}
+
+// The same on a robot whose nominal frames are the identity (the paper's arm), a subset of each
+// frame's terms estimated.
+TEST(JacobianWithFrameTerms, SubsetsOnTheIdentityFrames) {
+  const RobotModel& robot = testing::PaperRobot();
+  const MeasurementModel model(
+      robot, testing::PaperPlane(),
+      MakeParameterSet(robot, PlaneTerms{}, {}, "--fix", RangerTerms{},
+                       FrameTerms::Parse("y,roll,yaw", "b"), FrameTerms::Parse("x,z,pitch", "t")));
+  const ConfigurationSet configs = testing::PaperHittingConfigurations(20, 4);
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> ue(-0.01, 0.01);
+  std::vector<double> e(model.num_parameters());
+  for (double& v : e) v = ue(rng);
+  ModelPoint point;
+  model.Prepare(e.data(), &point);
+  for (int i = 0; i < configs.size(); ++i) ExpectRowMatches<WideJet>(model, point, e, configs, i);
 }
 
 // Three planes, every plane term and both ranger terms estimated (36 parameters): each row's
