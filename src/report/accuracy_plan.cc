@@ -579,7 +579,11 @@ std::string AccuracyPlan::ToText() const {
   std::ostringstream out;
   out << search_table.ToText()
       << "(— : no campaign there: the prediction is not finite, e.g. parameters the "
-         "planes cannot identify, or more readings than --repetitions allows)\n\n";
+         "planes cannot identify, or more readings than --repetitions allows)\n"
+      << "The first-order search predicts the reading noise's part only (the estimated "
+         "parameters' covariance). The Monte-Carlo confirmation simulates the study's truth: it "
+         "has every error that truth has and no other; terms the calibration holds at nominal "
+         "count only as far as the truth moves them (README: What a calibration cannot see).\n\n";
   const bool stopped = options.stop_precision > 0;
   std::vector<std::string> header = {"campaign",
                                      "configurations",

@@ -151,12 +151,18 @@ TEST(PlanAccuracy, ConfirmationStopsWhenPreciseEnough) {
   std::ofstream(study) << "name: setup\nseed: 4\ntrials: 10\nrobot: "
                        << testing::SourcePath("studies/robots/paper.yaml")
                        << "\npool: {size: 60}\nvalidation: {size: 10}\n";
-  const std::string plan = testing::LrcalBinary() + " plan-accuracy " + study +
+  const std::string base = testing::LrcalBinary() + " plan-accuracy " + study +
                            " --target rms_pos=0.08mm --configurations 40:60:10 --trials 5000 "
-                           "--format json --out " +
+                           "--out " +
                            dir + "/plan";
+  const std::string plan = base + " --format json";
   std::string out;
   ASSERT_EQ(testing::RunCommand(plan + " --stop-precision 0.1", &out), 0) << out;
+  // The text says what the first-order search leaves out (the same plan, resumed).
+  std::string text;
+  ASSERT_EQ(testing::RunCommand(base + " --stop-precision 0.1", &text), 0) << text;
+  EXPECT_THAT(text, ::testing::HasSubstr("The first-order search predicts the reading noise's "
+                                         "part only"));
   const Json j = Json::parse(out.substr(out.find('{')));
   for (const auto& c : j["campaigns"]) {
     const long long trials = c["trials"].get<long long>();
