@@ -30,13 +30,6 @@ ParameterSet CompleteParameterSet(const RobotModel& robot, int num_planes) {
                           "complete parameter set", RangerTerms{true, true}, all, all);
 }
 
-bool IsFrameTermName(const std::string& name) {
-  for (int f = 0; f < 2; ++f)
-    for (int k = 0; k < 6; ++k)
-      if (name == FrameTermName(f, k)) return true;
-  return false;
-}
-
 namespace {
 
 // Where each of `names` is in `all`; throws InternalError for a name `all` lacks.

@@ -1,6 +1,5 @@
 #include "lrcal/measurement/measurement_model.h"
 
-#include <Eigen/Geometry>
 #include <cmath>
 
 #include "lrcal/core/error.h"
@@ -86,21 +85,17 @@ void MeasurementModel::Prepare(const double* e, ModelPoint* point) const {
 RigidTransform MeasurementModel::FrameAt(int f, const double* e, Eigen::Matrix3d* axes) const {
   const RigidTransform& nominal = f == 0 ? robot_->base() : robot_->tool();
   double d[6];
-  for (int k = 0; k < 6; ++k) {
-    const int c = parameters_.frame_columns[f][k];
-    d[k] = c >= 0 ? e[c] : 0.0;
-  }
+  FrameTermValues(e, f, d);
   const Eigen::Matrix4d X = MovedTransformMatrix<double>(nominal, d);
   RigidTransform out;
   out.rotation = X.block<3, 3>(0, 0);
   out.translation = X.block<3, 1>(0, 3);
   if (axes) {
     // d(R0·Rz·Ry·Rx)/dφ = [w]×·R: w = R0·Rz·Ry·e_x (roll), R0·Rz·e_y (pitch), R0·e_z (yaw).
-    const Eigen::Matrix3d Rz = Eigen::AngleAxisd(d[5], Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    const Eigen::Matrix3d Ry = Eigen::AngleAxisd(d[4], Eigen::Vector3d::UnitY()).toRotationMatrix();
+    // With R = R0·Rz·Ry·Rx: R0·Rz·Ry·e_x = R·e_x and R0·Rz·e_y = R·Rxᵀ·e_y.
+    axes->col(0) = out.rotation.col(0);
+    axes->col(1) = out.rotation * Eigen::Vector3d(0, std::cos(d[3]), -std::sin(d[3]));
     axes->col(2) = nominal.rotation.col(2);
-    axes->col(1) = nominal.rotation * Rz.col(1);
-    axes->col(0) = nominal.rotation * Rz * Ry.col(0);
   }
   return out;
 }

@@ -87,12 +87,29 @@ std::string FrameTerms::ToString() const {
   return out.empty() ? "none" : out;
 }
 
-bool FrameTerms::any() const {
-  return std::find(estimated.begin(), estimated.end(), true) != estimated.end();
-}
-
 std::string FrameTermName(int frame, int k) {
   return std::string(kFrameNames[frame]) + "_" + kFrameTermNames[k];
+}
+
+namespace {
+
+// "base_roll" → (0, 3); "tool_x" → (1, 0); else false.
+bool ParseFrameTermName(const std::string& name, int* frame, int* term) {
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 6; ++k)
+      if (name == FrameTermName(f, k)) {
+        *frame = f;
+        *term = k;
+        return true;
+      }
+  return false;
+}
+
+}  // namespace
+
+bool IsFrameTermName(const std::string& name) {
+  int frame, term;
+  return ParseFrameTermName(name, &frame, &term);
 }
 
 bool ParameterSet::EstimatesFrames() const {
@@ -193,18 +210,6 @@ struct FixedNames {
   bool ranger_offset = false, ranger_scale = false;
   bool frames[2][6] = {};
 };
-
-// "base_roll" → (0, 3); "tool_x" → (1, 0); else false.
-bool ParseFrameTermName(const std::string& name, int* frame, int* term) {
-  for (int f = 0; f < 2; ++f)
-    for (int k = 0; k < 6; ++k)
-      if (name == FrameTermName(f, k)) {
-        *frame = f;
-        *term = k;
-        return true;
-      }
-  return false;
-}
 
 FixedNames ParseFixed(const RobotModel& robot, const std::vector<std::string>& fixed,
                       int num_planes, const std::string& source) {

@@ -11,7 +11,6 @@
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/identification/pose_accuracy.h"
-#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "test_util.h"
 
@@ -89,7 +88,7 @@ TEST(FrameTermsIdentifiability, NamesTheDependencesOnTheEndLinks) {
     bool frame = false, end_link = false;
     for (const auto& term : d.terms) {
       const std::string& name = term.first;
-      const bool is_frame = name.rfind("base_", 0) == 0 || name.rfind("tool_", 0) == 0;
+      const bool is_frame = IsFrameTermName(name);
       frame |= is_frame;
       end_link |= !is_frame && (name.back() == '1' || name.back() == '6');
     }

@@ -66,8 +66,6 @@ struct UnestimatedTerms {
 /// parameter, each plane's u1, u2 and f, the ranger's offset and scale, the base's and the tool's
 /// six terms (MakeParameterSet's order).
 ParameterSet CompleteParameterSet(const RobotModel& robot, int num_planes);
-/// True for "base_x" ... "tool_yaw".
-bool IsFrameTermName(const std::string& name);
 /// "the base transform, tool_x tool_y": the frames whose six terms are all in `exact`, then the
 /// other frame terms in `exact` by name.
 std::string ExactFramesText(const std::vector<std::string>& exact);

@@ -104,11 +104,7 @@ class MeasurementModel {
     Pose<T> pose;
     if (parameters_.EstimatesFrames()) {
       T d[2][6];
-      for (int f = 0; f < 2; ++f)
-        for (int k = 0; k < 6; ++k) {
-          const int c = parameters_.frame_columns[f][k];
-          d[f][k] = c >= 0 ? e[c] : T(0);
-        }
+      for (int f = 0; f < 2; ++f) FrameTermValues(e, f, d[f]);
       pose = ForwardKinematics<T>(*robot_, values.data(), q,
                                   MovedTransformMatrix<T>(robot_->base(), d[0]),
                                   MovedTransformMatrix<T>(robot_->tool(), d[1]));
@@ -133,6 +129,14 @@ class MeasurementModel {
   void ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const;
 
  private:
+  // Frame f's six terms (x, y, z, roll, pitch, yaw) at estimate e: 0 where not estimated.
+  template <typename T>
+  void FrameTermValues(const T* e, int f, T* d) const {
+    for (int k = 0; k < 6; ++k) {
+      const int c = parameters_.frame_columns[f][k];
+      d[k] = c >= 0 ? e[c] : T(0);
+    }
+  }
   // Frame f's transform at estimate e (0 base, 1 tool) and its rotation axes in the parent frame.
   RigidTransform FrameAt(int f, const double* e, Eigen::Matrix3d* axes) const;
   // The frame terms' entries of one configuration's row (before the ranger's scale): the file

@@ -56,7 +56,6 @@ struct FrameTerms {
   static FrameTerms Parse(const std::string& text, const std::string& source);
   /// The canonical text: "none", "all", "xyz", "rpy" or the list (Parse's inverse).
   std::string ToString() const;
-  bool any() const;
 };
 /// "x", "y", "z", "roll", "pitch", "yaw".
 inline constexpr const char* kFrameTermNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
@@ -64,6 +63,8 @@ inline constexpr const char* kFrameTermNames[6] = {"x", "y", "z", "roll", "pitch
 inline constexpr const char* kFrameNames[2] = {"base", "tool"};
 /// "base_x", "tool_yaw", ...: frame f (0 base, 1 tool), term k (kFrameTermNames).
 std::string FrameTermName(int frame, int k);
+/// True for "base_x" ... "tool_yaw".
+bool IsFrameTermName(const std::string& name);
 
 /// Where one plane's terms are in e.
 struct PlaneColumns {
