@@ -19,6 +19,7 @@ AccuracyPlanOptions ReadOptions(const po::variables_map& vm) {
   if (vm.count("seed")) o.seed = ParseSeed(vm);
   if (vm.count("out")) o.out_dir = vm["out"].as<std::string>();
   o.threads = vm["threads"].as<int>();
+  o.plan_on = ParsePlanBasis(vm["plan-on"].as<std::string>());
   return o;
 }
 
@@ -45,6 +46,11 @@ int PlanAccuracyCommand(const std::vector<std::string>& args) {
       "out", po::value<std::string>(),
       "folder for the confirmation study and run (default: output/STUDY-plan-HASH, named by the "
       "plan's settings)")("threads", po::value<int>()->default_value(0), "threads (0: all cores)")(
+      "plan-on",
+      po::value<std::string>()->default_value(
+          NameOf(kPlanBasisNames, AccuracyPlanOptions{}.plan_on)),
+      "total: the target holds for the first-order total (the reading noise's part plus the "
+      "terms held at nominal at their tolerances); data: for the reading noise's part alone")(
       "format", po::value<std::string>()->default_value("text"), "text or json");
   AddSettingOptions(o, AccuracyPlanOptions::NumericSettings());
   po::positional_options_description pos;

@@ -200,14 +200,17 @@ std::optional<AccuracyPrediction> PredictAccuracyAfterFit(const MeasurementModel
   return p;
 }
 
-AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const double* e,
-                                        const Eigen::MatrixXd& covariance,
-                                        const UnestimatedTerms& held,
-                                        const ConfigurationSet& configs) {
+namespace {
+
+// The estimated terms' pose Jacobian P and the held terms' pose columns (P·S − P_u)·diag(σ) at
+// `configs` for the estimate e.
+struct HeldPose {
+  Eigen::MatrixXd P, M;
+};
+
+HeldPose HeldPoseAt(const MeasurementModel& solved, const double* e, const UnestimatedTerms& held,
+                    const ConfigurationSet& configs) {
   const int n = solved.num_parameters(), k = static_cast<int>(held.names.size());
-  if (covariance.rows() != n || covariance.cols() != n)
-    throw InputError("covariance", "expected " + std::to_string(n) + " x " + std::to_string(n) +
-                                       " (one row and column per estimated parameter)");
   if (held.estimate_shift.rows() != n || held.estimate_shift.cols() != k || held.sigma.size() != k)
     throw InputError("held terms", "expected an estimate shift of " + std::to_string(n) + " x " +
                                        std::to_string(k) + " and one sigma per held term");
@@ -218,9 +221,31 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
   for (int i = 0; i < n; ++i) e_all[est[i]] = e[i];
   const MeasurementModel complete(solved.robot(), solved.nominal_planes(), all);
   const Eigen::MatrixXd J = PoseJacobian(complete, e_all.data(), configs);
-  const Eigen::MatrixXd P = Columns(J, est), Pu = Columns(J, at_held);
+  HeldPose out;
+  out.P = Columns(J, est);
   // Per held term, the pose error of one prior σ: (P·S − P_u)·diag(σ).
-  const Eigen::MatrixXd M = (P * held.estimate_shift - Pu) * held.sigma.asDiagonal();
+  out.M = (out.P * held.estimate_shift - Columns(J, at_held)) * held.sigma.asDiagonal();
+  return out;
+}
+
+}  // namespace
+
+Eigen::MatrixXd HeldTermPoseColumns(const MeasurementModel& solved, const double* e,
+                                    const UnestimatedTerms& held, const ConfigurationSet& configs) {
+  return HeldPoseAt(solved, e, held, configs).M;
+}
+
+AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const double* e,
+                                        const Eigen::MatrixXd& covariance,
+                                        const UnestimatedTerms& held,
+                                        const ConfigurationSet& configs) {
+  const int n = solved.num_parameters(), k = static_cast<int>(held.names.size());
+  if (covariance.rows() != n || covariance.cols() != n)
+    throw InputError("covariance", "expected " + std::to_string(n) + " x " + std::to_string(n) +
+                                       " (one row and column per estimated parameter)");
+  const HeldPose pose = HeldPoseAt(solved, e, held, configs);
+  const Eigen::MatrixXd& P = pose.P;
+  const Eigen::MatrixXd& M = pose.M;
 
   AccuracyPrediction out;
   out.defaulted = held.defaulted;

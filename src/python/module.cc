@@ -1425,9 +1425,10 @@ Returns an lrcal.RunResult. Read the results with lrcal.load_run(out_dir).)doc")
          const std::string& cost, const std::optional<std::string>& configurations,
          const std::string& repetitions, const std::optional<std::string>& planes, int trials,
          double stop_precision, const std::optional<long long>& seed,
-         const std::optional<std::string>& out_dir, int threads) {
+         const std::optional<std::string>& out_dir, int threads, const std::string& plan_on) {
         const Study study = LoadStudy(ResolveStudyPath(study_arg));
         AccuracyPlanOptions o;
+        o.plan_on = ParsePlanBasis(plan_on);
         o.target = AccuracyTarget::Parse(target);
         o.confidence = confidence;
         o.cost = CampaignCosts::Parse(cost);
@@ -1455,14 +1456,19 @@ Returns an lrcal.RunResult. Read the results with lrcal.load_run(out_dir).)doc")
           FindSetting(AccuracyPlanOptions::NumericSettings(), "trials")->Default()),
       py::arg("stop_precision") =
           FindSetting(AccuracyPlanOptions::NumericSettings(), "stop_precision")->Default(),
-      py::arg("seed") = py::none(), py::arg("out_dir") = py::none(), py::arg("threads") = 0, R"doc(
+      py::arg("seed") = py::none(), py::arg("out_dir") = py::none(), py::arg("threads") = 0,
+      py::arg("plan_on") = NameOf(kPlanBasisNames, AccuracyPlanOptions{}.plan_on), R"doc(
 The cheapest campaign that meets an accuracy target, as `lrcal plan-accuracy STUDY --target ...`
 (report/accuracy_plan.h: the same search, confirmation run and numbers). target: e.g.
 "rms_pos=0.05mm" (also rms_ori, max_pos, max_ori, with mm or mrad); cost:
 "configuration=30s,reading=1s[,plane=600s]"; configurations, repetitions, planes: FIRST:LAST[:STEP]
-ranges. Returns the plan as `--format json` prints it: a dict with target, search_seconds,
-campaigns (label, configurations, repetitions, cost_seconds, predicted and monte_carlo in the
-target's unit, meets_target, ...), study and run (the confirmation study file and run folder).)doc");
+ranges; plan_on: "total" (the reading noise's part plus every term held at nominal at its
+tolerance) or "data" (the reading noise's part alone). Returns the plan as `--format json` prints
+it: a dict with target, plan_on, defaulted and taken_as_exact (held terms with lrcal's default
+tolerance, frame terms taken as exact), search_seconds, campaigns (label, configurations,
+repetitions, cost_seconds, predicted (of the plan's basis), predicted_total, predicted_data and
+monte_carlo in the target's unit, meets_target, ...), study and run (the confirmation study file
+and run folder).)doc");
 }
 
 // --- one function per command (the command's library call, its JSON as Python objects) -------

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -55,6 +57,32 @@ double WorstAxisQuantile(const Eigen::MatrixXd& draws, const AccuracyTarget& t, 
   for (Eigen::Index d = 0; d < draws.rows(); ++d)
     worst[d] = std::max({draws(d, t.first()), draws(d, t.first() + 1), draws(d, t.first() + 2)});
   return Quantile(&worst, 100 * confidence);
+}
+
+// The first index of `reps` (ascending) at which `meets` holds, the quantile falling as the
+// readings grow; none when the last does not. It checks the index the guess (in readings) falls
+// on and its neighbour first, then bisects: two or three evaluations when the guess is right.
+template <typename Meets>
+std::optional<std::size_t> FirstMeeting(const std::vector<int>& reps, double guess, Meets meets) {
+  std::size_t lo = 0, hi = reps.size() - 1, i = 0;  // the answer is in [lo, hi]
+  while (i < hi && reps[i] < guess) ++i;
+  if (meets(i)) {
+    hi = i;
+    if (i > 0 && !meets(i - 1)) return i;
+  } else {
+    if (i == hi || !meets(hi)) return std::nullopt;
+    lo = i + 1;
+    if (meets(lo)) return lo;
+  }
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (meets(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return hi;
 }
 
 // A study file for the set-up with the given cells (zip of configurations and repetitions). The
@@ -156,6 +184,7 @@ struct PlanInputs {
   std::string configurations;  // as given, or empty
   std::string out_dir;
   std::uint64_t seed = 0;
+  PlanBasis plan_on = PlanBasis::kTotal;
 };
 
 // What a plan's results depend on (not its threads): kept in its folder as plan.json.
@@ -172,7 +201,8 @@ Json PlanSettings(const PlanInputs& in, const Study& study) {
           {"repetitions", in.repetitions},
           {"trials", in.trials},
           {"stop_precision", in.stop_precision},
-          {"seed", in.seed}};
+          {"seed", in.seed},
+          {"plan_on", NameOf(kPlanBasisNames, in.plan_on)}};
 }
 
 PlanInputs Resolve(const AccuracyPlanOptions& o, const Study& study) {
@@ -190,6 +220,7 @@ PlanInputs Resolve(const AccuracyPlanOptions& o, const Study& study) {
   in.repetitions = ParseRange(o.repetitions, "repetitions", 1);
   in.configurations = o.configurations;
   in.seed = o.seed ? *o.seed : study.seed;
+  in.plan_on = o.plan_on;
   // The default folder is named by the plan's settings: another seed, cost or target plans in a
   // folder of its own instead of being refused by the last plan's.
   in.out_dir = o.out_dir.empty() ? "output/" + study.name + "-plan-" +
@@ -232,12 +263,16 @@ class Planner {
         for (int mask = 1; mask < (1 << K); ++mask)
           if (__builtin_popcount(static_cast<unsigned>(mask)) == size) AddCandidateSubset(mask);
     }
-    std::vector<std::string> header = {"configurations", "predicted at 1 reading",
-                                       "readings needed", "cost (h)"};
+    const std::string unit = " (" + in_.target.unit() + ")";
+    std::vector<std::string> header = {"configurations",    "reading noise at 1 reading" + unit,
+                                       "held terms" + unit, "readings needed",
+                                       "total" + unit,      "cost (h)"};
     if (subsets_.size() > 1) header.insert(header.begin(), "planes");
-    search_table_ = Table(header,
-                          "First-order search (the quantile of the worst axis at one reading per "
-                          "configuration)");
+    search_table_ = Table(
+        header, std::string("First-order search (the quantile of the worst axis; planned on ") +
+                    (in_.plan_on == PlanBasis::kTotal ? "the total" : "the reading noise's part") +
+                    "; held terms and total at the readings needed, or at the most readings "
+                    "considered)");
   }
 
   // The first-order search: one prepared cell per plane subset and number of configurations, at
@@ -260,43 +295,27 @@ class Planner {
       const Study search = LoadStudy(path);
       for (const Cell& cell : search.cells) {
         const PreparedCell prepared = PreparedCell::Prepare(search, cell);
-        AddSearchRow(static_cast<int>(sub), cell.typed.select_count,
-                     WorstAxisQuantile(prepared.LinearisedValidationDraws(4000), in_.target,
-                                       in_.confidence));
+        if (&cell == &search.cells.front()) NoteHeldTerms(prepared);  // the same for every count
+        AddSearchRow(static_cast<int>(sub), cell.typed.select_count, prepared);
       }
     }
     search_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (feasible_.empty())
-      Refuse(
-          "target", "no campaign in the ranges reaches " +
-                        [&] {
-                          std::ostringstream v;
-                          v << in_.target.shown();  // 6 significant digits
-                          return v.str();
-                        }() +
-                        " " + in_.target.unit() +
-                        " by the first-order prediction; widen the configurations or "
-                        "repetitions to consider");
+    if (feasible_.empty()) RefuseUnreachable();
     std::stable_sort(
         feasible_.begin(), feasible_.end(),
-        [](const PlannedCampaign& a, const PlannedCampaign& b) { return a.cost < b.cost; });
+        [](const Candidate& a, const Candidate& b) { return a.campaign.cost < b.campaign.cost; });
   }
 
   // Monte Carlo: the cheapest, the same with one reading fewer, and two runner-ups.
   void Confirm() {
-    confirm_ = {feasible_[0]};
+    confirm_ = {feasible_[0].campaign};
     confirm_[0].label = "chosen";
-    if (feasible_[0].repetitions > 1) {
-      PlannedCampaign cheaper = feasible_[0];
-      --cheaper.repetitions;
-      cheaper.predicted = feasible_[0].predicted *
-                          std::sqrt(double(feasible_[0].repetitions) / cheaper.repetitions);
-      cheaper.cost -= cheaper.configurations * in_.per_reading;
-      cheaper.label = "one reading fewer";
-      confirm_.push_back(cheaper);
+    if (feasible_[0].campaign.repetitions > 1) {
+      confirm_.push_back(feasible_[0].fewer);
+      confirm_.back().label = "one reading fewer";
     }
     for (std::size_t i = 1; i < feasible_.size() && i <= 2; ++i) {
-      confirm_.push_back(feasible_[i]);
+      confirm_.push_back(feasible_[i].campaign);
       confirm_.back().label = "runner-up " + std::to_string(i);
     }
     study_path_ = in_.out_dir + "/campaigns.yaml";
@@ -319,6 +338,8 @@ class Planner {
     plan.subsets = std::move(subsets_);
     plan.campaigns = std::move(confirm_);
     plan.search_seconds = search_seconds_;
+    plan.defaulted = std::move(defaulted_);
+    plan.exact = std::move(exact_);
     plan.study_path = study_path_;
     plan.run_dir = run_dir_;
     return plan;
@@ -389,35 +410,127 @@ class Planner {
     AddSubset(std::move(subset), PreparedCell::Prepare(setup, setup.cells.at(0)));
   }
 
-  void AddSearchRow(int sub, int k, double q1) {
+  // A campaign found by the search, with the same campaign one reading fewer per configuration.
+  struct Candidate {
+    PlannedCampaign campaign, fewer;
+  };
+
+  // The quantiles of each part of a prepared search cell's first-order prediction at R readings.
+  struct Quantiles {
+    double data = NAN, held = NAN, total = NAN;
+  };
+  Quantiles QuantilesAt(const PreparedCell& cell, int R) const {
+    constexpr int kDraws = 4000;
+    const FirstOrderDraws draws = cell.LinearisedValidationDraws(kDraws, R);
+    return {WorstAxisQuantile(draws.data, in_.target, in_.confidence),
+            WorstAxisQuantile(draws.held, in_.target, in_.confidence),
+            WorstAxisQuantile(draws.total, in_.target, in_.confidence)};
+  }
+  double Basis(const Quantiles& q) const {
+    return in_.plan_on == PlanBasis::kTotal ? q.total : q.data;
+  }
+
+  // The held terms that took a default tolerance and the frame terms taken as exact, in the order
+  // first met.
+  void NoteHeldTerms(const PreparedCell& cell) {
+    const std::optional<AccuracyPrediction> stated = cell.StatedValidationAccuracy(1);
+    if (!stated) return;
+    const auto add = [](std::vector<std::string>* to, const std::vector<std::string>& names) {
+      for (const std::string& name : names)
+        if (std::find(to->begin(), to->end(), name) == to->end()) to->push_back(name);
+    };
+    add(&defaulted_, stated->defaulted);
+    add(&exact_, stated->exact);
+  }
+
+  // One row of the search: the fewest readings whose quantile of the plan's basis meets the
+  // target (none if the range's last does not), the held terms' part and the total there. The
+  // search starts where the quantiles' model q² ≈ q₁²/R + q_held² puts the answer (exact for the
+  // data part without priors) and checks it and its neighbour; a bisection over the range
+  // settles anything else (the quantile falls as R grows).
+  void AddSearchRow(int sub, int k, const PreparedCell& cell) {
     const PlaneSubset& subset = subsets_[sub];
-    // Readings needed per configuration, as a double first: far below reach it exceeds any int
-    // (a cast would overflow and plan a 1-reading campaign).
-    const double needed_real = std::ceil(std::pow(q1 / in_.target.value, 2));
-    const bool ok = std::isfinite(q1) && needed_real <= in_.repetitions.back();
-    const int needed = ok ? std::max(in_.repetitions.front(), static_cast<int>(needed_real)) : -1;
+    const std::vector<int>& reps = in_.repetitions;
+    std::map<int, Quantiles> known;
+    const auto at = [&](int R) -> const Quantiles& {
+      auto it = known.find(R);
+      if (it == known.end()) it = known.emplace(R, QuantilesAt(cell, R)).first;
+      return it->second;
+    };
+    const auto meets = [&](std::size_t i) {
+      const double q = Basis(at(reps[i]));
+      return std::isfinite(q) && q <= in_.target.value;
+    };
+    const Quantiles& one = at(1);
+    const double q1 = one.data;
+    const double target2 = in_.target.value * in_.target.value;
+    const double held = in_.plan_on == PlanBasis::kTotal ? one.held : 0.0;
+    const double guess = target2 > held * held ? q1 * q1 / (target2 - held * held) : reps.back();
+    const std::optional<std::size_t> first = FirstMeeting(reps, guess, meets);
+    const bool ok = first.has_value();
+    const int needed = ok ? reps[*first] : -1;
+    const Quantiles& there = at(ok ? needed : reps.back());
+    if (std::isfinite(there.held)) smallest_held_ = std::min(smallest_held_, there.held);
     const double cost = subset.num_planes * in_.per_plane + k * in_.per_configuration +
                         double(k) * needed * in_.per_reading;
-    std::vector<std::string> row = {std::to_string(k), Fixed(q1 * 1e3, 4),
-                                    ok ? std::to_string(needed) : "—",
-                                    ok ? Fixed(cost / 3600, 2) : "—"};
+    std::vector<std::string> row = {std::to_string(k),           Fixed(q1 * 1e3, 4),
+                                    Fixed(there.held * 1e3, 4),  ok ? std::to_string(needed) : "—",
+                                    Fixed(there.total * 1e3, 4), ok ? Fixed(cost / 3600, 2) : "—"};
     if (subsets_.size() > 1) row.insert(row.begin(), subset.label);
     search_table_.AddRow(row);
     if (!ok) return;
-    PlannedCampaign c;
-    c.subset = sub;
-    c.configurations = k;
-    c.repetitions = needed;
-    c.predicted = q1 / std::sqrt(double(needed));
-    c.cost = cost;
+    Candidate c;
+    c.campaign.subset = sub;
+    c.campaign.configurations = k;
+    c.campaign.repetitions = needed;
+    c.campaign.predicted_data = there.data;
+    c.campaign.predicted_total = there.total;
+    c.campaign.predicted = Basis(there);
+    c.campaign.cost = cost;
+    if (needed > 1) {
+      c.fewer = c.campaign;
+      --c.fewer.repetitions;
+      const Quantiles& q = at(c.fewer.repetitions);
+      c.fewer.predicted_data = q.data;
+      c.fewer.predicted_total = q.total;
+      c.fewer.predicted = Basis(q);
+      c.fewer.cost -= k * in_.per_reading;
+    }
     feasible_.push_back(c);
+  }
+
+  // No campaign in the ranges meets the target: say why, and what would.
+  [[noreturn]] void RefuseUnreachable() const {
+    std::ostringstream v;
+    v << in_.target.shown();  // 6 significant digits
+    std::string why = "no campaign in the ranges reaches " + v.str() + " " + in_.target.unit() +
+                      " by the first-order prediction";
+    if (in_.plan_on == PlanBasis::kTotal && smallest_held_ > in_.target.value) {
+      why += " of the total: the terms the calibration holds at nominal give " +
+             Fixed(smallest_held_ * 1e3, 4) + " " + in_.target.unit() +
+             " on their own at best (the search table's held terms)";
+      if (!defaulted_.empty()) {
+        why += ", with lrcal's default tolerances (" + DefaultTolerances{}.ToString() + ") for";
+        for (const std::string& name : defaulted_) why += " " + name;
+      }
+      why +=
+          "; estimate them (identification.estimate_plane, identification.estimate_ranger), "
+          "give their tolerances (the robot file's tolerances:, identification.prior_sigma), "
+          "or plan on the reading noise's part alone (--plan-on data; Python plan_on='data')";
+    } else {
+      why += "; widen the configurations or repetitions to consider";
+    }
+    Refuse("target", why);
   }
 
   const Study& study_;
   PlanInputs in_;
   std::string validation_file_, study_path_, run_dir_;
   std::vector<PlaneSubset> subsets_;
-  std::vector<PlannedCampaign> feasible_, confirm_;
+  std::vector<Candidate> feasible_;
+  std::vector<PlannedCampaign> confirm_;
+  std::vector<std::string> defaulted_, exact_;
+  double smallest_held_ = std::numeric_limits<double>::infinity();
   double search_seconds_ = 0;
   Table search_table_{{}};
 };
@@ -448,6 +561,9 @@ const std::vector<SettingSpec>& AccuracyPlanOptions::Settings() {
        nullptr, true},
       {"plan", "out_dir", "out", "", 1, "", 0, kInf, false, false, "", "",
        "folder for the confirmation study and run", "out_dir"},
+      {"plan", "plan_on", "plan_on", "", 1, "", 0, kInf, false, false, "", "",
+       "total (the reading noise's part plus the terms held at nominal, at their tolerances) "
+       "or data (the reading noise's part alone)"},
   };
   return specs;
 }
@@ -470,6 +586,13 @@ void AccuracyPlanOptions::Validate() const {
     if (!(c >= 0) || !std::isfinite(c)) Refuse("cost", "expected costs >= 0 (s)");
   ParseRange(repetitions, "repetitions", 1);
   if (threads < 0) throw InputError("threads", "expected 0 (all cores) or more");
+}
+
+PlanBasis ParsePlanBasis(const std::string& text) {
+  PlanBasis basis = PlanBasis::kTotal;
+  if (!TryParseName(kPlanBasisNames, text, &basis))
+    Refuse("plan_on", "expected " + NameList(kPlanBasisNames) + ", got '" + text + "'");
+  return basis;
 }
 
 AccuracyTarget AccuracyTarget::Parse(const std::string& text) {
@@ -554,6 +677,9 @@ ResultJson AccuracyPlan::ToJson() const {
                  {"unit", options.target.unit()},
                  {"confidence", options.confidence}};
   j["search_seconds"] = search_seconds;
+  j["plan_on"] = NameOf(kPlanBasisNames, options.plan_on);
+  j["defaulted"] = defaulted;
+  j["taken_as_exact"] = exact;
   ResultJson cs = ResultJson::array();
   const auto mm = [](double x) { return std::isnan(x) ? ResultJson() : ResultJson(x * 1e3); };
   for (const PlannedCampaign& c : campaigns)
@@ -565,6 +691,8 @@ ResultJson AccuracyPlan::ToJson() const {
          {"readings", c.configurations * c.repetitions},
          {"cost_seconds", c.cost},
          {"predicted", c.predicted * 1e3},
+         {"predicted_total", c.predicted_total * 1e3},
+         {"predicted_data", c.predicted_data * 1e3},
          {"monte_carlo", mm(c.mc)},
          {"monte_carlo_ci", {mm(c.mc_low), mm(c.mc_high)}},
          {"trials", c.trials},
@@ -580,19 +708,39 @@ std::string AccuracyPlan::ToText() const {
   out << search_table.ToText()
       << "(— : no campaign there: the prediction is not finite, e.g. parameters the "
          "planes cannot identify, or more readings than --repetitions allows)\n"
-      << "The first-order search predicts the reading noise's part only (the estimated "
-         "parameters' covariance). The Monte-Carlo confirmation simulates the study's truth: it "
-         "has every error that truth has and no other; terms the calibration holds at nominal "
-         "count only as far as the truth moves them (README: What a calibration cannot see).\n\n";
+      << "reading noise: the estimated parameters' covariance; held terms: every term the "
+         "calibration holds at nominal (fixed parameters, plane and ranger terms not estimated, "
+         "a base or tool term with a tolerance), each at its tolerance (identification."
+         "prior_sigma, else the robot file's tolerances:, else lrcal's defaults); total: both "
+         "(README: What a calibration cannot see). The plan is on "
+      << (options.plan_on == PlanBasis::kTotal
+              ? "the total (--plan-on data, Python plan_on='data': on the reading noise's part "
+                "alone)"
+              : "the reading noise's part alone (plan_on data): the held terms may make the "
+                "calibrated arm less accurate than planned")
+      << ". The Monte-Carlo confirmation simulates the study's truth: it has every error that "
+         "truth has and no other, so the held terms count there only as far as the truth moves "
+         "them.\n";
+  if (!defaulted.empty()) {
+    out << "warning: no tolerance known for " << defaulted.size()
+        << " held terms; the stated defaults (" << defaults.ToString() << ") were used for:";
+    for (const std::string& name : defaulted) out << " " << name;
+    out << "\n";
+  }
+  if (!exact.empty())
+    out << "note: taken as exact (no tolerance given, not estimated): " << ExactFramesText(exact)
+        << "\n";
+  out << "\n";
   const bool stopped = options.stop_precision > 0;
   std::vector<std::string> header = {"campaign",
                                      "configurations",
                                      "readings each",
                                      "readings",
                                      "cost (h)",
-                                     "predicted (" + options.target.unit() + ")",
+                                     "predicted total (" + options.target.unit() + ")",
+                                     "predicted reading noise (" + options.target.unit() + ")",
                                      "Monte Carlo [95 % CI] (" + options.target.unit() + ")",
-                                     "meets target"};
+                                     "meets target (Monte Carlo)"};
   if (stopped) header.push_back("trials");
   const bool planes = subsets.size() > 1;
   if (planes) header.insert(header.begin() + 1, "planes");
@@ -604,14 +752,17 @@ std::string AccuracyPlan::ToText() const {
               " Monte-Carlo trials each" +
               (stopped ? ", stopped at relative precision " + Fixed(options.stop_precision, 3)
                        : std::string()) +
-              ")");
+              "; planned on " +
+              (options.plan_on == PlanBasis::kTotal ? "the total" : "the reading noise's part") +
+              ", Monte Carlo of the study's truth)");
   for (const PlannedCampaign& c : campaigns) {
     std::vector<std::string> row = {c.label,
                                     std::to_string(c.configurations),
                                     std::to_string(c.repetitions),
                                     std::to_string(c.configurations * c.repetitions),
                                     Fixed(c.cost / 3600, 2),
-                                    Fixed(c.predicted * 1e3, 4),
+                                    Fixed(c.predicted_total * 1e3, 4),
+                                    Fixed(c.predicted_data * 1e3, 4),
                                     Fixed(c.mc * 1e3, 4) + " [" + Fixed(c.mc_low * 1e3, 4) + ", " +
                                         Fixed(c.mc_high * 1e3, 4) + "]",
                                     Meets(c)};
@@ -619,8 +770,13 @@ std::string AccuracyPlan::ToText() const {
     if (planes) row.insert(row.begin() + 1, subsets[c.subset].label);
     t.AddRow(row);
   }
-  out << t.ToText() << "\nsearch " << Fixed(search_seconds, 1)
-      << " s; the campaigns as a study: " << study_path << " (run it with another "
+  out << t.ToText();
+  if (options.plan_on == PlanBasis::kTotal)
+    out << "The Monte Carlo has the held terms' errors only as far as the study's truth has them: "
+           "it confirms the rest; the held terms' part of the total is first order, from their "
+           "tolerances.\n";
+  out << "\nsearch " << Fixed(search_seconds, 1) << " s; the campaigns as a study: " << study_path
+      << " (run it with another "
       << "seed to check), its run: " << run_dir << "\n";
   return out.str();
 }

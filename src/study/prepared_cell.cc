@@ -25,6 +25,14 @@ Eigen::MatrixXd PreparedCell::LinearisedValidationDraws(int draws) const {
   return lrcal::LinearisedValidationDraws(*context_, draws);
 }
 
+FirstOrderDraws PreparedCell::LinearisedValidationDraws(int draws, int repetitions) const {
+  return lrcal::LinearisedValidationDraws(*context_, draws, repetitions);
+}
+
+std::optional<AccuracyPrediction> PreparedCell::StatedValidationAccuracy(int repetitions) const {
+  return lrcal::StatedValidationAccuracy(*context_, repetitions);
+}
+
 TrialRecord PreparedCell::Run(long long trial, TrialDetails* details) const {
   TrialWorkspace workspace;
   return RunTrial(*context_, trial, &workspace, details);

@@ -360,43 +360,128 @@ void CacheTruth(const CellSettings& s, CellContext* c) {
       ComparePoses(*c->robot, truth, c->robot->nominal_values(), c->validation).stats;
 }
 
-Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
-  const Eigen::MatrixXd& C = c.predicted_covariance;
+// Per draw and axis (position xyz, orientation xyz), the sum of squares and the largest
+// magnitude of pose errors over the validation poses, added a block of poses at a time (6 rows
+// per pose, one column per draw), the poses in order.
+struct PartSums {
+  Eigen::MatrixXd ss, max;  // draws × 6
+  explicit PartSums(int draws)
+      : ss(Eigen::MatrixXd::Zero(draws, 6)), max(Eigen::MatrixXd::Zero(draws, 6)) {}
+  void Add(Eigen::Index d, int a, double x) {
+    ss(d, a) += x * x;
+    max(d, a) = std::max(max(d, a), std::fabs(x));
+  }
+  // draws × 12: rms pos xyz, rms ori xyz, max pos xyz, max ori xyz over `m` poses.
+  Eigen::MatrixXd Metrics(int m) const {
+    Eigen::MatrixXd out(ss.rows(), 12);
+    out.leftCols(6) = (ss / m).cwiseSqrt();
+    out.rightCols(6) = max;
+    return out;
+  }
+};
+
+// Adds a block of poses' data-part errors E and, if given, held-part errors H (6 rows per pose,
+// one column per draw) to the sums of each part, in one pass.
+void AddPoseBlock(const Eigen::MatrixXd& E, const Eigen::MatrixXd* H, PartSums* data,
+                  PartSums* held, PartSums* total) {
+  const auto poses = static_cast<int>(E.rows() / 6);
+  for (Eigen::Index d = 0; d < E.cols(); ++d)
+    for (int a = 0; a < 6; ++a)  // position xyz, orientation xyz
+      for (int j = 0; j < poses; ++j) {
+        const double x = E(6 * j + a, d);
+        data->Add(d, a, x);
+        if (H == nullptr) continue;
+        const double y = (*H)(6 * j + a, d);
+        held->Add(d, a, y);
+        total->Add(d, a, x + y);
+      }
+}
+
+// The first-order draws of the validation metrics: `draws` Gaussian parameter errors from the
+// covariance C pushed through the validation poses' Jacobian (the data part) and, when `held` has
+// columns, the held terms' part M·w and the sum of both. Z (n × draws) and w (k × draws) come
+// from the validation set's prediction stream, Z first, so every call on a cell uses the same
+// normals (common random numbers). Without held columns the held part is zero and the total the
+// data part.
+FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Eigen::MatrixXd& C,
+                                    const Eigen::MatrixXd& held) {
   const int n = c.model->num_parameters(), m = c.validation.size();
-  Eigen::MatrixXd out = Eigen::MatrixXd::Constant(draws, 12, std::nan(""));
+  const auto k = static_cast<int>(held.cols());
+  FirstOrderDraws out;
+  out.data = out.held = out.total = Eigen::MatrixXd::Constant(draws, 12, std::nan(""));
   if (c.rank_deficient || C.size() == 0 || !C.allFinite() || m == 0) return out;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(C);
   const Eigen::MatrixXd L =
       eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   Eigen::MatrixXd Z(n, draws);
   const RandomStream stream(0, c.validation_stream, 0, RandomPurpose::kPrediction);
-  stream.Normals(0, n * draws, Z.data());
+  stream.Normals(0, static_cast<std::uint64_t>(n) * draws, Z.data());
   const Eigen::MatrixXd LZ = L * Z;  // n × draws
+  Eigen::MatrixXd W(k, draws);
+  if (k > 0)
+    stream.Normals(static_cast<std::uint64_t>(n) * draws, static_cast<std::uint64_t>(k) * draws,
+                   W.data());
   // The poses' pose Jacobian (6 rows per pose: position, then orientation; its sign is
-  // irrelevant here, the draws enter through squares and magnitudes), applied to the draws a
-  // block of poses at a time: memory per validation pose stays about 1 KB, not 6 × draws
-  // doubles. Each draw's sums run over the poses in order, so the bits do not depend on the block.
+  // irrelevant here, the draws are symmetric and enter through squares and magnitudes),
+  // applied to the draws a block of poses at a time: memory per validation pose stays about
+  // 1 KB, not 6 × draws doubles. Each draw's sums run over the poses in order, so the bits do not
+  // depend on the block.
   const std::vector<double> zero(n, 0.0);
   const Eigen::MatrixXd J6 = PoseJacobian(*c.model, zero.data(), c.validation);
   constexpr int kPosesPerBlock = 256;
-  Eigen::MatrixXd ss = Eigen::MatrixXd::Zero(draws, 6), max = Eigen::MatrixXd::Zero(draws, 6);
+  PartSums data(draws), held_part(draws), total(draws);
   for (int j0 = 0; j0 < m; j0 += kPosesPerBlock) {
     const int mc = std::min(kPosesPerBlock, m - j0);
     const Eigen::MatrixXd E = J6.middleRows(6 * j0, 6 * mc) * LZ;  // 6·mc × draws
-    for (int d = 0; d < draws; ++d)
-      for (int k = 0; k < 6; ++k)  // position xyz, orientation xyz
-        for (int j = 0; j < mc; ++j) {
-          const double x = E(6 * j + k, d);
-          ss(d, k) += x * x;
-          max(d, k) = std::max(max(d, k), std::fabs(x));
-        }
+    const Eigen::MatrixXd H =
+        k > 0 ? Eigen::MatrixXd(held.middleRows(6 * j0, 6 * mc) * W) : Eigen::MatrixXd();
+    AddPoseBlock(E, k > 0 ? &H : nullptr, &data, &held_part, &total);
   }
-  for (int d = 0; d < draws; ++d)
-    for (int k = 0; k < 6; ++k) {
-      out(d, k) = std::sqrt(ss(d, k) / m);  // rms pos xyz, rms ori xyz
-      out(d, 6 + k) = max(d, k);            // max pos xyz, max ori xyz
-    }
+  out.data = data.Metrics(m);
+  out.held = held_part.Metrics(m);
+  out.total = k > 0 ? total.Metrics(m) : out.data;
   return out;
+}
+
+Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
+  return LinearisedPartDraws(c, draws, c.predicted_covariance, Eigen::MatrixXd()).data;
+}
+
+// The cell's settings with `repetitions` readings per configuration.
+CellSettings WithRepetitions(const CellSettings& s, int repetitions) {
+  CellSettings out = s;
+  out.noise.repetitions = repetitions;
+  return out;
+}
+
+// The covariance predicted for the cell's design under settings `s` (as PrepareDesign predicts
+// it for the cell's own); empty when it is undefined.
+Eigen::MatrixXd DesignCovariance(const CellSettings& s, const CellContext& c) {
+  if (c.rank_deficient) return {};
+  const Eigen::MatrixXd& Gd = c.design_nominal.G;
+  if (ModelledUncertainty(s)) {
+    const PriorInformation posterior = PosteriorOn(s, c, c.design.configs, Gd);
+    return posterior.defined ? posterior.posterior_covariance : Eigen::MatrixXd();
+  }
+  return ParameterCovariance(s.noise.EffectiveReadings() * (Gd.transpose() * Gd), s.noise.sigma);
+}
+
+// The terms a calibration of the cell's design under settings `s` holds at nominal, at the
+// nominal model: each at the identification's prior, else the robot file's tolerance, else
+// lrcal's default (FindUnestimatedTerms), as `identify --predict-at` states them.
+UnestimatedTerms DesignHeldTerms(const CellSettings& s, const CellContext& c) {
+  const int n = c.model->num_parameters(), m = c.design.configs.size();
+  IdentificationSummary at_nominal;
+  at_nominal.delta = Eigen::VectorXd::Zero(n);
+  MeasurementSet design;
+  design.configs = c.design.configs;
+  design.mean_h.assign(static_cast<std::size_t>(m), 0.0);
+  design.repetitions.assign(static_cast<std::size_t>(m), s.noise.repetitions);
+  if (!s.noise.average.IsMean())
+    design.variance_factor.assign(static_cast<std::size_t>(m),
+                                  s.noise.repetitions / s.noise.EffectiveReadings());
+  return FindUnestimatedTerms(*c.model, at_nominal, design, s.identification,
+                              c.tolerances.OverriddenBy(s.identification.priors));
 }
 
 // The first-order prediction of the validation metrics' means, the planner's estimate: the
@@ -420,20 +505,8 @@ void PredictValidation(CellContext* c) {
 // default, as `identify --predict-at` states them.
 void StateCoverageRadii(const CellSettings& s, CellContext* c) {
   if (!s.coverage || c->rank_deficient || c->predicted_covariance.size() == 0) return;
-  const int n = c->model->num_parameters(), m = c->design.configs.size();
-  IdentificationSummary at_nominal;
-  at_nominal.delta = Eigen::VectorXd::Zero(n);
-  MeasurementSet design;
-  design.configs = c->design.configs;
-  design.mean_h.assign(static_cast<std::size_t>(m), 0.0);
-  design.repetitions.assign(static_cast<std::size_t>(m), s.noise.repetitions);
-  if (!s.noise.average.IsMean())
-    design.variance_factor.assign(static_cast<std::size_t>(m),
-                                  s.noise.repetitions / s.noise.EffectiveReadings());
-  const UnestimatedTerms held =
-      FindUnestimatedTerms(*c->model, at_nominal, design, s.identification,
-                           c->tolerances.OverriddenBy(s.identification.priors));
-  const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
+  const UnestimatedTerms held = DesignHeldTerms(s, *c);
+  const std::vector<double> zero(static_cast<std::size_t>(c->model->num_parameters()), 0.0);
   const AccuracyPrediction stated =
       PredictTotalAccuracy(*c->model, zero.data(), c->predicted_covariance, held, c->validation);
   for (const PoseAccuracy& pose : stated.poses) {
@@ -686,6 +759,31 @@ const char* TrialStatusReason(TrialStatus s) {
 
 Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws) {
   return LinearisedDraws(c, draws);
+}
+
+FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int repetitions) {
+  if (repetitions < 1)
+    throw InputError("repetitions", "expected 1 or more readings per configuration, got " +
+                                        std::to_string(repetitions));
+  const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
+  const Eigen::MatrixXd C = DesignCovariance(s, c);
+  Eigen::MatrixXd held;
+  if (C.size() > 0) {
+    const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
+    held = HeldTermPoseColumns(*c.model, zero.data(), DesignHeldTerms(s, c), c.validation);
+  }
+  return LinearisedPartDraws(c, draws, C, held);
+}
+
+std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c, int repetitions) {
+  if (repetitions < 1)
+    throw InputError("repetitions", "expected 1 or more readings per configuration, got " +
+                                        std::to_string(repetitions));
+  const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
+  const Eigen::MatrixXd C = DesignCovariance(s, c);
+  if (C.size() == 0 || !C.allFinite()) return std::nullopt;
+  const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
+  return PredictTotalAccuracy(*c.model, zero.data(), C, DesignHeldTerms(s, c), c.validation);
 }
 
 }  // namespace lrcal

@@ -23,6 +23,7 @@
 #include <Eigen/Eigenvalues>
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,9 @@
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/identification/prior.h"
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/kinematics/pose_errors.h"
+#include "lrcal/study/prepared_cell.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial.h"
 #include "lrcal/study/trial_store.h"
@@ -50,6 +53,12 @@ struct TrialTruth {
 /// planner's distribution of any validation statistic. NaN when there is no prediction.
 struct CellContext;
 Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws);
+/// The same at `repetitions` readings per configuration of the cell's design (its covariance and
+/// its held terms recomputed for them), each part (prepared_cell.h).
+FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int repetitions);
+/// The total statement at the validation poses, at the nominal model, for `repetitions`
+/// readings per configuration of the design; none when the covariance is undefined.
+std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c, int repetitions);
 
 /// A design: configurations and their slots in the pool (which address the noise).
 struct TrialDesign {

@@ -276,12 +276,22 @@ def test_plan_accuracy_is_the_programs_plan(tmp_path):
     study.write_text("name: setup\nseed: 4\ntrials: 10\nrobot: paper\n"
                      "pool: {size: 50}\nvalidation: {size: 8}\n")
     plan = lrcal.plan_accuracy(str(study), "rms_pos=0.1mm", configurations="30:50:10",
-                               trials=100, out_dir=str(tmp_path / "plan"), threads=2)
+                               trials=100, out_dir=str(tmp_path / "plan"), threads=2,
+                               plan_on="data")
     assert plan["target"] == {"metric": "rms_pos", "value": 0.1, "unit": "mm",
                               "confidence": 0.95}
+    assert plan["plan_on"] == "data" and "plane_f" in plan["defaulted"]
     chosen = plan["campaigns"][0]
     assert chosen["label"] == "chosen" and chosen["predicted"] <= 0.1
+    assert chosen["predicted"] == chosen["predicted_data"] < chosen["predicted_total"]
     assert chosen["trials"] == 100 and pathlib.Path(plan["study"]).is_file()
+    # On the total (the default) the paper's plane and ranger, taken as known with lrcal's
+    # default tolerances, put 0.1 mm out of reach, and the message says what would help.
+    with pytest.raises(lrcal.InputError, match="plan_on='data'"):
+        lrcal.plan_accuracy(str(study), "rms_pos=0.1mm", configurations="30:50:10",
+                            out_dir=str(tmp_path / "total"))
+    with pytest.raises(lrcal.InputError, match="plan_on=: expected total or data"):
+        lrcal.plan_accuracy(str(study), "rms_pos=0.1mm", plan_on="noise")
     with pytest.raises(lrcal.InputError, match="target=: the value needs its unit"):
         lrcal.plan_accuracy(str(study), "rms_pos=0.1")
     with pytest.raises(lrcal.InputError, match="confidence="):

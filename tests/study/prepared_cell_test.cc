@@ -75,5 +75,43 @@ TEST(PreparedCell, DescribesTheCell) {
   EXPECT_TRUE((draws.array() >= 0).all());  // RMS and max errors
 }
 
+// The draws at R readings and of each part: the data part at the cell's own readings is the
+// cell's prediction bit for bit and scales as 1/√R without priors; the held terms' part has, on
+// average over the draws, the mean-square position error that the total statement's sources give
+// (an independent path: per-pose covariances, not draws); the total's mean square is the sum of
+// the parts'.
+TEST(PreparedCell, FirstOrderDrawsOfEachPartAgreeWithTheTotalStatement) {
+  const std::string dir = testing::TempDir("prepared_cell_parts");
+  std::ofstream(dir + "/s.yaml") << "name: p\nseed: 3\ntrials: 4\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 60}\nvalidation: {size: 30}\n"
+                                    "noise: {repetitions: 4}\nselection: {count: 40}\n"
+                                    "identification: {fix: [d6]}\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  const PreparedCell cell = PreparedCell::Prepare(study, study.cells.at(0));
+  constexpr int kDraws = 4000;
+  const FirstOrderDraws own = cell.LinearisedValidationDraws(kDraws, 4);
+  EXPECT_EQ(own.data, cell.LinearisedValidationDraws(kDraws));
+  // One reading: the same normals, the covariance 4 times larger.
+  EXPECT_TRUE(cell.LinearisedValidationDraws(kDraws, 1).data.isApprox(2 * own.data, 1e-12));
+
+  const auto mean_square_position = [](const Eigen::MatrixXd& d) {
+    return d.leftCols(3).array().square().rowwise().sum().mean();  // Σ axes rms², mean over draws
+  };
+  const std::optional<AccuracyPrediction> stated = cell.StatedValidationAccuracy(4);
+  ASSERT_TRUE(stated.has_value());
+  double held_ms = 0, data_ms = 0;
+  for (const AccuracySource& s : stated->sources)
+    (s.prior_sigma > 0 ? held_ms : data_ms) += s.position_rms * s.position_rms;
+  EXPECT_THAT(stated->defaulted, ::testing::Contains("d6"));
+  EXPECT_THAT(stated->defaulted, ::testing::Contains("ranger_offset"));
+  // 4000 draws of a sum of squares: a relative standard error of a few per cent at most.
+  constexpr double kDrawTolerance = 0.08;
+  EXPECT_NEAR(mean_square_position(own.held) / held_ms, 1, kDrawTolerance);
+  EXPECT_NEAR(mean_square_position(own.data) / data_ms, 1, kDrawTolerance);
+  EXPECT_NEAR(mean_square_position(own.total) / (held_ms + data_ms), 1, kDrawTolerance);
+  EXPECT_THROW(cell.LinearisedValidationDraws(10, 0), InputError);
+}
+
 }  // namespace
 }  // namespace lrcal

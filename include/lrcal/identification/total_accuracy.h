@@ -129,6 +129,13 @@ AccuracyPrediction PredictTotalAccuracy(const MeasurementModel& solved, const do
                                         const UnestimatedTerms& held,
                                         const ConfigurationSet& configs);
 
+/// The pose error of one prior σ of each held term at `configs` for the estimate e of `solved`'s
+/// parameter set: (P·S − P_u)·diag(σ), six rows per configuration (position, then orientation, as
+/// PoseJacobian lays them out), one column per held term. A draw w ~ N(0, I) gives the held
+/// terms' part of the calibrated model's pose error, M·w.
+Eigen::MatrixXd HeldTermPoseColumns(const MeasurementModel& solved, const double* e,
+                                    const UnestimatedTerms& held, const ConfigurationSet& configs);
+
 /// The statement at `poses` after the identification `s` on `model`, what `identify --predict-at`
 /// and the calibration report give: the σ ChooseSigma picks with its covariance, the estimate
 /// and the held terms `held` (FindUnestimatedTerms). Empty when that covariance is undefined (as

@@ -10,12 +10,18 @@
 // confidence must not exceed the target.
 //
 // Search: for each number of configurations k the study's selection chooses the design; the
-// first-order prediction (LinearisedValidationDraws, 4000 draws at one reading per configuration)
-// gives the quantile q₁(k). The mean of R readings has σ/√R, and the linearised errors scale with
-// it, so q(k, R) = q₁(k)/√R and the fewest readings are R(k) = ⌈(q₁(k)/target)²⌉. Cost:
-// k·(configuration cost) + k·R·(reading cost) (+ planes·(plane cost)). Confirmation: the cheapest
-// campaign, the next cheaper one (one reading fewer per configuration) and the runner-ups are run
-// as an ordinary study (a file in the plan's folder, rerunnable with another seed).
+// first-order prediction (PreparedCell::LinearisedValidationDraws, 4000 draws) at R readings per
+// configuration gives the quantile q(k, R) of the data part (the estimate's covariance at R
+// readings; q₁(k)/√R without priors), of the held terms' part (every term the calibration holds
+// at nominal at its tolerance: identification.prior_sigma, else the robot file's tolerances,
+// else lrcal's stated defaults) and of their total. The fewest readings R(k) are the first R of
+// the range whose quantile of the plan's basis (plan_on: total by default) is at most the target,
+// found by bisection (the quantile falls as R grows; the held terms' part does not fall with R,
+// so a target below it is out of reach). Cost: k·(configuration cost) + k·R·(reading cost)
+// (+ planes·(plane cost)). Confirmation: the cheapest campaign, the next cheaper one (one reading
+// fewer per configuration) and the runner-ups are run as an ordinary study (a file in the plan's
+// folder, rerunnable with another seed). The Monte Carlo simulates the study's truth: the held
+// terms count there only as far as that truth moves them.
 //
 // Candidate planes: when the study's plane is a list of two or more, every subset of them (with
 // a number of planes in `planes`) is searched like the whole set-up, each with its own pool drawn
@@ -34,6 +40,7 @@
 #include "lrcal/core/json.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/result_json.h"
 #include "lrcal/kinematics/validation_metric.h"
 #include "lrcal/study/study.h"
@@ -53,6 +60,16 @@ struct AccuracyTarget {
   /// The index of the metric's x component in TrialRecord::validation.
   int first() const { return 3 * static_cast<int>(metric); }
 };
+
+/// What a plan's target is held against: the first-order total (the reading noise's part plus
+/// every term the calibration holds at nominal, at its tolerance) or the reading noise's part
+/// alone (the estimated parameters' covariance).
+enum class PlanBasis { kTotal, kData };
+inline constexpr EnumName<PlanBasis> kPlanBasisNames[] = {{PlanBasis::kTotal, "total"},
+                                                          {PlanBasis::kData, "data"}};
+
+/// "total" or "data". Throws SettingError (`plan_on`).
+PlanBasis ParsePlanBasis(const std::string& text);
 
 /// What a campaign costs, in seconds.
 struct CampaignCosts {
@@ -84,9 +101,12 @@ struct AccuracyPlanOptions {
   /// the settings, so that another seed, cost or target gets a folder of its own.
   std::string out_dir;
   int threads = 0;  ///< 0: all cores
+  /// The total by default: a plan on the data part alone promises what the held terms (a plane
+  /// or a ranger offset taken as known) may not allow.
+  PlanBasis plan_on = PlanBasis::kTotal;
 
   /// Every setting's name at the interfaces (target, confidence, cost, configurations,
-  /// repetitions, planes, trials, stop_precision, seed, out), for SettingError.
+  /// repetitions, planes, trials, stop_precision, seed, out, plan_on), for SettingError.
   static const std::vector<SettingSpec>& Settings();
   /// The numeric ones bound to their members, their defaults this struct's: confidence (a share
   /// in (0, 1)), trials (100 to 10,000,000), stop_precision ([0, 1): 0 runs every trial). The
@@ -111,8 +131,10 @@ struct PlaneSubset {
 struct PlannedCampaign {
   int subset = 0;  ///< index into the plan's plane subsets
   int configurations = 0, repetitions = 0;
-  double predicted = 0;                          ///< SI: the quantile predicted
-  double cost = 0;                               ///< seconds
+  double predicted = 0;        ///< SI: the quantile predicted of the plan's basis (plan_on)
+  double predicted_data = 0;   ///< SI: the quantile of the reading noise's part alone
+  double predicted_total = 0;  ///< SI: the quantile of the total
+  double cost = 0;             ///< seconds
   double mc = NAN, mc_low = NAN, mc_high = NAN;  ///< SI: the quantile and its 95 % interval
   long long trials = 0;
   std::string label;  ///< "chosen", "one reading fewer", "runner-up 1", ...
@@ -124,6 +146,10 @@ struct AccuracyPlan {
   Table search_table{{}};  ///< the first-order search, one row per candidate campaign
   std::vector<PlaneSubset> subsets;
   std::vector<PlannedCampaign> campaigns;  ///< the confirmed ones
+  /// Held terms that took lrcal's default tolerance, and base and tool terms taken as exact,
+  /// over every plane subset (total_accuracy.h).
+  std::vector<std::string> defaulted, exact;
+  DefaultTolerances defaults;
   double search_seconds = 0;
   std::string study_path;  ///< the confirmation study
   std::string run_dir;     ///< its run

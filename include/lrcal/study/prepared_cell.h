@@ -10,9 +10,11 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "lrcal/identification/total_accuracy.h"
 #include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial.h"
@@ -21,6 +23,16 @@ namespace lrcal {
 
 struct CellContext;
 struct TrialWorkspace;
+
+/// A cell's first-order draws of the validation metrics (draws × 12 each, the layout of
+/// TrialRecord::validation, SI), by part: the reading noise's (the estimate's covariance: the data
+/// part), the held terms' (every term the calibration holds at nominal, each at its tolerance:
+/// the identification's prior_sigma, else the robot file's tolerances, else lrcal's stated
+/// defaults) and their sum, the total (identification/total_accuracy.h). Draw d of each part
+/// comes from the same normals.
+struct FirstOrderDraws {
+  Eigen::MatrixXd data, held, total;
+};
 
 class PreparedCell {
  public:
@@ -46,6 +58,17 @@ class PreparedCell {
   /// the validation poses' Jacobian (first order): draws × 12 validation metrics in the layout of
   /// TrialRecord::validation (SI); NaN when the covariance cannot be predicted.
   Eigen::MatrixXd LinearisedValidationDraws(int draws) const;
+  /// The same at `repetitions` readings per configuration of the cell's design (the covariance
+  /// and the held terms' estimate shift computed for them: exact with priors and any averaging),
+  /// by part: the data part's draws equal the call above at the cell's own readings; the held
+  /// terms' part is, per draw, M·w (HeldTermPoseColumns, w ~ N(0, I)); the total their sum. The
+  /// draws use common random numbers across `repetitions`, so the metrics vary smoothly with it.
+  /// NaN when the covariance cannot be predicted. Throws InputError for repetitions < 1.
+  FirstOrderDraws LinearisedValidationDraws(int draws, int repetitions) const;
+  /// The total statement a calibration of this cell's design with `repetitions` readings per
+  /// configuration would make at the validation poses, at the nominal model (its sources,
+  /// defaulted and exact terms); none when the covariance cannot be predicted.
+  std::optional<AccuracyPrediction> StatedValidationAccuracy(int repetitions) const;
 
   /// Runs trial `trial` (and fills `details` with the realisation, if given). Safe to call from
   /// several threads at once; each call has its own scratch space.
