@@ -154,8 +154,8 @@ int SimulateCommand(const std::vector<std::string>& args) {
   const ConfigurationSet configs =
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   NoiseModel noise;
-  noise.ranger_offset = rig.ranger_offset;  // the robot file's true ranger errors
-  noise.ranger_scale = rig.ranger_scale;
+  noise.ranger_offset = rig.truth.ranger_offset;  // the robot file's true ranger errors
+  noise.ranger_scale = rig.truth.ranger_scale;
   ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
   if (static_cast<double>(noise.repetitions) * configs.size() > static_cast<double>(kMaxCsvRows))
     throw InputError("--repetitions", "would write " + std::to_string(configs.size()) + " x " +
@@ -166,7 +166,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
   const int missed = SimulateReadings(
-      robot, robot.true_values(), planes, rig.ranger, configs, noise,
+      robot, rig.truth.LinkValues(robot), planes, rig.ranger, configs, noise,
       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data, &misses, &raw);
   const std::string path = vm["out"].as<std::string>();
   WriteReadings(path, data.configs, raw, noise.repetitions);
@@ -439,7 +439,7 @@ int PaperCommand(const std::vector<std::string>& args) {
   options.case1_selection.method =
       ParseSelectionMethod(vm["case1-selection"].as<std::string>(), "--case1-selection");
   ReadSettingOptions(vm, SelectionOptions::Settings(), &options.case1_selection);
-  const PaperCasesResult r = RunPaperCases(robot, (*rig.planes)[0], options);
+  const PaperCasesResult r = RunPaperCases(robot, rig.truth, (*rig.planes)[0], options);
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << PaperCasesJson(r, options).dump(2) << "\n";
   } else {

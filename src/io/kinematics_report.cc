@@ -55,14 +55,13 @@ Table JacobianTable(const std::vector<std::string>& names, const ResultJson& row
   return t;
 }
 
-// `robot` with its simulated true values as its nominal ones (and no errors).
-RobotModel AtTrueValues(const RobotModel& robot) {
+// `robot` with the true values of `truth` as its nominal ones.
+RobotModel AtTrueValues(const RobotModel& robot, const Truth& truth) {
   std::vector<Link> links = robot.links();
-  const Eigen::VectorXd truth = robot.true_values();
+  const Eigen::VectorXd values = truth.LinkValues(robot);
   for (int j = 0; j < robot.num_links(); ++j)
-    for (int v = 0; v < kValuesPerLink; ++v) links[j].nominal[v] = truth[kValuesPerLink * j + v];
-  return RobotModel(robot.name(), links, Eigen::VectorXd::Zero(robot.num_values()), robot.source,
-                    robot.base(), robot.tool());
+    for (int v = 0; v < kValuesPerLink; ++v) links[j].nominal[v] = values[kValuesPerLink * j + v];
+  return RobotModel(robot.name(), links, robot.source, robot.base(), robot.tool());
 }
 
 }  // namespace
@@ -73,18 +72,18 @@ KinematicsReport ReportKinematics(const RobotFile& rig, const PlaneSet& planes,
   // The true model: every link value at its true value (the parameters of the set and the
   // fixed ones alike) and the ranger's true offset and scale, so that it reads what a
   // noise-free simulation reads.
-  const RobotModel robot = true_model ? AtTrueValues(rig.robot) : rig.robot;
+  const RobotModel robot = true_model ? AtTrueValues(rig.robot, rig.truth) : rig.robot;
   const MeasurementModel model(robot, planes, parameters);
   std::vector<double> e(parameters.size(), 0.0);
   RangerErrors outside;
   if (true_model) {
-    outside = {rig.ranger_offset, rig.ranger_scale};
+    outside = {rig.truth.ranger_offset, rig.truth.ranger_scale};
     if (parameters.ranger_offset_index >= 0) {
-      e[parameters.ranger_offset_index] = rig.ranger_offset;
+      e[parameters.ranger_offset_index] = rig.truth.ranger_offset;
       outside.offset = 0;
     }
     if (parameters.ranger_scale_index >= 0) {
-      e[parameters.ranger_scale_index] = rig.ranger_scale;
+      e[parameters.ranger_scale_index] = rig.truth.ranger_scale;
       outside.scale = 0;
     }
   }

@@ -471,12 +471,12 @@ void ParseRangerErrors(const YAML::Node& root, const std::string& path, RobotFil
   const YAML::Node te = root["true_errors"];
   if (!te) return;
   if (te["ranger_offset_mm"])
-    file->ranger_offset =
+    file->truth.ranger_offset =
         Number(te["ranger_offset_mm"], path, "true_errors.ranger_offset_mm") * 1e-3;
   if (te["ranger_scale_ppm"]) {
-    file->ranger_scale =
+    file->truth.ranger_scale =
         Number(te["ranger_scale_ppm"], path, "true_errors.ranger_scale_ppm") * 1e-6;
-    if (!(std::fabs(file->ranger_scale) < 0.5))
+    if (!(std::fabs(file->truth.ranger_scale) < 0.5))
       throw InputError(Where(path, te["ranger_scale_ppm"], "true_errors.ranger_scale_ppm"),
                        "expected a scale error in ppm, below 500,000 in magnitude");
   }
@@ -514,9 +514,9 @@ RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
   const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
   const std::vector<Link> links = ParseLinks(root, path);
   RobotFile file;
-  file.robot =
-      RobotModel(name, links, ParseTrueErrors(root, path, links), path,
-                 ParseFixedTransform(root, path, "base"), ParseFixedTransform(root, path, "tool"));
+  file.robot = RobotModel(name, links, path, ParseFixedTransform(root, path, "base"),
+                          ParseFixedTransform(root, path, "tool"));
+  file.truth.link_errors = ParseTrueErrors(root, path, links);
   file.planes = ParsePlanes(root, path);
   file.ranger = ParseRanger(root, path);
   file.path = path;

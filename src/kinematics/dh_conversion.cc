@@ -133,7 +133,7 @@ RobotModel RobotFromJointAxes(const std::string& name, const std::vector<JointAx
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(tool.rotation,
                                               Eigen::ComputeFullU | Eigen::ComputeFullV);
   tool.rotation = svd.matrixU() * svd.matrixV().transpose();
-  return RobotModel(name, std::move(links), Eigen::VectorXd(), source, base, tool);
+  return RobotModel(name, std::move(links), source, base, tool);
 }
 
 }  // namespace lrcal

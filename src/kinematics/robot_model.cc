@@ -11,8 +11,8 @@ const char* LinkValueName(int value) {
   return kNames[value];
 }
 
-RobotModel::RobotModel(std::string name, std::vector<Link> links, Eigen::VectorXd true_errors,
-                       const std::string& where, RigidTransform base, RigidTransform tool)
+RobotModel::RobotModel(std::string name, std::vector<Link> links, const std::string& where,
+                       RigidTransform base, RigidTransform tool)
     : name_(std::move(name)), links_(std::move(links)), base_(base), tool_(tool) {
   base_.Validate(where + ": base");
   tool_.Validate(where + ": tool");
@@ -28,16 +28,6 @@ RobotModel::RobotModel(std::string name, std::vector<Link> links, Eigen::VectorX
       if (link.is_parameter[v]) parameter_indices_.push_back(kValuesPerLink * i + v);
     }
   }
-  if (true_errors.size() == 0) true_errors = Eigen::VectorXd::Zero(num_values());
-  if (true_errors.size() != num_values())
-    throw InputError(where, "true errors: expected " + std::to_string(num_values()) +
-                                " link values, got " + std::to_string(true_errors.size()));
-  for (int k = 0; k < num_values(); ++k) {
-    if (true_errors[k] != 0 && !links_[k / kValuesPerLink].is_parameter[k % kValuesPerLink])
-      throw InputError(where, "true error given for '" + ValueName(k) +
-                                  "', which is fixed (not a parameter) on this robot");
-  }
-  true_errors_ = true_errors;
 }
 
 RobotModel RobotModel::WithFrames(const RigidTransform& base, const RigidTransform& tool) const {

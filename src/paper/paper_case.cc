@@ -35,10 +35,11 @@ const double kPaperValidation[3][3][4] = {{{2.7612, 3.1491, 11.7347, 16.1688},
                                            {0.2974, 0.3374, 1.4779, 1.2271},
                                            {0.3785, 0.7671, 1.5664, 2.3669}}};
 
-PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
+PaperCasesResult RunPaperCases(const RobotModel& robot, const Truth& true_arm, const Plane& plane,
                                const PaperCaseOptions& options) {
   PaperCasesResult result;
-  const Eigen::VectorXd truth = robot.true_values();
+  result.true_errors = true_arm.LinkErrors(robot);
+  const Eigen::VectorXd truth = true_arm.LinkValues(robot);
   SamplingOptions pool_options = options.sampling;
   pool_options.true_link_values = truth;  // the simulated readings must exist
   pool_options.true_planes = PlaneSet(plane);
@@ -87,7 +88,7 @@ Table PaperParameterTable(const RobotModel& robot, const PaperCasesResult& resul
     const double unit = 1e3;  // rad → mrad, m → mm
     std::vector<std::string> row = {std::to_string(link + 1), robot.ValueName(k),
                                     IsAngle(v) ? "mrad" : "mm",
-                                    Fixed(robot.true_errors()[k] * unit)};
+                                    Fixed(result.true_errors[k] * unit)};
     for (int c = 0; c < 2; ++c) {
       double ours = std::numeric_limits<double>::quiet_NaN();
       if (c < static_cast<int>(result.cases.size())) {

@@ -197,11 +197,12 @@ ParameterSet ResolveParameters(const RobotModel& robot, int num_planes,
 }
 
 // The 5N link values of `model`: "nominal", "true", or an array of 5N values (SI).
-Eigen::VectorXd ResolveLinkValues(const RobotModel& robot, const py::object& model) {
+Eigen::VectorXd ResolveLinkValues(const RobotFile& rig, const py::object& model) {
+  const RobotModel& robot = rig.robot;
   if (py::isinstance<py::str>(model)) {
     const std::string which = model.cast<std::string>();
     if (which == "nominal") return robot.nominal_values();
-    if (which == "true") return robot.true_values();
+    if (which == "true") return rig.truth.LinkValues(robot);
     throw InputError("model", "expected 'nominal', 'true' or an array of " +
                                   std::to_string(robot.num_values()) + " link values, got '" +
                                   which + "'");
@@ -273,7 +274,7 @@ py::array_t<double> ForwardKinematicsPy(const RobotFile& rig, const Array& q,
                                         const py::object& model) {
   const RobotModel& robot = rig.robot;
   const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
-  const Eigen::VectorXd values = ResolveLinkValues(robot, model);
+  const Eigen::VectorXd values = ResolveLinkValues(rig, model);
   py::array_t<double> out(
       {static_cast<py::ssize_t>(configs.size()), py::ssize_t{4}, py::ssize_t{4}});
   auto w = out.mutable_unchecked<3>();
@@ -296,7 +297,7 @@ py::object LaserReadingsPy(const RobotFile& rig, const Array& q, const py::objec
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
   const ConfigurationSet configs =
       WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
-  const Eigen::VectorXd values = ResolveLinkValues(robot, model);
+  const Eigen::VectorXd values = ResolveLinkValues(rig, model);
   std::vector<double> h;
   std::vector<BeamMiss> misses;
   ExactReadings(robot, values, planes, rig.ranger, configs, &h, &misses);
@@ -378,12 +379,12 @@ Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
   const ConfigurationSet configs =
       WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
-  const Eigen::VectorXd values = ResolveLinkValues(robot, model);
+  const Eigen::VectorXd values = ResolveLinkValues(rig, model);
   NoiseModel noise = ToNoiseModel(noise_args, sigma_m);
   // The robot file's true ranger errors are part of its true model (as lrcal simulate reads).
   if (py::isinstance<py::str>(model) && model.cast<std::string>() == "true") {
-    noise.ranger_offset = rig.ranger_offset;
-    noise.ranger_scale = rig.ranger_scale;
+    noise.ranger_offset = rig.truth.ranger_offset;
+    noise.ranger_scale = rig.truth.ranger_scale;
   }
   MeasurementSet data;
   std::vector<BeamMiss> misses;
@@ -917,10 +918,10 @@ Raises lrcal.InputError naming the file, line and key of anything wrong.)doc")
           "nominal_values", [](const RobotFile& r) { return r.robot.nominal_values(); },
           "Nominal link values (5N,), SI.")
       .def_property_readonly(
-          "true_errors", [](const RobotFile& r) { return r.robot.true_errors(); },
+          "true_errors", [](const RobotFile& r) { return r.truth.LinkErrors(r.robot); },
           "Simulated true errors of the link values (5N,), SI.")
       .def_property_readonly(
-          "true_values", [](const RobotFile& r) { return r.robot.true_values(); },
+          "true_values", [](const RobotFile& r) { return r.truth.LinkValues(r.robot); },
           "nominal_values + true_errors (5N,), SI.")
       .def_property_readonly(
           "joint_limits",

@@ -59,7 +59,7 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
       truth.errors[k] = is_param ? stream.Normal(k) * sigma : 0.0;
     }
   } else {
-    truth.errors = robot.true_errors() * s.truth.scale;
+    truth.errors = c.file_true_errors * s.truth.scale;
   }
   truth.values = robot.nominal_values() + truth.errors;
   const ParameterSet& ps = c.model->parameters();
@@ -138,8 +138,10 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   c->robot = std::make_shared<RobotModel>(std::move(file.robot));
   c->ranger = file.ranger;
   const double scale = s.truth.random ? 1.0 : s.truth.scale;
-  c->ranger_offset = s.truth.ranger_offset ? *s.truth.ranger_offset : file.ranger_offset * scale;
-  c->ranger_scale = s.truth.ranger_scale ? *s.truth.ranger_scale : file.ranger_scale * scale;
+  c->file_true_errors = file.truth.LinkErrors(*c->robot);
+  c->ranger_offset =
+      s.truth.ranger_offset ? *s.truth.ranger_offset : file.truth.ranger_offset * scale;
+  c->ranger_scale = s.truth.ranger_scale ? *s.truth.ranger_scale : file.truth.ranger_scale * scale;
   for (const PriorSigmas::Entry& e : file.tolerances.entries)
     if (s.plane_from_robot || TermClass(e.key).rfind("plane", 0) != 0)
       c->tolerances.entries.push_back(e);

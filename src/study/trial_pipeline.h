@@ -77,6 +77,8 @@ struct CellContext {
   std::shared_ptr<const RobotModel> robot;
   PlaneSet planes;
   RangerSpec ranger;  ///< the robot file's ranger limits
+  /// The robot file's true link errors (5N, SI): a robot_file truth's, × truth.scale.
+  Eigen::VectorXd file_true_errors;
   /// The true ranger's errors (robot file × truth.scale for a robot_file truth): it reads
   /// (1 + ranger_scale)·h + ranger_offset (m).
   double ranger_offset = 0, ranger_scale = 0;

@@ -134,7 +134,7 @@ TEST_F(CliTest, SampleSimulateIdentifyRoundTrip) {
   EXPECT_EQ(j["covariance"].size(), 25u);
   const RobotModel& robot = testing::PaperRobot();
   for (const auto& p : j["parameters"]) {
-    const double truth = robot.true_errors()[robot.FindValue(p["name"])];
+    const double truth = testing::PaperTrueErrors()[robot.FindValue(p["name"])];
     // Within 5 predicted standard deviations of the truth.
     EXPECT_LT(std::fabs(p["delta"].get<double>() - truth), 5 * p["std_given_sigma"].get<double>())
         << p["name"];
@@ -404,7 +404,7 @@ TEST_F(CliTest, RobotFileWithPlanesRoundTrip) {
   EXPECT_EQ(j["rank"], 25);
   const RobotModel& paper = testing::PaperRobot();
   for (const auto& p : j["parameters"]) {
-    const double truth = paper.true_errors()[paper.FindValue(p["name"])];
+    const double truth = testing::PaperTrueErrors()[paper.FindValue(p["name"])];
     EXPECT_LT(std::fabs(p["delta"].get<double>() - truth), 5 * p["std_given_sigma"].get<double>())
         << p["name"];
   }
@@ -620,7 +620,7 @@ TEST_F(CliTest, IdentifyWritesTheCalibratedRobot) {
     const int k = cal.robot.FindValue(name);
     ASSERT_GE(k, 0) << name;
     EXPECT_EQ(cal.robot.nominal_values()[k], p["estimate"].get<double>()) << name;
-    EXPECT_EQ(cal.robot.true_errors()[k], 0.0);
+    EXPECT_EQ(cal.truth.LinkErrors(cal.robot)[k], 0.0);
   }
   const std::string text = testing::ReadFile(Path("cal.yaml"));
   EXPECT_THAT(text, ::testing::HasSubstr("data_fnv1a"));

@@ -19,7 +19,7 @@ namespace {
 MeasurementSet Simulated(const ConfigurationSet& configs, NoiseModel noise, std::uint64_t seed,
                          const PlaneSet& planes = testing::PaperPlane()) {
   MeasurementSet data;
-  SimulateReadings(testing::PaperRobot(), testing::PaperRobot().true_values(), planes,
+  SimulateReadings(testing::PaperRobot(), testing::PaperTrueValues(), planes,
                    testing::PaperRig().ranger, configs, noise,
                    RandomStream(seed, 0, 0, RandomPurpose::kNoise), &data);
   return data;

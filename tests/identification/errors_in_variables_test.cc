@@ -16,7 +16,7 @@
 namespace lrcal {
 namespace {
 
-constexpr double kSigma = 0.05e-3;      // m, one reading
+constexpr double kEivSigma = 0.05e-3;   // m, one reading
 constexpr double kJointSigma = 0.1e-3;  // rad, each recorded joint value
 
 // ∂h/∂q_j is ∂h/∂θ_j for a revolute joint (θ = θ0 + q): the weights follow from the analytic
@@ -30,7 +30,7 @@ TEST(ErrorsInVariables, WeightsFollowTheJointGradientOfEachReading) {
   data.configs = configs;
   data.y.assign(configs.size(), 0.0);
   data.repetitions.assign(configs.size(), 4);
-  const std::vector<double> w = ErrorsInVariablesWeights(kind, data, kSigma, kJointSigma);
+  const std::vector<double> w = ErrorsInVariablesWeights(kind, data, kEivSigma, kJointSigma);
   const Eigen::MatrixXd G = MeasurementJacobian(kind, configs);
   for (int i = 0; i < configs.size(); ++i) {
     double g2 = 0;
@@ -38,9 +38,9 @@ TEST(ErrorsInVariables, WeightsFollowTheJointGradientOfEachReading) {
       const double g = G(i, model.parameters().Find("theta" + std::to_string(j)));
       g2 += g * g;
     }
-    const double variance = kSigma * kSigma / 4 + kJointSigma * kJointSigma * g2;
+    const double variance = kEivSigma * kEivSigma / 4 + kJointSigma * kJointSigma * g2;
     constexpr double kRelative = 1e-7;  // central differences, step 1e-6 rad
-    EXPECT_NEAR(w[i], kSigma * kSigma / variance, kRelative * w[i]) << "configuration " << i;
+    EXPECT_NEAR(w[i], kEivSigma * kEivSigma / variance, kRelative * w[i]) << "configuration " << i;
     EXPECT_LT(w[i], 4.0);
   }
 }
@@ -54,15 +54,15 @@ TEST(ErrorsInVariables, ChiSquaredAndCovarianceHoldWithNoisyJointValues) {
   const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 3);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   IdentificationOptions eiv;
-  eiv.sigma = kSigma;
+  eiv.sigma = kEivSigma;
   eiv.encoder_sigma = kJointSigma;
   IdentificationOptions plain;
-  plain.sigma = kSigma;
+  plain.sigma = kEivSigma;
   NoiseModel noise;
-  noise.sigma = kSigma;
+  noise.sigma = kEivSigma;
   noise.repetitions = 1;  // one joint error per configuration, as the weights assume
   noise.encoder_sigma = kJointSigma;
-  const Eigen::VectorXd truth = robot.true_errors();
+  const Eigen::VectorXd truth = testing::PaperTrueErrors();
   const int n = model.num_parameters(), trials = 200;
   const double limit =
       boost::math::quantile(boost::math::chi_squared_distribution<double>(n), 0.95);
@@ -71,8 +71,9 @@ TEST(ErrorsInVariables, ChiSquaredAndCovarianceHoldWithNoisyJointValues) {
   int dof = 0;
   for (int t = 0; t < trials; ++t) {
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, noise, RandomStream(300 + t, 0, 0, RandomPurpose::kNoise), &data);
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, noise,
+                     RandomStream(300 + t, 0, 0, RandomPurpose::kNoise), &data);
     const IdentificationSummary s = Identify(model, data, eiv);
     ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
     Eigen::VectorXd error(n);
@@ -109,12 +110,12 @@ TEST(ErrorsInVariables, ApplyOnTopOfAMediansWeights) {
   kind.Bind(configs)->Predict(std::vector<double>(model.num_parameters(), 0.0).data(),
                               median.y.data(), nullptr);
   IdentificationOptions eiv;
-  eiv.sigma = kSigma;
+  eiv.sigma = kEivSigma;
   eiv.encoder_sigma = kJointSigma;
   IdentificationOptions plain;
-  plain.sigma = kSigma;
+  plain.sigma = kEivSigma;
   MeasuredValues weighted = median;
-  weighted.weights = ErrorsInVariablesWeights(kind, median, kSigma, kJointSigma);
+  weighted.weights = ErrorsInVariablesWeights(kind, median, kEivSigma, kJointSigma);
   for (int i = 0; i < configs.size(); ++i) {
     EXPECT_GT(weighted.weights[i], 0.0);
     EXPECT_LT(weighted.weights[i], median.weights[i]);

@@ -43,14 +43,14 @@ class RecoveryTest : public ::testing::TestWithParam<IdentificationOptions::Solv
 TEST_P(RecoveryTest, RecoversPapersTrueRobotWithPlaneKnown) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  MeasurementSet data = Exact(robot, robot.true_values(), testing::PaperPlane(),
+  MeasurementSet data = Exact(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                               testing::PaperHittingConfigurations(100));
   IdentificationOptions options;
   options.solver = GetParam();
   IdentificationSummary s = Identify(model, data, options);
   ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
   for (int k = 0; k < model.num_parameters(); ++k)
-    EXPECT_NEAR(s.delta[k], robot.true_errors()[model.parameters().robot_values[k]],
+    EXPECT_NEAR(s.delta[k], testing::PaperTrueErrors()[model.parameters().robot_values[k]],
                 kRecoveryTolerance)
         << s.names[k];
   EXPECT_LT(s.residual_rms, 1e-12);
@@ -60,7 +60,7 @@ TEST_P(RecoveryTest, RecoversRobotAndPlaneWhenPlaneEstimated) {
   // Plane normal and offset estimated: theta1 and d1 are then confounded with the plane
   // (identifiability_test.cc), so the truth keeps them at nominal and the set fixes them.
   const RobotModel& robot = PaperRobot();
-  Eigen::VectorXd truth = robot.true_values();
+  Eigen::VectorXd truth = testing::PaperTrueValues();
   truth[robot.FindValue("theta1")] = robot.nominal_values()[robot.FindValue("theta1")];
   truth[robot.FindValue("d1")] = robot.nominal_values()[robot.FindValue("d1")];
   MeasurementModel model(robot, testing::PaperPlane(),
@@ -96,12 +96,12 @@ TEST_P(RecoveryTest, RankDeficientSetIsReportedNotConverged) {
   ConfigurationSet pool = testing::PaperHittingConfigurations(400, 9);
   std::vector<double> h;
   std::vector<BeamMiss> misses;
-  ExactReadings(robot, robot.true_values(), horizontal, testing::PaperRig().ranger, pool, &h,
+  ExactReadings(robot, testing::PaperTrueValues(), horizontal, testing::PaperRig().ranger, pool, &h,
                 &misses);
   for (int i = 0; i < pool.size() && configs.size() < 100; ++i)
     if (misses[i] == BeamMiss::kNone) configs.Add(pool.q(i));
   ASSERT_GE(configs.size(), 40);
-  MeasurementSet data = Exact(robot, robot.true_values(), horizontal, configs);
+  MeasurementSet data = Exact(robot, testing::PaperTrueValues(), horizontal, configs);
   IdentificationOptions options;
   options.solver = GetParam();
   IdentificationSummary s = Identify(model, data, options);
@@ -132,8 +132,9 @@ TEST(Identification, LevenbergMarquardtAgreesWithCeresOnNoisyPaperCases) {
   for (int m : {50, 100}) {
     ConfigurationSet configs = testing::PaperHittingConfigurations(m, 21);
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, NoiseModel{}, RandomStream(42, 0, 0, RandomPurpose::kNoise), &data);
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, NoiseModel{},
+                     RandomStream(42, 0, 0, RandomPurpose::kNoise), &data);
     IdentificationOptions lm_options, ceres_options;
     ceres_options.solver = IdentificationOptions::Solver::kCeres;
     IdentificationSummary a = Identify(model, data, lm_options);
@@ -155,8 +156,9 @@ TEST(Identification, CachedNominalLinearisationGivesTheSameEstimate) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(100, 8);
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, NoiseModel{}, RandomStream(5, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, NoiseModel{},
+                   RandomStream(5, 0, 0, RandomPurpose::kNoise), &data);
   LevenbergMarquardt::Nominal nominal;
   std::vector<BeamMiss> misses;
   ExactReadings(robot, robot.nominal_values(), testing::PaperPlane(), testing::PaperRig().ranger,
@@ -180,7 +182,7 @@ TEST(Identification, BareSolverReportsRankDeficiencyLikeTheFullPath) {
   MeasurementModel model(robot, testing::PaperPlane(),
                          MakeParameterSet(robot, PlaneTerms{true, false}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(100);
-  MeasurementSet data = Exact(robot, robot.true_values(), testing::PaperPlane(), configs);
+  MeasurementSet data = Exact(robot, testing::PaperTrueValues(), testing::PaperPlane(), configs);
   std::vector<double> w(data.size(), 10.0);
   LevenbergMarquardt lm;
   Eigen::VectorXd e;
@@ -194,8 +196,9 @@ TEST(Identification, CovarianceIsSigmaSquaredTimesInverseNormalMatrix) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(60, 4);
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, NoiseModel{}, RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, NoiseModel{},
+                   RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
   IdentificationOptions options;
   options.sigma = 0.2e-3;
   IdentificationSummary s = Identify(model, data, options);
@@ -216,14 +219,16 @@ TEST(Identification, RobustLossesResistOutlyingReadings) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   ConfigurationSet configs = testing::PaperHittingConfigurations(80, 12);
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, NoiseModel{}, RandomStream(8, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, NoiseModel{},
+                   RandomStream(8, 0, 0, RandomPurpose::kNoise), &data);
   for (int i : {3, 17, 31, 52, 66}) data.mean_h[i] += 5e-3;
   auto error = [&](const IdentificationSummary& s) {
     double worst = 0;
     for (int k = 0; k < model.num_parameters(); ++k)
       worst = std::max(
-          worst, std::fabs(s.delta[k] - robot.true_errors()[model.parameters().robot_values[k]]));
+          worst,
+          std::fabs(s.delta[k] - testing::PaperTrueErrors()[model.parameters().robot_values[k]]));
     return worst;
   };
   IdentificationOptions plain;
@@ -247,9 +252,10 @@ TEST(Identification, RobustLossesResistOutlyingReadings) {
 MeasurementSet NoisyReadings(const MeasurementModel& model, int count, int outliers) {
   const RobotModel& robot = model.robot();
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   testing::PaperHittingConfigurations(count, 21), NoiseModel{0.2e-3, 10, true},
-                   RandomStream(5, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, testing::PaperHittingConfigurations(count, 21),
+                   NoiseModel{0.2e-3, 10, true}, RandomStream(5, 0, 0, RandomPurpose::kNoise),
+                   &data);
   for (int i = 0; i < outliers; ++i) data.mean_h[7 + 11 * i] += 5e-3 * (i % 2 ? -1 : 1);
   return data;
 }
@@ -310,16 +316,16 @@ TEST(Identification, RobustFitsConvergeOnCleanData) {
         EXPECT_TRUE(s.IsSolutionUsable()) << s.FullReport();
       }
   MeasurementSet exact;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   testing::PaperHittingConfigurations(70, 21), NoiseModel{0.0, 1, true},
-                   RandomStream(5, 0, 0, RandomPurpose::kNoise), &exact);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, testing::PaperHittingConfigurations(70, 21),
+                   NoiseModel{0.0, 1, true}, RandomStream(5, 0, 0, RandomPurpose::kNoise), &exact);
   IdentificationOptions o;
   o.loss = RobustLoss::kCauchy;
   o.loss_scale = 1e-6;
   const IdentificationSummary s = Identify(model, exact, o);
   ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
   for (int k = 0; k < model.num_parameters(); ++k)
-    EXPECT_NEAR(s.delta[k], robot.true_errors()[model.parameters().robot_values[k]],
+    EXPECT_NEAR(s.delta[k], testing::PaperTrueErrors()[model.parameters().robot_values[k]],
                 kRecoveryTolerance);
 }
 
@@ -344,7 +350,7 @@ TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
       EXPECT_THAT(text, ::testing::HasSubstr("a2")) << text;
     }
   }
-  Eigen::VectorXd truth = robot.true_values();
+  Eigen::VectorXd truth = testing::PaperTrueValues();
   truth[robot.FindValue("d6")] = robot.nominal_values()[robot.FindValue("d6")];
   truth[robot.FindValue("a2")] = robot.nominal_values()[robot.FindValue("a2")];
   NoiseModel exact{0.0, 1, true};
@@ -398,7 +404,7 @@ ConfigurationSet ThreePlaneConfigurations(const PlaneSet& planes, int per_plane)
 TEST(Identification, ThreeEstimatedPlanesRecoverTheTruth) {
   const RobotModel& robot = PaperRobot();
   const PlaneSet planes = ThreePlanes();
-  Eigen::VectorXd truth = robot.true_values();
+  Eigen::VectorXd truth = testing::PaperTrueValues();
   for (const char* name : {"theta1", "d1"})
     truth[robot.FindValue(name)] = robot.nominal_values()[robot.FindValue(name)];
   MeasurementModel model(robot, planes,
@@ -457,8 +463,8 @@ TEST(Identification, RangerScaleIsFoundAgainstThreeKnownPlanes) {
   NoiseModel exact{0.0, 1, true};
   exact.ranger_scale = 250e-6;
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), planes, testing::PaperRig().ranger, configs, exact,
-                   RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), planes, testing::PaperRig().ranger, configs,
+                   exact, RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
   for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
                       IdentificationOptions::Solver::kCeres}) {
     IdentificationOptions o;
@@ -467,7 +473,7 @@ TEST(Identification, RangerScaleIsFoundAgainstThreeKnownPlanes) {
     ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
     const ParameterSet& ps = model.parameters();
     for (int k = 0; k < ps.num_robot(); ++k)
-      EXPECT_NEAR(s.delta[k], robot.true_errors()[ps.robot_values[k]], kRecoveryTolerance)
+      EXPECT_NEAR(s.delta[k], testing::PaperTrueErrors()[ps.robot_values[k]], kRecoveryTolerance)
           << ps.names[k];
     EXPECT_NEAR(s.delta[ps.ranger_scale_index], 250e-6, kRecoveryTolerance);
   }
@@ -477,7 +483,7 @@ TEST(Identification, RangerScaleIsFoundAgainstThreeKnownPlanes) {
 TEST(Identification, ReadingOnAPlaneTheModelLacksIsAnInputError) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  MeasurementSet data = Exact(robot, robot.true_values(), testing::PaperPlane(),
+  MeasurementSet data = Exact(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                               testing::PaperHittingConfigurations(40));
   ConfigurationSet tagged(6);
   for (int i = 0; i < data.configs.size(); ++i) tagged.Add(data.configs.q(i), i == 7 ? 1 : 0);
@@ -502,8 +508,8 @@ TEST(Identification, FitCheckAgainstTheStatedNoise) {
   const int seeds = 200;
   for (int seed = 0; seed < seeds; ++seed) {
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, NoiseModel{0.2e-3, 10, true},
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, NoiseModel{0.2e-3, 10, true},
                      RandomStream(seed, 0, 0, RandomPurpose::kNoise), &data);
     IdentificationOptions o;
     o.sigma = 0.2e-3;
@@ -562,8 +568,8 @@ void ExpectRobustFitCheckHolds(RobustLoss loss, double scale_in_sigma, int seeds
   double p_sum = 0;
   for (int seed = 0; seed < seeds; ++seed) {
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, NoiseModel{kSigma, 10, true},
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, NoiseModel{kSigma, 10, true},
                      RandomStream(seed, 0, 0, RandomPurpose::kNoise), &data);
     IdentificationOptions o;
     o.sigma = kSigma;
@@ -610,9 +616,10 @@ TEST(Identification, SuspectsAndTooFewConfigurations) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   testing::PaperHittingConfigurations(60, 15), NoiseModel{0.2e-3, 10, true},
-                   RandomStream(4, 0, 0, RandomPurpose::kNoise), &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, testing::PaperHittingConfigurations(60, 15),
+                   NoiseModel{0.2e-3, 10, true}, RandomStream(4, 0, 0, RandomPurpose::kNoise),
+                   &data);
   data.mean_h[17] += 3e-3;
   IdentificationOptions o;
   const IdentificationSummary s = Identify(model, data, o);
@@ -627,18 +634,20 @@ TEST(Identification, SuspectsAndTooFewConfigurations) {
   EXPECT_THAT(labelled.fit.Explain(), ::testing::HasSubstr("18 'pose_117' ("));
   EXPECT_EQ(labelled.fit.LabelOf(17), "pose_117");
   MeasurementSet exact;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   testing::PaperHittingConfigurations(25, 15), NoiseModel{0.2e-3, 10, true},
-                   RandomStream(4, 0, 0, RandomPurpose::kNoise), &exact);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, testing::PaperHittingConfigurations(25, 15),
+                   NoiseModel{0.2e-3, 10, true}, RandomStream(4, 0, 0, RandomPurpose::kNoise),
+                   &exact);
   const IdentificationSummary square = Identify(model, exact, o);
   ASSERT_TRUE(square.IsSolutionUsable()) << square.FullReport();
   EXPECT_TRUE(std::isnan(square.sigma_hat));
   EXPECT_TRUE(std::isnan(square.std_residual[0]));
   EXPECT_THAT(square.ParameterTable(), ::testing::HasSubstr("undefined"));
   MeasurementSet few;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   testing::PaperHittingConfigurations(10, 15), NoiseModel{0.2e-3, 10, true},
-                   RandomStream(4, 0, 0, RandomPurpose::kNoise), &few);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, testing::PaperHittingConfigurations(10, 15),
+                   NoiseModel{0.2e-3, 10, true}, RandomStream(4, 0, 0, RandomPurpose::kNoise),
+                   &few);
   const IdentificationSummary too_few = Identify(model, few, o);
   EXPECT_EQ(too_few.termination, Termination::kInvalidInput);
   EXPECT_THAT(too_few.message, ::testing::HasSubstr("25 parameters need at least"));

@@ -28,12 +28,14 @@ TEST(PoseAccuracy, PredictionMatchesAMonteCarloOfTheIdentification) {
   std::vector<PoseAccuracy> predicted;
   for (int t = 0; t < kTrials; ++t) {
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, noise, RandomStream(t, 0, 0, RandomPurpose::kNoise), &data);
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, noise,
+                     RandomStream(t, 0, 0, RandomPurpose::kNoise), &data);
     const IdentificationSummary s = Identify(model, data, o);
     ASSERT_TRUE(s.IsSolutionUsable());
     errors.push_back(
-        ComparePoses(robot, robot.true_values(), model.LinkValues(s.delta.data()), poses).position);
+        ComparePoses(robot, testing::PaperTrueValues(), model.LinkValues(s.delta.data()), poses)
+            .position);
     if (t == 0) predicted = PredictPoseAccuracy(model, s.delta.data(), s.covariance_given, poses);
   }
   for (int j = 0; j < poses.size(); ++j) {

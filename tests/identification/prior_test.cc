@@ -23,7 +23,7 @@ using testing::EigenNear;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-constexpr double kSigma = 0.2e-3;  // m, the noise of one reading in these tests
+constexpr double kPriorTestSigma = 0.2e-3;  // m, the noise of one reading in these tests
 
 TEST(PriorSigmas, ParsesNamesAndClassesWithTheirUnits) {
   const PriorSigmas p =
@@ -63,7 +63,7 @@ MeasurementSet Readings(const RobotModel& robot, const Eigen::VectorXd& values, 
                         const ConfigurationSet& configs, std::uint64_t seed) {
   MeasurementSet data;
   NoiseModel noise;
-  noise.sigma = kSigma;
+  noise.sigma = kPriorTestSigma;
   noise.repetitions = 4;
   noise.draw_mean = true;
   SimulateReadings(robot, values, plane, testing::PaperRig().ranger, configs, noise,
@@ -73,7 +73,7 @@ MeasurementSet Readings(const RobotModel& robot, const Eigen::VectorXd& values, 
 
 IdentificationOptions WithPriors(const std::string& priors) {
   IdentificationOptions options;
-  options.sigma = kSigma;
+  options.sigma = kPriorTestSigma;
   options.priors = PriorSigmas::Parse(priors);
   return options;
 }
@@ -81,7 +81,7 @@ IdentificationOptions WithPriors(const std::string& priors) {
 TEST(Priors, MapEstimateSatisfiesItsNormalEquationsAndStatesTheirCovariance) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const MeasurementSet data = Readings(robot, robot.true_values(), testing::PaperPlane(),
+  const MeasurementSet data = Readings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                                        testing::PaperHittingConfigurations(40, 3), 11);
   const IdentificationOptions options =
       WithPriors("theta=1mrad,alpha=1mrad,beta=1mrad,a=1mm,d=1mm");
@@ -99,7 +99,8 @@ TEST(Priors, MapEstimateSatisfiesItsNormalEquationsAndStatesTheirCovariance) {
     w[i] = data.repetitions[i];
   }
   const Eigen::VectorXd prior = options.priors.SigmasOf(s.names);
-  const Eigen::VectorXd lambda = (kSigma * kSigma) * prior.array().square().inverse().matrix();
+  const Eigen::VectorXd lambda =
+      (kPriorTestSigma * kPriorTestSigma) * prior.array().square().inverse().matrix();
   // Stationarity of Σw r² + Σ λ_k e_k²: Gᵀ W r = Λ e (relative to the terms' size).
   const Eigen::VectorXd gradient =
       G.transpose() * w.asDiagonal() * r - lambda.asDiagonal() * s.delta;
@@ -107,7 +108,7 @@ TEST(Priors, MapEstimateSatisfiesItsNormalEquationsAndStatesTheirCovariance) {
             1e-9 * (G.transpose() * w.asDiagonal() * r).cwiseAbs().maxCoeff() + 1e-18);
   const Eigen::MatrixXd A =
       G.transpose() * w.asDiagonal() * G + Eigen::MatrixXd(lambda.asDiagonal());
-  const Eigen::MatrixXd covariance = kSigma * kSigma * A.inverse();
+  const Eigen::MatrixXd covariance = kPriorTestSigma * kPriorTestSigma * A.inverse();
   EXPECT_THAT(s.covariance_given, EigenNear(covariance, 1e-6 * covariance.cwiseAbs().maxCoeff()));
   EXPECT_THAT(
       s.posterior_to_prior,
@@ -129,10 +130,10 @@ TEST(Priors, DataDecideWhereTheyCanAndPriorsWhereTheyCannot) {
   const RobotModel& robot = testing::PaperRobot();
   const std::string priors = "theta=1mrad,alpha=1mrad,beta=1mrad,a=1mm,d=1mm";
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const MeasurementSet data = Readings(robot, robot.true_values(), testing::PaperPlane(),
+  const MeasurementSet data = Readings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                                        testing::PaperHittingConfigurations(100, 5), 3);
   IdentificationOptions least_squares;
-  least_squares.sigma = kSigma;
+  least_squares.sigma = kPriorTestSigma;
   const IdentificationSummary ls = Identify(model, data, least_squares);
   const IdentificationSummary map = Identify(model, data, WithPriors(priors));
   ASSERT_TRUE(ls.IsSolutionUsable() && map.IsSolutionUsable());
@@ -145,7 +146,8 @@ TEST(Priors, DataDecideWhereTheyCanAndPriorsWhereTheyCannot) {
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
   const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 100, 6);
   const MeasurementModel flat(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
-  const MeasurementSet flat_data = Readings(robot, robot.true_values(), horizontal, configs, 4);
+  const MeasurementSet flat_data =
+      Readings(robot, testing::PaperTrueValues(), horizontal, configs, 4);
   const IdentifiabilityReport report = AnalyzeIdentifiability(flat, configs);
   ASSERT_FALSE(report.full_rank());
   EXPECT_EQ(Identify(flat, flat_data, least_squares).termination, Termination::kRankDeficient);
@@ -163,7 +165,7 @@ TEST(Priors, NeedTheReadingNoise) {
   IdentificationOptions options = WithPriors("d=1mm");
   options.sigma = 0;
   EXPECT_THAT(Identify(model,
-                       Readings(robot, robot.true_values(), testing::PaperPlane(),
+                       Readings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                                 testing::PaperHittingConfigurations(40, 3), 1),
                        options)
                   .message,
@@ -244,14 +246,14 @@ TEST(PriorInformation, IsThePosteriorOfReadingsAtTheConfigurations) {
   const MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model);
   NoiseModel noise;
-  noise.sigma = kSigma;
+  noise.sigma = kPriorTestSigma;
   noise.repetitions = 10;
   const PriorSigmas priors = PriorSigmas::Parse("theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d=5mm");
   const PriorInformation info = InformationFromPriors(kind, configs, noise, priors);
   ASSERT_TRUE(info.defined);
   const Eigen::MatrixXd G = IdentificationJacobian(model, configs);
   const Eigen::VectorXd prior = priors.SigmasOf(model.parameters().names);
-  const Eigen::MatrixXd A = 10 * G.transpose() * G / (kSigma * kSigma) +
+  const Eigen::MatrixXd A = 10 * G.transpose() * G / (kPriorTestSigma * kPriorTestSigma) +
                             Eigen::MatrixXd(prior.array().square().inverse().matrix().asDiagonal());
   const Eigen::VectorXd posterior = A.inverse().diagonal().cwiseSqrt();
   EXPECT_THAT(info.posterior_sigma, EigenNear(posterior, 1e-6 * posterior.maxCoeff()));
@@ -280,7 +282,7 @@ namespace {
 TEST(Priors, FewerReadingsThanTermsAreEnoughWithPriorsOnEveryTerm) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const MeasurementSet data = Readings(robot, robot.true_values(), testing::PaperPlane(),
+  const MeasurementSet data = Readings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                                        testing::PaperHittingConfigurations(12, 2), 5);
   const IdentificationSummary s =
       Identify(model, data, WithPriors("theta=5mrad,alpha=5mrad,beta=5mrad,a=5mm,d=5mm"));

@@ -15,8 +15,8 @@
 namespace lrcal {
 namespace {
 
-constexpr double kSigma = 0.05e-3;  // m, one reading
-constexpr int kReadings = 5;        // per configuration
+constexpr double kAveragingSigma = 0.05e-3;  // m, one reading
+constexpr int kReadings = 5;                 // per configuration
 
 struct Outcome {
   int inside = 0;            // parameter errors inside the 95 % ellipsoid
@@ -31,16 +31,17 @@ Outcome Calibrate(const NoiseModel& noise, int trials, std::uint64_t seed) {
   const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 3);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   IdentificationOptions options;
-  options.sigma = kSigma;
-  const Eigen::VectorXd truth = robot.true_errors();
+  options.sigma = kAveragingSigma;
+  const Eigen::VectorXd truth = testing::PaperTrueErrors();
   const int n = model.num_parameters();
   const double limit =
       boost::math::quantile(boost::math::chi_squared_distribution<double>(n), 0.95);
   Outcome out;
   for (int t = 0; t < trials; ++t) {
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, noise, RandomStream(seed + t, 0, 0, RandomPurpose::kNoise), &data);
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, noise,
+                     RandomStream(seed + t, 0, 0, RandomPurpose::kNoise), &data);
     const IdentificationSummary s = Identify(model, data, options);
     EXPECT_TRUE(s.IsSolutionUsable()) << s.FullReport();
     Eigen::VectorXd error(n);
@@ -57,7 +58,7 @@ Outcome Calibrate(const NoiseModel& noise, int trials, std::uint64_t seed) {
 
 TEST(RobustAveraging, TheMediansWeightsKeepTheChiSquaredAndTheCovarianceHonest) {
   NoiseModel noise;
-  noise.sigma = kSigma;
+  noise.sigma = kAveragingSigma;
   noise.repetitions = kReadings;
   noise.average = Averaging::Parse("median");
   const int trials = 200;
@@ -75,7 +76,7 @@ TEST(RobustAveraging, TheMediansWeightsKeepTheChiSquaredAndTheCovarianceHonest) 
 
 TEST(RobustAveraging, AMedianResistsGrossErrorsThatPullAMean) {
   NoiseModel noise;
-  noise.sigma = kSigma;
+  noise.sigma = kAveragingSigma;
   noise.repetitions = kReadings;
   noise.outlier_fraction = 0.05;  // about one configuration in four has a gross reading
   noise.outlier_sigma = 5e-3;

@@ -24,9 +24,9 @@ TEST(RobotFile, PaperFileHasTheTwentyFiveNamedParameters) {
       "a5",     "d5",     "theta6", "alpha6", "a6",     "d6",     "beta6"};
   EXPECT_EQ(names, expected);
   // Errors in SI: theta1 -7.23 mrad, a2 1.94 mm, beta6 -3.36 mrad.
-  EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("theta1")], -7.23e-3);
-  EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("a2")], 1.94e-3);
-  EXPECT_DOUBLE_EQ(robot.true_errors()[robot.FindValue("beta6")], -3.36e-3);
+  EXPECT_DOUBLE_EQ(rig.truth.link_errors[robot.FindValue("theta1")], -7.23e-3);
+  EXPECT_DOUBLE_EQ(rig.truth.link_errors[robot.FindValue("a2")], 1.94e-3);
+  EXPECT_DOUBLE_EQ(rig.truth.link_errors[robot.FindValue("beta6")], -3.36e-3);
   ASSERT_TRUE(rig.planes.has_value());
   EXPECT_NEAR((*rig.planes)[0].normal.norm(), 1.0, 1e-15);
   EXPECT_NEAR((*rig.planes)[0].offset, -0.69 / std::sqrt(1 + 4.6 * 4.6), 1e-15);

@@ -126,7 +126,7 @@ TEST(Urdf, PaperArmExportedMatchesAndReadsBack) {
   const RobotFile back = LoadRobotFile(path);
   ExpectSameKinematics(back.robot, path, "tool");
   // The calibrated values, not the nominal ones, are what an export writes.
-  const Eigen::VectorXd truth = paper.true_values();
+  const Eigen::VectorXd truth = testing::PaperTrueValues();
   std::ofstream(path) << UrdfText(paper, truth);
   std::mt19937 rng(3);
   for (int trial = 0; trial < 20; ++trial) {

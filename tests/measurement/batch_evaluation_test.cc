@@ -100,7 +100,7 @@ TEST(BatchEvaluator, MatchesWithAPrismaticJoint) {
   links[1].q_max = 1;
   links[2].nominal = {-0.3, 0.0, 0.4, 0.2, 0.02};
   for (auto& l : links) l.is_parameter = {true, true, true, true, true};
-  RobotModel robot("three", links, Eigen::VectorXd());
+  RobotModel robot("three", links);
   MeasurementModel model(robot, Plane::FromCoefficients(0.1, 0.2, 1.0, 2.0),
                          MakeParameterSet(robot, PlaneTerms{true, true}));
   ConfigurationSet configs(3);

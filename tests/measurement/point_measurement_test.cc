@@ -25,7 +25,7 @@ using ::testing::HasSubstr;
 namespace tolerance = testing::tolerance;
 
 constexpr int kMaxTerms = 48;
-using Jet = ceres::Jet<double, kMaxTerms>;
+using TermJet = ceres::Jet<double, kMaxTerms>;
 
 // A tracker 2 m in front of the arm, turned and tilted, seeing two reflectors on the tool.
 PointSetup TrackerSetup() {
@@ -108,14 +108,14 @@ TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
   Eigen::MatrixXd J(m, n);
   ASSERT_TRUE(evaluator->Predict(e.data(), y.data(), J.data()));
 
-  std::vector<Jet> ej(n);
-  for (int k = 0; k < n; ++k) ej[k] = Jet(e[k], k);
-  const std::vector<Jet> all_jets = AllTerms(kind, ej);
+  std::vector<TermJet> ej(n);
+  for (int k = 0; k < n; ++k) ej[k] = TermJet(e[k], k);
+  const std::vector<TermJet> all_jets = AllTerms(kind, ej);
   Eigen::MatrixXd autodiff(m, n), central(m, n);
   Eigen::VectorXd reference(m);
   constexpr double kStep = 1e-6;
   for (int i = 0; i < configs.size(); ++i) {
-    const Eigen::Matrix<Jet, 3, 1> p =
+    const Eigen::Matrix<TermJet, 3, 1> p =
         ReferencePoint(kind, all_jets, configs.q(i), configs.plane(i));
     for (int c = 0; c < 3; ++c) {
       reference[3 * i + c] = p[c].a;
@@ -148,8 +148,7 @@ RobotModel TrueRobot(const RobotModel& robot, const Eigen::VectorXd& errors) {
   std::vector<Link> links = robot.links();
   for (int index = 0; index < robot.num_values(); ++index)
     links[index / kValuesPerLink].nominal[index % kValuesPerLink] += errors[index];
-  return RobotModel("truth", links, Eigen::VectorXd::Zero(robot.num_values()), "test", robot.base(),
-                    robot.tool());
+  return RobotModel("truth", links, "test", robot.base(), robot.tool());
 }
 
 TEST(PointMeasurement, NoiseFreeIdentificationRecoversTheTruth) {

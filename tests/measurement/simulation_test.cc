@@ -22,13 +22,14 @@ Eigen::MatrixXd MeanErrors(const ConfigurationSet& configs, const NoiseModel& no
   const RobotModel& robot = testing::PaperRobot();
   std::vector<double> exact;
   std::vector<BeamMiss> misses;
-  ExactReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                configs, &exact, &misses);
+  ExactReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                testing::PaperRig().ranger, configs, &exact, &misses);
   Eigen::MatrixXd err(trials, configs.size());
   for (int t = 0; t < trials; ++t) {
     MeasurementSet data;
-    SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                     configs, noise, RandomStream(3, 0, t, RandomPurpose::kNoise), &data);
+    SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                     testing::PaperRig().ranger, configs, noise,
+                     RandomStream(3, 0, t, RandomPurpose::kNoise), &data);
     EXPECT_EQ(data.size(), configs.size());
     for (int i = 0; i < configs.size(); ++i) err(t, i) = data.mean_h[i] - exact[i];
   }
@@ -46,7 +47,7 @@ TEST(Simulation, EncoderNoiseMovesTheBeamByTheJointJacobian) {
   MeasurementModel truth(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const std::vector<double> zero(truth.num_parameters(), 0.0);
   ModelPoint point;
-  PrepareModelPoint(robot, robot.true_values().data(), testing::PaperPlane(), &point);
+  PrepareModelPoint(robot, testing::PaperTrueValues().data(), testing::PaperPlane(), &point);
   for (bool draw_mean : {false, true}) {
     NoiseModel noise{0.0, 4, draw_mean};
     noise.encoder_sigma = 0.1e-3;
@@ -68,13 +69,14 @@ TEST(Simulation, EncoderNoiseMovesTheBeamByTheJointJacobian) {
   noise.encoder_sigma = 1e-3;
   MeasurementSet data;
   const RandomStream stream(3, 0, 5, RandomPurpose::kNoise);
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, noise, stream, &data);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, noise, stream, &data);
   const RandomStream encoder = stream.WithPurpose(RandomPurpose::kEncoder);
   for (int i = 0; i < configs.size(); ++i) {
     double q[6];
     for (int j = 0; j < 6; ++j) q[j] = configs.q(i)[j] + 1e-3 * encoder.Normal(i * 6 + j);
-    const Pose<double> pose = ForwardKinematics<double>(robot, robot.true_values().data(), q);
+    const Pose<double> pose =
+        ForwardKinematics<double>(robot, testing::PaperTrueValues().data(), q);
     const Plane& plane = testing::PaperPlane();
     const double expected =
         LaserDistance<double>(pose.p_BT, pose.R_BT.col(2), plane.normal, plane.offset);
@@ -90,16 +92,16 @@ TEST(Simulation, PlaneFormErrorIsSharedByTheReadingsOfAConfiguration) {
   noise.form_sigma = 0.05e-3;
   std::vector<double> raw;
   MeasurementSet data;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, noise, RandomStream(3, 0, 1, RandomPurpose::kNoise), &data, nullptr,
-                   &raw);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, noise,
+                   RandomStream(3, 0, 1, RandomPurpose::kNoise), &data, nullptr, &raw);
   for (int i = 0; i < configs.size(); ++i)
     for (int r = 1; r < 5; ++r) EXPECT_EQ(raw[i * 5 + r], raw[i * 5]);
   // The reading moves by ε/|n·b|: variance σ_form²/(n·b)².
   noise.draw_mean = true;
   const Eigen::MatrixXd err = MeanErrors(configs, noise, 4000);
   ModelPoint point;
-  PrepareModelPoint(robot, robot.true_values().data(), testing::PaperPlane(), &point);
+  PrepareModelPoint(robot, testing::PaperTrueValues().data(), testing::PaperPlane(), &point);
   for (int i = 0; i < configs.size(); ++i) {
     const double nb = testing::PaperPlane().normal.dot(ToolPose(point, configs, i).R_BT.col(2));
     const double predicted = std::pow(noise.form_sigma / nb, 2);
@@ -155,8 +157,8 @@ TEST(Simulation, AMedianIsTheMiddleOfTheWrittenReadingsWithItsVarianceFactor) {
   const RandomStream stream(5, 0, 0, RandomPurpose::kNoise);
   MeasurementSet data, drawn;
   std::vector<double> raw;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, noise, stream, &data, nullptr, &raw);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, noise, stream, &data, nullptr, &raw);
   ASSERT_EQ(data.size(), 8);
   ASSERT_EQ(raw.size(), 40u);
   for (int i = 0; i < data.size(); ++i) {
@@ -166,13 +168,13 @@ TEST(Simulation, AMedianIsTheMiddleOfTheWrittenReadingsWithItsVarianceFactor) {
     EXPECT_EQ(data.Weight(i), 5 / noise.average.VarianceFactor(5));
   }
   noise.draw_mean = true;
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, noise, stream, &drawn);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, noise, stream, &drawn);
   EXPECT_EQ(drawn.mean_h, data.mean_h);
   // The mean keeps no factors: its weights are its counts.
   noise.average = Averaging{};
-  SimulateReadings(robot, robot.true_values(), testing::PaperPlane(), testing::PaperRig().ranger,
-                   configs, noise, stream, &drawn);
+  SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
+                   testing::PaperRig().ranger, configs, noise, stream, &drawn);
   EXPECT_TRUE(drawn.variance_factor.empty());
   EXPECT_EQ(drawn.Weight(0), 5.0);
 }

@@ -29,7 +29,7 @@ TEST(PaperCases, BothCasesIdentifyTheTruthAndBeatTheNominalArm) {
   const RobotFile& rig = testing::PaperRig();
   PaperCaseOptions options;
   options.sampling.ranger = rig.ranger;
-  const PaperCasesResult r = RunPaperCases(rig.robot, (*rig.planes)[0], options);
+  const PaperCasesResult r = RunPaperCases(rig.robot, rig.truth, (*rig.planes)[0], options);
   EXPECT_EQ(r.pool.size(), 101);
   EXPECT_EQ(r.validation.size(), 20);
   ASSERT_EQ(r.cases.size(), 2u);
@@ -41,7 +41,8 @@ TEST(PaperCases, BothCasesIdentifyTheTruthAndBeatTheNominalArm) {
     for (std::size_t k = 0; k < pc.summary.names.size(); ++k) {
       const int index = rig.robot.FindValue(pc.summary.names[k]);
       ASSERT_GE(index, 0);
-      EXPECT_NEAR(pc.summary.delta[k], rig.robot.true_errors()[index], 5 * pc.summary.std_given[k])
+      EXPECT_NEAR(pc.summary.delta[k], rig.truth.LinkErrors(rig.robot)[index],
+                  5 * pc.summary.std_given[k])
           << pc.label << " " << pc.summary.names[k];
     }
     for (int a = 0; a < 3; ++a)

@@ -121,8 +121,8 @@ TEST(RigDisturbances, RangerErrorsFromTheRobotFileAreEstimated) {
   robot.replace(robot.find("ranger_scale_ppm: 0"), 19, "ranger_scale_ppm: 150");
   std::ofstream(dir + "/ranger2.yaml") << robot;
   const RobotFile file = LoadRobotFile(dir + "/ranger2.yaml");
-  EXPECT_DOUBLE_EQ(file.ranger_offset, 0.3e-3);
-  EXPECT_DOUBLE_EQ(file.ranger_scale, 150e-6);
+  EXPECT_DOUBLE_EQ(file.truth.ranger_offset, 0.3e-3);
+  EXPECT_DOUBLE_EQ(file.truth.ranger_scale, 150e-6);
 }
 
 // truth.ranger_offset_mm / ranger_scale_ppm override the robot file's ranger errors as sweep

@@ -444,8 +444,9 @@ TEST(CellPrediction, AtTheTruthIsTheNominalFormulaForAnArmWhoseNominalIsTheTruth
   std::vector<Link> links = robot.links();
   for (int i = 0; i < robot.num_links(); ++i)
     for (int v = 0; v < kValuesPerLink; ++v)
-      links[i].nominal[v] = robot.true_values()[kValuesPerLink * i + v];
-  const RobotModel at_truth("truth", links, Eigen::VectorXd::Zero(robot.num_values()));
+      links[i].nominal[v] = robot.nominal_values()[kValuesPerLink * i + v] +
+                            cell->file_true_errors[kValuesPerLink * i + v];
+  const RobotModel at_truth("truth", links);
   const MeasurementModel model(at_truth, cell->planes, cell->model->parameters());
   const Eigen::MatrixXd G = IdentificationJacobian(model, cell->design.configs);
   const CellSettings& s = cell->cell->typed;

@@ -30,6 +30,14 @@ const RobotFile& PaperRig() {
 }
 
 const RobotModel& PaperRobot() { return PaperRig().robot; }
+const Eigen::VectorXd& PaperTrueErrors() {
+  static const Eigen::VectorXd errors = PaperRig().truth.LinkErrors(PaperRobot());
+  return errors;
+}
+const Eigen::VectorXd& PaperTrueValues() {
+  static const Eigen::VectorXd values = PaperRig().truth.LinkValues(PaperRobot());
+  return values;
+}
 
 const Plane& PaperPlane() { return (*PaperRig().planes)[0]; }
 
@@ -61,7 +69,7 @@ const RobotModel& PaperRobotWithFrames() {
                                                            Eigen::Vector3d(0.05, -0.1, 0.7));
     const RigidTransform tool = RigidTransform::FromXyzRpy(Eigen::Vector3d(0.03, -0.05, 0.1),
                                                            Eigen::Vector3d(0.2, -0.3, 0.1));
-    return RobotModel("paper with frames", paper.links(), paper.true_errors(), "test", base, tool);
+    return RobotModel("paper with frames", paper.links(), "test", base, tool);
   }();
   return robot;
 }

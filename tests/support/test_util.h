@@ -62,6 +62,10 @@ std::string LrcalBinary();
 const RobotFile& PaperRig();
 /// The paper's arm and plane.
 const RobotModel& PaperRobot();
+/// The paper's simulated arm (its robot file's true_errors): the errors (5N, SI) and the true
+/// link values, nominal + errors. PaperRobotWithFrames has the same links and the same truth.
+const Eigen::VectorXd& PaperTrueErrors();
+const Eigen::VectorXd& PaperTrueValues();
 const Plane& PaperPlane();
 /// The paper's arm on a tilted, shifted base with the ranger mounted off the flange (a tool
 /// transform of 3–10 cm and 0.1–0.3 rad): the base and tool frames of a real rig.

@@ -14,6 +14,7 @@
 #include "lrcal/identification/prior.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/truth.h"
 
 namespace lrcal {
 
@@ -44,10 +45,9 @@ struct RobotFile {
   std::optional<PlaneSet> planes;
   RangerSpec ranger;  ///< the ranger's limits (defaults unless the file gives them)
   std::string path;   ///< where it was read from
-  /// The true ranger's errors (true_errors.ranger_offset_mm, ranger_scale_ppm): it reads
-  /// (1 + ranger_scale)·h + ranger_offset (m) for a true distance h. For simulation.
-  double ranger_offset = 0;
-  double ranger_scale = 0;
+  /// The file's `true_errors:` (the links' and the ranger's: ranger_offset_mm,
+  /// ranger_scale_ppm): the real arm and ranger simulations read from. Not part of `robot`.
+  Truth truth;
   /// The file's `tolerances:` (prior standard deviations around its nominal values, by class for
   /// every link and by name per link, plane and ranger term): what `identify --prior` uses.
   /// Empty when the file has none; never written back (a calibrated file's record has the

@@ -61,9 +61,8 @@ class RobotModel {
   RobotModel() = default;
   /// Builds a model; throws InputError (where = `source`) if the description is inconsistent.
   /// `base` and `tool` are the fixed transforms around the chain (identity by default).
-  RobotModel(std::string name, std::vector<Link> links, Eigen::VectorXd true_errors,
-             const std::string& source = "robot", RigidTransform base = {},
-             RigidTransform tool = {});
+  RobotModel(std::string name, std::vector<Link> links, const std::string& source = "robot",
+             RigidTransform base = {}, RigidTransform tool = {});
 
   const std::string& name() const { return name_; }
   int num_links() const { return static_cast<int>(links_.size()); }
@@ -80,10 +79,6 @@ class RobotModel {
 
   /// All 5N nominal link values (SI).
   const Eigen::VectorXd& nominal_values() const { return nominal_values_; }
-  /// The "true" robot's errors from the robot file (5N, SI; zero where fixed).
-  const Eigen::VectorXd& true_errors() const { return true_errors_; }
-  /// nominal_values() + true_errors().
-  Eigen::VectorXd true_values() const { return nominal_values_ + true_errors_; }
 
   /// Indices (into the 5N link values) of the geometric parameters, in robot file order.
   const std::vector<int>& parameter_indices() const { return parameter_indices_; }
@@ -100,7 +95,6 @@ class RobotModel {
   std::vector<Link> links_;
   RigidTransform base_, tool_;
   Eigen::VectorXd nominal_values_;
-  Eigen::VectorXd true_errors_;
   std::vector<int> parameter_indices_;
 };
 

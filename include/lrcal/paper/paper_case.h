@@ -20,6 +20,7 @@
 #include "lrcal/io/result_json.h"
 #include "lrcal/kinematics/pose_errors.h"
 #include "lrcal/measurement/simulation.h"
+#include "lrcal/measurement/truth.h"
 
 namespace lrcal {
 
@@ -46,13 +47,16 @@ struct PaperCase {
 };
 
 struct PaperCasesResult {
+  Eigen::VectorXd true_errors;  ///< the simulated arm's link value errors (5N, SI)
   ConfigurationSet pool, validation;
   SamplingReport pool_report, validation_report;
   PoseErrors nominal_validation;  ///< nominal model vs truth
   std::vector<PaperCase> cases;   ///< case 1, case 2
 };
 
-PaperCasesResult RunPaperCases(const RobotModel& robot, const Plane& plane,
+/// The paper's two cases on `robot`, simulated with the link errors of `truth` (a robot file's
+/// true_errors; its ranger errors are not used: the paper's ranger is exact).
+PaperCasesResult RunPaperCases(const RobotModel& robot, const Truth& truth, const Plane& plane,
                                const PaperCaseOptions& options);
 
 /// The slides' published identified parameter errors [case][link][θ α a d β] in mrad / mm
