@@ -7,7 +7,7 @@
 #   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
 #   docs     the API reference (Doxygen) builds without a warning
 #   fuzz     libFuzzer on the CSV readers, robot files, URDFs, study files and the number parser
-#            (ASan + UBSan, 25 s each: scripts/fuzz.sh)
+#            (ASan + UBSan, 15 s each in CI: scripts/fuzz.sh)
 # Usage: bash scripts/checks.sh [format|layers|tidy|docs|asan|tsan|fuzz ...]  (default: all, in order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,9 +18,10 @@ stages=("$@")
 stage() { echo "== checks: $1 ($(date -u +%H:%M:%S))"; }
 sanitizer_build() {  # dir, sanitizers, targets...
   local dir=$1 san=$2; shift 2
-  # The library as a unity build (CMakeLists.txt, LRCAL_UNITY): about half its compile time. Two
-  # sources that define the same name in their anonymous namespaces clash here: give such a
-  # helper one home (core/strings.h FileNumber, for one).
+  # The library and the test binaries as unity builds (CMakeLists.txt, LRCAL_UNITY): about half
+  # their compile time. Two sources of one target that define the same name in their anonymous
+  # namespaces clash here: give such a helper one home (core/strings.h FileNumber, core/
+  # settings.h kInf) or, in tests, a name of its own.
   cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
     -DLRCAL_SANITIZE="$san" -DLRCAL_BUILD_BENCH=OFF -DLRCAL_UNITY=ON > /dev/null
   cmake --build "$dir" -j2 --target "$@"
@@ -52,8 +53,11 @@ for s in "${stages[@]}"; do
       # The end-to-end report tests spend their time in Python and Chromium and in whole studies
       # whose C++ (runner, trials, tables) the study and CLI tests already run under ASan; they
       # run in the Release suite (setup.sh test) and stay out of this stage, which they would
-      # lengthen by several minutes for no code of their own.
-      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial)|Storage\.MergeAndReportThatCannotWrite.*)$'
+      # lengthen by several minutes for no code of their own. So do the statistical checks that
+      # repeat one computation hundreds of times (a sensitivity study of single trials, forty
+      # seeds of P95 intervals, the robust fit checks over many noise draws: 100 s of this
+      # stage's CPU time): one pass of the same code runs under ASan in other tests.
+      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial)|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*)$'
       # OpenMPI's own allocations are not freed at exit: leak checks off for the MPI tests only.
       ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j2 --output-on-failure \
         -E "^Mpi\.|$heavy"
@@ -64,13 +68,15 @@ for s in "${stages[@]}"; do
       # The statistics and sensitivity tests that run dozens of whole studies (4 of the 88, half
       # of this stage's time) repeat, on more trials, the threaded runner code that the
       # MonteCarlo, StopWhen and Mpi tests already run under TSan; they run in the Release and
-      # ASan suites.
-      repeats='^(Statistics\.(P95IntervalsOfFortySeeds.*|StreamingSummaryHasTheBitsOfSortingEveryValue)|SensitivityStudy\.(ASingleTrialsFigureHasTheNoiseAsAnInput|PlanPointsAreCells.*))$'
+      # ASan suites. So do the two kill -9 tests (100 s of this stage's CPU time): what they
+      # check is the store's durability across processes, not threads; the threaded runs they
+      # resume are the other MonteCarlo and Mpi tests' code.
+      repeats='^(Statistics\.(P95IntervalsOfFortySeeds.*|StreamingSummaryHasTheBitsOfSortingEveryValue)|SensitivityStudy\.(ASingleTrialsFigureHasTheNoiseAsAnInput|PlanPointsAreCells.*)|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables|MonteCarlo\.KilledProcessResumesToTheSameTables)$'
       TSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/tsan.supp:halt_on_error=1" \
         ctest --test-dir build-tsan -j2 --output-on-failure -L study -E "$repeats" ;;
     fuzz)
       stage fuzz
-      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-25}" ;;
+      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-15}" ;;
     *) echo "unknown stage '$s' (format, layers, tidy, docs, asan, tsan, fuzz)" >&2; exit 2 ;;
   esac
 done

@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "lrcal/core/settings.h"
 #include "lrcal/core/text_table.h"
 
 namespace lrcal {
@@ -15,7 +16,6 @@ namespace lrcal {
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // The sum of the k largest entries.
 double TopKSum(const Eigen::VectorXd& v, int k) {

@@ -12,9 +12,7 @@
 
 namespace lrcal {
 
-namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
-}  // namespace
+namespace {}  // namespace
 
 std::string DesignRequest::CriterionName() const {
   return task.count > 0 ? "I" : DesignCriterionName(selection.criterion);

@@ -93,7 +93,8 @@ PriorSigmas PriorSigmas::Parse(const std::string& text, const std::string& sourc
       throw InputError(source, where + ": '" + key +
                                    "' is neither a term nor a class of terms (theta, alpha, a, "
                                    "d, beta, plane_u, plane_f, ranger_offset, ranger_scale, "
-                                   "instrument_*, target_*, or one of their names: d6)");
+                                   "instrument_*, target_*, base_*, tool_*, or one of their "
+                                   "names: d6)");
     for (const Entry& e : priors.entries)
       if (e.key == key) throw InputError(source, where + ": '" + key + "' is given twice");
     std::string value = item.substr(eq + 1);

@@ -7,9 +7,7 @@
 
 namespace lrcal {
 
-namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
-}  // namespace
+namespace {}  // namespace
 
 const std::vector<SettingField<NoiseModel>>& NoiseModel::Settings() {
   using N = NoiseModel;

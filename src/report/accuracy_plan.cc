@@ -538,7 +538,6 @@ class Planner {
 }  // namespace
 
 const std::vector<SettingSpec>& AccuracyPlanOptions::Settings() {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   static const std::vector<SettingSpec> specs = {
       {"plan", "target", "target", "", 1, "", 0, kInf, false, false, "", "",
        "e.g. rms_pos=0.05mm: the quantile at the confidence of the worst axis must not exceed it"},

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lrcal/core/error.h"
+#include "lrcal/core/settings.h"
 #include "lrcal/study/statistics.h"
 #include "lrcal/study/trial_store.h"
 
@@ -41,7 +42,6 @@ void CellStopping::Add(const TrialRecord& r) {
 }
 
 void CellStopping::Evaluate() {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   // x/|y| with 0/0 = 0 (a metric that is exactly zero in every trial is known exactly).
   const auto relative = [](double x, double y) {
     if (x == 0) return 0.0;

@@ -5,9 +5,7 @@
 
 namespace lrcal {
 
-namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
-}  // namespace
+namespace {}  // namespace
 
 const std::vector<SettingField<TruthOptions>>& TruthOptions::Settings() {
   using T = TruthOptions;

@@ -17,7 +17,7 @@
 namespace lrcal {
 namespace {
 
-struct BadInput {
+struct BadInputCase {
   std::string name;
   std::map<std::string, std::string> files;  // name in {dir} → content
   std::string args;                          // the lrcal command line
@@ -25,7 +25,7 @@ struct BadInput {
   std::vector<std::string> expected;  // substrings of the output, all required
   std::string setup = "";             // shell command run first (in {dir})
 };
-void PrintTo(const BadInput& b, std::ostream* os) { *os << b.name; }
+void PrintTo(const BadInputCase& b, std::ostream* os) { *os << b.name; }
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
   for (std::size_t p = 0; (p = s.find(from, p)) != std::string::npos; p += to.size())
@@ -39,10 +39,10 @@ const char* kTwoLinkRobot =
     "name: two\nlinks:\n  - {theta: 0, alpha: 0, a: 0.5, d: 0, parameters: [theta, a]}\n"
     "  - {theta: 0, alpha: 0, a: 0.4, d: 0, parameters: [theta, a]}\n";
 
-class BadInputTest : public ::testing::TestWithParam<BadInput> {};
+class BadInputTest : public ::testing::TestWithParam<BadInputCase> {};
 
 TEST_P(BadInputTest, ExitCodeAndMessageNameWhereAndWhat) {
-  const BadInput& c = GetParam();
+  const BadInputCase& c = GetParam();
   const std::string dir = testing::TempDir("bad_" + c.name);
   const auto fill = [&](const std::string& s) {
     std::string out = Replace(Replace(s, "{study}", kStudy), "{dir}", dir);
@@ -64,8 +64,8 @@ TEST_P(BadInputTest, ExitCodeAndMessageNameWhereAndWhat) {
 
 std::string Nul() { return std::string("q1,q2,q3,q4,q5,q6\n0.1\0garbage,0,0,0,0,0\n", 39); }
 
-const std::vector<BadInput>& Cases() {
-  static const std::vector<BadInput> cases = {
+const std::vector<BadInputCase>& Cases() {
+  static const std::vector<BadInputCase> cases = {
       // ---- CSV files ---------------------------------------------------------------------
       {"CsvEmpty", {{"c.csv", ""}}, "kinematics --configs c.csv", 2, {"c.csv: empty file"}},
       {"CsvOnlyComments",
@@ -859,7 +859,7 @@ const std::vector<BadInput>& Cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, BadInputTest, ::testing::ValuesIn(Cases()),
-                         [](const ::testing::TestParamInfo<BadInput>& info) {
+                         [](const ::testing::TestParamInfo<BadInputCase>& info) {
                            return info.param.name;
                          });
 

@@ -18,7 +18,7 @@ namespace {
 using testing::LrcalBinary;
 using testing::RunCommand;
 
-int Lrcal(const std::string& args, std::string* out) {
+int ReplayLrcal(const std::string& args, std::string* out) {
   return RunCommand(LrcalBinary() + " " + args, out);
 }
 
@@ -30,7 +30,7 @@ void RunPaperStudy(const std::string& dir, const std::string& head, const std::s
                                  << "\n"
                                  << body;
   std::string out;
-  ASSERT_EQ(Lrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
+  ASSERT_EQ(ReplayLrcal("run " + dir + "/s.yaml --out " + dir + "/run --quiet", &out), 0) << out;
 }
 
 // The rows of `sql` on dir/run/trials.sqlite, every column as text.
@@ -57,7 +57,7 @@ class TrialReplayTest : public ::testing::Test {
     study_ = dir_ + "/s.yaml";
     WriteStudy(7);
     std::string out;
-    ASSERT_EQ(Lrcal("run " + study_ + " --out " + dir_ + "/run --quiet", &out), 0) << out;
+    ASSERT_EQ(ReplayLrcal("run " + study_ + " --out " + dir_ + "/run --quiet", &out), 0) << out;
   }
   void WriteStudy(int seed) const {
     std::ofstream(study_)
@@ -72,14 +72,17 @@ class TrialReplayTest : public ::testing::Test {
 TEST_F(TrialReplayTest, RecomputesARecordedTrialBitForBit) {
   std::string out;
   ASSERT_EQ(
-      Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.3' --trial 12 --format json", &out), 0)
+      ReplayLrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.3' --trial 12 --format json",
+                  &out),
+      0)
       << out;
   const auto j = nlohmann::json::parse(out);
   EXPECT_TRUE(j["stored"].get<bool>());
   EXPECT_TRUE(j["identical"].get<bool>());
   EXPECT_EQ(j["configurations"].size(), 30u);
   EXPECT_EQ(j["record"]["errors"].size(), j["parameters"].size());
-  ASSERT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 0", &out), 0) << out;
+  ASSERT_EQ(ReplayLrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 0", &out), 0)
+      << out;
   EXPECT_THAT(out, ::testing::HasSubstr("identical to the stored record, bit for bit")) << out;
 }
 
@@ -93,7 +96,8 @@ TEST_F(TrialReplayTest, ATamperedRecordIsReportedWithTheFieldsThatDiffer) {
             SQLITE_OK);
   sqlite3_close(db);
   std::string out;
-  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 4", &out), 1) << out;
+  EXPECT_EQ(ReplayLrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 4", &out), 1)
+      << out;
   EXPECT_THAT(out,
               ::testing::HasSubstr("DIFFERS from the stored record in: iterations val_rms_pos_y"))
       << out;
@@ -101,15 +105,17 @@ TEST_F(TrialReplayTest, ATamperedRecordIsReportedWithTheFieldsThatDiffer) {
 
 TEST_F(TrialReplayTest, BadRequestsAndAChangedStudyAreClearErrors) {
   std::string out;
-  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell nope --trial 1", &out), 2) << out;
+  EXPECT_EQ(ReplayLrcal("trial " + dir_ + "/run --cell nope --trial 1", &out), 2) << out;
   EXPECT_THAT(out,
               ::testing::HasSubstr("--cell: no cell 'nope' in the run; cells: noise.sigma_mm=0.1"))
       << out;
-  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 30", &out), 2) << out;
+  EXPECT_EQ(ReplayLrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 30", &out), 2)
+      << out;
   EXPECT_THAT(out, ::testing::HasSubstr("--trial: expected 0 to 29, got 30")) << out;
-  EXPECT_EQ(Lrcal("trial " + dir_ + " --cell x --trial 1", &out), 2) << out;  // not a run
+  EXPECT_EQ(ReplayLrcal("trial " + dir_ + " --cell x --trial 1", &out), 2) << out;  // not a run
   WriteStudy(8);
-  EXPECT_EQ(Lrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 1", &out), 2) << out;
+  EXPECT_EQ(ReplayLrcal("trial " + dir_ + "/run --cell 'noise.sigma_mm=0.1' --trial 1", &out), 2)
+      << out;
   EXPECT_THAT(out, ::testing::HasSubstr("has changed since the run")) << out;
 }
 
@@ -136,12 +142,12 @@ TEST(TrialReplayOfFailedTrials, EachStatusReplaysAndMatchesItsRecord) {
     statuses.insert(status);
     SCOPED_TRACE(status + " in cell " + label);
     const std::string args = "trial " + dir + "/run --cell " + label + " --trial " + trial;
-    ASSERT_EQ(Lrcal(args + " --format json", &out), 0) << out;
+    ASSERT_EQ(ReplayLrcal(args + " --format json", &out), 0) << out;
     const auto j = nlohmann::json::parse(out);
     EXPECT_TRUE(j["identical"].get<bool>()) << out;
     EXPECT_EQ(j["record"]["status"], status);
     EXPECT_EQ(j["failure"].is_null(), status == "ok");
-    ASSERT_EQ(Lrcal(args, &out), 0) << out;
+    ASSERT_EQ(ReplayLrcal(args, &out), 0) << out;
     EXPECT_THAT(out, ::testing::HasSubstr("identical to the stored record, bit for bit"));
     if (status != "ok") {
       EXPECT_THAT(out, ::testing::HasSubstr("the trial failed (" + status + "): "));
@@ -171,12 +177,12 @@ TEST(TrialReplayOfFailedTrials, AMissedBeamDropsItsConfigurationNotTheTrial) {
   EXPECT_EQ(status, "ok");
   ASSERT_GT(missed, 0) << "the study should make some true beams miss";
   const std::string args = "trial " + dir + "/run --cell base --trial " + trial;
-  ASSERT_EQ(Lrcal(args + " --format json", &out), 0) << out;
+  ASSERT_EQ(ReplayLrcal(args + " --format json", &out), 0) << out;
   const auto j = nlohmann::json::parse(out);
   EXPECT_TRUE(j["identical"].get<bool>()) << out;
   EXPECT_EQ(j["record"]["missed_configurations"], missed);
   EXPECT_EQ(j["configurations"].size() + static_cast<std::size_t>(missed), 40u);
-  ASSERT_EQ(Lrcal(args, &out), 0) << out;
+  ASSERT_EQ(ReplayLrcal(args, &out), 0) << out;
   EXPECT_THAT(out, ::testing::HasSubstr(std::to_string(missed) +
                                         " more of the design had no reading (the true beam "
                                         "missed its plane) and were left out"));

@@ -14,7 +14,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 const SettingSpec kSigma{"noise", "sigma", "sigma_mm", "mm", 1e-3, "m", 0, kInf, false, false};
 const SettingSpec kCount{"noise",
                          "repetitions",
@@ -75,7 +74,7 @@ TEST(Settings, ExclusiveEndsAreRefusedAndSaidSo) {
 TEST(Settings, TheLibraryNamesItsFieldInSiAndFrontEndsRespellIt) {
   EXPECT_THAT([] { kSigma.Check(-2e-4); },
               ThrowsMessage<SettingError>(
-                  testing::StrEq("noise.sigma: expected a finite value >= 0 (m), got -0.0002")));
+                  ::testing::StrEq("noise.sigma: expected a finite value >= 0 (m), got -0.0002")));
   try {
     kSigma.Check(-2e-4);
     FAIL() << "no error";

@@ -13,7 +13,7 @@
 namespace lrcal {
 namespace {
 
-Eigen::MatrixXd RandomMatrix(int rows, int cols, unsigned seed) {
+Eigen::MatrixXd BaselineRandomMatrix(int rows, int cols, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n;  // test data only
   Eigen::MatrixXd G(rows, cols);
@@ -23,7 +23,7 @@ Eigen::MatrixXd RandomMatrix(int rows, int cols, unsigned seed) {
 }
 
 TEST(RandomBaseline, ScoresTheChosenRowsAndDrawsTheRandomDesignsFromTheSeed) {
-  const Eigen::MatrixXd G = RandomMatrix(40, 4, 7);
+  const Eigen::MatrixXd G = BaselineRandomMatrix(40, 4, 7);
   SelectionOptions exchange;
   exchange.method = SelectionMethod::kExchange;
   const SelectionResult chosen =
@@ -53,7 +53,7 @@ TEST(RandomBaseline, ScoresTheChosenRowsAndDrawsTheRandomDesignsFromTheSeed) {
 }
 
 TEST(RandomBaseline, RefusesACountOutOfRangeNamingTheSetting) {
-  const Eigen::MatrixXd G = RandomMatrix(10, 2, 1);
+  const Eigen::MatrixXd G = BaselineRandomMatrix(10, 2, 1);
   try {
     CompareWithRandomDesigns(G, {0, 1, 2}, 0, 1);
     FAIL() << "no error";

@@ -20,7 +20,7 @@ namespace {
 using ::testing::Contains;
 using ::testing::HasSubstr;
 
-constexpr double kRecoveryTolerance = testing::tolerance::kRoundTrip;  // SI (m or rad)
+constexpr double kFrameRecoveryTolerance = testing::tolerance::kRoundTrip;  // SI (m or rad)
 
 FrameTerms All() {
   FrameTerms t;
@@ -29,7 +29,7 @@ FrameTerms All() {
 }
 
 // Three planes around the paper's arm on its tilted base, a ranger off the flange.
-PlaneSet ThreePlanes() {
+PlaneSet TiltedThreePlanes() {
   return PlaneSet(
       {Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8), Plane::FromCoefficients(1, 0.1, 0, 0.9),
        Plane::FromCoefficients(0, 1, 0.2, 0.9)},
@@ -72,7 +72,7 @@ bool Mentions(const Dependency& d, const std::string& name) {
 // yaw turns the arm about joint 1's axis exactly as θ1 does.
 TEST(FrameTermsIdentifiability, NamesTheDependencesOnTheEndLinks) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
-  const PlaneSet planes = ThreePlanes();
+  const PlaneSet planes = TiltedThreePlanes();
   const MeasurementModel model(robot, planes,
                                MakeParameterSet(robot, std::vector<PlaneTerms>(3), {}, "--fix",
                                                 RangerTerms{}, All(), All()));
@@ -103,7 +103,7 @@ TEST(FrameTermsIdentifiability, NamesTheDependencesOnTheEndLinks) {
 // readings of a robot whose base and tool are really moved, with either solver.
 TEST(FrameTermsRecovery, RecoversLinksBaseAndToolFromNoiseFreeReadings) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
-  const PlaneSet planes = ThreePlanes();
+  const PlaneSet planes = TiltedThreePlanes();
   const ConfigurationSet configs = FacingAll(robot, planes, 40);
   const ParameterSet asked =
       MakeParameterSet(robot, std::vector<PlaneTerms>(3), {}, "--fix", RangerTerms{}, All(), All());
@@ -130,7 +130,7 @@ TEST(FrameTermsRecovery, RecoversLinksBaseAndToolFromNoiseFreeReadings) {
     const IdentificationSummary s = Identify(model, data, options);
     ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
     for (int k = 0; k < ps.size(); ++k)
-      EXPECT_NEAR(s.delta[k], e_true[k], kRecoveryTolerance)
+      EXPECT_NEAR(s.delta[k], e_true[k], kFrameRecoveryTolerance)
           << s.names[k] << (solver == IdentificationOptions::Solver::kCeres ? " (Ceres)" : "");
     EXPECT_LT(s.residual_rms, 1e-12);
   }

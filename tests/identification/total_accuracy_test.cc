@@ -18,7 +18,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kSigma = 0.1e-3;  // m, the noise of one reading in these tests
+constexpr double kTotalSigma = 0.1e-3;  // m, the noise of one reading in these tests
 
 // Readings of the arm whose every term (robot, plane, ranger) deviates by e_all from nominal
 // (laid out as the complete parameter set); noise-free when seed is 0.
@@ -27,7 +27,7 @@ MeasurementSet ReadingsOfTruth(const Eigen::VectorXd& e_all, const Configuration
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel complete(robot, plane, CompleteParameterSet(robot, 1));
   NoiseModel noise;
-  noise.sigma = seed ? kSigma : 0;
+  noise.sigma = seed ? kTotalSigma : 0;
   noise.repetitions = 1;
   noise.ranger_offset = e_all[complete.parameters().ranger_offset_index];
   noise.ranger_scale = e_all[complete.parameters().ranger_scale_index];
@@ -41,7 +41,7 @@ MeasurementSet ReadingsOfTruth(const Eigen::VectorXd& e_all, const Configuration
 
 IdentificationOptions GivenSigma() {
   IdentificationOptions options;
-  options.sigma = kSigma;
+  options.sigma = kTotalSigma;
   return options;
 }
 
@@ -152,7 +152,7 @@ TEST(ChooseSigma, UsesTheResidualsWhenTheGivenSigmaIsRejected) {
   const IdentificationSummary good = Identify(model, data, GivenSigma());
   ASSERT_TRUE(good.fit.consistent);
   EXPECT_EQ(ChooseSigma(good, GivenSigma()).source, "given");
-  EXPECT_EQ(ChooseSigma(good, GivenSigma()).sigma, kSigma);
+  EXPECT_EQ(ChooseSigma(good, GivenSigma()).sigma, kTotalSigma);
   data.mean_h[3] += 3e-3;
   data.mean_h[17] += 3e-3;
   const IdentificationSummary bad = Identify(model, data, GivenSigma());
@@ -160,7 +160,7 @@ TEST(ChooseSigma, UsesTheResidualsWhenTheGivenSigmaIsRejected) {
   const SigmaUsed used = ChooseSigma(bad, GivenSigma());
   EXPECT_EQ(used.source, "residual");
   EXPECT_EQ(used.sigma, bad.sigma_hat);
-  EXPECT_GT(used.sigma, 5 * kSigma);
+  EXPECT_GT(used.sigma, 5 * kTotalSigma);
   EXPECT_THAT(used.reason, HasSubstr("rejects the given sigma 0.1000 mm"));
   EXPECT_EQ(&CovarianceFor(bad, used), &bad.covariance_residual);
   EXPECT_EQ(ChooseSigma(bad, IdentificationOptions{}).source, "residual");

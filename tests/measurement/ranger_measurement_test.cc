@@ -16,7 +16,7 @@ namespace {
 
 using testing::EigenNear;
 // The batch kernel against the per-configuration path: the same formulas in another order.
-constexpr double kBatchAgreement = 1e-13;
+constexpr double kRangerBatchAgreement = 1e-13;
 
 TEST(RangerMeasurement, PredictionsAndJacobianAreTheMeasurementModels) {
   const RobotModel& robot = testing::PaperRobot();
@@ -31,7 +31,8 @@ TEST(RangerMeasurement, PredictionsAndJacobianAreTheMeasurementModels) {
   std::vector<double> e(kind.num_parameters());
   for (int k = 0; k < kind.num_parameters(); ++k) e[k] = (k % 2 ? 1e-3 : -2e-3);
   const Eigen::MatrixXd G = MeasurementJacobian(kind, configs, e.data());
-  EXPECT_THAT(G, EigenNear(IdentificationJacobian(model, configs, e.data()), kBatchAgreement));
+  EXPECT_THAT(G,
+              EigenNear(IdentificationJacobian(model, configs, e.data()), kRangerBatchAgreement));
   std::vector<double> y(configs.size());
   kind.Bind(configs)->Predict(e.data(), y.data(), nullptr);
   ModelPoint point;
@@ -39,7 +40,7 @@ TEST(RangerMeasurement, PredictionsAndJacobianAreTheMeasurementModels) {
   for (int i = 0; i < configs.size(); ++i) {
     double h;
     model.Evaluate(point, configs, i, &h, nullptr);
-    EXPECT_NEAR(y[i], h, kBatchAgreement) << i;
+    EXPECT_NEAR(y[i], h, kRangerBatchAgreement) << i;
   }
   // Nominal values: link values, the plane's offset, zero for chart and ranger terms.
   const Eigen::VectorXd nominal = kind.NominalValues();

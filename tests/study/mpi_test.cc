@@ -31,7 +31,7 @@ bool MpiAvailable() {
   return BuiltWithMpi() && testing::RunCommand("command -v mpirun", &out) == 0;
 }
 
-std::map<std::string, std::string> Tables(const std::string& dir) {
+std::map<std::string, std::string> MpiTables(const std::string& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::directory_iterator(fs::path(dir) / "tables")) {
     std::ifstream in(e.path(), std::ios::binary);
@@ -42,7 +42,7 @@ std::map<std::string, std::string> Tables(const std::string& dir) {
   return out;
 }
 
-std::string Study(const std::string& dir, int trials) {
+std::string MpiStudyFile(const std::string& dir, int trials) {
   const std::string path = dir + "/mpi.yaml";
   std::ofstream(path) << "name: mpi\nseed: 5\ntrials: " << trials
                       << "\nrobot: " << testing::SourcePath("studies/robots/paper.yaml")
@@ -70,7 +70,7 @@ void ExpectRanksMatchSingleProcess(const std::string& dir, const std::string& st
                             &out),
         0)
         << out;
-    EXPECT_EQ(Tables(dir + "/single"), Tables(run)) << "np " << np << " " << extra;
+    EXPECT_EQ(MpiTables(dir + "/single"), MpiTables(run)) << "np " << np << " " << extra;
     EXPECT_FALSE(fs::exists(run + "/trials.rank1.sqlite"));  // merged into trials.sqlite
   }
 }
@@ -85,7 +85,7 @@ TEST(Mpi, DynamicScheduleGivesTheSameTables) {
   if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
   const std::string dir = testing::TempDir("mpi_dynamic");
   // 600 trials: 10 chunks of 64 over the ranks.
-  ExpectRanksMatchSingleProcess(dir, Study(dir, 150), "--schedule dynamic");
+  ExpectRanksMatchSingleProcess(dir, MpiStudyFile(dir, 150), "--schedule dynamic");
 }
 
 TEST(Mpi, StopWhenStopsTheCellsAtTheSameTrialsAsASingleProcess) {
@@ -101,7 +101,7 @@ TEST(Mpi, StopWhenStopsTheCellsAtTheSameTrialsAsASingleProcess) {
          "sweep:\n  axes:\n    - key: selection.count\n      values: [30, 59]\n";
   ExpectRanksMatchSingleProcess(dir, study, "");
   ExpectRanksMatchSingleProcess(dir + "/dynamic", study, "--schedule dynamic");
-  const std::string summary = Tables(dir + "/np2").at("summary.json");
+  const std::string summary = MpiTables(dir + "/np2").at("summary.json");
   EXPECT_THAT(summary, ::testing::HasSubstr("\"reason\": \"precision\""));
 }
 
@@ -109,7 +109,7 @@ TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
   if (!MpiAvailable()) GTEST_SKIP() << "lrcal built without MPI, or no mpirun";
   const std::string dir = testing::TempDir("mpi_kill");
   const std::string study =
-      Study(dir, 6000);  // 24,000 trials: about a second on 3 single-thread ranks
+      MpiStudyFile(dir, 6000);  // 24,000 trials: about a second on 3 single-thread ranks
   const std::string run = dir + "/run";
   const pid_t launcher = fork();
   if (launcher == 0) {
@@ -159,7 +159,7 @@ TEST(Mpi, KilledRankResumesWithAnotherRankCountToTheSameTables) {
           testing::LrcalBinary() + " run " + study + " --out " + dir + "/single --quiet", &out),
       0)
       << out;
-  EXPECT_EQ(Tables(dir + "/single"), Tables(run));
+  EXPECT_EQ(MpiTables(dir + "/single"), MpiTables(run));
 }
 
 }  // namespace

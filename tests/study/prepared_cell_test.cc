@@ -15,7 +15,7 @@
 namespace lrcal {
 namespace {
 
-std::string SmallStudy(const std::string& dir) {
+std::string PreparedSmallStudy(const std::string& dir) {
   std::ofstream(dir + "/s.yaml") << "name: p\nseed: 3\ntrials: 4\nrobot: "
                                  << testing::SourcePath("studies/robots/paper.yaml")
                                  << "\npool: {size: 60}\nvalidation: {size: 5}\n"
@@ -36,7 +36,7 @@ void ExpectSameRecord(const TrialRecord& a, const TrialRecord& b) {
 
 TEST(PreparedCell, ATrialIsTheRunnersRecordBitForBitFromAnyThread) {
   const std::string dir = testing::TempDir("prepared_cell");
-  const Study study = LoadStudy(SmallStudy(dir));
+  const Study study = LoadStudy(PreparedSmallStudy(dir));
   RunOptions o;
   o.out_dir = dir + "/run";
   o.threads = 2;
@@ -60,7 +60,7 @@ TEST(PreparedCell, ATrialIsTheRunnersRecordBitForBitFromAnyThread) {
 
 TEST(PreparedCell, DescribesTheCell) {
   const std::string dir = testing::TempDir("prepared_cell_describe");
-  const Study study = LoadStudy(SmallStudy(dir));
+  const Study study = LoadStudy(PreparedSmallStudy(dir));
   const PreparedCell cell = PreparedCell::Prepare(study, study.cells.at(0));
   EXPECT_EQ(cell.pool().size(), 60);
   EXPECT_EQ(cell.validation().size(), 5);

@@ -27,7 +27,7 @@ const char kStudy[] =
     "  inputs:\n    - {key: noise.sigma_mm, min: 0.1, max: 0.4}\n"
     "    - {key: noise.outlier_sigma_mm, min: 1, max: 10}\n";
 
-std::string WriteStudy(const std::string& dir, const std::string& method) {
+std::string WriteSensitivityStudy(const std::string& dir, const std::string& method) {
   std::string text = kStudy;
   text.replace(text.find("METHOD"), 6, method);
   std::ofstream(dir + "/s.yaml") << text;
@@ -36,7 +36,7 @@ std::string WriteStudy(const std::string& dir, const std::string& method) {
 
 TEST(SensitivityStudy, PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices) {
   const std::string dir = testing::TempDir("sensitivity_sobol");
-  const Study study = LoadStudy(WriteStudy(dir, "sobol"));
+  const Study study = LoadStudy(WriteSensitivityStudy(dir, "sobol"));
   // Saltelli: N(d+2) = 6·4 = 24 points; AB_2 differs from A only in outlier_sigma_mm (the same
   // cells as A), and AB_1 only from B: 12 distinct cells.
   ASSERT_EQ(study.sensitivity["plan_cells"].size(), 24u);
@@ -63,7 +63,7 @@ TEST(SensitivityStudy, PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices) 
 
 TEST(SensitivityStudy, MorrisScreensTheInputs) {
   const std::string dir = testing::TempDir("sensitivity_morris");
-  const Study study = LoadStudy(WriteStudy(dir, "morris"));
+  const Study study = LoadStudy(WriteSensitivityStudy(dir, "morris"));
   EXPECT_EQ(study.sensitivity["plan_cells"].size(), 6u * 3);  // r(d+1)
   ASSERT_TRUE(testing::RunStudyFile(dir + "/s.yaml", dir + "/run", 2).complete);
   const auto j = nlohmann::json::parse(testing::ReadFile(dir + "/run/tables/summary.json"));

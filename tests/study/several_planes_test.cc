@@ -21,7 +21,7 @@ constexpr const char* kTwoPlanes =
     "  - {normal: [0, 1, 4.6], offset: -0.69, name: paper, share: 2}\n"
     "  - {normal: [1, 0, 0], offset: 0.9, name: wall, estimate: offset}\n";
 
-std::string WriteStudy(const std::string& dir, const std::string& body) {
+std::string WritePlanesStudy(const std::string& dir, const std::string& body) {
   const std::string path = dir + "/s.yaml";
   std::ofstream(path) << "name: planes\nseed: 3\ntrials: 5\nrobot: paper\n"
                          "selection: {count: 40}\n"
@@ -37,8 +37,8 @@ int CountOn(const ConfigurationSet& c, int plane) {
 
 TEST(SeveralPlanes, ThePoolIsSplitByShareAndEveryBeamHitsItsPlane) {
   const std::string dir = testing::TempDir("several_planes_split");
-  const Study study = LoadStudy(
-      WriteStudy(dir, std::string(kTwoPlanes) + "pool: {size: 61}\nvalidation: {size: 10}\n"));
+  const Study study = LoadStudy(WritePlanesStudy(
+      dir, std::string(kTwoPlanes) + "pool: {size: 61}\nvalidation: {size: 10}\n"));
   const auto c = PrepareCell(study, study.cells[0]);
   ASSERT_EQ(c->planes.size(), 2);
   EXPECT_EQ(c->planes.name(1), "wall");
@@ -74,7 +74,7 @@ TEST(SeveralPlanes, PoolFilePlaneColumnIsResolvedAndValidationsIgnored) {
     std::ofstream(dir + "/val.csv") << "q1,q2,q3,q4,q5,q6,plane\n0.1,-0.7,0.2,0,0.3,0,9\n"
                                        "0.2,-0.5,0.1,0.4,0.3,0.2,9\n";
   }
-  const Study study = LoadStudy(WriteStudy(
+  const Study study = LoadStudy(WritePlanesStudy(
       dir, std::string(kTwoPlanes) + "pool: {file: pool.csv}\nvalidation: {file: val.csv}\n"));
   const auto c = PrepareCell(study, study.cells[0]);
   // Rows whose true beam misses are dropped; the rest keep their plane.
@@ -85,7 +85,7 @@ TEST(SeveralPlanes, PoolFilePlaneColumnIsResolvedAndValidationsIgnored) {
 
   // A pool naming a plane the study does not list is refused, naming the file's line.
   std::ofstream(dir + "/pool.csv", std::ios::app) << "0,0,0,0,0,0,ceiling\n";
-  const Study bad = LoadStudy(WriteStudy(
+  const Study bad = LoadStudy(WritePlanesStudy(
       dir, std::string(kTwoPlanes) + "pool: {file: pool.csv}\nvalidation: {file: val.csv}\n"));
   try {
     PrepareCell(bad, bad.cells[0]);

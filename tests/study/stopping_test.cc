@@ -170,7 +170,7 @@ RunResult RunAdaptive(const std::string& study, const std::string& out, int thre
   return testing::RunStudyFile(study, out, threads, shard_index, shard_count, max_new, 13);
 }
 
-std::map<std::string, std::string> Tables(const std::string& dir) {
+std::map<std::string, std::string> StoppingTables(const std::string& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::directory_iterator(fs::path(dir) / "tables"))
     out[e.path().filename().string()] = testing::ReadFile(e.path().string());
@@ -199,10 +199,10 @@ TEST(StopWhen, StopsEveryCellWithThePrecisionStatedBitIdenticalAcrossThreadsShar
   } while (!slice.complete);
   EXPECT_GT(slices, 2);
 
-  const auto reference = Tables(dir + "/t1");
-  EXPECT_EQ(reference, Tables(dir + "/t2"));
-  EXPECT_EQ(reference, Tables(dir + "/merged"));
-  EXPECT_EQ(reference, Tables(dir + "/sliced"));
+  const auto reference = StoppingTables(dir + "/t1");
+  EXPECT_EQ(reference, StoppingTables(dir + "/t2"));
+  EXPECT_EQ(reference, StoppingTables(dir + "/merged"));
+  EXPECT_EQ(reference, StoppingTables(dir + "/sliced"));
 
   // Every cell stopped early with the precision stated, checked on the tables' own numbers, and
   // not one block later than needed.
@@ -249,13 +249,13 @@ TEST(StopWhen, ACellThatNeverGetsPreciseRunsToTheMaximum) {
   const RunResult r = RunAdaptive(study, dir + "/run", 2);
   EXPECT_TRUE(r.complete);
   EXPECT_EQ(r.computed, 4 * 150);
-  const Json summary = Json::parse(Tables(dir + "/run").at("summary.json"));
+  const Json summary = Json::parse(StoppingTables(dir + "/run").at("summary.json"));
   for (const auto& c : summary["cells"]) {
     EXPECT_EQ(c["stop"]["reason"], "maximum");
     EXPECT_EQ(c["stop"]["trials_used"], 150);
     EXPECT_GT(c["stop"]["relative_se"].get<double>(), 0.0001);
   }
-  EXPECT_THAT(Tables(dir + "/run").at("summary.md"),
+  EXPECT_THAT(StoppingTables(dir + "/run").at("summary.md"),
               ::testing::HasSubstr("maximum 150 (precision not reached)"));
 }
 

@@ -22,6 +22,10 @@
 
 namespace lrcal {
 
+/// +∞: the open upper end of a setting's range (SettingSpec::max), one definition for every
+/// settings table.
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
 /// Who reads a setting, for its spelling in messages.
 enum class Frontend { kLibrary, kStudyFile, kCommandLine, kPython };
 
