@@ -20,16 +20,17 @@ int main(int argc, char** argv) {
   const lrcal::ConfigurationSet configs = lrcal::SampleConfigurations(
       rig.robot, planes, {60}, lrcal::RandomStream(7, 0, 0, lrcal::RandomPurpose::kPool), sampling);
   lrcal::MeasurementSet data;
-  lrcal::SimulateReadings(rig.robot, rig.robot.true_values(), planes, rig.ranger, configs,
+  lrcal::SimulateReadings(rig.robot, rig.truth.LinkValues(rig.robot), planes, rig.ranger, configs,
                           lrcal::NoiseModel{0.2e-3, 10},
                           lrcal::RandomStream(7, 0, 0, lrcal::RandomPurpose::kNoise), &data);
   const lrcal::MeasurementModel model(rig.robot, planes,
                                       lrcal::MakeParameterSet(rig.robot, lrcal::PlaneTerms{}));
   const lrcal::IdentificationSummary s = lrcal::Identify(model, data);
+  // The file's true_errors: (RobotFile::truth), what the simulation read from.
+  const Eigen::VectorXd true_errors = rig.truth.LinkErrors(rig.robot);
   double worst = 0;
   for (std::size_t k = 0; k < s.names.size(); ++k)
-    worst = std::max(
-        worst, std::abs(s.delta[k] - rig.robot.true_errors()[rig.robot.FindValue(s.names[k])]));
+    worst = std::max(worst, std::abs(s.delta[k] - true_errors[rig.robot.FindValue(s.names[k])]));
   std::cout << s.BriefReport() << "\nlargest error of the identified parameters: " << worst * 1e3
             << " (mm or mrad)\n";
   return s.IsSolutionUsable() ? 0 : 1;
