@@ -314,7 +314,9 @@ std::string PoseTable(const AccuracyPrediction& p) {
   return t.ToText();
 }
 
-std::string SourceTable(const AccuracyPrediction& p) {
+}  // namespace
+
+std::string AccuracySourceTable(const AccuracyPrediction& p) {
   constexpr std::size_t kShown = 12;
   Table t({"source", "prior", "absorbed by", "position RMS mm", "orientation RMS mrad",
            "share of the total"},
@@ -346,8 +348,6 @@ std::string SourceTable(const AccuracyPrediction& p) {
   return t.ToText();
 }
 
-}  // namespace
-
 std::string AccuracyPredictionText(const AccuracyPrediction& p) {
   std::vector<double> radii;
   double data_ms = 0;
@@ -367,7 +367,7 @@ std::string AccuracyPredictionText(const AccuracyPrediction& p) {
   if (!p.sigma_used.source.empty())
     t += "sigma used: " + Fixed(p.sigma_used.sigma * 1e3) + " mm per reading (" +
          p.sigma_used.reason + ")\n";
-  t += SourceTable(p);
+  t += AccuracySourceTable(p);
   if (!p.defaulted.empty()) {
     t += "warning: no tolerance known for " + std::to_string(p.defaulted.size()) +
          " held terms; the stated defaults (" + p.defaults.ToString() + ") were used for:";

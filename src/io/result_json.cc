@@ -193,6 +193,20 @@ ResultJson CrossValidationJson(const CrossValidation& cv) {
           {"beyond_4", beyond}};
 }
 
+ResultJson AccuracySourcesJson(const std::vector<AccuracySource>& sources) {
+  ResultJson out = ResultJson::array();
+  for (const AccuracySource& s : sources)
+    out.push_back(
+        {{"name", s.name},
+         {"prior_sigma", s.prior_sigma > 0 ? ResultJson(s.prior_sigma) : ResultJson()},
+         {"defaulted", s.defaulted},
+         {"absorbed_by", s.absorbed_by.empty() ? ResultJson() : ResultJson(s.absorbed_by)},
+         {"position_rms", s.position_rms},
+         {"orientation_rms", s.orientation_rms},
+         {"share", s.share}});
+  return out;
+}
+
 ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction, const ConfigurationSet& configs) {
   const std::vector<PoseAccuracy>& poses = prediction.poses;
   ResultJson list = ResultJson::array();
@@ -207,16 +221,7 @@ ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction, const Configur
                     {"orientation_std_total", Vec3(p.orientation_std_total)},
                     {"position_radius_95_total", p.position_radius_95_total}});
   }
-  ResultJson sources = ResultJson::array();
-  for (const AccuracySource& s : prediction.sources)
-    sources.push_back(
-        {{"name", s.name},
-         {"prior_sigma", s.prior_sigma > 0 ? ResultJson(s.prior_sigma) : ResultJson()},
-         {"defaulted", s.defaulted},
-         {"absorbed_by", s.absorbed_by.empty() ? ResultJson() : ResultJson(s.absorbed_by)},
-         {"position_rms", s.position_rms},
-         {"orientation_rms", s.orientation_rms},
-         {"share", s.share}});
+  const ResultJson sources = AccuracySourcesJson(prediction.sources);
   const PoseAccuracySummary s = SummarizePoseAccuracy(poses);
   return {{"poses", list},
           {"rms_position", s.rms_position},

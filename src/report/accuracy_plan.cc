@@ -292,6 +292,7 @@ class Planner {
                                (subsets_.size() > 1 ? "_" + std::to_string(sub + 1) : "") + ".yaml";
       WriteStudy(study_, path, study_.name + "-search", 1, in_.seed, one, subsets_,
                  validation_file_);
+      search_paths_.push_back(path);
       const Study search = LoadStudy(path);
       for (const Cell& cell : search.cells) {
         const PreparedCell prepared = PreparedCell::Prepare(search, cell);
@@ -304,6 +305,19 @@ class Planner {
     std::stable_sort(
         feasible_.begin(), feasible_.end(),
         [](const Candidate& a, const Candidate& b) { return a.campaign.cost < b.campaign.cost; });
+  }
+
+  // The chosen campaign's statement by source: its search cell prepared again (the same design),
+  // at its readings.
+  void StateChosen() {
+    const PlannedCampaign& c = feasible_[0].campaign;
+    const Study search = LoadStudy(search_paths_.at(c.subset));
+    for (const Cell& cell : search.cells)
+      if (cell.typed.select_count == c.configurations) {
+        chosen_statement_ =
+            PreparedCell::Prepare(search, cell).StatedValidationAccuracy(c.repetitions);
+        return;
+      }
   }
 
   // Monte Carlo: the cheapest, the same with one reading fewer, and two runner-ups.
@@ -338,6 +352,7 @@ class Planner {
     plan.subsets = std::move(subsets_);
     plan.campaigns = std::move(confirm_);
     plan.search_seconds = search_seconds_;
+    plan.chosen_statement = std::move(chosen_statement_);
     plan.defaulted = std::move(defaulted_);
     plan.exact = std::move(exact_);
     plan.study_path = study_path_;
@@ -530,6 +545,8 @@ class Planner {
   std::vector<Candidate> feasible_;
   std::vector<PlannedCampaign> confirm_;
   std::vector<std::string> defaulted_, exact_;
+  std::vector<std::string> search_paths_;  // the search study of each plane subset
+  std::optional<AccuracyPrediction> chosen_statement_;
   double smallest_held_ = std::numeric_limits<double>::infinity();
   double search_seconds_ = 0;
   Table search_table_{{}};
@@ -697,22 +714,26 @@ ResultJson AccuracyPlan::ToJson() const {
          {"trials", c.trials},
          {"meets_target", Meets(c)}});
   j["campaigns"] = cs;
+  j["chosen_sources"] =
+      chosen_statement ? AccuracySourcesJson(chosen_statement->sources) : ResultJson();
   j["study"] = study_path;
   j["run"] = run_dir;
   return j;
 }
 
-std::string AccuracyPlan::ToText() const {
+namespace {
+
+// What the search table holds and leaves out, and which held terms took a default tolerance.
+std::string SearchNotes(const AccuracyPlan& plan) {
   std::ostringstream out;
-  out << search_table.ToText()
-      << "(— : no campaign there: the prediction is not finite, e.g. parameters the "
+  out << "(— : no campaign there: the prediction is not finite, e.g. parameters the "
          "planes cannot identify, or more readings than --repetitions allows)\n"
       << "reading noise: the estimated parameters' covariance; held terms: every term the "
          "calibration holds at nominal (fixed parameters, plane and ranger terms not estimated, "
          "a base or tool term with a tolerance), each at its tolerance (identification."
          "prior_sigma, else the robot file's tolerances:, else lrcal's defaults); total: both "
          "(README: What a calibration cannot see). The plan is on "
-      << (options.plan_on == PlanBasis::kTotal
+      << (plan.options.plan_on == PlanBasis::kTotal
               ? "the total (--plan-on data, Python plan_on='data': on the reading noise's part "
                 "alone)"
               : "the reading noise's part alone (plan_on data): the held terms may make the "
@@ -720,15 +741,23 @@ std::string AccuracyPlan::ToText() const {
       << ". The Monte-Carlo confirmation simulates the study's truth: it has every error that "
          "truth has and no other, so the held terms count there only as far as the truth moves "
          "them.\n";
-  if (!defaulted.empty()) {
-    out << "warning: no tolerance known for " << defaulted.size()
-        << " held terms; the stated defaults (" << defaults.ToString() << ") were used for:";
-    for (const std::string& name : defaulted) out << " " << name;
+  if (!plan.defaulted.empty()) {
+    out << "warning: no tolerance known for " << plan.defaulted.size()
+        << " held terms; the stated defaults (" << plan.defaults.ToString() << ") were used for:";
+    for (const std::string& name : plan.defaulted) out << " " << name;
     out << "\n";
   }
-  if (!exact.empty())
-    out << "note: taken as exact (no tolerance given, not estimated): " << ExactFramesText(exact)
-        << "\n";
+  if (!plan.exact.empty())
+    out << "note: taken as exact (no tolerance given, not estimated): "
+        << ExactFramesText(plan.exact) << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+std::string AccuracyPlan::ToText() const {
+  std::ostringstream out;
+  out << search_table.ToText() << SearchNotes(*this);
   out << "\n";
   const bool stopped = options.stop_precision > 0;
   std::vector<std::string> header = {"campaign",
@@ -774,6 +803,11 @@ std::string AccuracyPlan::ToText() const {
     out << "The Monte Carlo has the held terms' errors only as far as the study's truth has them: "
            "it confirms the rest; the held terms' part of the total is first order, from their "
            "tolerances.\n";
+  if (chosen_statement)
+    out << "\nThe chosen campaign's total by source (first order, "
+        << std::to_string(campaigns.empty() ? 0 : campaigns[0].repetitions)
+        << " readings per configuration, over the validation poses):\n"
+        << AccuracySourceTable(*chosen_statement);
   out << "\nsearch " << Fixed(search_seconds, 1) << " s; the campaigns as a study: " << study_path
       << " (run it with another "
       << "seed to check), its run: " << run_dir << "\n";
@@ -784,6 +818,7 @@ AccuracyPlan PlanAccuracy(const Study& study, const AccuracyPlanOptions& options
   Planner planner(study, Resolve(options, study));
   planner.PrepareSetUp();
   planner.Search();
+  planner.StateChosen();
   planner.Confirm();
   return std::move(planner).Finish(options);
 }

@@ -104,6 +104,16 @@ TEST(PlanAccuracy, PlansOnTheTotalAndTheMonteCarloOfAHeldTermConfirmsIt) {
   EXPECT_LE(chosen["predicted_total"].get<double>(), 0.08) << chosen.dump();
   EXPECT_EQ(chosen["predicted"], chosen["predicted_total"]);
   EXPECT_LT(chosen["predicted_data"].get<double>(), chosen["predicted_total"].get<double>());
+  // The chosen campaign's total by source: the held d6 and the reading noise's part.
+  std::set<std::string> sources;
+  double shares = 0;
+  for (const auto& s : total["chosen_sources"]) {
+    sources.insert(s["name"].get<std::string>());
+    shares += s["share"].get<double>();
+  }
+  EXPECT_THAT(sources, ::testing::Contains("d6")) << total["chosen_sources"].dump();
+  EXPECT_THAT(sources, ::testing::Contains("estimated parameters (reading noise)"));
+  EXPECT_NEAR(shares, 1, 1e-9);  // the shares of the mean square add up to the total
   for (const auto& c : total["campaigns"]) {
     if (c["label"] == "one reading fewer") {
       EXPECT_GT(c["predicted_total"].get<double>(), 0.08);

@@ -146,6 +146,11 @@ std::optional<AccuracyPrediction> PredictAccuracyAfterFit(const MeasurementModel
                                                           const UnestimatedTerms& held,
                                                           const ConfigurationSet& poses);
 
+/// The sources of a statement as a table: name, prior σ (and whether it is the default), the
+/// estimated term that absorbs it, its position and orientation RMS over the poses (mm, mrad) and
+/// its share of the total mean square; the twelve largest, the rest summed in one row.
+std::string AccuracySourceTable(const AccuracyPrediction& prediction);
+
 /// The statement as text: the summary, the σ used, the source table, a warning naming the terms
 /// that took a default tolerance (if any), then the per-pose table (data part and total, mm and
 /// mrad).

@@ -45,6 +45,9 @@ ResultJson CrossValidationJson(const CrossValidation& cv);
 /// orientation_rms, share), `defaulted` (held terms with the default σ), `defaults` (the
 /// stated defaults in words) and `sigma_used`
 /// (sigma, source "given" or "residual", reason).
+/// The sources of a statement: name, prior_sigma (SI, null for the data part), defaulted,
+/// absorbed_by (null when none), position_rms (m), orientation_rms (rad), share.
+ResultJson AccuracySourcesJson(const std::vector<AccuracySource>& sources);
 ResultJson PoseAccuracyJson(const AccuracyPrediction& prediction, const ConfigurationSet& configs);
 /// A design certificate with its statement.
 ResultJson CertificateJson(const DesignCertificate& certificate, const std::string& statement);

@@ -150,6 +150,9 @@ struct AccuracyPlan {
   /// over every plane subset (total_accuracy.h).
   std::vector<std::string> defaulted, exact;
   DefaultTolerances defaults;
+  /// The chosen campaign's total by source at the validation poses (first order at its
+  /// readings: the statement a calibration of it would make); none when not predicted.
+  std::optional<AccuracyPrediction> chosen_statement;
   double search_seconds = 0;
   std::string study_path;  ///< the confirmation study
   std::string run_dir;     ///< its run
