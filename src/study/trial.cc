@@ -449,8 +449,11 @@ Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
   return LinearisedPartDraws(c, draws, c.predicted_covariance, Eigen::MatrixXd()).data;
 }
 
-// The cell's settings with `repetitions` readings per configuration.
+// The cell's settings with `repetitions` readings per configuration (InputError below 1).
 CellSettings WithRepetitions(const CellSettings& s, int repetitions) {
+  if (repetitions < 1)
+    throw InputError("repetitions", "expected 1 or more readings per configuration, got " +
+                                        std::to_string(repetitions));
   CellSettings out = s;
   out.noise.repetitions = repetitions;
   return out;
@@ -764,9 +767,6 @@ Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws) {
 }
 
 FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int repetitions) {
-  if (repetitions < 1)
-    throw InputError("repetitions", "expected 1 or more readings per configuration, got " +
-                                        std::to_string(repetitions));
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
   const Eigen::MatrixXd C = DesignCovariance(s, c);
   Eigen::MatrixXd held;
@@ -778,9 +778,6 @@ FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int r
 }
 
 std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c, int repetitions) {
-  if (repetitions < 1)
-    throw InputError("repetitions", "expected 1 or more readings per configuration, got " +
-                                        std::to_string(repetitions));
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
   const Eigen::MatrixXd C = DesignCovariance(s, c);
   if (C.size() == 0 || !C.allFinite()) return std::nullopt;
