@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   // The file's planes (one here): 60 configurations whose beam hits them, readings, and the
   // identification against the same planes.
   const lrcal::PlaneSet& planes = *rig.planes;
-  const lrcal::ConfigurationSet configs = lrcal::SampleConfigurations(
+  const lrcal::TargetedConfigurations configs = lrcal::SampleConfigurations(
       rig.robot, planes, {60}, lrcal::RandomStream(7, 0, 0, lrcal::RandomPurpose::kPool), sampling);
   lrcal::MeasurementSet data;
   lrcal::SimulateReadings(rig.robot, rig.truth.LinkValues(rig.robot), planes, rig.ranger, configs,

@@ -86,7 +86,7 @@ int KinematicsCommand(const std::vector<std::string>& args) {
   const std::string which = vm["model"].as<std::string>();
   if (which != "nominal" && which != "true")
     throw InputError("--model", "expected nominal or true, got '" + which + "'");
-  const ConfigurationSet configs =
+  const TargetedConfigurations configs =
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   const KinematicsReport report =
       ReportKinematics(rig, planes, ResolveParameterSet(robot, vm, planes.size()), which == "true",
@@ -126,7 +126,7 @@ int SampleCommand(const std::vector<std::string>& args) {
   options.Validate();
   SamplingReport report;
   const bool validation = vm["validation"].as<bool>();
-  ConfigurationSet configs = SampleConfigurations(
+  TargetedConfigurations configs = SampleConfigurations(
       robot, planes, std::vector<int>(planes.size(), count),
       RandomStream(ParseSeed(vm), 0, 0,
                    validation ? RandomPurpose::kValidation : RandomPurpose::kPool),
@@ -151,7 +151,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const PlaneSet& planes = setup.planes;
-  const ConfigurationSet configs =
+  const TargetedConfigurations configs =
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   NoiseModel noise;
   noise.ranger_offset = rig.truth.ranger_offset;  // the robot file's true ranger errors
@@ -360,7 +360,7 @@ namespace {
 std::optional<PriorInformation> PriorInformationAt(const po::variables_map& vm,
                                                    const RobotFile& rig,
                                                    const MeasurementModel& model,
-                                                   const ConfigurationSet& configs) {
+                                                   const TargetedConfigurations& configs) {
   const PriorSigmas priors = ResolvePriors(vm, rig);
   if (priors.empty()) return std::nullopt;
   NoiseModel noise;
@@ -394,7 +394,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const PlaneSet& planes = setup.planes;
-  const ConfigurationSet configs =
+  const TargetedConfigurations configs =
       ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   IdentifiabilityOptions options;

@@ -39,7 +39,7 @@ void AddDesignOptions(po::options_description& o) {
 }
 
 struct ResolvedPool {
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   SamplingReport report;
   std::string source;
 };
@@ -50,7 +50,7 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
   const RobotModel& robot = setup.rig.robot;
   if (vm.count("pool") == vm.count("generate"))
     throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
-  ResolvedPool pool{ConfigurationSet(robot.num_links()), {}, ""};
+  ResolvedPool pool{TargetedConfigurations(robot.num_links()), {}, ""};
   if (vm.count("generate")) {
     const int n = vm["generate"].as<int>();
     if (n < 1 || n > 100000)

@@ -21,10 +21,11 @@ std::string SamplingReport::ToString() const {
 
 namespace {
 
-BeamMiss BeamOf(const ModelPoint& point, const ConfigurationSet& one, const RangerSpec& ranger) {
+BeamMiss BeamOf(const ModelPoint& point, const TargetedConfigurations& one,
+                const RangerSpec& ranger) {
   const Pose<double> pose = ToolPose(point, one, 0);
   double nb;
-  const double h = BeamReading(pose, point.planes[one.plane(0)], &nb);
+  const double h = BeamReading(pose, point.planes[one.target(0)], &nb);
   return ClassifyReading(h, nb, ranger);
 }
 
@@ -42,7 +43,7 @@ InputError SamplingExhausted(const PlaneSet& planes, int p, int accepted, int wa
 // Why a drawn configuration (one row, tagged with its plane) is rejected: "" when it is usable.
 // `truth` is null when the true rig is not checked.
 std::string RejectionOf(const RobotModel& robot, const ModelPoint& nominal, const ModelPoint* truth,
-                        const ConfigurationSet& one, const SamplingOptions& options) {
+                        const TargetedConfigurations& one, const SamplingOptions& options) {
   if (options.require_beam_hit) {
     BeamMiss miss = BeamOf(nominal, one, options.ranger);
     if (miss == BeamMiss::kNone && truth) miss = BeamOf(*truth, one, options.ranger);
@@ -58,16 +59,19 @@ std::string RejectionOf(const RobotModel& robot, const ModelPoint& nominal, cons
 
 }  // namespace
 
-ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
-                                      const RandomStream& stream, const SamplingOptions& options,
-                                      SamplingReport* report) {
+TargetedConfigurations SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
+                                            const RandomStream& stream,
+                                            const SamplingOptions& options,
+                                            SamplingReport* report) {
   return SampleConfigurations(robot, PlaneSet(plane), std::vector<int>{count}, stream, options,
                               report);
 }
 
-ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& planes,
-                                      const std::vector<int>& counts, const RandomStream& stream,
-                                      const SamplingOptions& options, SamplingReport* report) {
+TargetedConfigurations SampleConfigurations(const RobotModel& robot, const PlaneSet& planes,
+                                            const std::vector<int>& counts,
+                                            const RandomStream& stream,
+                                            const SamplingOptions& options,
+                                            SamplingReport* report) {
   options.Validate();
   if (static_cast<int>(counts.size()) != planes.size())
     throw InputError("configuration sampling", "expected one count per plane");
@@ -85,7 +89,7 @@ ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& p
       throw InputError("configuration sampling", "expected one true plane per plane");
     PrepareModelPoint(robot, options.true_link_values->data(), true_planes, &truth);
   }
-  ConfigurationSet out(N);
+  TargetedConfigurations out(N);
   out.Reserve(rep.requested);
   std::vector<double> q(N);
   long long a = 0;  // attempts so far, over all planes: draw a·N + j is joint j of attempt a
@@ -102,7 +106,7 @@ ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& p
         const Link& link = robot.links()[j];
         q[j] = link.q_min + (link.q_max - link.q_min) * stream.Uniform(a * N + j);
       }
-      ConfigurationSet one(N);
+      TargetedConfigurations one(N);
       one.Add(q, p);
       const std::string rejection =
           RejectionOf(robot, nominal, check_truth ? &truth : nullptr, one, options);
@@ -118,9 +122,9 @@ ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& p
 }
 
 CandidatePool UsableCandidates(const RobotModel& robot, const PlaneSet& planes,
-                               const RangerSpec& ranger, const ConfigurationSet& pool) {
+                               const RangerSpec& ranger, const TargetedConfigurations& pool) {
   CandidatePool out;
-  out.configs = ConfigurationSet(pool.num_joints());
+  out.configs = TargetedConfigurations(pool.num_joints());
   std::vector<double> h;
   ExactReadings(robot, robot.nominal_values(), planes, ranger, pool, &h, &out.misses);
   out.report.requested = out.report.attempts = pool.size();

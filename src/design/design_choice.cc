@@ -38,7 +38,7 @@ void DesignRequest::Validate() const {
   selection.Validate();
 }
 
-DesignChoice ChooseDesign(const MeasurementModel& model, const ConfigurationSet& pool,
+DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigurations& pool,
                           const DesignRequest& request) {
   request.Validate();
   SelectionOptions options = request.selection;
@@ -57,7 +57,7 @@ DesignChoice ChooseDesign(const MeasurementModel& model, const ConfigurationSet&
   out.certificate_statement =
       out.certificate.ToString(options.criterion, request.count, static_cast<int>(pool.size()));
   out.per_plane.assign(model.nominal_planes().size(), 0);
-  for (int i : out.chosen.indices) ++out.per_plane[pool.plane(i)];
+  for (int i : out.chosen.indices) ++out.per_plane[pool.target(i)];
   if (task)
     out.task_rms_per_sigma =
         TaskRmsPositionPerUnitSigma(model, pool.Subset(out.chosen.indices), request.task);

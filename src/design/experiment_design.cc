@@ -727,7 +727,7 @@ Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
   return llt.matrixL().solve(G.transpose()).transpose();
 }
 
-Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
+Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const TargetedConfigurations& pool,
                                DesignScaling scaling, double angle, double length) {
   return ScaleColumns(IdentificationJacobian(model, pool), scaling,
                       ExpectedErrors(model.parameters(), angle, length));

@@ -59,7 +59,7 @@ bool StillLost(const Eigen::VectorXd& v, const Eigen::MatrixXd& N, const Eigen::
 
 struct Context {
   const MeasurementModel* model;
-  const ConfigurationSet* configs;
+  const TargetedConfigurations* configs;
   const RemedyOptions* options;
   Eigen::MatrixXd G;        // the identification Jacobian of the set as it is
   Eigen::VectorXd weights;  // column norms (1 for zero columns): a unit-free comparison
@@ -142,32 +142,32 @@ ParameterSet WithAddedPlane(const ParameterSet& in, PlaneTerms terms,
 
 // Configurations whose nominal beam hits `plane` (as plane index p), or an empty set when none
 // are found within the budget (the plane is out of reach).
-ConfigurationSet ConfigurationsOn(const Context& c, const Plane& plane, int p, int count) {
+TargetedConfigurations ConfigurationsOn(const Context& c, const Plane& plane, int p, int count) {
   SamplingOptions s;
   s.ranger = c.options->ranger;
   s.max_attempts_per_configuration = 300;
   try {
-    const ConfigurationSet drawn =
+    const TargetedConfigurations drawn =
         SampleConfigurations(c.model->robot(), plane, count,
                              RandomStream(c.options->seed, 77 + p, 0, RandomPurpose::kPool), s);
-    ConfigurationSet out(drawn.num_joints());
+    TargetedConfigurations out(drawn.num_joints());
     for (int i = 0; i < drawn.size(); ++i) out.Add(drawn.q(i), p);
     return out;
   } catch (const InputError&) {
-    return ConfigurationSet(c.model->robot().num_links());
+    return TargetedConfigurations(c.model->robot().num_links());
   }
 }
 
 // Adding `plane` with `terms`, read at its own configurations `extra`.
 std::vector<int> RecoveredByAdding(const Context& c, const Plane& plane, PlaneTerms terms,
-                                   const ConfigurationSet& extra) {
+                                   const TargetedConfigurations& extra) {
   const MeasurementModel& model = *c.model;
   std::vector<int> old_to_new;
   ParameterSet ps = WithAddedPlane(model.parameters(), terms, &old_to_new);
   std::vector<Plane> planes(model.nominal_planes().begin(), model.nominal_planes().end());
   planes.push_back(plane);
   const MeasurementModel augmented(model.robot(), PlaneSet(planes, {}), ps);
-  ConfigurationSet all(c.configs->num_joints());
+  TargetedConfigurations all(c.configs->num_joints());
   for (int i = 0; i < c.configs->size(); ++i) all.AddFrom(*c.configs, i);
   for (int i = 0; i < extra.size(); ++i) all.AddFrom(extra, i);
   const Eigen::MatrixXd Na =
@@ -180,7 +180,7 @@ std::vector<int> RecoveredByAdding(const Context& c, const Plane& plane, PlaneTe
 // A plane facing base axis `axis` that the arm can read: tried at a few distances on both sides
 // of the base, as fractions of the arm's nominal reach.
 bool ReachablePlane(const Context& c, int axis, int count, Plane* plane,
-                    ConfigurationSet* configs) {
+                    TargetedConfigurations* configs) {
   double reach = 0;
   const RobotModel& robot = c.model->robot();
   for (int j = 0; j < robot.num_links(); ++j)
@@ -238,7 +238,7 @@ void AddPlaneRemedies(const Context& c, RemedyReport* out) {
   std::vector<Remedy> known;
   for (int axis = 0; axis < 3; ++axis) {
     Plane plane;
-    ConfigurationSet extra(c.configs->num_joints());
+    TargetedConfigurations extra(c.configs->num_joints());
     if (!ReachablePlane(c, axis, count, &plane, &extra)) {
       out->unreachable.push_back(std::string("a plane facing ") + axes[axis]);
       continue;
@@ -270,7 +270,7 @@ void AddPlaneRemedies(const Context& c, RemedyReport* out) {
 
 }  // namespace
 
-RemedyReport FindRemedies(const MeasurementModel& model, const ConfigurationSet& configs,
+RemedyReport FindRemedies(const MeasurementModel& model, const TargetedConfigurations& configs,
                           const IdentifiabilityReport& report, const RemedyOptions& options) {
   RemedyReport out;
   if (report.full_rank()) return out;

@@ -18,14 +18,14 @@ TaskPoses TaskPosesAt(const MeasurementModel& model, const ConfigurationSet& pos
   return task;
 }
 
-Eigen::MatrixXd TaskDesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
-                                   const TaskPoses& task) {
+Eigen::MatrixXd TaskDesignJacobian(const MeasurementModel& model,
+                                   const TargetedConfigurations& pool, const TaskPoses& task) {
   return TaskWeightedJacobian(DesignJacobian(model, pool, DesignScaling::kSI, 0, 0),
                               task.position_rows);
 }
 
-double TaskRmsPositionPerUnitSigma(const MeasurementModel& model, const ConfigurationSet& design,
-                                   const TaskPoses& task) {
+double TaskRmsPositionPerUnitSigma(const MeasurementModel& model,
+                                   const TargetedConfigurations& design, const TaskPoses& task) {
   const Eigen::MatrixXd G = DesignJacobian(model, design, DesignScaling::kSI, 0, 0);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(G.transpose() * G);
   const Eigen::MatrixXd& P = task.position_rows;

@@ -78,7 +78,7 @@ class OneConfigurationCost : public ceres::CostFunction {
 // analytic Jacobian: all configurations in one block, or one configuration (`subset`).
 class KindCost : public ceres::CostFunction {
  public:
-  KindCost(const MeasurementKind& kind, ConfigurationSet configs, const double* y,
+  KindCost(const MeasurementKind& kind, TargetedConfigurations configs, const double* y,
            const double* weights)
       : configs_(std::move(configs)), y_(y), weights_(weights) {
     evaluator_ = kind.Bind(configs_);
@@ -104,7 +104,7 @@ class KindCost : public ceres::CostFunction {
   }
 
  private:
-  ConfigurationSet configs_;
+  TargetedConfigurations configs_;
   std::unique_ptr<MeasurementEvaluator> evaluator_;
   const double* y_;
   const double* weights_;

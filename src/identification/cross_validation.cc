@@ -42,7 +42,7 @@ namespace {
 
 MeasurementSet FoldData(const MeasurementSet& data, int folds, int fold, bool held_out) {
   MeasurementSet out;
-  out.configs = ConfigurationSet(data.configs.num_joints());
+  out.configs = TargetedConfigurations(data.configs.num_joints());
   for (int i = 0; i < data.size(); ++i) {
     if ((i % folds == fold) != held_out) continue;
     out.configs.AddFrom(data.configs, i);

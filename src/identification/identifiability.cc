@@ -49,7 +49,7 @@ std::string IdentifiabilityReport::ToString() const {
 }
 
 Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
-                                       const ConfigurationSet& configs, const double* e) {
+                                       const TargetedConfigurations& configs, const double* e) {
   const int n = model.num_parameters();
   std::vector<double> zero(n, 0.0);
   if (!e) e = zero.data();
@@ -212,7 +212,7 @@ IdentifiabilityReport AnalyzeJacobian(const Eigen::MatrixXd& G,
 }
 
 IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
-                                             const ConfigurationSet& configs, const double* e,
+                                             const TargetedConfigurations& configs, const double* e,
                                              const IdentifiabilityOptions& options) {
   options.Validate();
   return AnalyzeJacobian(IdentificationJacobian(model, configs, e), model.parameters().names,
@@ -220,7 +220,7 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
 }
 
 IdentifiabilityReport AnalyzeIdentifiability(const MeasurementKind& kind,
-                                             const ConfigurationSet& configs, const double* e,
+                                             const TargetedConfigurations& configs, const double* e,
                                              const IdentifiabilityOptions& options) {
   options.Validate();
   return AnalyzeJacobian(MeasurementJacobian(kind, configs, e), kind.parameter_names(),

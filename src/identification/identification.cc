@@ -217,14 +217,14 @@ std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
   std::vector<double> gradient2(static_cast<std::size_t>(k) * m, 0.0), plus(k * m), minus(k * m);
   constexpr double kStep = 1e-6;  // rad or m: truncation O(step²), rounding O(1e-16/step)
   for (int j = 0; j < nj; ++j) {
-    ConfigurationSet up(nj), down(nj);
+    TargetedConfigurations up(nj), down(nj);
     std::vector<double> q(nj);
     for (int i = 0; i < m; ++i) {
       std::copy(data.configs.q(i), data.configs.q(i) + nj, q.begin());
       q[j] += kStep;
-      up.Add(q.data(), data.configs.plane(i));
+      up.Add(q.data(), data.configs.target(i));
       q[j] -= 2 * kStep;
-      down.Add(q.data(), data.configs.plane(i));
+      down.Add(q.data(), data.configs.target(i));
     }
     kind.Bind(up)->Predict(e.data(), plus.data(), nullptr);
     kind.Bind(down)->Predict(e.data(), minus.data(), nullptr);
@@ -261,9 +261,9 @@ IdentificationSummary IdentifyReadings(const MeasurementModel& model_in, const M
     s.message = "measurement set is inconsistent (configurations, readings, repetitions)";
     return s;
   }
-  if (data.configs.num_planes_referenced() > model_in.num_planes()) {
+  if (data.configs.num_targets_referenced() > model_in.num_planes()) {
     s.message = "a configuration is aimed at plane " +
-                std::to_string(data.configs.num_planes_referenced()) + " but the model has " +
+                std::to_string(data.configs.num_targets_referenced()) + " but the model has " +
                 std::to_string(model_in.num_planes()) + " plane(s)";
     return s;
   }

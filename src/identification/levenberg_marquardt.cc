@@ -188,7 +188,7 @@ void LevenbergMarquardt::FormNormalEquations() {
 }
 
 LevenbergMarquardt::Result LevenbergMarquardt::Solve(const MeasurementModel& model,
-                                                     const ConfigurationSet& configs,
+                                                     const TargetedConfigurations& configs,
                                                      const double* mean_h, const double* weights,
                                                      const IdentificationOptions& options,
                                                      Eigen::VectorXd* e, const Nominal* nominal) {

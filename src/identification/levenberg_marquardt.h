@@ -98,9 +98,9 @@ class LevenbergMarquardt {
   /// of ½·Σ ρ(r_i²), r_i the weighted residual, ρ Ceres' HuberLoss / CauchyLoss of scale
   /// options.LossScale(): the same cost, started from the same point, as the Ceres path (tested to
   /// agree to 1e-8).
-  Result Solve(const MeasurementModel& model, const ConfigurationSet& configs, const double* mean_h,
-               const double* weights, const IdentificationOptions& options, Eigen::VectorXd* e,
-               const Nominal* nominal = nullptr);
+  Result Solve(const MeasurementModel& model, const TargetedConfigurations& configs,
+               const double* mean_h, const double* weights, const IdentificationOptions& options,
+               Eigen::VectorXd* e, const Nominal* nominal = nullptr);
   /// The same for any measurement kind (measurement_kind.h): `measured` and `weights` have
   /// evaluator.num_rows() entries (a configuration's repetitions on each of its rows); `nominal`,
   /// if given, is the evaluator's prediction and Jacobian at e = 0. With a ranger's evaluator

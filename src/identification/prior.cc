@@ -194,7 +194,8 @@ PriorInformation InformationFromPriors(const Eigen::MatrixXd& G, const std::vect
   return info;
 }
 
-PriorInformation InformationFromPriors(const MeasurementKind& kind, const ConfigurationSet& configs,
+PriorInformation InformationFromPriors(const MeasurementKind& kind,
+                                       const TargetedConfigurations& configs,
                                        const NoiseModel& noise, const PriorSigmas& priors) {
   noise.Validate();
   if (!(noise.sigma > 0))

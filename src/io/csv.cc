@@ -230,13 +230,13 @@ std::vector<int> PlaneColumn(const CsvTable& t, const PlaneSet* planes) {
 
 }  // namespace
 
-ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
-                                    const PlaneSet* planes) {
+TargetedConfigurations ReadConfigurations(const std::string& path, int num_joints,
+                                          const PlaneSet* planes) {
   CsvTable t = ReadCsv(path);
   std::vector<int> cols = JointColumns(t, num_joints);
   if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
   const std::vector<int> plane = PlaneColumn(t, planes);
-  ConfigurationSet out(num_joints);
+  TargetedConfigurations out(num_joints);
   for (std::size_t r = 0; r < t.rows.size(); ++r) out.Add(JointValues(t, r, cols), plane[r]);
   return out;
 }
@@ -259,7 +259,7 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const R
     throw InputError(Location(path, 1) + " column 'h'", "missing: expected the reading h (m)");
   if (t.rows.empty()) throw InputError(path, "no readings (only a header)");
   const std::vector<int> plane = PlaneColumn(t, planes);
-  ConfigurationSet q(num_joints);
+  TargetedConfigurations q(num_joints);
   q.Reserve(static_cast<int>(t.rows.size()));
   std::vector<double> h;
   // An optional `configuration` column labels the readings of one pose (any text).
@@ -301,30 +301,34 @@ void CheckOutputFile(const std::string& path, const std::string& option) {
         option, "cannot write '" + path + "': the folder '" + parent.string() + "' does not exist");
 }
 
-void WriteConfigurations(const std::string& path, const ConfigurationSet& configs) {
+void WriteConfigurations(const std::string& path, const TargetedConfigurations& configs) {
   std::ostringstream out;
-  const bool planes = configs.num_planes_referenced() > 1;
+  const bool planes = configs.num_targets_referenced() > 1;
   for (int j = 0; j < configs.num_joints(); ++j) out << (j ? "," : "") << "q" << j + 1;
   out << (planes ? ",plane\n" : "\n");
   for (int i = 0; i < configs.size(); ++i) {
     for (int j = 0; j < configs.num_joints(); ++j)
       out << (j ? "," : "") << FormatExact(configs.q(i)[j]);
-    if (planes) out << "," << configs.plane(i) + 1;
+    if (planes) out << "," << configs.target(i) + 1;
     out << "\n";
   }
   WriteOutputFile(path, out.str());
 }
 
-void WriteReadings(const std::string& path, const ConfigurationSet& configs,
+void WritePoses(const std::string& path, const ConfigurationSet& poses) {
+  WriteConfigurations(path, TargetedConfigurations(poses));
+}
+
+void WriteReadings(const std::string& path, const TargetedConfigurations& configs,
                    const std::vector<double>& readings, int repetitions) {
   std::ostringstream out;
   for (int j = 0; j < configs.num_joints(); ++j) out << "q" << j + 1 << ",";
-  const bool planes = configs.num_planes_referenced() > 1;
+  const bool planes = configs.num_targets_referenced() > 1;
   out << (planes ? "plane,h,repetition\n" : "h,repetition\n");
   for (int i = 0, k = 0; i < configs.size(); ++i)
     for (int r = 0; r < repetitions; ++r, ++k) {
       for (int j = 0; j < configs.num_joints(); ++j) out << FormatExact(configs.q(i)[j]) << ",";
-      if (planes) out << configs.plane(i) + 1 << ",";
+      if (planes) out << configs.target(i) + 1 << ",";
       out << FormatExact(readings[k]) << "," << r + 1 << "\n";
     }
   WriteOutputFile(path, out.str());

@@ -15,7 +15,7 @@ struct RangerErrors {
 };
 
 ResultJson KinematicsRow(const MeasurementModel& model, const ModelPoint& point,
-                         const ConfigurationSet& configs, int i, const RangerSpec& ranger,
+                         const TargetedConfigurations& configs, int i, const RangerSpec& ranger,
                          const RangerErrors& outside, bool jacobian, Table* table) {
   const ParameterSet& ps = model.parameters();
   std::vector<double> row(ps.size());
@@ -68,7 +68,7 @@ RobotModel AtTrueValues(const RobotModel& robot, const Truth& truth) {
 
 KinematicsReport ReportKinematics(const RobotFile& rig, const PlaneSet& planes,
                                   const ParameterSet& parameters, bool true_model,
-                                  const ConfigurationSet& configs, bool jacobian) {
+                                  const TargetedConfigurations& configs, bool jacobian) {
   // The true model: every link value at its true value (the parameters of the set and the
   // fixed ones alike) and the ranger's true offset and scale, so that it reads what a
   // noise-free simulation reads.

@@ -23,9 +23,9 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
     }
 }
 
-ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
-                                         const PlaneSet* planes) {
-  ConfigurationSet configs = ReadConfigurations(path, robot.num_links(), planes);
+TargetedConfigurations ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
+                                               const PlaneSet* planes) {
+  TargetedConfigurations configs = ReadConfigurations(path, robot.num_links(), planes);
   CheckJointRanges(configs, robot, path);
   return configs;
 }

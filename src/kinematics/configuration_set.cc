@@ -5,8 +5,7 @@
 
 namespace lrcal {
 
-void ConfigurationSet::Add(const double* q, int plane) {
-  plane_.push_back(plane);
+void ConfigurationSet::Add(const double* q) {
   for (int j = 0; j < num_joints_; ++j) {
     q_.push_back(q[j]);
     cos_q_.push_back(std::cos(q[j]));
@@ -18,13 +17,6 @@ void ConfigurationSet::AddFrom(const ConfigurationSet& other, int i) {
   q_.insert(q_.end(), other.q(i), other.q(i) + num_joints_);
   cos_q_.insert(cos_q_.end(), other.cos_q(i), other.cos_q(i) + num_joints_);
   sin_q_.insert(sin_q_.end(), other.sin_q(i), other.sin_q(i) + num_joints_);
-  plane_.push_back(other.plane(i));
-}
-
-int ConfigurationSet::num_planes_referenced() const {
-  int n = 0;
-  for (int p : plane_) n = std::max(n, p + 1);
-  return n;
 }
 
 void ConfigurationSet::Reserve(int n) {
@@ -32,7 +24,6 @@ void ConfigurationSet::Reserve(int n) {
   q_.reserve(values);
   cos_q_.reserve(values);
   sin_q_.reserve(values);
-  plane_.reserve(static_cast<std::size_t>(std::max(n, 0)));
 }
 
 ConfigurationSet ConfigurationSet::Subset(const std::vector<int>& indices) const {

@@ -16,7 +16,7 @@ constexpr int kFrameArrays = 15;
 enum : int { kZPrev = 0, kOPrev = 3, kXCommon = 6, kYTwist = 9, kO = 12 };
 }  // namespace
 
-void BatchEvaluator::SetConfigurations(const ConfigurationSet& configs) {
+void BatchEvaluator::SetConfigurations(const TargetedConfigurations& configs) {
   m_ = configs.size();
   joints_ = configs.num_joints();
   q_.resize(static_cast<std::size_t>(joints_) * m_);
@@ -30,10 +30,10 @@ void BatchEvaluator::SetConfigurations(const ConfigurationSet& configs) {
     }
   }
   plane_.clear();
-  num_planes_referenced_ = configs.num_planes_referenced();
-  if (num_planes_referenced_ > 1) {
+  num_targets_referenced_ = configs.num_targets_referenced();
+  if (num_targets_referenced_ > 1) {
     plane_.resize(m_);
-    for (int i = 0; i < m_; ++i) plane_[i] = configs.plane(i);
+    for (int i = 0; i < m_; ++i) plane_[i] = configs.target(i);
   }
   state_.resize(12 * static_cast<std::size_t>(m_));
   frames_.resize(static_cast<std::size_t>(kFrameArrays) * joints_ * m_);
@@ -489,9 +489,9 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
 
 bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
                               double* J, Isa isa) {
-  if (num_planes_referenced_ > model.num_planes())
+  if (num_targets_referenced_ > model.num_planes())
     throw std::invalid_argument("BatchEvaluator: a configuration is aimed at plane " +
-                                std::to_string(num_planes_referenced_) + " of " +
+                                std::to_string(num_targets_referenced_) + " of " +
                                 std::to_string(model.num_planes()));
   const KernelArgs args{m_,
                         &point,

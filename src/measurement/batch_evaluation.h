@@ -18,7 +18,7 @@ namespace lrcal {
 class BatchEvaluator {
  public:
   /// Takes the configurations' joint values and their cos/sin (transposed to arrays per joint).
-  void SetConfigurations(const ConfigurationSet& configs);
+  void SetConfigurations(const TargetedConfigurations& configs);
   int size() const { return m_; }
 
   /// Readings h[0..m) at `point`; if `J` is not null also ∂h/∂e into the column-major m×n
@@ -30,7 +30,7 @@ class BatchEvaluator {
                 Isa isa);
 
  private:
-  int m_ = 0, joints_ = 0, num_planes_referenced_ = 0;
+  int m_ = 0, joints_ = 0, num_targets_referenced_ = 0;
   std::vector<double> q_, cq_, sq_;  // [joint·m + i]
   // Each configuration's plane; empty when every configuration is aimed at plane 0 (the
   // single-plane kernel, which keeps the plane's normal in registers).

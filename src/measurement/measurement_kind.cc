@@ -32,7 +32,7 @@ std::vector<double> MeasuredValues::RowWeights(int rows_per_configuration) const
   return weights;
 }
 
-int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& configs,
+int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurations& configs,
                          const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
                          std::vector<std::string>* misses) {
   CheckNoiseFitsKind(truth, noise);
@@ -43,7 +43,7 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
   evaluator->Predict(zero.data(), exact.data(), nullptr);
   const std::vector<std::string> reasons = truth.MissReasons(configs, zero.data());
   if (misses) *misses = reasons;
-  *data = MeasuredValues{ConfigurationSet(configs.num_joints()), {}, {}};
+  *data = MeasuredValues{TargetedConfigurations(configs.num_joints()), {}, {}};
   int missed = 0;
   std::vector<double> z(static_cast<std::size_t>(R) * k);
   std::vector<double> readings(static_cast<std::size_t>(R));  // one component's R readings
@@ -74,8 +74,8 @@ int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& c
   return missed;
 }
 
-Eigen::MatrixXd MeasurementJacobian(const MeasurementKind& kind, const ConfigurationSet& configs,
-                                    const double* e) {
+Eigen::MatrixXd MeasurementJacobian(const MeasurementKind& kind,
+                                    const TargetedConfigurations& configs, const double* e) {
   std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(configs);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kind.num_parameters());
   Eigen::MatrixXd G(evaluator->num_rows(), kind.num_parameters());

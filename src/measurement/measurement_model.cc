@@ -144,11 +144,11 @@ void MeasurementModel::ApplyRanger(const ModelPoint& point, int m, double* h, do
   for (int i = 0; i < m; ++i) h[i] = (1 + s) * h[i] + o;
 }
 
-double MeasurementModel::Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i,
-                                  double* h, double* row) const {
+double MeasurementModel::Evaluate(const ModelPoint& point, const TargetedConfigurations& configs,
+                                  int i, double* h, double* row) const {
   ChainFrames frames;
   const Pose<double> pose = ToolPose(point, configs, i, row ? &frames : nullptr);
-  const int plane = configs.plane(i);
+  const int plane = configs.target(i);
   const Eigen::Vector3d& n = point.planes[plane].normal;
   const Eigen::Vector3d b = pose.R_BT.col(2);
   double nb;

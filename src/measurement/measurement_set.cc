@@ -11,7 +11,7 @@ namespace {
 
 // The label and joint values of each labelled configuration: its first reading's joint values
 // if all its readings agree, else their mean (summed in reading order).
-void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& group,
+void LabelledJointValues(const TargetedConfigurations& q, const std::vector<int>& group,
                          const std::vector<int>& first, const std::vector<std::string>& labels,
                          MeasurementSet* data) {
   for (int r : first) data->labels.push_back(labels[static_cast<std::size_t>(r)]);
@@ -27,7 +27,7 @@ void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& grou
       differ[g] = differ[g] || q.q(r)[j] != q.q(first[g])[j];
     }
   }
-  data->configs = ConfigurationSet(n);
+  data->configs = TargetedConfigurations(n);
   data->configs.Reserve(m);
   std::vector<double> mean(n);
   for (int g = 0; g < m; ++g) {
@@ -36,7 +36,7 @@ void LabelledJointValues(const ConfigurationSet& q, const std::vector<int>& grou
       continue;
     }
     for (int j = 0; j < n; ++j) mean[j] = sum[static_cast<std::size_t>(g) * n + j] / count[g];
-    data->configs.Add(mean.data(), q.plane(first[g]));
+    data->configs.Add(mean.data(), q.target(first[g]));
   }
 }
 
@@ -61,7 +61,7 @@ void CombineRobustly(const std::vector<double>& h, const std::vector<int>& group
 
 }  // namespace
 
-MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
+MeasurementSet GroupReadings(const TargetedConfigurations& q, const std::vector<double>& h,
                              const RangerSpec* ranger, const std::function<std::string(int)>& where,
                              const std::vector<std::string>* labels, const Averaging& average) {
   if (static_cast<std::size_t>(q.size()) != h.size())
@@ -92,13 +92,13 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
       id = label_index.emplace((*labels)[r], next).first->second;
     } else {
       std::vector<double> key(q.q(r), q.q(r) + n);
-      key.push_back(q.plane(r));  // one pose read on two planes would be two configurations
+      key.push_back(q.target(r));  // one pose read on two planes would be two configurations
       id = index.emplace(std::move(key), next).first->second;
     }
-    if (id != next && q.plane(r) != q.plane(first[id]))
-      throw InputError(where(r), "this reading is on plane " + std::to_string(q.plane(r) + 1) +
+    if (id != next && q.target(r) != q.target(first[id]))
+      throw InputError(where(r), "this reading is on plane " + std::to_string(q.target(r) + 1) +
                                      " but earlier readings of its configuration are on plane " +
-                                     std::to_string(q.plane(first[id]) + 1) +
+                                     std::to_string(q.target(first[id]) + 1) +
                                      "; one configuration's readings are on one plane");
     if (id == next) {
       first.push_back(r);
@@ -113,7 +113,7 @@ MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double
   if (labels) {
     LabelledJointValues(q, group, first, *labels, &data);
   } else {
-    data.configs = ConfigurationSet(n);
+    data.configs = TargetedConfigurations(n);
     data.configs.Reserve(static_cast<int>(first.size()));
     for (std::size_t i = 0; i < first.size(); ++i) data.configs.AddFrom(q, first[i]);
   }

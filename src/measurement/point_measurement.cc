@@ -36,7 +36,7 @@ Eigen::Vector3d PointMotion(const ChainFrames& f, int index, const Eigen::Vector
 
 class PointEvaluator : public MeasurementEvaluator {
  public:
-  PointEvaluator(const PointMeasurement& kind, const ConfigurationSet& configs)
+  PointEvaluator(const PointMeasurement& kind, const TargetedConfigurations& configs)
       : kind_(kind), configs_(configs) {}
   int num_rows() const override { return 3 * configs_.size(); }
   int num_parameters() const override { return kind_.num_parameters(); }
@@ -47,7 +47,7 @@ class PointEvaluator : public MeasurementEvaluator {
     if (J) std::fill(J, J + static_cast<std::size_t>(m) * num_parameters(), 0.0);
     for (int i = 0; i < configs_.size(); ++i) {
       const Pose<double> pose = ToolPose(chain_, configs_, i, J ? &frames_ : nullptr);
-      const int target = configs_.plane(i);
+      const int target = configs_.target(i);
       const Eigen::Vector3d P = pose.p_BT + pose.R_BT * state_.targets[target];
       const Eigen::Vector3d value = state_.R_BI.transpose() * (P - state_.p_BI);
       for (int c = 0; c < 3; ++c) y[3 * i + c] = value[c];
@@ -83,7 +83,7 @@ class PointEvaluator : public MeasurementEvaluator {
   }
 
   const PointMeasurement& kind_;
-  const ConfigurationSet& configs_;
+  const TargetedConfigurations& configs_;
   PointMeasurement::State state_;
   ChainPoint chain_;
   ChainFrames frames_;
@@ -196,20 +196,20 @@ void PointMeasurement::StateAt(const double* e, State* s) const {
 }
 
 std::unique_ptr<MeasurementEvaluator> PointMeasurement::Bind(
-    const ConfigurationSet& configs) const {
+    const TargetedConfigurations& configs) const {
   if (configs.num_joints() != robot_->num_links())
     throw InputError("configurations", "the robot has " + std::to_string(robot_->num_links()) +
                                            " joints, the configurations " +
                                            std::to_string(configs.num_joints()));
-  if (configs.num_planes_referenced() > static_cast<int>(setup_.targets.size()))
+  if (configs.num_targets_referenced() > static_cast<int>(setup_.targets.size()))
     throw InputError("configurations", "a configuration names target " +
-                                           std::to_string(configs.num_planes_referenced()) +
+                                           std::to_string(configs.num_targets_referenced()) +
                                            " but the set-up has " +
                                            std::to_string(setup_.targets.size()) + " target(s)");
   return std::make_unique<PointEvaluator>(*this, configs);
 }
 
-std::vector<std::string> PointMeasurement::MissReasons(const ConfigurationSet& configs,
+std::vector<std::string> PointMeasurement::MissReasons(const TargetedConfigurations& configs,
                                                        const double*) const {
   return std::vector<std::string>(configs.size(), "ok");
 }

@@ -9,7 +9,7 @@ namespace lrcal {
 RangerEvaluator::RangerEvaluator() : batch_(std::make_unique<BatchEvaluator>()) {}
 RangerEvaluator::~RangerEvaluator() = default;
 
-void RangerEvaluator::Bind(const MeasurementModel& model, const ConfigurationSet& configs) {
+void RangerEvaluator::Bind(const MeasurementModel& model, const TargetedConfigurations& configs) {
   model_ = &model;
   batch_->SetConfigurations(configs);
 }
@@ -44,7 +44,7 @@ Eigen::VectorXd RangerMeasurement::NominalValues() const {
 }
 
 std::unique_ptr<MeasurementEvaluator> RangerMeasurement::Bind(
-    const ConfigurationSet& configs) const {
+    const TargetedConfigurations& configs) const {
   CheckPlanesReferenced(configs, model_.nominal_planes());
   if (configs.num_joints() != model_.robot().num_links())
     throw InputError("configurations",
@@ -55,7 +55,7 @@ std::unique_ptr<MeasurementEvaluator> RangerMeasurement::Bind(
   return evaluator;
 }
 
-std::vector<std::string> RangerMeasurement::MissReasons(const ConfigurationSet& configs,
+std::vector<std::string> RangerMeasurement::MissReasons(const TargetedConfigurations& configs,
                                                         const double* e) const {
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model_.num_parameters());
   const double* at = e ? e : zero.data();

@@ -9,7 +9,7 @@ namespace lrcal {
 
 void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
                    const PlaneSet& planes, const RangerSpec& ranger,
-                   const ConfigurationSet& configs, std::vector<double>* h,
+                   const TargetedConfigurations& configs, std::vector<double>* h,
                    std::vector<BeamMiss>* misses) {
   CheckPlanesReferenced(configs, planes);
   ModelPoint point;
@@ -19,15 +19,15 @@ void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
   for (int i = 0; i < configs.size(); ++i) {
     const Pose<double> pose = ToolPose(point, configs, i);
     double nb;
-    (*h)[i] = BeamReading(pose, planes[configs.plane(i)], &nb);
+    (*h)[i] = BeamReading(pose, planes[configs.target(i)], &nb);
     if (misses) (*misses)[i] = ClassifyReading((*h)[i], nb, ranger);
   }
 }
 
-void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& planes) {
-  if (configs.num_planes_referenced() > planes.size())
+void CheckPlanesReferenced(const TargetedConfigurations& configs, const PlaneSet& planes) {
+  if (configs.num_targets_referenced() > planes.size())
     throw InputError("planes", "a configuration is aimed at plane " +
-                                   std::to_string(configs.num_planes_referenced()) +
+                                   std::to_string(configs.num_targets_referenced()) +
                                    " but the set-up has " + std::to_string(planes.size()) +
                                    " plane(s)");
 }
@@ -37,7 +37,7 @@ namespace {
 // The exact readings under encoder noise and form error: per configuration (draw_mean, at the
 // mean joint error) or per reading. Misses are those of the recorded configuration.
 void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
-                       const PlaneSet& planes, const ConfigurationSet& configs,
+                       const PlaneSet& planes, const TargetedConfigurations& configs,
                        const NoiseModel& noise, const RandomStream& stream,
                        const std::vector<int>* noise_slots, std::vector<double>* out) {
   const int R = noise.repetitions, per = noise.DrawsMean() ? 1 : R, nj = configs.num_joints();
@@ -45,7 +45,7 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
   const RandomStream form = stream.WithPurpose(RandomPurpose::kPlaneForm);
   const double sigma_q = noise.DrawsMean() ? noise.encoder_sigma / std::sqrt(static_cast<double>(R))
                                            : noise.encoder_sigma;
-  ConfigurationSet disturbed(nj);
+  TargetedConfigurations disturbed(nj);
   disturbed.Reserve(configs.size() * per);
   std::vector<double> q(nj);
   for (int i = 0; i < configs.size(); ++i) {
@@ -54,7 +54,7 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
       for (int j = 0; j < nj; ++j)
         q[j] = configs.q(i)[j] +
                (sigma_q > 0 ? sigma_q * encoder.Normal((slot * R + r) * nj + j) : 0.0);
-      disturbed.Add(q.data(), configs.plane(i));
+      disturbed.Add(q.data(), configs.target(i));
     }
   }
   ModelPoint point;
@@ -62,7 +62,7 @@ void DisturbedReadings(const RobotModel& robot, const Eigen::VectorXd& link_valu
   out->resize(disturbed.size());
   for (int k = 0; k < disturbed.size(); ++k) {
     const std::uint64_t slot = noise_slots ? (*noise_slots)[k / per] : k / per;
-    Plane local = planes[disturbed.plane(k)];
+    Plane local = planes[disturbed.target(k)];
     if (noise.form_sigma > 0) local.offset += noise.form_sigma * form.Normal(slot);
     double nb;
     (*out)[k] = BeamReading(ToolPose(point, disturbed, k), local, &nb);
@@ -113,7 +113,7 @@ double MeanOfReadings(const NoiseModel& noise, const RandomStream& stream,
 
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const PlaneSet& true_planes, const RangerSpec& ranger,
-                     const ConfigurationSet& configs, const NoiseModel& noise,
+                     const TargetedConfigurations& configs, const NoiseModel& noise,
                      const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses, std::vector<double>* raw,
                      const std::vector<int>* noise_slots) {
@@ -133,12 +133,12 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
 }
 
 int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
-             const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
-             MeasurementSet* data, std::vector<double>* raw, const std::vector<int>* noise_slots,
-             const std::vector<double>* per_reading) {
+             const TargetedConfigurations& configs, const NoiseModel& noise,
+             const RandomStream& stream, MeasurementSet* data, std::vector<double>* raw,
+             const std::vector<int>* noise_slots, const std::vector<double>* per_reading) {
   // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial).
   if (data->configs.num_joints() != configs.num_joints())
-    data->configs = ConfigurationSet(configs.num_joints());
+    data->configs = TargetedConfigurations(configs.num_joints());
   data->configs.Clear();
   data->configs.Reserve(configs.size());
   data->mean_h.clear();

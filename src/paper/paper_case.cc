@@ -64,7 +64,7 @@ PaperCasesResult RunPaperCases(const RobotModel& robot, const Truth& true_arm, c
     pc.label = "case " + std::to_string(c + 1);
     pc.selection = SelectConfigurations(
         G, counts[c], *selections[c], RandomStream(options.seed, c, 0, RandomPurpose::kSelection));
-    ConfigurationSet chosen = result.pool.Subset(pc.selection.indices);
+    TargetedConfigurations chosen = result.pool.Subset(pc.selection.indices);
     SimulateReadings(robot, truth, plane, options.sampling.ranger, chosen, options.noise, noise,
                      &pc.data, nullptr, nullptr, &pc.selection.indices);
     IdentificationOptions id = options.identification;

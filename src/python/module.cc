@@ -224,7 +224,7 @@ py::array_t<double> ToArray(const std::vector<double>& v) {
   return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
 }
 
-py::array_t<double> ToArray(const ConfigurationSet& configs) {
+py::array_t<double> ToArray(const TargetedConfigurations& configs) {
   py::array_t<double> out(
       {static_cast<py::ssize_t>(configs.size()), static_cast<py::ssize_t>(configs.num_joints())});
   auto w = out.mutable_unchecked<2>();
@@ -260,13 +260,14 @@ RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_lin
 }
 
 PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
-ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_of, int num_planes);
+TargetedConfigurations WithPlanes(const ConfigurationSet& q, const py::object& plane_of,
+                                  int num_planes);
 
 // One plane number (from 1) per configuration, as a CSV's plane column.
-py::array_t<int> PlaneNumbers(const ConfigurationSet& configs) {
+py::array_t<int> PlaneNumbers(const TargetedConfigurations& configs) {
   py::array_t<int> out(configs.size());
   auto w = out.mutable_unchecked<1>();
-  for (int i = 0; i < configs.size(); ++i) w(i) = configs.plane(i) + 1;
+  for (int i = 0; i < configs.size(); ++i) w(i) = configs.target(i) + 1;
   return out;
 }
 
@@ -295,7 +296,7 @@ py::object LaserReadingsPy(const RobotFile& rig, const Array& q, const py::objec
                            const py::object& plane_of) {
   const RobotModel& robot = rig.robot;
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
-  const ConfigurationSet configs =
+  const TargetedConfigurations configs =
       WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
   const Eigen::VectorXd values = ResolveLinkValues(rig, model);
   std::vector<double> h;
@@ -330,7 +331,7 @@ py::object SampleConfigurationsPy(const RobotFile& rig, int count, long long see
   options.Validate();
   const RandomStream stream(ToSeed(seed), 0, 0,
                             validation ? RandomPurpose::kValidation : RandomPurpose::kPool);
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   {
     py::gil_scoped_release release;
     configs = planes.size() == 1
@@ -377,7 +378,7 @@ Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise
                     const py::object& sigma_m, const py::object& plane_of) {
   const RobotModel& robot = rig.robot;
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
-  const ConfigurationSet configs =
+  const TargetedConfigurations configs =
       WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, planes.size());
   const Eigen::VectorXd values = ResolveLinkValues(rig, model);
   NoiseModel noise = ToNoiseModel(noise_args, sigma_m);
@@ -419,7 +420,7 @@ Readings SimulatePy(const RobotFile& rig, const Array& q, const NoiseArgs& noise
   if (planes.size() > 1) {
     py::array_t<int> tags(m);
     auto wt = tags.mutable_unchecked<1>();
-    for (py::ssize_t r = 0; r < m; ++r) wt(r) = configs.plane(wc(r)) + 1;
+    for (py::ssize_t r = 0; r < m; ++r) wt(r) = configs.target(wc(r)) + 1;
     out.plane_of = std::move(tags);
   }
   return out;
@@ -496,7 +497,8 @@ py::object FromJson(const std::string& json) {
 // The readings' configurations with the plane each is aimed at: `plane_of` has one plane number
 // (from 1, in `planes`' order) per reading, as a measurement CSV's plane column; it may be left
 // out with one plane only.
-ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_of, int num_planes) {
+TargetedConfigurations WithPlanes(const ConfigurationSet& q, const py::object& plane_of,
+                                  int num_planes) {
   if (plane_of.is_none()) {
     if (num_planes > 1)
       throw InputError("plane_of", std::to_string(num_planes) +
@@ -504,7 +506,7 @@ ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_o
                                        "a number from 1 to " +
                                        std::to_string(num_planes) +
                                        " per reading (as a measurement CSV's plane column)");
-    return q;
+    return TargetedConfigurations(q);
   }
   std::vector<double> tags;
   try {
@@ -516,7 +518,7 @@ ConfigurationSet WithPlanes(const ConfigurationSet& q, const py::object& plane_o
     throw InputError("plane_of", "expected one plane number per reading (" +
                                      std::to_string(q.size()) + "), got " +
                                      std::to_string(tags.size()));
-  ConfigurationSet out(q.num_joints());
+  TargetedConfigurations out(q.num_joints());
   out.Reserve(q.size());
   for (int i = 0; i < q.size(); ++i) {
     const double t = tags[i];
@@ -570,7 +572,7 @@ struct IdentifyExtras {
 // the command line's --data or --configs, --plane,
 // --estimate-plane, --estimate-ranger and --fix give them.
 struct ConfigsAndModel {
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   std::unique_ptr<MeasurementModel> model;
 };
 ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
@@ -589,7 +591,7 @@ ConfigsAndModel ResolveConfigsAndModel(const RobotFile& rig, const Array& q,
 
 // Where identify()'s readings came from, for the calibrated file's record: data_file= (hashed)
 // or the arrays themselves (described, and hashed as their float64 bytes).
-DataSource ReadingsSource(const py::object& data_file, const ConfigurationSet& configs,
+DataSource ReadingsSource(const py::object& data_file, const TargetedConfigurations& configs,
                           const std::vector<double>& h) {
   if (!data_file.is_none()) return DataSource::File(py::str(data_file).cast<std::string>());
   std::string bytes;
@@ -694,7 +696,7 @@ IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
   const ConfigsAndModel set =
       ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane,
                              {estimate_ranger, estimate_base, estimate_tool}, fix);
-  const ConfigurationSet& configs = set.configs;
+  const TargetedConfigurations& configs = set.configs;
   const MeasurementModel& model = *set.model;
   IdentifiabilityOptions options;
   options.rank_tolerance = rank_tolerance;
@@ -711,7 +713,7 @@ PriorInformation PriorInformationPy(const RobotFile& rig, const Array& q,
                                     const std::string& estimate_ranger) {
   const ConfigsAndModel set =
       ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane, estimate_ranger, fix);
-  const ConfigurationSet& configs = set.configs;
+  const TargetedConfigurations& configs = set.configs;
   const MeasurementModel& model = *set.model;
   const PriorSigmas priors = PriorsFor(rig, prior, prior_sigma, "prior=", "prior_sigma=");
   if (priors.empty())
@@ -1497,7 +1499,7 @@ py::object KinematicsPy(const RobotFile& rig, const Array& q, const std::string&
   if (which != "nominal" && which != "true")
     throw InputError("model", "expected 'nominal' or 'true', got '" + which + "'");
   const PlaneSet planes = ResolvePlanes(rig, plane);
-  const ConfigurationSet configs = ToConfigurations(q, rig.robot.num_links(), "q");
+  const TargetedConfigurations configs(ToConfigurations(q, rig.robot.num_links(), "q"));
   CheckJointRanges(configs, rig.robot, "q");
   const ParameterSet ps =
       ResolveParameters(rig.robot, planes.size(), estimate_plane, estimate_ranger, fix);

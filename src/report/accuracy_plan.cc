@@ -243,7 +243,7 @@ class Planner {
     WriteFileAtomically(in_.out_dir + "/plan.json", PlanSettings(in_, study_).dump(2) + "\n");
     const PreparedCell base_cell = PreparedCell::Prepare(study_, study_.cells.at(0));
     validation_file_ = in_.out_dir + "/validation.csv";
-    WriteConfigurations(validation_file_, base_cell.validation());
+    WritePoses(validation_file_, base_cell.validation());
     const Json& planes = study_.base["plane"];
     if (!planes.is_array() || planes.size() < 2) {
       if (!in_.planes.empty())

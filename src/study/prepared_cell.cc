@@ -13,7 +13,7 @@ PreparedCell PreparedCell::Prepare(const Study& study, const Cell& cell) {
   return PreparedCell(PrepareCell(study, cell));
 }
 
-const ConfigurationSet& PreparedCell::pool() const { return context_->pool; }
+const TargetedConfigurations& PreparedCell::pool() const { return context_->pool; }
 const ConfigurationSet& PreparedCell::validation() const { return context_->validation; }
 int PreparedCell::num_parameters() const { return context_->model->num_parameters(); }
 const std::vector<std::string>& PreparedCell::parameter_names() const {

@@ -73,7 +73,7 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
 // G of a candidate pool at the nominal model, scaled as the cell's selection says (the paper:
 // SI). Expected-error scaling uses the truth's prior σ (truth.angle_sigma_mrad,
 // truth.length_sigma_mm) for robot parameters and plane terms alike.
-Eigen::MatrixXd CellDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
+Eigen::MatrixXd CellDesignJacobian(const CellContext& c, const TargetedConfigurations& pool) {
   const CellSettings& s = c.cell->typed;
   return DesignJacobian(*c.model, pool, s.scaling, s.truth.angle_sigma, s.truth.length_sigma);
 }
@@ -100,8 +100,8 @@ std::vector<int> PerPlaneCounts(const CellSettings& s, const PlaneSet& planes, i
   return counts;
 }
 
-ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::VectorXd& truth,
-                            SamplingReport* report) {
+TargetedConfigurations SamplePool(const CellContext& c, long long trial,
+                                  const Eigen::VectorXd& truth, SamplingReport* report) {
   const CellSettings& s = c.cell->typed;
   SamplingOptions o;
   o.ranger = c.ranger;
@@ -115,7 +115,7 @@ ConfigurationSet SamplePool(const CellContext& c, long long trial, const Eigen::
 }
 
 // Selects the design of trial `trial` (0 for the cell's own) from a pool and its scaled G.
-TrialDesign SelectDesign(const CellContext& c, long long trial, const ConfigurationSet& pool,
+TrialDesign SelectDesign(const CellContext& c, long long trial, const TargetedConfigurations& pool,
                          const Eigen::MatrixXd& pool_G) {
   const CellSettings& s = c.cell->typed;
   const RandomStream stream(c.selection_seed, c.pool_stream, static_cast<std::uint64_t>(trial),
@@ -170,13 +170,13 @@ void BuildParameterSet(const CellSettings& s, CellContext* c) {
 // A study's configuration file (pool.file, validation.file), read for the cell's robot.
 // `planes`: the cell's planes, against which a pool's plane column is resolved; null for a
 // validation file (poses: a plane column is not read).
-ConfigurationSet ReadStudyConfigurations(const Study& study, const std::string& file,
-                                         const std::string& key, const RobotModel& robot,
-                                         const PlaneSet* planes) {
+TargetedConfigurations ReadStudyConfigurations(const Study& study, const std::string& file,
+                                               const std::string& key, const RobotModel& robot,
+                                               const PlaneSet* planes) {
   try {
     const std::string path = ResolveStudyFile(file, study.folder());
     return planes ? ReadConfigurations(path, robot.num_links(), planes)
-                  : ReadPoses(path, robot.num_links());
+                  : TargetedConfigurations(ReadPoses(path, robot.num_links()));
   } catch (const InputError& e) {
     throw InputError(key, e.what());
   }
@@ -184,8 +184,9 @@ ConfigurationSet ReadStudyConfigurations(const Study& study, const std::string& 
 
 // The candidates of a pool file whose beam hits the plane (nominal model, and the fixed truth
 // when there is one); the others are reported like a drawn pool's rejections.
-ConfigurationSet UsablePoolFromFile(const Study& study, const CellSettings& s, CellContext* c) {
-  const ConfigurationSet given =
+TargetedConfigurations UsablePoolFromFile(const Study& study, const CellSettings& s,
+                                          CellContext* c) {
+  const TargetedConfigurations given =
       ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, &c->planes);
   CandidatePool usable = UsableCandidates(*c->robot, c->planes, c->ranger, given);
   if (!s.truth.random) {  // the true beam must hit too
@@ -193,7 +194,7 @@ ConfigurationSet UsablePoolFromFile(const Study& study, const CellSettings& s, C
     std::vector<BeamMiss> misses;
     ExactReadings(*c->robot, c->fixed_truth.values, c->planes, c->ranger, usable.configs, &h,
                   &misses);
-    ConfigurationSet kept(usable.configs.num_joints());
+    TargetedConfigurations kept(usable.configs.num_joints());
     for (int i = 0; i < usable.configs.size(); ++i) {
       if (misses[i] == BeamMiss::kNone) {
         kept.AddFrom(usable.configs, i);
@@ -257,7 +258,7 @@ bool ModelledUncertainty(const CellSettings& s) {
 // Jacobian is G: each configuration's weight its effective readings, with errors in variables
 // their weights (identification.h).
 PriorInformation PosteriorOn(const CellSettings& s, const CellContext& c,
-                             const ConfigurationSet& configs, const Eigen::MatrixXd& G) {
+                             const TargetedConfigurations& configs, const Eigen::MatrixXd& G) {
   std::vector<double> w(static_cast<std::size_t>(configs.size()), s.noise.EffectiveReadings());
   if (s.identification.encoder_sigma > 0) {
     MeasuredValues values{configs, std::vector<double>(w.size(), 0.0),
@@ -291,7 +292,7 @@ void CheckIdentifiability(const CellSettings& s, CellContext* c) {
 
 // The task criterion's selection matrix (selection.criterion: I), weighted by the validation
 // configurations (task_criterion.h).
-Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const ConfigurationSet& pool) {
+Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const TargetedConfigurations& pool) {
   return TaskDesignJacobian(*c.model, pool, TaskPosesAt(*c.model, c.validation, "validation"));
 }
 
@@ -545,7 +546,7 @@ bool DesignOfTrial(const CellContext& c, long long trial, const TrialTruth& trut
   *design = &c.design;
   if (!s.pool_redraw && !s.selection_redraw) return true;
   if (s.pool_redraw) {
-    ConfigurationSet pool;
+    TargetedConfigurations pool;
     try {
       pool = SamplePool(c, trial, truth.values, nullptr);
     } catch (const InputError&) {
@@ -645,7 +646,7 @@ TrialStatus StatusOf(Termination t) {
 void FillDetails(const CellContext& c, const TrialTruth& truth, const Eigen::VectorXd& identified,
                  const TrialWorkspace& ws, TrialDetails* details) {
   const Eigen::VectorXd& nominal = c.robot->nominal_values();
-  const ConfigurationSet& configs = ws.data.configs;
+  const TargetedConfigurations& configs = ws.data.configs;
   std::vector<double> h_nominal, h_identified;
   std::vector<BeamMiss> unused;
   ExactReadings(*c.robot, nominal, c.planes, c.ranger, configs, &h_nominal, &unused);

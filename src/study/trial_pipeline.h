@@ -62,7 +62,7 @@ std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c,
 
 /// A design: configurations and their slots in the pool (which address the noise).
 struct TrialDesign {
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   std::vector<int> slots;
   double sigma_min = 0;  ///< σ_min of the design's G (SI)
 };
@@ -87,7 +87,7 @@ struct CellContext {
   bool rank_deficient = false;              ///< and not fixed: every trial fails
   std::string rank_message;
   std::uint64_t pool_stream = 0, validation_stream = 0;
-  ConfigurationSet pool;  ///< the cell's pool (a trial may redraw its own)
+  TargetedConfigurations pool;  ///< the cell's pool (a trial may redraw its own)
   SamplingReport pool_report;
   TrialDesign design;                          ///< the cell's selected design
   LevenbergMarquardt::Nominal design_nominal;  ///< h and G of the nominal model on the design
@@ -97,7 +97,7 @@ struct CellContext {
   std::vector<double> design_true_h;  ///< exact true readings on the design (fixed truth)
   std::vector<BeamMiss> design_true_miss;
   std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
-  ConfigurationSet validation;                      ///< shared by every trial of the cell
+  TargetedConfigurations validation;                ///< shared by every trial of the cell
   Eigen::VectorXd predicted_std;  ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
   /// The same with G at the true parameters: the Cramér–Rao bound of the simulated experiment
   /// (fixed truth and design; empty otherwise).

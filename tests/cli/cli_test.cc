@@ -339,8 +339,8 @@ TEST_F(CliTest, DesignTaskCriterionMinimisesThePredictedErrorAtThePoses) {
       << out;
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const ConfigurationSet pool = ReadConfigurations(Path("pool.csv"), 6);
-  const ConfigurationSet poses = ReadConfigurations(Path("poses.csv"), 6);
+  const TargetedConfigurations pool = ReadConfigurations(Path("pool.csv"), 6);
+  const TargetedConfigurations poses = ReadConfigurations(Path("poses.csv"), 6);
   const Eigen::MatrixXd G = IdentificationJacobian(model, pool);
   const std::vector<double> zero(25, 0.0);
   const Eigen::MatrixXd J6 = PoseJacobian(model, zero.data(), poses);

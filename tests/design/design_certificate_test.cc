@@ -69,7 +69,7 @@ Eigen::MatrixXd PaperArmPoolJacobian(std::uint64_t seed) {
   SamplingOptions so;
   so.ranger = rig.ranger;
   so.min_jacobian_singular_value = 0.05;
-  const ConfigurationSet pool = SampleConfigurations(
+  const TargetedConfigurations pool = SampleConfigurations(
       rig.robot, (*rig.planes)[0], 101, RandomStream(seed, 7, 0, RandomPurpose::kPool), so);
   const MeasurementModel model(rig.robot, (*rig.planes)[0],
                                MakeParameterSet(rig.robot, PlaneTerms{}, {}, "fix"));

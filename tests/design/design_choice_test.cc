@@ -19,7 +19,7 @@ class DesignChoiceTest : public ::testing::Test {
  protected:
   MeasurementModel model_{testing::PaperRobot(), testing::PaperPlane(),
                           MakeParameterSet(testing::PaperRobot(), PlaneTerms{})};
-  ConfigurationSet pool_ =
+  TargetedConfigurations pool_ =
       testing::ConfigurationsFacing(testing::PaperRobot(), testing::PaperPlane(), 45, 11);
 };
 

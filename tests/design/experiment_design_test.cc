@@ -329,7 +329,7 @@ TEST(DesignJacobian, ScalesTheIdentificationJacobianAsAsked) {
   const MeasurementModel model(testing::PaperRobot(), testing::PaperPlane(),
                                MakeParameterSet(testing::PaperRobot(), PlaneTerms{}));
   SamplingOptions sampling;
-  const ConfigurationSet pool =
+  const TargetedConfigurations pool =
       SampleConfigurations(testing::PaperRobot(), testing::PaperPlane(), 40,
                            RandomStream(3, 0, 0, RandomPurpose::kPool), sampling);
   const Eigen::MatrixXd G = IdentificationJacobian(model, pool);
@@ -344,7 +344,7 @@ TEST(UsableCandidates, KeepsTheConfigurationsWhoseNominalBeamHitsAndSaysWhyOther
   const RobotModel& robot = testing::PaperRobot();
   SamplingOptions anywhere;
   anywhere.require_beam_hit = false;
-  const ConfigurationSet pool =
+  const TargetedConfigurations pool =
       SampleConfigurations(robot, testing::PaperPlane(), 200,
                            RandomStream(5, 0, 0, RandomPurpose::kValidation), anywhere);
   const CandidatePool usable = UsableCandidates(robot, testing::PaperPlane(), RangerSpec{}, pool);

@@ -23,10 +23,10 @@ PlaneSet ThreePlanes() {
                   {});
 }
 
-ConfigurationSet OnEachPlane(const PlaneSet& planes, int per_plane) {
-  ConfigurationSet out(6);
+TargetedConfigurations OnEachPlane(const PlaneSet& planes, int per_plane) {
+  TargetedConfigurations out(6);
   for (int p = 0; p < planes.size(); ++p) {
-    const ConfigurationSet c = testing::HittingConfigurations(planes[p], per_plane, 40 + p);
+    const TargetedConfigurations c = testing::HittingConfigurations(planes[p], per_plane, 40 + p);
     for (int i = 0; i < c.size(); ++i) out.Add(c.q(i), p);
   }
   return out;
@@ -67,7 +67,7 @@ TEST(IdentifiabilityRemedies, ThreeEstimatedPlanesLoseASpinAndAShift) {
   const MeasurementModel model(
       robot, planes,
       MakeParameterSet(robot, std::vector<PlaneTerms>(3, PlaneTerms{true, true}), {}));
-  const ConfigurationSet configs = OnEachPlane(planes, 40);
+  const TargetedConfigurations configs = OnEachPlane(planes, 40);
   const IdentifiabilityReport report = AnalyzeIdentifiability(model, configs);
   ASSERT_EQ(report.num_params(), 34);
   ASSERT_EQ(report.rank, 32);
@@ -105,7 +105,7 @@ TEST(IdentifiabilityRemedies, RangerOffsetOnlyByFixingAndScaleByASecondKnownPlan
   const MeasurementModel model(
       robot, testing::PaperPlane(),
       MakeParameterSet(robot, PlaneTerms{}, {}, "--fix", RangerTerms{true, true}));
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(80, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(80, 4);
   const IdentifiabilityReport report = AnalyzeIdentifiability(model, configs);
   ASSERT_EQ(report.rank, 25);
   const RemedyReport r = FindRemedies(model, configs, report, Options());
@@ -127,7 +127,7 @@ TEST(IdentifiabilityRemedies, RangerOffsetOnlyByFixingAndScaleByASecondKnownPlan
 TEST(IdentifiabilityRemedies, FullRankNeedsNothing) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 4);
   const IdentifiabilityReport report = AnalyzeIdentifiability(model, configs);
   ASSERT_TRUE(report.full_rank());
   const RemedyReport r = FindRemedies(model, configs, report, Options());

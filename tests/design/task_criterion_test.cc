@@ -37,7 +37,7 @@ TEST(TaskCriterion, PositionRowsAreThoseOfThePoseJacobianAtNominal) {
 
 TEST(TaskCriterion, AOnTheWeightedJacobianIsTheSummedMeanSquarePositionError) {
   const MeasurementModel model = PaperModel();
-  const ConfigurationSet pool =
+  const TargetedConfigurations pool =
       testing::ConfigurationsFacing(model.robot(), testing::PaperPlane(), 60, /*seed=*/5);
   const TaskPoses task = TaskPosesAt(model, WorkspacePoses(model.robot(), 20, 1), "workspace");
   const Eigen::MatrixXd Gt = TaskDesignJacobian(model, pool, task);

@@ -50,7 +50,7 @@ TEST(CpuDispatch, BatchKernelHasTheSameBitsInEveryVariant) {
   const RobotModel& robot = testing::PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(),
                          MakeParameterSet(robot, PlaneTerms{true, true}));
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(101);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(101);
   std::vector<double> e(model.num_parameters(), 1e-3);
   ModelPoint point;
   model.Prepare(e.data(), &point);

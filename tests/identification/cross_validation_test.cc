@@ -16,8 +16,8 @@
 namespace lrcal {
 namespace {
 
-MeasurementSet Simulated(const ConfigurationSet& configs, NoiseModel noise, std::uint64_t seed,
-                         const PlaneSet& planes = testing::PaperPlane()) {
+MeasurementSet Simulated(const TargetedConfigurations& configs, NoiseModel noise,
+                         std::uint64_t seed, const PlaneSet& planes = testing::PaperPlane()) {
   MeasurementSet data;
   SimulateReadings(testing::PaperRobot(), testing::PaperTrueValues(), planes,
                    testing::PaperRig().ranger, configs, noise,
@@ -80,7 +80,7 @@ TEST(CrossValidation, ConsistentDataPassUnderstatedNoiseAndMissingTermsDoNot) {
   NoiseModel noise;
   noise.sigma = 0.2e-3;
   noise.repetitions = 1;
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 13);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 13);
   IdentificationOptions stated;
   stated.sigma = noise.sigma;
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
@@ -97,9 +97,9 @@ TEST(CrossValidation, ConsistentDataPassUnderstatedNoiseAndMissingTermsDoNot) {
   EXPECT_THAT(low.ToString(), ::testing::HasSubstr("WORSE than the fit says"));
 
   const PlaneSet planes({testing::PaperPlane(), Plane::FromCoefficients(1, 0, 0, 0.9)}, {});
-  ConfigurationSet both(6);
+  TargetedConfigurations both(6);
   for (int p = 0; p < 2; ++p) {
-    const ConfigurationSet c = testing::HittingConfigurations(planes[p], 40, 20 + p);
+    const TargetedConfigurations c = testing::HittingConfigurations(planes[p], 40, 20 + p);
     for (int i = 0; i < c.size(); ++i) both.Add(c.q(i), p);
   }
   NoiseModel scaled = noise;

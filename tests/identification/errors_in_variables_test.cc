@@ -23,7 +23,7 @@ constexpr double kJointSigma = 0.1e-3;  // rad, each recorded joint value
 // Jacobian's θ columns, computed here independently of the central differences they use.
 TEST(ErrorsInVariables, WeightsFollowTheJointGradientOfEachReading) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(30, 2);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(30, 2);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model);
   MeasuredValues data;
@@ -51,7 +51,7 @@ TEST(ErrorsInVariables, WeightsFollowTheJointGradientOfEachReading) {
 // without them the χ² check rejects nearly every calibration.
 TEST(ErrorsInVariables, ChiSquaredAndCovarianceHoldWithNoisyJointValues) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 3);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 3);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   IdentificationOptions eiv;
   eiv.sigma = kEivSigma;
@@ -99,7 +99,7 @@ TEST(ErrorsInVariables, ChiSquaredAndCovarianceHoldWithNoisyJointValues) {
 // when the values had weights: a median fit then ignored encoder_sigma).
 TEST(ErrorsInVariables, ApplyOnTopOfAMediansWeights) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(40, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(40, 4);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model);
   MeasuredValues median;

@@ -36,10 +36,10 @@ PlaneSet TiltedThreePlanes() {
       {});
 }
 
-ConfigurationSet FacingAll(const RobotModel& robot, const PlaneSet& planes, int per_plane) {
-  ConfigurationSet configs(robot.num_links());
+TargetedConfigurations FacingAll(const RobotModel& robot, const PlaneSet& planes, int per_plane) {
+  TargetedConfigurations configs(robot.num_links());
   for (int p = 0; p < planes.size(); ++p) {
-    const ConfigurationSet facing =
+    const TargetedConfigurations facing =
         testing::ConfigurationsFacing(robot, planes[p], per_plane, 7 + p);
     for (int i = 0; i < facing.size(); ++i) configs.Add(facing.q(i), p);
   }
@@ -49,12 +49,12 @@ ConfigurationSet FacingAll(const RobotModel& robot, const PlaneSet& planes, int 
 // Noise-free readings of `robot` (its own base and tool) at link values `values`: the reference
 // kinematics, independent of the measurement model's frame terms.
 MeasurementSet Exact(const RobotModel& robot, const Eigen::VectorXd& values, const PlaneSet& planes,
-                     const ConfigurationSet& configs) {
+                     const TargetedConfigurations& configs) {
   MeasurementSet data;
   data.configs = configs;
   for (int i = 0; i < configs.size(); ++i) {
     const Pose<double> pose = ForwardKinematics<double>(robot, values.data(), configs.q(i));
-    const Plane& plane = planes[configs.plane(i)];
+    const Plane& plane = planes[configs.target(i)];
     data.mean_h.push_back(
         LaserDistance<double>(pose.p_BT, pose.R_BT.col(2), plane.normal, plane.offset));
   }
@@ -104,7 +104,7 @@ TEST(FrameTermsIdentifiability, NamesTheDependencesOnTheEndLinks) {
 TEST(FrameTermsRecovery, RecoversLinksBaseAndToolFromNoiseFreeReadings) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
   const PlaneSet planes = TiltedThreePlanes();
-  const ConfigurationSet configs = FacingAll(robot, planes, 40);
+  const TargetedConfigurations configs = FacingAll(robot, planes, 40);
   const ParameterSet asked =
       MakeParameterSet(robot, std::vector<PlaneTerms>(3), {}, "--fix", RangerTerms{}, All(), All());
   const IdentifiabilityReport report =
@@ -143,7 +143,8 @@ TEST(FrameTermsPoses, PoseJacobianColumnsOfTheFrames) {
   const MeasurementModel model(
       robot, testing::PaperPlane(),
       MakeParameterSet(robot, PlaneTerms{}, {}, "--fix", RangerTerms{}, All(), All()));
-  const ConfigurationSet configs = testing::ConfigurationsFacing(robot, testing::PaperPlane(), 4);
+  const TargetedConfigurations configs =
+      testing::ConfigurationsFacing(robot, testing::PaperPlane(), 4);
   const std::vector<double> e(model.num_parameters(), 0.0);
   const Eigen::MatrixXd J = PoseJacobian(model, e.data(), configs);
   const ParameterSet& ps = model.parameters();

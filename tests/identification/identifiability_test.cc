@@ -20,7 +20,7 @@ std::vector<std::string> Sorted(std::vector<std::string> v) {
   return v;
 }
 
-ConfigurationSet HittingConfigurations(const Plane& plane, int count) {
+TargetedConfigurations HittingConfigurations(const Plane& plane, int count) {
   return testing::HittingConfigurations(plane, count, 5);
 }
 
@@ -93,7 +93,7 @@ TEST(Identifiability, EveryDependenceIsANullDirectionOfG) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(),
                          MakeParameterSet(robot, PlaneTerms{true, true}));
-  ConfigurationSet configs = testing::PaperHittingConfigurations(80);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(80);
   auto report = AnalyzeIdentifiability(model, configs);
   Eigen::MatrixXd G = IdentificationJacobian(model, configs);
   for (const auto& dep : report.dependencies) {

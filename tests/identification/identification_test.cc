@@ -29,7 +29,7 @@ constexpr double kRecoveryTolerance = testing::tolerance::kRoundTrip;  // SI (m 
 constexpr double kSolverAgreement = 1e-9;  // relative to the largest |estimate error|
 
 MeasurementSet Exact(const RobotModel& robot, const Eigen::VectorXd& values, const Plane& plane,
-                     const ConfigurationSet& configs) {
+                     const TargetedConfigurations& configs) {
   MeasurementSet data;
   data.configs = configs;
   std::vector<BeamMiss> misses;
@@ -92,8 +92,8 @@ TEST_P(RecoveryTest, RankDeficientSetIsReportedNotConverged) {
   Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
   MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
   // Configurations whose beams hit the horizontal plane.
-  ConfigurationSet configs(6);
-  ConfigurationSet pool = testing::PaperHittingConfigurations(400, 9);
+  TargetedConfigurations configs(6);
+  TargetedConfigurations pool = testing::PaperHittingConfigurations(400, 9);
   std::vector<double> h;
   std::vector<BeamMiss> misses;
   ExactReadings(robot, testing::PaperTrueValues(), horizontal, testing::PaperRig().ranger, pool, &h,
@@ -130,7 +130,7 @@ TEST(Identification, LevenbergMarquardtAgreesWithCeresOnNoisyPaperCases) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   for (int m : {50, 100}) {
-    ConfigurationSet configs = testing::PaperHittingConfigurations(m, 21);
+    TargetedConfigurations configs = testing::PaperHittingConfigurations(m, 21);
     MeasurementSet data;
     SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                      testing::PaperRig().ranger, configs, NoiseModel{},
@@ -154,7 +154,7 @@ TEST(Identification, CachedNominalLinearisationGivesTheSameEstimate) {
   // solver must reach the same minimum as without them.
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  ConfigurationSet configs = testing::PaperHittingConfigurations(100, 8);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(100, 8);
   MeasurementSet data;
   SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                    testing::PaperRig().ranger, configs, NoiseModel{},
@@ -181,7 +181,7 @@ TEST(Identification, BareSolverReportsRankDeficiencyLikeTheFullPath) {
   // The paper's own Δe (robot + plane normal) is rank-deficient (theta1 ~ plane_u1).
   MeasurementModel model(robot, testing::PaperPlane(),
                          MakeParameterSet(robot, PlaneTerms{true, false}));
-  ConfigurationSet configs = testing::PaperHittingConfigurations(100);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(100);
   MeasurementSet data = Exact(robot, testing::PaperTrueValues(), testing::PaperPlane(), configs);
   std::vector<double> w(data.size(), 10.0);
   LevenbergMarquardt lm;
@@ -194,7 +194,7 @@ TEST(Identification, BareSolverReportsRankDeficiencyLikeTheFullPath) {
 TEST(Identification, CovarianceIsSigmaSquaredTimesInverseNormalMatrix) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  ConfigurationSet configs = testing::PaperHittingConfigurations(60, 4);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 4);
   MeasurementSet data;
   SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                    testing::PaperRig().ranger, configs, NoiseModel{},
@@ -217,7 +217,7 @@ TEST(Identification, RobustLossesResistOutlyingReadings) {
   // away from the truth, the Huber and Cauchy losses (Ceres, scale 0.2 mm) much less.
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  ConfigurationSet configs = testing::PaperHittingConfigurations(80, 12);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(80, 12);
   MeasurementSet data;
   SimulateReadings(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                    testing::PaperRig().ranger, configs, NoiseModel{},
@@ -335,7 +335,7 @@ TEST(Identification, RobustFitsConvergeOnCleanData) {
 // (their true errors zero here) noise-free readings give back o, s and every other parameter.
 TEST(Identification, RangerOffsetAndScaleAreFoundOrNamedAsDependent) {
   const RobotModel& robot = PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 9);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 9);
   for (const char* term : {"offset", "scale"}) {
     MeasurementModel model(
         robot, testing::PaperPlane(),
@@ -388,10 +388,10 @@ PlaneSet ThreePlanes() {
 }
 
 // `per_plane` configurations whose nominal beam hits each plane, tagged with it.
-ConfigurationSet ThreePlaneConfigurations(const PlaneSet& planes, int per_plane) {
-  ConfigurationSet out(6);
+TargetedConfigurations ThreePlaneConfigurations(const PlaneSet& planes, int per_plane) {
+  TargetedConfigurations out(6);
   for (int p = 0; p < planes.size(); ++p) {
-    const ConfigurationSet c = testing::HittingConfigurations(planes[p], per_plane, 31 + p);
+    const TargetedConfigurations c = testing::HittingConfigurations(planes[p], per_plane, 31 + p);
     for (int i = 0; i < c.size(); ++i) out.Add(c.q(i), p);
   }
   return out;
@@ -422,7 +422,7 @@ TEST(Identification, ThreeEstimatedPlanesRecoverTheTruth) {
     e_true[ps.plane_columns[p].f] = 0.001 * (p + 1);
   }
   const PlaneSet true_planes = model.PlanesAt(e_true.data());
-  const ConfigurationSet configs = ThreePlaneConfigurations(planes, 40);
+  const TargetedConfigurations configs = ThreePlaneConfigurations(planes, 40);
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   ExactReadings(robot, truth, true_planes, testing::PaperRig().ranger, configs, &data.mean_h,
@@ -458,7 +458,7 @@ TEST(Identification, RangerScaleIsFoundAgainstThreeKnownPlanes) {
   MeasurementModel model(robot, planes,
                          MakeParameterSet(robot, std::vector<PlaneTerms>(3), {}, "--fix", scale));
   ASSERT_EQ(model.num_parameters(), 26);
-  const ConfigurationSet configs = ThreePlaneConfigurations(planes, 40);
+  const TargetedConfigurations configs = ThreePlaneConfigurations(planes, 40);
   EXPECT_EQ(AnalyzeIdentifiability(model, configs).rank, 26);
   NoiseModel exact{0.0, 1, true};
   exact.ranger_scale = 250e-6;
@@ -485,7 +485,7 @@ TEST(Identification, ReadingOnAPlaneTheModelLacksIsAnInputError) {
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   MeasurementSet data = Exact(robot, testing::PaperTrueValues(), testing::PaperPlane(),
                               testing::PaperHittingConfigurations(40));
-  ConfigurationSet tagged(6);
+  TargetedConfigurations tagged(6);
   for (int i = 0; i < data.configs.size(); ++i) tagged.Add(data.configs.q(i), i == 7 ? 1 : 0);
   data.configs = tagged;
   const IdentificationSummary s = Identify(model, data, IdentificationOptions{});
@@ -502,7 +502,7 @@ TEST(Identification, FitCheckAgainstTheStatedNoise) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   // 62 configurations whose nominal beam hits, 61 of which the true beam does: dof 36 (even).
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(62, 14);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(62, 14);
   int flagged = 0, flagged_inflated = 0;
   double p_sum = 0;
   const int seeds = 200;
@@ -562,7 +562,7 @@ TEST(Identification, FitCheckAgainstTheStatedNoise) {
 void ExpectRobustFitCheckHolds(RobustLoss loss, double scale_in_sigma, int seeds) {
   const RobotModel& robot = PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(62, 14);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(62, 14);
   constexpr double kSigma = 0.2e-3;
   int flagged = 0, flagged_outliers = 0, flagged_outliers_chi2 = 0, flagged_inflated = 0;
   double p_sum = 0;
@@ -743,7 +743,7 @@ TEST(MeasurementKindIdentification, RankDeficiencyIsNamedAndFixedLikeTheRangerPa
   // A horizontal plane: θ1, a1 and d-type terms cannot all be seen (RecoveryTest above).
   const RobotModel& robot = PaperRobot();
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
-  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 80, 4);
+  const TargetedConfigurations configs = testing::HittingConfigurations(horizontal, 80, 4);
   const MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model, testing::PaperRig().ranger);
   const IdentifiabilityReport a = AnalyzeIdentifiability(model, configs);

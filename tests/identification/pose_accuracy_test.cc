@@ -18,8 +18,8 @@ namespace {
 TEST(PoseAccuracy, PredictionMatchesAMonteCarloOfTheIdentification) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 31);
-  const ConfigurationSet poses = testing::PaperHittingConfigurations(5, 32);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 31);
+  const TargetedConfigurations poses = testing::PaperHittingConfigurations(5, 32);
   const NoiseModel noise{0.2e-3, 10, true};
   IdentificationOptions o;
   o.sigma = noise.sigma;
@@ -63,7 +63,7 @@ TEST(PoseAccuracy, RadiusOfAnIsotropicErrorIsTheChiQuantile) {
   // Σ = s²·I in 3-D: |x|/s is χ with 3 degrees of freedom, whose 0.95 quantile is 2.7955.
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
-  const ConfigurationSet pose = testing::PaperHittingConfigurations(1, 3);
+  const TargetedConfigurations pose = testing::PaperHittingConfigurations(1, 3);
   const Eigen::MatrixXd J = PoseJacobian(model, std::vector<double>(25, 0.0).data(), pose);
   // With C = s²·Jp⁺(Jp⁺)ᵀ, Jp·C·Jpᵀ = s²·I for the full-row-rank position Jacobian Jp.
   const Eigen::MatrixXd Jp = J.topRows(3);

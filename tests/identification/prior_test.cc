@@ -60,7 +60,7 @@ TEST(PriorSigmas, BadItemsAreNamed) {
 }
 
 MeasurementSet Readings(const RobotModel& robot, const Eigen::VectorXd& values, const Plane& plane,
-                        const ConfigurationSet& configs, std::uint64_t seed) {
+                        const TargetedConfigurations& configs, std::uint64_t seed) {
   MeasurementSet data;
   NoiseModel noise;
   noise.sigma = kPriorTestSigma;
@@ -144,7 +144,7 @@ TEST(Priors, DataDecideWhereTheyCanAndPriorsWhereTheyCannot) {
   EXPECT_TRUE(map.SetByPrior().empty()) << map.FullReport();
 
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
-  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 100, 6);
+  const TargetedConfigurations configs = testing::HittingConfigurations(horizontal, 100, 6);
   const MeasurementModel flat(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
   const MeasurementSet flat_data =
       Readings(robot, testing::PaperTrueValues(), horizontal, configs, 4);
@@ -176,7 +176,7 @@ TEST(PriorRowsEvaluator, AppendsOneRowPerPriorTerm) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model);
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(5, 2);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(5, 2);
   std::unique_ptr<MeasurementEvaluator> readings = kind.Bind(configs);
   PriorRowsEvaluator evaluator(*readings, {1, 4});
   const int n = kind.num_parameters();
@@ -202,7 +202,7 @@ TEST(PriorRowsEvaluator, AppendsOneRowPerPriorTerm) {
 TEST(Priors, PosteriorCovarianceCoversTruthsDrawnFromThePriors) {
   const RobotModel& robot = testing::PaperRobot();
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
-  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 60, 8);
+  const TargetedConfigurations configs = testing::HittingConfigurations(horizontal, 60, 8);
   const MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
   const IdentificationOptions options =
       WithPriors("theta=1mrad,alpha=1mrad,beta=1mrad,a=1mm,d=1mm");
@@ -242,7 +242,7 @@ namespace {
 TEST(PriorInformation, IsThePosteriorOfReadingsAtTheConfigurations) {
   const RobotModel& robot = testing::PaperRobot();
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
-  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 60, 8);
+  const TargetedConfigurations configs = testing::HittingConfigurations(horizontal, 60, 8);
   const MeasurementModel model(robot, horizontal, MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model);
   NoiseModel noise;

@@ -28,7 +28,7 @@ struct Outcome {
 
 Outcome Calibrate(const NoiseModel& noise, int trials, std::uint64_t seed) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(60, 3);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(60, 3);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   IdentificationOptions options;
   options.sigma = kAveragingSigma;

@@ -22,7 +22,7 @@ constexpr double kTotalSigma = 0.1e-3;  // m, the noise of one reading in these 
 
 // Readings of the arm whose every term (robot, plane, ranger) deviates by e_all from nominal
 // (laid out as the complete parameter set); noise-free when seed is 0.
-MeasurementSet ReadingsOfTruth(const Eigen::VectorXd& e_all, const ConfigurationSet& configs,
+MeasurementSet ReadingsOfTruth(const Eigen::VectorXd& e_all, const TargetedConfigurations& configs,
                                std::uint64_t seed, const Plane& plane = testing::PaperPlane()) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel complete(robot, plane, CompleteParameterSet(robot, 1));
@@ -49,7 +49,7 @@ IdentificationOptions GivenSigma() {
 // (central differences) moves the estimate by S·δ.
 TEST(UnestimatedTerms, EstimateShiftIsTheDerivativeOfTheEstimate) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(50, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(50, 4);
   const MeasurementModel model(robot, testing::PaperPlane(),
                                MakeParameterSet(robot, PlaneTerms{}, {"theta1", "a2"}));
   const int n_all = CompleteParameterSet(robot, 1).size();
@@ -84,7 +84,7 @@ TEST(UnestimatedTerms, EstimateShiftIsTheDerivativeOfTheEstimate) {
 // and every pose moves by the offset along the beam — the source's RMS is its prior σ.
 TEST(AccuracyPrediction, AConfoundedRangerOffsetMovesEveryPoseByItself) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(50, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(50, 4);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const MeasurementSet data =
       ReadingsOfTruth(Eigen::VectorXd::Zero(CompleteParameterSet(robot, 1).size()), configs, 7);
@@ -94,7 +94,7 @@ TEST(AccuracyPrediction, AConfoundedRangerOffsetMovesEveryPoseByItself) {
   const UnestimatedTerms held =
       FindUnestimatedTerms(SolvedModel(model, s), s, data, GivenSigma(), known);
   EXPECT_THAT(held.defaulted, ::testing::ElementsAre("ranger_scale"));
-  const ConfigurationSet poses = testing::PaperHittingConfigurations(40, 9);
+  const TargetedConfigurations poses = testing::PaperHittingConfigurations(40, 9);
   const AccuracyPrediction p =
       PredictTotalAccuracy(SolvedModel(model, s), s.delta.data(), s.covariance_given, held, poses);
   double shares = 0;
@@ -120,7 +120,7 @@ TEST(AccuracyPrediction, AConfoundedRangerOffsetMovesEveryPoseByItself) {
 // Without held terms the total is the data part, bit for bit.
 TEST(AccuracyPrediction, WithNothingHeldTheTotalIsTheDataPart) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(50, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(50, 4);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const IdentificationSummary s = Identify(
       model,
@@ -129,7 +129,7 @@ TEST(AccuracyPrediction, WithNothingHeldTheTotalIsTheDataPart) {
   ASSERT_TRUE(s.IsSolutionUsable());
   UnestimatedTerms none;
   none.estimate_shift.resize(s.delta.size(), 0);
-  const ConfigurationSet poses = testing::PaperHittingConfigurations(10, 9);
+  const TargetedConfigurations poses = testing::PaperHittingConfigurations(10, 9);
   const AccuracyPrediction p =
       PredictTotalAccuracy(SolvedModel(model, s), s.delta.data(), s.covariance_given, none, poses);
   const std::vector<PoseAccuracy> data_only =
@@ -145,7 +145,7 @@ TEST(AccuracyPrediction, WithNothingHeldTheTotalIsTheDataPart) {
 // A fit the χ² check rejects (two configurations 3 mm off) is stated with σ̂, and says so.
 TEST(ChooseSigma, UsesTheResidualsWhenTheGivenSigmaIsRejected) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(50, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(50, 4);
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   MeasurementSet data =
       ReadingsOfTruth(Eigen::VectorXd::Zero(CompleteParameterSet(robot, 1).size()), configs, 5);
@@ -175,8 +175,8 @@ TEST(ChooseSigma, UsesTheResidualsWhenTheGivenSigmaIsRejected) {
 TEST(AccuracyPrediction, TotalRadiusCoversTruthsDrawnFromThePriors) {
   const RobotModel& robot = testing::PaperRobot();
   const Plane horizontal = Plane::FromCoefficients(0, 0, 1, 0.3);
-  const ConfigurationSet configs = testing::HittingConfigurations(horizontal, 60, 8);
-  const ConfigurationSet pool = testing::PaperHittingConfigurations(300, 21);
+  const TargetedConfigurations configs = testing::HittingConfigurations(horizontal, 60, 8);
+  const TargetedConfigurations pool = testing::PaperHittingConfigurations(300, 21);
   const MeasurementModel model(
       robot, horizontal, MakeParameterSet(robot, PlaneTerms{true, false}, {"theta1", "a1", "d3"}));
   const PriorSigmas known = PriorSigmas::Parse(
@@ -201,7 +201,7 @@ TEST(AccuracyPrediction, TotalRadiusCoversTruthsDrawnFromThePriors) {
     const MeasurementModel solved = SolvedModel(model, s);
     const UnestimatedTerms held = FindUnestimatedTerms(solved, s, data, GivenSigma(), known);
     ASSERT_TRUE(held.defaulted.empty());
-    ConfigurationSet pose(robot.num_links());
+    TargetedConfigurations pose(robot.num_links());
     pose.Add(pool.q(t));
     const AccuracyPrediction p = PredictTotalAccuracy(
         solved, s.delta.data(), CovarianceFor(s, ChooseSigma(s, GivenSigma())), held, pose);

@@ -69,7 +69,7 @@ void ExpectSameKinematics(const RobotModel& robot, const std::string& urdf,
     const Eigen::Isometry3d expected = UrdfForwardKinematics(urdf, tool_link, q);
     const Pose<double> ref =
         ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
-    ConfigurationSet one(robot.num_links());
+    TargetedConfigurations one(robot.num_links());
     one.Add(q);
     const Pose<double> fast = ToolPose(point, one, 0);
     for (const Pose<double>* pose : {&ref, &fast}) {

@@ -14,7 +14,7 @@ namespace {
 // Same formulas, different order of operations: agreement to a few ulps of O(1) values.
 constexpr double kTolerance = 1e-13;
 
-void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs,
+void ExpectSame(const MeasurementModel& model, const TargetedConfigurations& configs,
                 Isa isa = ActiveIsa()) {
   const int n = model.num_parameters(), m = configs.size();
   std::mt19937 rng(3);
@@ -42,7 +42,7 @@ void ExpectSame(const MeasurementModel& model, const ConfigurationSet& configs,
 
 TEST(BatchEvaluator, MatchesPerConfigurationEvaluationForEveryPlaneTerm) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(37);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(37);
   for (PlaneTerms terms : {PlaneTerms{false, false}, PlaneTerms{true, false},
                            PlaneTerms{false, true}, PlaneTerms{true, true}}) {
     MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, terms));
@@ -64,10 +64,10 @@ TEST(BatchEvaluator, MatchesPerConfigurationEvaluationWithSeveralPlanes) {
   const PlaneSet planes({testing::PaperPlane(), Plane::FromCoefficients(1, 0, 0, 0.9),
                          Plane::FromCoefficients(0, 1, 0, 0.9)},
                         {});
-  ConfigurationSet mixed(6), second_only(6);
+  TargetedConfigurations mixed(6), second_only(6);
   for (int k = 0; k < 13; ++k)
     for (int p = 0; p < 3; ++p) {
-      const ConfigurationSet c = testing::HittingConfigurations(planes[p], 13, 2 + p);
+      const TargetedConfigurations c = testing::HittingConfigurations(planes[p], 13, 2 + p);
       mixed.Add(c.q(k), p);
       if (p == 1) second_only.Add(c.q(k), 1);
     }
@@ -103,7 +103,7 @@ TEST(BatchEvaluator, MatchesWithAPrismaticJoint) {
   RobotModel robot("three", links);
   MeasurementModel model(robot, Plane::FromCoefficients(0.1, 0.2, 1.0, 2.0),
                          MakeParameterSet(robot, PlaneTerms{true, true}));
-  ConfigurationSet configs(3);
+  TargetedConfigurations configs(3);
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < 20; ++i) configs.Add(std::vector<double>{u(rng), 0.5 + 0.4 * u(rng), u(rng)});
@@ -125,9 +125,10 @@ TEST(BatchEvaluator, MatchesWithEstimatedBaseAndToolTermsOnEveryVariant) {
       {Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8), Plane::FromCoefficients(1, 0.1, 0, 0.9),
        Plane::FromCoefficients(0, 1, 0.2, 0.9)},
       {});
-  ConfigurationSet mixed(robot.num_links());
+  TargetedConfigurations mixed(robot.num_links());
   for (int p = 0; p < planes.size(); ++p) {
-    const ConfigurationSet facing = testing::ConfigurationsFacing(robot, planes[p], 13, 3 + p);
+    const TargetedConfigurations facing =
+        testing::ConfigurationsFacing(robot, planes[p], 13, 3 + p);
     for (int i = 0; i < facing.size(); ++i) mixed.Add(facing.q(i), p);
   }
   const FrameTerms all = FrameTerms::Parse("all", "base"), some = FrameTerms::Parse("x,z,rpy", "t");

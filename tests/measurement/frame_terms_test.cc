@@ -95,7 +95,8 @@ TEST(FrameTerms, MovedFramesAreTheRobotsOwnAtTheEstimate) {
       moved.tool().translation,
       testing::EigenNear(robot.tool().translation - Eigen::Vector3d(1e-3, -2e-3, 3e-3), 1e-15));
   // The reading of the moved robot's reference kinematics is the model's at e.
-  const ConfigurationSet configs = testing::ConfigurationsFacing(robot, testing::PaperPlane(), 5);
+  const TargetedConfigurations configs =
+      testing::ConfigurationsFacing(robot, testing::PaperPlane(), 5);
   for (int i = 0; i < configs.size(); ++i) {
     const Pose<double> pose =
         ForwardKinematics<double>(moved, robot.nominal_values().data(), configs.q(i));

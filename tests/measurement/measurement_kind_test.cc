@@ -20,7 +20,7 @@ TEST(SimulateMeasurements, NoiseFreeValuesAreTheExactReadingsAndMissesAreLeftOut
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model, testing::PaperRig().ranger);
-  ConfigurationSet configs = testing::PaperHittingConfigurations(10, 3);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(10, 3);
   configs.Add(std::vector<double>(6, 0.0));  // the arm stretched out: the beam misses
   NoiseModel exact;
   exact.sigma = 0;
@@ -53,8 +53,8 @@ TEST(SimulateMeasurements, AConfigurationsNoiseDoesNotDependOnTheOthers) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model, testing::PaperRig().ranger);
-  const ConfigurationSet all = testing::PaperHittingConfigurations(12, 5);
-  const ConfigurationSet first = all.Subset({0, 1, 2, 3});
+  const TargetedConfigurations all = testing::PaperHittingConfigurations(12, 5);
+  const TargetedConfigurations first = all.Subset({0, 1, 2, 3});
   NoiseModel noise;
   const RandomStream stream(9, 0, 0, RandomPurpose::kNoise);
   MeasuredValues a, b;

@@ -41,9 +41,9 @@ class JacobianTest : public ::testing::TestWithParam<Case> {};
 // reading against the reference too. Returns the row.
 template <typename JetT>
 std::vector<double> ExpectRowMatches(const MeasurementModel& model, const ModelPoint& point,
-                                     const std::vector<double>& e, const ConfigurationSet& configs,
-                                     int i) {
-  const int n = model.num_parameters(), plane = configs.plane(i);
+                                     const std::vector<double>& e,
+                                     const TargetedConfigurations& configs, int i) {
+  const int n = model.num_parameters(), plane = configs.target(i);
   const double* q = configs.q(i);
   double h = 0;
   std::vector<double> row(n);
@@ -76,7 +76,7 @@ TEST_P(JacobianTest, AnalyticMatchesAutodiffAndCentralDifferences) {
       MakeParameterSet(robot, GetParam().terms, GetParam().fixed, "--fix", GetParam().ranger));
   const int n = model.num_parameters();
   ASSERT_LE(n, kMaxParams);
-  ConfigurationSet configs = testing::PaperHittingConfigurations(30, 3);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(30, 3);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> ue(-0.01, 0.01);
   for (int point_index = 0; point_index < 3; ++point_index) {
@@ -118,7 +118,7 @@ TEST(JacobianWithFrames, AnalyticMatchesAutodiffAndCentralDifferences) {
       MakeParameterSet(robot, PlaneTerms{true, true}, {}, "--fix", RangerTerms{true, true}));
   const int n = model.num_parameters();
   ASSERT_LE(n, kMaxParams);
-  const ConfigurationSet configs = testing::ConfigurationsFacing(robot, plane, 30, 7);
+  const TargetedConfigurations configs = testing::ConfigurationsFacing(robot, plane, 30, 7);
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> ue(-0.01, 0.01);
   std::vector<double> e(n);
@@ -141,7 +141,7 @@ TEST(JacobianWithFrameTerms, AnalyticMatchesAutodiffAndCentralDifferences) {
   const int n = model.num_parameters();
   ASSERT_EQ(n, 42);
   ASSERT_LE(n, 48);
-  const ConfigurationSet configs = testing::ConfigurationsFacing(robot, plane, 25, 5);
+  const TargetedConfigurations configs = testing::ConfigurationsFacing(robot, plane, 25, 5);
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> ue(-0.02, 0.02);
   for (int at = 0; at < 2; ++at) {
@@ -162,7 +162,7 @@ TEST(JacobianWithFrameTerms, SubsetsOnTheIdentityFrames) {
       robot, testing::PaperPlane(),
       MakeParameterSet(robot, PlaneTerms{}, {}, "--fix", RangerTerms{},
                        FrameTerms::Parse("y,roll,yaw", "b"), FrameTerms::Parse("x,z,pitch", "t")));
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(20, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(20, 4);
   std::mt19937 rng(19);
   std::uniform_real_distribution<double> ue(-0.01, 0.01);
   std::vector<double> e(model.num_parameters());
@@ -186,7 +186,7 @@ TEST(JacobianSeveralPlanes, AnalyticMatchesAutodiffAndCentralDifferences) {
   constexpr int kParams = 36;
   using BigJet = ceres::Jet<double, kParams>;
   ASSERT_EQ(model.num_parameters(), kParams);
-  ConfigurationSet configs(6);
+  TargetedConfigurations configs(6);
   for (int k = 0; k < 8; ++k)
     for (int p = 0; p < 3; ++p)
       configs.Add(testing::HittingConfigurations(planes[p], 8, 5 + p).q(k), p);
@@ -198,7 +198,7 @@ TEST(JacobianSeveralPlanes, AnalyticMatchesAutodiffAndCentralDifferences) {
   model.Prepare(e.data(), &point);
   const ParameterSet& ps = model.parameters();
   for (int i = 0; i < configs.size(); ++i) {
-    const int plane = configs.plane(i);
+    const int plane = configs.target(i);
     const std::vector<double> row = ExpectRowMatches<BigJet>(model, point, e, configs, i);
     for (int p = 0; p < 3; ++p) {
       const PlaneColumns& c = ps.plane_columns[p];

@@ -12,7 +12,7 @@ namespace {
 std::string Where(int r) { return r < 0 ? "data" : "row " + std::to_string(r); }
 
 TEST(GroupReadings, AveragesIdenticalJointValuesInOrderOfFirstAppearance) {
-  ConfigurationSet q(2);
+  TargetedConfigurations q(2);
   q.Add({0.1, 0.2});
   q.Add({0.3, 0.4});
   q.Add({0.1, 0.2});
@@ -29,7 +29,7 @@ TEST(GroupReadings, AveragesIdenticalJointValuesInOrderOfFirstAppearance) {
 
 // With a median, a configuration's value is its middle reading and its weight R/c.
 TEST(GroupReadings, AMedianTakesTheMiddleReadingAndItsVarianceFactor) {
-  ConfigurationSet q(2);
+  TargetedConfigurations q(2);
   for (int r = 0; r < 5; ++r) q.Add({0.1, 0.2});
   q.Add({0.3, 0.4});
   const std::vector<double> h = {1.0, 1.2, 9.0, 1.1, 1.3, 2.0};
@@ -45,7 +45,7 @@ TEST(GroupReadings, AMedianTakesTheMiddleReadingAndItsVarianceFactor) {
 // With labels (a `configuration` column) readings group by label: jittering joint values of
 // one pose are one configuration at their mean; identical ones keep their bits.
 TEST(GroupReadings, LabelsGroupJitteringJointValues) {
-  ConfigurationSet q(2);
+  TargetedConfigurations q(2);
   q.Add({0.1, 0.2});
   q.Add({0.3, 0.4});
   q.Add({0.1000002, 0.2});
@@ -65,7 +65,7 @@ TEST(GroupReadings, LabelsGroupJitteringJointValues) {
 }
 
 TEST(GroupReadings, RefusesNonPositiveOutOfRangeAndMismatchedReadings) {
-  ConfigurationSet q(1);
+  TargetedConfigurations q(1);
   q.Add({0.0});
   q.Add({1.0});
   try {

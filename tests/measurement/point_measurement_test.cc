@@ -37,11 +37,11 @@ PointSetup TrackerSetup() {
 }
 
 // Random configurations of the paper's arm, each seeing target (i mod targets).
-ConfigurationSet RandomConfigurations(const RobotModel& robot, int count, int targets,
-                                      unsigned seed) {
+TargetedConfigurations RandomConfigurations(const RobotModel& robot, int count, int targets,
+                                            unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> angle(-2.5, 2.5);
-  ConfigurationSet configs(robot.num_links());
+  TargetedConfigurations configs(robot.num_links());
   for (int i = 0; i < count; ++i) {
     std::vector<double> q(robot.num_links());
     for (double& v : q) v = angle(rng);
@@ -96,7 +96,7 @@ class PointJacobianTest : public ::testing::TestWithParam<std::vector<std::strin
 TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
   const PointMeasurement kind(robot, TrackerSetup(), GetParam());
-  const ConfigurationSet configs = RandomConfigurations(robot, 12, 2, 7);
+  const TargetedConfigurations configs = RandomConfigurations(robot, 12, 2, 7);
   const int n = kind.num_parameters(), m = 3 * configs.size();
   ASSERT_LE(n, kMaxTerms);
   // Away from nominal: rotation terms of 0.05 rad, lengths of 5 mm.
@@ -116,7 +116,7 @@ TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
   constexpr double kStep = 1e-6;
   for (int i = 0; i < configs.size(); ++i) {
     const Eigen::Matrix<TermJet, 3, 1> p =
-        ReferencePoint(kind, all_jets, configs.q(i), configs.plane(i));
+        ReferencePoint(kind, all_jets, configs.q(i), configs.target(i));
     for (int c = 0; c < 3; ++c) {
       reference[3 * i + c] = p[c].a;
       for (int k = 0; k < n; ++k) autodiff(3 * i + c, k) = p[c].v[k];
@@ -154,7 +154,7 @@ RobotModel TrueRobot(const RobotModel& robot, const Eigen::VectorXd& errors) {
 TEST(PointMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
   const PointMeasurement full(robot, TrackerSetup());
-  const ConfigurationSet configs = RandomConfigurations(robot, 60, 2, 11);
+  const TargetedConfigurations configs = RandomConfigurations(robot, 60, 2, 11);
   // The terms a point cannot see (found by the analysis) are held at nominal in the truth too.
   const IdentifiabilityReport report = AnalyzeIdentifiability(full, configs);
   ASSERT_FALSE(report.full_rank());
@@ -199,7 +199,7 @@ TEST(PointMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
 TEST(PointMeasurement, IdentifiabilityRankMatchesAnIndependentJacobian) {
   const RobotModel& robot = testing::PaperRobot();
   const PointMeasurement kind(robot, TrackerSetup());
-  const ConfigurationSet configs = RandomConfigurations(robot, 40, 2, 3);
+  const TargetedConfigurations configs = RandomConfigurations(robot, 40, 2, 3);
   const IdentifiabilityReport report = AnalyzeIdentifiability(kind, configs);
   // The rank of central differences of the reference point, columns scaled to unit norm.
   const int n = kind.num_parameters(), m = 3 * configs.size();
@@ -211,8 +211,8 @@ TEST(PointMeasurement, IdentifiabilityRankMatchesAnIndependentJacobian) {
     em[k] = -kStep;
     const std::vector<double> ap = AllTerms(kind, ep), am = AllTerms(kind, em);
     for (int i = 0; i < configs.size(); ++i) {
-      const Eigen::Vector3d d = (ReferencePoint(kind, ap, configs.q(i), configs.plane(i)) -
-                                 ReferencePoint(kind, am, configs.q(i), configs.plane(i))) /
+      const Eigen::Vector3d d = (ReferencePoint(kind, ap, configs.q(i), configs.target(i)) -
+                                 ReferencePoint(kind, am, configs.q(i), configs.target(i))) /
                                 (2 * kStep);
       G.block<3, 1>(3 * i, k) = d;
     }
@@ -231,7 +231,7 @@ TEST(PointMeasurement, IdentifiabilityRankMatchesAnIndependentJacobian) {
 TEST(PointMeasurement, SimulatedNoiseHasTheStatedLaw) {
   const RobotModel& robot = testing::PaperRobot();
   const PointMeasurement kind(robot, TrackerSetup());
-  const ConfigurationSet configs = RandomConfigurations(robot, 2000, 2, 9);
+  const TargetedConfigurations configs = RandomConfigurations(robot, 2000, 2, 9);
   NoiseModel noise;
   noise.sigma = 1e-3;
   noise.repetitions = 4;
@@ -284,7 +284,7 @@ TEST(PointMeasurement, BadTermsAndTargetsAreNamed) {
   const PointMeasurement kind(robot, one);
   EXPECT_THAT(kind.parameter_names(), ::testing::Contains("target_x"));
   EXPECT_EQ(DisplayUnitOf("instrument_yaw").unit, std::string("mrad"));
-  const ConfigurationSet configs = RandomConfigurations(robot, 4, 2, 1);  // target index 1
+  const TargetedConfigurations configs = RandomConfigurations(robot, 4, 2, 1);  // target index 1
   try {
     kind.Bind(configs);
     ADD_FAILURE() << "a configuration naming a missing target was accepted";

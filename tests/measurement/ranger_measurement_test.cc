@@ -27,7 +27,7 @@ TEST(RangerMeasurement, PredictionsAndJacobianAreTheMeasurementModels) {
   EXPECT_STREQ(kind.name(), "ranger");
   EXPECT_EQ(kind.rows_per_configuration(), 1);
   EXPECT_EQ(kind.parameter_names(), model.parameters().names);
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(30, 4);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(30, 4);
   std::vector<double> e(kind.num_parameters());
   for (int k = 0; k < kind.num_parameters(); ++k) e[k] = (k % 2 ? 1e-3 : -2e-3);
   const Eigen::MatrixXd G = MeasurementJacobian(kind, configs, e.data());
@@ -54,7 +54,7 @@ TEST(RangerMeasurement, MissesAreTheSimulationsAndFixingIsWithoutParameters) {
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model, testing::PaperRig().ranger);
   // Random configurations: many beams miss the plane, for several reasons.
-  ConfigurationSet configs = testing::PaperHittingConfigurations(20, 2);
+  TargetedConfigurations configs = testing::PaperHittingConfigurations(20, 2);
   for (int i = 0; i < 20; ++i) {
     std::vector<double> q(6, 0.3 * i - 3.0);
     configs.Add(q);
@@ -82,10 +82,10 @@ TEST(RangerMeasurement, ConfigurationsThatDoNotFitAreRefused) {
   const RobotModel& robot = testing::PaperRobot();
   const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const RangerMeasurement kind(model, testing::PaperRig().ranger);
-  ConfigurationSet second_plane(6);
+  TargetedConfigurations second_plane(6);
   second_plane.Add(std::vector<double>(6, 0.1), 1);
   EXPECT_THROW(kind.Bind(second_plane), InputError);
-  ConfigurationSet five_joints(5);
+  TargetedConfigurations five_joints(5);
   five_joints.Add(std::vector<double>(5, 0.1));
   try {
     kind.Bind(five_joints);

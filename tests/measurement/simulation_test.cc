@@ -18,7 +18,8 @@ namespace {
 
 // Readings of the true arm at `configs` over `trials` trial streams: (trial, configuration)
 // errors of the mean reading against the exact one.
-Eigen::MatrixXd MeanErrors(const ConfigurationSet& configs, const NoiseModel& noise, int trials) {
+Eigen::MatrixXd MeanErrors(const TargetedConfigurations& configs, const NoiseModel& noise,
+                           int trials) {
   const RobotModel& robot = testing::PaperRobot();
   std::vector<double> exact;
   std::vector<BeamMiss> misses;
@@ -42,7 +43,7 @@ double Variance(const Eigen::VectorXd& x) {
 
 TEST(Simulation, EncoderNoiseMovesTheBeamByTheJointJacobian) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(4, 2);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(4, 2);
   // ∂h/∂q_j = ∂h/∂θ_j: the joint angle and its offset enter the chain as θ_j + q_j.
   MeasurementModel truth(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
   const std::vector<double> zero(truth.num_parameters(), 0.0);
@@ -87,7 +88,7 @@ TEST(Simulation, EncoderNoiseMovesTheBeamByTheJointJacobian) {
 
 TEST(Simulation, PlaneFormErrorIsSharedByTheReadingsOfAConfiguration) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(3, 5);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(3, 5);
   NoiseModel noise{0.0, 5, false};
   noise.form_sigma = 0.05e-3;
   std::vector<double> raw;
@@ -110,7 +111,7 @@ TEST(Simulation, PlaneFormErrorIsSharedByTheReadingsOfAConfiguration) {
 }
 
 TEST(Simulation, OutliersHitTheStatedShareOfReadingsAndAverageInTheMean) {
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(10, 6);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(10, 6);
   NoiseModel noise{0.0, 1, false};
   noise.outlier_fraction = 0.1;
   noise.outlier_sigma = 5e-3;
@@ -149,7 +150,7 @@ TEST(Simulation, OutliersHitTheStatedShareOfReadingsAndAverageInTheMean) {
 // with its variance factor; draw_mean does not apply (every reading is drawn).
 TEST(Simulation, AMedianIsTheMiddleOfTheWrittenReadingsWithItsVarianceFactor) {
   const RobotModel& robot = testing::PaperRobot();
-  const ConfigurationSet configs = testing::PaperHittingConfigurations(8, 3);
+  const TargetedConfigurations configs = testing::PaperHittingConfigurations(8, 3);
   NoiseModel noise;
   noise.repetitions = 5;
   noise.outlier_fraction = 0.2;

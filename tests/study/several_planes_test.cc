@@ -29,9 +29,9 @@ std::string WritePlanesStudy(const std::string& dir, const std::string& body) {
   return path;
 }
 
-int CountOn(const ConfigurationSet& c, int plane) {
+int CountOn(const TargetedConfigurations& c, int plane) {
   int n = 0;
-  for (int i = 0; i < c.size(); ++i) n += c.plane(i) == plane;
+  for (int i = 0; i < c.size(); ++i) n += c.target(i) == plane;
   return n;
 }
 
@@ -65,7 +65,7 @@ TEST(SeveralPlanes, PoolFilePlaneColumnIsResolvedAndValidationsIgnored) {
     pool.precision(17);
     pool << "q1,q2,q3,q4,q5,q6,plane\n";
     for (int p = 0; p < 2; ++p) {
-      const ConfigurationSet c = testing::HittingConfigurations(planes[p], 30, 7 + p);
+      const TargetedConfigurations c = testing::HittingConfigurations(planes[p], 30, 7 + p);
       for (int i = 0; i < c.size(); ++i) {
         for (int j = 0; j < 6; ++j) pool << c.q(i)[j] << ",";
         pool << (p == 0 ? "1" : "wall") << "\n";

@@ -74,34 +74,34 @@ const RobotModel& PaperRobotWithFrames() {
   return robot;
 }
 
-ConfigurationSet ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
-                                      unsigned seed) {
+TargetedConfigurations ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
+                                            unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-M_PI, M_PI);
-  ConfigurationSet out(robot.num_links());
+  TargetedConfigurations out(robot.num_links());
   ModelPoint point;
   PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
   std::vector<double> q(robot.num_links());
   while (out.size() < count) {
     for (double& v : q) v = u(rng);
-    ConfigurationSet one(robot.num_links());
+    TargetedConfigurations one(robot.num_links());
     one.Add(q);
     if (std::fabs(plane.normal.dot(ToolPose(point, one, 0).R_BT.col(2))) >= 0.2) out.Add(q);
   }
   return out;
 }
 
-ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed) {
+TargetedConfigurations HittingConfigurations(const Plane& plane, int count, unsigned seed) {
   const RobotModel& robot = PaperRobot();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-M_PI, M_PI);
-  ConfigurationSet out(robot.num_links());
+  TargetedConfigurations out(robot.num_links());
   ModelPoint point;
   PrepareModelPoint(robot, robot.nominal_values().data(), plane, &point);
   while (out.size() < count) {
     double q[6];
     for (double& v : q) v = u(rng);
-    ConfigurationSet one(6);
+    TargetedConfigurations one(6);
     one.Add(q);
     const Pose<double> pose = ToolPose(point, one, 0);
     double nb;
@@ -111,7 +111,7 @@ ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned s
   return out;
 }
 
-ConfigurationSet PaperHittingConfigurations(int count, unsigned seed) {
+TargetedConfigurations PaperHittingConfigurations(int count, unsigned seed) {
   return HittingConfigurations(PaperPlane(), count, seed);
 }
 

@@ -76,13 +76,13 @@ const RobotModel& PaperRobotWithFrames();
 std::pair<double, double> GeometricJacobianDeviation(const RobotModel& robot, const double* q);
 /// `count` random configurations of `robot` whose beam meets `plane` at |n·b| ≥ 0.2 (any sign of
 /// the distance): for checks of formulas, not of readings.
-ConfigurationSet ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
-                                      unsigned seed = 1);
+TargetedConfigurations ConfigurationsFacing(const RobotModel& robot, const Plane& plane, int count,
+                                            unsigned seed = 1);
 /// `count` configurations of the paper's arm whose nominal beam hits `plane` (a usable reading),
 /// drawn from a fixed std::mt19937 seed (test data only; the library uses counter-based streams).
-ConfigurationSet HittingConfigurations(const Plane& plane, int count, unsigned seed = 1);
+TargetedConfigurations HittingConfigurations(const Plane& plane, int count, unsigned seed = 1);
 /// The same for the paper's own plane.
-ConfigurationSet PaperHittingConfigurations(int count, unsigned seed = 1);
+TargetedConfigurations PaperHittingConfigurations(int count, unsigned seed = 1);
 /// Writes a candidate pool (`pool` configurations whose beam hits the paper's plane) and a
 /// validation set (`validation` configurations anywhere) of the paper's arm to DIR/pool.csv and
 /// DIR/val.csv, drawn with the given seeds: a user's own configuration files for a study.

@@ -52,29 +52,31 @@ struct SamplingReport {
 
 /// Draws `count` accepted configurations. Throws InputError if the constraints reject so many
 /// that `count` cannot be reached within the attempt budget (a plane the beam can never hit).
-ConfigurationSet SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
-                                      const RandomStream& stream, const SamplingOptions& options,
-                                      SamplingReport* report = nullptr);
+TargetedConfigurations SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
+                                            const RandomStream& stream,
+                                            const SamplingOptions& options,
+                                            SamplingReport* report = nullptr);
 
-/// Several planes: counts[p] configurations aimed at plane p (tagged p, configuration_set.h),
+/// Several planes: counts[p] configurations aimed at plane p (tagged p, targeted_configurations.h),
 /// plane 0's first. Attempts are numbered on across the planes, so plane 0's configurations are
 /// those of the one-plane call with the same stream.
-ConfigurationSet SampleConfigurations(const RobotModel& robot, const PlaneSet& planes,
-                                      const std::vector<int>& counts, const RandomStream& stream,
-                                      const SamplingOptions& options,
-                                      SamplingReport* report = nullptr);
+TargetedConfigurations SampleConfigurations(const RobotModel& robot, const PlaneSet& planes,
+                                            const std::vector<int>& counts,
+                                            const RandomStream& stream,
+                                            const SamplingOptions& options,
+                                            SamplingReport* report = nullptr);
 
 /// The candidates of a given pool whose nominal beam hits its plane within `ranger`'s limits (the
 /// others cannot give a reading): the usable configurations, the pool index of each (`kept`,
 /// ascending), every candidate's BeamMiss (`misses`, kNone when kept) and a report by reason.
 struct CandidatePool {
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   std::vector<int> kept;
   std::vector<BeamMiss> misses;
   SamplingReport report;
 };
 CandidatePool UsableCandidates(const RobotModel& robot, const PlaneSet& planes,
-                               const RangerSpec& ranger, const ConfigurationSet& pool);
+                               const RangerSpec& ranger, const TargetedConfigurations& pool);
 
 /// The number of workspace poses (`workspace.count`: --workspace, workspace=): 1 to 100,000.
 const SettingSpec& WorkspacePosesSetting();

@@ -57,7 +57,7 @@ struct DesignChoice {
 
 /// Chooses request.count of `pool` for `model` (its nominal parameters). Throws InputError for
 /// an impossible request (count above the pool, below the parameters).
-DesignChoice ChooseDesign(const MeasurementModel& model, const ConfigurationSet& pool,
+DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigurations& pool,
                           const DesignRequest& request);
 
 /// "I (predicted RMS position error at 200 workspace poses: 0.61 mm per mm of reading noise)"

@@ -29,8 +29,8 @@
 #include "lrcal/core/enum_names.h"
 #include "lrcal/core/random.h"
 #include "lrcal/core/settings.h"
-#include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/measurement/measurement_model.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
@@ -126,7 +126,7 @@ Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
 
 /// The identification Jacobian of `pool` at the nominal model, columns scaled as `scaling` says
 /// (expected errors `angle` rad and `length` m for kExpectedErrors): what design selects from.
-Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
+Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const TargetedConfigurations& pool,
                                DesignScaling scaling, double angle, double length);
 
 /// Chooses k rows of G (N×n). Throws InputError for an empty pool, k > N, k < n, or an

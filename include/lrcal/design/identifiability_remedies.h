@@ -70,7 +70,7 @@ struct RemedyOptions {
 
 /// The remedies for the lost directions in `report` (the analysis of `model` at `configs`).
 /// Empty when the set is full rank.
-RemedyReport FindRemedies(const MeasurementModel& model, const ConfigurationSet& configs,
+RemedyReport FindRemedies(const MeasurementModel& model, const TargetedConfigurations& configs,
                           const IdentifiabilityReport& report, const RemedyOptions& options = {});
 
 }  // namespace lrcal

@@ -31,13 +31,13 @@ TaskPoses TaskPosesAt(const MeasurementModel& model, const ConfigurationSet& pos
 
 /// Criterion I's selection matrix for `pool`: the pool's identification Jacobian at the nominal
 /// model (SI) weighted by the task (TaskWeightedJacobian); criterion A on it is criterion I.
-Eigen::MatrixXd TaskDesignJacobian(const MeasurementModel& model, const ConfigurationSet& pool,
-                                   const TaskPoses& task);
+Eigen::MatrixXd TaskDesignJacobian(const MeasurementModel& model,
+                                   const TargetedConfigurations& pool, const TaskPoses& task);
 
 /// What criterion I predicts for the configurations `design`: √(tr(PᵀP·(GᵀG)⁻¹)/M), the RMS
 /// position error at the task poses (m) per 1 m of reading noise σ (equally mm per mm), from G of
 /// `design` directly (no ridge; the selection score loses ~1e-6 to its conditioning).
-double TaskRmsPositionPerUnitSigma(const MeasurementModel& model, const ConfigurationSet& design,
-                                   const TaskPoses& task);
+double TaskRmsPositionPerUnitSigma(const MeasurementModel& model,
+                                   const TargetedConfigurations& design, const TaskPoses& task);
 
 }  // namespace lrcal

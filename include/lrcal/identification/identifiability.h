@@ -67,7 +67,7 @@ struct IdentifiabilityReport {
 
 /// Analyses G at estimate `e` (nullptr: the nominal model, e = 0).
 IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
-                                             const ConfigurationSet& configs,
+                                             const TargetedConfigurations& configs,
                                              const double* e = nullptr,
                                              const IdentifiabilityOptions& options = {});
 
@@ -75,7 +75,7 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementModel& model,
 /// component (rows_per_configuration per configuration). For the ranger this is the overload
 /// above (the same report, tested).
 IdentifiabilityReport AnalyzeIdentifiability(const MeasurementKind& kind,
-                                             const ConfigurationSet& configs,
+                                             const TargetedConfigurations& configs,
                                              const double* e = nullptr,
                                              const IdentifiabilityOptions& options = {});
 
@@ -94,6 +94,7 @@ Eigen::MatrixXd UnobservableDirections(const Eigen::MatrixXd& G,
 /// The identification Jacobian G (m×n) at `e` (nullptr: nominal). Readings that miss the
 /// plane still give their row (the formula is finite unless the beam is parallel).
 Eigen::MatrixXd IdentificationJacobian(const MeasurementModel& model,
-                                       const ConfigurationSet& configs, const double* e = nullptr);
+                                       const TargetedConfigurations& configs,
+                                       const double* e = nullptr);
 
 }  // namespace lrcal

@@ -83,7 +83,8 @@ PriorInformation InformationFromPriors(const Eigen::MatrixXd& G, const std::vect
 /// The same for a kind's terms at `configs` (at the nominal model), each configuration the mean
 /// of noise.repetitions readings of noise σ. Throws SettingError naming noise.sigma unless it is
 /// > 0 (priors are weighed against it).
-PriorInformation InformationFromPriors(const MeasurementKind& kind, const ConfigurationSet& configs,
+PriorInformation InformationFromPriors(const MeasurementKind& kind,
+                                       const TargetedConfigurations& configs,
                                        const NoiseModel& noise, const PriorSigmas& priors);
 
 /// A kind's evaluator with one more row per term that has a prior: row m + p predicts the term's

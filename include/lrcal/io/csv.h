@@ -46,10 +46,10 @@ CsvTable ReadCsv(const std::string& path);
 /// (a 1-based index or a plane's name), resolved against `planes` (the set-up's; null: one
 /// unnamed plane). A plane that was not given is an error naming the line; several planes given
 /// and no column is an error too: a file is never read against the wrong planes silently.
-ConfigurationSet ReadConfigurations(const std::string& path, int num_joints,
-                                    const PlaneSet* planes = nullptr);
+TargetedConfigurations ReadConfigurations(const std::string& path, int num_joints,
+                                          const PlaneSet* planes = nullptr);
 /// Arm configurations only (validation poses, which need no reading): a `plane` column, if
-/// any, is not read and every row is tagged plane 0.
+/// any, is not read.
 ConfigurationSet ReadPoses(const std::string& path, int num_joints);
 /// Readings grouped by configuration (and plane, as ReadConfigurations). With a `ranger`, a
 /// reading outside its range is an error naming the line (and suggesting the likely unit
@@ -63,12 +63,15 @@ MeasurementSet ReadMeasurements(const std::string& path, int num_joints,
 /// or in a folder that does not exist.
 void CheckOutputFile(const std::string& path, const std::string& option);
 
-/// Writes configurations (header q1..qN) at full precision. The file is written whole or not at
-/// all; any failure (a full disk, a folder that cannot be written) is an InputError naming it.
-void WriteConfigurations(const std::string& path, const ConfigurationSet& configs);
+/// Writes configurations (header q1..qN, and `plane` with the 1-based target when they refer to
+/// several) at full precision. The file is written whole or not at all; any failure (a full
+/// disk, a folder that cannot be written) is an InputError naming it.
+void WriteConfigurations(const std::string& path, const TargetedConfigurations& configs);
+/// Poses (no target): the columns q1..qN, as WriteConfigurations writes them.
+void WritePoses(const std::string& path, const ConfigurationSet& poses);
 /// Writes single readings (header q1..qN,h,repetition): `readings` holds `repetitions` readings
 /// per configuration, configuration-major. Whole or not at all, like WriteConfigurations.
-void WriteReadings(const std::string& path, const ConfigurationSet& configs,
+void WriteReadings(const std::string& path, const TargetedConfigurations& configs,
                    const std::vector<double>& readings, int repetitions);
 
 }  // namespace lrcal

@@ -30,6 +30,6 @@ struct KinematicsReport {
 /// there.
 KinematicsReport ReportKinematics(const RobotFile& rig, const PlaneSet& planes,
                                   const ParameterSet& parameters, bool true_model,
-                                  const ConfigurationSet& configs, bool jacobian);
+                                  const TargetedConfigurations& configs, bool jacobian);
 
 }  // namespace lrcal

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "lrcal/io/robot_file.h"
-#include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/measurement/measurement_set.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
@@ -19,8 +19,8 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
 
 /// A configurations CSV for `robot`, joint ranges checked; its optional `plane` column is
 /// resolved against `planes`.
-ConfigurationSet ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
-                                         const PlaneSet* planes = nullptr);
+TargetedConfigurations ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
+                                               const PlaneSet* planes = nullptr);
 
 /// Poses for `robot` (where to state an accuracy: no beam, so a `plane` column, if any, is not
 /// read), joint ranges checked.

@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "lrcal/core/random.h"
-#include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/measurement/noise_model.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
@@ -64,10 +64,11 @@ class MeasurementKind {
   virtual Eigen::VectorXd NominalValues() const = 0;
   /// An evaluator bound to `configs`. Throws InputError when a configuration does not fit the
   /// kind (a plane or target index it does not have, a wrong number of joints).
-  virtual std::unique_ptr<MeasurementEvaluator> Bind(const ConfigurationSet& configs) const = 0;
+  virtual std::unique_ptr<MeasurementEvaluator> Bind(
+      const TargetedConfigurations& configs) const = 0;
   /// Why each configuration has no measurement at estimate e ("ok" where it has one). Used by
   /// simulation: a configuration that misses is left out of the data, never filled with a NaN.
-  virtual std::vector<std::string> MissReasons(const ConfigurationSet& configs,
+  virtual std::vector<std::string> MissReasons(const TargetedConfigurations& configs,
                                                const double* e) const = 0;
   /// The same kind with the terms `names` held at nominal (what identifiability suggests to fix).
   /// Throws InputError naming an unknown term.
@@ -78,7 +79,7 @@ class MeasurementKind {
 /// rows_per_configuration values y[i·k .. i·k + k) (SI), each the mean of repetitions[i] readings
 /// (its residual weight).
 struct MeasuredValues {
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   std::vector<double> y;
   std::vector<int> repetitions;
   int size() const { return configs.size(); }
@@ -103,13 +104,14 @@ struct MeasuredValues {
 /// i·k + c (the same distribution). The rig disturbances of NoiseModel (encoder noise, plane form,
 /// outliers, ranger errors) are the ranger's (simulation.h): for another kind they are refused
 /// with an InputError rather than ignored. Returns the number of missed configurations.
-int SimulateMeasurements(const MeasurementKind& truth, const ConfigurationSet& configs,
+int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurations& configs,
                          const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
                          std::vector<std::string>* misses = nullptr);
 
 /// The Jacobian ∂y/∂e (num_rows × num_parameters) of `kind` at `configs` and estimate e
 /// (nullptr: nominal). Throws InputError when a prediction is undefined there.
-Eigen::MatrixXd MeasurementJacobian(const MeasurementKind& kind, const ConfigurationSet& configs,
+Eigen::MatrixXd MeasurementJacobian(const MeasurementKind& kind,
+                                    const TargetedConfigurations& configs,
                                     const double* e = nullptr);
 
 }  // namespace lrcal

@@ -22,7 +22,7 @@
 // Tests check this against Ceres autodiff through kinematics.h and against central differences.
 //
 // Speed: joint angles enter only through cos q, sin q, precomputed once per configuration
-// (ConfigurationSet); the link angles' sines and cosines are computed once per estimate
+// (TargetedConfigurations); the link angles' sines and cosines are computed once per estimate
 // (ModelPoint). The per-configuration work is trig-free and allocation-free.
 #pragma once
 
@@ -30,11 +30,11 @@
 #include <vector>
 
 #include "lrcal/kinematics/chain.h"
-#include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
@@ -85,13 +85,13 @@ class MeasurementModel {
   /// The robot with its base and tool at estimate e (its link values stay nominal: LinkValues).
   RobotModel RobotAt(const double* e) const;
 
-  /// Reading h (m) for configuration i (on its plane, configs.plane(i)) at `point`, and (if
+  /// Reading h (m) for configuration i (on its plane, configs.target(i)) at `point`, and (if
   /// jacobian_row is not null) the num_parameters() entries of ∂h/∂e: the columns of other
   /// planes' terms are zero. Returns n·b (the cosine of the beam's incidence, signed) so callers
   /// can classify the reading; h is finite unless n·b == 0. With ranger terms the reading is
   /// r = (1 + s)·h_geo + o: the geometric columns are scaled by (1 + s), ∂r/∂o = 1 and
   /// ∂r/∂s = h_geo.
-  double Evaluate(const ModelPoint& point, const ConfigurationSet& configs, int i, double* h,
+  double Evaluate(const ModelPoint& point, const TargetedConfigurations& configs, int i, double* h,
                   double* jacobian_row) const;
 
   /// Templated reading for autodiff (tests): e has num_parameters() entries; the beam is aimed

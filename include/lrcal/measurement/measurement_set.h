@@ -5,15 +5,15 @@
 #include <string>
 #include <vector>
 
-#include "lrcal/kinematics/configuration_set.h"
 #include "lrcal/measurement/averaging.h"
 #include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
 /// Readings to identify from: one entry per configuration.
 struct MeasurementSet {
-  ConfigurationSet configs;
+  TargetedConfigurations configs;
   std::vector<double> mean_h;    ///< m, mean of the readings at each configuration
   std::vector<int> repetitions;  ///< number of readings averaged
   /// Each configuration's variance factor c (averaging.h): its value's variance is c·σ²/R.
@@ -57,7 +57,7 @@ struct MeasurementSet {
 ///
 /// With `average` other than the mean, each configuration's value is the median or trimmed mean
 /// of its readings and variance_factor holds the factor each count of readings implies.
-MeasurementSet GroupReadings(const ConfigurationSet& q, const std::vector<double>& h,
+MeasurementSet GroupReadings(const TargetedConfigurations& q, const std::vector<double>& h,
                              const RangerSpec* ranger, const std::function<std::string(int)>& where,
                              const std::vector<std::string>* labels = nullptr,
                              const Averaging& average = {});

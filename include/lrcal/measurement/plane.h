@@ -45,7 +45,7 @@ inline constexpr int kMaxPlanes = 8;
 
 /// The planes of a set-up: the paper's one, or several (Zhuang, Motaghedi and Roth 1999: one plane
 /// leaves directions unobservable; three are equivalent to point measurement). A configuration
-/// set tags each configuration with the index of its plane (configuration_set.h). Implicitly
+/// set tags each configuration with the index of its plane (targeted_configurations.h). Implicitly
 /// built from one Plane, so single-plane code reads as before.
 class PlaneSet {
  public:

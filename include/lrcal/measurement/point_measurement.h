@@ -6,8 +6,8 @@
 //
 // (R_BT, p_BT) is the tool pose in the base frame B (the chain with its base and tool transforms,
 // chain.h), t_k the offset of target k in the tool frame T, (R_BI, p_BI) the instrument's pose in
-// B. Which target a configuration sees is its tag (ConfigurationSet::plane(i), the index the
-// ranger uses for its plane). Estimated terms, in this order:
+// B. Which target a configuration sees is its tag (TargetedConfigurations::target(i), the index
+// the ranger uses for its plane). Estimated terms, in this order:
 //  - the robot's link values, as the ranger's (names "theta1", ...);
 //  - the instrument's pose: "instrument_x", "instrument_y", "instrument_z" (m, a shift of p_BI in
 //    B) and "instrument_roll", "instrument_pitch", "instrument_yaw" (rad: R_BI = R_BI0·Rz(yaw)·
@@ -63,8 +63,8 @@ class PointMeasurement : public MeasurementKind {
   /// Link values, the instrument's nominal position (x, y, z) with 0 for its rotation terms, and
   /// each target's nominal offset.
   Eigen::VectorXd NominalValues() const override;
-  std::unique_ptr<MeasurementEvaluator> Bind(const ConfigurationSet& configs) const override;
-  std::vector<std::string> MissReasons(const ConfigurationSet& configs,
+  std::unique_ptr<MeasurementEvaluator> Bind(const TargetedConfigurations& configs) const override;
+  std::vector<std::string> MissReasons(const TargetedConfigurations& configs,
                                        const double* e) const override;
   std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const override;
 

@@ -25,9 +25,9 @@ class RangerEvaluator : public MeasurementEvaluator {
   ~RangerEvaluator() override;
   RangerEvaluator(const RangerEvaluator&) = delete;
   RangerEvaluator& operator=(const RangerEvaluator&) = delete;
-  /// Binds to `model` at `configs` (each configuration aimed at its plane, configs.plane(i));
+  /// Binds to `model` at `configs` (each configuration aimed at its plane, configs.target(i));
   /// both must outlive the binding.
-  void Bind(const MeasurementModel& model, const ConfigurationSet& configs);
+  void Bind(const MeasurementModel& model, const TargetedConfigurations& configs);
   int num_rows() const override;
   int num_parameters() const override { return model_ ? model_->num_parameters() : 0; }
   /// The readings (1 + s)·h + o at e and their Jacobian (measurement_model.h); false when a beam
@@ -41,7 +41,7 @@ class RangerEvaluator : public MeasurementEvaluator {
 };
 
 /// The ranger as a measurement kind: one reading per configuration, a configuration's plane is
-/// configs.plane(i). A configuration misses (MissReasons) when the beam at e does not give a
+/// configs.target(i). A configuration misses (MissReasons) when the beam at e does not give a
 /// usable reading within `ranger`'s limits (BeamMiss names).
 class RangerMeasurement : public MeasurementKind {
  public:
@@ -58,8 +58,8 @@ class RangerMeasurement : public MeasurementKind {
   /// Link values at nominal, each plane's offset f0 for plane_f, the base's and tool's translation
   /// for their shifts, 0 for chart, ranger and frame rotation terms.
   Eigen::VectorXd NominalValues() const override;
-  std::unique_ptr<MeasurementEvaluator> Bind(const ConfigurationSet& configs) const override;
-  std::vector<std::string> MissReasons(const ConfigurationSet& configs,
+  std::unique_ptr<MeasurementEvaluator> Bind(const TargetedConfigurations& configs) const override;
+  std::vector<std::string> MissReasons(const TargetedConfigurations& configs,
                                        const double* e) const override;
   std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const override;
 

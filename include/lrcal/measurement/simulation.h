@@ -31,14 +31,14 @@
 namespace lrcal {
 
 /// The model readings of (link values, planes) at every configuration (on its own plane,
-/// configs.plane(i)), and each one's BeamMiss.
+/// configs.target(i)), and each one's BeamMiss.
 void ExactReadings(const RobotModel& robot, const Eigen::VectorXd& link_values,
                    const PlaneSet& planes, const RangerSpec& ranger,
-                   const ConfigurationSet& configs, std::vector<double>* h,
+                   const TargetedConfigurations& configs, std::vector<double>* h,
                    std::vector<BeamMiss>* misses);
 
 /// Throws InputError unless every configuration's plane index is one of `planes`.
-void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& planes);
+void CheckPlanesReferenced(const TargetedConfigurations& configs, const PlaneSet& planes);
 
 /// Noisy readings of the true model. Fills `data` with the configurations that have a reading
 /// (mean of R) and returns the number of configurations whose true beam missed; `misses` (if
@@ -48,7 +48,7 @@ void CheckPlanesReferenced(const ConfigurationSet& configs, const PlaneSet& plan
 /// two designs drawn from one pool see the same noise on the configurations they share.
 int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_values,
                      const PlaneSet& true_planes, const RangerSpec& ranger,
-                     const ConfigurationSet& configs, const NoiseModel& noise,
+                     const TargetedConfigurations& configs, const NoiseModel& noise,
                      const RandomStream& stream, MeasurementSet* data,
                      std::vector<BeamMiss>* misses = nullptr, std::vector<double>* raw = nullptr,
                      const std::vector<int>* noise_slots = nullptr);
@@ -58,8 +58,8 @@ int SimulateReadings(const RobotModel& robot, const Eigen::VectorXd& true_link_v
 /// when the noise does not disturb the geometry (!noise.DisturbsGeometry()); `per_reading`
 /// (configs.size()·R values, if given) replaces exact_h for the raw readings.
 int AddNoise(const std::vector<double>& exact_h, const std::vector<BeamMiss>& misses,
-             const ConfigurationSet& configs, const NoiseModel& noise, const RandomStream& stream,
-             MeasurementSet* data, std::vector<double>* raw = nullptr,
+             const TargetedConfigurations& configs, const NoiseModel& noise,
+             const RandomStream& stream, MeasurementSet* data, std::vector<double>* raw = nullptr,
              const std::vector<int>* noise_slots = nullptr,
              const std::vector<double>* per_reading = nullptr);
 

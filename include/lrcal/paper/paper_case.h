@@ -48,7 +48,7 @@ struct PaperCase {
 
 struct PaperCasesResult {
   Eigen::VectorXd true_errors;  ///< the simulated arm's link value errors (5N, SI)
-  ConfigurationSet pool, validation;
+  TargetedConfigurations pool, validation;
   SamplingReport pool_report, validation_report;
   PoseErrors nominal_validation;  ///< nominal model vs truth
   std::vector<PaperCase> cases;   ///< case 1, case 2

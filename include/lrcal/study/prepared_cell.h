@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "lrcal/identification/total_accuracy.h"
-#include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/targeted_configurations.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial.h"
 
@@ -46,7 +46,7 @@ class PreparedCell {
 
   /// The candidate pool the design is selected from, and the validation poses every trial is
   /// judged on (rad).
-  const ConfigurationSet& pool() const;
+  const TargetedConfigurations& pool() const;
   const ConfigurationSet& validation() const;
   /// The estimated parameters after any fixed for rank deficiency, and their names.
   int num_parameters() const;

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "lrcal/io/result_json.h"
-#include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/targeted_configurations.h"
 #include "lrcal/study/trial.h"
 
 namespace lrcal {
@@ -23,11 +23,11 @@ struct TrialReplay {
   std::vector<std::string> differences;
   std::vector<std::string> parameter_names;
   // What the trial used and found (SI):
-  ConfigurationSet configurations;  ///< the design's configurations, one per reading mean
-  std::vector<double> mean_h;       ///< m, the simulated mean readings
-  std::vector<int> repetitions;     ///< readings averaged per configuration
-  Eigen::VectorXd estimate_delta;   ///< identified errors in the estimate layout
-  TrialDetails details;             ///< residuals and pose errors, nominal and identified
+  TargetedConfigurations configurations;  ///< the design's configurations, one per reading mean
+  std::vector<double> mean_h;             ///< m, the simulated mean readings
+  std::vector<int> repetitions;           ///< readings averaged per configuration
+  Eigen::VectorXd estimate_delta;         ///< identified errors in the estimate layout
+  TrialDetails details;                   ///< residuals and pose errors, nominal and identified
   bool identical() const { return stored.has_value() && differences.empty(); }
   /// `lrcal trial --format json`: the record, the failure's reason, every configuration with its
   /// reading and residuals, the estimate (SI).
