@@ -95,16 +95,17 @@ std::string TargetTermName(int k, int num_targets, const std::string& axis) {
   return num_targets == 1 ? "target_" + axis : "target" + std::to_string(k + 1) + "_" + axis;
 }
 
-void PointSetup::Validate(const std::string& source) const {
-  instrument.Validate(source + ": instrument");
+void PointSetup::Validate() const {
+  instrument.Validate("point.instrument");
   if (!instrument.translation.allFinite())
-    throw InputError(source, "the instrument's position must be finite");
+    throw InputError("point.instrument", "expected a finite position (m)");
   if (targets.empty() || static_cast<int>(targets.size()) > kMaxTargets)
-    throw InputError(source, "expected 1 to " + std::to_string(kMaxTargets) + " targets, got " +
-                                 std::to_string(targets.size()));
+    throw InputError("point.targets", "expected 1 to " + std::to_string(kMaxTargets) +
+                                          " targets, got " + std::to_string(targets.size()));
   for (std::size_t k = 0; k < targets.size(); ++k)
     if (!targets[k].allFinite())
-      throw InputError(source, "target " + std::to_string(k + 1) + "'s offset must be finite");
+      throw InputError("point.targets[" + std::to_string(k) + "]",
+                       "expected a finite offset in the tool frame (m)");
 }
 
 PointMeasurement::PointMeasurement(const RobotModel& robot, PointSetup setup,

@@ -279,6 +279,15 @@ TEST(PointMeasurement, BadTermsAndTargetsAreNamed) {
                                     "expected a robot parameter, instrument_x … instrument_yaw, "
                                     "or target1_x … target2_z"));
   }
+  PointSetup none = TrackerSetup();
+  none.targets.clear();
+  EXPECT_THAT([&] { PointMeasurement(robot, none); },
+              ::testing::ThrowsMessage<InputError>(
+                  HasSubstr("point.targets: expected 1 to 16 targets, got 0")));
+  PointSetup far = TrackerSetup();
+  far.targets[1].x() = std::nan("");
+  EXPECT_THAT([&] { far.Validate(); }, ::testing::ThrowsMessage<InputError>(HasSubstr(
+                                           "point.targets[1]: expected a finite offset")));
   PointSetup one = TrackerSetup();
   one.targets.resize(1);
   const PointMeasurement kind(robot, one);

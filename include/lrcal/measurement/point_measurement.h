@@ -38,9 +38,10 @@ struct PointSetup {
   /// Each target's offset in the tool frame T (m); at least one, at most kMaxTargets.
   std::vector<Eigen::Vector3d> targets{Eigen::Vector3d::Zero()};
   static constexpr int kMaxTargets = 16;
-  /// Throws InputError (where = `source`) unless the instrument's rotation is a rotation, every
-  /// offset is finite and there are 1 to kMaxTargets targets.
-  void Validate(const std::string& source = "point set-up") const;
+  /// Throws InputError naming the library field (point.instrument, point.targets,
+  /// point.targets[k]) unless the instrument's rotation is a rotation and its position finite,
+  /// every offset is finite and there are 1 to kMaxTargets targets.
+  void Validate() const;
 };
 
 class PointMeasurement : public MeasurementKind {
