@@ -1,18 +1,19 @@
 #include "lrcal/design/design_choice.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
+#include "lrcal/core/error.h"
 #include "lrcal/core/random.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/random_baseline.h"
+#include "lrcal/measurement/ranger_measurement.h"
 
 namespace lrcal {
-
-namespace {}  // namespace
 
 std::string DesignRequest::CriterionName() const {
   return task.count > 0 ? "I" : DesignCriterionName(selection.criterion);
@@ -38,14 +39,19 @@ void DesignRequest::Validate() const {
   selection.Validate();
 }
 
-DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigurations& pool,
+DesignChoice ChooseDesign(const MeasurementKind& kind, const TargetedConfigurations& pool,
                           const DesignRequest& request) {
   request.Validate();
+  if (kind.rows_per_configuration() != 1)
+    throw InputError("design", std::string("a ") + kind.name() + " measurement has " +
+                                   std::to_string(kind.rows_per_configuration()) +
+                                   " values per configuration; design chooses configurations "
+                                   "of one value (a ranger's reading) only so far");
   SelectionOptions options = request.selection;
   const bool task = request.task.count > 0;
   if (task) options.criterion = DesignCriterion::kA;  // I is A on the task-weighted G
-  const Eigen::MatrixXd G = task ? TaskDesignJacobian(model, pool, request.task)
-                                 : DesignJacobian(model, pool, request.scaling,
+  const Eigen::MatrixXd G = task ? TaskDesignJacobian(kind, pool, request.task)
+                                 : DesignJacobian(kind, pool, request.scaling,
                                                   request.expected_angle, request.expected_length);
   DesignChoice out;
   const auto t0 = std::chrono::steady_clock::now();
@@ -56,11 +62,19 @@ DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigura
   out.certificate = CertifyDesign(G, out.chosen.indices, options.criterion);
   out.certificate_statement =
       out.certificate.ToString(options.criterion, request.count, static_cast<int>(pool.size()));
-  out.per_plane.assign(model.nominal_planes().size(), 0);
-  for (int i : out.chosen.indices) ++out.per_plane[pool.target(i)];
+  out.per_plane.assign(static_cast<std::size_t>(std::max(pool.num_targets_referenced(), 1)), 0);
+  for (int i : out.chosen.indices) ++out.per_plane[static_cast<std::size_t>(pool.target(i))];
   if (task)
     out.task_rms_per_sigma =
-        TaskRmsPositionPerUnitSigma(model, pool.Subset(out.chosen.indices), request.task);
+        TaskRmsPositionPerUnitSigma(kind, pool.Subset(out.chosen.indices), request.task);
+  return out;
+}
+
+DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigurations& pool,
+                          const DesignRequest& request) {
+  DesignChoice out = ChooseDesign(RangerMeasurement(model), pool, request);
+  out.per_plane.resize(
+      std::max(out.per_plane.size(), static_cast<std::size_t>(model.nominal_planes().size())), 0);
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/design/design_certificate.h"
 #include "lrcal/identification/identifiability.h"
+#include "lrcal/measurement/ranger_measurement.h"
 
 namespace lrcal {
 
@@ -717,6 +718,13 @@ Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, dou
   return expected;
 }
 
+Eigen::VectorXd ExpectedErrors(const std::vector<std::string>& names, double angle, double length) {
+  Eigen::VectorXd expected(static_cast<Eigen::Index>(names.size()));
+  for (std::size_t k = 0; k < names.size(); ++k)
+    expected[static_cast<Eigen::Index>(k)] = IsAngularName(names[k]) ? angle : length;
+  return expected;
+}
+
 Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
                                      const Eigen::MatrixXd& position_rows) {
   const int n = static_cast<int>(G.cols());
@@ -727,10 +735,15 @@ Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
   return llt.matrixL().solve(G.transpose()).transpose();
 }
 
+Eigen::MatrixXd DesignJacobian(const MeasurementKind& kind, const TargetedConfigurations& pool,
+                               DesignScaling scaling, double angle, double length) {
+  return ScaleColumns(MeasurementJacobian(kind, pool), scaling,
+                      ExpectedErrors(kind.parameter_names(), angle, length));
+}
+
 Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const TargetedConfigurations& pool,
                                DesignScaling scaling, double angle, double length) {
-  return ScaleColumns(IdentificationJacobian(model, pool), scaling,
-                      ExpectedErrors(model.parameters(), angle, length));
+  return DesignJacobian(RangerMeasurement(model), pool, scaling, angle, length);
 }
 
 Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,

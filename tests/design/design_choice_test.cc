@@ -9,7 +9,10 @@
 
 #include "lrcal/core/random.h"
 #include "lrcal/design/configuration_sampling.h"
+#include "lrcal/identification/identifiability.h"
 #include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -76,6 +79,63 @@ TEST_F(DesignChoiceTest, RefusesANonPositiveExpectedErrorInEachFrontEndsWords) {
                 ::testing::HasSubstr("--expected-length-mm: expected a finite value > 0 (mm)"));
     EXPECT_THAT(e.Respelled(Frontend::kPython).what(), ::testing::HasSubstr("expected_length_mm="));
   }
+}
+
+// Design works against the measurement interface: the ranger's route through it keeps the
+// identification Jacobian's bits, so the choice is the model overload's exactly.
+TEST_F(DesignChoiceTest, TheRangerAsAMeasurementKindChoosesWhatTheModelChooses) {
+  EXPECT_EQ(DesignJacobian(model_, pool_, DesignScaling::kSI, 0, 0),
+            IdentificationJacobian(model_, pool_));
+  DesignRequest request;
+  request.count = 30;
+  request.baseline = 10;
+  request.selection.method = SelectionMethod::kExchange;
+  const RangerMeasurement ranger(model_);
+  const DesignChoice by_kind = ChooseDesign(ranger, pool_, request);
+  const DesignChoice by_model = ChooseDesign(model_, pool_, request);
+  EXPECT_EQ(by_kind.chosen.indices, by_model.chosen.indices);
+  EXPECT_EQ(by_kind.chosen.score, by_model.chosen.score);
+  request.task = TaskPosesAt(model_, WorkspacePoses(model_.robot(), 12, 5), "workspace");
+  EXPECT_EQ(ChooseDesign(ranger, pool_, request).task_rms_per_sigma,
+            ChooseDesign(model_, pool_, request).task_rms_per_sigma);
+}
+
+// Another kind's terms: its Jacobian's columns are weighed by their own units, the task's pose
+// rows reach its link terms by name and leave the instrument's and targets' at zero, and a
+// kind of three values per configuration is refused by name rather than chosen row by row.
+TEST_F(DesignChoiceTest, AnyKindsJacobianScalesAndWeighsByItsOwnTerms) {
+  PointSetup setup;
+  setup.instrument =
+      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.0, -0.4, 0.3), Eigen::Vector3d(0.1, -0.2, 2.8));
+  const PointMeasurement tracker(model_.robot(), setup);
+  const TargetedConfigurations some = pool_.Subset({0, 1, 2, 3, 4});
+  const Eigen::MatrixXd G = DesignJacobian(tracker, some, DesignScaling::kSI, 0, 0);
+  EXPECT_EQ(G, MeasurementJacobian(tracker, some));
+  EXPECT_EQ(G.rows(), 15);
+  const std::vector<std::string>& names = tracker.parameter_names();
+  const Eigen::MatrixXd scaled =
+      DesignJacobian(tracker, some, DesignScaling::kExpectedErrors, 2e-3, 5e-4);
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto j = static_cast<Eigen::Index>(k);
+    EXPECT_EQ(scaled.col(j), G.col(j) * (IsAngularName(names[k]) ? 2e-3 : 5e-4)) << names[k];
+  }
+  const TaskPoses task = TaskPosesAt(model_, WorkspacePoses(model_.robot(), 4, 9), "workspace");
+  const Eigen::MatrixXd P = PositionRowsFor(task, names);
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto in_task = std::find(task.names.begin(), task.names.end(), names[k]);
+    if (in_task == task.names.end())
+      EXPECT_TRUE(P.col(static_cast<Eigen::Index>(k)).isZero()) << names[k];
+    else
+      EXPECT_EQ(P.col(static_cast<Eigen::Index>(k)),
+                task.position_rows.col(in_task - task.names.begin()))
+          << names[k];
+  }
+  EXPECT_EQ(std::count(names.begin(), names.end(), "instrument_x"), 1);
+  DesignRequest request;
+  request.count = 20;
+  EXPECT_THAT([&] { ChooseDesign(tracker, pool_, request); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(
+                  "a point measurement has 3 values per configuration; design chooses")));
 }
 
 }  // namespace

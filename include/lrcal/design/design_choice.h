@@ -55,8 +55,13 @@ struct DesignChoice {
   std::optional<double> task_rms_per_sigma;
 };
 
-/// Chooses request.count of `pool` for `model` (its nominal parameters). Throws InputError for
-/// an impossible request (count above the pool, below the parameters).
+/// Chooses request.count of `pool` for measurements of `kind` (at its nominal terms); per_plane
+/// counts the chosen configurations per target. Throws InputError for an impossible request
+/// (count above the pool, below the terms) and for a kind of more than one row per
+/// configuration (choosing blocks of rows is not done yet: see DesignJacobian).
+DesignChoice ChooseDesign(const MeasurementKind& kind, const TargetedConfigurations& pool,
+                          const DesignRequest& request);
+/// The ranger's: ChooseDesign of RangerMeasurement(model), per_plane over the model's planes.
 DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigurations& pool,
                           const DesignRequest& request);
 

@@ -29,6 +29,7 @@
 #include "lrcal/core/enum_names.h"
 #include "lrcal/core/random.h"
 #include "lrcal/core/settings.h"
+#include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/measurement/targeted_configurations.h"
 
@@ -115,6 +116,8 @@ Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
 /// Expected error magnitudes of a parameter set's entries: `angle` (rad) for angular ones,
 /// `length` (m) for the others; the column weights of DesignScaling::kExpectedErrors.
 Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, double length);
+/// The same for terms named `names` (IsAngularName, parameter_set.h): any kind's terms.
+Eigen::VectorXd ExpectedErrors(const std::vector<std::string>& names, double angle, double length);
 
 /// The task criterion's selection matrix (criterion I): G (N×n, SI) times L⁻ᵀ, where
 /// W = LLᵀ = PᵀP + ridge and P (3M×n) stacks the position rows of ∂(pose)/∂e at M poses, so that
@@ -124,8 +127,16 @@ Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, dou
 Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
                                      const Eigen::MatrixXd& position_rows);
 
-/// The identification Jacobian of `pool` at the nominal model, columns scaled as `scaling` says
-/// (expected errors `angle` rad and `length` m for kExpectedErrors): what design selects from.
+/// The Jacobian ∂y/∂e of `kind`'s measurements at `pool` at its nominal terms
+/// (MeasurementJacobian, rows_per_configuration rows per candidate), columns scaled as
+/// `scaling` says (expected errors `angle` rad and `length` m for kExpectedErrors): what design
+/// selects from, for any measurement kind. SelectConfigurations chooses rows, so a kind of one
+/// row per configuration (the ranger) is selected by configuration; choosing blocks of rows (a
+/// tracker's three) is not done here yet (ChooseDesign refuses it).
+Eigen::MatrixXd DesignJacobian(const MeasurementKind& kind, const TargetedConfigurations& pool,
+                               DesignScaling scaling, double angle, double length);
+/// The ranger's: the same for RangerMeasurement(model) (the bits of the identification's
+/// Jacobian, IdentificationJacobian).
 Eigen::MatrixXd DesignJacobian(const MeasurementModel& model, const TargetedConfigurations& pool,
                                DesignScaling scaling, double angle, double length);
 
