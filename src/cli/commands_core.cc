@@ -429,21 +429,16 @@ int PaperCommand(const std::vector<std::string>& args) {
   po::variables_map vm;
   if (!Parse("paper", "[--seed K] [options]", o, args, &vm)) return 0;
   const RobotFile rig = LoadRobot(vm["robot"].as<std::string>());
-  const RobotModel& robot = rig.robot;
-  if (!rig.planes || rig.planes->size() != 1)
-    throw InputError("--robot", "the robot file '" + rig.path +
-                                    "' has no plane (the paper's study uses one plane)");
   PaperCaseOptions options;
-  options.sampling.ranger = rig.ranger;
   options.seed = ParseSeed(vm);
   options.case1_selection.method =
       ParseSelectionMethod(vm["case1-selection"].as<std::string>(), "--case1-selection");
   ReadSettingOptions(vm, SelectionOptions::Settings(), &options.case1_selection);
-  const PaperCasesResult r = RunPaperCases(robot, rig.truth, (*rig.planes)[0], options);
+  const PaperCasesResult r = RunPaperCases(rig, options);
   if (ResolveFormat(vm) == Format::kJson) {
     std::cout << PaperCasesJson(r, options).dump(2) << "\n";
   } else {
-    std::cout << PaperCasesText(robot, r, options);
+    std::cout << PaperCasesText(rig.robot, r, options);
   }
   return 0;
 }

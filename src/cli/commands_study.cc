@@ -159,20 +159,9 @@ int MergeCommand(const std::vector<std::string>& args) {
   if (!Parse("merge", "DIR... --out DIR", o, args, &vm, &pos)) return 0;
   const auto& dirs = vm["dirs"].as<std::vector<std::string>>();
   const std::string out = vm["out"].as<std::string>();
-  const bool complete = MergeRuns(dirs, out);
-  if (complete) {
-    std::cout << RunStatus(out) << "tables: " << out << "/tables/summary.md\n";
-    return 0;
-  }
-  // Not every trial is in the shards: say which shards to finish, write no tables.
-  const RunStatusInfo merged = GetRunStatus(out);
-  std::cout << merged.text.substr(0, merged.text.find("last session"));
-  std::vector<RunStatusInfo> infos;
-  for (const auto& d : dirs) infos.push_back(GetRunStatus(d));
-  std::cout << ShardAdvice(dirs, infos);
-  std::cout << "tables not written: the shards do not hold every trial yet; finish them and run "
-               "lrcal merge again\n";
-  return 1;
+  const MergeOutcome merged = MergeRunsAndReport(dirs, out);
+  std::cout << merged.text;
+  return merged.complete ? 0 : 1;
 }
 
 int AggregateCommand(const std::vector<std::string>& args) {

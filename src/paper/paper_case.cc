@@ -79,6 +79,15 @@ PaperCasesResult RunPaperCases(const RobotModel& robot, const Truth& true_arm, c
   return result;
 }
 
+PaperCasesResult RunPaperCases(const RobotFile& rig, PaperCaseOptions options) {
+  if (!rig.planes || rig.planes->size() != 1)
+    throw InputError(rig.path, "the robot file has " +
+                                   std::to_string(rig.planes ? rig.planes->size() : 0) +
+                                   " planes; the paper's study uses exactly one");
+  options.sampling.ranger = rig.ranger;
+  return RunPaperCases(rig.robot, rig.truth, (*rig.planes)[0], options);
+}
+
 Table PaperParameterTable(const RobotModel& robot, const PaperCasesResult& result) {
   Table t({"link", "parameter", "unit", "true", "case 1 (lrcal)", "case 1 (paper)",
            "case 2 (lrcal)", "case 2 (paper)"},

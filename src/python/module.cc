@@ -45,6 +45,7 @@
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
+#include "lrcal/paper/paper_case.h"
 #include "lrcal/report/accuracy_plan.h"
 #include "lrcal/report/calibration_report.h"
 #include "lrcal/report/report_data.h"
@@ -1576,6 +1577,35 @@ calibration record; plane: the planes to write instead of the file's).)doc");
 A dry run of a study, as `lrcal plan --format json`: every cell prepared and a few trials timed.
 Returns a dict with study, threads, total_trials, estimate_seconds and cells [{label, id, trials,
 prepare_seconds, seconds_per_trial, estimate_seconds, settings}].)doc");
+  m.def(
+      "paper",
+      [](const RobotFile& rig, long long seed, const std::string& case1_selection, int samples) {
+        PaperCaseOptions options;
+        options.seed = ToSeed(seed);
+        options.case1_selection.method = ParseSelectionMethod(case1_selection, "case1_selection");
+        options.case1_selection.samples = samples;
+        options.case1_selection.Validate();
+        std::string json, text;
+        {
+          py::gil_scoped_release release;
+          const PaperCasesResult r = RunPaperCases(rig, options);
+          json = PaperCasesJson(r, options).dump();
+          text = PaperCasesText(rig.robot, r, options);
+        }
+        py::dict out = FromJson(json);
+        out["text"] = text;
+        return out;
+      },
+      py::arg("robot"), py::arg("seed") = 1, py::arg("case1_selection") = "backward",
+      py::arg("samples") =
+          static_cast<int>(FindSetting(SelectionOptions::Settings(), "samples")->Default()),
+      R"doc(
+The paper's case 1 and case 2, one realisation, as `lrcal paper --format json`: on the robot
+file's arm, its simulated truth and its one plane, a pool of 101 candidates, case 1 choosing 50
+(case1_selection: backward, exchange, greedy, sampled as the paper did with `samples` random
+subsets, or random) and case 2 100 by E-optimality, each identified and validated. Returns the
+command's JSON as a dict (per case the selection, termination, estimates in SI with their standard
+deviations, the validation metrics) and "text", the command's tables beside the slides'.)doc");
 }
 
 // A run directory's commands: replay a trial, its status, its report.
@@ -1613,6 +1643,41 @@ trials, complete, cells [{id, label, done, total, stopped_early}], last_session 
 state (running, stopped: its process is gone, completed, interrupted, max_trials, ...),
 trials_computed, seconds, trials_per_second}, to_finish and report (the commands that finish or
 report it) and "text", the command's text. Safe on a run in progress.)doc");
+  m.def(
+      "merge",
+      [](const std::vector<std::string>& shards, const std::string& out) {
+        std::string json, text;
+        bool complete = false;
+        {
+          py::gil_scoped_release release;
+          const MergeOutcome merged = MergeRunsAndReport(shards, out);
+          json = merged.status.json.dump();
+          text = merged.text;
+          complete = merged.complete;
+        }
+        py::dict d;
+        d["complete"] = complete;
+        d["status"] = FromJson(json);
+        d["text"] = text;
+        return d;
+      },
+      py::arg("shards"), py::arg("out"), R"doc(
+Combines shard run directories into the run directory `out`, as `lrcal merge SHARD... --out OUT`:
+when every trial of the study is there the tables are written. Returns a dict: complete (whether
+they were), status (lrcal.status of `out`) and "text", the command's output (with the shards to
+finish when not complete).)doc");
+  m.def(
+      "aggregate",
+      [](const std::string& run_dir) {
+        {
+          py::gil_scoped_release release;
+          WriteRunTables(run_dir);
+        }
+        return run_dir + "/tables/summary.md";
+      },
+      py::arg("run_dir"), R"doc(
+Rewrites the tables of a run directory from its trial store, as `lrcal aggregate RUN_DIR`; returns
+the path of its summary.md.)doc");
   m.def(
       "_prepare_report",
       [](const std::string& run_dir) {

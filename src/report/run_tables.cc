@@ -53,4 +53,23 @@ bool MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& ou
   return true;
 }
 
+MergeOutcome MergeRunsAndReport(const std::vector<std::string>& shard_dirs,
+                                const std::string& out_dir) {
+  MergeOutcome out;
+  out.complete = MergeRuns(shard_dirs, out_dir);
+  out.status = GetRunStatus(out_dir);
+  if (out.complete) {
+    out.text = out.status.text + "tables: " + out_dir + "/tables/summary.md\n";
+    return out;
+  }
+  // Not every trial is in the shards: say which shards to finish; no tables were written.
+  std::vector<RunStatusInfo> shards;
+  for (const auto& d : shard_dirs) shards.push_back(GetRunStatus(d));
+  out.text = out.status.text.substr(0, out.status.text.find("last session")) +
+             ShardAdvice(shard_dirs, shards) +
+             "tables not written: the shards do not hold every trial yet; finish them and run "
+             "lrcal merge again\n";
+  return out;
+}
+
 }  // namespace lrcal

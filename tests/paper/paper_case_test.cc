@@ -2,10 +2,12 @@
 // with the paper's robot file.
 #include "lrcal/paper/paper_case.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "lrcal/core/error.h"
 #include "test_util.h"
 
 namespace lrcal {
@@ -52,6 +54,27 @@ TEST(PaperCases, BothCasesIdentifyTheTruthAndBeatTheNominalArm) {
   // The tables lrcal prints beside the paper's.
   EXPECT_EQ(PaperValidationTable(r).num_rows(), 9);
   EXPECT_GT(PaperParameterTable(rig.robot, r).num_rows(), 0);
+}
+
+// On a robot file: the file's arm, truth, plane and ranger, and a file of another number of
+// planes is refused by its path.
+TEST(PaperCases, OnARobotFileAreTheCasesOfItsArmPlaneAndRanger) {
+  const RobotFile& rig = testing::PaperRig();
+  PaperCaseOptions options;
+  options.case1_selection.method = SelectionMethod::kGreedy;
+  const PaperCasesResult from_file = RunPaperCases(rig, options);
+  options.sampling.ranger = rig.ranger;
+  const PaperCasesResult direct = RunPaperCases(rig.robot, rig.truth, (*rig.planes)[0], options);
+  ASSERT_EQ(from_file.cases.size(), 2u);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(from_file.cases[c].selection.indices, direct.cases[c].selection.indices);
+    EXPECT_EQ(from_file.cases[c].summary.delta, direct.cases[c].summary.delta);
+  }
+  RobotFile two = rig;
+  two.planes = PlaneSet({(*rig.planes)[0], Plane::FromCoefficients(1, 0, 0, 2.0)}, {});
+  EXPECT_THAT([&] { RunPaperCases(two, options); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(
+                  rig.path + ": the robot file has 2 planes; the paper's study uses exactly one")));
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 """One Python function per command, through the same library call as the program: the same
 numbers, bit for bit, and the same checks (sample, kinematics, accuracy, export, plan,
-replay_trial, status, report; design and plan_accuracy are in test_calibration.py, run_study and load_run
+replay_trial, status, report, merge, aggregate, paper; design and plan_accuracy are in test_calibration.py, run_study and load_run
 in test_study.py)."""
 import json
 import os
@@ -99,3 +99,37 @@ def test_plan_replay_and_report_of_a_run(tmp_path, cli):
     assert not os.path.exists(os.path.join(run, "report", "trials.snapshot.sqlite"))
     with pytest.raises(lrcal.InputError):
         lrcal.report(str(tmp_path / "missing"))
+
+
+def test_merge_and_aggregate_are_the_programs(tmp_path, cli):
+    study = small_study(tmp_path, trials=4)
+    shards = [str(tmp_path / f"shard{i}") for i in (1, 2)]
+    lrcal.run_study(study, shards[0], threads=1, shard="1/2")
+    partial = lrcal.merge(shards[:1], str(tmp_path / "partial"))
+    program = cli("merge", shards[0], "--out", tmp_path / "partial_cli", check=False)
+    assert program.returncode == 1 and not partial["complete"]
+    assert "tables not written" in partial["text"] and "unfinished or missing shards: 2" in partial["text"]
+    assert partial["status"]["done"] == 4 and partial["status"]["total"] == 8
+    lrcal.run_study(study, shards[1], threads=1, shard="2/2")
+    merged = lrcal.merge(shards, str(tmp_path / "merged"))
+    cli("merge", *shards, "--out", tmp_path / "merged_cli")
+    assert merged["complete"] and merged["status"]["complete"]
+    assert merged["text"].endswith(f"tables: {tmp_path / 'merged'}/tables/summary.md\n")
+    summary = (tmp_path / "merged" / "tables" / "summary.md").read_text()
+    assert summary == (tmp_path / "merged_cli" / "tables" / "summary.md").read_text()
+    os.remove(tmp_path / "merged" / "tables" / "summary.md")
+    assert lrcal.aggregate(str(tmp_path / "merged")) == f"{tmp_path / 'merged'}/tables/summary.md"
+    assert (tmp_path / "merged" / "tables" / "summary.md").read_text() == summary
+    with pytest.raises(lrcal.InputError):
+        lrcal.aggregate(str(tmp_path / "missing"))
+
+
+def test_paper_is_the_programs_paper(cli, paper):
+    ours = lrcal.paper(paper, seed=3, case1_selection="greedy")
+    text = ours.pop("text")
+    program = json.loads(cli("paper", "--seed", 3, "--case1-selection", "greedy",
+                             "--format", "json").stdout)
+    assert ours == program
+    assert text == cli("paper", "--seed", 3, "--case1-selection", "greedy").stdout
+    with pytest.raises(lrcal.InputError, match="samples=: expected"):
+        lrcal.paper(paper, case1_selection="sampled", samples=0)

@@ -18,6 +18,7 @@
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identification.h"
 #include "lrcal/io/result_json.h"
+#include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/pose_errors.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/measurement/truth.h"
@@ -58,6 +59,10 @@ struct PaperCasesResult {
 /// true_errors; its ranger errors are not used: the paper's ranger is exact).
 PaperCasesResult RunPaperCases(const RobotModel& robot, const Truth& truth, const Plane& plane,
                                const PaperCaseOptions& options);
+/// The same on a robot file, what `lrcal paper --robot` and Python's lrcal.paper run: its arm,
+/// its truth, its one plane, and its ranger's limits for the sampling (options.sampling.ranger).
+/// Throws InputError naming the file when it has not exactly one plane.
+PaperCasesResult RunPaperCases(const RobotFile& rig, PaperCaseOptions options);
 
 /// The slides' published identified parameter errors [case][link][θ α a d β] in mrad / mm
 /// (NaN where the link has no such parameter).

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lrcal/report/study_tables.h"
+#include "lrcal/study/run_directory.h"
 #include "lrcal/study/runner.h"
 
 namespace lrcal {
@@ -26,5 +27,17 @@ RunResult RunStudyAndWriteTables(const Study& study, const RunOptions& options,
 /// the study is there, writes the tables; returns whether it did (a partial merge writes none:
 /// finish the shards and merge again).
 bool MergeRuns(const std::vector<std::string>& shard_dirs, const std::string& out_dir);
+
+/// What a merge came to, as `lrcal merge` and Python's lrcal.merge say it: complete (the tables
+/// are written), the merged run's status and, when the shards do not hold every trial, which
+/// shards to finish (ShardAdvice) and that no tables were written.
+struct MergeOutcome {
+  bool complete = false;
+  RunStatusInfo status;  ///< of `out_dir` after the merge
+  std::string text;      ///< the command's output
+};
+/// MergeRuns, then the outcome.
+MergeOutcome MergeRunsAndReport(const std::vector<std::string>& shard_dirs,
+                                const std::string& out_dir);
 
 }  // namespace lrcal

@@ -25,8 +25,9 @@ try:
                          Plane, PriorInformation, Ranger, Readings, Robot, RunProgress, RunResult,
                          StorageError, __version__, accuracy, data_directory, design, export,
                          forward_kinematics, identifiability, identify, kinematics,
-                         laser_readings, plan, plan_accuracy, prior_information, replay_trial,
-                         run_study, sample_configurations, simulate, status)
+                         laser_readings, merge, aggregate, paper, plan, plan_accuracy,
+                         prior_information, replay_trial, run_study, sample_configurations,
+                         simulate, status)
     from ._lrcal import set_data_directory as _set_data_directory
 except ModuleNotFoundError as _missing:
     # Only the Python files are installed (a build without pybind11, e.g. a sanitizer build):
@@ -60,7 +61,7 @@ from .report import report
 
 __all__ = ["Design", "Dependency", "Error", "Identifiability", "Identification", "InputError",
            "Plane", "PriorInformation", "Ranger", "Readings", "Robot", "Run", "RunProgress", "RunResult",
-           "StorageError", "__version__", "accuracy", "data_directory", "design", "export",
+           "StorageError", "__version__", "accuracy", "aggregate", "data_directory", "design", "export",
            "forward_kinematics", "identifiability", "identify", "kinematics", "laser_readings",
-           "load_run", "plan", "plan_accuracy", "prior_information", "replay_trial", "report", "run_study", "sample",
+           "load_run", "merge", "paper", "plan", "plan_accuracy", "prior_information", "replay_trial", "report", "run_study", "sample",
            "sample_configurations", "simulate", "status"]
