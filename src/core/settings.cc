@@ -1,5 +1,6 @@
 #include "lrcal/core/settings.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -98,10 +99,64 @@ SettingError::SettingError(const SettingSpec& spec, double value_si)
 SettingError::SettingError(const SettingSpec& spec, const std::string& problem)
     : InputError(spec.Spelling(Frontend::kLibrary), problem), spec_(spec), problem_(problem) {}
 
-std::string SettingError::Problem() const { return problem_; }
+namespace {
+
+// How `frontend` writes setting `spec` given `value`: "--plan-on data", "plan_on='data'",
+// "plan.plan_on: data" (library and study file).
+std::string WithValue(const SettingSpec& spec, Frontend frontend, const std::string& value) {
+  switch (frontend) {
+    case Frontend::kCommandLine:
+      return spec.Spelling(frontend) + " " + value;
+    case Frontend::kPython:
+      return spec.Spelling(frontend) + "'" + value + "'";
+    default:
+      return spec.Spelling(frontend) + ": " + value;
+  }
+}
+
+// `text` with every {i} replaced by mentions[i] as `frontend` spells it, and every {i:value} by
+// that setting given `value`.
+std::string WithMentions(const std::string& text, const std::vector<SettingSpec>& mentions,
+                         Frontend frontend) {
+  std::string out;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t open = text.find('{', at);
+    const std::size_t close = open == std::string::npos ? open : text.find('}', open);
+    if (close == std::string::npos) break;
+    const std::string inner = text.substr(open + 1, close - open - 1);
+    const std::size_t colon = inner.find(':');
+    const std::string index = inner.substr(0, colon);
+    if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos ||
+        std::stoul(index) >= mentions.size()) {
+      out += text.substr(at, close + 1 - at);  // not a mention: kept as written
+    } else {
+      const SettingSpec& spec = mentions[std::stoul(index)];
+      out += text.substr(at, open - at) +
+             (colon == std::string::npos ? spec.Spelling(frontend)
+                                         : WithValue(spec, frontend, inner.substr(colon + 1)));
+    }
+    at = close + 1;
+  }
+  return out + text.substr(std::min(at, text.size()));
+}
+
+}  // namespace
+
+SettingError::SettingError(const SettingSpec& spec, const std::string& problem,
+                           std::vector<SettingSpec> mentions)
+    : InputError(spec.Spelling(Frontend::kLibrary),
+                 WithMentions(problem, mentions, Frontend::kLibrary)),
+      spec_(spec),
+      problem_(problem),
+      mentions_(std::move(mentions)) {}
+
+std::string SettingError::ProblemFor(Frontend frontend) const {
+  return WithMentions(problem_, mentions_, frontend);
+}
 
 InputError SettingError::Respelled(Frontend frontend, const std::string& where) const {
-  return InputError(where.empty() ? spec_.Spelling(frontend) : where, Problem());
+  return InputError(where.empty() ? spec_.Spelling(frontend) : where, ProblemFor(frontend));
 }
 
 }  // namespace lrcal

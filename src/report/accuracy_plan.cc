@@ -23,6 +23,11 @@ namespace lrcal {
 
 namespace {
 
+// What a plan is on, in the tables' and notes' words.
+const char* PlanBasisPhrase(PlanBasis basis) {
+  return basis == PlanBasis::kTotal ? "the total" : "the reading noise's part";
+}
+
 namespace fs = std::filesystem;
 
 const SettingSpec& Spec(const char* name) {
@@ -270,7 +275,7 @@ class Planner {
     if (subsets_.size() > 1) header.insert(header.begin(), "planes");
     search_table_ = Table(
         header, std::string("First-order search (the quantile of the worst axis; planned on ") +
-                    (in_.plan_on == PlanBasis::kTotal ? "the total" : "the reading noise's part") +
+                    PlanBasisPhrase(in_.plan_on) +
                     "; held terms and total at the readings needed, or at the most readings "
                     "considered)");
   }
@@ -531,11 +536,12 @@ class Planner {
       why +=
           "; estimate them (identification.estimate_plane, identification.estimate_ranger), "
           "give their tolerances (the robot file's tolerances:, identification.prior_sigma), "
-          "or plan on the reading noise's part alone (--plan-on data; Python plan_on='data')";
+          "or plan on the reading noise's part alone ({0:data})";
     } else {
-      why += "; widen the configurations or repetitions to consider";
+      why += "; widen the {1} or {2} to consider";
     }
-    Refuse("target", why);
+    throw SettingError(Spec("target"), why,
+                       {Spec("plan_on"), Spec("configurations"), Spec("repetitions")});
   }
 
   const Study& study_;
@@ -727,17 +733,16 @@ namespace {
 std::string SearchNotes(const AccuracyPlan& plan) {
   std::ostringstream out;
   out << "(— : no campaign there: the prediction is not finite, e.g. parameters the "
-         "planes cannot identify, or more readings than --repetitions allows)\n"
+         "planes cannot identify, or more readings than plan.repetitions allows)\n"
       << "reading noise: the estimated parameters' covariance; held terms: every term the "
          "calibration holds at nominal (fixed parameters, plane and ranger terms not estimated, "
          "a base or tool term with a tolerance), each at its tolerance (identification."
          "prior_sigma, else the robot file's tolerances:, else lrcal's defaults); total: both "
          "(README: What a calibration cannot see). The plan is on "
+      << PlanBasisPhrase(plan.options.plan_on)
       << (plan.options.plan_on == PlanBasis::kTotal
-              ? "the total (--plan-on data, Python plan_on='data': on the reading noise's part "
-                "alone)"
-              : "the reading noise's part alone (plan_on data): the held terms may make the "
-                "calibrated arm less accurate than planned")
+              ? " (or, with plan_on data, on the reading noise's part alone)"
+              : " alone: the held terms may make the calibrated arm less accurate than planned")
       << ". The Monte-Carlo confirmation simulates the study's truth: it has every error that "
          "truth has and no other, so the held terms count there only as far as the truth moves "
          "them.\n";
@@ -780,8 +785,7 @@ std::string AccuracyPlan::ToText() const {
               " Monte-Carlo trials each" +
               (stopped ? ", stopped at relative precision " + Fixed(options.stop_precision, 3)
                        : std::string()) +
-              "; planned on " +
-              (options.plan_on == PlanBasis::kTotal ? "the total" : "the reading noise's part") +
+              "; planned on " + PlanBasisPhrase(options.plan_on) +
               ", Monte Carlo of the study's truth)");
   for (const PlannedCampaign& c : campaigns) {
     std::vector<std::string> row = {c.label,

@@ -504,6 +504,15 @@ void PredictValidation(CellContext* c) {
   for (int k = 0; k < 12; ++k) c->predicted_validation[k] = sum[k] / kDraws;
 }
 
+// What a calibration of this cell states at its validation poses at the nominal model, for the
+// estimate's covariance C (SI): the data part and the total with the terms held at nominal
+// (DesignHeldTerms), as `identify --predict-at` states them.
+AccuracyPrediction StatedAtValidation(const CellSettings& s, const CellContext& c,
+                                      const Eigen::MatrixXd& C) {
+  const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
+  return PredictTotalAccuracy(*c.model, zero.data(), C, DesignHeldTerms(s, c), c.validation);
+}
+
 // validation.coverage: what a calibration of this cell would state at each validation pose, at
 // the nominal model: the 95 % position radius of the predicted covariance (the data part) and of
 // the total, with every term the cell holds at nominal (plane and ranger terms, fixed
@@ -511,10 +520,7 @@ void PredictValidation(CellContext* c) {
 // default, as `identify --predict-at` states them.
 void StateCoverageRadii(const CellSettings& s, CellContext* c) {
   if (!s.coverage || c->rank_deficient || c->predicted_covariance.size() == 0) return;
-  const UnestimatedTerms held = DesignHeldTerms(s, *c);
-  const std::vector<double> zero(static_cast<std::size_t>(c->model->num_parameters()), 0.0);
-  const AccuracyPrediction stated =
-      PredictTotalAccuracy(*c->model, zero.data(), c->predicted_covariance, held, c->validation);
+  const AccuracyPrediction stated = StatedAtValidation(s, *c, c->predicted_covariance);
   for (const PoseAccuracy& pose : stated.poses) {
     c->coverage_radius.push_back(pose.position_radius_95);
     c->coverage_radius_total.push_back(pose.position_radius_95_total);
@@ -782,8 +788,7 @@ std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c,
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
   const Eigen::MatrixXd C = DesignCovariance(s, c);
   if (C.size() == 0 || !C.allFinite()) return std::nullopt;
-  const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
-  return PredictTotalAccuracy(*c.model, zero.data(), C, DesignHeldTerms(s, c), c.validation);
+  return StatedAtValidation(s, c, C);
 }
 
 }  // namespace lrcal

@@ -253,9 +253,9 @@ TEST(PlanAccuracy, ConfirmationStopsWhenPreciseEnough) {
   // The text says what a plan on the data part leaves out (the same plan, resumed).
   std::string text;
   ASSERT_EQ(testing::RunCommand(base + " --stop-precision 0.1", &text), 0) << text;
-  EXPECT_THAT(text, ::testing::HasSubstr("The plan is on the reading noise's part alone (plan_on "
-                                         "data): the held terms may make the calibrated arm less "
-                                         "accurate than planned"));
+  EXPECT_THAT(text, ::testing::HasSubstr("The plan is on the reading noise's part alone: the held "
+                                         "terms may make the calibrated arm less accurate than "
+                                         "planned"));
   EXPECT_THAT(text, ::testing::HasSubstr("were used for: plane_u1 plane_u2 plane_f "
                                          "ranger_offset ranger_scale"));
   const Json j = Json::parse(out.substr(out.find('{')));

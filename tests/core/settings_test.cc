@@ -94,6 +94,22 @@ TEST(Settings, TheLibraryNamesItsFieldInSiAndFrontEndsRespellIt) {
               ThrowsMessage<SettingError>(HasSubstr("expected a finite value > 0 (m)")));
 }
 
+// Advice that names another setting is in each reader's words too: {i} is the setting, {i:v}
+// the setting given v; braces that are not a mention stay as written.
+TEST(Settings, OtherSettingsNamedInAProblemAreRespelledWithIt) {
+  const SettingSpec plan_on = SettingSpec::Named("plan", "plan_on", "plan_on");
+  const SettingError e(kSigma, "too small for {x}; raise {0} or set {1:data}", {kCount, plan_on});
+  EXPECT_STREQ(e.what(),
+               "noise.sigma: too small for {x}; raise noise.repetitions or set plan.plan_on: data");
+  EXPECT_STREQ(e.Respelled(Frontend::kCommandLine).what(),
+               "--sigma-mm: too small for {x}; raise --repetitions or set --plan-on data");
+  EXPECT_STREQ(e.Respelled(Frontend::kPython).what(),
+               "sigma_mm=: too small for {x}; raise repetitions= or set plan_on='data'");
+  EXPECT_STREQ(e.Respelled(Frontend::kStudyFile, "s.yaml:2").what(),
+               "s.yaml:2: too small for {x}; raise noise.repetitions or set plan.plan_on: data");
+  EXPECT_STREQ(SettingError(kSigma, "{2} and {", {kCount}).what(), "noise.sigma: {2} and {");
+}
+
 TEST(Settings, SiValuesReadBackInTheSettingsUnitWithoutRoundingNoise) {
   EXPECT_EQ(kSigma.FromSi(0.2e-3), 0.2);  // 0.2e-3 / 1e-3 is 0.19999999999999998
   EXPECT_EQ(kSigma.FromSi(5e-3), 5.0);

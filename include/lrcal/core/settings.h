@@ -75,16 +75,24 @@ class SettingError : public InputError {
   /// Any other problem with the setting (`problem` says what was expected, in the setting's
   /// terms, with no unit conversion needed).
   SettingError(const SettingSpec& spec, const std::string& problem);
+  /// A problem whose text names other settings as {0}, {1}, ...: `mentions`[i], each spelt as
+  /// the front end spells it ("--plan-on", "plan_on=", "plan.plan_on"), so that advice such as
+  /// "or plan on the reading noise's part alone ({0} data)" is in the reader's words.
+  SettingError(const SettingSpec& spec, const std::string& problem,
+               std::vector<SettingSpec> mentions);
   const SettingSpec& spec() const { return spec_; }
-  /// "expected a finite value >= 0 (mm), got -1": the value in the setting's unit.
-  std::string Problem() const;
+  /// "expected a finite value >= 0 (mm), got -1": the value in the setting's unit (other
+  /// settings named as the library names them).
+  std::string Problem() const { return ProblemFor(Frontend::kLibrary); }
   /// The error as `frontend` says it: "--sigma-mm: expected ..., got -1". A study file's
   /// reader passes the location of the key as `where` ("s.yaml:4 key 'noise.sigma_mm'").
   InputError Respelled(Frontend frontend, const std::string& where = "") const;
 
  private:
+  std::string ProblemFor(Frontend frontend) const;
   SettingSpec spec_;
   std::string problem_;
+  std::vector<SettingSpec> mentions_;
 };
 
 /// A setting bound to a member of the option struct `Options` (a double, an int or a long long,
