@@ -7,7 +7,7 @@
 #   tsan     the Monte-Carlo runner and MPI tests (ctest label 'study') with ThreadSanitizer
 #   docs     the API reference (Doxygen) builds without a warning
 #   fuzz     libFuzzer on the CSV readers, robot files, URDFs, study files and the number parser
-#            (ASan + UBSan, 15 s each in CI: scripts/fuzz.sh)
+#            (ASan + UBSan, 10 s each in CI: scripts/fuzz.sh)
 # Usage: bash scripts/checks.sh [format|layers|tidy|docs|asan|tsan|fuzz ...]  (default: all, in order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -56,12 +56,15 @@ for s in "${stages[@]}"; do
       # lengthen by several minutes for no code of their own. So do the statistical checks that
       # repeat one computation hundreds of times (a sensitivity study of single trials, forty
       # seeds of P95 intervals, the robust fit checks over many noise draws: 100 s of this
-      # stage's CPU time): one pass of the same code runs under ASan in other tests.
-      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial)|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*)$'
+      # stage's CPU time): one pass of the same code runs under ASan in other tests. The two
+      # kill -9 tests (40 s) check the store's durability across processes; the resumes they
+      # make are the other MonteCarlo and Mpi tests' code, which run here.
+      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial)|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
       # OpenMPI's own allocations are not freed at exit: leak checks off for the MPI tests only.
       ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j2 --output-on-failure \
         -E "^Mpi\.|$heavy"
-      ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-asan -j2 --output-on-failure -R '^Mpi\.' ;;
+      ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-asan -j2 --output-on-failure -R '^Mpi\.' \
+        -E "$heavy" ;;
     tsan)
       stage tsan
       sanitizer_build build-tsan thread lrcal_cli lrcal_study_tests
@@ -76,7 +79,7 @@ for s in "${stages[@]}"; do
         ctest --test-dir build-tsan -j2 --output-on-failure -L study -E "$repeats" ;;
     fuzz)
       stage fuzz
-      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-15}" ;;
+      bash scripts/fuzz.sh "${LRCAL_FUZZ_SECONDS:-10}" ;;
     *) echo "unknown stage '$s' (format, layers, tidy, docs, asan, tsan, fuzz)" >&2; exit 2 ;;
   esac
 done

@@ -4,7 +4,8 @@
 #   bash scripts/setup.sh run    # build and run the main job
 #   bash scripts/setup.sh test   # build and run every test (what .ci/run does first)
 #   bash scripts/setup.sh build  # build only
-# LRCAL_WERROR=ON (CI) turns warnings into errors.
+# LRCAL_WERROR=ON (CI) turns warnings into errors; LRCAL_UNITY_TESTS=ON (CI) compiles the test
+# binaries as unity builds (faster from scratch, slower to rebuild after an edit).
 set -euo pipefail
 action="${1:-run}"
 case "$action" in run|test|build) ;; *) echo "usage: bash scripts/setup.sh run|test|build" >&2; exit 2;; esac
@@ -17,7 +18,8 @@ packages=(g++ cmake make git pkg-config
   pybind11-dev python3-dev python3-pytest liburdfdom-dev libtinyxml-dev)
 bash scripts/install_packages.sh "${packages[@]}"
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLRCAL_WERROR="${LRCAL_WERROR:-OFF}"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLRCAL_WERROR="${LRCAL_WERROR:-OFF}" \
+  -DLRCAL_UNITY_TESTS="${LRCAL_UNITY_TESTS:-OFF}"
 cmake --build build -j2
 
 case "$action" in
