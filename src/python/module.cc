@@ -1643,6 +1643,10 @@ trials, complete, cells [{id, label, done, total, stopped_early}], last_session 
 state (running, stopped: its process is gone, completed, interrupted, max_trials, ...),
 trials_computed, seconds, trials_per_second}, to_finish and report (the commands that finish or
 report it) and "text", the command's text. Safe on a run in progress.)doc");
+}
+
+// Shard run directories merged, and a run's tables rewritten.
+void DefineMergeCommands(py::module_& m) {
   m.def(
       "merge",
       [](const std::vector<std::string>& shards, const std::string& out) {
@@ -1678,6 +1682,10 @@ finish when not complete).)doc");
       py::arg("run_dir"), R"doc(
 Rewrites the tables of a run directory from its trial store, as `lrcal aggregate RUN_DIR`; returns
 the path of its summary.md.)doc");
+}
+
+// The report's helpers for the package's Python part (lrcal.report).
+void DefineReportHelpers(py::module_& m) {
   m.def(
       "_prepare_report",
       [](const std::string& run_dir) {
@@ -1716,6 +1724,8 @@ PYBIND11_MODULE(_lrcal, m) {
   lp::DefineStudy(m);
   lp::DefineCommands(m);
   lp::DefineRunCommands(m);
+  lp::DefineMergeCommands(m);
+  lp::DefineReportHelpers(m);
   m.def("set_data_directory", &lrcal::SetEmbeddedDataDirectory, py::arg("path"),
         "Registers where lrcal's shipped data is (the package does this on import).");
   m.def(

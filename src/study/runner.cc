@@ -213,7 +213,7 @@ class StudyRunner {
 
   RunResult Run() {
     start_ = Clock::now();
-    PrepareCells();
+    if (!AlreadyComplete()) PrepareCells();
     if (stop_->stop_requested()) {  // a signal while the cells were prepared: nothing written
       result_.interrupted = true;
       result_.seconds = Seconds(start_, Clock::now());
@@ -221,6 +221,8 @@ class StudyRunner {
     }
     OpenRunDirectory();
     FindMissingTrials();
+    // Insurance: should the store show work after all, the cells are prepared now.
+    if (contexts_.empty() && result_.done_before < result_.total) PrepareCells();
     try {
       RunTrials();
     } catch (const StorageError& e) {
@@ -257,6 +259,29 @@ class StudyRunner {
            " trials are safely recorded in " + store_path_ +
            " (committed batches are never lost). Free space or fix the disk, then run the same "
            "command again: the run resumes where it stopped and gives the same tables.";
+  }
+
+  // A rerun of a finished run has nothing to compute and so nothing to prepare: every trial of
+  // this process's share is recorded in a run directory of this very study. The store already
+  // holds every cell's row, the session is still recorded and the tables still written, so the
+  // rerun gives what it gave before, without minutes of preparing cells. Only for one process
+  // and fixed trial counts: a stop_when run decides in the loop, which needs its cells. Anything
+  // unusual (no manifest, another study, a damaged store) takes the ordinary path, whose checks
+  // say what is wrong.
+  bool AlreadyComplete() const {
+    if (ranks_ > 1 || (study_.stop_when.enabled() && options_.shard_count == 1) ||
+        !dir_.HasManifest())
+      return false;
+    try {
+      const Json manifest = dir_.ReadManifest();
+      RunDirectory::CheckCompatible(manifest, study_.ToJson(), study_.path, options_.shard_index,
+                                    options_.shard_count);
+      // More trials per cell than recorded extend the run: there is work, so cells are needed.
+      if (manifest["study"].value("trials", 0LL) != study_.trials) return false;
+      return GetRunStatus(options_.out_dir).complete;
+    } catch (const std::exception&) {
+      return false;
+    }
   }
 
   // Every rank prepares every cell (the same deterministic result).

@@ -63,11 +63,18 @@ TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
   EXPECT_THAT(log, ::testing::HasSubstr("session 1 ended (max_trials): 50 trials computed"));
   EXPECT_THAT(log, ::testing::HasSubstr("session 2 ended (completed): 150 trials computed, 50 "
                                         "recorded before, of 200"));
-  // Once more: nothing to do, said so (not "0 trials computed").
-  ASSERT_EQ(Lrcal("run quick --out " + dir + "/run --quiet", &out), 0) << out;
+  // Once more: nothing to do, said so (not "0 trials computed"), and no cell is prepared for it
+  // (issue 32: a finished study's rerun spent minutes preparing cells it would not use).
+  ASSERT_EQ(RunCommand("LRCAL_PROGRESS_SECONDS=0 " + LrcalBinary() + " run quick --out " + dir +
+                           "/run 2>&1 | cat",
+                       &out),
+            0)
+      << out;
   EXPECT_THAT(out, ::testing::HasSubstr(
                        "nothing to compute: all 200 trials of this run were already recorded"))
       << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("preparing cells"))) << out;
+  EXPECT_EQ(LastSessionEnd(dir + "/run"), "completed");
   // A short run does not print a meaningless overhead percentage.
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/small --quiet --threads 2", &out), 0) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("too short to measure the runner's overhead")) << out;
