@@ -262,7 +262,8 @@ class StudyRunner {
   }
 
   // A rerun of a finished run has nothing to compute and so nothing to prepare: every trial of
-  // this process's share is recorded in a run directory of this very study. The store already
+  // this process's share is recorded in a run directory of this very study (the count
+  // FindMissingTrials makes again under the lock). The store already
   // holds every cell's row, the session is still recorded and the tables still written, so the
   // rerun gives what it gave before, without minutes of preparing cells. Only for one process
   // and fixed trial counts: a stop_when run decides in the loop, which needs its cells. Anything
@@ -278,10 +279,27 @@ class StudyRunner {
                                     options_.shard_count);
       // More trials per cell than recorded extend the run: there is work, so cells are needed.
       if (manifest["study"].value("trials", 0LL) != study_.trials) return false;
-      return GetRunStatus(options_.out_dir).complete;
+      for (const auto& cell : dir_.ReadDone(study_))
+        if (MissingInShare(cell) > 0) return false;
+      return true;
     } catch (const std::exception&) {
       return false;
     }
+  }
+
+  // This shard's trials of a cell: indices shard_index, shard_index + shard_count, ...
+  long long ShareSize() const {
+    return study_.trials > options_.shard_index
+               ? (study_.trials - options_.shard_index + options_.shard_count - 1) /
+                     options_.shard_count
+               : 0;
+  }
+  // How many of this shard's trials of a cell (`recorded`: one flag per trial) are not recorded.
+  long long MissingInShare(const std::vector<bool>& recorded) const {
+    long long missing = 0;
+    for (long long t = options_.shard_index; t < study_.trials; t += options_.shard_count)
+      missing += !recorded[static_cast<std::size_t>(t)];
+    return missing;
   }
 
   // Every rank prepares every cell (the same deterministic result).
@@ -361,13 +379,11 @@ class StudyRunner {
     done_ = dir_.ReadDone(study_, store_.get());
     collective_->Barrier();          // nobody writes before every rank has read
     std::vector<long long> missing;  // per cell, this process's share (for the ETA)
+    const long long share = ShareSize();
     for (const auto& cell : done_) {
-      missing.push_back(0);
-      for (long long t = options_.shard_index; t < study_.trials; t += options_.shard_count) {
-        ++result_.total;
-        if (cell[t]) ++result_.done_before;
-        missing.back() += !cell[t];
-      }
+      missing.push_back(MissingInShare(cell));
+      result_.total += share;
+      result_.done_before += share - missing.back();
       missing.back() = (missing.back() + ranks_ - 1) / ranks_;
     }
     eta_ = std::make_unique<RemainingTimeEstimate>(std::move(missing));
