@@ -127,7 +127,10 @@ std::string WithMentions(const std::string& text, const std::vector<SettingSpec>
     const std::string inner = text.substr(open + 1, close - open - 1);
     const std::size_t colon = inner.find(':');
     const std::string index = inner.substr(0, colon);
-    if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos ||
+    // At most three digits: a longer number in braces is text, not a mention (and never
+    // overflows the conversion).
+    if (index.empty() || index.size() > 3 ||
+        index.find_first_not_of("0123456789") != std::string::npos ||
         std::stoul(index) >= mentions.size()) {
       out += text.substr(at, close + 1 - at);  // not a mention: kept as written
     } else {

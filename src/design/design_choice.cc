@@ -73,8 +73,8 @@ DesignChoice ChooseDesign(const MeasurementKind& kind, const TargetedConfigurati
 DesignChoice ChooseDesign(const MeasurementModel& model, const TargetedConfigurations& pool,
                           const DesignRequest& request) {
   DesignChoice out = ChooseDesign(RangerMeasurement(model), pool, request);
-  out.per_plane.resize(
-      std::max(out.per_plane.size(), static_cast<std::size_t>(model.nominal_planes().size())), 0);
+  // Bind refused any target beyond the model's planes: this only adds the planes none chose.
+  out.per_plane.resize(static_cast<std::size_t>(model.nominal_planes().size()), 0);
   return out;
 }
 

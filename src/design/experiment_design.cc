@@ -712,10 +712,7 @@ double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion
 }
 
 Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, double length) {
-  Eigen::VectorXd expected(parameters.size());
-  for (int k = 0; k < parameters.size(); ++k)
-    expected[k] = parameters.IsAngular(k) ? angle : length;
-  return expected;
+  return ExpectedErrors(parameters.names, angle, length);
 }
 
 Eigen::VectorXd ExpectedErrors(const std::vector<std::string>& names, double angle, double length) {

@@ -108,6 +108,8 @@ TEST(Settings, OtherSettingsNamedInAProblemAreRespelledWithIt) {
   EXPECT_STREQ(e.Respelled(Frontend::kStudyFile, "s.yaml:2").what(),
                "s.yaml:2: too small for {x}; raise noise.repetitions or set plan.plan_on: data");
   EXPECT_STREQ(SettingError(kSigma, "{2} and {", {kCount}).what(), "noise.sigma: {2} and {");
+  EXPECT_STREQ(SettingError(kSigma, "got '{99999999999999999999}'", {kCount}).what(),
+               "noise.sigma: got '{99999999999999999999}'");
 }
 
 TEST(Settings, SiValuesReadBackInTheSettingsUnitWithoutRoundingNoise) {
