@@ -44,10 +44,24 @@ int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurati
   const std::vector<std::string> reasons = truth.MissReasons(configs, zero.data());
   if (misses) *misses = reasons;
   *data = MeasuredValues{TargetedConfigurations(configs.num_joints()), {}, {}};
+  // Each component's σ, and its weight in single readings of σ (an angle's (σ/σ_angle)² per
+  // reading: the variance ratio, measurement_kind.h MeasuredValues::weights).
+  std::vector<double> sigma(static_cast<std::size_t>(k), noise.sigma);
+  std::vector<double> weight(static_cast<std::size_t>(k),
+                             noise.average.IsMean() ? R : R / noise.average.VarianceFactor(R));
+  bool weighted = !noise.average.IsMean();
+  for (int c = 0; c < k; ++c) {
+    if (!truth.RowIsAngle(c)) continue;
+    const auto u = static_cast<std::size_t>(c);
+    sigma[u] = noise.sigma_angle;
+    if (noise.sigma > 0 && noise.sigma_angle > 0) {
+      weight[u] *= (noise.sigma / noise.sigma_angle) * (noise.sigma / noise.sigma_angle);
+      weighted = true;
+    }
+  }
   int missed = 0;
   std::vector<double> z(static_cast<std::size_t>(R) * k);
   std::vector<double> readings(static_cast<std::size_t>(R));  // one component's R readings
-  const double robust_weight = noise.average.IsMean() ? 0 : R / noise.average.VarianceFactor(R);
   for (int i = 0; i < configs.size(); ++i) {
     if (reasons[i] != "ok" || !std::isfinite(exact[static_cast<std::size_t>(i) * k])) {
       ++missed;
@@ -55,19 +69,20 @@ int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurati
     }
     data->configs.AddFrom(configs, i);
     data->repetitions.push_back(R);
-    if (!noise.average.IsMean()) data->weights.insert(data->weights.end(), k, robust_weight);
+    if (weighted) data->weights.insert(data->weights.end(), weight.begin(), weight.end());
     if (noise.DrawsMean()) {
       stream.Normals(static_cast<std::uint64_t>(i) * k, k, z.data());
       for (int c = 0; c < k; ++c)
         data->y.push_back(exact[static_cast<std::size_t>(i) * k + c] +
-                          noise.sigma / std::sqrt(static_cast<double>(R)) * z[c]);
+                          sigma[static_cast<std::size_t>(c)] / std::sqrt(static_cast<double>(R)) *
+                              z[c]);
       continue;
     }
     stream.Normals(static_cast<std::uint64_t>(i) * R * k, R * k, z.data());
     for (int c = 0; c < k; ++c) {
       for (int r = 0; r < R; ++r)
-        readings[static_cast<std::size_t>(r)] =
-            exact[static_cast<std::size_t>(i) * k + c] + noise.sigma * z[r * k + c];
+        readings[static_cast<std::size_t>(r)] = exact[static_cast<std::size_t>(i) * k + c] +
+                                                sigma[static_cast<std::size_t>(c)] * z[r * k + c];
       data->y.push_back(noise.average.Combine(readings.data(), R));
     }
   }

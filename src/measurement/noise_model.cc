@@ -48,6 +48,8 @@ void NoiseModel::Validate() const {
     throw InputError("noise.ranger_offset", "expected a finite offset (m)");
   if (!(std::fabs(ranger_scale) < 0.5))
     throw InputError("noise.ranger_scale", "expected a scale error of magnitude below 0.5");
+  if (!(sigma_angle >= 0) || !std::isfinite(sigma_angle))
+    throw InputError("noise.sigma_angle", "expected a finite standard deviation >= 0 (rad)");
 }
 
 }  // namespace lrcal

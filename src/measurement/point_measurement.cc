@@ -6,6 +6,8 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/kinematics/chain.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/pose_measurement.h"
 
 namespace lrcal {
 
@@ -15,6 +17,23 @@ constexpr const char* kInstrumentTerms[6] = {"instrument_x",     "instrument_y",
                                              "instrument_z",     "instrument_roll",
                                              "instrument_pitch", "instrument_yaw"};
 constexpr const char* kAxes[3] = {"x", "y", "z"};
+constexpr const char* kRotations[3] = {"roll", "pitch", "yaw"};
+
+// The body-frame angular motion ω_B (base frame) of the tool per link value `index`: the joint
+// axis for θ, the common normal for α, the twist axis for β; none for the lengths d and a.
+Eigen::Vector3d AngularMotion(const ChainFrames& f, int index) {
+  const int link = index / kValuesPerLink;
+  switch (index % kValuesPerLink) {
+    case kTheta:
+      return f.z_prev[link];
+    case kAlpha:
+      return f.x_common[link];
+    case kBeta:
+      return f.y_twist[link];
+    default:  // kD, kA
+      return Eigen::Vector3d::Zero();
+  }
+}
 
 // The point's differential motion ∂P/∂v for link value `index` (base frame), from the chain's
 // frames at one configuration: the ranger's hit-point formulas (measurement_model.h).
@@ -36,9 +55,13 @@ Eigen::Vector3d PointMotion(const ChainFrames& f, int index, const Eigen::Vector
 
 class PointEvaluator : public MeasurementEvaluator {
  public:
-  PointEvaluator(const PointMeasurement& kind, const TargetedConfigurations& configs)
-      : kind_(kind), configs_(configs) {}
-  int num_rows() const override { return 3 * configs_.size(); }
+  PointEvaluator(const PointMeasurement& kind, const TargetedConfigurations& configs,
+                 std::vector<Eigen::Matrix3d> chart_centres)
+      : kind_(kind),
+        configs_(configs),
+        k_(kind.rows_per_configuration()),
+        chart_centres_(std::move(chart_centres)) {}
+  int num_rows() const override { return k_ * configs_.size(); }
   int num_parameters() const override { return kind_.num_parameters(); }
   bool Predict(const double* e, double* y, double* J) override {
     kind_.StateAt(e, &state_);
@@ -50,40 +73,76 @@ class PointEvaluator : public MeasurementEvaluator {
       const int target = configs_.target(i);
       const Eigen::Vector3d P = pose.p_BT + pose.R_BT * state_.targets[target];
       const Eigen::Vector3d value = state_.R_BI.transpose() * (P - state_.p_BI);
-      for (int c = 0; c < 3; ++c) y[3 * i + c] = value[c];
+      for (int c = 0; c < 3; ++c) y[k_ * i + c] = value[c];
       if (J) FillRows(pose, P, target, i, m, J);
+      if (k_ == 6) PredictOrientation(pose, target, i, m, y, J);
     }
     return true;
   }
 
  private:
-  void Put(double* J, int m, int column, int i, const Eigen::Vector3d& rows) const {
+  void Put(double* J, int m, int column, int row, const Eigen::Vector3d& rows) const {
     if (column < 0) return;
-    for (int c = 0; c < 3; ++c) J[static_cast<std::size_t>(column) * m + 3 * i + c] = rows[c];
+    for (int c = 0; c < 3; ++c) J[static_cast<std::size_t>(column) * m + row + c] = rows[c];
   }
   void FillRows(const Pose<double>& pose, const Eigen::Vector3d& P, int target, int i, int m,
                 double* J) const {
+    const int row = k_ * i;
     const Eigen::Matrix3d Rt = state_.R_BI.transpose();
     const std::vector<int>& values = kind_.robot_values();
     for (int k = 0; k < static_cast<int>(values.size()); ++k)
-      Put(J, m, k, i, Rt * PointMotion(frames_, values[k], P));
-    for (int c = 0; c < 3; ++c) Put(J, m, kind_.instrument_column(c), i, -Rt.col(c));
+      Put(J, m, k, row, Rt * PointMotion(frames_, values[k], P));
+    for (int c = 0; c < 3; ++c) Put(J, m, kind_.instrument_column(c), row, -Rt.col(c));
     // y = Rxᵀ·Ryᵀ·Rzᵀ·v, v = R_BI0ᵀ·(P − p_BI); dR/dφ = R·[e]× for each elementary rotation.
     const Eigen::Vector3d u2 =
         state_.Rz.transpose() * (state_.R_BI0.transpose() * (P - state_.p_BI));
     const Eigen::Vector3d u1 = state_.Ry.transpose() * u2;
     const Eigen::Vector3d value = state_.Rx.transpose() * u1;
-    Put(J, m, kind_.instrument_column(3), i, -Eigen::Vector3d::UnitX().cross(value));
-    Put(J, m, kind_.instrument_column(4), i,
+    Put(J, m, kind_.instrument_column(3), row, -Eigen::Vector3d::UnitX().cross(value));
+    Put(J, m, kind_.instrument_column(4), row,
         -(state_.Rx.transpose() * Eigen::Vector3d::UnitY().cross(u1)));
-    Put(J, m, kind_.instrument_column(5), i,
+    Put(J, m, kind_.instrument_column(5), row,
         -(state_.Rx.transpose() * (state_.Ry.transpose() * Eigen::Vector3d::UnitZ().cross(u2))));
     const Eigen::Matrix3d dy_dt = Rt * pose.R_BT;
-    for (int c = 0; c < 3; ++c) Put(J, m, kind_.target_column(target, c), i, dy_dt.col(c));
+    for (int c = 0; c < 3; ++c) Put(J, m, kind_.target_column(target, c), row, dy_dt.col(c));
+  }
+  // Rows 3–5 of configuration i: φ = log(Cᵀ·R_IM) and, if J, J_r⁻¹(φ)·ω per term, ω the body
+  // (M-frame) rotation the term causes (pose_measurement.h).
+  void PredictOrientation(const Pose<double>& pose, int target, int i, int m, double* y,
+                          double* J) const {
+    const int row = k_ * i + 3;
+    const Eigen::Matrix3d R_BM = pose.R_BT * state_.R_TM[target];
+    const Eigen::Matrix3d R_IM = state_.R_BI.transpose() * R_BM;
+    const Eigen::Vector3d phi = RotationLog(chart_centres_[i].transpose() * R_IM);
+    for (int c = 0; c < 3; ++c) y[row + c] = phi[c];
+    if (!J) return;
+    const Eigen::Matrix3d Jinv = InverseRightJacobian(phi);
+    const Eigen::Matrix3d to_body = Jinv * R_BM.transpose();  // base-frame ω → rows
+    const std::vector<int>& values = kind_.robot_values();
+    for (int k = 0; k < static_cast<int>(values.size()); ++k)
+      Put(J, m, k, row, to_body * AngularMotion(frames_, values[k]));
+    // The instrument's rotations turn R_IM on the left (frame I): ω_M = −R_IMᵀ·ω_I.
+    const Eigen::Matrix3d from_instrument = -Jinv * R_IM.transpose();
+    Put(J, m, kind_.instrument_column(3), row, from_instrument * Eigen::Vector3d::UnitX());
+    Put(J, m, kind_.instrument_column(4), row,
+        from_instrument * (state_.Rx.transpose() * Eigen::Vector3d::UnitY()));
+    Put(J, m, kind_.instrument_column(5), row,
+        from_instrument *
+            (state_.Rx.transpose() * (state_.Ry.transpose() * Eigen::Vector3d::UnitZ())));
+    // The target's rotations turn R_IM on the right (frame M).
+    const Eigen::Matrix3d& Rx = state_.target_Rx[target];
+    const Eigen::Matrix3d& Ry = state_.target_Ry[target];
+    Put(J, m, kind_.target_rotation_column(target, 0), row, Jinv * Eigen::Vector3d::UnitX());
+    Put(J, m, kind_.target_rotation_column(target, 1), row,
+        Jinv * (Rx.transpose() * Eigen::Vector3d::UnitY()));
+    Put(J, m, kind_.target_rotation_column(target, 2), row,
+        Jinv * (Rx.transpose() * (Ry.transpose() * Eigen::Vector3d::UnitZ())));
   }
 
   const PointMeasurement& kind_;
   const TargetedConfigurations& configs_;
+  const int k_;
+  const std::vector<Eigen::Matrix3d> chart_centres_;
   PointMeasurement::State state_;
   ChainPoint chain_;
   ChainFrames frames_;
@@ -106,11 +165,24 @@ void PointSetup::Validate() const {
     if (!targets[k].allFinite())
       throw InputError("point.targets[" + std::to_string(k) + "]",
                        "expected a finite offset in the tool frame (m)");
+  if (!target_orientations.empty() && target_orientations.size() != targets.size())
+    throw InputError("point.target_orientations", "expected none or one per target (" +
+                                                      std::to_string(targets.size()) + "), got " +
+                                                      std::to_string(target_orientations.size()));
+  for (std::size_t k = 0; k < target_orientations.size(); ++k)
+    RigidTransform{target_orientations[k], Eigen::Vector3d::Zero()}.Validate(
+        "point.target_orientations[" + std::to_string(k) + "]");
+}
+
+Eigen::Matrix3d PointSetup::TargetOrientation(int k) const {
+  return target_orientations.empty() ? Eigen::Matrix3d::Identity()
+                                     : target_orientations[static_cast<std::size_t>(k)];
 }
 
 PointMeasurement::PointMeasurement(const RobotModel& robot, PointSetup setup,
-                                   const std::vector<std::string>& fixed, const std::string& source)
-    : robot_(&robot), setup_(std::move(setup)), fixed_(fixed) {
+                                   const std::vector<std::string>& fixed, const std::string& source,
+                                   bool orientation)
+    : robot_(&robot), setup_(std::move(setup)), fixed_(fixed), orientation_(orientation) {
   setup_.Validate();
   CheckTermNames(fixed, source);
   const auto is_fixed = [&](const std::string& name) {
@@ -131,13 +203,21 @@ PointMeasurement::PointMeasurement(const RobotModel& robot, PointSetup setup,
   }
   const int targets = static_cast<int>(setup_.targets.size());
   target_columns_.assign(3 * targets, -1);
-  for (int t = 0; t < targets; ++t)
+  rotation_columns_.assign(3 * targets, -1);
+  for (int t = 0; t < targets; ++t) {
     for (int c = 0; c < 3; ++c) {
       const std::string name = TargetTermName(t, targets, kAxes[c]);
       if (is_fixed(name)) continue;
       target_columns_[3 * t + c] = static_cast<int>(names_.size());
       names_.push_back(name);
     }
+    for (int c = 0; c < 3 && orientation_; ++c) {
+      const std::string name = TargetTermName(t, targets, kRotations[c]);
+      if (is_fixed(name)) continue;
+      rotation_columns_[3 * t + c] = static_cast<int>(names_.size());
+      names_.push_back(name);
+    }
+  }
 }
 
 std::vector<std::string> PointMeasurement::AllTermNames() const {
@@ -147,8 +227,11 @@ std::vector<std::string> PointMeasurement::AllTermNames() const {
       names.push_back(LinkValueFullName(index));
   for (const char* term : kInstrumentTerms) names.emplace_back(term);
   const int targets = static_cast<int>(setup_.targets.size());
-  for (int t = 0; t < targets; ++t)
+  for (int t = 0; t < targets; ++t) {
     for (const char* axis : kAxes) names.push_back(TargetTermName(t, targets, axis));
+    if (orientation_)
+      for (const char* axis : kRotations) names.push_back(TargetTermName(t, targets, axis));
+  }
   return names;
 }
 
@@ -157,9 +240,9 @@ void PointMeasurement::CheckTermNames(const std::vector<std::string>& names,
   const std::vector<std::string> all = AllTermNames();
   for (const std::string& name : names)
     if (std::find(all.begin(), all.end(), name) == all.end())
-      throw InputError(source, "'" + name +
-                                   "' is not a term of the point measurement: expected a robot "
-                                   "parameter, instrument_x … instrument_yaw, or " +
+      throw InputError(source, "'" + name + "' is not a term of the " + this->name() +
+                                   " measurement: expected a robot parameter, instrument_x … "
+                                   "instrument_yaw, or " +
                                    TargetTermName(0, static_cast<int>(setup_.targets.size()), "x") +
                                    " … " + all.back());
 }
@@ -189,15 +272,38 @@ void PointMeasurement::StateAt(const double* e, State* s) const {
   s->R_BI = s->R_BI0 * s->Rz * s->Ry * s->Rx;
   s->p_BI = setup_.instrument.translation + Eigen::Vector3d(d[0], d[1], d[2]);
   s->targets = setup_.targets;
-  for (std::size_t t = 0; t < s->targets.size(); ++t)
+  const int targets = static_cast<int>(s->targets.size());
+  for (int t = 0; t < targets; ++t)
     for (int c = 0; c < 3; ++c) {
-      const int column = target_column(static_cast<int>(t), c);
-      if (column >= 0) s->targets[t][c] += e[column];
+      const int column = target_column(t, c);
+      if (column >= 0) s->targets[static_cast<std::size_t>(t)][c] += e[column];
     }
+  if (!orientation_) return;
+  s->R_TM.resize(s->targets.size());
+  s->target_Rx.resize(s->targets.size());
+  s->target_Ry.resize(s->targets.size());
+  for (int t = 0; t < targets; ++t) {
+    double r[3];
+    for (int k = 0; k < 3; ++k) {
+      const int column = target_rotation_column(t, k);
+      r[k] = column >= 0 ? e[column] : 0.0;
+    }
+    const auto u = static_cast<std::size_t>(t);
+    s->target_Rx[u] = Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()).toRotationMatrix();
+    s->target_Ry[u] = Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()).toRotationMatrix();
+    s->R_TM[u] = setup_.TargetOrientation(t) *
+                 Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                 s->target_Ry[u] * s->target_Rx[u];
+  }
 }
 
 std::unique_ptr<MeasurementEvaluator> PointMeasurement::Bind(
     const TargetedConfigurations& configs) const {
+  CheckConfigurations(configs);
+  return std::make_unique<PointEvaluator>(*this, configs, ChartCentres(configs));
+}
+
+void PointMeasurement::CheckConfigurations(const TargetedConfigurations& configs) const {
   if (configs.num_joints() != robot_->num_links())
     throw InputError("configurations", "the robot has " + std::to_string(robot_->num_links()) +
                                            " joints, the configurations " +
@@ -207,7 +313,6 @@ std::unique_ptr<MeasurementEvaluator> PointMeasurement::Bind(
                                            std::to_string(configs.num_targets_referenced()) +
                                            " but the set-up has " +
                                            std::to_string(setup_.targets.size()) + " target(s)");
-  return std::make_unique<PointEvaluator>(*this, configs);
 }
 
 std::vector<std::string> PointMeasurement::MissReasons(const TargetedConfigurations& configs,
@@ -222,6 +327,76 @@ std::unique_ptr<MeasurementKind> PointMeasurement::Without(
   for (const std::string& name : names)
     if (std::find(fixed.begin(), fixed.end(), name) == fixed.end()) fixed.push_back(name);
   return std::make_unique<PointMeasurement>(*robot_, setup_, fixed);
+}
+
+}  // namespace lrcal
+
+namespace lrcal {
+
+Eigen::Vector3d RotationLog(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  Eigen::Matrix3d hat;
+  hat << 0, -phi.z(), phi.y(), phi.z(), 0, -phi.x(), -phi.y(), phi.x(), 0;
+  // The coefficient of [φ]×², 1/θ² − (1 + cos θ)/(2θ sin θ), tends to 1/12 (+ θ²/720).
+  const double c =
+      theta < 1e-4 ? 1.0 / 12.0 + theta * theta / 720.0
+                   : 1.0 / (theta * theta) - (1 + std::cos(theta)) / (2 * theta * std::sin(theta));
+  return Eigen::Matrix3d::Identity() + 0.5 * hat + c * hat * hat;
+}
+
+PoseMeasurement::PoseMeasurement(const RobotModel& robot, PointSetup setup,
+                                 const std::vector<std::string>& fixed, const std::string& source)
+    : PointMeasurement(robot, std::move(setup), fixed, source, true),
+      chart_robot_(&robot),
+      chart_setup_(this->setup()) {}
+
+void PoseMeasurement::UseChartOf(const PoseMeasurement& nominal) {
+  if (nominal.robot().num_links() != robot().num_links() ||
+      nominal.setup().targets.size() != setup().targets.size())
+    throw InputError("pose chart",
+                     "the nominal kind has " + std::to_string(nominal.robot().num_links()) +
+                         " joints and " + std::to_string(nominal.setup().targets.size()) +
+                         " target(s), this one " + std::to_string(robot().num_links()) + " and " +
+                         std::to_string(setup().targets.size()));
+  chart_robot_ = nominal.chart_robot_;
+  chart_setup_ = nominal.chart_setup_;
+}
+
+Eigen::Matrix3d PoseMeasurement::ChartCentre(const double* q, int target) const {
+  const Pose<double> pose =
+      ForwardKinematics<double>(*chart_robot_, chart_robot_->nominal_values().data(), q);
+  return chart_setup_.instrument.rotation.transpose() * pose.R_BT *
+         chart_setup_.TargetOrientation(target);
+}
+
+Eigen::Vector3d PoseMeasurement::OrientationValue(const double* q, int target,
+                                                  const Eigen::Matrix3d& R_IM) const {
+  return RotationLog(ChartCentre(q, target).transpose() * R_IM);
+}
+
+std::vector<Eigen::Matrix3d> PoseMeasurement::ChartCentres(
+    const TargetedConfigurations& configs) const {
+  std::vector<Eigen::Matrix3d> centres(static_cast<std::size_t>(configs.size()));
+  for (int i = 0; i < configs.size(); ++i)
+    centres[static_cast<std::size_t>(i)] = ChartCentre(configs.q(i), configs.target(i));
+  return centres;
+}
+
+std::unique_ptr<MeasurementKind> PoseMeasurement::Without(
+    const std::vector<std::string>& names) const {
+  std::vector<std::string> fixed_terms = fixed();
+  for (const std::string& name : names)
+    if (std::find(fixed_terms.begin(), fixed_terms.end(), name) == fixed_terms.end())
+      fixed_terms.push_back(name);
+  auto kind = std::make_unique<PoseMeasurement>(robot(), setup(), fixed_terms);
+  kind->chart_robot_ = chart_robot_;
+  kind->chart_setup_ = chart_setup_;
+  return kind;
 }
 
 }  // namespace lrcal

@@ -53,8 +53,14 @@ class MeasurementKind {
   virtual ~MeasurementKind() = default;
   /// The kind's name as users write it: "ranger", "point".
   virtual const char* name() const = 0;
-  /// Measured values per configuration: 1 for a distance, 3 for a point.
+  /// Measured values per configuration: 1 for a distance, 3 for a point, 6 for a pose.
   virtual int rows_per_configuration() const = 0;
+  /// True when component `component` (0 ≤ component < rows_per_configuration()) is an angle
+  /// (rad, a pose's orientation) rather than a length (m): its noise is NoiseModel::sigma_angle.
+  virtual bool RowIsAngle(int component) const {
+    (void)component;
+    return false;
+  }
   /// The estimated terms, in the order of e. Units follow the name (DisplayUnitOf in
   /// parameter_set.h: angles in rad, lengths in m).
   virtual const std::vector<std::string>& parameter_names() const = 0;
@@ -95,15 +101,16 @@ struct MeasuredValues {
 /// Simulated measurements: `truth` (the kind built on the true geometry) predicts the exact
 /// values at e = 0; configurations it misses are left out (their reasons in `misses`, if
 /// given, one per configuration). Each component of each reading carries independent noise
-/// N(0, noise.sigma²); a configuration's value is the mean (or noise.average's median or trimmed
-/// mean, each component on its own, with weights R/VarianceFactor(R)) of noise.repetitions
-/// readings. Reading
-/// r of component c of configuration i draws the standard normal at index (i·R + r)·k + c of
-/// `stream` (R repetitions, k rows per configuration), so a configuration's noise does not depend
-/// on the others; with noise.draw_mean the mean's error is drawn directly as σ/√R·z, z at index
-/// i·k + c (the same distribution). The rig disturbances of NoiseModel (encoder noise, plane form,
-/// outliers, ranger errors) are the ranger's (simulation.h): for another kind they are refused
-/// with an InputError rather than ignored. Returns the number of missed configurations.
+/// N(0, noise.sigma²) (N(0, noise.sigma_angle²) for an angle, RowIsAngle, whose values are then
+/// weighed (sigma/sigma_angle)² per reading in data->weights); a configuration's value is the mean
+/// (or noise.average's median or trimmed mean, each component on its own, with weights
+/// R/VarianceFactor(R)) of noise.repetitions readings. Reading r of component c of configuration i
+/// draws the standard normal at index (i·R + r)·k + c of `stream` (R repetitions, k rows per
+/// configuration), so a configuration's noise does not depend on the others; with noise.draw_mean
+/// the mean's error is drawn directly as σ/√R·z, z at index i·k + c (the same distribution). The
+/// rig disturbances of NoiseModel (encoder noise, plane form, outliers, ranger errors) are the
+/// ranger's (simulation.h): for another kind they are refused with an InputError rather than
+/// ignored. Returns the number of missed configurations.
 int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurations& configs,
                          const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
                          std::vector<std::string>* misses = nullptr);

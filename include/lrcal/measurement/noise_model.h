@@ -30,6 +30,10 @@ struct NoiseModel {
   /// median or trimmed mean; not a numeric setting (noise.average, --average, average=). A
   /// median or trimmed mean draws every reading even with draw_mean (its law is not normal).
   Averaging average{};
+  /// rad, standard deviation of one reading of an orientation component (the pose kind's rows
+  /// 3–5, measurement_kind.h RowIsAngle): a 6-D probe's or a camera marker's angular noise. Kept
+  /// last so that aggregate initialisation {sigma, repetitions, draw_mean} keeps its meaning.
+  double sigma_angle = 0.2e-3;
   /// Readings averaged per configuration as the identification weighs them: R for the mean,
   /// R / average.VarianceFactor(R) otherwise (the averaged value's variance is σ²/this).
   double EffectiveReadings() const;
@@ -44,7 +48,8 @@ struct NoiseModel {
   static const std::vector<SettingField<NoiseModel>>& Settings();
   /// Throws SettingError naming the library field (noise.sigma, ...) unless every setting is
   /// in range (a median or trimmed mean of at most Averaging::kMaxRobustReadings readings);
-  /// InputError unless the ranger's offset is finite and |scale| < 0.5.
+  /// InputError unless the ranger's offset is finite, |scale| < 0.5 and sigma_angle is finite and
+  /// ≥ 0.
   void Validate() const;
 };
 

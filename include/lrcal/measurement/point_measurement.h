@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lrcal/kinematics/rigid_transform.h"
@@ -37,11 +38,17 @@ struct PointSetup {
   RigidTransform instrument;
   /// Each target's offset in the tool frame T (m); at least one, at most kMaxTargets.
   std::vector<Eigen::Vector3d> targets{Eigen::Vector3d::Zero()};
+  /// The pose kind only (pose_measurement.h): each target's orientation R_TM in the tool frame
+  /// (a 6-D probe's or a marker's axes); empty: the tool's axes for every target.
+  std::vector<Eigen::Matrix3d> target_orientations{};
   static constexpr int kMaxTargets = 16;
   /// Throws InputError naming the library field (point.instrument, point.targets,
-  /// point.targets[k]) unless the instrument's rotation is a rotation and its position finite,
-  /// every offset is finite and there are 1 to kMaxTargets targets.
+  /// point.targets[k], point.target_orientations[k]) unless the instrument's rotation is a
+  /// rotation and its position finite, every offset is finite, there are 1 to kMaxTargets
+  /// targets and target_orientations is empty or holds one rotation per target.
   void Validate() const;
+  /// Target k's orientation in T: target_orientations[k], or the identity when empty.
+  Eigen::Matrix3d TargetOrientation(int k) const;
 };
 
 class PointMeasurement : public MeasurementKind {
@@ -50,7 +57,8 @@ class PointMeasurement : public MeasurementKind {
   /// target's three, except the names in `fixed` (held at nominal). Throws InputError (where =
   /// `source`) for a name that is not a term of this kind. `robot` must outlive this kind.
   PointMeasurement(const RobotModel& robot, PointSetup setup,
-                   const std::vector<std::string>& fixed = {}, const std::string& source = "fix");
+                   const std::vector<std::string>& fixed = {}, const std::string& source = "fix")
+      : PointMeasurement(robot, std::move(setup), fixed, source, false) {}
 
   const RobotModel& robot() const { return *robot_; }
   const PointSetup& setup() const { return setup_; }
@@ -58,8 +66,12 @@ class PointMeasurement : public MeasurementKind {
   /// The names of every term of this kind, estimated or not, in layout order.
   std::vector<std::string> AllTermNames() const;
 
-  const char* name() const override { return "point"; }
-  int rows_per_configuration() const override { return 3; }
+  /// True for the pose kind: three orientation rows follow each configuration's position.
+  bool measures_orientation() const { return orientation_; }
+
+  const char* name() const override { return orientation_ ? "pose" : "point"; }
+  int rows_per_configuration() const override { return orientation_ ? 6 : 3; }
+  bool RowIsAngle(int component) const override { return orientation_ && component >= 3; }
   const std::vector<std::string>& parameter_names() const override { return names_; }
   /// Link values, the instrument's nominal position (x, y, z) with 0 for its rotation terms, and
   /// each target's nominal offset.
@@ -69,12 +81,15 @@ class PointMeasurement : public MeasurementKind {
                                        const double* e) const override;
   std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const override;
 
-  /// The geometry at estimate e: link values (5N), the instrument's pose and the targets.
+  /// The geometry at estimate e: link values (5N), the instrument's pose and the targets (with
+  /// the pose kind, each target's orientation R_TM = R_TM0·Rz(yaw)·Ry(pitch)·Rx(roll), its
+  /// elementary rotations kept for the Jacobian).
   struct State {
     Eigen::VectorXd link_values;
     Eigen::Matrix3d R_BI, Rz, Ry, Rx, R_BI0;
     Eigen::Vector3d p_BI;
     std::vector<Eigen::Vector3d> targets;
+    std::vector<Eigen::Matrix3d> R_TM, target_Ry, target_Rx;
   };
   void StateAt(const double* e, State* state) const;
   /// Where the terms are in e (-1 when fixed): link value index → column, the instrument's six
@@ -82,6 +97,23 @@ class PointMeasurement : public MeasurementKind {
   const std::vector<int>& robot_values() const { return robot_values_; }
   int instrument_column(int k) const { return instrument_columns_[k]; }
   int target_column(int target, int axis) const { return target_columns_[3 * target + axis]; }
+  /// The pose kind's target orientation terms (roll, pitch, yaw: k = 0, 1, 2); -1 when fixed or
+  /// for the point kind.
+  int target_rotation_column(int target, int k) const {
+    return orientation_ ? rotation_columns_[3 * target + k] : -1;
+  }
+
+ protected:
+  PointMeasurement(const RobotModel& robot, PointSetup setup, const std::vector<std::string>& fixed,
+                   const std::string& source, bool orientation);
+  /// Throws InputError unless `configs` have the robot's joints and name only set-up targets.
+  void CheckConfigurations(const TargetedConfigurations& configs) const;
+  /// Per configuration, the rotation the orientation rows are measured from (the pose kind's
+  /// chart centres, pose_measurement.h); none for the point kind.
+  virtual std::vector<Eigen::Matrix3d> ChartCentres(const TargetedConfigurations& configs) const {
+    (void)configs;
+    return {};
+  }
 
  private:
   // Throws InputError (where = `source`) naming the first of `names` that is not a term.
@@ -92,7 +124,8 @@ class PointMeasurement : public MeasurementKind {
   std::vector<std::string> fixed_, names_;
   std::vector<int> robot_values_;
   int instrument_columns_[6] = {-1, -1, -1, -1, -1, -1};
-  std::vector<int> target_columns_;
+  std::vector<int> target_columns_, rotation_columns_;
+  bool orientation_ = false;
 };
 
 /// The name of target `k`'s term `axis` ("x", "y" or "z") among `num_targets`: "target_x" with
