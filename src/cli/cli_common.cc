@@ -85,6 +85,95 @@ Setup ResolveSetup(const po::variables_map& vm) {
   return setup;
 }
 
+void AddSensorOptions(po::options_description& o) {
+  o.add_options()("sensor", po::value<std::string>()->default_value("ranger"),
+                  "the measurement: ranger (a distance to a plane), point (a tracker's reflector "
+                  "in the instrument's frame) or pose (a 6-D probe: position and orientation)")(
+      "instrument", po::value<std::string>()->default_value("0,0,0,0,0,0"),
+      "point and pose: the instrument's frame in the base frame as x,y,z,roll,pitch,yaw (m, "
+      "rad; URDF's origin convention); its six terms are estimated unless fixed")(
+      "target", po::value<std::vector<std::string>>()->composing(),
+      "point and pose: a target's offset in the tool frame as x,y,z (m), for pose optionally "
+      "x,y,z,roll,pitch,yaw (rad); repeat for several (a CSV's target column numbers them from "
+      "1); default: one target at the tool frame's origin");
+}
+
+std::string ResolveSensor(const po::variables_map& vm) {
+  const std::string sensor = vm["sensor"].as<std::string>();
+  if (sensor == "ranger" || sensor == "point" || sensor == "pose") return sensor;
+  throw InputError(
+      "--sensor",
+      "'" + CellExcerpt(sensor) + "' is not a sensor lrcal models: expected ranger, point or pose");
+}
+
+namespace {
+
+// "x,y,z" or "x,y,z,roll,pitch,yaw" (m, rad) as a transform; `sizes` says which counts are allowed.
+RigidTransform ParseXyzRpy(const std::string& text, const std::string& option, bool allow_three) {
+  const std::vector<std::string> parts = SplitList(text);
+  const char* expected =
+      allow_three ? "x,y,z (m) or x,y,z,roll,pitch,yaw (m, rad)" : "x,y,z,roll,pitch,yaw (m, rad)";
+  if (parts.size() != 6 && !(allow_three && parts.size() == 3))
+    throw InputError(option,
+                     "expected " + std::string(expected) + "; got '" + CellExcerpt(text) + "'");
+  double v[6] = {0, 0, 0, 0, 0, 0};
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (!ParseAngleExpression(parts[k], &v[k]))
+      throw InputError(
+          option, "'" + CellExcerpt(parts[k]) + "' is not a number (expected " + expected + ")");
+  return RigidTransform::FromXyzRpy(Eigen::Vector3d(v[0], v[1], v[2]),
+                                    Eigen::Vector3d(v[3], v[4], v[5]));
+}
+
+}  // namespace
+
+PointSetup ResolvePointSetup(const po::variables_map& vm) {
+  PointSetup setup;
+  setup.instrument = ParseXyzRpy(vm["instrument"].as<std::string>(), "--instrument", false);
+  if (!vm.count("target")) return setup;
+  const auto& texts = vm["target"].as<std::vector<std::string>>();
+  setup.targets.clear();
+  for (std::size_t k = 0; k < texts.size(); ++k) {
+    const RigidTransform t = ParseXyzRpy(
+        texts[k], texts.size() == 1 ? "--target" : "--target (" + std::to_string(k + 1) + ")",
+        true);
+    setup.targets.push_back(t.translation);
+    setup.target_orientations.push_back(t.rotation);
+  }
+  if (static_cast<int>(texts.size()) > PointSetup::kMaxTargets)
+    throw InputError("--target", "expected at most " + std::to_string(PointSetup::kMaxTargets) +
+                                     " targets, got " + std::to_string(texts.size()));
+  return setup;
+}
+
+std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
+                                                  const std::string& sensor,
+                                                  const po::variables_map& vm) {
+  std::vector<std::string> fixed;
+  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  PointSetup setup = ResolvePointSetup(vm);
+  if (sensor == "pose") return std::make_unique<PoseMeasurement>(robot, setup, fixed, "--fix");
+  for (std::size_t k = 0; k < setup.target_orientations.size(); ++k)
+    if (!setup.target_orientations[k].isIdentity(0))
+      throw InputError(
+          setup.targets.size() == 1 ? "--target" : "--target (" + std::to_string(k + 1) + ")",
+          "an orientation is given but --sensor point reads positions only: give "
+          "x,y,z, or use --sensor pose");
+  setup.target_orientations.clear();
+  return std::make_unique<PointMeasurement>(robot, setup, fixed, "--fix");
+}
+
+void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
+                         const std::vector<std::string>& options) {
+  for (const std::string& option : options)
+    if (vm.count(option) && !vm[option].defaulted())
+      throw InputError(
+          "--" + option,
+          "is the ranger's; --sensor " + sensor +
+              " estimates the instrument's frame and the targets instead (--instrument, "
+              "--target, --fix)");
+}
+
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
                                  int num_planes) {
   PlaneTerms terms;

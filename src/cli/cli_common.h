@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -20,6 +21,7 @@
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/pose_measurement.h"
 
 namespace lrcal::cli {
 
@@ -64,6 +66,22 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
                                  int num_planes = 1);
 /// --estimate-base and --estimate-tool (parameter_set.h FrameTerms), read by ResolveParameterSet.
 void AddFrameTermOptions(po::options_description& o);
+
+/// --sensor (ranger, point, pose), --instrument and --target: which measurement a command reads
+/// or makes and, for a tracker's point or pose, the nominal geometry (point_measurement.h).
+void AddSensorOptions(po::options_description& o);
+/// The --sensor value, checked (InputError naming --sensor and the kinds available).
+std::string ResolveSensor(const po::variables_map& vm);
+/// The tracker's nominal geometry from --instrument and --target (InputError naming the option).
+PointSetup ResolvePointSetup(const po::variables_map& vm);
+/// The point or pose kind (`sensor`) on `robot` with --instrument, --target and --fix.
+std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
+                                                  const std::string& sensor,
+                                                  const po::variables_map& vm);
+/// Throws InputError naming the first of `options` given on the command line (not defaulted):
+/// they are the ranger's and mean nothing to `sensor`.
+void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
+                         const std::vector<std::string>& options);
 
 /// --seed: a non-negative integer.
 std::uint64_t ParseSeed(const po::variables_map& vm);

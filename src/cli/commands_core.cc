@@ -368,6 +368,33 @@ std::optional<PriorInformation> PriorInformationAt(const po::variables_map& vm,
   return InformationFromPriors(RangerMeasurement(model), configs, noise, priors);
 }
 
+// identifiability --sensor point|pose: the tracker's terms at the configurations (a `target`
+// column says which target each row sees).
+int TrackerIdentifiability(const po::variables_map& vm, const std::string& sensor) {
+  RefuseRangerOptions(vm, sensor,
+                      {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
+                       "estimate-tool", "prior-sigma", "prior"});
+  const RobotFile rig = LoadRobot(vm);
+  const std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
+  const TargetedConfigurations configs = ReadRobotTargetConfigurations(
+      vm["configs"].as<std::string>(), rig.robot, static_cast<int>(kind->setup().targets.size()));
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  const IdentifiabilityReport r = AnalyzeIdentifiability(*kind, configs, nullptr, options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentifiabilityJson(r);
+    j["sensor"] = sensor;
+    j["values_per_configuration"] = kind->rows_per_configuration();
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: " << sensor << " ("
+              << (sensor == "pose" ? "x, y, z in m and an orientation in rad" : "x, y, z in m")
+              << " per configuration, in the instrument's frame)\n"
+              << r.ToString();
+  }
+  return 0;
+}
+
 }  // namespace
 
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
@@ -386,10 +413,13 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "prior", po::bool_switch(),
       "the same with the robot file's tolerances: (--prior-sigma entries replace the same keys)");
   AddFrameTermOptions(o);
+  AddSensorOptions(o);
   AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
   AddSettingOptions(o, IdentifiabilityOptions::Settings(), {"rank_tolerance"});
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
+  const std::string sensor = ResolveSensor(vm);
+  if (sensor != "ranger") return TrackerIdentifiability(vm, sensor);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;

@@ -230,6 +230,40 @@ std::vector<int> PlaneColumn(const CsvTable& t, const PlaneSet* planes) {
 
 }  // namespace
 
+TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num_joints,
+                                                int num_targets) {
+  CsvTable t = ReadCsv(path);
+  std::vector<int> cols = JointColumns(t, num_joints);
+  if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
+  const int tc = t.Column("target");
+  if (tc < 0 && num_targets > 1)
+    throw InputError(Location(path, 1) + " column 'target'",
+                     "missing: " + std::to_string(num_targets) +
+                         " targets are given, so each row must say which one is measured (1 to " +
+                         std::to_string(num_targets) + ")");
+  TargetedConfigurations out(num_joints);
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    int target = 0;
+    if (tc >= 0) {
+      const std::string& ref = t.rows[r][tc];
+      std::size_t used = 0;
+      int k = 0;
+      try {
+        k = std::stoi(ref, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != ref.size() || ref.empty() || k < 1 || k > num_targets)
+        throw InputError(Location(path, t.lines[r]) + " column 'target'",
+                         "'" + CellExcerpt(ref) + "' is not a target: expected 1 to " +
+                             std::to_string(num_targets) + " (the targets given, in order)");
+      target = k - 1;
+    }
+    out.Add(JointValues(t, r, cols), target);
+  }
+  return out;
+}
+
 TargetedConfigurations ReadConfigurations(const std::string& path, int num_joints,
                                           const PlaneSet* planes) {
   CsvTable t = ReadCsv(path);

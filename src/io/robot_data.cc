@@ -30,6 +30,13 @@ TargetedConfigurations ReadRobotConfigurations(const std::string& path, const Ro
   return configs;
 }
 
+TargetedConfigurations ReadRobotTargetConfigurations(const std::string& path,
+                                                     const RobotModel& robot, int num_targets) {
+  TargetedConfigurations configs = ReadTargetConfigurations(path, robot.num_links(), num_targets);
+  CheckJointRanges(configs, robot, path);
+  return configs;
+}
+
 ConfigurationSet ReadRobotPoses(const std::string& path, const RobotModel& robot) {
   ConfigurationSet poses = ReadPoses(path, robot.num_links());
   CheckJointRanges(poses, robot, path);

@@ -48,6 +48,11 @@ CsvTable ReadCsv(const std::string& path);
 /// and no column is an error too: a file is never read against the wrong planes silently.
 TargetedConfigurations ReadConfigurations(const std::string& path, int num_joints,
                                           const PlaneSet* planes = nullptr);
+/// Configurations q1..qN of a tracker's measurement (point_measurement.h) with an optional
+/// `target` column: which of the `num_targets` targets (1-based) each row's instrument sees.
+/// Several targets and no column is an error, as for planes.
+TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num_joints,
+                                                int num_targets);
 /// Arm configurations only (validation poses, which need no reading): a `plane` column, if
 /// any, is not read.
 ConfigurationSet ReadPoses(const std::string& path, int num_joints);

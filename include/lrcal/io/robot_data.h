@@ -22,6 +22,11 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
 TargetedConfigurations ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
                                                const PlaneSet* planes = nullptr);
 
+/// A tracker's configurations CSV for `robot` (ReadTargetConfigurations: an optional `target`
+/// column, 1 to `num_targets`), joint ranges checked.
+TargetedConfigurations ReadRobotTargetConfigurations(const std::string& path,
+                                                     const RobotModel& robot, int num_targets);
+
 /// Poses for `robot` (where to state an accuracy: no beam, so a `plane` column, if any, is not
 /// read), joint ranges checked.
 ConfigurationSet ReadRobotPoses(const std::string& path, const RobotModel& robot);
