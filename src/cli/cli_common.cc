@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -167,11 +168,35 @@ void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
                          const std::vector<std::string>& options) {
   for (const std::string& option : options)
     if (vm.count(option) && !vm[option].defaulted())
-      throw InputError(
-          "--" + option,
-          "is the ranger's; --sensor " + sensor +
-              " estimates the instrument's frame and the targets instead (--instrument, "
-              "--target, --fix)");
+      throw InputError("--" + option, "is the ranger's; --sensor " + sensor +
+                                          " does not take it (its own terms are the instrument's "
+                                          "frame and the targets: --instrument, --target, --fix)");
+}
+
+void AddOrientationNoiseOption(po::options_description& o) {
+  o.add_options()("sigma-mrad", po::value<double>()->default_value(0.2),
+                  "--sensor pose: standard deviation of one reading of an orientation component "
+                  "(mrad); its rows weigh (sigma-mm/sigma-mrad)^2 against the positions'");
+}
+
+double ResolveSigmaAngle(const po::variables_map& vm, bool allow_zero) {
+  const double sigma = vm["sigma-mrad"].as<double>();
+  if (!(sigma > 0 || (allow_zero && sigma == 0)) || !std::isfinite(sigma))
+    throw InputError("--sigma-mrad",
+                     std::string("expected a finite standard deviation ") +
+                         (allow_zero ? ">= 0" : "> 0 (it weighs the orientations)") +
+                         " (mrad), got " + FormatExact(sigma));
+  return sigma * 1e-3;
+}
+
+std::unique_ptr<PointMeasurement> MakeTrueTrackerKind(const RobotModel& true_robot,
+                                                      const PointMeasurement& nominal) {
+  if (const auto* pose = dynamic_cast<const PoseMeasurement*>(&nominal)) {
+    auto truth = std::make_unique<PoseMeasurement>(true_robot, nominal.setup(), nominal.fixed());
+    truth->UseChartOf(*pose);
+    return truth;
+  }
+  return std::make_unique<PointMeasurement>(true_robot, nominal.setup(), nominal.fixed());
 }
 
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,

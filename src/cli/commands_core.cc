@@ -18,9 +18,11 @@
 #include "lrcal/io/csv.h"
 #include "lrcal/io/kinematics_report.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
+#include "lrcal/measurement/truth.h"
 #include "lrcal/paper/paper_case.h"
 #include "lrcal/report/calibration_report.h"
 
@@ -137,16 +139,51 @@ int SampleCommand(const std::vector<std::string>& args) {
   return 0;
 }
 
+namespace {
+
+// simulate --sensor point|pose: the tracker's values of the true arm (the robot file's
+// true_errors; the instrument and targets as given), each the mean of --repetitions readings.
+int TrackerSimulate(const po::variables_map& vm, const std::string& sensor) {
+  RefuseRangerOptions(
+      vm, sensor,
+      {"plane", "encoder-sigma-mrad", "form-sigma-mm", "outlier-fraction", "outlier-sigma-mm"});
+  const RobotFile rig = LoadRobot(vm);
+  const std::unique_ptr<PointMeasurement> nominal = MakeTrackerKind(rig.robot, sensor, vm);
+  const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
+  const std::unique_ptr<PointMeasurement> truth = MakeTrueTrackerKind(true_robot, *nominal);
+  const TargetedConfigurations configs =
+      ReadRobotTargetConfigurations(vm["configs"].as<std::string>(), rig.robot,
+                                    static_cast<int>(nominal->setup().targets.size()));
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  noise.sigma_angle = ResolveSigmaAngle(vm, true);
+  MeasuredValues data;
+  SimulateMeasurements(*truth, configs, noise,
+                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data);
+  const std::string path = vm["out"].as<std::string>();
+  WriteTrackerMeasurements(path, *nominal, data);
+  std::cerr << "lrcal simulate: " << data.size() << " " << sensor
+            << " measurements (each the mean of " << noise.repetitions << " readings) written to "
+            << path << "\n";
+  return 0;
+}
+
+}  // namespace
+
 int SimulateCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal simulate options");
   AddCommonOptions(o);
   o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
       "seed", po::value<long long>()->default_value(1), "random seed")(
       "out", po::value<std::string>()->required(), "measurement CSV to write");
+  AddSensorOptions(o);
   AddSettingOptions(o, NoiseModel::Settings());
+  AddOrientationNoiseOption(o);
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
+  const std::string sensor = ResolveSensor(vm);
+  if (sensor != "ranger") return TrackerSimulate(vm, sensor);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
@@ -301,13 +338,71 @@ void AddIdentifyOptions(po::options_description& o) {
   AddFrameTermOptions(o);
 }
 
+namespace {
+
+// identify --sensor point|pose: the tracker's terms from its measurement file (tracker_data.h).
+// A pose's orientation rows weigh (σ/σ_angle)² per reading against its positions.
+int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
+  RefuseRangerOptions(
+      vm, sensor,
+      {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
+       "prior-sigma", "prior", "average", "predict-at", "write-robot", "holdout", "report"});
+  const RobotFile rig = LoadRobot(vm);
+  const std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
+  const std::string file = vm["data"].as<std::string>();
+  MeasuredValues data = ReadTrackerMeasurements(file, *kind);
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
+  if (sensor == "pose") {
+    const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
+    const double ratio = sigma / ResolveSigmaAngle(vm, false);
+    data.weights = data.RowWeights(6);
+    for (std::size_t r = 3; r < data.weights.size(); r += (r % 6 == 5 ? 4 : 1))
+      data.weights[r] *= ratio * ratio;
+  }
+  const IdentificationSummary s = Identify(*kind, data, options);
+  if (s.termination == Termination::kInvalidInput && data.size() * 3 < kind->num_parameters())
+    throw InputError(file, s.message);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentificationJson(s);
+    j["sensor"] = sensor;
+    j["values_per_configuration"] = kind->rows_per_configuration();
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: " << sensor << " (" << data.size() << " measurements of "
+              << kind->setup().targets.size() << " target(s); lengths in m, angles in rad)\n"
+              << s.FullReport();
+  }
+  if (s.termination == Termination::kRankDeficient) {
+    std::string list;
+    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
+    std::cerr << "lrcal identify: the " << sensor
+              << " terms are not identifiable from these configurations; fix the suggested ones "
+                 "(--fix "
+              << list << ") or pass --auto-fix\n";
+    return 3;
+  }
+  if (s.IsSolutionUsable() && !s.fit.consistent) {
+    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm"
+              << (sensor == "pose" ? " and --sigma-mrad" : "") << " (p = " << s.fit.p_value
+              << " < 0.001); see the fit line above\n";
+    return 4;
+  }
+  return s.IsSolutionUsable() ? 0 : 1;
+}
+
+}  // namespace
+
 int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddIdentifyOptions(o);
   AddSettingOptions(o, IdentificationOptions::Settings(),
                     {"loss_scale_mm", "loss_scale_sigma", "sigma_mm"});
+  AddSensorOptions(o);
+  AddOrientationNoiseOption(o);
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
+  const std::string sensor = ResolveSensor(vm);
+  if (sensor != "ranger") return TrackerIdentify(vm, sensor);
   // A calibrated robot file that could not be written is refused before the fit, not after.
   if (vm.count("write-robot"))
     CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");

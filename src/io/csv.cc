@@ -230,18 +230,17 @@ std::vector<int> PlaneColumn(const CsvTable& t, const PlaneSet* planes) {
 
 }  // namespace
 
-TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num_joints,
-                                                int num_targets) {
-  CsvTable t = ReadCsv(path);
+TargetedConfigurations TargetConfigurations(const CsvTable& t, int num_joints, int num_targets) {
   std::vector<int> cols = JointColumns(t, num_joints);
-  if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
+  if (t.rows.empty()) throw InputError(t.path, "no configurations (only a header)");
   const int tc = t.Column("target");
   if (tc < 0 && num_targets > 1)
-    throw InputError(Location(path, 1) + " column 'target'",
+    throw InputError(Location(t.path, 1) + " column 'target'",
                      "missing: " + std::to_string(num_targets) +
                          " targets are given, so each row must say which one is measured (1 to " +
                          std::to_string(num_targets) + ")");
   TargetedConfigurations out(num_joints);
+  out.Reserve(static_cast<int>(t.rows.size()));
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     int target = 0;
     if (tc >= 0) {
@@ -254,7 +253,7 @@ TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num
         used = 0;
       }
       if (used != ref.size() || ref.empty() || k < 1 || k > num_targets)
-        throw InputError(Location(path, t.lines[r]) + " column 'target'",
+        throw InputError(Location(t.path, t.lines[r]) + " column 'target'",
                          "'" + CellExcerpt(ref) + "' is not a target: expected 1 to " +
                              std::to_string(num_targets) + " (the targets given, in order)");
       target = k - 1;
@@ -262,6 +261,11 @@ TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num
     out.Add(JointValues(t, r, cols), target);
   }
   return out;
+}
+
+TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num_joints,
+                                                int num_targets) {
+  return TargetConfigurations(ReadCsv(path), num_joints, num_targets);
 }
 
 TargetedConfigurations ReadConfigurations(const std::string& path, int num_joints,

@@ -1,6 +1,8 @@
 #include "lrcal/measurement/truth.h"
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lrcal/core/error.h"
 
@@ -21,6 +23,16 @@ Eigen::VectorXd Truth::LinkErrors(const RobotModel& robot) const {
 
 Eigen::VectorXd Truth::LinkValues(const RobotModel& robot) const {
   return robot.nominal_values() + LinkErrors(robot);
+}
+
+RobotModel Truth::TrueRobot(const RobotModel& robot) const {
+  const Eigen::VectorXd errors = LinkErrors(robot);
+  std::vector<Link> links = robot.links();
+  for (int index = 0; index < robot.num_values(); ++index)
+    links[index / kValuesPerLink].nominal[index % kValuesPerLink] += errors[index];
+  RobotModel out(robot.name(), std::move(links), robot.source, robot.base(), robot.tool());
+  out.source = robot.source;
+  return out;
 }
 
 }  // namespace lrcal

@@ -699,7 +699,7 @@ const std::vector<BadInputCase>& Cases() {
        {{"c.csv", kConfigs}},
        "identifiability --configs c.csv --sensor point --estimate-plane normal",
        2,
-       {"--estimate-plane: is the ranger's; --sensor point estimates the instrument's frame"}},
+       {"--estimate-plane: is the ranger's; --sensor point does not take it"}},
       {"SensorUnknownTerm",
        {{"c.csv", kConfigs}},
        "identifiability --configs c.csv --sensor pose --fix target_w",

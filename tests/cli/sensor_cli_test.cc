@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -74,6 +75,57 @@ TEST_F(SensorCli, ASecondProbeAddsItsSixTermsWhenTheTargetColumnSaysWhichIsSeen)
   const Json pose = Identifiability("--sensor pose --target 0,0,0.1 --target 0.05,0,0.1,0,0.5,0");
   EXPECT_EQ(pose["n_params"], 25 + 6 + 12);
   EXPECT_EQ(pose["rank"], 36);
+}
+
+// simulate --sensor pose writes the true arm's probe poses (the robot file's true errors);
+// identify --sensor pose --auto-fix reads them back and finds those errors: noise-free to
+// rounding, with noise consistently with the stated σ's (exit 0, not 4).
+TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
+  const std::string tracker = " --instrument 2.5,0.3,0.2,0,0,3";
+  std::string out;
+  ASSERT_EQ(Run("simulate --sensor pose --configs " + Path("c.csv") + tracker +
+                    " --sigma-mm 0 --sigma-mrad 0 --repetitions 1 --out " + Path("exact.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identify --sensor pose --data " + Path("exact.csv") + tracker +
+                    " --auto-fix --format json",
+                &out),
+            0)
+      << out;
+  const Json exact = Json::parse(out.substr(out.find('{')));
+  EXPECT_EQ(exact["sensor"], "pose");
+  const auto at = [&](const std::string& name) {
+    for (const Json& p : exact["parameters"])
+      if (p["name"] == name) return p["delta"].get<double>();
+    ADD_FAILURE() << name << " not estimated";
+    return 0.0;
+  };
+  // The paper's true errors (studies/robots/paper.yaml), SI; d1's 0.73 mm goes to the
+  // instrument's height, β6's −3.36 mrad to the probe's pitch (the dependences of the README).
+  constexpr double kExact = 1e-9;
+  EXPECT_NEAR(at("theta1"), -7.23e-3, kExact);
+  EXPECT_NEAR(at("a2"), 1.94e-3, kExact);
+  EXPECT_NEAR(at("instrument_z"), -0.73e-3, kExact);
+  EXPECT_NEAR(at("target_pitch"), -3.36e-3, kExact);
+
+  ASSERT_EQ(Run("simulate --sensor point --configs " + Path("c.csv") + tracker +
+                    " --sigma-mm 0.05 --repetitions 4 --seed 7 --out " + Path("noisy.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker +
+                    " --auto-fix --sigma-mm 0.05",
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("consistent with the stated noise"));
+  // A ranger-only option is refused by name.
+  EXPECT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + " --write-robot " +
+                    Path("r.yaml"),
+                &out),
+            2);
+  EXPECT_THAT(out, HasSubstr("--write-robot: is the ranger's; --sensor point does not take it"));
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
 #include "test_util.h"
+#include "tracker_fixtures.h"
 
 namespace lrcal {
 namespace {
@@ -27,27 +28,12 @@ namespace tolerance = testing::tolerance;
 constexpr int kMaxTerms = 48;
 using TermJet = ceres::Jet<double, kMaxTerms>;
 
-// A tracker 2 m in front of the arm, turned and tilted, seeing two reflectors on the tool.
-PointSetup TrackerSetup() {
-  PointSetup setup;
-  setup.instrument =
-      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.0, -0.4, 0.3), Eigen::Vector3d(0.1, -0.2, 2.8));
-  setup.targets = {Eigen::Vector3d(0.05, 0.0, 0.10), Eigen::Vector3d(-0.03, 0.04, 0.12)};
-  return setup;
-}
+using testing::AllTrackerTerms;
+using testing::TrackerSetup;
 
-// Random configurations of the paper's arm, each seeing target (i mod targets).
 TargetedConfigurations RandomConfigurations(const RobotModel& robot, int count, int targets,
                                             unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> angle(-2.5, 2.5);
-  TargetedConfigurations configs(robot.num_links());
-  for (int i = 0; i < count; ++i) {
-    std::vector<double> q(robot.num_links());
-    for (double& v : q) v = angle(rng);
-    configs.Add(q, i % targets);
-  }
-  return configs;
+  return testing::RandomTrackerConfigurations(robot.num_links(), count, targets, seed);
 }
 
 // The point in the instrument's frame written out independently of the library: the reference
@@ -79,18 +65,6 @@ Eigen::Matrix<T, 3, 1> ReferencePoint(const PointMeasurement& kind, const std::v
   return R_BI.transpose() * (pose.p_BT + pose.R_BT * offset - p_BI);
 }
 
-// Every term's deviation (AllTermNames order) from the estimate e of `kind`.
-template <typename T>
-std::vector<T> AllTerms(const PointMeasurement& kind, const std::vector<T>& e) {
-  std::vector<T> all(kind.AllTermNames().size(), T(0));
-  const std::vector<std::string> names = kind.AllTermNames();
-  for (int k = 0; k < kind.num_parameters(); ++k) {
-    const auto it = std::find(names.begin(), names.end(), kind.parameter_names()[k]);
-    all[it - names.begin()] = e[k];
-  }
-  return all;
-}
-
 class PointJacobianTest : public ::testing::TestWithParam<std::vector<std::string>> {};
 
 TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
@@ -99,10 +73,7 @@ TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
   const TargetedConfigurations configs = RandomConfigurations(robot, 12, 2, 7);
   const int n = kind.num_parameters(), m = 3 * configs.size();
   ASSERT_LE(n, kMaxTerms);
-  // Away from nominal: rotation terms of 0.05 rad, lengths of 5 mm.
-  std::vector<double> e(n);
-  for (int k = 0; k < n; ++k)
-    e[k] = (k % 2 ? 1 : -1) * (IsAngularName(kind.parameter_names()[k]) ? 0.05 : 0.005);
+  const std::vector<double> e = testing::OffNominalEstimate(kind);
   std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(configs);
   std::vector<double> y(m);
   Eigen::MatrixXd J(m, n);
@@ -110,10 +81,9 @@ TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
 
   std::vector<TermJet> ej(n);
   for (int k = 0; k < n; ++k) ej[k] = TermJet(e[k], k);
-  const std::vector<TermJet> all_jets = AllTerms(kind, ej);
-  Eigen::MatrixXd autodiff(m, n), central(m, n);
+  const std::vector<TermJet> all_jets = AllTrackerTerms(kind, ej);
+  Eigen::MatrixXd autodiff(m, n);
   Eigen::VectorXd reference(m);
-  constexpr double kStep = 1e-6;
   for (int i = 0; i < configs.size(); ++i) {
     const Eigen::Matrix<TermJet, 3, 1> p =
         ReferencePoint(kind, all_jets, configs.q(i), configs.target(i));
@@ -122,15 +92,7 @@ TEST_P(PointJacobianTest, MatchesAutodiffAndCentralDifferences) {
       for (int k = 0; k < n; ++k) autodiff(3 * i + c, k) = p[c].v[k];
     }
   }
-  for (int k = 0; k < n; ++k) {
-    std::vector<double> ep = e, em = e;
-    ep[k] += kStep;
-    em[k] -= kStep;
-    std::vector<double> yp(m), ym(m);
-    evaluator->Predict(ep.data(), yp.data(), nullptr);
-    evaluator->Predict(em.data(), ym.data(), nullptr);
-    for (int r = 0; r < m; ++r) central(r, k) = (yp[r] - ym[r]) / (2 * kStep);
-  }
+  const Eigen::MatrixXd central = testing::CentralDifferences(*evaluator, e);
   EXPECT_THAT(Eigen::Map<Eigen::VectorXd>(y.data(), m), EigenNear(reference, tolerance::kUrdf));
   EXPECT_THAT(J, EigenNear(autodiff, tolerance::kAutodiff));
   EXPECT_THAT(J, EigenNear(central, tolerance::kCentralDifference));
@@ -143,14 +105,6 @@ INSTANTIATE_TEST_SUITE_P(Terms, PointJacobianTest,
                                            std::vector<std::string>{"instrument_x", "instrument_y",
                                                                     "instrument_z", "target1_x"}));
 
-// A robot whose nominal values are `robot`'s true ones (nominal + true errors).
-RobotModel TrueRobot(const RobotModel& robot, const Eigen::VectorXd& errors) {
-  std::vector<Link> links = robot.links();
-  for (int index = 0; index < robot.num_values(); ++index)
-    links[index / kValuesPerLink].nominal[index % kValuesPerLink] += errors[index];
-  return RobotModel("truth", links, "test", robot.base(), robot.tool());
-}
-
 TEST(PointMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
   const PointMeasurement full(robot, TrackerSetup());
@@ -161,39 +115,7 @@ TEST(PointMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
   const std::unique_ptr<MeasurementKind> kind = full.Without(report.suggested_fixed);
   const auto& point_kind = dynamic_cast<const PointMeasurement&>(*kind);
   // Truth: every identifiable term off nominal by 1–3 mm or 1–3 mrad.
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> size(1e-3, 3e-3);
-  Eigen::VectorXd truth(kind->num_parameters()),
-      link_errors = Eigen::VectorXd::Zero(robot.num_values());
-  PointSetup true_setup = TrackerSetup();
-  for (int k = 0; k < kind->num_parameters(); ++k) truth[k] = (k % 2 ? 1 : -1) * size(rng);
-  for (std::size_t k = 0; k < point_kind.robot_values().size(); ++k)
-    link_errors[point_kind.robot_values()[k]] = truth[static_cast<Eigen::Index>(k)];
-  const RobotModel true_robot = TrueRobot(robot, link_errors);
-  // The truth kind: the true robot, instrument and targets, estimating the same terms.
-  PointMeasurement::State state;
-  point_kind.StateAt(truth.data(), &state);
-  true_setup.instrument.rotation = state.R_BI;
-  true_setup.instrument.translation = state.p_BI;
-  true_setup.targets = state.targets;
-  const PointMeasurement true_kind(true_robot, true_setup, point_kind.fixed());
-
-  NoiseModel exact;
-  exact.sigma = 0;
-  exact.repetitions = 1;
-  MeasuredValues data;
-  ASSERT_EQ(SimulateMeasurements(true_kind, configs, exact,
-                                 RandomStream(1, 0, 0, RandomPurpose::kNoise), &data),
-            0);
-  for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
-                      IdentificationOptions::Solver::kCeres}) {
-    IdentificationOptions options;
-    options.solver = solver;
-    const IdentificationSummary s = Identify(*kind, data, options);
-    ASSERT_TRUE(s.IsSolutionUsable()) << s.message;
-    EXPECT_THAT(s.delta, EigenNear(truth, tolerance::kRoundTrip)) << s.solver;
-    EXPECT_LT(s.residual_rms, 1e-12);
-  }
+  testing::ExpectNoiseFreeRoundTrip(point_kind, configs, testing::SomeTruth(*kind, 5));
 }
 
 TEST(PointMeasurement, IdentifiabilityRankMatchesAnIndependentJacobian) {
@@ -209,7 +131,7 @@ TEST(PointMeasurement, IdentifiabilityRankMatchesAnIndependentJacobian) {
     std::vector<double> ep(n, 0.0), em(n, 0.0);
     ep[k] = kStep;
     em[k] = -kStep;
-    const std::vector<double> ap = AllTerms(kind, ep), am = AllTerms(kind, em);
+    const std::vector<double> ap = AllTrackerTerms(kind, ep), am = AllTrackerTerms(kind, em);
     for (int i = 0; i < configs.size(); ++i) {
       const Eigen::Vector3d d = (ReferencePoint(kind, ap, configs.q(i), configs.target(i)) -
                                  ReferencePoint(kind, am, configs.q(i), configs.target(i))) /

@@ -53,6 +53,8 @@ TargetedConfigurations ReadConfigurations(const std::string& path, int num_joint
 /// Several targets and no column is an error, as for planes.
 TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num_joints,
                                                 int num_targets);
+/// The same from a table already read (the tracker's measurement files, tracker_data.h).
+TargetedConfigurations TargetConfigurations(const CsvTable& t, int num_joints, int num_targets);
 /// Arm configurations only (validation poses, which need no reading): a `plane` column, if
 /// any, is not read.
 ConfigurationSet ReadPoses(const std::string& path, int num_joints);
@@ -63,6 +65,10 @@ ConfigurationSet ReadPoses(const std::string& path, int num_joints);
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints,
                                 const RangerSpec* ranger = nullptr,
                                 const PlaneSet* planes = nullptr, const Averaging& average = {});
+
+/// Writes `text` to `path` whole or not at all: a path that cannot be a file is an InputError
+/// (CheckOutputFile), a full or failing disk a StorageError naming the file.
+void WriteOutputFile(const std::string& path, const std::string& text);
 
 /// Refuses (InputError naming `option`) an output path that cannot be a file: empty, a folder,
 /// or in a folder that does not exist.

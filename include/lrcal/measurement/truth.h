@@ -21,6 +21,10 @@ struct Truth {
   Eigen::VectorXd LinkValues(const RobotModel& robot) const;
   /// link_errors, or zeros of `robot`'s length when empty.
   Eigen::VectorXd LinkErrors(const RobotModel& robot) const;
+  /// The true arm as a model: `robot` with LinkValues(robot) as its nominal values (its base,
+  /// tool, joint ranges and parameter marks kept). What a kind built on the true geometry (a
+  /// tracker's truth, point_measurement.h) needs.
+  RobotModel TrueRobot(const RobotModel& robot) const;
 };
 
 }  // namespace lrcal
