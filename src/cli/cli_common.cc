@@ -189,16 +189,6 @@ double ResolveSigmaAngle(const po::variables_map& vm, bool allow_zero) {
   return sigma * 1e-3;
 }
 
-std::unique_ptr<PointMeasurement> MakeTrueTrackerKind(const RobotModel& true_robot,
-                                                      const PointMeasurement& nominal) {
-  if (const auto* pose = dynamic_cast<const PoseMeasurement*>(&nominal)) {
-    auto truth = std::make_unique<PoseMeasurement>(true_robot, nominal.setup(), nominal.fixed());
-    truth->UseChartOf(*pose);
-    return truth;
-  }
-  return std::make_unique<PointMeasurement>(true_robot, nominal.setup(), nominal.fixed());
-}
-
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
                                  int num_planes) {
   PlaneTerms terms;

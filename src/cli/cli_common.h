@@ -83,10 +83,6 @@ void AddOrientationNoiseOption(po::options_description& o);
 /// --sigma-mrad in rad (InputError naming it unless finite and > 0, or ≥ 0 with `allow_zero`:
 /// a simulation may be noise-free, a fit's weights need a σ).
 double ResolveSigmaAngle(const po::variables_map& vm, bool allow_zero);
-/// The tracker's kind on the true arm (the robot file's true_errors: Truth::TrueRobot, which must
-/// outlive it) with `nominal`'s set-up and terms; a pose is written in `nominal`'s chart.
-std::unique_ptr<PointMeasurement> MakeTrueTrackerKind(const RobotModel& true_robot,
-                                                      const PointMeasurement& nominal);
 /// Throws InputError naming the first of `options` given on the command line (not defaulted):
 /// they are the ranger's and mean nothing to `sensor`.
 void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,

@@ -150,7 +150,7 @@ int TrackerSimulate(const po::variables_map& vm, const std::string& sensor) {
   const RobotFile rig = LoadRobot(vm);
   const std::unique_ptr<PointMeasurement> nominal = MakeTrackerKind(rig.robot, sensor, vm);
   const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
-  const std::unique_ptr<PointMeasurement> truth = MakeTrueTrackerKind(true_robot, *nominal);
+  const std::unique_ptr<PointMeasurement> truth = TrackerKindOn(true_robot, *nominal);
   const TargetedConfigurations configs =
       ReadRobotTargetConfigurations(vm["configs"].as<std::string>(), rig.robot,
                                     static_cast<int>(nominal->setup().targets.size()));
@@ -352,13 +352,9 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
   const std::string file = vm["data"].as<std::string>();
   MeasuredValues data = ReadTrackerMeasurements(file, *kind);
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
-  if (sensor == "pose") {
-    const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
-    const double ratio = sigma / ResolveSigmaAngle(vm, false);
-    data.weights = data.RowWeights(6);
-    for (std::size_t r = 3; r < data.weights.size(); r += (r % 6 == 5 ? 4 : 1))
-      data.weights[r] *= ratio * ratio;
-  }
+  if (sensor == "pose")
+    WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
+                   ResolveSigmaAngle(vm, false), &data);
   const IdentificationSummary s = Identify(*kind, data, options);
   if (s.termination == Termination::kInvalidInput && data.size() * 3 < kind->num_parameters())
     throw InputError(file, s.message);

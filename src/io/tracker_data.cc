@@ -91,14 +91,8 @@ void WriteTrackerMeasurements(const std::string& path, const PointMeasurement& k
     const double* y = &data.y[static_cast<std::size_t>(i) * k];
     for (int c = 0; c < 3; ++c) out << FormatExact(y[c]) << ",";
     if (pose) {
-      // The orientation rows back to the target's axes in the instrument's frame: C·exp([φ]×).
-      const Eigen::Vector3d phi(y[3], y[4], y[5]);
-      const double angle = phi.norm();
-      const Eigen::Matrix3d turn = angle > 0
-                                       ? Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix()
-                                       : Eigen::Matrix3d::Identity();
-      const Eigen::Quaterniond q(pose->ChartCentre(data.configs.q(i), data.configs.target(i)) *
-                                 turn);
+      const Eigen::Quaterniond q(pose->OrientationOf(data.configs.q(i), data.configs.target(i),
+                                                     Eigen::Vector3d(y[3], y[4], y[5])));
       for (double v : {q.x(), q.y(), q.z(), q.w()}) out << FormatExact(v) << ",";
     }
     out << data.repetitions[static_cast<std::size_t>(i)] << "\n";

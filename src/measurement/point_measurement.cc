@@ -379,6 +379,14 @@ Eigen::Vector3d PoseMeasurement::OrientationValue(const double* q, int target,
   return RotationLog(ChartCentre(q, target).transpose() * R_IM);
 }
 
+Eigen::Matrix3d PoseMeasurement::OrientationOf(const double* q, int target,
+                                               const Eigen::Vector3d& phi) const {
+  const double angle = phi.norm();
+  const Eigen::Matrix3d turn = angle > 0 ? Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix()
+                                         : Eigen::Matrix3d::Identity();
+  return ChartCentre(q, target) * turn;
+}
+
 std::vector<Eigen::Matrix3d> PoseMeasurement::ChartCentres(
     const TargetedConfigurations& configs) const {
   std::vector<Eigen::Matrix3d> centres(static_cast<std::size_t>(configs.size()));
@@ -397,6 +405,34 @@ std::unique_ptr<MeasurementKind> PoseMeasurement::Without(
   kind->chart_robot_ = chart_robot_;
   kind->chart_setup_ = chart_setup_;
   return kind;
+}
+
+std::unique_ptr<PointMeasurement> TrackerKindOn(const RobotModel& robot,
+                                                const PointMeasurement& like) {
+  if (const auto* pose = dynamic_cast<const PoseMeasurement*>(&like)) {
+    auto kind = std::make_unique<PoseMeasurement>(robot, like.setup(), like.fixed());
+    kind->UseChartOf(*pose);
+    return kind;
+  }
+  return std::make_unique<PointMeasurement>(robot, like.setup(), like.fixed());
+}
+
+void WeighAngleRows(const MeasurementKind& kind, double sigma, double sigma_angle,
+                    MeasuredValues* data) {
+  if (!(sigma > 0) || !std::isfinite(sigma) || !(sigma_angle > 0) || !std::isfinite(sigma_angle))
+    throw InputError("noise",
+                     "orientations are weighed against positions by sigma/sigma_angle: "
+                     "expected both finite and > 0");
+  const int k = kind.rows_per_configuration();
+  bool angles = false;
+  for (int c = 0; c < k; ++c) angles = angles || kind.RowIsAngle(c);
+  if (!angles) return;
+  std::vector<double> weights = data->RowWeights(k);
+  const double ratio = sigma / sigma_angle;
+  for (std::size_t r = 0; r < weights.size(); ++r)
+    if (kind.RowIsAngle(static_cast<int>(r % static_cast<std::size_t>(k))))
+      weights[r] *= ratio * ratio;
+  data->weights = std::move(weights);
 }
 
 }  // namespace lrcal

@@ -12,6 +12,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -43,8 +44,10 @@
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
+#include "lrcal/measurement/truth.h"
 #include "lrcal/paper/paper_case.h"
 #include "lrcal/report/accuracy_plan.h"
 #include "lrcal/report/calibration_report.h"
@@ -687,13 +690,255 @@ IdentificationSummary IdentifyPy(const RobotFile& rig, const Array& q, const Arr
   return s;
 }
 
-IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
-                                        const py::object& plane_arg,
-                                        const std::string& estimate_plane, const py::object& fix,
-                                        double rank_tolerance, const py::object& plane_of,
-                                        const std::string& estimate_ranger,
-                                        const std::string& estimate_base,
-                                        const std::string& estimate_tool) {
+// --- trackers (point_measurement.h, pose_measurement.h) ----------------------------------------
+
+// A transform from (x, y, z) or (x, y, z, roll, pitch, yaw) (m, rad; URDF's rpy order).
+RigidTransform ToXyzRpy(const py::object& value, const std::string& where, bool allow_three) {
+  std::vector<double> v;
+  try {
+    v = value.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    v.clear();
+  }
+  if (v.size() != 6 && !(allow_three && v.size() == 3))
+    throw InputError(where, allow_three ? "expected (x, y, z) in m or (x, y, z, roll, pitch, "
+                                          "yaw) in m and rad"
+                                        : "expected (x, y, z, roll, pitch, yaw) in m and rad");
+  v.resize(6, 0.0);
+  return RigidTransform::FromXyzRpy(Eigen::Vector3d(v[0], v[1], v[2]),
+                                    Eigen::Vector3d(v[3], v[4], v[5]));
+}
+
+// The tracker's kind on `robot`: sensor "point" or "pose", instrument= (6 numbers; None: the base
+// frame), targets= (a list of 3 or 6 numbers each; None: one target at the tool frame's origin)
+// and fix=, as the command line's --sensor, --instrument, --target and --fix.
+std::unique_ptr<PointMeasurement> ToTrackerKind(const RobotModel& robot, const std::string& sensor,
+                                                const py::object& instrument,
+                                                const py::object& targets, const py::object& fix) {
+  if (sensor != "point" && sensor != "pose")
+    throw InputError("sensor",
+                     "'" + CellExcerpt(sensor) + "' is not a tracker: expected 'point' or 'pose'");
+  PointSetup setup;
+  if (!instrument.is_none()) setup.instrument = ToXyzRpy(instrument, "instrument", false);
+  if (!targets.is_none()) {
+    setup.targets.clear();
+    int k = 0;
+    for (const py::handle target : targets) {
+      const RigidTransform t = ToXyzRpy(py::reinterpret_borrow<py::object>(target),
+                                        "targets[" + std::to_string(k++) + "]", true);
+      setup.targets.push_back(t.translation);
+      setup.target_orientations.push_back(t.rotation);
+      if (sensor == "point" && !t.rotation.isIdentity(0))
+        throw InputError("targets[" + std::to_string(k - 1) + "]",
+                         "an orientation is given but sensor='point' reads positions only");
+    }
+    if (sensor == "point") setup.target_orientations.clear();
+  }
+  if (sensor == "pose") return std::make_unique<PoseMeasurement>(robot, setup, ToNames(fix), "fix");
+  return std::make_unique<PointMeasurement>(robot, setup, ToNames(fix), "fix");
+}
+
+// q (N, joints) with the target each row sees: target_of (N numbers from 1; None: target 1, which
+// needs a single target), joint ranges checked.
+TargetedConfigurations ToTrackerConfigurations(const RobotModel& robot, const Array& q,
+                                               const py::object& target_of, int num_targets) {
+  const ConfigurationSet poses = ToConfigurations(q, robot.num_links(), "q");
+  CheckJointRanges(poses, robot, "q");
+  if (target_of.is_none() && num_targets > 1)
+    throw InputError("target_of", std::to_string(num_targets) +
+                                      " targets: give the target each row sees, a number from 1 "
+                                      "to " +
+                                      std::to_string(num_targets) + " per row");
+  std::vector<double> tags(static_cast<std::size_t>(poses.size()), 1.0);
+  if (!target_of.is_none()) tags = ToVector(target_of.cast<Array>(), "target_of");
+  if (static_cast<int>(tags.size()) != poses.size())
+    throw InputError("target_of", "expected one target number per row (" +
+                                      std::to_string(poses.size()) + "), got " +
+                                      std::to_string(tags.size()));
+  TargetedConfigurations configs(robot.num_links());
+  for (int i = 0; i < poses.size(); ++i) {
+    const double t = tags[static_cast<std::size_t>(i)];
+    if (!(t >= 1 && t <= num_targets && t == std::floor(t)))
+      throw InputError("target_of[" + std::to_string(i) + "]",
+                       "expected a target number from 1 to " + std::to_string(num_targets));
+    configs.AddFrom(poses, i, static_cast<int>(t) - 1);
+  }
+  return configs;
+}
+
+// The ranger's arguments mean nothing to a tracker: refused by name unless at their defaults.
+void RefuseRangerArguments(const std::string& sensor,
+                           const std::vector<std::pair<std::string, bool>>& given) {
+  for (const auto& [name, is_given] : given)
+    if (is_given)
+      throw InputError(name, "is the ranger's; sensor='" + sensor + "' does not take it");
+}
+
+// identifiability(sensor='point'|'pose', ...).
+IdentifiabilityReport TrackerIdentifiabilityPy(const RobotFile& rig, const Array& q,
+                                               const std::string& sensor,
+                                               const py::object& instrument,
+                                               const py::object& targets,
+                                               const py::object& target_of, const py::object& fix,
+                                               double rank_tolerance) {
+  const std::unique_ptr<PointMeasurement> kind =
+      ToTrackerKind(rig.robot, sensor, instrument, targets, fix);
+  const TargetedConfigurations configs = ToTrackerConfigurations(
+      rig.robot, q, target_of, static_cast<int>(kind->setup().targets.size()));
+  IdentifiabilityOptions options;
+  options.rank_tolerance = rank_tolerance;
+  options.Validate();
+  py::gil_scoped_release release;
+  return AnalyzeIdentifiability(*kind, configs, nullptr, options);
+}
+
+// The noise of simulate_tracker: σ per position component (mm), per orientation component (mrad).
+struct TrackerNoiseArgs {
+  double sigma_mm, sigma_mrad;
+  long long repetitions, seed;
+};
+
+// simulate_tracker: the true arm's (the robot file's true errors) tracker values at q.
+py::dict SimulateTrackerPy(const RobotFile& rig, const Array& q, const std::string& sensor,
+                           const py::object& instrument, const py::object& targets,
+                           const py::object& target_of, const TrackerNoiseArgs& a) {
+  const std::unique_ptr<PointMeasurement> nominal =
+      ToTrackerKind(rig.robot, sensor, instrument, targets, py::none());
+  const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
+  const std::unique_ptr<PointMeasurement> truth = TrackerKindOn(true_robot, *nominal);
+  const TargetedConfigurations configs = ToTrackerConfigurations(
+      rig.robot, q, target_of, static_cast<int>(nominal->setup().targets.size()));
+  NoiseModel noise;
+  noise.sigma = a.sigma_mm * 1e-3;
+  noise.sigma_angle = a.sigma_mrad * 1e-3;
+  if (a.repetitions < 1 || a.repetitions > 1000000)
+    throw InputError("repetitions", "expected 1 to 1,000,000 readings per configuration");
+  noise.repetitions = static_cast<int>(a.repetitions);
+  MeasuredValues data;  // every reading drawn, as lrcal simulate --sensor draws them
+  SimulateMeasurements(*truth, configs, noise,
+                       RandomStream(ToSeed(a.seed), 0, 0, RandomPurpose::kNoise), &data);
+  const int k = nominal->rows_per_configuration();
+  py::array_t<double> xyz({static_cast<py::ssize_t>(data.size()), py::ssize_t{3}});
+  auto w = xyz.mutable_unchecked<2>();
+  for (int i = 0; i < data.size(); ++i)
+    for (int c = 0; c < 3; ++c) w(i, c) = data.y[static_cast<std::size_t>(i * k + c)];
+  py::dict out;
+  out["q"] = ToArray(data.configs);
+  out["target_of"] = PlaneNumbers(data.configs);
+  out["xyz"] = xyz;
+  out["repetitions"] = data.repetitions;
+  if (const auto* pose = dynamic_cast<const PoseMeasurement*>(nominal.get())) {
+    py::array_t<double> quaternion({static_cast<py::ssize_t>(data.size()), py::ssize_t{4}});
+    auto wq = quaternion.mutable_unchecked<2>();
+    for (int i = 0; i < data.size(); ++i) {
+      const double* phi = &data.y[static_cast<std::size_t>(i * k + 3)];
+      const Eigen::Quaterniond qt(pose->OrientationOf(data.configs.q(i), data.configs.target(i),
+                                                      Eigen::Vector3d(phi[0], phi[1], phi[2])));
+      wq(i, 0) = qt.x();
+      wq(i, 1) = qt.y();
+      wq(i, 2) = qt.z();
+      wq(i, 3) = qt.w();
+    }
+    out["quaternion"] = quaternion;
+  }
+  return out;
+}
+
+// identify_tracker's arguments besides the robot, q, xyz and the sensor.
+struct TrackerFitArgs {
+  py::object quaternion, instrument, targets, target_of, repetitions, fix;
+  bool auto_fix;
+  double sigma_mm, sigma_mrad;
+  std::string solver;
+};
+
+// An (N, columns) array's values, row by row (InputError naming `name` for another shape).
+std::vector<double> ToRows(const Array& a, int columns, int rows, const char* name) {
+  if (a.ndim() != 2 || a.shape(0) != rows || a.shape(1) != columns)
+    throw InputError(name, "expected an array of shape (" + std::to_string(rows) + ", " +
+                               std::to_string(columns) + "), one row per row of q");
+  return std::vector<double>(a.data(), a.data() + a.size());
+}
+
+// The measured values of identify_tracker: xyz (N, 3) m, a pose's quaternion (N, 4) as (qx, qy,
+// qz, qw), repetitions (N, optional).
+MeasuredValues ToTrackerValues(const PointMeasurement& kind, TargetedConfigurations configs,
+                               const Array& xyz, const TrackerFitArgs& a) {
+  const auto* pose = dynamic_cast<const PoseMeasurement*>(&kind);
+  const std::vector<double> p = ToRows(xyz, 3, configs.size(), "xyz");
+  if (!pose && !a.quaternion.is_none())
+    throw InputError("quaternion", "is the pose's; sensor='point' reads positions only");
+  if (pose && a.quaternion.is_none())
+    throw InputError("quaternion", "sensor='pose' needs (N, 4) orientations (qx, qy, qz, qw)");
+  const std::vector<double> quat =
+      pose ? ToRows(a.quaternion.cast<Array>(), 4, configs.size(), "quaternion")
+           : std::vector<double>{};
+  MeasuredValues data{std::move(configs), {}, {}};
+  for (int i = 0; i < data.size(); ++i) {
+    for (int c = 0; c < 3; ++c) data.y.push_back(p[static_cast<std::size_t>(3 * i + c)]);
+    if (!pose) continue;
+    const double* v = &quat[static_cast<std::size_t>(4 * i)];
+    const Eigen::Quaterniond qt(v[3], v[0], v[1], v[2]);
+    if (!(std::fabs(qt.norm() - 1) <= 1e-6))
+      throw InputError(
+          "quaternion[" + std::to_string(i) + "]",
+          "expected a unit quaternion (norm 1 within 1e-6), got norm " + FormatExact(qt.norm()));
+    const Eigen::Vector3d phi = pose->OrientationValue(data.configs.q(i), data.configs.target(i),
+                                                       qt.normalized().toRotationMatrix());
+    for (int c = 0; c < 3; ++c) data.y.push_back(phi[c]);
+  }
+  data.repetitions.assign(static_cast<std::size_t>(data.size()), 1);
+  if (!a.repetitions.is_none()) data.repetitions = a.repetitions.cast<std::vector<int>>();
+  if (static_cast<int>(data.repetitions.size()) != data.size())
+    throw InputError("repetitions", "expected one count per row of q");
+  for (int r : data.repetitions)
+    if (r < 1) throw InputError("repetitions", "expected counts of at least 1");
+  return data;
+}
+
+// identify_tracker: the tracker's terms from its values, as identify --sensor point|pose.
+IdentificationSummary IdentifyTrackerPy(const RobotFile& rig, const Array& q, const Array& xyz,
+                                        const std::string& sensor, const TrackerFitArgs& a) {
+  const std::unique_ptr<PointMeasurement> kind =
+      ToTrackerKind(rig.robot, sensor, a.instrument, a.targets, a.fix);
+  MeasuredValues data =
+      ToTrackerValues(*kind,
+                      ToTrackerConfigurations(rig.robot, q, a.target_of,
+                                              static_cast<int>(kind->setup().targets.size())),
+                      xyz, a);
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, a.solver, "solver", "solver");
+  options.sigma = a.sigma_mm * 1e-3;
+  options.fix_dependent_parameters = a.auto_fix;
+  options.Validate();
+  if (sensor == "pose")
+    WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
+                   a.sigma_mrad * 1e-3, &data);
+  py::gil_scoped_release release;
+  return Identify(*kind, data, options);
+}
+
+IdentifiabilityReport IdentifiabilityPy(
+    const RobotFile& rig, const Array& q, const py::object& plane_arg,
+    const std::string& estimate_plane, const py::object& fix, double rank_tolerance,
+    const py::object& plane_of, const std::string& estimate_ranger,
+    const std::string& estimate_base, const std::string& estimate_tool, const std::string& sensor,
+    const py::object& instrument, const py::object& targets, const py::object& target_of) {
+  if (sensor != "ranger") {
+    RefuseRangerArguments(sensor, {{"plane", !plane_arg.is_none()},
+                                   {"plane_of", !plane_of.is_none()},
+                                   {"estimate_plane", estimate_plane != "none"},
+                                   {"estimate_ranger", estimate_ranger != "none"},
+                                   {"estimate_base", estimate_base != "none"},
+                                   {"estimate_tool", estimate_tool != "none"}});
+    return TrackerIdentifiabilityPy(rig, q, sensor, instrument, targets, target_of, fix,
+                                    rank_tolerance);
+  }
+  if (!instrument.is_none() || !targets.is_none() || !target_of.is_none())
+    throw InputError(!instrument.is_none() ? "instrument"
+                     : !targets.is_none()  ? "targets"
+                                           : "target_of",
+                     "is a tracker's: give sensor='point' or sensor='pose'");
   const ConfigsAndModel set =
       ResolveConfigsAndModel(rig, q, plane_arg, plane_of, estimate_plane,
                              {estimate_ranger, estimate_base, estimate_tool}, fix);
@@ -1330,19 +1575,74 @@ void DefineIdentify(py::module_& m) {
       py::arg("estimate_tool") = "none", kIdentifyDoc);
 }
 
-void DefineCalibration(py::module_& m) {
-  DefineIdentify(m);
+// identifiability(): the ranger's parameter set or, with sensor=, a tracker's terms.
+void DefineIdentifiability(py::module_& m) {
   m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
         py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
         py::arg("fix") = py::none(),
         py::arg("rank_tolerance") =
             FindSetting(IdentifiabilityOptions::Settings(), "rank_tolerance")->Default(),
         py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
-        py::arg("estimate_base") = "none", py::arg("estimate_tool") = "none", R"doc(
+        py::arg("estimate_base") = "none", py::arg("estimate_tool") = "none",
+        py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
+        py::arg("targets") = py::none(), py::arg("target_of") = py::none(), R"doc(
 What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
 estimate_plane, estimate_ranger, estimate_base, estimate_tool, fix as in identify: several
 planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
-`lrcal identifiability`.)doc");
+`lrcal identifiability`. sensor='point' or 'pose' analyses a tracker's terms instead (`lrcal
+identifiability --sensor`): instrument=(x, y, z, roll, pitch, yaw) in the base frame (m, rad;
+None: the base frame), targets=[(x, y, z), ...] in the tool frame ((x, y, z, roll, pitch, yaw)
+for a 6-D probe; None: one at the tool frame's origin), target_of (N numbers from 1) the target
+each row sees, fix= as above.)doc");
+}
+
+// The trackers' simulation and fit (point_measurement.h, pose_measurement.h); their
+// identifiability is identifiability(sensor=).
+void DefineTrackers(py::module_& m) {
+  m.def(
+      "simulate_tracker",
+      [](const RobotFile& rig, const Array& q, const std::string& sensor,
+         const py::object& instrument, const py::object& targets, const py::object& target_of,
+         double sigma_mm, double sigma_mrad, long long repetitions, long long seed) {
+        return SimulateTrackerPy(rig, q, sensor, instrument, targets, target_of,
+                                 {sigma_mm, sigma_mrad, repetitions, seed});
+      },
+      py::arg("robot"), py::arg("q"), py::arg("sensor") = "point",
+      py::arg("instrument") = py::none(), py::arg("targets") = py::none(),
+      py::arg("target_of") = py::none(), py::arg("sigma_mm") = 0.2, py::arg("sigma_mrad") = 0.2,
+      py::arg("repetitions") = 10, py::arg("seed") = 1, R"doc(
+What a tracker sees of the true arm (nominal + the robot file's true errors) at q (N, joints):
+`lrcal simulate --sensor point|pose`. sensor, instrument, targets and target_of as in
+identifiability; each row the mean of `repetitions` readings with noise sigma_mm per position
+component and sigma_mrad per orientation component. Returns a dict: q, target_of (from 1),
+xyz (N, 3) m in the instrument's frame, repetitions, and for a pose quaternion (N, 4) as
+(qx, qy, qz, qw), the target's axes in the instrument's frame.)doc");
+  m.def(
+      "identify_tracker",
+      [](const RobotFile& rig, const Array& q, const Array& xyz, const std::string& sensor,
+         const py::object& quaternion, const py::object& instrument, const py::object& targets,
+         const py::object& target_of, const py::object& repetitions, const py::object& fix,
+         bool auto_fix, double sigma_mm, double sigma_mrad, const std::string& solver) {
+        return IdentifyTrackerPy(rig, q, xyz, sensor,
+                                 {quaternion, instrument, targets, target_of, repetitions, fix,
+                                  auto_fix, sigma_mm, sigma_mrad, solver});
+      },
+      py::arg("robot"), py::arg("q"), py::arg("xyz"), py::arg("sensor") = "point",
+      py::arg("quaternion") = py::none(), py::arg("instrument") = py::none(),
+      py::arg("targets") = py::none(), py::arg("target_of") = py::none(),
+      py::arg("repetitions") = py::none(), py::arg("fix") = py::none(), py::arg("auto_fix") = false,
+      py::arg("sigma_mm") = 0.0, py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm", R"doc(
+The tracker's terms (the arm's link values, the instrument's frame, the targets) from its
+values: `lrcal identify --sensor point|pose`. xyz (N, 3) m and, for sensor='pose', quaternion
+(N, 4) as simulate_tracker returns them; repetitions (N,) each row's weight (default 1);
+sigma_mm (0: unknown, judged from the residuals) and sigma_mrad weigh a pose's orientations
+against its positions. Returns an lrcal.Identification.)doc");
+}
+
+void DefineCalibration(py::module_& m) {
+  DefineIdentifiability(m);
+  DefineTrackers(m);
+  DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,
         py::arg("sigma_mm") = FindSetting(NoiseModel::Settings(), "sigma_mm")->Default(),

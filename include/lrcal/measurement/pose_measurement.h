@@ -50,6 +50,9 @@ class PoseMeasurement : public PointMeasurement {
   /// A measured orientation R_IM (the target's axes in the instrument's frame) as this kind's
   /// three orientation rows at `q`: log(C(q)ᵀ·R_IM) (rad).
   Eigen::Vector3d OrientationValue(const double* q, int target, const Eigen::Matrix3d& R_IM) const;
+  /// The inverse: the orientation R_IM = C(q)·exp([φ]×) whose rows are φ (what a file or an
+  /// array of quaternions holds).
+  Eigen::Matrix3d OrientationOf(const double* q, int target, const Eigen::Vector3d& phi) const;
 
   std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const override;
 
@@ -60,6 +63,18 @@ class PoseMeasurement : public PointMeasurement {
   const RobotModel* chart_robot_;
   PointSetup chart_setup_;
 };
+
+/// The same kind (point or pose), set-up and estimated terms on another arm: a simulation's truth
+/// on the true arm (`robot` must outlive it), a pose written in `like`'s chart (UseChartOf).
+std::unique_ptr<PointMeasurement> TrackerKindOn(const RobotModel& robot,
+                                                const PointMeasurement& like);
+
+/// Weighs `data`'s angle rows (kind.RowIsAngle) against its lengths: each value's weight becomes
+/// its configuration's repetitions times (sigma/sigma_angle)² for an angle, as SimulateMeasurements
+/// weighs them (measured values of a pose read from a file carry only their repetitions). No
+/// change for a kind without angle rows. Throws InputError unless both σ are finite and > 0.
+void WeighAngleRows(const MeasurementKind& kind, double sigma, double sigma_angle,
+                    MeasuredValues* data);
 
 /// The rotation vector φ (rad, |φ| ≤ π) of a rotation R: R = exp([φ]×).
 Eigen::Vector3d RotationLog(const Eigen::Matrix3d& R);

@@ -1,0 +1,89 @@
+"""The tracker kinds from Python (lrcal.identifiability(sensor=), simulate_tracker,
+identify_tracker) against the program's `--sensor point|pose`: the same counts, the same
+simulated values bit for bit, the same fit."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import lrcal
+
+TRACKER = (2.5, 0.3, 0.2, 0.0, 0.0, 3.0)
+TRACKER_ARG = "2.5,0.3,0.2,0,0,3"
+
+
+def test_identifiability_counts_the_slides_and_everetts_terms(paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    assert lrcal.identifiability(paper, q).rank == 25
+    point = lrcal.identifiability(paper, q, sensor="point", instrument=TRACKER)
+    assert (point.rank, len(point.names)) == (27, 34)
+    pose = lrcal.identifiability(paper, q, sensor="pose", instrument=TRACKER)
+    assert (pose.rank, len(pose.names)) == (30, 37)
+    two = lrcal.identifiability(paper, q, sensor="pose", instrument=TRACKER,
+                                targets=[(0, 0, 0.1), (0.05, 0, 0.1, 0, 0.5, 0)],
+                                target_of=[1 + i % 2 for i in range(40)])
+    assert (two.rank, len(two.names)) == (36, 43)
+
+
+def test_simulated_values_match_the_program_bit_for_bit_and_calibrate(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    configs = tmp_path / "c.csv"
+    with open(configs, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)])
+        writer.writerows([[repr(v) for v in row] for row in q])
+    cli("simulate", "--sensor", "pose", "--configs", configs, "--instrument", TRACKER_ARG,
+        "--sigma-mm", "0.05", "--sigma-mrad", "0.1", "--repetitions", "3", "--seed", "9",
+        "--out", tmp_path / "m.csv")
+    sim = lrcal.simulate_tracker(paper, q, sensor="pose", instrument=TRACKER, sigma_mm=0.05,
+                                 sigma_mrad=0.1, repetitions=3, seed=9)
+    with open(tmp_path / "m.csv") as f:
+        rows = list(csv.DictReader(f))
+    xyz = np.array([[float(r[c]) for c in "xyz"] for r in rows])
+    quaternion = np.array([[float(r[c]) for c in ("qx", "qy", "qz", "qw")] for r in rows])
+    np.testing.assert_array_equal(sim["xyz"], xyz)
+    # Written with 17 digits; the sign of a quaternion is free.
+    np.testing.assert_allclose(np.abs(np.sum(sim["quaternion"] * quaternion, axis=1)), 1.0,
+                               atol=1e-12)
+    assert list(sim["repetitions"]) == [3] * 40
+
+    fit = lrcal.identify_tracker(paper, sim["q"], sim["xyz"], sensor="pose",
+                                 quaternion=sim["quaternion"], instrument=TRACKER,
+                                 repetitions=sim["repetitions"], auto_fix=True, sigma_mm=0.05,
+                                 sigma_mrad=0.1)
+    done = cli("identify", "--sensor", "pose", "--data", tmp_path / "m.csv", "--instrument",
+               TRACKER_ARG, "--auto-fix", "--sigma-mm", "0.05", "--sigma-mrad", "0.1",
+               "--format", "json")
+    program = json.loads(done.stdout)
+    assert fit.names == [p["name"] for p in program["parameters"]]
+    np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
+                               rtol=0, atol=1e-12)
+
+
+def test_noise_free_tracker_data_give_the_true_errors(paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    sim = lrcal.simulate_tracker(paper, q, sensor="point", instrument=TRACKER, sigma_mm=0,
+                                 repetitions=1)
+    fit = lrcal.identify_tracker(paper, sim["q"], sim["xyz"], instrument=TRACKER, auto_fix=True)
+    delta = dict(zip(fit.names, fit.delta))
+    assert delta["theta1"] == pytest.approx(-7.23e-3, abs=1e-9)
+    assert delta["a2"] == pytest.approx(1.94e-3, abs=1e-9)
+
+
+def test_bad_tracker_arguments_are_named(paper):
+    q = lrcal.sample_configurations(paper, 5, seed=3)
+    with pytest.raises(lrcal.InputError, match="estimate_plane: is the ranger's"):
+        lrcal.identifiability(paper, q, sensor="point", estimate_plane="normal")
+    with pytest.raises(lrcal.InputError, match="instrument: is a tracker's"):
+        lrcal.identifiability(paper, q, instrument=TRACKER)
+    with pytest.raises(lrcal.InputError, match="'scanner' is not a tracker"):
+        lrcal.simulate_tracker(paper, q, sensor="scanner")
+    sim = lrcal.simulate_tracker(paper, q, sensor="pose", repetitions=1)
+    with pytest.raises(lrcal.InputError, match=r"quaternion\[0\]: expected a unit quaternion"):
+        lrcal.identify_tracker(paper, sim["q"], sim["xyz"], sensor="pose",
+                               quaternion=2 * sim["quaternion"])
+    with pytest.raises(lrcal.InputError, match=r"xyz: expected an array of shape \(5, 3\)"):
+        lrcal.identify_tracker(paper, sim["q"], sim["xyz"][:4])
+    with pytest.raises(lrcal.InputError, match="target_of: 2 targets"):
+        lrcal.identifiability(paper, q, sensor="point", targets=[(0, 0, 0), (0, 0, 0.1)])
