@@ -59,7 +59,10 @@ for s in "${stages[@]}"; do
       # stage's CPU time): one pass of the same code runs under ASan in other tests. The two
       # kill -9 tests (40 s) check the store's durability across processes; the resumes they
       # make are the other MonteCarlo and Mpi tests' code, which run here.
-      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial)|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
+      # The same holds for the Monte-Carlo confirmations of plan-accuracy (one of them,
+      # ConfirmationStopsWhenPreciseEnough, runs here), the calibration report in Chromium and
+      # the averaging efficiency over large counts.
+      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial|CalibrationReportRendersInHeadlessChromium)|PlanAccuracy\.(PlansOnTheTotalAndTheMonteCarloOfAHeldTermConfirmsIt|ChoosesAmongCandidatePlanes|ThePlanDoesNotDependOnWhereItIsWritten|EachPlanHasItsFolderAndAFolderKeepsItsSettings)|Averaging\.LargeCountsApproachTheAsymptoticEfficiency|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
       # OpenMPI's own allocations are not freed at exit: leak checks off for the MPI tests only.
       ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j2 --output-on-failure \
         -E "^Mpi\.|$heavy"

@@ -4,8 +4,10 @@
 #   bash scripts/setup.sh run    # build and run the main job
 #   bash scripts/setup.sh test   # build and run every test (what .ci/run does first)
 #   bash scripts/setup.sh build  # build only
-# LRCAL_WERROR=ON (CI) turns warnings into errors; LRCAL_UNITY_TESTS=ON (CI) compiles the test
-# binaries as unity builds (faster from scratch, slower to rebuild after an edit).
+# LRCAL_WERROR=ON (CI) turns warnings into errors; LRCAL_UNITY=ON (CI) compiles the library and
+# the test binaries as unity builds (faster from scratch, slower to rebuild after an edit; the
+# results have the same bits: no fused multiply-adds, CMakeLists.txt), LRCAL_UNITY_TESTS=ON the
+# test binaries only.
 set -euo pipefail
 action="${1:-run}"
 case "$action" in run|test|build) ;; *) echo "usage: bash scripts/setup.sh run|test|build" >&2; exit 2;; esac
@@ -19,7 +21,7 @@ packages=(g++ cmake make git pkg-config
 bash scripts/install_packages.sh "${packages[@]}"
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLRCAL_WERROR="${LRCAL_WERROR:-OFF}" \
-  -DLRCAL_UNITY_TESTS="${LRCAL_UNITY_TESTS:-OFF}"
+  -DLRCAL_UNITY="${LRCAL_UNITY:-OFF}" -DLRCAL_UNITY_TESTS="${LRCAL_UNITY_TESTS:-${LRCAL_UNITY:-OFF}}"
 cmake --build build -j2
 
 case "$action" in

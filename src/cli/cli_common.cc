@@ -89,10 +89,15 @@ Setup ResolveSetup(const po::variables_map& vm) {
 void AddSensorOptions(po::options_description& o) {
   o.add_options()("sensor", po::value<std::string>()->default_value("ranger"),
                   "the measurement: ranger (a distance to a plane), point (a tracker's reflector "
-                  "in the instrument's frame) or pose (a 6-D probe: position and orientation)")(
-      "instrument", po::value<std::string>()->default_value("0,0,0,0,0,0"),
-      "point and pose: the instrument's frame in the base frame as x,y,z,roll,pitch,yaw (m, "
-      "rad; URDF's origin convention); its six terms are estimated unless fixed")(
+                  "in the instrument's frame) or pose (a 6-D probe: position and orientation)");
+  AddTrackerGeometryOptions(o);
+}
+
+void AddTrackerGeometryOptions(po::options_description& o) {
+  o.add_options()("instrument", po::value<std::string>()->default_value("0,0,0,0,0,0"),
+                  "point and pose: the instrument's frame in the base frame as "
+                  "x,y,z,roll,pitch,yaw (m, rad; URDF's origin convention); its six terms are "
+                  "estimated unless fixed")(
       "target", po::value<std::vector<std::string>>()->composing(),
       "point and pose: a target's offset in the tool frame as x,y,z (m), for pose optionally "
       "x,y,z,roll,pitch,yaw (rad); repeat for several (a CSV's target column numbers them from "

@@ -70,6 +70,8 @@ void AddFrameTermOptions(po::options_description& o);
 /// --sensor (ranger, point, pose), --instrument and --target: which measurement a command reads
 /// or makes and, for a tracker's point or pose, the nominal geometry (point_measurement.h).
 void AddSensorOptions(po::options_description& o);
+/// --instrument and --target alone (what `accuracy --measured` registers).
+void AddTrackerGeometryOptions(po::options_description& o);
 /// The --sensor value, checked (InputError naming --sensor and the kinds available).
 std::string ResolveSensor(const po::variables_map& vm);
 /// The tracker's nominal geometry from --instrument and --target (InputError naming the option).

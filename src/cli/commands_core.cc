@@ -346,7 +346,10 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
   RefuseRangerOptions(
       vm, sensor,
       {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
-       "prior-sigma", "prior", "average", "predict-at", "write-robot", "holdout", "report"});
+       "prior-sigma", "prior", "average", "predict-at", "holdout", "report"});
+  // A calibrated robot file that could not be written is refused before the fit, not after.
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
   const RobotFile rig = LoadRobot(vm);
   const std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
   const std::string file = vm["data"].as<std::string>();
@@ -376,6 +379,12 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
                  "(--fix "
               << list << ") or pass --auto-fix\n";
     return 3;
+  }
+  if (vm.count("write-robot") && s.IsSolutionUsable()) {
+    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
+                                *kind, data, s, options);
+    std::cerr << "lrcal identify: calibrated robot written to "
+              << vm["write-robot"].as<std::string>() << "\n";
   }
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm"

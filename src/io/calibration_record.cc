@@ -9,7 +9,9 @@
 #include "lrcal/build_info.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
+#include "lrcal/core/json.h"
 #include "lrcal/core/settings.h"
+#include "lrcal/measurement/pose_measurement.h"
 
 namespace lrcal {
 
@@ -47,6 +49,104 @@ CalibrationRecord MakeCalibrationRecord(const DataSource& data, const Identifica
   r.held_defaulted = held.defaulted;
   r.estimate_shift = held.estimate_shift;
   return r;
+}
+
+namespace {
+
+// The link terms a tracker's fit held (every link value the robot marks, not in s.names): their σ
+// from the rig's tolerances or the defaults, and S = ∂ê/∂u over all of the fit's terms (its
+// instrument and targets included) at the estimate, as FindUnestimatedTerms does for the ranger.
+UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const PointMeasurement& kind,
+                                  const MeasuredValues& values, const IdentificationSummary& s,
+                                  const IdentificationOptions& options) {
+  const RobotModel& robot = rig.robot;
+  // Every term of the kind, nothing fixed: the columns of the estimated and the held terms.
+  const std::unique_ptr<PointMeasurement> unfixed =
+      dynamic_cast<const PoseMeasurement*>(&kind)
+          ? std::make_unique<PoseMeasurement>(kind.robot(), kind.setup())
+          : std::make_unique<PointMeasurement>(kind.robot(), kind.setup());
+  const PointMeasurement& full = *unfixed;
+  const std::vector<std::string>& names = full.parameter_names();
+  std::vector<int> est, held;
+  UnestimatedTerms out;
+  const DefaultTolerances defaults;
+  for (int c = 0; c < static_cast<int>(names.size()); ++c) {
+    const bool estimated = std::find(s.names.begin(), s.names.end(), names[c]) != s.names.end();
+    if (estimated) {
+      est.push_back(c);
+    } else if (robot.FindValue(names[c]) >= 0) {
+      held.push_back(c);
+      out.names.push_back(names[c]);
+    }
+  }
+  const int k = static_cast<int>(held.size()), n = static_cast<int>(s.names.size());
+  out.sigma.resize(k);
+  for (int c = 0; c < k; ++c) {
+    out.sigma[c] = rig.tolerances.SigmaOf(out.names[c]);
+    if (!(out.sigma[c] > 0)) {
+      out.sigma[c] = defaults.Of(out.names[c]);
+      out.defaulted.push_back(out.names[c]);
+    }
+  }
+  out.estimate_shift = Eigen::MatrixXd::Zero(n, k);
+  if (k == 0) return out;
+  Eigen::VectorXd e_all = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(names.size()));
+  for (int i = 0; i < n; ++i) {
+    const auto it = std::find(names.begin(), names.end(), s.names[i]);
+    e_all[it - names.begin()] = s.delta[i];
+  }
+  const Eigen::MatrixXd G_all = MeasurementJacobian(full, values.configs, e_all.data());
+  const std::vector<double> rows = values.RowWeights(full.rows_per_configuration());
+  const Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(rows.data(), rows.size());
+  // The fit's columns in s.names' order.
+  Eigen::MatrixXd G(G_all.rows(), n), Gu(G_all.rows(), k);
+  for (int i = 0; i < n; ++i) {
+    const auto it = std::find(names.begin(), names.end(), s.names[i]);
+    G.col(i) = G_all.col(it - names.begin());
+  }
+  for (int c = 0; c < k; ++c) Gu.col(c) = G_all.col(held[c]);
+  (void)options;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(G.transpose() * w.asDiagonal() * G);
+  if (ldlt.info() != Eigen::Success)
+    throw std::logic_error("tracker record: the estimated terms' normal matrix is singular");
+  out.estimate_shift = ldlt.solve(G.transpose() * w.asDiagonal() * Gu);
+  return out;
+}
+
+}  // namespace
+
+void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data,
+                                 const RobotFile& rig, const PointMeasurement& kind,
+                                 const MeasuredValues& values, const IdentificationSummary& s,
+                                 const IdentificationOptions& options) {
+  const RobotModel& robot = rig.robot;
+  Eigen::VectorXd link_values = robot.nominal_values();
+  const UnestimatedTerms held = TrackerHeldTerms(rig, kind, values, s, options);
+  const CalibrationRecord all = MakeCalibrationRecord(data, s, options, held);
+  std::vector<Eigen::Index> links;
+  for (std::size_t k = 0; k < s.names.size(); ++k) {
+    const int index = robot.FindValue(s.names[k]);
+    if (index < 0) continue;  // the instrument's and the targets' terms
+    links.push_back(static_cast<Eigen::Index>(k));
+    link_values[index] = s.estimate[static_cast<Eigen::Index>(k)];
+  }
+  CalibrationRecord record = all;
+  record.parameters.clear();
+  record.estimate.resize(static_cast<Eigen::Index>(links.size()));
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    record.parameters.push_back(s.names[static_cast<std::size_t>(links[k])]);
+    record.estimate[static_cast<Eigen::Index>(k)] = all.estimate[links[k]];
+  }
+  if (all.covariance.size() > 0) record.covariance = all.covariance(links, links);
+  if (all.estimate_shift.size() > 0)
+    record.estimate_shift = all.estimate_shift(links, Eigen::placeholders::all);
+  const std::string header =
+      "# A calibrated robot: written by lrcal identify --sensor point|pose --write-robot from " +
+      data.name +
+      ".\n# Nominal values are the estimates (SI: rad, m); the record below says "
+      "from what (the arm's terms; the tracker's frame and targets are the campaign's).\n";
+  WriteFileAtomically(path, header + RobotFileText(rig, link_values, rig.planes,
+                                                   robot.name() + " (calibrated)", &record));
 }
 
 void WriteCalibratedRobot(const std::string& path, const DataSource& data, const RobotFile& rig,

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -121,11 +122,84 @@ TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
       << out;
   EXPECT_THAT(out, HasSubstr("consistent with the stated noise"));
   // A ranger-only option is refused by name.
-  EXPECT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + " --write-robot " +
-                    Path("r.yaml"),
+  EXPECT_EQ(
+      Run("identify --sensor point --data " + Path("noisy.csv") + " --report " + Path("report"),
+          &out),
+      2);
+  EXPECT_THAT(out, HasSubstr("--report: is the ranger's; --sensor point does not take it"));
+}
+
+// identify --sensor point --write-robot writes a robot file every command takes: its link values
+// are the fit's, so tracker points the fit never saw are predicted exactly (noise-free), the
+// tracker's frame registered.
+TEST_F(SensorCli, ATrackerCalibrationIsARobotFileOtherCommandsTake) {
+  const std::string tracker = " --instrument 2.5,0.3,0.2,0,0,3 --target 0.02,0,0.05";
+  std::string out;
+  ASSERT_EQ(Run("simulate --sensor point --configs " + Path("c.csv") + tracker +
+                    " --sigma-mm 0 --repetitions 1 --out " + Path("fit.csv"),
                 &out),
-            2);
-  EXPECT_THAT(out, HasSubstr("--write-robot: is the ranger's; --sensor point does not take it"));
+            0);
+  ASSERT_EQ(Run("identify --sensor point --data " + Path("fit.csv") + tracker +
+                    " --auto-fix --write-robot " + Path("cal.yaml"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("calibrated robot written to"));
+  ASSERT_EQ(Run("sample --validation --count 30 --seed 5 --out " + Path("v.csv"), &out), 0);
+  ASSERT_EQ(Run("simulate --sensor point --configs " + Path("v.csv") + tracker +
+                    " --sigma-mm 0 --repetitions 1 --out " + Path("points.csv"),
+                &out),
+            0);
+  ASSERT_EQ(Run("accuracy --robot " + Path("cal.yaml") + " --format json --measured " +
+                    Path("points.csv") + tracker,
+                &out),
+            0)
+      << out;
+  EXPECT_LT(Json::parse(out)["worst"].get<double>(), 1e-9);
+  // Its record names the arm's terms only, with their covariance: accuracy predicts from it.
+  std::ifstream file(Path("cal.yaml"));
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_THAT(text, HasSubstr("calibration:"));
+  EXPECT_THAT(text, ::testing::Not(HasSubstr("instrument_x")));
+}
+
+// accuracy --measured judges a model with tracker points it was not calibrated on: the nominal
+// model is millimetres off the true arm; a noise-free ranger calibration is exact, even with the
+// tracker's frame given 1 cm and 10 mrad off (it is registered to the points).
+TEST_F(SensorCli, MeasuredPointsJudgeARangerCalibration) {
+  std::string out;
+  ASSERT_EQ(Run("sample --validation --count 30 --seed 5 --out " + Path("v.csv"), &out), 0);
+  ASSERT_EQ(Run("simulate --sensor point --configs " + Path("v.csv") +
+                    " --instrument 2.5,0.3,0.2,0,0,3 --target 0.02,0,0.05 --sigma-mm 0 "
+                    "--repetitions 1 --out " +
+                    Path("points.csv"),
+                &out),
+            0)
+      << out;
+  const std::string measured = " --measured " + Path("points.csv") +
+                               " --instrument 2.51,0.29,0.2,0,0,3.01 --target 0.02,0,0.05";
+  ASSERT_EQ(Run("accuracy --robot paper --format json" + measured, &out), 0) << out;
+  const Json nominal = Json::parse(out);
+  EXPECT_EQ(nominal["points"], 30);
+  EXPECT_GT(nominal["rms"].get<double>(), 1e-3);  // the paper's errors: millimetres at the tool
+  EXPECT_GE(nominal["worst"].get<double>(), nominal["rms"].get<double>());
+
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --sigma-mm 0 --repetitions 1 --out " +
+                    Path("m.csv"),
+                &out),
+            0);
+  ASSERT_EQ(Run("identify --data " + Path("m.csv") + " --write-robot " + Path("cal.yaml"), &out), 0)
+      << out;
+  ASSERT_EQ(Run("accuracy --robot " + Path("cal.yaml") + " --format json" + measured, &out), 0)
+      << out;
+  const Json calibrated = Json::parse(out);
+  EXPECT_LT(calibrated["worst"].get<double>(), 1e-9);
+  // The registered instrument is the one the points were taken with.
+  EXPECT_NEAR(calibrated["instrument"]["xyz"][0].get<double>(), 2.5, 1e-9);
+  EXPECT_NEAR(calibrated["instrument"]["rpy"][2].get<double>(), 3.0, 1e-9);
+
+  ASSERT_EQ(Run("accuracy --robot paper" + measured, &out), 0);
+  EXPECT_THAT(out, HasSubstr("error at the measured points: RMS"));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "lrcal/identification/identification.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/measurement/point_measurement.h"
 
 namespace lrcal {
 
@@ -32,6 +33,19 @@ CalibrationRecord MakeCalibrationRecord(const DataSource& data, const Identifica
 void WriteCalibratedRobot(const std::string& path, const DataSource& data, const RobotFile& rig,
                           const MeasurementModel& model, const IdentificationSummary& s,
                           const IdentificationOptions& options, const UnestimatedTerms& held = {});
+
+/// A tracker's fit (identify --sensor point|pose: its summary `s` of `values` on `kind`) as a
+/// calibrated robot file at `path`: `rig` with the estimated link values as its nominal values,
+/// its planes and ranger limits if it has them, and a record of the link terms alone with their
+/// marginal covariance (the instrument's frame and the targets belong to that campaign's set-up,
+/// not to the arm; they stay in the fit's output). The link terms the fit held at nominal (fixed,
+/// or confounded with the instrument's frame or a target: d1 with the tracker's height) are the
+/// record's held terms, with the rig's tolerances or the defaults and their effect on the estimate,
+/// so that the file's stated total accuracy includes them. Throws StorageError.
+void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data,
+                                 const RobotFile& rig, const PointMeasurement& kind,
+                                 const MeasuredValues& values, const IdentificationSummary& s,
+                                 const IdentificationOptions& options);
 
 /// The parameter set the calibration record `r` names: plane and ranger terms from their names,
 /// robot parameters not named are fixed, in MakeParameterSet's order. `source` names the record in
