@@ -139,7 +139,7 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
   }
   if (all.covariance.size() > 0) record.covariance = all.covariance(links, links);
   if (all.estimate_shift.size() > 0)
-    record.estimate_shift = all.estimate_shift(links, Eigen::placeholders::all);
+    record.estimate_shift = all.estimate_shift(links, Eigen::all);
   const std::string header =
       "# A calibrated robot: written by lrcal identify --sensor point|pose --write-robot from " +
       data.name +
