@@ -138,8 +138,7 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
     record.estimate[static_cast<Eigen::Index>(k)] = all.estimate[links[k]];
   }
   if (all.covariance.size() > 0) record.covariance = all.covariance(links, links);
-  if (all.estimate_shift.size() > 0)
-    record.estimate_shift = all.estimate_shift(links, Eigen::all);
+  if (all.estimate_shift.size() > 0) record.estimate_shift = all.estimate_shift(links, Eigen::all);
   const std::string header =
       "# A calibrated robot: written by lrcal identify --sensor point|pose --write-robot from " +
       data.name +
