@@ -60,9 +60,10 @@ for s in "${stages[@]}"; do
       # kill -9 tests (40 s) check the store's durability across processes; the resumes they
       # make are the other MonteCarlo and Mpi tests' code, which run here.
       # The same holds for the Monte-Carlo confirmations of plan-accuracy (one of them,
-      # ConfirmationStopsWhenPreciseEnough, runs here), the calibration report in Chromium and
-      # the averaging efficiency over large counts.
-      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial|CalibrationReportRendersInHeadlessChromium)|PlanAccuracy\.(PlansOnTheTotalAndTheMonteCarloOfAHeldTermConfirmsIt|ChoosesAmongCandidatePlanes|ThePlanDoesNotDependOnWhereItIsWritten|EachPlanHasItsFolderAndAFolderKeepsItsSettings)|Averaging\.LargeCountsApproachTheAsymptoticEfficiency|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
+      # ConfirmationStopsWhenPreciseEnough, runs here), the calibration report in Chromium, the
+      # averaging efficiency over large counts and a sensitivity study's plan points (the other
+      # sensitivity tests run here).
+      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial|CalibrationReportRendersInHeadlessChromium)|PlanAccuracy\.(PlansOnTheTotalAndTheMonteCarloOfAHeldTermConfirmsIt|ChoosesAmongCandidatePlanes|ThePlanDoesNotDependOnWhereItIsWritten|EachPlanHasItsFolderAndAFolderKeepsItsSettings)|Averaging\.LargeCountsApproachTheAsymptoticEfficiency|SensitivityStudy\.PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
       # OpenMPI's own allocations are not freed at exit: leak checks off for the MPI tests only.
       ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j2 --output-on-failure \
         -E "^Mpi\.|$heavy"
