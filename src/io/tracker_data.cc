@@ -28,6 +28,16 @@ int RequiredColumn(const CsvTable& t, const std::string& name, const std::string
 
 }  // namespace
 
+Eigen::Vector3d QuaternionOrientationValue(const PoseMeasurement& pose,
+                                           const TargetedConfigurations& configs, int i,
+                                           const double* xyzw, const std::string& where) {
+  const Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+  if (!(std::fabs(q.norm() - 1) <= kUnitQuaternionTolerance))
+    throw InputError(where, "expected a unit quaternion (norm 1 within 1e-6), got norm " +
+                                FormatExact(q.norm()));
+  return pose.OrientationValue(configs.q(i), configs.target(i), q.normalized().toRotationMatrix());
+}
+
 MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasurement& kind) {
   const CsvTable t = ReadCsv(path);
   const RobotModel& robot = kind.robot();
@@ -52,14 +62,9 @@ MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasu
     if (pose) {
       double v[4];
       for (int c = 0; c < 4; ++c) v[c] = t.Number(r, quaternion[c]);
-      const Eigen::Quaterniond q(v[3], v[0], v[1], v[2]);
-      if (!(std::fabs(q.norm() - 1) <= kUnitQuaternionTolerance))
-        throw InputError(
-            Location(t.path, t.lines[r]) + " columns qx,qy,qz,qw",
-            "expected a unit quaternion (norm 1 within 1e-6), got norm " + FormatExact(q.norm()));
-      const int i = static_cast<int>(r);
-      const Eigen::Vector3d phi = pose->OrientationValue(data.configs.q(i), data.configs.target(i),
-                                                         q.normalized().toRotationMatrix());
+      const Eigen::Vector3d phi =
+          QuaternionOrientationValue(*pose, data.configs, static_cast<int>(r), v,
+                                     Location(t.path, t.lines[r]) + " columns qx,qy,qz,qw");
       for (int c = 0; c < 3; ++c) data.y.push_back(phi[c]);
     }
     int count = 1;

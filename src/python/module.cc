@@ -40,6 +40,7 @@
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/measurement_set.h"
@@ -877,14 +878,9 @@ MeasuredValues ToTrackerValues(const PointMeasurement& kind, TargetedConfigurati
   for (int i = 0; i < data.size(); ++i) {
     for (int c = 0; c < 3; ++c) data.y.push_back(p[static_cast<std::size_t>(3 * i + c)]);
     if (!pose) continue;
-    const double* v = &quat[static_cast<std::size_t>(4 * i)];
-    const Eigen::Quaterniond qt(v[3], v[0], v[1], v[2]);
-    if (!(std::fabs(qt.norm() - 1) <= 1e-6))
-      throw InputError(
-          "quaternion[" + std::to_string(i) + "]",
-          "expected a unit quaternion (norm 1 within 1e-6), got norm " + FormatExact(qt.norm()));
-    const Eigen::Vector3d phi = pose->OrientationValue(data.configs.q(i), data.configs.target(i),
-                                                       qt.normalized().toRotationMatrix());
+    const Eigen::Vector3d phi =
+        QuaternionOrientationValue(*pose, data.configs, i, &quat[static_cast<std::size_t>(4 * i)],
+                                   "quaternion[" + std::to_string(i) + "]");
     for (int c = 0; c < 3; ++c) data.y.push_back(phi[c]);
   }
   data.repetitions.assign(static_cast<std::size_t>(data.size()), 1);

@@ -9,10 +9,12 @@
 // Each row is one measured value of its configuration; rows are never merged.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 
 #include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/pose_measurement.h"
 
 namespace lrcal {
 
@@ -22,6 +24,14 @@ namespace lrcal {
 /// a cell that is not a finite number, a target out of range, a quaternion whose norm is not 1
 /// within 1e-6, or a `readings` cell that is not a whole number from 1 to 1,000,000.
 MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasurement& kind);
+
+/// A pose's three orientation rows (PoseMeasurement::OrientationValue) at configuration i of
+/// `configs` from its measured unit quaternion `xyzw` (qx, qy, qz, qw). Throws InputError at
+/// `where` unless the quaternion's norm is 1 within 1e-6. What the file reader and Python's
+/// identify_tracker share.
+Eigen::Vector3d QuaternionOrientationValue(const PoseMeasurement& pose,
+                                           const TargetedConfigurations& configs, int i,
+                                           const double* xyzw, const std::string& where);
 
 /// Writes `data` (values of `kind`, as SimulateMeasurements makes them) at full precision, the
 /// `target` column when the kind has several targets, each row's repetitions as `readings`.
