@@ -89,8 +89,13 @@ Setup ResolveSetup(const po::variables_map& vm) {
 void AddSensorOptions(po::options_description& o) {
   o.add_options()("sensor", po::value<std::string>()->default_value("ranger"),
                   "the measurement: ranger (a distance to a plane), point (a tracker's reflector "
-                  "in the instrument's frame) or pose (a 6-D probe: position and orientation)");
+                  "in the instrument's frame), pose (a 6-D probe: position and orientation) or "
+                  "socket (the tool point seated in fixed sockets: a CSV's socket column)");
   AddTrackerGeometryOptions(o);
+  o.add_options()("socket-distance", po::value<std::vector<std::string>>()->composing(),
+                  "socket: a known distance between two sockets as A,B=METRES (socket ids, m; "
+                  "e.g. 0,1=0.05): the length reference that fixes the arm's scale; repeat for "
+                  "several (a tree: each places one more socket)");
 }
 
 void AddTrackerGeometryOptions(po::options_description& o) {
@@ -106,10 +111,15 @@ void AddTrackerGeometryOptions(po::options_description& o) {
 
 std::string ResolveSensor(const po::variables_map& vm) {
   const std::string sensor = vm["sensor"].as<std::string>();
-  if (sensor == "ranger" || sensor == "point" || sensor == "pose") return sensor;
-  throw InputError(
-      "--sensor",
-      "'" + CellExcerpt(sensor) + "' is not a sensor lrcal models: expected ranger, point or pose");
+  if (sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket") {
+    if (sensor != "socket" && vm.count("socket-distance"))
+      throw InputError("--socket-distance",
+                       "is the socket sensor's; --sensor " + sensor + " does not take it");
+    return sensor;
+  }
+  throw InputError("--sensor", "'" + CellExcerpt(sensor) +
+                                   "' is not a sensor lrcal models: expected ranger, point, pose "
+                                   "or socket");
 }
 
 namespace {
@@ -173,9 +183,49 @@ void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
                          const std::vector<std::string>& options) {
   for (const std::string& option : options)
     if (vm.count(option) && !vm[option].defaulted())
-      throw InputError("--" + option, "is the ranger's; --sensor " + sensor +
-                                          " does not take it (its own terms are the instrument's "
-                                          "frame and the targets: --instrument, --target, --fix)");
+      throw InputError(
+          "--" + option,
+          "is the ranger's; --sensor " + sensor + " does not take it (its own terms " +
+              (sensor == "socket" ? "are the tool point and the sockets: --target, "
+                                    "--socket-distance, --fix)"
+                                  : "are the instrument's frame and the targets: --instrument, "
+                                    "--target, --fix)"));
+}
+
+std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) {
+  std::vector<SocketDistance> distances;
+  if (!vm.count("socket-distance")) return distances;
+  for (const std::string& text : vm["socket-distance"].as<std::vector<std::string>>())
+    distances.push_back(SocketDistance::Parse(text, "--socket-distance"));
+  return distances;
+}
+
+std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
+                                                  const po::variables_map& vm) {
+  if (vm.count("instrument") && !vm["instrument"].defaulted())
+    throw InputError("--instrument",
+                     "--sensor socket has no instrument: the sockets are estimated in the base "
+                     "frame");
+  const PointSetup point = ResolvePointSetup(vm);
+  if (point.targets.size() != 1 ||
+      (!point.target_orientations.empty() && !point.target_orientations[0].isIdentity(0)))
+    throw InputError("--target", "--sensor socket takes one tool point as x,y,z (m, tool frame)");
+  std::vector<std::string> fixed;
+  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  SocketSetup setup;
+  setup.ids = data.ids;
+  setup.tool_point = point.targets[0];
+  setup.positions = SocketPositionsFromData(robot, setup.tool_point, data.values.configs,
+                                            static_cast<int>(data.ids.size()));
+  setup.distances = ResolveSocketDistances(vm);
+  for (const SocketDistance& d : setup.distances)
+    for (int id : {d.a, d.b})
+      if (setup.IndexOf(id) < 0)
+        throw InputError("--socket-distance", "socket " + std::to_string(id) +
+                                                  " has no configuration in the data (its "
+                                                  "socket column names " +
+                                                  std::to_string(data.ids.size()) + " socket(s))");
+  return std::make_unique<SocketMeasurement>(robot, setup, fixed, "--fix");
 }
 
 void AddOrientationNoiseOption(po::options_description& o) {

@@ -19,9 +19,11 @@
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/socket_data.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/socket_measurement.h"
 
 namespace lrcal::cli {
 
@@ -79,6 +81,13 @@ PointSetup ResolvePointSetup(const po::variables_map& vm);
 /// The point or pose kind (`sensor`) on `robot` with --instrument, --target and --fix.
 std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
                                                   const std::string& sensor,
+                                                  const po::variables_map& vm);
+/// --socket-distance A,B=METRES (repeatable): the known distances between sockets.
+std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm);
+/// The socket kind on `robot` for `data` (its socket ids; the sockets' nominal positions are the
+/// nominal model's mean tool point per socket) with the tool point from --target (x,y,z, one),
+/// --socket-distance and --fix. Refuses --instrument (InputError naming it).
+std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
                                                   const po::variables_map& vm);
 /// --sigma-mrad: the standard deviation of one reading of a pose's orientation component.
 void AddOrientationNoiseOption(po::options_description& o);

@@ -168,6 +168,56 @@ int TrackerSimulate(const po::variables_map& vm, const std::string& sensor) {
   return 0;
 }
 
+// simulate --sensor socket: the configurations (a CSV with a socket column: where to start)
+// moved until the true arm's tool point sits in its socket (--socket x,y,z per socket id, in
+// order of the ids) plus a play of --sigma-mm per axis.
+int SocketSimulate(const po::variables_map& vm) {
+  RefuseRangerOptions(
+      vm, "socket",
+      {"plane", "encoder-sigma-mrad", "form-sigma-mm", "outlier-fraction", "outlier-sigma-mm"});
+  const RobotFile rig = LoadRobot(vm);
+  const SocketData starts = ReadSocketData(vm["configs"].as<std::string>(), rig.robot);
+  if (!vm.count("socket"))
+    throw InputError("--socket",
+                     "--sensor socket simulates sockets at known true positions: "
+                     "give --socket x,y,z (m, base frame) for each socket id of the "
+                     "configurations, in ascending order of id");
+  const auto& texts = vm["socket"].as<std::vector<std::string>>();
+  if (texts.size() != starts.ids.size())
+    throw InputError("--socket", "the configurations name " + std::to_string(starts.ids.size()) +
+                                     " socket(s); " + std::to_string(texts.size()) +
+                                     " --socket positions given");
+  const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
+  SocketSetup setup;
+  setup.ids = starts.ids;
+  setup.positions.clear();
+  for (const std::string& text : texts) {
+    const std::vector<std::string> parts = SplitList(text);
+    double v[3];
+    if (parts.size() != 3 || !ParseDecimal(parts[0], &v[0]) || !ParseDecimal(parts[1], &v[1]) ||
+        !ParseDecimal(parts[2], &v[2]))
+      throw InputError("--socket", "'" + CellExcerpt(text) + "': expected x,y,z (m)");
+    setup.positions.emplace_back(v[0], v[1], v[2]);
+  }
+  const PointSetup point = ResolvePointSetup(vm);
+  setup.tool_point = point.targets[0];
+  setup.distances = ResolveSocketDistances(vm);
+  const SocketMeasurement truth(true_robot, setup);
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  MeasuredValues data;
+  std::vector<std::string> misses;
+  const int missed = SimulateSocketMeasurements(
+      truth, starts.values.configs, noise, RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise),
+      &data, &misses);
+  const std::string path = vm["out"].as<std::string>();
+  WriteSocketData(path, setup.ids, data);
+  std::cerr << "lrcal simulate: " << data.size() << " socket seatings written to " << path;
+  if (missed > 0) std::cerr << " (" << missed << " start(s) out of reach, left out)";
+  std::cerr << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int SimulateCommand(const std::vector<std::string>& args) {
@@ -179,10 +229,17 @@ int SimulateCommand(const std::vector<std::string>& args) {
   AddSensorOptions(o);
   AddSettingOptions(o, NoiseModel::Settings());
   AddOrientationNoiseOption(o);
+  o.add_options()("socket", po::value<std::vector<std::string>>()->composing(),
+                  "--sensor socket: a socket's true position as x,y,z (m, base frame), one per "
+                  "socket id of the configurations, in ascending order of id");
   po::variables_map vm;
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const std::string sensor = ResolveSensor(vm);
+  if (sensor == "socket") return SocketSimulate(vm);
+  if (vm.count("socket"))
+    throw InputError("--socket",
+                     "is the socket sensor's; --sensor " + sensor + " does not take it");
   if (sensor != "ranger") return TrackerSimulate(vm, sensor);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
@@ -395,6 +452,58 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
   return s.IsSolutionUsable() ? 0 : 1;
 }
 
+// identify --sensor socket: the arm's terms, the tool point and the sockets from socket data
+// (socket_data.h); the sockets' nominal positions are the nominal model's mean tool points.
+int SocketIdentify(const po::variables_map& vm) {
+  RefuseRangerOptions(
+      vm, "socket",
+      {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
+       "prior-sigma", "prior", "average", "predict-at", "holdout", "report"});
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  const RobotFile rig = LoadRobot(vm);
+  const std::string file = vm["data"].as<std::string>();
+  const SocketData data = ReadSocketData(file, rig.robot);
+  const std::unique_ptr<SocketMeasurement> kind = MakeSocketKind(rig.robot, data, vm);
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
+  const IdentificationSummary s = Identify(*kind, data.values, options);
+  if (s.termination == Termination::kInvalidInput &&
+      data.values.size() * 3 < kind->num_parameters())
+    throw InputError(file, s.message);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentificationJson(s);
+    j["sensor"] = "socket";
+    j["values_per_configuration"] = 3;
+    j["sockets"] = data.ids;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: socket (" << data.values.size() << " seatings in " << data.ids.size()
+              << " socket(s); lengths in m, angles in rad)\n"
+              << s.FullReport();
+  }
+  if (s.termination == Termination::kRankDeficient) {
+    std::string list;
+    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
+    std::cerr << "lrcal identify: the socket terms are not identifiable from these "
+                 "configurations; fix the suggested ones (--fix "
+              << list << ") or pass --auto-fix\n";
+    return 3;
+  }
+  if (vm.count("write-robot") && s.IsSolutionUsable()) {
+    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
+                                *kind, data.values, s, options);
+    std::cerr << "lrcal identify: calibrated robot written to "
+              << vm["write-robot"].as<std::string>() << "\n";
+  }
+  if (s.IsSolutionUsable() && !s.fit.consistent) {
+    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (the play in the "
+                 "sockets; p = "
+              << s.fit.p_value << " < 0.001); see the fit line above\n";
+    return 4;
+  }
+  return s.IsSolutionUsable() ? 0 : 1;
+}
+
 }  // namespace
 
 int IdentifyCommand(const std::vector<std::string>& args) {
@@ -407,6 +516,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const std::string sensor = ResolveSensor(vm);
+  if (sensor == "socket") return SocketIdentify(vm);
   if (sensor != "ranger") return TrackerIdentify(vm, sensor);
   // A calibrated robot file that could not be written is refused before the fit, not after.
   if (vm.count("write-robot"))
@@ -495,6 +605,35 @@ int TrackerIdentifiability(const po::variables_map& vm, const std::string& senso
   return 0;
 }
 
+// identifiability --sensor socket: the arm's terms, the tool point and the sockets at the
+// configurations (a `socket` column says which socket each row is in).
+int SocketIdentifiability(const po::variables_map& vm) {
+  RefuseRangerOptions(vm, "socket",
+                      {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
+                       "estimate-tool", "prior-sigma", "prior"});
+  const RobotFile rig = LoadRobot(vm);
+  const SocketData data = ReadSocketData(vm["configs"].as<std::string>(), rig.robot);
+  const std::unique_ptr<SocketMeasurement> kind = MakeSocketKind(rig.robot, data, vm);
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  const IdentifiabilityReport r =
+      AnalyzeIdentifiability(*kind, data.values.configs, nullptr, options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentifiabilityJson(r);
+    j["sensor"] = "socket";
+    j["values_per_configuration"] = 3;
+    j["sockets"] = data.ids;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: socket (the tool point at its socket: x, y, z in m per configuration, "
+                 "in the base frame; "
+              << data.ids.size() << " socket(s), " << kind->setup().distances.size()
+              << " known distance(s))\n"
+              << r.ToString();
+  }
+  return 0;
+}
+
 }  // namespace
 
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
@@ -519,6 +658,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
   const std::string sensor = ResolveSensor(vm);
+  if (sensor == "socket") return SocketIdentifiability(vm);
   if (sensor != "ranger") return TrackerIdentifiability(vm, sensor);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;

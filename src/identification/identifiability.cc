@@ -223,8 +223,8 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementKind& kind,
                                              const TargetedConfigurations& configs, const double* e,
                                              const IdentifiabilityOptions& options) {
   options.Validate();
-  return AnalyzeJacobian(MeasurementJacobian(kind, configs, e), kind.parameter_names(),
-                         configs.size(), options);
+  return AnalyzeJacobian(MeasurementJacobian(kind, kind.LinearisationConfigurations(configs), e),
+                         kind.parameter_names(), configs.size(), options);
 }
 
 }  // namespace lrcal

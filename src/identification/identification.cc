@@ -387,7 +387,8 @@ IdentifiabilityReport AnalyzeRows(const MeasurementKind& kind, const MeasuredVal
   if (options.priors.empty())
     return AnalyzeIdentifiability(kind, data.configs, nullptr, options.identifiability);
   const Rows rows = MakeRows(kind, data, options);
-  const Eigen::MatrixXd G = MeasurementJacobian(kind, data.configs);
+  const Eigen::MatrixXd G =
+      MeasurementJacobian(kind, kind.LinearisationConfigurations(data.configs));
   const int m = static_cast<int>(G.rows()), p = static_cast<int>(rows.prior_terms.size());
   Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(m + p, G.cols());
   augmented.topRows(m) = G;

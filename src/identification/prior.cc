@@ -35,6 +35,13 @@ constexpr const char* kClasses[] = {"theta",
                                     "target_x",
                                     "target_y",
                                     "target_z",
+                                    "target_roll",
+                                    "target_pitch",
+                                    "target_yaw",
+                                    "socket_x",
+                                    "socket_y",
+                                    "socket_z",
+                                    "socket_u",
                                     "base_x",
                                     "base_y",
                                     "base_z",
@@ -90,11 +97,12 @@ PriorSigmas PriorSigmas::Parse(const std::string& text, const std::string& sourc
     const std::string key = item.substr(0, eq);
     const std::string cls = TermClass(key);
     if (std::find(std::begin(kClasses), std::end(kClasses), cls) == std::end(kClasses))
-      throw InputError(source, where + ": '" + key +
-                                   "' is neither a term nor a class of terms (theta, alpha, a, "
-                                   "d, beta, plane_u, plane_f, ranger_offset, ranger_scale, "
-                                   "instrument_*, target_*, base_*, tool_*, or one of their "
-                                   "names: d6)");
+      throw InputError(source,
+                       where + ": '" + key +
+                           "' is neither a term nor a class of terms (theta, alpha, a, "
+                           "d, beta, plane_u, plane_f, ranger_offset, ranger_scale, "
+                           "instrument_*, target_*, socket_*, base_*, tool_*, or one of their "
+                           "names: d6)");
     for (const Entry& e : priors.entries)
       if (e.key == key) throw InputError(source, where + ": '" + key + "' is given twice");
     std::string value = item.substr(eq + 1);

@@ -12,6 +12,7 @@
 #include "lrcal/core/json.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/socket_measurement.h"
 
 namespace lrcal {
 
@@ -56,16 +57,21 @@ namespace {
 // The link terms a tracker's fit held (every link value the robot marks, not in s.names): their σ
 // from the rig's tolerances or the defaults, and S = ∂ê/∂u over all of the fit's terms (its
 // instrument and targets included) at the estimate, as FindUnestimatedTerms does for the ranger.
-UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const PointMeasurement& kind,
+UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const MeasurementKind& kind,
                                   const MeasuredValues& values, const IdentificationSummary& s,
                                   const IdentificationOptions& options) {
   const RobotModel& robot = rig.robot;
   // Every term of the kind, nothing fixed: the columns of the estimated and the held terms.
-  const std::unique_ptr<PointMeasurement> unfixed =
-      dynamic_cast<const PoseMeasurement*>(&kind)
-          ? std::make_unique<PoseMeasurement>(kind.robot(), kind.setup())
-          : std::make_unique<PointMeasurement>(kind.robot(), kind.setup());
-  const PointMeasurement& full = *unfixed;
+  std::unique_ptr<MeasurementKind> unfixed;
+  if (const auto* socket = dynamic_cast<const SocketMeasurement*>(&kind)) {
+    unfixed = std::make_unique<SocketMeasurement>(socket->robot(), socket->setup());
+  } else {
+    const auto& point = dynamic_cast<const PointMeasurement&>(kind);
+    unfixed = dynamic_cast<const PoseMeasurement*>(&kind)
+                  ? std::make_unique<PoseMeasurement>(point.robot(), point.setup())
+                  : std::make_unique<PointMeasurement>(point.robot(), point.setup());
+  }
+  const MeasurementKind& full = *unfixed;
   const std::vector<std::string>& names = full.parameter_names();
   std::vector<int> est, held;
   UnestimatedTerms out;
@@ -116,7 +122,7 @@ UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const PointMeasurement& 
 }  // namespace
 
 void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data,
-                                 const RobotFile& rig, const PointMeasurement& kind,
+                                 const RobotFile& rig, const MeasurementKind& kind,
                                  const MeasuredValues& values, const IdentificationSummary& s,
                                  const IdentificationOptions& options) {
   const RobotModel& robot = rig.robot;
@@ -126,7 +132,7 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
   std::vector<Eigen::Index> links;
   for (std::size_t k = 0; k < s.names.size(); ++k) {
     const int index = robot.FindValue(s.names[k]);
-    if (index < 0) continue;  // the instrument's and the targets' terms
+    if (index < 0) continue;  // the instrument's, the targets' and the sockets' terms
     links.push_back(static_cast<Eigen::Index>(k));
     link_values[index] = s.estimate[static_cast<Eigen::Index>(k)];
   }
@@ -140,10 +146,11 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
   if (all.covariance.size() > 0) record.covariance = all.covariance(links, links);
   if (all.estimate_shift.size() > 0) record.estimate_shift = all.estimate_shift(links, Eigen::all);
   const std::string header =
-      "# A calibrated robot: written by lrcal identify --sensor point|pose --write-robot from " +
-      data.name +
+      "# A calibrated robot: written by lrcal identify --sensor " + std::string(kind.name()) +
+      " --write-robot from " + data.name +
       ".\n# Nominal values are the estimates (SI: rad, m); the record below says "
-      "from what (the arm's terms; the tracker's frame and targets are the campaign's).\n";
+      "from what (the arm's terms; the instrument's frame, the targets and the sockets are the "
+      "campaign's).\n";
   WriteFileAtomically(path, header + RobotFileText(rig, link_values, rig.planes,
                                                    robot.name() + " (calibrated)", &record));
 }

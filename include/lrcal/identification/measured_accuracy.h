@@ -18,6 +18,7 @@
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/socket_measurement.h"
 
 namespace lrcal {
 
@@ -48,5 +49,39 @@ MeasuredAccuracy AccuracyAtMeasuredPoints(const RobotModel& robot, const PointSe
 
 /// The point kind that registers `setup` on `robot`: every link value of the robot fixed.
 PointMeasurement RegistrationKind(const RobotModel& robot, const PointSetup& setup);
+
+/// How consistent a model is with socket data not used in its calibration (MUKCa's figures of
+/// merit): where the model puts the tool point at each configuration of a socket should be one
+/// point, and the sockets' centres should be their known distance apart. Nothing is registered:
+/// the sockets' centres are the means of the model's predictions.
+struct SocketConsistency {
+  struct Socket {
+    int id = 0;
+    int count = 0;            ///< configurations in this socket
+    Eigen::Vector3d centre;   ///< m, base frame: the mean predicted tool point
+    double rms_spread = 0;    ///< m, √ of the mean squared distance from the centre
+    double worst_spread = 0;  ///< m, the largest distance from the centre
+  };
+  struct Distance {
+    SocketDistance known;
+    double predicted = 0;  ///< m, between the two centres
+    double error = 0;      ///< m, predicted − known
+  };
+  std::vector<Socket> sockets;
+  std::vector<Distance> distances;
+  /// m: √ of the mean squared distance from its socket's centre over every configuration.
+  double rms_spread = 0;
+  /// A table per socket and per known distance, in mm.
+  std::string ToString() const;
+};
+
+/// The consistency of `robot` (its nominal values: a calibrated robot file's estimates) with the
+/// tool point `tool_point` (m, tool frame) at `configs` (tags: indices into `ids`, as
+/// ReadSocketData gives them). Throws InputError when a known distance names a socket without
+/// configurations.
+SocketConsistency ConsistencyAtSockets(const RobotModel& robot, const Eigen::Vector3d& tool_point,
+                                       const TargetedConfigurations& configs,
+                                       const std::vector<int>& ids,
+                                       const std::vector<SocketDistance>& distances);
 
 }  // namespace lrcal

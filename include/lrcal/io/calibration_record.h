@@ -34,16 +34,17 @@ void WriteCalibratedRobot(const std::string& path, const DataSource& data, const
                           const MeasurementModel& model, const IdentificationSummary& s,
                           const IdentificationOptions& options, const UnestimatedTerms& held = {});
 
-/// A tracker's fit (identify --sensor point|pose: its summary `s` of `values` on `kind`) as a
+/// A tracker's or a socket campaign's fit (identify --sensor point|pose|socket: its summary `s`
+/// of `values` on `kind`, a PointMeasurement, PoseMeasurement or SocketMeasurement) as a
 /// calibrated robot file at `path`: `rig` with the estimated link values as its nominal values,
 /// its planes and ranger limits if it has them, and a record of the link terms alone with their
-/// marginal covariance (the instrument's frame and the targets belong to that campaign's set-up,
-/// not to the arm; they stay in the fit's output). The link terms the fit held at nominal (fixed,
-/// or confounded with the instrument's frame or a target: d1 with the tracker's height) are the
-/// record's held terms, with the rig's tolerances or the defaults and their effect on the estimate,
-/// so that the file's stated total accuracy includes them. Throws StorageError.
+/// marginal covariance (the instrument's frame, the targets and the sockets belong to that
+/// campaign's set-up, not to the arm; they stay in the fit's output). The link terms the fit held
+/// at nominal (fixed, or confounded with the instrument's frame or a target: d1 with the tracker's
+/// height) are the record's held terms, with the rig's tolerances or the defaults and their effect
+/// on the estimate, so that the file's stated total accuracy includes them. Throws StorageError.
 void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data,
-                                 const RobotFile& rig, const PointMeasurement& kind,
+                                 const RobotFile& rig, const MeasurementKind& kind,
                                  const MeasuredValues& values, const IdentificationSummary& s,
                                  const IdentificationOptions& options);
 

@@ -76,6 +76,16 @@ class MeasurementKind {
   /// simulation: a configuration that misses is left out of the data, never filled with a NaN.
   virtual std::vector<std::string> MissReasons(const TargetedConfigurations& configs,
                                                const double* e) const = 0;
+  /// The configurations the rank analysis (identifiability.h) linearises at, for measurements
+  /// at `configs`: `configs` themselves, except for a kind whose measured values are constraints
+  /// (the socket kind: the tool point at its socket) — there real data leave residuals, along
+  /// which a symmetry of the constraints (turning the arm and its sockets together about the base
+  /// z axis) is not exact, so the analysis takes the configurations moved until the nominal
+  /// model satisfies the constraints, where every symmetry shows as a deficiency.
+  virtual TargetedConfigurations LinearisationConfigurations(
+      const TargetedConfigurations& configs) const {
+    return configs;
+  }
   /// The same kind with the terms `names` held at nominal (what identifiability suggests to fix).
   /// Throws InputError naming an unknown term.
   virtual std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const = 0;

@@ -1,0 +1,79 @@
+#include "lrcal/io/socket_data.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/core/strings.h"
+#include "lrcal/io/csv.h"
+#include "lrcal/io/robot_data.h"
+
+namespace lrcal {
+
+namespace {
+
+constexpr double kMaxSocketId = 1e9;
+constexpr int kMaxReadingsPerRow = 1000000;
+
+}  // namespace
+
+SocketData ReadSocketData(const std::string& path, const RobotModel& robot) {
+  const CsvTable t = ReadCsv(path);
+  const TargetedConfigurations joints = TargetConfigurations(t, robot.num_links(), 1);
+  CheckJointRanges(joints, robot, path);
+  const int column = t.Column("socket");
+  if (column < 0)
+    throw InputError(Location(t.path, 1) + " column 'socket'",
+                     "missing: expected the id of the socket each row's tool point sits in (a "
+                     "whole number ≥ 0)");
+  const int readings = t.Column("readings");
+  std::vector<int> socket(t.rows.size()), count(t.rows.size(), 1);
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    const std::string& cell = t.rows[r][column];
+    double v;
+    if (!ParseDecimal(cell, &v) || !(v >= 0 && v <= kMaxSocketId) || v != std::floor(v))
+      throw InputError(Location(t.path, t.lines[r]) + " column 'socket'",
+                       "'" + CellExcerpt(cell) +
+                           "' is not a socket id: expected a whole number from 0 to 1000000000");
+    socket[r] = static_cast<int>(v);
+    if (readings < 0) continue;
+    const double n = t.Number(r, readings);
+    if (!(n >= 1 && n <= kMaxReadingsPerRow && n == std::floor(n)))
+      throw InputError(Location(t.path, t.lines[r]) + " column 'readings'",
+                       "expected a whole number of seatings from 1 to 1,000,000, got '" +
+                           CellExcerpt(t.rows[r][readings]) + "'");
+    count[r] = static_cast<int>(n);
+  }
+  SocketData data;
+  data.ids = socket;
+  std::sort(data.ids.begin(), data.ids.end());
+  data.ids.erase(std::unique(data.ids.begin(), data.ids.end()), data.ids.end());
+  data.values.configs = TargetedConfigurations(robot.num_links());
+  data.values.configs.Reserve(joints.size());
+  for (int i = 0; i < joints.size(); ++i) {
+    const auto index =
+        std::lower_bound(data.ids.begin(), data.ids.end(), socket[static_cast<std::size_t>(i)]) -
+        data.ids.begin();
+    data.values.configs.AddFrom(joints, i, static_cast<int>(index));
+  }
+  data.values.y.assign(3 * t.rows.size(), 0.0);
+  data.values.repetitions = count;
+  return data;
+}
+
+void WriteSocketData(const std::string& path, const std::vector<int>& ids,
+                     const MeasuredValues& data) {
+  std::ostringstream out;
+  for (int j = 0; j < data.configs.num_joints(); ++j) out << "q" << j + 1 << ",";
+  out << "socket,readings\n";
+  for (int i = 0; i < data.size(); ++i) {
+    for (int j = 0; j < data.configs.num_joints(); ++j)
+      out << FormatExact(data.configs.q(i)[j]) << ",";
+    out << ids[static_cast<std::size_t>(data.configs.target(i))] << ","
+        << data.repetitions[static_cast<std::size_t>(i)] << "\n";
+  }
+  WriteOutputFile(path, out.str());
+}
+
+}  // namespace lrcal
