@@ -225,6 +225,17 @@ std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const
                                                   " has no configuration in the data (its "
                                                   "socket column names " +
                                                   std::to_string(data.ids.size()) + " socket(s))");
+  try {
+    setup.Validate();
+  } catch (const InputError& e) {
+    // A cycle or a socket placed twice: the command line's option, with the item.
+    if (e.where().rfind("socket.distances[", 0) != 0) throw;
+    const std::size_t k = std::stoul(e.where().substr(std::string("socket.distances[").size()));
+    const std::string what = std::string(e.what()).substr(e.where().size() + 2);
+    throw InputError(
+        "--socket-distance '" + vm["socket-distance"].as<std::vector<std::string>>()[k] + "'",
+        what);
+  }
   return std::make_unique<SocketMeasurement>(robot, setup, fixed, "--fix");
 }
 

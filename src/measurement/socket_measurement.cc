@@ -76,6 +76,22 @@ class SocketEvaluator : public MeasurementEvaluator {
   std::vector<Eigen::MatrixXd> derivative_;
 };
 
+// Brings each revolute joint of q into its range by whole turns where it can; true when every
+// joint is then within its range.
+bool WithinJointRanges(const RobotModel& robot, double* q) {
+  constexpr double kTurn = 2 * 3.141592653589793;
+  bool within = true;
+  for (int j = 0; j < robot.num_links(); ++j) {
+    const Link& link = robot.links()[static_cast<std::size_t>(j)];
+    if (link.joint == JointType::kRevolute) {
+      while (q[j] > link.q_max && q[j] - kTurn >= link.q_min) q[j] -= kTurn;
+      while (q[j] < link.q_min && q[j] + kTurn <= link.q_max) q[j] += kTurn;
+    }
+    within = within && q[j] >= link.q_min && q[j] <= link.q_max;
+  }
+  return within;
+}
+
 }  // namespace
 
 std::string SocketTermName(int id, const std::string& term) {
@@ -427,9 +443,14 @@ int SimulateSocketMeasurements(const SocketMeasurement& truth, const TargetedCon
         noise.sigma / std::sqrt(static_cast<double>(R)) * Eigen::Vector3d(z[0], z[1], z[2]);
     std::copy(starts.q(i), starts.q(i) + nj, q.begin());
     const auto s = static_cast<std::size_t>(starts.target(i));
-    if (!SeatToolPoint(truth.robot(), tool_point, sockets[s] + play, q.data())) {
+    const char* reason = nullptr;
+    if (!SeatToolPoint(truth.robot(), tool_point, sockets[s] + play, q.data()))
+      reason = "out of reach";
+    else if (!WithinJointRanges(truth.robot(), q.data()))
+      reason = "outside the joint ranges";
+    if (reason) {
       ++missed;
-      if (misses) (*misses)[static_cast<std::size_t>(i)] = "out of reach";
+      if (misses) (*misses)[static_cast<std::size_t>(i)] = reason;
       continue;
     }
     data->configs.Add(q.data(), starts.target(i));

@@ -707,6 +707,14 @@ const std::vector<BadInputCase>& Cases() {
        "identifiability --configs c.csv --sensor socket --socket-distance 0,1=0.05",
        2,
        {"--socket-distance: socket 1 has no configuration in the data"}},
+      {"SocketDistancesInACycle",
+       {{"c.csv",
+         "q1,q2,q3,q4,q5,q6,socket\n0.1,0.2,0.3,0.4,0.5,0.6,0\n0.1,0.2,0.3,0.4,0.5,0.7,1\n"
+         "0.1,0.2,0.3,0.4,0.5,0.8,2\n"}},
+       "identifiability --configs c.csv --sensor socket --socket-distance 0,1=0.05 "
+       "--socket-distance 1,2=0.05 --socket-distance 2,0=0.05",
+       2,
+       {"--socket-distance '2,0=0.05': the known distances between sockets 2 and 0 close a cycle"}},
       {"SocketDistanceForTheRanger",
        {{"c.csv", kConfigs}},
        "identifiability --configs c.csv --socket-distance 0,1=0.05",

@@ -151,7 +151,9 @@ bool SeatToolPoint(const RobotModel& robot, const Eigen::Vector3d& tool_point,
 /// sits at its socket's true position plus the seating's play, δ_i ~ N(0, σ²/R·I) (σ =
 /// noise.sigma, R = noise.repetitions; δ's components are the standard normals at indices 3i …
 /// 3i + 2 of `stream`, times σ/√R); the recorded value is 0 (three rows) with weight R. A start
-/// that cannot be seated is left out, its reason "out of reach" in `misses`. Only sigma and
+/// that cannot be seated is left out, its reason "out of reach" in `misses`; one seated outside
+/// the arm's joint ranges (after whole turns of its revolute joints) likewise, "outside the joint
+/// ranges". Only sigma and
 /// repetitions apply: NoiseModel's ranger disturbances and averaging are refused. Returns the
 /// number left out.
 int SimulateSocketMeasurements(const SocketMeasurement& truth, const TargetedConfigurations& starts,
