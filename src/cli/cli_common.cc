@@ -212,31 +212,11 @@ std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const
     throw InputError("--target", "--sensor socket takes one tool point as x,y,z (m, tool frame)");
   std::vector<std::string> fixed;
   if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
-  SocketSetup setup;
-  setup.ids = data.ids;
-  setup.tool_point = point.targets[0];
-  setup.positions = SocketPositionsFromData(robot, setup.tool_point, data.values.configs,
-                                            static_cast<int>(data.ids.size()));
-  setup.distances = ResolveSocketDistances(vm);
-  for (const SocketDistance& d : setup.distances)
-    for (int id : {d.a, d.b})
-      if (setup.IndexOf(id) < 0)
-        throw InputError("--socket-distance", "socket " + std::to_string(id) +
-                                                  " has no configuration in the data (its "
-                                                  "socket column names " +
-                                                  std::to_string(data.ids.size()) + " socket(s))");
-  try {
-    setup.Validate();
-  } catch (const InputError& e) {
-    // A cycle or a socket placed twice: the command line's option, with the item.
-    if (e.where().rfind("socket.distances[", 0) != 0) throw;
-    const std::size_t k = std::stoul(e.where().substr(std::string("socket.distances[").size()));
-    const std::string what = std::string(e.what()).substr(e.where().size() + 2);
-    throw InputError(
-        "--socket-distance '" + vm["socket-distance"].as<std::vector<std::string>>()[k] + "'",
-        what);
-  }
-  return std::make_unique<SocketMeasurement>(robot, setup, fixed, "--fix");
+  return std::make_unique<SocketMeasurement>(
+      robot,
+      SocketSetupFromData(robot, data, point.targets[0], ResolveSocketDistances(vm),
+                          "--socket-distance"),
+      fixed, "--fix");
 }
 
 void AddOrientationNoiseOption(po::options_description& o) {

@@ -205,6 +205,8 @@ int SocketSimulate(const po::variables_map& vm) {
   const SocketMeasurement truth(true_robot, setup);
   NoiseModel noise;
   ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  // One seating per row unless --repetitions says otherwise (a ranger's default is 10 readings).
+  if (vm.count("repetitions") && vm["repetitions"].defaulted()) noise.repetitions = 1;
   MeasuredValues data;
   std::vector<std::string> misses;
   const int missed = SimulateSocketMeasurements(

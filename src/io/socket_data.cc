@@ -45,21 +45,74 @@ SocketData ReadSocketData(const std::string& path, const RobotModel& robot) {
                            CellExcerpt(t.rows[r][readings]) + "'");
     count[r] = static_cast<int>(n);
   }
+  return MakeSocketData(joints, socket, count, path);
+}
+
+SocketData MakeSocketData(const ConfigurationSet& configs, const std::vector<int>& socket_ids,
+                          std::vector<int> repetitions, const std::string& source) {
+  const auto n = static_cast<std::size_t>(configs.size());
+  if (socket_ids.size() != n || repetitions.size() != n)
+    throw InputError(
+        source, "expected one socket id and one count of seatings per configuration (" +
+                    std::to_string(n) + "), got " + std::to_string(socket_ids.size()) + " and " +
+                    std::to_string(repetitions.size()));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (socket_ids[i] < 0)
+      throw InputError(source, "configuration " + std::to_string(i + 1) +
+                                   ": expected a socket id ≥ 0, got " +
+                                   std::to_string(socket_ids[i]));
+    if (repetitions[i] < 1)
+      throw InputError(source,
+                       "configuration " + std::to_string(i + 1) + ": expected at least 1 seating");
+  }
   SocketData data;
-  data.ids = socket;
+  data.ids = socket_ids;
   std::sort(data.ids.begin(), data.ids.end());
   data.ids.erase(std::unique(data.ids.begin(), data.ids.end()), data.ids.end());
-  data.values.configs = TargetedConfigurations(robot.num_links());
-  data.values.configs.Reserve(joints.size());
-  for (int i = 0; i < joints.size(); ++i) {
-    const auto index =
-        std::lower_bound(data.ids.begin(), data.ids.end(), socket[static_cast<std::size_t>(i)]) -
-        data.ids.begin();
-    data.values.configs.AddFrom(joints, i, static_cast<int>(index));
+  data.values.configs = TargetedConfigurations(configs.num_joints());
+  data.values.configs.Reserve(configs.size());
+  for (int i = 0; i < configs.size(); ++i) {
+    const auto index = std::lower_bound(data.ids.begin(), data.ids.end(),
+                                        socket_ids[static_cast<std::size_t>(i)]) -
+                       data.ids.begin();
+    data.values.configs.AddFrom(configs, i, static_cast<int>(index));
   }
-  data.values.y.assign(3 * t.rows.size(), 0.0);
-  data.values.repetitions = count;
+  data.values.y.assign(3 * n, 0.0);
+  data.values.repetitions = std::move(repetitions);
   return data;
+}
+
+SocketSetup SocketSetupFromData(const RobotModel& robot, const SocketData& data,
+                                const Eigen::Vector3d& tool_point,
+                                const std::vector<SocketDistance>& distances,
+                                const std::string& distances_source) {
+  SocketSetup setup;
+  setup.ids = data.ids;
+  setup.tool_point = tool_point;
+  setup.positions = SocketPositionsFromData(robot, tool_point, data.values.configs,
+                                            static_cast<int>(data.ids.size()));
+  setup.distances = distances;
+  for (const SocketDistance& d : distances)
+    for (int id : {d.a, d.b})
+      if (setup.IndexOf(id) < 0)
+        throw InputError(distances_source, "socket " + std::to_string(id) +
+                                               " has no configuration in the data (they name " +
+                                               std::to_string(data.ids.size()) + " socket(s))");
+  try {
+    setup.Validate();
+  } catch (const InputError& e) {
+    // A cycle or a socket placed twice: named by the distance as given.
+    const std::string prefix = "socket.distances[";
+    if (e.where().rfind(prefix, 0) != 0) throw;
+    const std::size_t k = std::stoul(e.where().substr(prefix.size()));
+    const SocketDistance& d = distances[k];
+    std::ostringstream item;
+    item.precision(15);
+    item << d.a << "," << d.b << "=" << d.metres;
+    throw InputError(distances_source + " '" + item.str() + "'",
+                     std::string(e.what()).substr(e.where().size() + 2));
+  }
+  return setup;
 }
 
 void WriteSocketData(const std::string& path, const std::vector<int>& ids,

@@ -122,9 +122,13 @@ int SocketSetup::IndexOf(int id) const {
   return it == ids.end() ? -1 : static_cast<int>(it - ids.begin());
 }
 
-void SocketSetup::Validate() const {
-  if (ids.empty() || static_cast<int>(ids.size()) > kMaxSockets)
-    throw InputError("socket.ids", "expected 1 to " + std::to_string(kMaxSockets) +
+namespace {
+
+// The ids, positions and tool point of `setup` (SocketSetup::Validate's first half).
+void ValidateSockets(const SocketSetup& setup) {
+  const std::vector<int>& ids = setup.ids;
+  if (ids.empty() || static_cast<int>(ids.size()) > SocketSetup::kMaxSockets)
+    throw InputError("socket.ids", "expected 1 to " + std::to_string(SocketSetup::kMaxSockets) +
                                        " sockets, got " + std::to_string(ids.size()));
   for (std::size_t k = 0; k < ids.size(); ++k) {
     if (ids[k] < 0)
@@ -133,16 +137,22 @@ void SocketSetup::Validate() const {
         ids.begin() + static_cast<std::ptrdiff_t>(k))
       throw InputError("socket.ids", "socket " + std::to_string(ids[k]) + " is listed twice");
   }
-  if (positions.size() != ids.size())
+  if (setup.positions.size() != ids.size())
     throw InputError("socket.positions", "expected one position per socket (" +
                                              std::to_string(ids.size()) + "), got " +
-                                             std::to_string(positions.size()));
-  for (std::size_t k = 0; k < positions.size(); ++k)
-    if (!positions[k].allFinite())
+                                             std::to_string(setup.positions.size()));
+  for (std::size_t k = 0; k < setup.positions.size(); ++k)
+    if (!setup.positions[k].allFinite())
       throw InputError("socket.positions[" + std::to_string(k) + "]",
                        "expected a finite position in the base frame (m)");
-  if (!tool_point.allFinite())
+  if (!setup.tool_point.allFinite())
     throw InputError("socket.tool_point", "expected a finite offset in the tool frame (m)");
+}
+
+}  // namespace
+
+void SocketSetup::Validate() const {
+  ValidateSockets(*this);
   // Union-find over the sockets: a distance joining two sockets already joined closes a cycle.
   std::vector<int> root(ids.size()), placed(ids.size(), 0);
   std::iota(root.begin(), root.end(), 0);
@@ -191,6 +201,26 @@ SocketMeasurement::SocketMeasurement(const RobotModel& robot, SocketSetup setup,
     return std::find(fixed.begin(), fixed.end(), name) != fixed.end();
   };
   names_ = arm_.parameter_names();
+  OrderSockets();
+  nominal_ = setup_.positions;
+  const int first = first_socket_column();
+  for (int k : order_) {
+    Placement& p = placement_[static_cast<std::size_t>(k)];
+    const int id = setup_.ids[static_cast<std::size_t>(k)];
+    const bool free = p.parent < 0;
+    if (!free) PlaceByDistance(k);
+    const char* const position_terms[3] = {"x", "y", "z"};
+    const char* const chart_terms[2] = {"u1", "u2"};
+    for (int c = 0; c < (free ? 3 : 2); ++c) {
+      const std::string name = SocketTermName(id, free ? position_terms[c] : chart_terms[c]);
+      if (is_fixed(name)) continue;
+      p.column[c] = static_cast<int>(names_.size()) - first;
+      names_.push_back(name);
+    }
+  }
+}
+
+void SocketMeasurement::OrderSockets() {
   const int n = static_cast<int>(setup_.ids.size());
   placement_.assign(static_cast<std::size_t>(n), Placement{});
   for (const SocketDistance& d : setup_.distances) {
@@ -209,34 +239,21 @@ SocketMeasurement::SocketMeasurement(const RobotModel& robot, SocketSetup setup,
       done[static_cast<std::size_t>(k)] = true;
       order_.push_back(k);
     }
-  nominal_ = setup_.positions;
-  const int first = first_socket_column();
-  for (int k : order_) {
-    Placement& p = placement_[static_cast<std::size_t>(k)];
-    const int id = setup_.ids[static_cast<std::size_t>(k)];
-    const bool free = p.parent < 0;
-    if (!free) {
-      const Eigen::Vector3d& from = nominal_[static_cast<std::size_t>(p.parent)];
-      Eigen::Vector3d v = setup_.positions[static_cast<std::size_t>(k)] - from;
-      // Sockets given at one point (no nominal direction): any direction, x.
-      p.direction = v.norm() > 0 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::UnitX();
-      // A tangent basis: the axis least aligned with the direction, orthogonalised.
-      Eigen::Index smallest;
-      p.direction.cwiseAbs().minCoeff(&smallest);
-      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(smallest);
-      p.tangent1 = (axis - axis.dot(p.direction) * p.direction).normalized();
-      p.tangent2 = p.direction.cross(p.tangent1);
-      nominal_[static_cast<std::size_t>(k)] = from + p.distance * p.direction;
-    }
-    const char* const position_terms[3] = {"x", "y", "z"};
-    const char* const chart_terms[2] = {"u1", "u2"};
-    for (int c = 0; c < (free ? 3 : 2); ++c) {
-      const std::string name = SocketTermName(id, free ? position_terms[c] : chart_terms[c]);
-      if (is_fixed(name)) continue;
-      p.column[c] = static_cast<int>(names_.size()) - first;
-      names_.push_back(name);
-    }
-  }
+}
+
+void SocketMeasurement::PlaceByDistance(int k) {
+  Placement& p = placement_[static_cast<std::size_t>(k)];
+  const Eigen::Vector3d& from = nominal_[static_cast<std::size_t>(p.parent)];
+  const Eigen::Vector3d v = setup_.positions[static_cast<std::size_t>(k)] - from;
+  // Sockets given at one point (no nominal direction): any direction, x.
+  p.direction = v.norm() > 0 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::UnitX();
+  // A tangent basis: the axis least aligned with the direction, orthogonalised.
+  Eigen::Index smallest;
+  p.direction.cwiseAbs().minCoeff(&smallest);
+  const Eigen::Vector3d axis = Eigen::Vector3d::Unit(smallest);
+  p.tangent1 = (axis - axis.dot(p.direction) * p.direction).normalized();
+  p.tangent2 = p.direction.cross(p.tangent1);
+  nominal_[static_cast<std::size_t>(k)] = from + p.distance * p.direction;
 }
 
 std::vector<std::string> SocketMeasurement::SocketTermNames() const {
@@ -279,38 +296,46 @@ Eigen::VectorXd SocketMeasurement::NominalValues() const {
 
 void SocketMeasurement::SocketsAt(const double* e, std::vector<Eigen::Vector3d>* positions,
                                   std::vector<Eigen::MatrixXd>* derivative) const {
-  const int terms = num_socket_terms();
   const double* s = e + first_socket_column();
   positions->assign(nominal_.size(), Eigen::Vector3d::Zero());
-  if (derivative) derivative->assign(nominal_.size(), Eigen::MatrixXd::Zero(3, terms));
+  if (derivative) derivative->assign(nominal_.size(), Eigen::MatrixXd::Zero(3, num_socket_terms()));
   for (int k : order_) {
     const auto u = static_cast<std::size_t>(k);
+    Eigen::MatrixXd* d = derivative ? &(*derivative)[u] : nullptr;
     const Placement& p = placement_[u];
-    Eigen::Vector3d& position = (*positions)[u];
     if (p.parent < 0) {
-      position = nominal_[u];
-      for (int c = 0; c < 3; ++c)
-        if (p.column[c] >= 0) {
-          position[c] += s[p.column[c]];
-          if (derivative) (*derivative)[u](c, p.column[c]) = 1;
-        }
-      continue;
+      (*positions)[u] = nominal_[u];
+      for (int c = 0; c < 3; ++c) {
+        if (p.column[c] < 0) continue;
+        (*positions)[u][c] += s[p.column[c]];
+        if (d) (*d)(c, p.column[c]) = 1;
+      }
+    } else {
+      const auto parent = static_cast<std::size_t>(p.parent);
+      PlacedSocketAt(p, s, (*positions)[parent], d ? &(*derivative)[parent] : nullptr,
+                     &(*positions)[u], d);
     }
-    // u_b = v/|v|, v = u0 + c1·t1 + c2·t2; ∂u_b/∂c = (I − u·uᵀ)·t/|v|.
-    const double c1 = p.column[0] >= 0 ? s[p.column[0]] : 0.0;
-    const double c2 = p.column[1] >= 0 ? s[p.column[1]] : 0.0;
-    const Eigen::Vector3d v = p.direction + c1 * p.tangent1 + c2 * p.tangent2;
-    const double norm = v.norm();
-    const Eigen::Vector3d direction = v / norm;
-    const auto parent = static_cast<std::size_t>(p.parent);
-    position = (*positions)[parent] + p.distance * direction;
-    if (!derivative) continue;
-    (*derivative)[u] = (*derivative)[parent];
-    const Eigen::Matrix3d project =
-        (Eigen::Matrix3d::Identity() - direction * direction.transpose()) * (p.distance / norm);
-    if (p.column[0] >= 0) (*derivative)[u].col(p.column[0]) += project * p.tangent1;
-    if (p.column[1] >= 0) (*derivative)[u].col(p.column[1]) += project * p.tangent2;
   }
+}
+
+void SocketMeasurement::PlacedSocketAt(const Placement& p, const double* s,
+                                       const Eigen::Vector3d& parent,
+                                       const Eigen::MatrixXd* parent_derivative,
+                                       Eigen::Vector3d* position,
+                                       Eigen::MatrixXd* derivative) const {
+  // u_b = v/|v|, v = u0 + c1·t1 + c2·t2; ∂u_b/∂c = (I − u·uᵀ)·t/|v|.
+  const double c1 = p.column[0] >= 0 ? s[p.column[0]] : 0.0;
+  const double c2 = p.column[1] >= 0 ? s[p.column[1]] : 0.0;
+  const Eigen::Vector3d v = p.direction + c1 * p.tangent1 + c2 * p.tangent2;
+  const double norm = v.norm();
+  const Eigen::Vector3d direction = v / norm;
+  *position = parent + p.distance * direction;
+  if (!derivative) return;
+  *derivative = *parent_derivative;
+  const Eigen::Matrix3d project =
+      (Eigen::Matrix3d::Identity() - direction * direction.transpose()) * (p.distance / norm);
+  if (p.column[0] >= 0) derivative->col(p.column[0]) += project * p.tangent1;
+  if (p.column[1] >= 0) derivative->col(p.column[1]) += project * p.tangent2;
 }
 
 std::unique_ptr<MeasurementEvaluator> SocketMeasurement::Bind(

@@ -33,6 +33,7 @@
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/measured_accuracy.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/calibration_record.h"
 #include "lrcal/io/csv.h"
@@ -40,6 +41,7 @@
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/socket_data.h"
 #include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
@@ -914,12 +916,96 @@ IdentificationSummary IdentifyTrackerPy(const RobotFile& rig, const Array& q, co
   return Identify(*kind, data, options);
 }
 
-IdentifiabilityReport IdentifiabilityPy(
-    const RobotFile& rig, const Array& q, const py::object& plane_arg,
-    const std::string& estimate_plane, const py::object& fix, double rank_tolerance,
-    const py::object& plane_of, const std::string& estimate_ranger,
-    const std::string& estimate_base, const std::string& estimate_tool, const std::string& sensor,
-    const py::object& instrument, const py::object& targets, const py::object& target_of) {
+// identifiability(sensor='socket')'s own arguments.
+struct SocketArgs {
+  py::object socket_of, distances, tool_point;
+};
+
+// Socket seatings from Python: q (N, joints), socket_of (N ids ≥ 0), repetitions (N or None).
+SocketData ToSocketData(const RobotModel& robot, const Array& q, const py::object& socket_of,
+                        const py::object& repetitions) {
+  const ConfigurationSet configs = ToConfigurations(q, robot.num_links(), "q");
+  CheckJointRanges(configs, robot, "q");
+  if (socket_of.is_none())
+    throw InputError("socket_of", "give each row's socket id (N whole numbers ≥ 0)");
+  std::vector<int> ids;
+  for (double v : ToVector(socket_of.cast<Array>(), "socket_of")) {
+    if (!(v >= 0 && v <= 1e9 && v == std::floor(v)))
+      throw InputError("socket_of", "expected whole numbers from 0 to 1000000000");
+    ids.push_back(static_cast<int>(v));
+  }
+  std::vector<int> counts(static_cast<std::size_t>(configs.size()), 1);
+  if (!repetitions.is_none()) counts = repetitions.cast<std::vector<int>>();
+  return MakeSocketData(configs, ids, counts, "socket_of/repetitions");
+}
+
+// socket_distances=[(a, b, metres), ...] or None.
+std::vector<SocketDistance> ToSocketDistances(const py::object& distances) {
+  std::vector<SocketDistance> out;
+  if (distances.is_none()) return out;
+  int k = 0;
+  for (const py::handle item : distances) {
+    const auto t = py::reinterpret_borrow<py::object>(item).cast<std::tuple<int, int, double>>();
+    const std::string text = std::to_string(std::get<0>(t)) + "," + std::to_string(std::get<1>(t)) +
+                             "=" + FormatExact(std::get<2>(t));
+    out.push_back(SocketDistance::Parse(text, "socket_distances[" + std::to_string(k++) + "]"));
+  }
+  return out;
+}
+
+Eigen::Vector3d ToToolPoint(const py::object& tool_point) {
+  if (tool_point.is_none()) return Eigen::Vector3d::Zero();
+  const RigidTransform t = ToXyzRpy(tool_point, "tool_point", true);
+  if (!t.rotation.isIdentity(0)) throw InputError("tool_point", "expected (x, y, z) in m");
+  return t.translation;
+}
+
+// The socket kind for `data`, as identify --sensor socket builds it.
+std::unique_ptr<SocketMeasurement> ToSocketKind(const RobotModel& robot, const SocketData& data,
+                                                const py::object& tool_point,
+                                                const py::object& distances,
+                                                const py::object& fix) {
+  return std::make_unique<SocketMeasurement>(
+      robot,
+      SocketSetupFromData(robot, data, ToToolPoint(tool_point), ToSocketDistances(distances),
+                          "socket_distances"),
+      ToNames(fix), "fix");
+}
+
+IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
+                                        const py::object& plane_arg,
+                                        const std::string& estimate_plane, const py::object& fix,
+                                        double rank_tolerance, const py::object& plane_of,
+                                        const std::string& estimate_ranger,
+                                        const std::string& estimate_base,
+                                        const std::string& estimate_tool, const std::string& sensor,
+                                        const py::object& instrument, const py::object& targets,
+                                        const py::object& target_of, const SocketArgs& sockets) {
+  if (sensor != "socket" &&
+      !(sockets.socket_of.is_none() && sockets.distances.is_none() && sockets.tool_point.is_none()))
+    throw InputError(!sockets.socket_of.is_none()   ? "socket_of"
+                     : !sockets.distances.is_none() ? "socket_distances"
+                                                    : "tool_point",
+                     "is the socket sensor's: give sensor='socket'");
+  if (sensor == "socket") {
+    RefuseRangerArguments(sensor, {{"plane", !plane_arg.is_none()},
+                                   {"plane_of", !plane_of.is_none()},
+                                   {"estimate_plane", estimate_plane != "none"},
+                                   {"estimate_ranger", estimate_ranger != "none"},
+                                   {"estimate_base", estimate_base != "none"},
+                                   {"estimate_tool", estimate_tool != "none"},
+                                   {"instrument", !instrument.is_none()},
+                                   {"targets", !targets.is_none()},
+                                   {"target_of", !target_of.is_none()}});
+    const SocketData data = ToSocketData(rig.robot, q, sockets.socket_of, py::none());
+    const std::unique_ptr<SocketMeasurement> kind =
+        ToSocketKind(rig.robot, data, sockets.tool_point, sockets.distances, fix);
+    IdentifiabilityOptions options;
+    options.rank_tolerance = rank_tolerance;
+    options.Validate();
+    py::gil_scoped_release release;
+    return AnalyzeIdentifiability(*kind, data.values.configs, nullptr, options);
+  }
   if (sensor != "ranger") {
     RefuseRangerArguments(sensor, {{"plane", !plane_arg.is_none()},
                                    {"plane_of", !plane_of.is_none()},
@@ -1573,15 +1659,29 @@ void DefineIdentify(py::module_& m) {
 
 // identifiability(): the ranger's parameter set or, with sensor=, a tracker's terms.
 void DefineIdentifiability(py::module_& m) {
-  m.def("identifiability", &IdentifiabilityPy, py::arg("robot"), py::arg("q"),
-        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(),
-        py::arg("rank_tolerance") =
-            FindSetting(IdentifiabilityOptions::Settings(), "rank_tolerance")->Default(),
-        py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
-        py::arg("estimate_base") = "none", py::arg("estimate_tool") = "none",
-        py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
-        py::arg("targets") = py::none(), py::arg("target_of") = py::none(), R"doc(
+  m.def(
+      "identifiability",
+      [](const RobotFile& rig, const Array& q, const py::object& plane,
+         const std::string& estimate_plane, const py::object& fix, double rank_tolerance,
+         const py::object& plane_of, const std::string& estimate_ranger,
+         const std::string& estimate_base, const std::string& estimate_tool,
+         const std::string& sensor, const py::object& instrument, const py::object& targets,
+         const py::object& target_of, const py::object& socket_of,
+         const py::object& socket_distances, const py::object& tool_point) {
+        return IdentifiabilityPy(rig, q, plane, estimate_plane, fix, rank_tolerance, plane_of,
+                                 estimate_ranger, estimate_base, estimate_tool, sensor, instrument,
+                                 targets, target_of, {socket_of, socket_distances, tool_point});
+      },
+      py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
+      py::arg("estimate_plane") = "none", py::arg("fix") = py::none(),
+      py::arg("rank_tolerance") =
+          FindSetting(IdentifiabilityOptions::Settings(), "rank_tolerance")->Default(),
+      py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
+      py::arg("estimate_base") = "none", py::arg("estimate_tool") = "none",
+      py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
+      py::arg("targets") = py::none(), py::arg("target_of") = py::none(),
+      py::arg("socket_of") = py::none(), py::arg("socket_distances") = py::none(),
+      py::arg("tool_point") = py::none(), R"doc(
 What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
 estimate_plane, estimate_ranger, estimate_base, estimate_tool, fix as in identify: several
 planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
@@ -1589,7 +1689,8 @@ planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives
 identifiability --sensor`): instrument=(x, y, z, roll, pitch, yaw) in the base frame (m, rad;
 None: the base frame), targets=[(x, y, z), ...] in the tool frame ((x, y, z, roll, pitch, yaw)
 for a 6-D probe; None: one at the tool frame's origin), target_of (N numbers from 1) the target
-each row sees, fix= as above.)doc");
+each row sees, fix= as above. sensor='socket' analyses seatings in sockets (`--sensor socket`):
+socket_of (N socket ids), socket_distances=[(a, b, metres), ...], tool_point=(x, y, z).)doc");
 }
 
 // The trackers' simulation and fit (point_measurement.h, pose_measurement.h); their
@@ -1635,9 +1736,136 @@ sigma_mm (0: unknown, judged from the residuals) and sigma_mrad weigh a pose's o
 against its positions. Returns an lrcal.Identification.)doc");
 }
 
+// simulate_sockets: starts seated on the true arm at the true sockets, as simulate --sensor
+// socket.
+py::dict SimulateSocketsPy(const RobotFile& rig, const Array& q, const py::object& socket_of,
+                           const py::object& sockets, const py::object& tool_point,
+                           const py::object& distances, double sigma_mm, long long repetitions,
+                           long long seed) {
+  const SocketData starts = ToSocketData(rig.robot, q, socket_of, py::none());
+  SocketSetup setup;
+  setup.ids = starts.ids;
+  setup.positions.clear();
+  for (const py::handle p : sockets) {
+    const RigidTransform t = ToXyzRpy(py::reinterpret_borrow<py::object>(p), "sockets", true);
+    setup.positions.push_back(t.translation);
+  }
+  if (setup.positions.size() != starts.ids.size())
+    throw InputError("sockets", "socket_of names " + std::to_string(starts.ids.size()) +
+                                    " socket(s); give one true (x, y, z) each, in ascending "
+                                    "order of id");
+  setup.tool_point = ToToolPoint(tool_point);
+  setup.distances = ToSocketDistances(distances);
+  const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
+  const SocketMeasurement truth(true_robot, setup);
+  NoiseModel noise;
+  noise.sigma = sigma_mm * 1e-3;
+  if (repetitions < 1 || repetitions > 1000000)
+    throw InputError("repetitions", "expected 1 to 1,000,000 seatings per configuration");
+  noise.repetitions = static_cast<int>(repetitions);
+  MeasuredValues data;
+  std::vector<std::string> misses;
+  SimulateSocketMeasurements(truth, starts.values.configs, noise,
+                             RandomStream(ToSeed(seed), 0, 0, RandomPurpose::kNoise), &data,
+                             &misses);
+  std::vector<int> ids;
+  for (int i = 0; i < data.size(); ++i)
+    ids.push_back(setup.ids[static_cast<std::size_t>(data.configs.target(i))]);
+  py::dict out;
+  out["q"] = ToArray(data.configs);
+  out["socket_of"] = ids;
+  out["repetitions"] = data.repetitions;
+  out["misses"] = misses;
+  return out;
+}
+
+// identify_sockets: as identify --sensor socket.
+IdentificationSummary IdentifySocketsPy(const RobotFile& rig, const Array& q,
+                                        const py::object& socket_of, const py::object& tool_point,
+                                        const py::object& distances, const py::object& repetitions,
+                                        const py::object& fix, bool auto_fix, double sigma_mm,
+                                        const std::string& solver) {
+  const SocketData data = ToSocketData(rig.robot, q, socket_of, repetitions);
+  const std::unique_ptr<SocketMeasurement> kind =
+      ToSocketKind(rig.robot, data, tool_point, distances, fix);
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
+  options.sigma = sigma_mm * 1e-3;
+  options.fix_dependent_parameters = auto_fix;
+  options.Validate();
+  py::gil_scoped_release release;
+  return Identify(*kind, data.values, options);
+}
+
+// socket_consistency: as accuracy --sockets.
+py::dict SocketConsistencyPy(const RobotFile& rig, const Array& q, const py::object& socket_of,
+                             const py::object& tool_point, const py::object& distances) {
+  const SocketData data = ToSocketData(rig.robot, q, socket_of, py::none());
+  const SocketConsistency r =
+      ConsistencyAtSockets(rig.robot, ToToolPoint(tool_point), data.values.configs, data.ids,
+                           ToSocketDistances(distances));
+  py::list sockets, known;
+  for (const SocketConsistency::Socket& k : r.sockets) {
+    py::dict d;
+    d["id"] = k.id;
+    d["configurations"] = k.count;
+    d["centre"] = Eigen::Vector3d(k.centre);
+    d["rms_spread"] = k.rms_spread;
+    d["worst_spread"] = k.worst_spread;
+    sockets.append(d);
+  }
+  for (const SocketConsistency::Distance& k : r.distances) {
+    py::dict d;
+    d["sockets"] = py::make_tuple(k.known.a, k.known.b);
+    d["known"] = k.known.metres;
+    d["predicted"] = k.predicted;
+    d["error"] = k.error;
+    known.append(d);
+  }
+  py::dict out;
+  out["rms_spread"] = r.rms_spread;
+  out["sockets"] = sockets;
+  out["distances"] = known;
+  return out;
+}
+
+// The socket kind (socket_measurement.h): simulation, fit and judgement; its identifiability is
+// identifiability(sensor='socket').
+void DefineSockets(py::module_& m) {
+  m.def("simulate_sockets", &SimulateSocketsPy, py::arg("robot"), py::arg("q"),
+        py::arg("socket_of"), py::arg("sockets"), py::arg("tool_point") = py::none(),
+        py::arg("socket_distances") = py::none(), py::arg("sigma_mm") = 0.2,
+        py::arg("repetitions") = 1, py::arg("seed") = 1, R"doc(
+Socket seatings of the true arm (nominal + the robot file's true errors): `lrcal simulate
+--sensor socket`. Each row of q (N, joints) is a start, moved until the true tool point
+(tool_point, (x, y, z) m in the tool frame; None: the origin) sits in its socket (socket_of: N
+ids) at its true position (sockets: one (x, y, z) m in the base frame per id, ascending) plus a
+play of sigma_mm per axis (of the mean of `repetitions` seatings). Returns a dict: q, socket_of,
+repetitions of the seated rows, and misses (one reason per start: "ok", "out of reach",
+"outside the joint ranges").)doc");
+  m.def("identify_sockets", &IdentifySocketsPy, py::arg("robot"), py::arg("q"),
+        py::arg("socket_of"), py::arg("tool_point") = py::none(),
+        py::arg("socket_distances") = py::none(), py::arg("repetitions") = py::none(),
+        py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
+        py::arg("solver") = "lm", R"doc(
+The arm's link values, the tool point and the sockets from seatings: `lrcal identify --sensor
+socket`. q (N, joints), socket_of (N socket ids); tool_point the nominal offset (None: the tool
+frame's origin); socket_distances=[(a, b, metres), ...] known distances (a tree); repetitions
+(N,) each row's weight; fix, auto_fix, sigma_mm (the play per axis; 0: judged from the
+residuals) and solver as in identify. Returns an lrcal.Identification.)doc");
+  m.def("socket_consistency", &SocketConsistencyPy, py::arg("robot"), py::arg("q"),
+        py::arg("socket_of"), py::arg("tool_point") = py::none(),
+        py::arg("socket_distances") = py::none(), R"doc(
+How consistently a model (robot: a calibrated robot file) puts the tool point in each socket,
+and the error of the known socket distances: `lrcal accuracy --sockets`. Returns a dict:
+rms_spread (m), sockets (id, configurations, centre, rms_spread, worst_spread), distances
+(sockets, known, predicted, error; m).)doc");
+}
+
 void DefineCalibration(py::module_& m) {
   DefineIdentifiability(m);
   DefineTrackers(m);
+  DefineSockets(m);
   DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

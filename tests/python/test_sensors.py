@@ -87,3 +87,53 @@ def test_bad_tracker_arguments_are_named(paper):
         lrcal.identify_tracker(paper, sim["q"], sim["xyz"][:4])
     with pytest.raises(lrcal.InputError, match="target_of: 2 targets"):
         lrcal.identifiability(paper, q, sensor="point", targets=[(0, 0, 0), (0, 0, 0.1)])
+
+
+SOCKETS = [(0.8, 0.3, 0.4), (0.8, 0.35, 0.4)]
+
+
+def test_sockets_simulate_identify_and_judge_as_the_program(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    socket_of = [i % 2 for i in range(40)]
+    starts = tmp_path / "s.csv"
+    with open(starts, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)] + ["socket"])
+        writer.writerows([[repr(v) for v in row] + [s] for row, s in zip(q, socket_of)])
+    cli("simulate", "--sensor", "socket", "--configs", starts, "--socket", "0.8,0.3,0.4",
+        "--socket", "0.8,0.35,0.4", "--sigma-mm", "0.1", "--seed", "4",
+        "--out", tmp_path / "seated.csv")
+    sim = lrcal.simulate_sockets(paper, q, socket_of, SOCKETS, sigma_mm=0.1, seed=4)
+    with open(tmp_path / "seated.csv") as f:
+        rows = list(csv.DictReader(f))
+    seated = np.array([[float(r[f"q{j + 1}"]) for j in range(6)] for r in rows])
+    np.testing.assert_array_equal(sim["q"], seated)
+    assert list(sim["socket_of"]) == [int(r["socket"]) for r in rows]
+    assert sim["misses"].count("ok") == len(rows)
+
+    distances = [(0, 1, 0.05)]
+    analysis = lrcal.identifiability(paper, sim["q"], sensor="socket",
+                                     socket_of=sim["socket_of"], socket_distances=distances)
+    assert (analysis.rank, len(analysis.names)) == (26, 33)
+    fit = lrcal.identify_sockets(paper, sim["q"], sim["socket_of"], socket_distances=distances,
+                                 auto_fix=True, sigma_mm=0.1)
+    done = cli("identify", "--sensor", "socket", "--data", tmp_path / "seated.csv",
+               "--socket-distance", "0,1=0.05", "--auto-fix", "--sigma-mm", "0.1",
+               "--format", "json")
+    program = json.loads(done.stdout)
+    assert fit.names == [p["name"] for p in program["parameters"]]
+    np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
+                               rtol=0, atol=1e-12)
+
+    judged = lrcal.socket_consistency(paper, sim["q"], sim["socket_of"],
+                                      socket_distances=distances)
+    done = cli("accuracy", "--robot", "paper", "--sockets", tmp_path / "seated.csv",
+               "--socket-distance", "0,1=0.05", "--format", "json")
+    program = json.loads(done.stdout)
+    assert judged["rms_spread"] == pytest.approx(program["rms_spread"], abs=1e-15)
+    assert judged["distances"][0]["error"] == pytest.approx(program["distances"][0]["error"],
+                                                            abs=1e-15)
+    with pytest.raises(lrcal.InputError, match="socket_distances\\[0\\]"):
+        lrcal.identify_sockets(paper, sim["q"], sim["socket_of"], socket_distances=[(0, 0, 0.05)])
+    with pytest.raises(lrcal.InputError, match="socket_of: is the socket sensor's"):
+        lrcal.identifiability(paper, sim["q"], socket_of=sim["socket_of"])

@@ -13,6 +13,7 @@
 
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/measurement_kind.h"
+#include "lrcal/measurement/socket_measurement.h"
 
 namespace lrcal {
 
@@ -29,6 +30,21 @@ struct SocketData {
 /// from 0 to 1,000,000,000, a joint cell that is not a finite number, or a `readings` cell that
 /// is not a whole number from 1 to 1,000,000.
 SocketData ReadSocketData(const std::string& path, const RobotModel& robot);
+
+/// Socket data from configurations and each one's socket id (≥ 0) and weight (repetitions ≥ 1):
+/// ids sorted and tagged as ReadSocketData does. Throws InputError (where = `source`) for an id
+/// below 0 or a count of repetitions below 1, or lengths that differ.
+SocketData MakeSocketData(const ConfigurationSet& configs, const std::vector<int>& socket_ids,
+                          std::vector<int> repetitions, const std::string& source);
+
+/// The socket kind's nominal set-up for `data`: its ids, the nominal model's mean tool point per
+/// socket as the sockets' positions (SocketPositionsFromData), the tool point and the known
+/// distances. Throws InputError (where = `distances_source`) for a distance naming a socket the
+/// data do not have, closing a cycle or placing a socket twice.
+SocketSetup SocketSetupFromData(const RobotModel& robot, const SocketData& data,
+                                const Eigen::Vector3d& tool_point,
+                                const std::vector<SocketDistance>& distances,
+                                const std::string& distances_source);
 
 /// Writes `data` (configurations tagged by index into `ids`) at full precision: q1..qN, socket
 /// (the id), readings. Written whole or not at all (StorageError naming the file).

@@ -121,6 +121,15 @@ class SocketMeasurement : public MeasurementKind {
   };
 
   std::vector<std::string> SocketTermNames() const;
+  // Each socket's parent and distance, and order_ (parents first).
+  void OrderSockets();
+  // Socket k's nominal direction, chart and position from its parent's nominal position.
+  void PlaceByDistance(int k);
+  // A socket placed by a distance at estimate s (the socket columns): its position from its
+  // parent's and, with `derivative`, its derivative from the parent's.
+  void PlacedSocketAt(const Placement& p, const double* s, const Eigen::Vector3d& parent,
+                      const Eigen::MatrixXd* parent_derivative, Eigen::Vector3d* position,
+                      Eigen::MatrixXd* derivative) const;
 
   PointMeasurement arm_;
   SocketSetup setup_;
