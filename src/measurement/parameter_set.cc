@@ -187,7 +187,8 @@ bool IsAngularName(const std::string& name) {
       return true;
   // A socket's direction from its parent (socket_measurement.h): "socket1_u1", "socket1_u2".
   if (name.rfind("socket", 0) == 0 && name.size() > 3 &&
-      (name.compare(name.size() - 3, 3, "_u1") == 0 || name.compare(name.size() - 3, 3, "_u2") == 0))
+      (name.compare(name.size() - 3, 3, "_u1") == 0 ||
+       name.compare(name.size() - 3, 3, "_u2") == 0))
     return true;
   int plane;
   std::string term;
