@@ -405,7 +405,7 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
   RefuseRangerOptions(
       vm, sensor,
       {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
-       "prior-sigma", "prior", "average", "predict-at", "holdout", "report"});
+       "average", "predict-at", "holdout", "report"});
   // A calibrated robot file that could not be written is refused before the fit, not after.
   if (vm.count("write-robot"))
     CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
@@ -460,7 +460,7 @@ int SocketIdentify(const po::variables_map& vm) {
   RefuseRangerOptions(
       vm, "socket",
       {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
-       "prior-sigma", "prior", "average", "predict-at", "holdout", "report"});
+       "average", "predict-at", "holdout", "report"});
   if (vm.count("write-robot"))
     CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
   const RobotFile rig = LoadRobot(vm);

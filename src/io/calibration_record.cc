@@ -111,8 +111,15 @@ UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const MeasurementKind& k
     G.col(i) = G_all.col(it - names.begin());
   }
   for (int c = 0; c < k; ++c) Gu.col(c) = G_all.col(held[c]);
-  (void)options;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(G.transpose() * w.asDiagonal() * G);
+  // With priors the fit solved the augmented rows (prior.h): their weights (σ/σ_k)² join the
+  // normal matrix, so a term only the prior sets still has a finite shift.
+  Eigen::MatrixXd A = G.transpose() * w.asDiagonal() * G;
+  if (!options.priors.empty()) {
+    const Eigen::VectorXd prior = options.priors.SigmasOf(s.names);
+    for (int i = 0; i < n; ++i)
+      if (prior[i] > 0) A(i, i) += (options.sigma / prior[i]) * (options.sigma / prior[i]);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
   if (ldlt.info() != Eigen::Success)
     throw std::logic_error("tracker record: the estimated terms' normal matrix is singular");
   out.estimate_shift = ldlt.solve(G.transpose() * w.asDiagonal() * Gu);

@@ -185,10 +185,13 @@ bool IsAngularName(const std::string& name) {
     if (name.size() > suffix.size() &&
         name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
       return true;
-  // A socket's direction from its parent (socket_measurement.h): "socket1_u1", "socket1_u2".
-  if (name.rfind("socket", 0) == 0 && name.size() > 3 &&
-      (name.compare(name.size() - 3, 3, "_u1") == 0 ||
-       name.compare(name.size() - 3, 3, "_u2") == 0))
+  // A socket's direction from its parent (socket_measurement.h): "socket1_u1", "socket1_u2",
+  // and their class "socket_u".
+  const auto ends_with = [&](const std::string& suffix) {
+    return name.size() > suffix.size() &&
+           name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (name.rfind("socket", 0) == 0 && (ends_with("_u1") || ends_with("_u2") || ends_with("_u")))
     return true;
   int plane;
   std::string term;

@@ -255,6 +255,18 @@ TEST_F(SensorCli, SocketSeatingsCalibrateTheArmWithALengthReference) {
   EXPECT_NEAR(at("beta2"), 1.45e-3, kExact);
   EXPECT_NEAR(at("alpha5"), -4.83e-3, kExact);
   EXPECT_NEAR(at("d6"), 0.85e-3, kExact);
+  // With priors nothing needs holding: the gauge directions are set by the priors, and a
+  // robot file is still written with the arm's terms.
+  ASSERT_EQ(Run("identify --sensor socket --data " + Path("seated.csv") + sockets +
+                    " --sigma-mm 0.1 --prior-sigma theta=5mrad,alpha=5mrad,beta=5mrad,a=1mm,d=1mm,"
+                    "target_x=1mm,target_y=1mm,target_z=1mm,socket_z=10mm,socket_u=20mrad "
+                    "--write-robot " +
+                    Path("prior.yaml"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("set by the prior (posterior/prior std above 0.9):"));
+  EXPECT_THAT(out, ::testing::Not(HasSubstr("fixed at nominal because of rank deficiency")));
   for (const std::string& model : {std::string("paper"), Path("cal.yaml")}) {
     ASSERT_EQ(Run("accuracy --format json --robot " + model + " --sockets " + Path("seated.csv") +
                       sockets,
