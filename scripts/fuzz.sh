@@ -23,7 +23,7 @@ sources=(core/strings core/json core/hash core/data_dir core/random core/setting
          identification/identification_options identification/prior design/design_options io/csv
          io/robot_file io/urdf io/yaml_util study/study study/stop_when study/sensitivity
          study/truth_options io/socket_data io/robot_data measurement/socket_measurement
-         measurement/point_measurement kinematics/chain)
+         measurement/point_measurement kinematics/chain kinematics/joint_constraints)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
   local name=$1 obj="$out/obj/${1//\//_}.o"

@@ -80,6 +80,36 @@ Pose<double> ToolPose(const ChainPoint& point, const ConfigurationSet& configs, 
   return pose;
 }
 
+Eigen::Vector3d LinkValueRotation(const ChainFrames& f, int index) {
+  const int link = index / kValuesPerLink;
+  switch (index % kValuesPerLink) {
+    case kTheta:
+      return f.z_prev[link];
+    case kAlpha:
+      return f.x_common[link];
+    case kBeta:
+      return f.y_twist[link];
+    default:  // kD, kA
+      return Eigen::Vector3d::Zero();
+  }
+}
+
+Eigen::Vector3d LinkValuePointMotion(const ChainFrames& f, int index, const Eigen::Vector3d& P) {
+  const int link = index / kValuesPerLink;
+  switch (index % kValuesPerLink) {
+    case kTheta:
+      return f.z_prev[link].cross(P - f.o_prev[link]);
+    case kD:
+      return f.z_prev[link];
+    case kA:
+      return f.x_common[link];
+    case kAlpha:
+      return f.x_common[link].cross(P - f.o[link]);
+    default:  // kBeta
+      return f.y_twist[link].cross(P - f.o[link]);
+  }
+}
+
 Eigen::Matrix<double, 6, Eigen::Dynamic> GeometricJacobian(const RobotModel& model,
                                                            const Eigen::VectorXd& link_values,
                                                            const double* q) {

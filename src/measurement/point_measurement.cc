@@ -19,40 +19,6 @@ constexpr const char* kInstrumentTerms[6] = {"instrument_x",     "instrument_y",
 constexpr const char* kAxes[3] = {"x", "y", "z"};
 constexpr const char* kRotations[3] = {"roll", "pitch", "yaw"};
 
-// The body-frame angular motion ω_B (base frame) of the tool per link value `index`: the joint
-// axis for θ, the common normal for α, the twist axis for β; none for the lengths d and a.
-Eigen::Vector3d AngularMotion(const ChainFrames& f, int index) {
-  const int link = index / kValuesPerLink;
-  switch (index % kValuesPerLink) {
-    case kTheta:
-      return f.z_prev[link];
-    case kAlpha:
-      return f.x_common[link];
-    case kBeta:
-      return f.y_twist[link];
-    default:  // kD, kA
-      return Eigen::Vector3d::Zero();
-  }
-}
-
-// The point's differential motion ∂P/∂v for link value `index` (base frame), from the chain's
-// frames at one configuration: the ranger's hit-point formulas (measurement_model.h).
-Eigen::Vector3d PointMotion(const ChainFrames& f, int index, const Eigen::Vector3d& P) {
-  const int link = index / kValuesPerLink;
-  switch (index % kValuesPerLink) {
-    case kTheta:
-      return f.z_prev[link].cross(P - f.o_prev[link]);
-    case kD:
-      return f.z_prev[link];
-    case kA:
-      return f.x_common[link];
-    case kAlpha:
-      return f.x_common[link].cross(P - f.o[link]);
-    default:  // kBeta
-      return f.y_twist[link].cross(P - f.o[link]);
-  }
-}
-
 class PointEvaluator : public MeasurementEvaluator {
  public:
   PointEvaluator(const PointMeasurement& kind, const TargetedConfigurations& configs,
@@ -91,7 +57,7 @@ class PointEvaluator : public MeasurementEvaluator {
     const Eigen::Matrix3d Rt = state_.R_BI.transpose();
     const std::vector<int>& values = kind_.robot_values();
     for (int k = 0; k < static_cast<int>(values.size()); ++k)
-      Put(J, m, k, row, Rt * PointMotion(frames_, values[k], P));
+      Put(J, m, k, row, Rt * LinkValuePointMotion(frames_, values[k], P));
     for (int c = 0; c < 3; ++c) Put(J, m, kind_.instrument_column(c), row, -Rt.col(c));
     // y = Rxᵀ·Ryᵀ·Rzᵀ·v, v = R_BI0ᵀ·(P − p_BI); dR/dφ = R·[e]× for each elementary rotation.
     const Eigen::Vector3d u2 =
@@ -120,7 +86,7 @@ class PointEvaluator : public MeasurementEvaluator {
     const Eigen::Matrix3d to_body = Jinv * R_BM.transpose();  // base-frame ω → rows
     const std::vector<int>& values = kind_.robot_values();
     for (int k = 0; k < static_cast<int>(values.size()); ++k)
-      Put(J, m, k, row, to_body * AngularMotion(frames_, values[k]));
+      Put(J, m, k, row, to_body * LinkValueRotation(frames_, values[k]));
     // The instrument's rotations turn R_IM on the left (frame I): ω_M = −R_IMᵀ·ω_I.
     const Eigen::Matrix3d from_instrument = -Jinv * R_IM.transpose();
     Put(J, m, kind_.instrument_column(3), row, from_instrument * Eigen::Vector3d::UnitX());

@@ -1,6 +1,5 @@
 #include "lrcal/measurement/socket_measurement.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -8,8 +7,8 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
-#include "lrcal/kinematics/chain.h"
 #include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/kinematics/joint_constraints.h"
 
 namespace lrcal {
 
@@ -75,22 +74,6 @@ class SocketEvaluator : public MeasurementEvaluator {
   std::vector<Eigen::Vector3d> positions_;
   std::vector<Eigen::MatrixXd> derivative_;
 };
-
-// Brings each revolute joint of q into its range by whole turns where it can; true when every
-// joint is then within its range.
-bool WithinJointRanges(const RobotModel& robot, double* q) {
-  constexpr double kTurn = 2 * 3.141592653589793;
-  bool within = true;
-  for (int j = 0; j < robot.num_links(); ++j) {
-    const Link& link = robot.links()[static_cast<std::size_t>(j)];
-    if (link.joint == JointType::kRevolute) {
-      while (q[j] > link.q_max && q[j] - kTurn >= link.q_min) q[j] -= kTurn;
-      while (q[j] < link.q_min && q[j] + kTurn <= link.q_max) q[j] += kTurn;
-    }
-    within = within && q[j] >= link.q_min && q[j] <= link.q_max;
-  }
-  return within;
-}
 
 }  // namespace
 
@@ -411,30 +394,17 @@ std::vector<Eigen::Vector3d> SocketPositionsFromData(const RobotModel& robot,
 
 bool SeatToolPoint(const RobotModel& robot, const Eigen::Vector3d& tool_point,
                    const Eigen::Vector3d& target, double* q) {
-  constexpr int kMaxSteps = 100;
-  constexpr double kTolerance = 1e-12;  // m
-  const Eigen::VectorXd& values = robot.nominal_values();
-  const int n = robot.num_links();
-  for (int step = 0; step <= kMaxSteps; ++step) {
-    const Pose<double> pose = ForwardKinematics<double>(robot, values.data(), q);
-    const Eigen::Vector3d offset = pose.R_BT * tool_point;
-    const Eigen::Vector3d error = target - (pose.p_BT + offset);
-    if (!error.allFinite()) return false;
-    if (error.norm() < kTolerance) return true;
-    if (step == kMaxSteps) break;
-    // The point's velocity per joint: the origin's, plus ω × (R_BT·t).
-    const Eigen::Matrix<double, 6, Eigen::Dynamic> G = GeometricJacobian(robot, values, q);
-    Eigen::Matrix<double, 3, Eigen::Dynamic> J(3, n);
-    for (int j = 0; j < n; ++j) J.col(j) = G.col(j).head<3>() + G.col(j).tail<3>().cross(offset);
-    const Eigen::Matrix3d JJt = J * J.transpose();
-    const Eigen::LDLT<Eigen::Matrix3d> solve(JJt);
-    if (solve.info() != Eigen::Success || !(std::fabs(JJt.determinant()) > 1e-18)) return false;
-    const Eigen::VectorXd dq = J.transpose() * solve.solve(error);
-    // A step of more than 0.5 rad is cut: far from the solution the linearisation is poor.
-    const double scale = std::min(1.0, 0.5 / std::max(dq.cwiseAbs().maxCoeff(), 1e-300));
-    for (int j = 0; j < n; ++j) q[j] += scale * dq[j];
-  }
-  return false;
+  return SolveJointConstraints(
+      robot, 3,
+      [&](const Pose<double>& pose, const Eigen::Matrix<double, 6, Eigen::Dynamic>& G,
+          Eigen::VectorXd* r, Eigen::MatrixXd* J) {
+        // The point's velocity per joint: the origin's, plus ω × (R_BT·t).
+        const Eigen::Vector3d offset = pose.R_BT * tool_point;
+        *r = pose.p_BT + offset - target;
+        for (int j = 0; j < static_cast<int>(G.cols()); ++j)
+          J->col(j) = G.col(j).head<3>() + G.col(j).tail<3>().cross(offset);
+      },
+      q);
 }
 
 int SimulateSocketMeasurements(const SocketMeasurement& truth, const TargetedConfigurations& starts,
@@ -471,7 +441,7 @@ int SimulateSocketMeasurements(const SocketMeasurement& truth, const TargetedCon
     const char* reason = nullptr;
     if (!SeatToolPoint(truth.robot(), tool_point, sockets[s] + play, q.data()))
       reason = "out of reach";
-    else if (!WithinJointRanges(truth.robot(), q.data()))
+    else if (!WrapIntoJointRanges(truth.robot(), q.data()))
       reason = "outside the joint ranges";
     if (reason) {
       ++missed;

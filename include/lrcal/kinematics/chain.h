@@ -44,6 +44,16 @@ void PrepareChainPoint(const RobotModel& robot, const double* link_values, Chain
 Pose<double> ToolPose(const ChainPoint& point, const ConfigurationSet& configs, int i,
                       ChainFrames* frames = nullptr);
 
+/// The tool's rotation axis (base frame) per unit change of link value `index` (0 ≤ index < 5N),
+/// from the frames of one configuration: the joint axis z_{i−1} for θ_i, the common normal x_i
+/// for α_i, the twist axis for β_i; zero for the lengths d_i and a_i.
+Eigen::Vector3d LinkValueRotation(const ChainFrames& f, int index);
+
+/// The motion ∂P/∂v (base frame) of a point P (base frame) rigidly attached to the tool per unit
+/// change of link value `index`: a rotation about the link's axis through its origin, or a shift
+/// along it.
+Eigen::Vector3d LinkValuePointMotion(const ChainFrames& f, int index, const Eigen::Vector3d& P);
+
 /// Geometric Jacobian (6×N, rows: linear velocity of the tool origin in B, then angular
 /// velocity in B) at the given link values. Used for singularity checks.
 Eigen::Matrix<double, 6, Eigen::Dynamic> GeometricJacobian(const RobotModel& model,

@@ -1,0 +1,256 @@
+// The contact measurement (contact_measurement.h): its analytic Jacobian against Ceres autodiff
+// through the reference kinematics and the constraint written out here, and against central
+// differences, for point and flush contacts with the planes' terms; seating and its play;
+// identifiability; a noise-free round trip through both solvers; located errors.
+#include "lrcal/measurement/contact_measurement.h"
+
+#include <ceres/jet.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "lrcal/core/error.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/truth.h"
+#include "test_util.h"
+#include "tracker_fixtures.h"
+
+namespace lrcal {
+namespace {
+
+using testing::EigenNear;
+using ::testing::HasSubstr;
+namespace tolerance = testing::tolerance;
+
+constexpr int kMaxContactTerms = 40;
+using ContactJet = ceres::Jet<double, kMaxContactTerms>;
+
+// Two planes within the paper arm's reach, a tilted floor and a wall, both estimated.
+ContactSetup TwoPlanes(bool flush) {
+  ContactSetup setup;
+  setup.planes = PlaneSet(
+      {Plane::FromCoefficients(0.1, 0.2, 1.0, -0.3), Plane::FromCoefficients(1.0, 0.0, 0.2, -0.9)},
+      {}, "test");
+  setup.plane_terms = {PlaneTerms{true, true}, PlaneTerms{true, true}};
+  setup.tool_point = Eigen::Vector3d(0.01, -0.02, 0.1);
+  setup.flush = flush;
+  return setup;
+}
+
+// Random starts (joints uniform in ±2.5 rad), configuration i on plane i mod 2.
+TargetedConfigurations Starts(int count, unsigned seed) {
+  return testing::RandomTrackerConfigurations(6, count, 2, seed);
+}
+
+template <typename T>
+std::vector<T> AllContactTerms(const ContactMeasurement& kind, const std::vector<T>& e) {
+  const std::vector<std::string> names = kind.AllTermNames();
+  std::vector<T> all(names.size(), T(0));
+  for (int k = 0; k < kind.num_parameters(); ++k) {
+    const auto it = std::find(names.begin(), names.end(), kind.parameter_names()[k]);
+    all[static_cast<std::size_t>(it - names.begin())] = e[static_cast<std::size_t>(k)];
+  }
+  return all;
+}
+
+// The rows written out independently: the reference kinematics, the plane's chart n(u) as
+// plane.h defines it, the tool z axis's gnomonic coordinates in that chart minus u.
+template <typename T>
+std::vector<T> ReferenceRows(const ContactMeasurement& kind, const std::vector<T>& all,
+                             const double* q, int plane) {
+  using V = Eigen::Matrix<T, 3, 1>;
+  const RobotModel& robot = kind.robot();
+  const std::vector<std::string> names = kind.AllTermNames();
+  const auto term = [&](const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    return it == names.end() ? T(0) : all[static_cast<std::size_t>(it - names.begin())];
+  };
+  std::vector<T> values(robot.num_values());
+  for (int k = 0; k < robot.num_values(); ++k)
+    values[k] = T(robot.nominal_values()[k]) + term(robot.ValueName(k));
+  const Pose<T> pose = ForwardKinematics<T>(robot, values.data(), q);
+  const V t =
+      kind.setup().tool_point.cast<T>() + V(term("target_x"), term("target_y"), term("target_z"));
+  const int np = kind.setup().planes.size();
+  const T u1 = term(PlaneTermName(plane, np, "u1")), u2 = term(PlaneTermName(plane, np, "u2"));
+  const NormalChart chart(kind.setup().planes[plane].normal);
+  const V n = chart.Normal(u1, u2);
+  const T f = T(kind.setup().planes[plane].offset) + term(PlaneTermName(plane, np, "f"));
+  std::vector<T> rows = {n.dot(pose.p_BT + pose.R_BT * t) + f};
+  if (!kind.setup().flush) return rows;
+  const V z = pose.R_BT.col(2);
+  const T zn = z.dot(chart.n0.cast<T>());
+  rows.push_back(z.dot(chart.t1.cast<T>()) / zn - u1);
+  rows.push_back(z.dot(chart.t2.cast<T>()) / zn - u2);
+  return rows;
+}
+
+class ContactJacobianTest
+    : public ::testing::TestWithParam<std::pair<bool, std::vector<std::string>>> {};
+
+TEST_P(ContactJacobianTest, MatchesAutodiffAndCentralDifferences) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const ContactMeasurement kind(robot, TwoPlanes(GetParam().first), GetParam().second);
+  // Flush rows divide by z·n0: at the seated postures of a flush contact (z near ±n0) as data
+  // have them; a point contact at any posture.
+  const TargetedConfigurations configs =
+      GetParam().first ? kind.LinearisationConfigurations(Starts(12, 5)) : Starts(12, 5);
+  const int n = kind.num_parameters(), k = kind.rows_per_configuration(), m = k * configs.size();
+  ASSERT_LE(n, kMaxContactTerms);
+  std::vector<double> e(static_cast<std::size_t>(n));
+  for (int c = 0; c < n; ++c) e[c] = (c % 2 ? 1 : -1) * (0.002 + 0.0003 * c);
+  std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(configs);
+  std::vector<double> y(m);
+  Eigen::MatrixXd J(m, n);
+  ASSERT_TRUE(evaluator->Predict(e.data(), y.data(), J.data()));
+
+  std::vector<ContactJet> ej(n);
+  for (int c = 0; c < n; ++c) ej[c] = ContactJet(e[c], c);
+  const std::vector<ContactJet> all = AllContactTerms(kind, ej);
+  Eigen::MatrixXd autodiff(m, n);
+  Eigen::VectorXd reference(m);
+  for (int i = 0; i < configs.size(); ++i) {
+    const std::vector<ContactJet> rows = ReferenceRows(kind, all, configs.q(i), configs.target(i));
+    for (int r = 0; r < k; ++r) {
+      reference[k * i + r] = rows[r].a;
+      for (int c = 0; c < n; ++c) autodiff(k * i + r, c) = rows[r].v[c];
+    }
+  }
+  EXPECT_THAT(Eigen::Map<Eigen::VectorXd>(y.data(), m), EigenNear(reference, tolerance::kUrdf));
+  EXPECT_THAT(J, EigenNear(autodiff, tolerance::kAutodiff));
+  EXPECT_THAT(J,
+              EigenNear(testing::CentralDifferences(*evaluator, e), tolerance::kCentralDifference));
+}
+
+INSTANTIATE_TEST_SUITE_P(Terms, ContactJacobianTest,
+                         ::testing::Values(std::make_pair(false, std::vector<std::string>{}),
+                                           std::make_pair(true, std::vector<std::string>{}),
+                                           std::make_pair(true, std::vector<std::string>{
+                                                                    "plane2_u1", "plane1_f",
+                                                                    "target_y", "theta2"})));
+
+// The kind a campaign reads from when `kind`'s terms are off nominal by `truth`.
+std::unique_ptr<ContactMeasurement> TrueContactKind(const ContactMeasurement& kind,
+                                                    const Eigen::VectorXd& truth,
+                                                    RobotModel* true_robot) {
+  const RobotModel& robot = kind.robot();
+  Truth errors;
+  errors.link_errors = Eigen::VectorXd::Zero(robot.num_values());
+  for (std::size_t c = 0; c < kind.arm().robot_values().size(); ++c)
+    errors.link_errors[kind.arm().robot_values()[c]] = truth[static_cast<Eigen::Index>(c)];
+  *true_robot = errors.TrueRobot(robot);
+  PointMeasurement::State arm;
+  kind.arm().StateAt(truth.data(), &arm);
+  ContactSetup setup = kind.setup();
+  setup.tool_point = arm.targets[0];
+  for (int p = 0; p < setup.planes.size(); ++p) {
+    const ContactMeasurement::PlaneState plane = kind.PlaneAt(truth.data(), p);
+    setup.planes[p].normal = plane.normal;
+    setup.planes[p].offset = plane.offset;
+  }
+  // The true kind measures tilts in the nominal planes' charts, as the data are recorded.
+  auto true_kind = std::make_unique<ContactMeasurement>(*true_robot, setup, kind.fixed());
+  return true_kind;
+}
+
+TEST(ContactMeasurement, SeatingPutsTheToolPointOnItsPlaneWithTheStatedPlay) {
+  const RobotModel& robot = testing::PaperRobot();
+  const ContactMeasurement kind(robot, TwoPlanes(false));
+  NoiseModel noise;
+  noise.sigma = 2e-4;
+  noise.repetitions = 4;
+  MeasuredValues data;
+  std::vector<std::string> misses;
+  const TargetedConfigurations starts = Starts(1200, 3);
+  const int missed = SimulateContactMeasurements(
+      kind, starts, noise, RandomStream(2, 0, 0, RandomPurpose::kNoise), &data, &misses);
+  EXPECT_LT(missed, starts.size() / 4);
+  ASSERT_EQ(data.size() + missed, starts.size());
+  std::vector<double> y(data.size());
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kind.num_parameters());
+  kind.Bind(data.configs)->Predict(zero.data(), y.data(), nullptr);
+  double sum = 0, sum2 = 0;
+  for (double r : y) {
+    sum += r;
+    sum2 += r * r;
+  }
+  const double count = static_cast<double>(y.size()), sd = noise.sigma / 2;
+  EXPECT_NEAR(sum / count, 0.0, 4 * sd / std::sqrt(count));
+  EXPECT_NEAR(sum2 / count / (sd * sd), 1.0, 4 * std::sqrt(2 / count));
+}
+
+TEST(ContactMeasurement, FlushContactsSeeTheToolsTiltAndTheirRowsAreAngles) {
+  const RobotModel& robot = testing::PaperRobot();
+  const ContactMeasurement point(robot, TwoPlanes(false)), flush(robot, TwoPlanes(true));
+  EXPECT_EQ(point.rows_per_configuration(), 1);
+  EXPECT_EQ(flush.rows_per_configuration(), 3);
+  EXPECT_FALSE(flush.RowIsAngle(0));
+  EXPECT_TRUE(flush.RowIsAngle(1));
+  NoiseModel exact;
+  exact.sigma = 0;
+  exact.sigma_angle = 0;
+  MeasuredValues data;
+  SimulateContactMeasurements(flush, Starts(90, 4), exact,
+                              RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+  ASSERT_GT(data.size(), 40);
+  // Flush contacts also see the tool's orientation: more identifiable combinations.
+  const IdentifiabilityReport a = AnalyzeIdentifiability(point, data.configs);
+  const IdentifiabilityReport b = AnalyzeIdentifiability(flush, data.configs);
+  EXPECT_EQ(a.num_params(), b.num_params());
+  EXPECT_GT(b.rank, a.rank) << a.ToString() << b.ToString();
+}
+
+TEST(ContactMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
+  for (bool flush : {false, true}) {
+    SCOPED_TRACE(flush ? "flush" : "point contact");
+    const RobotModel& robot = testing::PaperRobotWithFrames();
+    const ContactMeasurement full(robot, TwoPlanes(flush));
+    NoiseModel exact;
+    exact.sigma = 0;
+    exact.sigma_angle = 0;
+    MeasuredValues nominal_data;
+    SimulateContactMeasurements(full, Starts(160, 8), exact,
+                                RandomStream(1, 0, 0, RandomPurpose::kNoise), &nominal_data);
+    const IdentifiabilityReport report = AnalyzeIdentifiability(full, nominal_data.configs);
+    const std::unique_ptr<MeasurementKind> reduced = full.Without(report.suggested_fixed);
+    const auto& kind = dynamic_cast<const ContactMeasurement&>(*reduced);
+    const Eigen::VectorXd truth = testing::SomeTruth(kind, 6);
+    RobotModel true_robot;
+    const std::unique_ptr<ContactMeasurement> true_kind = TrueContactKind(kind, truth, &true_robot);
+    MeasuredValues data;
+    SimulateContactMeasurements(*true_kind, Starts(160, 8), exact,
+                                RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);
+    ASSERT_GT(data.size(), kind.num_parameters());
+    for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
+                        IdentificationOptions::Solver::kCeres}) {
+      IdentificationOptions options;
+      options.solver = solver;
+      const IdentificationSummary s = Identify(kind, data, options);
+      ASSERT_TRUE(s.IsSolutionUsable()) << s.message;
+      EXPECT_THAT(s.delta, EigenNear(truth, tolerance::kRoundTrip)) << s.solver;
+      EXPECT_LT(s.residual_rms, 1e-12);
+    }
+  }
+}
+
+TEST(ContactMeasurement, BadSetUpsAndTermsAreNamed) {
+  const RobotModel& robot = testing::PaperRobot();
+  ContactSetup bad = TwoPlanes(false);
+  bad.plane_terms.resize(1);
+  EXPECT_THAT([&] { bad.Validate(); }, ::testing::ThrowsMessage<InputError>(HasSubstr(
+                                           "contact.plane_terms: expected none or one per plane")));
+  EXPECT_THAT([&] { ContactMeasurement(robot, TwoPlanes(false), {"plane3_u1"}, "--fix"); },
+              ::testing::ThrowsMessage<InputError>(
+                  HasSubstr("--fix: 'plane3_u1' is not a term of the contact measurement")));
+  const ContactMeasurement kind(robot, TwoPlanes(false));
+  TargetedConfigurations third(6);
+  third.Add(std::vector<double>(6, 0.1), 2);
+  EXPECT_THAT([&] { kind.Bind(third); },
+              ::testing::ThrowsMessage<InputError>(HasSubstr("touches plane 3")));
+}
+
+}  // namespace
+}  // namespace lrcal
