@@ -89,9 +89,13 @@ Setup ResolveSetup(const po::variables_map& vm) {
 void AddSensorOptions(po::options_description& o) {
   o.add_options()("sensor", po::value<std::string>()->default_value("ranger"),
                   "the measurement: ranger (a distance to a plane), point (a tracker's reflector "
-                  "in the instrument's frame), pose (a 6-D probe: position and orientation) or "
-                  "socket (the tool point seated in fixed sockets: a CSV's socket column)");
+                  "in the instrument's frame), pose (a 6-D probe: position and orientation), "
+                  "socket (the tool point seated in fixed sockets: a CSV's socket column) or "
+                  "contact (the tool point on a plane: a CSV's plane column)");
   AddTrackerGeometryOptions(o);
+  o.add_options()("flush", po::bool_switch(),
+                  "contact: every contact is flush (the tool's z axis square to the plane: two "
+                  "more values per configuration), where a file has no flush column");
   o.add_options()("socket-distance", po::value<std::vector<std::string>>()->composing(),
                   "socket: a known distance between two sockets as A,B=METRES (socket ids, m; "
                   "e.g. 0,1=0.05): the length reference that fixes the arm's scale; repeat for "
@@ -111,15 +115,19 @@ void AddTrackerGeometryOptions(po::options_description& o) {
 
 std::string ResolveSensor(const po::variables_map& vm) {
   const std::string sensor = vm["sensor"].as<std::string>();
-  if (sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket") {
+  if (sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket" ||
+      sensor == "contact") {
+    if (sensor != "contact" && vm.count("flush") && vm["flush"].as<bool>())
+      throw InputError("--flush",
+                       "is the contact sensor's; --sensor " + sensor + " does not take it");
     if (sensor != "socket" && vm.count("socket-distance"))
       throw InputError("--socket-distance",
                        "is the socket sensor's; --sensor " + sensor + " does not take it");
     return sensor;
   }
   throw InputError("--sensor", "'" + CellExcerpt(sensor) +
-                                   "' is not a sensor lrcal models: expected ranger, point, pose "
-                                   "or socket");
+                                   "' is not a sensor lrcal models: expected ranger, point, pose, "
+                                   "socket or contact");
 }
 
 namespace {
@@ -186,10 +194,12 @@ void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
       throw InputError(
           "--" + option,
           "is the ranger's; --sensor " + sensor + " does not take it (its own terms " +
-              (sensor == "socket" ? "are the tool point and the sockets: --target, "
-                                    "--socket-distance, --fix)"
-                                  : "are the instrument's frame and the targets: --instrument, "
-                                    "--target, --fix)"));
+              (sensor == "socket"    ? "are the tool point and the sockets: --target, "
+                                       "--socket-distance, --fix)"
+               : sensor == "contact" ? "are the tool point and the planes: --target, --plane, "
+                                       "--estimate-plane, --flush, --fix)"
+                                     : "are the instrument's frame and the targets: --instrument, "
+                                       "--target, --fix)"));
 }
 
 std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) {
@@ -200,22 +210,46 @@ std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) 
   return distances;
 }
 
-std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
-                                                  const po::variables_map& vm) {
+namespace {
+
+// The one tool point of --target for a constraint kind (socket, contact).
+Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string& sensor) {
   if (vm.count("instrument") && !vm["instrument"].defaulted())
-    throw InputError("--instrument",
-                     "--sensor socket has no instrument: the sockets are estimated in the base "
-                     "frame");
+    throw InputError("--instrument", "--sensor " + sensor +
+                                         " has no instrument: the tool touches fixed things "
+                                         "given in the base frame");
   const PointSetup point = ResolvePointSetup(vm);
   if (point.targets.size() != 1 ||
       (!point.target_orientations.empty() && !point.target_orientations[0].isIdentity(0)))
-    throw InputError("--target", "--sensor socket takes one tool point as x,y,z (m, tool frame)");
+    throw InputError("--target",
+                     "--sensor " + sensor + " takes one tool point as x,y,z (m, tool frame)");
+  return point.targets[0];
+}
+
+}  // namespace
+
+std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, const PlaneSet& planes,
+                                                    bool flush, const po::variables_map& vm) {
+  ContactSetup setup;
+  setup.planes = planes;
+  setup.tool_point = ResolveToolPoint(vm, "contact");
+  setup.flush = flush;
+  const PlaneTerms terms = PlaneTerms::Parse(
+      vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
+  setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);
+  std::vector<std::string> fixed;
+  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  return std::make_unique<ContactMeasurement>(robot, setup, fixed, "--fix");
+}
+
+std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
+                                                  const po::variables_map& vm) {
+  const Eigen::Vector3d tool_point = ResolveToolPoint(vm, "socket");
   std::vector<std::string> fixed;
   if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
   return std::make_unique<SocketMeasurement>(
       robot,
-      SocketSetupFromData(robot, data, point.targets[0], ResolveSocketDistances(vm),
-                          "--socket-distance"),
+      SocketSetupFromData(robot, data, tool_point, ResolveSocketDistances(vm), "--socket-distance"),
       fixed, "--fix");
 }
 

@@ -16,10 +16,12 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/io/contact_data.h"
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/socket_data.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/pose_measurement.h"
@@ -89,6 +91,11 @@ std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm);
 /// --socket-distance and --fix. Refuses --instrument (InputError naming it).
 std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
                                                   const po::variables_map& vm);
+/// The contact kind on `robot` and `planes` (--plane or the robot file's), flush or not, with the
+/// tool point from --target (x,y,z, one), the planes' terms from --estimate-plane and --fix.
+/// Refuses --instrument (InputError naming it).
+std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, const PlaneSet& planes,
+                                                    bool flush, const po::variables_map& vm);
 /// --sigma-mrad: the standard deviation of one reading of a pose's orientation component.
 void AddOrientationNoiseOption(po::options_description& o);
 /// --sigma-mrad in rad (InputError naming it unless finite and > 0, or ≥ 0 with `allow_zero`:

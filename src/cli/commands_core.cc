@@ -220,6 +220,38 @@ int SocketSimulate(const po::variables_map& vm) {
   return 0;
 }
 
+// simulate --sensor contact: the configurations (a CSV with a plane column: where to start)
+// moved until the true arm's tool point touches its plane (and, with --flush, the tool is square
+// to it), plus a play of --sigma-mm along the normal and a tilt of --sigma-mrad.
+int ContactSimulate(const po::variables_map& vm) {
+  RefuseRangerOptions(
+      vm, "contact",
+      {"encoder-sigma-mrad", "form-sigma-mm", "outlier-fraction", "outlier-sigma-mm"});
+  const Setup setup = ResolveSetup(vm);
+  const RobotModel true_robot = setup.rig.truth.TrueRobot(setup.rig.robot);
+  const bool flush = vm["flush"].as<bool>();
+  const ContactData starts =
+      ReadContactData(vm["configs"].as<std::string>(), setup.rig.robot, setup.planes, flush);
+  const std::unique_ptr<ContactMeasurement> truth =
+      MakeContactKind(true_robot, setup.planes, starts.flush, vm);
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  noise.sigma_angle = ResolveSigmaAngle(vm, true);
+  // One contact per row unless --repetitions says otherwise (a ranger's default is 10 readings).
+  if (vm["repetitions"].defaulted()) noise.repetitions = 1;
+  MeasuredValues data;
+  const int missed =
+      SimulateContactMeasurements(*truth, starts.values.configs, noise,
+                                  RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data);
+  const std::string path = vm["out"].as<std::string>();
+  WriteContactData(path, data, starts.flush);
+  std::cerr << "lrcal simulate: " << data.size() << (starts.flush ? " flush" : "")
+            << " contacts written to " << path;
+  if (missed > 0) std::cerr << " (" << missed << " start(s) out of reach, left out)";
+  std::cerr << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int SimulateCommand(const std::vector<std::string>& args) {
@@ -239,6 +271,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "socket") return SocketSimulate(vm);
+  if (sensor == "contact") return ContactSimulate(vm);
   if (vm.count("socket"))
     throw InputError("--socket",
                      "is the socket sensor's; --sensor " + sensor + " does not take it");
@@ -402,10 +435,9 @@ namespace {
 // identify --sensor point|pose: the tracker's terms from its measurement file (tracker_data.h).
 // A pose's orientation rows weigh (σ/σ_angle)² per reading against its positions.
 int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
-  RefuseRangerOptions(
-      vm, sensor,
-      {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
-       "average", "predict-at", "holdout", "report"});
+  RefuseRangerOptions(vm, sensor,
+                      {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
+                       "estimate-tool", "average", "predict-at", "holdout", "report"});
   // A calibrated robot file that could not be written is refused before the fit, not after.
   if (vm.count("write-robot"))
     CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
@@ -457,10 +489,9 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
 // identify --sensor socket: the arm's terms, the tool point and the sockets from socket data
 // (socket_data.h); the sockets' nominal positions are the nominal model's mean tool points.
 int SocketIdentify(const po::variables_map& vm) {
-  RefuseRangerOptions(
-      vm, "socket",
-      {"plane", "estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool",
-       "average", "predict-at", "holdout", "report"});
+  RefuseRangerOptions(vm, "socket",
+                      {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
+                       "estimate-tool", "average", "predict-at", "holdout", "report"});
   if (vm.count("write-robot"))
     CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
   const RobotFile rig = LoadRobot(vm);
@@ -506,6 +537,62 @@ int SocketIdentify(const po::variables_map& vm) {
   return s.IsSolutionUsable() ? 0 : 1;
 }
 
+// identify --sensor contact: the arm's terms, the tool point and the planes' estimated terms
+// from contact data (contact_data.h); a flush contact's tilt rows weigh (σ/σ_angle)².
+int ContactIdentify(const po::variables_map& vm) {
+  RefuseRangerOptions(vm, "contact",
+                      {"estimate-ranger", "estimate-base", "estimate-tool", "average", "predict-at",
+                       "holdout", "report"});
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
+  const std::string file = vm["data"].as<std::string>();
+  ContactData data = ReadContactData(file, rig.robot, setup.planes, vm["flush"].as<bool>());
+  const std::unique_ptr<ContactMeasurement> kind =
+      MakeContactKind(rig.robot, setup.planes, data.flush, vm);
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
+  if (data.flush)
+    WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
+                   ResolveSigmaAngle(vm, false), &data.values);
+  const IdentificationSummary s = Identify(*kind, data.values, options);
+  if (s.termination == Termination::kInvalidInput &&
+      data.values.size() * kind->rows_per_configuration() < kind->num_parameters())
+    throw InputError(file, s.message);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentificationJson(s);
+    j["sensor"] = "contact";
+    j["values_per_configuration"] = kind->rows_per_configuration();
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: contact (" << data.values.size() << (data.flush ? " flush" : "")
+              << " contacts on " << setup.planes.size()
+              << " plane(s); lengths in m, angles in rad)\n"
+              << s.FullReport();
+  }
+  if (s.termination == Termination::kRankDeficient) {
+    std::string list;
+    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
+    std::cerr << "lrcal identify: the contact terms are not identifiable from these "
+                 "configurations; fix the suggested ones (--fix "
+              << list << ") or pass --auto-fix\n";
+    return 3;
+  }
+  if (vm.count("write-robot") && s.IsSolutionUsable()) {
+    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
+                                *kind, data.values, s, options);
+    std::cerr << "lrcal identify: calibrated robot written to "
+              << vm["write-robot"].as<std::string>() << "\n";
+  }
+  if (s.IsSolutionUsable() && !s.fit.consistent) {
+    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm"
+              << (data.flush ? " and --sigma-mrad" : "") << " (p = " << s.fit.p_value
+              << " < 0.001); see the fit line above\n";
+    return 4;
+  }
+  return s.IsSolutionUsable() ? 0 : 1;
+}
+
 }  // namespace
 
 int IdentifyCommand(const std::vector<std::string>& args) {
@@ -519,6 +606,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "socket") return SocketIdentify(vm);
+  if (sensor == "contact") return ContactIdentify(vm);
   if (sensor != "ranger") return TrackerIdentify(vm, sensor);
   // A calibrated robot file that could not be written is refused before the fit, not after.
   if (vm.count("write-robot"))
@@ -636,6 +724,34 @@ int SocketIdentifiability(const po::variables_map& vm) {
   return 0;
 }
 
+// identifiability --sensor contact: the arm's terms, the tool point and the planes' terms at
+// the configurations (a `plane` column says which plane each row touches).
+int ContactIdentifiability(const po::variables_map& vm) {
+  RefuseRangerOptions(
+      vm, "contact", {"estimate-ranger", "estimate-base", "estimate-tool", "prior-sigma", "prior"});
+  const Setup setup = ResolveSetup(vm);
+  const ContactData data = ReadContactData(vm["configs"].as<std::string>(), setup.rig.robot,
+                                           setup.planes, vm["flush"].as<bool>());
+  const std::unique_ptr<ContactMeasurement> kind =
+      MakeContactKind(setup.rig.robot, setup.planes, data.flush, vm);
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  const IdentifiabilityReport r =
+      AnalyzeIdentifiability(*kind, data.values.configs, nullptr, options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentifiabilityJson(r);
+    j["sensor"] = "contact";
+    j["values_per_configuration"] = kind->rows_per_configuration();
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: contact (the tool point on its plane: a distance in m"
+              << (data.flush ? " and the tool's tilt in rad" : "") << " per configuration; "
+              << setup.planes.size() << " plane(s))\n"
+              << r.ToString();
+  }
+  return 0;
+}
+
 }  // namespace
 
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
@@ -661,6 +777,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "socket") return SocketIdentifiability(vm);
+  if (sensor == "contact") return ContactIdentifiability(vm);
   if (sensor != "ranger") return TrackerIdentifiability(vm, sensor);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;

@@ -11,6 +11,7 @@
 #include "lrcal/core/hash.h"
 #include "lrcal/core/json.h"
 #include "lrcal/core/settings.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/socket_measurement.h"
 
@@ -65,6 +66,8 @@ UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const MeasurementKind& k
   std::unique_ptr<MeasurementKind> unfixed;
   if (const auto* socket = dynamic_cast<const SocketMeasurement*>(&kind)) {
     unfixed = std::make_unique<SocketMeasurement>(socket->robot(), socket->setup());
+  } else if (const auto* contact = dynamic_cast<const ContactMeasurement*>(&kind)) {
+    unfixed = std::make_unique<ContactMeasurement>(contact->robot(), contact->setup());
   } else {
     const auto& point = dynamic_cast<const PointMeasurement&>(kind);
     unfixed = dynamic_cast<const PoseMeasurement*>(&kind)

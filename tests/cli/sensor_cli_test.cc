@@ -283,5 +283,68 @@ TEST_F(SensorCli, SocketSeatingsCalibrateTheArmWithALengthReference) {
   }
 }
 
+// Plane contacts as a user meets them: the 40 configurations, alternately on a tilted floor and a
+// wall, are seated on the true arm by `simulate --sensor contact`; the analysis counts what the
+// contacts identify with both planes estimated; noise-free, `identify --sensor contact
+// --auto-fix` leaves no residual and finds the true errors its held terms do not touch.
+TEST_F(SensorCli, PlaneContactsCalibrateTheArmWithThePlanesEstimated) {
+  std::ifstream in(Path("c.csv"));
+  std::ostringstream tagged;
+  std::string line;
+  std::getline(in, line);
+  tagged << line << ",plane\n";
+  for (int i = 0; std::getline(in, line); ++i) tagged << line << "," << 1 + i % 2 << "\n";
+  std::ofstream(Path("starts.csv")) << tagged.str();
+  const std::string planes = " --plane 0.1,0.2,1,-0.3 --plane 1,0,0.2,-0.9";
+  std::string out;
+  ASSERT_EQ(Run("simulate --sensor contact --configs " + Path("starts.csv") + planes +
+                    " --sigma-mm 0 --out " + Path("contacts.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("40 contacts written"));
+  ASSERT_EQ(Run("identifiability --sensor contact --format json --estimate-plane normal,offset "
+                "--configs " +
+                    Path("contacts.csv") + planes,
+                &out),
+            0)
+      << out;
+  const Json analysis = Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  EXPECT_EQ(analysis["sensor"], "contact");
+  EXPECT_EQ(analysis["values_per_configuration"], 1);
+  EXPECT_EQ(analysis["n_params"], 25 + 3 + 6);
+  EXPECT_EQ(analysis["rank"], 26);
+  ASSERT_EQ(Run("identify --sensor contact --format json --auto-fix --estimate-plane "
+                "normal,offset --data " +
+                    Path("contacts.csv") + planes,
+                &out),
+            0)
+      << out;
+  const Json fit = Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
+  const auto at = [&](const std::string& name) {
+    for (const Json& p : fit["parameters"])
+      if (p["name"] == name) return p["delta"].get<double>();
+    ADD_FAILURE() << name << " not estimated";
+    return 0.0;
+  };
+  constexpr double kExact = 1e-9;  // studies/robots/paper.yaml's true errors, SI
+  EXPECT_NEAR(at("beta2"), 1.45e-3, kExact);
+  EXPECT_NEAR(at("alpha5"), -4.83e-3, kExact);
+  // A flush file says so in its flush column; a file mixing both is refused by line.
+  ASSERT_EQ(Run("simulate --sensor contact --flush --configs " + Path("starts.csv") + planes +
+                    " --sigma-mm 0.01 --sigma-mrad 0.05 --out " + Path("flush.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identify --sensor contact --auto-fix --sigma-mm 0.01 --sigma-mrad 0.05 --data " +
+                    Path("flush.csv") + planes,
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("flush contacts on 2 plane(s)"));
+  EXPECT_THAT(out, HasSubstr("consistent with the stated noise"));
+}
+
 }  // namespace
 }  // namespace lrcal
