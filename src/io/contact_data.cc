@@ -12,7 +12,7 @@ namespace lrcal {
 
 namespace {
 
-constexpr int kMaxReadingsPerRow = 1000000;
+constexpr int kMaxContactReadingsPerRow = 1000000;
 
 }  // namespace
 
@@ -39,7 +39,7 @@ ContactData ReadContactData(const std::string& path, const RobotModel& robot,
     int count = 1;
     if (readings >= 0) {
       const double n = t.Number(r, readings);
-      if (!(n >= 1 && n <= kMaxReadingsPerRow && n == std::floor(n)))
+      if (!(n >= 1 && n <= kMaxContactReadingsPerRow && n == std::floor(n)))
         throw InputError(Location(t.path, t.lines[r]) + " column 'readings'",
                          "expected a whole number of contacts from 1 to 1,000,000, got '" +
                              CellExcerpt(t.rows[r][readings]) + "'");

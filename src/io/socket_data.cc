@@ -13,8 +13,8 @@ namespace lrcal {
 
 namespace {
 
-constexpr double kMaxSocketId = 1e9;
-constexpr int kMaxReadingsPerRow = 1000000;
+constexpr double kMaxSocketIdValue = 1e9;
+constexpr int kMaxSocketReadingsPerRow = 1000000;
 
 }  // namespace
 
@@ -32,14 +32,14 @@ SocketData ReadSocketData(const std::string& path, const RobotModel& robot) {
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     const std::string& cell = t.rows[r][column];
     double v;
-    if (!ParseDecimal(cell, &v) || !(v >= 0 && v <= kMaxSocketId) || v != std::floor(v))
+    if (!ParseDecimal(cell, &v) || !(v >= 0 && v <= kMaxSocketIdValue) || v != std::floor(v))
       throw InputError(Location(t.path, t.lines[r]) + " column 'socket'",
                        "'" + CellExcerpt(cell) +
                            "' is not a socket id: expected a whole number from 0 to 1000000000");
     socket[r] = static_cast<int>(v);
     if (readings < 0) continue;
     const double n = t.Number(r, readings);
-    if (!(n >= 1 && n <= kMaxReadingsPerRow && n == std::floor(n)))
+    if (!(n >= 1 && n <= kMaxSocketReadingsPerRow && n == std::floor(n)))
       throw InputError(Location(t.path, t.lines[r]) + " column 'readings'",
                        "expected a whole number of seatings from 1 to 1,000,000, got '" +
                            CellExcerpt(t.rows[r][readings]) + "'");

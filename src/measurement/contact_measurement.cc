@@ -11,25 +11,7 @@ namespace lrcal {
 
 namespace {
 
-constexpr const char* kInstrumentTerms[6] = {"instrument_x",     "instrument_y",
-                                             "instrument_z",     "instrument_roll",
-                                             "instrument_pitch", "instrument_yaw"};
 constexpr const char* kPlaneTerms[3] = {"u1", "u2", "f"};
-
-// The arm's point kind: the instrument at the base frame, held; the tool point its one target.
-PointSetup ArmSetup(const ContactSetup& setup) {
-  PointSetup arm;
-  arm.targets = {setup.tool_point};
-  return arm;
-}
-
-// The names of `fixed` that are the arm's, and the instrument's six (always held).
-std::vector<std::string> ArmFixed(const std::vector<std::string>& fixed) {
-  std::vector<std::string> arm(std::begin(kInstrumentTerms), std::end(kInstrumentTerms));
-  for (const std::string& name : fixed)
-    if (name.rfind("plane", 0) != 0) arm.push_back(name);
-  return arm;
-}
 
 // The gnomonic coordinates of direction z in `chart` (z·t/z·n0) and, if `d` is given, their
 // derivatives with respect to z (2 × 3).
@@ -144,7 +126,7 @@ void ContactSetup::Validate() const {
 ContactMeasurement::ContactMeasurement(const RobotModel& robot, ContactSetup setup,
                                        const std::vector<std::string>& fixed,
                                        const std::string& source)
-    : arm_(robot, ArmSetup(setup), ArmFixed(fixed), source),
+    : arm_(ToolPointKind(robot, setup.tool_point, fixed, source)),
       setup_(std::move(setup)),
       fixed_(fixed) {
   setup_.Validate();
@@ -189,8 +171,8 @@ std::vector<std::string> ContactMeasurement::PlaneTermNames() const {
 std::vector<std::string> ContactMeasurement::AllTermNames() const {
   std::vector<std::string> names;
   for (const std::string& name : arm_.AllTermNames())
-    if (std::find(std::begin(kInstrumentTerms), std::end(kInstrumentTerms), name) ==
-        std::end(kInstrumentTerms))
+    if (std::find(InstrumentTermNames().begin(), InstrumentTermNames().end(), name) ==
+        InstrumentTermNames().end())
       names.push_back(name);
   for (const std::string& name : PlaneTermNames()) names.push_back(name);
   return names;

@@ -116,6 +116,22 @@ class PointEvaluator : public MeasurementEvaluator {
 
 }  // namespace
 
+const std::vector<std::string>& InstrumentTermNames() {
+  static const std::vector<std::string> names(std::begin(kInstrumentTerms),
+                                              std::end(kInstrumentTerms));
+  return names;
+}
+
+PointMeasurement ToolPointKind(const RobotModel& robot, const Eigen::Vector3d& tool_point,
+                               const std::vector<std::string>& fixed, const std::string& source) {
+  PointSetup setup;
+  setup.targets = {tool_point};
+  std::vector<std::string> held = InstrumentTermNames();
+  for (const std::string& name : fixed)
+    if (robot.FindValue(name) >= 0 || name.rfind("target_", 0) == 0) held.push_back(name);
+  return PointMeasurement(robot, setup, held, source);
+}
+
 std::string TargetTermName(int k, int num_targets, const std::string& axis) {
   return num_targets == 1 ? "target_" + axis : "target" + std::to_string(k + 1) + "_" + axis;
 }

@@ -14,30 +14,11 @@ namespace lrcal {
 
 namespace {
 
-constexpr const char* kInstrumentTerms[6] = {"instrument_x",     "instrument_y",
-                                             "instrument_z",     "instrument_roll",
-                                             "instrument_pitch", "instrument_yaw"};
-
 // A non-negative integer id, or -1.
 int ParseId(const std::string& text) {
   double v;
   if (!ParseDecimal(text, &v) || v < 0 || v > 1e9 || v != std::floor(v)) return -1;
   return static_cast<int>(v);
-}
-
-// The arm's point kind: the instrument at the base frame, held; the tool point its one target.
-PointSetup ArmSetup(const SocketSetup& setup) {
-  PointSetup arm;
-  arm.targets = {setup.tool_point};
-  return arm;
-}
-
-// The names of `fixed` that are the arm's, and the instrument's six (always held).
-std::vector<std::string> ArmFixed(const std::vector<std::string>& fixed) {
-  std::vector<std::string> arm(std::begin(kInstrumentTerms), std::end(kInstrumentTerms));
-  for (const std::string& name : fixed)
-    if (name.rfind("socket", 0) != 0) arm.push_back(name);
-  return arm;
 }
 
 class SocketEvaluator : public MeasurementEvaluator {
@@ -168,7 +149,7 @@ void SocketSetup::Validate() const {
 SocketMeasurement::SocketMeasurement(const RobotModel& robot, SocketSetup setup,
                                      const std::vector<std::string>& fixed,
                                      const std::string& source)
-    : arm_(robot, ArmSetup(setup), ArmFixed(fixed), source),
+    : arm_(ToolPointKind(robot, setup.tool_point, fixed, source)),
       setup_(std::move(setup)),
       fixed_(fixed) {
   setup_.Validate();
@@ -257,8 +238,8 @@ std::vector<std::string> SocketMeasurement::SocketTermNames() const {
 std::vector<std::string> SocketMeasurement::AllTermNames() const {
   std::vector<std::string> names;
   for (const std::string& name : arm_.AllTermNames())
-    if (std::find(std::begin(kInstrumentTerms), std::end(kInstrumentTerms), name) ==
-        std::end(kInstrumentTerms))
+    if (std::find(InstrumentTermNames().begin(), InstrumentTermNames().end(), name) ==
+        InstrumentTermNames().end())
       names.push_back(name);
   for (const std::string& name : SocketTermNames()) names.push_back(name);
   return names;

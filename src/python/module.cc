@@ -36,6 +36,7 @@
 #include "lrcal/identification/measured_accuracy.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/calibration_record.h"
+#include "lrcal/io/contact_data.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/kinematics_report.h"
 #include "lrcal/io/result_json.h"
@@ -45,6 +46,7 @@
 #include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/pose_measurement.h"
@@ -1862,10 +1864,131 @@ rms_spread (m), sockets (id, configurations, centre, rms_spread, worst_spread), 
 (sockets, known, predicted, error; m).)doc");
 }
 
+// Contacts from Python: q (N, joints) on planes (plane_of: from 1, as for the ranger), the kind
+// as identify --sensor contact builds it.
+struct ContactArgs {
+  py::object plane, plane_of, tool_point, fix;
+  std::string estimate_plane;
+  bool flush;
+};
+
+std::unique_ptr<ContactMeasurement> ToContactKind(const RobotModel& robot, const PlaneSet& planes,
+                                                  const ContactArgs& a) {
+  ContactSetup setup;
+  setup.planes = planes;
+  setup.tool_point = ToToolPoint(a.tool_point);
+  setup.flush = a.flush;
+  setup.plane_terms.assign(static_cast<std::size_t>(planes.size()),
+                           PlaneTerms::Parse(a.estimate_plane, "estimate_plane"));
+  return std::make_unique<ContactMeasurement>(robot, setup, ToNames(a.fix), "fix");
+}
+
+TargetedConfigurations ToContactConfigurations(const RobotModel& robot, const Array& q,
+                                               const py::object& plane_of, int num_planes) {
+  TargetedConfigurations configs =
+      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, num_planes);
+  CheckJointRanges(configs, robot, "q");
+  return configs;
+}
+
+// simulate_contacts: as simulate --sensor contact.
+py::dict SimulateContactsPy(const RobotFile& rig, const Array& q, const ContactArgs& a,
+                            double sigma_mm, double sigma_mrad, long long repetitions,
+                            long long seed) {
+  const PlaneSet planes = ResolvePlanes(rig, a.plane);
+  const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
+  const std::unique_ptr<ContactMeasurement> truth = ToContactKind(true_robot, planes, a);
+  NoiseModel noise;
+  noise.sigma = sigma_mm * 1e-3;
+  noise.sigma_angle = sigma_mrad * 1e-3;
+  if (repetitions < 1 || repetitions > 1000000)
+    throw InputError("repetitions", "expected 1 to 1,000,000 contacts per configuration");
+  noise.repetitions = static_cast<int>(repetitions);
+  MeasuredValues data;
+  std::vector<std::string> misses;
+  SimulateContactMeasurements(
+      *truth, ToContactConfigurations(rig.robot, q, a.plane_of, planes.size()), noise,
+      RandomStream(ToSeed(seed), 0, 0, RandomPurpose::kNoise), &data, &misses);
+  py::dict out;
+  out["q"] = ToArray(data.configs);
+  out["plane_of"] = PlaneNumbers(data.configs);
+  out["repetitions"] = data.repetitions;
+  out["misses"] = misses;
+  return out;
+}
+
+// identify_contacts: as identify --sensor contact.
+IdentificationSummary IdentifyContactsPy(const RobotFile& rig, const Array& q, const ContactArgs& a,
+                                         const py::object& repetitions, bool auto_fix,
+                                         double sigma_mm, double sigma_mrad,
+                                         const std::string& solver) {
+  const PlaneSet planes = ResolvePlanes(rig, a.plane);
+  const std::unique_ptr<ContactMeasurement> kind = ToContactKind(rig.robot, planes, a);
+  MeasuredValues data{ToContactConfigurations(rig.robot, q, a.plane_of, planes.size()), {}, {}};
+  data.y.assign(static_cast<std::size_t>(kind->rows_per_configuration() * data.size()), 0.0);
+  data.repetitions.assign(static_cast<std::size_t>(data.size()), 1);
+  if (!repetitions.is_none()) data.repetitions = repetitions.cast<std::vector<int>>();
+  if (static_cast<int>(data.repetitions.size()) != data.size())
+    throw InputError("repetitions", "expected one count per row of q");
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
+  options.sigma = sigma_mm * 1e-3;
+  options.fix_dependent_parameters = auto_fix;
+  options.Validate();
+  if (a.flush)
+    WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma, sigma_mrad * 1e-3,
+                   &data);
+  py::gil_scoped_release release;
+  return Identify(*kind, data, options);
+}
+
+// The contact kind (contact_measurement.h): simulation and fit.
+void DefineContacts(py::module_& m) {
+  m.def(
+      "simulate_contacts",
+      [](const RobotFile& rig, const Array& q, const py::object& plane, const py::object& plane_of,
+         const py::object& tool_point, bool flush, double sigma_mm, double sigma_mrad,
+         long long repetitions, long long seed) {
+        return SimulateContactsPy(rig, q, {plane, plane_of, tool_point, py::none(), "none", flush},
+                                  sigma_mm, sigma_mrad, repetitions, seed);
+      },
+      py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
+      py::arg("plane_of") = py::none(), py::arg("tool_point") = py::none(),
+      py::arg("flush") = false, py::arg("sigma_mm") = 0.2, py::arg("sigma_mrad") = 0.2,
+      py::arg("repetitions") = 1, py::arg("seed") = 1, R"doc(
+Contacts of the true arm (nominal + the robot file's true errors) with planes: `lrcal simulate
+--sensor contact`. Each row of q (N, joints) is a start on plane plane_of[i] (from 1; plane= as
+in identify), moved until the true tool point (tool_point, (x, y, z) m in the tool frame)
+touches it, plus a play of sigma_mm along the normal; flush=True also squares the tool's z axis
+to the plane, with a tilt of sigma_mrad. Returns a dict: q, plane_of, repetitions of the seated
+rows, and misses (a reason per start).)doc");
+  m.def(
+      "identify_contacts",
+      [](const RobotFile& rig, const Array& q, const py::object& plane, const py::object& plane_of,
+         const py::object& tool_point, bool flush, const std::string& estimate_plane,
+         const py::object& repetitions, const py::object& fix, bool auto_fix, double sigma_mm,
+         double sigma_mrad, const std::string& solver) {
+        return IdentifyContactsPy(rig, q, {plane, plane_of, tool_point, fix, estimate_plane, flush},
+                                  repetitions, auto_fix, sigma_mm, sigma_mrad, solver);
+      },
+      py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
+      py::arg("plane_of") = py::none(), py::arg("tool_point") = py::none(),
+      py::arg("flush") = false, py::arg("estimate_plane") = "none",
+      py::arg("repetitions") = py::none(), py::arg("fix") = py::none(), py::arg("auto_fix") = false,
+      py::arg("sigma_mm") = 0.0, py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm", R"doc(
+The arm's link values, the tool point and the planes' estimated terms from contacts: `lrcal
+identify --sensor contact`. q (N, joints) on planes (plane, plane_of as in identify); flush,
+tool_point as in simulate_contacts; estimate_plane ("none", "normal", "offset",
+"normal,offset") for every plane; repetitions, fix, auto_fix, sigma_mm, sigma_mrad (a flush
+contact's tilt rows weigh (sigma_mm/sigma_mrad)^2) and solver as in identify_tracker. Returns an
+lrcal.Identification.)doc");
+}
+
 void DefineCalibration(py::module_& m) {
   DefineIdentifiability(m);
   DefineTrackers(m);
   DefineSockets(m);
+  DefineContacts(m);
   DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

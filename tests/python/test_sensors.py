@@ -137,3 +137,42 @@ def test_sockets_simulate_identify_and_judge_as_the_program(tmp_path, cli, paper
         lrcal.identify_sockets(paper, sim["q"], sim["socket_of"], socket_distances=[(0, 0, 0.05)])
     with pytest.raises(lrcal.InputError, match="socket_of: is the socket sensor's"):
         lrcal.identifiability(paper, sim["q"], socket_of=sim["socket_of"])
+
+
+PLANES = [lrcal.Plane([0.1, 0.2, 1.0], -0.3), lrcal.Plane([1.0, 0.0, 0.2], -0.9)]
+
+
+def test_contacts_simulate_and_identify_as_the_program(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    plane_of = [1 + i % 2 for i in range(40)]
+    starts = tmp_path / "s.csv"
+    with open(starts, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)] + ["plane"])
+        writer.writerows([[repr(v) for v in row] + [p] for row, p in zip(q, plane_of)])
+    planes = ["--plane", "0.1,0.2,1,-0.3", "--plane", "1,0,0.2,-0.9"]
+    cli("simulate", "--sensor", "contact", "--flush", "--configs", starts, *planes,
+        "--sigma-mm", "0.02", "--sigma-mrad", "0.1", "--seed", "4",
+        "--out", tmp_path / "contacts.csv")
+    sim = lrcal.simulate_contacts(paper, q, plane=PLANES, plane_of=plane_of, flush=True,
+                                  sigma_mm=0.02, sigma_mrad=0.1, seed=4)
+    with open(tmp_path / "contacts.csv") as f:
+        rows = list(csv.DictReader(f))
+    np.testing.assert_array_equal(sim["q"], [[float(r[f"q{j + 1}"]) for j in range(6)]
+                                             for r in rows])
+    assert list(sim["plane_of"]) == [int(r["plane"]) for r in rows]
+    assert {r["flush"] for r in rows} == {"1"}
+
+    fit = lrcal.identify_contacts(paper, sim["q"], plane=PLANES, plane_of=sim["plane_of"],
+                                  flush=True, estimate_plane="normal,offset", auto_fix=True,
+                                  sigma_mm=0.02, sigma_mrad=0.1)
+    done = cli("identify", "--sensor", "contact", "--data", tmp_path / "contacts.csv", *planes,
+               "--estimate-plane", "normal,offset", "--auto-fix", "--sigma-mm", "0.02",
+               "--sigma-mrad", "0.1", "--format", "json")
+    program = json.loads(done.stdout)
+    assert fit.names == [p["name"] for p in program["parameters"]]
+    np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
+                               rtol=0, atol=1e-12)
+    with pytest.raises(lrcal.InputError, match="estimate_plane"):
+        lrcal.identify_contacts(paper, sim["q"], plane=PLANES, plane_of=sim["plane_of"],
+                                estimate_plane="tilt")

@@ -128,6 +128,16 @@ class PointMeasurement : public MeasurementKind {
   bool orientation_ = false;
 };
 
+/// The instrument's six terms, in layout order: "instrument_x" … "instrument_yaw".
+const std::vector<std::string>& InstrumentTermNames();
+
+/// The point kind of a tool point given in the base frame itself: the instrument at B with its
+/// six terms held, `tool_point` (m, tool frame) its one target. What the constraint kinds
+/// (socket_measurement.h, contact_measurement.h) build their arm part on. Of `fixed`, only the
+/// robot's link values and target_x … target_z are taken (the rest are the other kind's).
+PointMeasurement ToolPointKind(const RobotModel& robot, const Eigen::Vector3d& tool_point,
+                               const std::vector<std::string>& fixed, const std::string& source);
+
 /// The name of target `k`'s term `axis` ("x", "y" or "z") among `num_targets`: "target_x" with
 /// one target, "target2_x" (k = 1) with several.
 std::string TargetTermName(int k, int num_targets, const std::string& axis);
