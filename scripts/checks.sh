@@ -62,8 +62,11 @@ for s in "${stages[@]}"; do
       # The same holds for the Monte-Carlo confirmations of plan-accuracy (one of them,
       # ConfirmationStopsWhenPreciseEnough, runs here), the calibration report in Chromium, the
       # averaging efficiency over large counts and a sensitivity study's plan points (the other
-      # sensitivity tests run here).
-      heavy='^(Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial|CalibrationReportRendersInHeadlessChromium)|PlanAccuracy\.(PlansOnTheTotalAndTheMonteCarloOfAHeldTermConfirmsIt|ChoosesAmongCandidatePlanes|ThePlanDoesNotDependOnWhereItIsWritten|EachPlanHasItsFolderAndAFolderKeepsItsSettings)|Averaging\.LargeCountsApproachTheAsymptoticEfficiency|SensitivityStudy\.PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
+      # sensitivity tests run here). Three more whole-run repeats (the sharded/resumed StopWhen
+      # check, a study whose plane is never hit, the plan-accuracy exit codes: 35 s of CPU) run
+      # in the Release suite only; their code runs here in the other StopWhen, study and
+      # plan-accuracy tests.
+      heavy='^(StopWhen\.StopsEveryCellWithThePrecisionStatedBitIdenticalAcrossThreadsShardsAndRestarts|Cases/BadStudyTest\.FailsBeforeAnythingRunsNamingLineAndKey/PlaneNeverHit.*|PlanAccuracy\.BadTargetsAndRangesAreExitTwo|Report\.(SensitivityStudyDrawsItsIndices|FiguresSayWhatTheyLeaveOut.*|QuickStudyReportRendersInHeadlessChromium|PartialRunIsReportedAsPartial|CalibrationReportRendersInHeadlessChromium)|PlanAccuracy\.(PlansOnTheTotalAndTheMonteCarloOfAHeldTermConfirmsIt|ChoosesAmongCandidatePlanes|ThePlanDoesNotDependOnWhereItIsWritten|EachPlanHasItsFolderAndAFolderKeepsItsSettings)|Averaging\.LargeCountsApproachTheAsymptoticEfficiency|SensitivityStudy\.PlanPointsAreCellsAndAnInputWithoutEffectHasZeroIndices|Storage\.MergeAndReportThatCannotWrite.*|SensitivityStudy\.ASingleTrialsFigureHasTheNoiseAsAnInput|Statistics\.P95IntervalsOfFortySeeds.*|Identification\.RobustFitCheckAgainstTheStatedNoise.*|MonteCarlo\.KilledProcessResumesToTheSameTables|Mpi\.KilledRankResumesWithAnotherRankCountToTheSameTables)$'
       # OpenMPI's own allocations are not freed at exit: leak checks off for the MPI tests only.
       ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j2 --output-on-failure \
         -E "^Mpi\.|$heavy"

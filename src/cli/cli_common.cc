@@ -249,7 +249,8 @@ std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const
   if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
   return std::make_unique<SocketMeasurement>(
       robot,
-      SocketSetupFromData(robot, data, tool_point, ResolveSocketDistances(vm), "--socket-distance"),
+      SocketSetupFromData(robot, data.ids, data.values.configs, tool_point,
+                          ResolveSocketDistances(vm), "--socket-distance"),
       fixed, "--fix");
 }
 

@@ -82,39 +82,6 @@ SocketData MakeSocketData(const ConfigurationSet& configs, const std::vector<int
   return data;
 }
 
-SocketSetup SocketSetupFromData(const RobotModel& robot, const SocketData& data,
-                                const Eigen::Vector3d& tool_point,
-                                const std::vector<SocketDistance>& distances,
-                                const std::string& distances_source) {
-  SocketSetup setup;
-  setup.ids = data.ids;
-  setup.tool_point = tool_point;
-  setup.positions = SocketPositionsFromData(robot, tool_point, data.values.configs,
-                                            static_cast<int>(data.ids.size()));
-  setup.distances = distances;
-  for (const SocketDistance& d : distances)
-    for (int id : {d.a, d.b})
-      if (setup.IndexOf(id) < 0)
-        throw InputError(distances_source, "socket " + std::to_string(id) +
-                                               " has no configuration in the data (they name " +
-                                               std::to_string(data.ids.size()) + " socket(s))");
-  try {
-    setup.Validate();
-  } catch (const InputError& e) {
-    // A cycle or a socket placed twice: named by the distance as given.
-    const std::string prefix = "socket.distances[";
-    if (e.where().rfind(prefix, 0) != 0) throw;
-    const std::size_t k = std::stoul(e.where().substr(prefix.size()));
-    const SocketDistance& d = distances[k];
-    std::ostringstream item;
-    item.precision(15);
-    item << d.a << "," << d.b << "=" << d.metres;
-    throw InputError(distances_source + " '" + item.str() + "'",
-                     std::string(e.what()).substr(e.where().size() + 2));
-  }
-  return setup;
-}
-
 void WriteSocketData(const std::string& path, const std::vector<int>& ids,
                      const MeasuredValues& data) {
   std::ostringstream out;

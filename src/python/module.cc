@@ -969,8 +969,8 @@ std::unique_ptr<SocketMeasurement> ToSocketKind(const RobotModel& robot, const S
                                                 const py::object& fix) {
   return std::make_unique<SocketMeasurement>(
       robot,
-      SocketSetupFromData(robot, data, ToToolPoint(tool_point), ToSocketDistances(distances),
-                          "socket_distances"),
+      SocketSetupFromData(robot, data.ids, data.values.configs, ToToolPoint(tool_point),
+                          ToSocketDistances(distances), "socket_distances"),
       ToNames(fix), "fix");
 }
 

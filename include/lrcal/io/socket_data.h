@@ -37,15 +37,6 @@ SocketData ReadSocketData(const std::string& path, const RobotModel& robot);
 SocketData MakeSocketData(const ConfigurationSet& configs, const std::vector<int>& socket_ids,
                           std::vector<int> repetitions, const std::string& source);
 
-/// The socket kind's nominal set-up for `data`: its ids, the nominal model's mean tool point per
-/// socket as the sockets' positions (SocketPositionsFromData), the tool point and the known
-/// distances. Throws InputError (where = `distances_source`) for a distance naming a socket the
-/// data do not have, closing a cycle or placing a socket twice.
-SocketSetup SocketSetupFromData(const RobotModel& robot, const SocketData& data,
-                                const Eigen::Vector3d& tool_point,
-                                const std::vector<SocketDistance>& distances,
-                                const std::string& distances_source);
-
 /// Writes `data` (configurations tagged by index into `ids`) at full precision: q1..qN, socket
 /// (the id), readings. Written whole or not at all (StorageError naming the file).
 void WriteSocketData(const std::string& path, const std::vector<int>& ids,

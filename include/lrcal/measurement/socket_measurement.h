@@ -147,6 +147,17 @@ std::vector<Eigen::Vector3d> SocketPositionsFromData(const RobotModel& robot,
                                                      const TargetedConfigurations& configs,
                                                      int num_sockets);
 
+/// The socket kind's nominal set-up for socket data (the sockets' `ids`, `configs` tagged by
+/// index into them): the nominal model's mean tool point per socket as the sockets' positions
+/// (SocketPositionsFromData), the tool point and the known distances. Throws InputError (where =
+/// `distances_source`, with the item) for a distance naming a socket the data do not have,
+/// closing a cycle or placing a socket twice.
+SocketSetup SocketSetupFromData(const RobotModel& robot, const std::vector<int>& ids,
+                                const TargetedConfigurations& configs,
+                                const Eigen::Vector3d& tool_point,
+                                const std::vector<SocketDistance>& distances,
+                                const std::string& distances_source);
+
 /// Moves the joints q (rad or m, `robot`'s N) so that the tool point `tool_point` (m, tool frame)
 /// of `robot`'s nominal model sits at `target` (m, base frame): Gauss–Newton steps of minimum
 /// norm on the point's 3 × N Jacobian, so the arm's remaining freedom keeps the starting posture
