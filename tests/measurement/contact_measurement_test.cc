@@ -45,17 +45,6 @@ TargetedConfigurations Starts(int count, unsigned seed) {
   return testing::RandomTrackerConfigurations(6, count, 2, seed);
 }
 
-template <typename T>
-std::vector<T> AllContactTerms(const ContactMeasurement& kind, const std::vector<T>& e) {
-  const std::vector<std::string> names = kind.AllTermNames();
-  std::vector<T> all(names.size(), T(0));
-  for (int k = 0; k < kind.num_parameters(); ++k) {
-    const auto it = std::find(names.begin(), names.end(), kind.parameter_names()[k]);
-    all[static_cast<std::size_t>(it - names.begin())] = e[static_cast<std::size_t>(k)];
-  }
-  return all;
-}
-
 // The rows written out independently: the reference kinematics, the plane's chart n(u) as
 // plane.h defines it, the tool z axis's gnomonic coordinates in that chart minus u.
 template <typename T>
@@ -109,7 +98,7 @@ TEST_P(ContactJacobianTest, MatchesAutodiffAndCentralDifferences) {
 
   std::vector<ContactJet> ej(n);
   for (int c = 0; c < n; ++c) ej[c] = ContactJet(e[c], c);
-  const std::vector<ContactJet> all = AllContactTerms(kind, ej);
+  const std::vector<ContactJet> all = testing::AllTrackerTerms(kind, ej);
   Eigen::MatrixXd autodiff(m, n);
   Eigen::VectorXd reference(m);
   for (int i = 0; i < configs.size(); ++i) {

@@ -63,18 +63,6 @@ TargetedConfigurations SocketStarts(int count, unsigned seed) {
   return starts;
 }
 
-// Every term's deviation (AllTermNames order) from e (0 where held).
-template <typename T>
-std::vector<T> AllSocketTerms(const SocketMeasurement& kind, const std::vector<T>& e) {
-  const std::vector<std::string> names = kind.AllTermNames();
-  std::vector<T> all(names.size(), T(0));
-  for (int k = 0; k < kind.num_parameters(); ++k) {
-    const auto it = std::find(names.begin(), names.end(), kind.parameter_names()[k]);
-    all[static_cast<std::size_t>(it - names.begin())] = e[static_cast<std::size_t>(k)];
-  }
-  return all;
-}
-
 // The constraint y = p_BT + R_BT·t − s_k written out independently: the reference kinematics,
 // socket 1 at D·v/|v| from socket 0 with its chart as the header states it.
 template <typename T>
@@ -136,7 +124,7 @@ TEST_P(SocketJacobianTest, MatchesAutodiffAndCentralDifferences) {
 
   std::vector<SocketJet> ej(n);
   for (int k = 0; k < n; ++k) ej[k] = SocketJet(e[k], k);
-  const std::vector<SocketJet> all = AllSocketTerms(kind, ej);
+  const std::vector<SocketJet> all = testing::AllTrackerTerms(kind, ej);
   Eigen::MatrixXd autodiff(m, n);
   Eigen::VectorXd reference(m);
   for (int i = 0; i < configs.size(); ++i) {

@@ -52,9 +52,10 @@ inline TargetedConfigurations RandomTrackerConfigurations(int num_joints, int co
   return configs;
 }
 
-/// Every term's deviation (AllTermNames order) from the estimate e of `kind` (0 where fixed).
-template <typename T>
-std::vector<T> AllTrackerTerms(const PointMeasurement& kind, const std::vector<T>& e) {
+/// Every term's deviation (AllTermNames order) from the estimate e of `kind` (0 where fixed): any
+/// kind with AllTermNames (point, pose, socket, contact).
+template <typename Kind, typename T>
+std::vector<T> AllTrackerTerms(const Kind& kind, const std::vector<T>& e) {
   const std::vector<std::string> names = kind.AllTermNames();
   std::vector<T> all(names.size(), T(0));
   for (int k = 0; k < kind.num_parameters(); ++k) {
