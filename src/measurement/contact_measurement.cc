@@ -6,6 +6,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/kinematics/chain.h"
 #include "lrcal/kinematics/joint_constraints.h"
+#include "lrcal/measurement/constraint_kinds.h"
 
 namespace lrcal {
 
@@ -219,34 +220,17 @@ std::vector<std::string> ContactMeasurement::MissReasons(const TargetedConfigura
 
 std::unique_ptr<MeasurementKind> ContactMeasurement::Without(
     const std::vector<std::string>& names) const {
-  const std::vector<std::string> all = AllTermNames();
-  std::vector<std::string> fixed = fixed_;
-  for (const std::string& name : names) {
-    if (std::find(all.begin(), all.end(), name) == all.end())
-      throw InputError("fix", "'" + name + "' is not a term of the contact measurement");
-    if (std::find(fixed.begin(), fixed.end(), name) == fixed.end()) fixed.push_back(name);
-  }
-  return std::make_unique<ContactMeasurement>(robot(), setup_, fixed);
+  return std::make_unique<ContactMeasurement>(robot(), setup_,
+                                              HeldTerms(fixed_, names, AllTermNames(), name()));
 }
 
 TargetedConfigurations ContactMeasurement::LinearisationConfigurations(
     const TargetedConfigurations& configs) const {
-  const int nj = configs.num_joints();
-  TargetedConfigurations seated(nj);
-  seated.Reserve(configs.size());
-  std::vector<double> q(static_cast<std::size_t>(nj));
-  for (int i = 0; i < configs.size(); ++i) {
-    std::copy(configs.q(i), configs.q(i) + nj, q.begin());
-    const int k = configs.target(i);
-    if (k < setup_.planes.size() && nj == robot().num_links() &&
-        SeatOnPlane(robot(), setup_.tool_point, setup_.planes[k], setup_.flush, 0,
-                    Eigen::Vector2d::Zero(), q.data())) {
-      seated.Add(q.data(), k);
-    } else {
-      seated.AddFrom(configs, i);
-    }
-  }
-  return seated;
+  return SeatEach(configs, [&](double* q, int k) {
+    return k < setup_.planes.size() && configs.num_joints() == robot().num_links() &&
+           SeatOnPlane(robot(), setup_.tool_point, setup_.planes[k], setup_.flush, 0,
+                       Eigen::Vector2d::Zero(), q);
+  });
 }
 
 bool SeatOnPlane(const RobotModel& robot, const Eigen::Vector3d& tool_point, const Plane& plane,

@@ -10,6 +10,7 @@
 #include "lrcal/core/strings.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/kinematics/joint_constraints.h"
+#include "lrcal/measurement/constraint_kinds.h"
 
 namespace lrcal {
 
@@ -320,34 +321,16 @@ std::vector<std::string> SocketMeasurement::MissReasons(const TargetedConfigurat
 
 std::unique_ptr<MeasurementKind> SocketMeasurement::Without(
     const std::vector<std::string>& names) const {
-  const std::vector<std::string> all = AllTermNames();
-  std::vector<std::string> fixed = fixed_;
-  for (const std::string& name : names) {
-    if (std::find(all.begin(), all.end(), name) == all.end())
-      throw InputError("fix", "'" + name + "' is not a term of the socket measurement");
-    if (std::find(fixed.begin(), fixed.end(), name) == fixed.end()) fixed.push_back(name);
-  }
-  return std::make_unique<SocketMeasurement>(robot(), setup_, fixed);
+  return std::make_unique<SocketMeasurement>(robot(), setup_,
+                                             HeldTerms(fixed_, names, AllTermNames(), name()));
 }
 
 TargetedConfigurations SocketMeasurement::LinearisationConfigurations(
     const TargetedConfigurations& configs) const {
-  const int nj = configs.num_joints();
-  TargetedConfigurations seated(nj);
-  seated.Reserve(configs.size());
-  std::vector<double> q(static_cast<std::size_t>(nj));
-  for (int i = 0; i < configs.size(); ++i) {
-    std::copy(configs.q(i), configs.q(i) + nj, q.begin());
-    const int k = configs.target(i);
-    if (k < static_cast<int>(nominal_.size()) && nj == robot().num_links() &&
-        SeatToolPoint(robot(), setup_.tool_point, nominal_[static_cast<std::size_t>(k)],
-                      q.data())) {
-      seated.Add(q.data(), k);
-    } else {
-      seated.AddFrom(configs, i);
-    }
-  }
-  return seated;
+  return SeatEach(configs, [&](double* q, int k) {
+    return k < static_cast<int>(nominal_.size()) && configs.num_joints() == robot().num_links() &&
+           SeatToolPoint(robot(), setup_.tool_point, nominal_[static_cast<std::size_t>(k)], q);
+  });
 }
 
 std::vector<Eigen::Vector3d> SocketPositionsFromData(const RobotModel& robot,
