@@ -58,6 +58,7 @@ IdentificationOptions ResolveIdentificationOptions(const po::variables_map& vm,
   options.fix_dependent_parameters = vm["auto-fix"].as<bool>();
   options.priors = ResolvePriors(vm, rig);
   options.encoder_sigma = vm["encoder-sigma-mrad"].as<double>() * 1e-3;
+  options.check_linearisation = true;  // one fit: the check's cost is not noticed
   options.Validate();
   return options;
 }

@@ -246,6 +246,15 @@ std::vector<double> ErrorsInVariablesWeights(const MeasurementKind& kind,
 
 namespace {
 
+// The second-order check of the fit's covariance when asked for (linearisation_check.h).
+void CheckLinearisationIfAsked(MeasurementEvaluator& evaluator, const std::vector<double>& weights,
+                               const Eigen::VectorXd& e, const IdentificationOptions& options,
+                               IdentificationSummary* s) {
+  if (!options.check_linearisation || !s->IsSolutionUsable()) return;
+  s->linearisation = CheckLinearisation(evaluator, weights, e, FitCovariance(*s, options),
+                                        options.sigma > 0 ? options.sigma : s->sigma_hat);
+}
+
 IdentificationSummary IdentifyReadings(const MeasurementModel& model_in, const MeasurementSet& data,
                                        const IdentificationOptions& options) {
   // The maximum a-posteriori estimate and errors in variables are the kind-neutral path's
@@ -306,6 +315,10 @@ IdentificationSummary IdentifyReadings(const MeasurementModel& model_in, const M
   }
 
   EstimateStatistics(*model, data, weights, e, options, &s);
+  if (options.check_linearisation) {
+    const RangerMeasurement kind(*model);
+    CheckLinearisationIfAsked(*kind.Bind(data.configs), weights, e, options, &s);
+  }
   return s;
 }
 
@@ -472,6 +485,7 @@ IdentificationSummary IdentifyWeighted(const MeasurementKind& kind_in, const Mea
   }
   EstimateKindStatistics(evaluator, rows, kind->NominalValues(), e, kind->rows_per_configuration(),
                          options, &s);
+  CheckLinearisationIfAsked(evaluator, rows.weights, e, options, &s);
   return s;
 }
 
@@ -655,7 +669,7 @@ std::string IdentificationSummary::FullReport() const {
   out << "sigma_hat per reading: "
       << (std::isnan(sigma_hat) ? std::string("undefined") : Fixed(sigma_hat * 1e3, 4) + " mm")
       << "\n"
-      << fit.Explain() << ParameterTable();
+      << fit.Explain() << linearisation.Explain(names) << ParameterTable();
   if (!fixed.empty()) {
     out << "fixed at nominal because of rank deficiency:";
     for (const auto& f : fixed) out << " " << f;

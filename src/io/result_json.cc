@@ -140,6 +140,22 @@ ResultJson IdentificationJson(const IdentificationSummary& s) {
   j["final_cost"] = s.final_cost;      // and at the estimate: after
   j["sigma_hat"] = OrNull(s.sigma_hat);
   if (s.IsSolutionUsable()) j["fit"] = FitJson(s.fit);
+  if (s.linearisation.num_parameters > 0) {
+    const LinearisationCheck& c = s.linearisation;
+    j["linearisation"] = {{"computed", c.computed},
+                          {"excess", OrNull(c.excess)},
+                          {"relative_excess", OrNull(c.RelativeExcess())},
+                          {"holds", c.Holds()},
+                          {"pairs", c.pairs},
+                          {"message", c.message}};
+    if (c.computed && c.worst_direction.size() == static_cast<Eigen::Index>(s.names.size())) {
+      ResultJson direction = ResultJson::object();
+      for (std::size_t k = 0; k < s.names.size(); ++k)
+        direction[s.names[k]] = c.worst_direction[static_cast<Eigen::Index>(k)];
+      j["linearisation"]["worst_direction"] = direction;
+      j["linearisation"]["worst_direction_sigma"] = c.worst_direction_sigma;
+    }
+  }
   j["n_configurations"] = s.num_configurations;
   j["solver"] = s.solver;
   j["loss"] = s.loss;

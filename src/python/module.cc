@@ -565,6 +565,7 @@ IdentificationOptions IdentifyOptionsPy(const RobotFile& rig, bool auto_fix,
   options.fix_dependent_parameters = auto_fix;
   options.priors = PriorsFor(rig, a.prior, a.prior_sigma, "prior=", "prior_sigma=");
   options.encoder_sigma = a.encoder_sigma_mrad * 1e-3;
+  options.check_linearisation = true;  // as lrcal identify
   options.Validate();
   return options;
 }
@@ -910,6 +911,7 @@ IdentificationSummary IdentifyTrackerPy(const RobotFile& rig, const Array& q, co
   options.solver = ParseName(kSolverNames, a.solver, "solver", "solver");
   options.sigma = a.sigma_mm * 1e-3;
   options.fix_dependent_parameters = a.auto_fix;
+  options.check_linearisation = true;  // as lrcal identify
   options.Validate();
   if (sensor == "pose")
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
@@ -1794,6 +1796,7 @@ IdentificationSummary IdentifySocketsPy(const RobotFile& rig, const Array& q,
   options.solver = ParseName(kSolverNames, solver, "solver", "solver");
   options.sigma = sigma_mm * 1e-3;
   options.fix_dependent_parameters = auto_fix;
+  options.check_linearisation = true;  // as lrcal identify
   options.Validate();
   py::gil_scoped_release release;
   return Identify(*kind, data.values, options);
@@ -1934,6 +1937,7 @@ IdentificationSummary IdentifyContactsPy(const RobotFile& rig, const Array& q, c
   options.solver = ParseName(kSolverNames, solver, "solver", "solver");
   options.sigma = sigma_mm * 1e-3;
   options.fix_dependent_parameters = auto_fix;
+  options.check_linearisation = true;  // as lrcal identify
   options.Validate();
   if (a.flush)
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma, sigma_mrad * 1e-3,

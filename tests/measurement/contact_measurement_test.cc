@@ -225,6 +225,51 @@ TEST(ContactMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
   }
 }
 
+// The stated covariance holds: over many noisy contacts the estimate's Mahalanobis distance from
+// the truth, δᵀ·Σ⁻¹·δ with Σ the covariance at the given σ, averages n (a χ²(n) law) within 4 of
+// its standard errors √(2n/realisations) — for flush contacts too, whose tilt rows (σ_angle) are
+// weighed against the distances (σ) as the simulation weighs them. The linearisation check (on
+// every 20th fit) agrees that it holds.
+TEST(ContactMeasurement, StatedCovarianceHoldsOverManyRealisations) {
+  constexpr int kRealisations = 200, kCheckEvery = 20;
+  for (bool flush : {false, true}) {
+    SCOPED_TRACE(flush ? "flush" : "point contact");
+    const RobotModel& robot = testing::PaperRobot();
+    const ContactMeasurement full(robot, TwoPlanes(flush));
+    const TargetedConfigurations starts = Starts(80, 5);
+    NoiseModel noise;
+    noise.sigma = 0.1e-3;
+    noise.sigma_angle = 0.5e-3;
+    noise.repetitions = 1;
+    MeasuredValues nominal_data;
+    NoiseModel exact = noise;
+    exact.sigma = exact.sigma_angle = 0;
+    SimulateContactMeasurements(full, starts, exact, RandomStream(1, 0, 0, RandomPurpose::kNoise),
+                                &nominal_data);
+    const std::unique_ptr<MeasurementKind> reduced =
+        full.Without(AnalyzeIdentifiability(full, nominal_data.configs).suggested_fixed);
+    const auto& kind = dynamic_cast<const ContactMeasurement&>(*reduced);
+    IdentificationOptions options;
+    options.sigma = noise.sigma;
+    const int n = kind.num_parameters();
+    double sum = 0;
+    int holding = 0;
+    for (int seed = 0; seed < kRealisations; ++seed) {
+      MeasuredValues data;
+      SimulateContactMeasurements(
+          kind, starts, noise,
+          RandomStream(static_cast<std::uint64_t>(seed), 0, 0, RandomPurpose::kNoise), &data);
+      options.check_linearisation = seed % kCheckEvery == 0;  // its cost: ~2n² predictions
+      const IdentificationSummary s = Identify(kind, data, options);
+      ASSERT_TRUE(s.IsSolutionUsable()) << s.message;
+      sum += s.delta.dot(s.covariance_given.ldlt().solve(s.delta));  // the truth is nominal
+      holding += s.linearisation.Holds();
+    }
+    EXPECT_EQ(holding, kRealisations / kCheckEvery);
+    EXPECT_NEAR(sum / kRealisations, n, 4 * std::sqrt(2.0 * n / kRealisations));
+  }
+}
+
 TEST(ContactMeasurement, BadSetUpsAndTermsAreNamed) {
   const RobotModel& robot = testing::PaperRobot();
   ContactSetup bad = TwoPlanes(false);

@@ -49,10 +49,10 @@ SocketSetup ThreeSockets(const RobotModel& robot, bool with_distance) {
   return setup;
 }
 
-// Starts near the postures (joints ±0.35 rad about them), configuration i in socket i mod 3.
-TargetedConfigurations SocketStarts(int count, unsigned seed) {
+// Starts near the postures (joints ±`spread` rad about them), configuration i in socket i mod 3.
+TargetedConfigurations SocketStarts(int count, unsigned seed, double spread = 0.35) {
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> wiggle(-0.35, 0.35);
+  std::uniform_real_distribution<double> wiggle(-spread, spread);
   TargetedConfigurations starts(6);
   for (int i = 0; i < count; ++i) {
     const double* base = i % 3 == 1 ? kPostureB : kPostureA;
@@ -245,6 +245,85 @@ TEST(SocketMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
     EXPECT_THAT(s.delta, EigenNear(truth, tolerance::kRoundTrip)) << s.solver;
     EXPECT_LT(s.residual_rms, 1e-12);
   }
+}
+
+// Monte Carlo over noisy seatings at fixed starts: the mean of the estimate's Mahalanobis
+// distance from the truth, δᵀ·Σ⁻¹·δ with Σ the covariance at the given σ (a χ²(n) law where the
+// linearisation holds), its standard error, and the mean excess the linearisation check predicts
+// (on every tenth realisation, `checks` of them).
+struct Coverage {
+  int n = 0;
+  double mean = 0, standard_error = 0, predicted_excess = 0;
+  int checks = 0, checks_holding = 0;
+};
+
+Coverage SocketCoverage(double wiggle, double sigma, int realisations) {
+  const RobotModel& robot = testing::PaperRobot();
+  const SocketMeasurement full(robot, ThreeSockets(robot, true));
+  const TargetedConfigurations starts = SocketStarts(60, 12, wiggle);
+  NoiseModel exact;
+  exact.sigma = 0;
+  MeasuredValues nominal_data;
+  SimulateSocketMeasurements(full, starts, exact, RandomStream(1, 0, 0, RandomPurpose::kNoise),
+                             &nominal_data);
+  const std::unique_ptr<MeasurementKind> reduced =
+      full.Without(AnalyzeIdentifiability(full, nominal_data.configs).suggested_fixed);
+  const auto& kind = dynamic_cast<const SocketMeasurement&>(*reduced);
+  NoiseModel noise;
+  noise.sigma = sigma;
+  noise.repetitions = 1;
+  IdentificationOptions options;
+  options.sigma = sigma;
+  constexpr int kCheckEvery = 10;  // the check's cost: ~2n² predictions per fit
+  Coverage c;
+  c.n = kind.num_parameters();
+  double sum2 = 0;
+  for (int seed = 0; seed < realisations; ++seed) {
+    MeasuredValues data;
+    SimulateSocketMeasurements(
+        kind, starts, noise,
+        RandomStream(static_cast<std::uint64_t>(seed), 0, 0, RandomPurpose::kNoise), &data);
+    options.check_linearisation = seed % kCheckEvery == 0;
+    const IdentificationSummary s = Identify(kind, data, options);
+    if (!s.IsSolutionUsable() || (options.check_linearisation && !s.linearisation.computed)) {
+      ADD_FAILURE() << s.message << " " << s.linearisation.message;
+      return c;
+    }
+    // The truth is the nominal model here: δ is the estimate's error.
+    const double distance = s.delta.dot(s.covariance_given.ldlt().solve(s.delta));
+    c.mean += distance / realisations;
+    sum2 += distance * distance / realisations;
+    if (!options.check_linearisation) continue;
+    c.predicted_excess += s.linearisation.excess / (realisations / kCheckEvery);
+    c.checks_holding += s.linearisation.Holds();
+    ++c.checks;
+  }
+  c.standard_error = std::sqrt((sum2 - c.mean * c.mean) / (realisations - 1));
+  return c;
+}
+
+// Configurations spread ±0.9 rad about the postures: the linearisation check says the covariance
+// holds, and it does — δᵀΣ⁻¹δ averages n within 4 of its standard errors √(2n/realisations).
+TEST(SocketMeasurement, StatedCovarianceHoldsWhereTheLinearisationCheckSaysSo) {
+  constexpr int kRealisations = 200;
+  const Coverage c = SocketCoverage(0.9, 0.1e-3, kRealisations);
+  EXPECT_EQ(c.checks_holding, c.checks);
+  EXPECT_EQ(c.checks, kRealisations / 10);
+  EXPECT_NEAR(c.mean, c.n, 4 * std::sqrt(2.0 * c.n / kRealisations));
+}
+
+// Configurations within ±0.6 rad, play 0.3 mm: the weakest terms are uncertain enough for the
+// model's curvature to bend the best-determined combinations, δᵀΣ⁻¹δ averages about a third more
+// than n, and the check both flags it and predicts the excess (within 4 Monte-Carlo standard
+// errors of the observed one).
+TEST(SocketMeasurement, LinearisationCheckPredictsTheCovariancesOptimism) {
+  constexpr int kRealisations = 200;
+  const Coverage c = SocketCoverage(0.6, 0.3e-3, kRealisations);
+  const double observed_excess = c.mean - c.n;
+  EXPECT_EQ(c.checks_holding, 0);
+  EXPECT_EQ(c.checks, kRealisations / 10);
+  EXPECT_GT(observed_excess, 2 * c.standard_error);  // the optimism is real, not noise
+  EXPECT_NEAR(observed_excess, c.predicted_excess, 4 * c.standard_error);
 }
 
 TEST(SocketMeasurement, BadDistancesAndTermsAreNamed) {

@@ -24,6 +24,7 @@
 #include "lrcal/core/enum_names.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/linearisation_check.h"
 #include "lrcal/identification/prior.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/measurement/measurement_set.h"
@@ -77,6 +78,10 @@ struct IdentificationOptions {
   /// configurations). Off where nothing reads the verdict (a study's trials); then the fit check
   /// is χ²'s as without a robust loss.
   bool robust_fit_check = true;
+  /// Check the covariance against the model's curvature (linearisation_check.h) and report it in
+  /// IdentificationSummary::linearisation: 2n + 4·n(n−1)/2 extra predictions, so off where
+  /// nothing reads it (a study's trials); lrcal identify turns it on.
+  bool check_linearisation = false;
   /// The numeric settings (settings.h): max_iterations (1 to 10,000), max_robust_iterations (1
   /// to 1,000,000), parameter_tolerance and function_tolerance (≥ 0), sigma_mm (σ, ≥ 0 mm; the
   /// command line's --sigma-mm), loss_scale_mm (> 0 mm; --loss-scale-mm) and loss_scale_sigma
@@ -191,6 +196,9 @@ struct IdentificationSummary {
   /// The cost minimised, in words: "least squares", or "huber loss, scale 0.269 mm" (the
   /// scale on each configuration's weighted residual √R·(h̄ − h)).
   std::string loss = "least squares";
+  /// Whether the stated covariance (covariance_given with σ, else covariance_residual) holds
+  /// at second order; computed with IdentificationOptions::check_linearisation.
+  LinearisationCheck linearisation;
   /// With priors (IdentificationOptions::priors): each estimated term's prior σ (SI, 0 where it
   /// has none) and the ratio of its posterior standard deviation (given σ) to it (NaN where it
   /// has none): near 1 the prior alone sets the term. Empty without priors.
