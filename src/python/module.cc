@@ -976,21 +976,70 @@ std::unique_ptr<SocketMeasurement> ToSocketKind(const RobotModel& robot, const S
       ToNames(fix), "fix");
 }
 
-IdentifiabilityReport IdentifiabilityPy(const RobotFile& rig, const Array& q,
-                                        const py::object& plane_arg,
-                                        const std::string& estimate_plane, const py::object& fix,
-                                        double rank_tolerance, const py::object& plane_of,
-                                        const std::string& estimate_ranger,
-                                        const std::string& estimate_base,
-                                        const std::string& estimate_tool, const std::string& sensor,
-                                        const py::object& instrument, const py::object& targets,
-                                        const py::object& target_of, const SocketArgs& sockets) {
+// Contacts from Python: q (N, joints) on planes (plane_of: from 1, as for the ranger), the kind
+// as identify --sensor contact builds it.
+struct ContactArgs {
+  py::object plane, plane_of, tool_point, fix;
+  std::string estimate_plane;
+  bool flush;
+};
+
+std::unique_ptr<ContactMeasurement> ToContactKind(const RobotModel& robot, const PlaneSet& planes,
+                                                  const ContactArgs& a) {
+  ContactSetup setup;
+  setup.planes = planes;
+  setup.tool_point = ToToolPoint(a.tool_point);
+  setup.flush = a.flush;
+  setup.plane_terms.assign(static_cast<std::size_t>(planes.size()),
+                           PlaneTerms::Parse(a.estimate_plane, "estimate_plane"));
+  return std::make_unique<ContactMeasurement>(robot, setup, ToNames(a.fix), "fix");
+}
+
+TargetedConfigurations ToContactConfigurations(const RobotModel& robot, const Array& q,
+                                               const py::object& plane_of, int num_planes) {
+  TargetedConfigurations configs =
+      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, num_planes);
+  CheckJointRanges(configs, robot, "q");
+  return configs;
+}
+
+IdentifiabilityReport IdentifiabilityPy(
+    const RobotFile& rig, const Array& q, const py::object& plane_arg,
+    const std::string& estimate_plane, const py::object& fix, double rank_tolerance,
+    const py::object& plane_of, const std::string& estimate_ranger,
+    const std::string& estimate_base, const std::string& estimate_tool, const std::string& sensor,
+    const py::object& instrument, const py::object& targets, const py::object& target_of,
+    const SocketArgs& sockets, bool flush) {
+  if (sensor != "contact" && flush)
+    throw InputError("flush", "is the contact sensor's: give sensor='contact'");
+  if (sensor == "contact") {
+    RefuseRangerArguments(sensor, {{"estimate_ranger", estimate_ranger != "none"},
+                                   {"estimate_base", estimate_base != "none"},
+                                   {"estimate_tool", estimate_tool != "none"},
+                                   {"instrument", !instrument.is_none()},
+                                   {"targets", !targets.is_none()},
+                                   {"target_of", !target_of.is_none()},
+                                   {"socket_of", !sockets.socket_of.is_none()},
+                                   {"socket_distances", !sockets.distances.is_none()}});
+    const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+    const std::unique_ptr<ContactMeasurement> kind = ToContactKind(
+        rig.robot, planes, {plane_arg, plane_of, sockets.tool_point, fix, estimate_plane, flush});
+    const TargetedConfigurations configs =
+        ToContactConfigurations(rig.robot, q, plane_of, planes.size());
+    IdentifiabilityOptions options;
+    options.rank_tolerance = rank_tolerance;
+    options.Validate();
+    py::gil_scoped_release release;
+    return AnalyzeIdentifiability(*kind, configs, nullptr, options);
+  }
   if (sensor != "socket" &&
       !(sockets.socket_of.is_none() && sockets.distances.is_none() && sockets.tool_point.is_none()))
     throw InputError(!sockets.socket_of.is_none()   ? "socket_of"
                      : !sockets.distances.is_none() ? "socket_distances"
                                                     : "tool_point",
-                     "is the socket sensor's: give sensor='socket'");
+                     sockets.socket_of.is_none() && sockets.distances.is_none()
+                         ? "is a constraint sensor's: give sensor='socket' or sensor='contact'"
+                         : "is the socket sensor's: give sensor='socket'");
   if (sensor == "socket") {
     RefuseRangerArguments(sensor, {{"plane", !plane_arg.is_none()},
                                    {"plane_of", !plane_of.is_none()},
@@ -1446,6 +1495,32 @@ str() gives the full text report; repr() the one-line summary.)doc")
           "configurations with |standardized| > 4), with suspect_labels when the readings were "
           "grouped by configuration labels; test says which check decided `consistent`: chi2, "
           "or robust_scale with a robust loss (robust_scale and robust_p_value).")
+      .def_property_readonly(
+          "linearisation",
+          [](const S& s) -> py::object {
+            const LinearisationCheck& c = s.linearisation;
+            if (c.num_parameters == 0) return py::none();
+            py::dict d;
+            d["computed"] = c.computed;
+            d["excess"] = c.excess;
+            d["relative_excess"] = c.RelativeExcess();
+            d["holds"] = c.Holds();
+            d["pairs"] = c.pairs;
+            d["message"] = c.message;
+            if (c.computed) {
+              py::dict direction;
+              for (std::size_t k = 0; k < s.names.size(); ++k)
+                direction[py::str(s.names[k])] = c.worst_direction[static_cast<Eigen::Index>(k)];
+              d["worst_direction"] = direction;
+              d["worst_direction_sigma"] = c.worst_direction_sigma;
+            }
+            return d;
+          },
+          "The linearisation check (lrcal/identification/linearisation_check.h), as identify's "
+          "JSON 'linearisation': excess (what the model's curvature adds to the expected "
+          "chi2(n) of the estimate's error), relative_excess (excess/n), holds (computed and "
+          "excess <= 0.1 n), worst_direction (term -> component) and its sigma; None when "
+          "not computed.")
       .def("__str__", &S::FullReport)
       .def("__repr__", &S::BriefReport);
 }
@@ -1671,10 +1746,11 @@ void DefineIdentifiability(py::module_& m) {
          const std::string& estimate_base, const std::string& estimate_tool,
          const std::string& sensor, const py::object& instrument, const py::object& targets,
          const py::object& target_of, const py::object& socket_of,
-         const py::object& socket_distances, const py::object& tool_point) {
+         const py::object& socket_distances, const py::object& tool_point, bool flush) {
         return IdentifiabilityPy(rig, q, plane, estimate_plane, fix, rank_tolerance, plane_of,
                                  estimate_ranger, estimate_base, estimate_tool, sensor, instrument,
-                                 targets, target_of, {socket_of, socket_distances, tool_point});
+                                 targets, target_of, {socket_of, socket_distances, tool_point},
+                                 flush);
       },
       py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("fix") = py::none(),
@@ -1685,7 +1761,7 @@ void DefineIdentifiability(py::module_& m) {
       py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
       py::arg("targets") = py::none(), py::arg("target_of") = py::none(),
       py::arg("socket_of") = py::none(), py::arg("socket_distances") = py::none(),
-      py::arg("tool_point") = py::none(), R"doc(
+      py::arg("tool_point") = py::none(), py::arg("flush") = false, R"doc(
 What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
 estimate_plane, estimate_ranger, estimate_base, estimate_tool, fix as in identify: several
 planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
@@ -1694,7 +1770,10 @@ identifiability --sensor`): instrument=(x, y, z, roll, pitch, yaw) in the base f
 None: the base frame), targets=[(x, y, z), ...] in the tool frame ((x, y, z, roll, pitch, yaw)
 for a 6-D probe; None: one at the tool frame's origin), target_of (N numbers from 1) the target
 each row sees, fix= as above. sensor='socket' analyses seatings in sockets (`--sensor socket`):
-socket_of (N socket ids), socket_distances=[(a, b, metres), ...], tool_point=(x, y, z).)doc");
+socket_of (N socket ids), socket_distances=[(a, b, metres), ...], tool_point=(x, y, z).
+sensor='contact' analyses contacts with planes (`--sensor contact`): plane, plane_of,
+estimate_plane and fix as for the ranger, tool_point=(x, y, z) in the tool frame, flush=True for
+flush contacts (two tilt rows each).)doc");
 }
 
 // The trackers' simulation and fit (point_measurement.h, pose_measurement.h); their
@@ -1865,33 +1944,6 @@ How consistently a model (robot: a calibrated robot file) puts the tool point in
 and the error of the known socket distances: `lrcal accuracy --sockets`. Returns a dict:
 rms_spread (m), sockets (id, configurations, centre, rms_spread, worst_spread), distances
 (sockets, known, predicted, error; m).)doc");
-}
-
-// Contacts from Python: q (N, joints) on planes (plane_of: from 1, as for the ranger), the kind
-// as identify --sensor contact builds it.
-struct ContactArgs {
-  py::object plane, plane_of, tool_point, fix;
-  std::string estimate_plane;
-  bool flush;
-};
-
-std::unique_ptr<ContactMeasurement> ToContactKind(const RobotModel& robot, const PlaneSet& planes,
-                                                  const ContactArgs& a) {
-  ContactSetup setup;
-  setup.planes = planes;
-  setup.tool_point = ToToolPoint(a.tool_point);
-  setup.flush = a.flush;
-  setup.plane_terms.assign(static_cast<std::size_t>(planes.size()),
-                           PlaneTerms::Parse(a.estimate_plane, "estimate_plane"));
-  return std::make_unique<ContactMeasurement>(robot, setup, ToNames(a.fix), "fix");
-}
-
-TargetedConfigurations ToContactConfigurations(const RobotModel& robot, const Array& q,
-                                               const py::object& plane_of, int num_planes) {
-  TargetedConfigurations configs =
-      WithPlanes(ToConfigurations(q, robot.num_links(), "q"), plane_of, num_planes);
-  CheckJointRanges(configs, robot, "q");
-  return configs;
 }
 
 // simulate_contacts: as simulate --sensor contact.

@@ -173,6 +173,35 @@ def test_contacts_simulate_and_identify_as_the_program(tmp_path, cli, paper):
     assert fit.names == [p["name"] for p in program["parameters"]]
     np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
                                rtol=0, atol=1e-12)
+    for key in ("excess", "holds", "pairs"):
+        assert fit.linearisation[key] == pytest.approx(program["linearisation"][key], rel=1e-9)
     with pytest.raises(lrcal.InputError, match="estimate_plane"):
         lrcal.identify_contacts(paper, sim["q"], plane=PLANES, plane_of=sim["plane_of"],
                                 estimate_plane="tilt")
+
+    # What the contacts identify, as `lrcal identifiability --sensor contact` says (the seated
+    # postures without the flush column for point contacts).
+    point_contacts = tmp_path / "point.csv"
+    with open(point_contacts, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)] + ["plane"])
+        writer.writerows([[repr(v) for v in row] + [p] for row, p in zip(sim["q"],
+                                                                         sim["plane_of"])])
+    counts = []
+    for flush, data in ((False, point_contacts), (True, tmp_path / "contacts.csv")):
+        analysis = lrcal.identifiability(paper, sim["q"], sensor="contact", plane=PLANES,
+                                         plane_of=sim["plane_of"], flush=flush,
+                                         estimate_plane="normal,offset")
+        done = cli("identifiability", "--sensor", "contact", "--configs", data, *planes,
+                   "--estimate-plane", "normal,offset", "--format", "json")
+        program = json.loads(done.stdout)
+        assert analysis.rank == program["rank"]
+        assert analysis.suggested_fixed == program["suggested_fixed"]
+        counts.append((analysis.rank, len(analysis.names)))
+    # The README's counts: flush contacts are analysed at postures squared to their planes.
+    assert counts == [(26, 34), (24, 34)]
+    with pytest.raises(lrcal.InputError, match="flush: is the contact sensor's"):
+        lrcal.identifiability(paper, sim["q"], flush=True)
+    with pytest.raises(lrcal.InputError, match="socket_of: is the contact sensor's|socket_of"):
+        lrcal.identifiability(paper, sim["q"], sensor="contact", plane=PLANES,
+                              plane_of=sim["plane_of"], socket_of=sim["plane_of"])
