@@ -3,12 +3,14 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -196,6 +198,39 @@ class ProgressReporter {
   std::string note_;
 };
 
+// "preparing cells: k/N done" on stderr while cells are prepared (from any thread): rewritten in
+// place on a terminal, a line every LRCAL_PROGRESS_SECONDS (10 s) on a log.
+class PreparationProgress {
+ public:
+  PreparationProgress(bool show, Clock::time_point start, int total)
+      : show_(show),
+        tty_(::isatty(STDERR_FILENO) != 0),
+        start_(start),
+        last_line_(start),
+        total_(total) {
+    if (const char* e = std::getenv("LRCAL_PROGRESS_SECONDS")) every_ = std::atof(e);
+  }
+  void CellDone() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    const auto now = Clock::now();
+    if (!show_ || (!tty_ && Seconds(last_line_, now) < every_)) return;
+    std::cerr << (tty_ ? "\r" : "") << "lrcal run: preparing cells: " << done_ << "/" << total_
+              << " done, " << Duration(Seconds(start_, now)) << (tty_ ? " " : "\n") << std::flush;
+    last_line_ = now;
+  }
+  void Finish() const {
+    if (show_ && tty_ && total_ > 0) std::cerr << "\n";
+  }
+
+ private:
+  bool show_, tty_;
+  Clock::time_point start_, last_line_;
+  int total_, done_ = 0;
+  double every_ = 10.0;  // s between lines on a log (as the trials' progress lines)
+  std::mutex mutex_;
+};
+
 class StudyRunner {
  public:
   StudyRunner(const Study& study, const RunOptions& options, Collective* collective,
@@ -302,7 +337,12 @@ class StudyRunner {
     return missing;
   }
 
-  // Every rank prepares every cell (the same deterministic result).
+  // Every rank prepares every cell (the same deterministic result), on all its threads: cells
+  // are independent and PrepareCell is a pure function of the study and the cell, so the
+  // contexts (and everything computed from them) do not depend on the thread count. Workers
+  // claim cells in order; after a failure no new cell is claimed, and the error of the first
+  // failing cell in order is thrown — every earlier cell was claimed and prepared, so it is the
+  // error a single thread would have met.
   void PrepareCells() {
     // Signals end the process at once while nothing is written (see OnStopSignal); a library
     // caller's own stop token is checked between cells.
@@ -310,24 +350,35 @@ class StudyRunner {
       Preparing() { g_preparing.store(true); }
       ~Preparing() { g_preparing.store(false); }
     } preparing;
-    const bool show = options_.progress && root();
-    const bool tty = ::isatty(STDERR_FILENO) != 0;
-    double every = 10.0;  // s between lines on a log (as the trials' progress lines)
-    if (const char* e = std::getenv("LRCAL_PROGRESS_SECONDS")) every = std::atof(e);
-    auto last_line = start_;
-    for (const Cell& cell : study_.cells) {
-      if (stop_->stop_requested()) break;
-      contexts_.push_back(PrepareCell(study_, cell));
-      cell_index_.emplace(cell.id, static_cast<int>(contexts_.size()) - 1);
-      const auto now = Clock::now();
-      if (show && (tty || Seconds(last_line, now) >= every)) {
-        std::cerr << (tty ? "\r" : "") << "lrcal run: preparing cells: " << contexts_.size() << "/"
-                  << study_.cells.size() << " done, " << Duration(Seconds(start_, now))
-                  << (tty ? " " : "\n") << std::flush;
-        last_line = now;
+    const int num_cells = static_cast<int>(study_.cells.size());
+    std::vector<std::unique_ptr<CellContext>> prepared(static_cast<std::size_t>(num_cells));
+    std::vector<std::exception_ptr> errors(prepared.size());
+    std::atomic<int> next{0};
+    std::atomic<bool> failed{false};
+    PreparationProgress progress(options_.progress && root(), start_, num_cells);
+    const auto work = [&] {
+      for (int i = next++; i < num_cells && !failed && !stop_->stop_requested(); i = next++) {
+        const auto u = static_cast<std::size_t>(i);
+        try {
+          prepared[u] = PrepareCell(study_, study_.cells[u]);
+        } catch (...) {
+          errors[u] = std::current_exception();
+          failed = true;
+        }
+        progress.CellDone();
       }
+    };
+    std::vector<std::thread> workers;
+    for (int t = 1; t < std::min(threads_, num_cells); ++t) workers.emplace_back(work);
+    work();
+    for (std::thread& w : workers) w.join();
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
+    for (std::size_t i = 0; i < prepared.size() && prepared[i]; ++i) {
+      cell_index_.emplace(study_.cells[i].id, static_cast<int>(i));
+      contexts_.push_back(std::move(prepared[i]));
     }
-    if (show && tty && !study_.cells.empty()) std::cerr << "\n";
+    progress.Finish();
     result_.prepare_seconds = Seconds(start_, Clock::now());
   }
 

@@ -454,6 +454,31 @@ TEST_P(BadStudyTest, FailsBeforeAnythingRunsNamingLineAndKey) {
   EXPECT_FALSE(fs::exists(dir + "/run/trials.sqlite"));
 }
 
+// Cells are prepared on every thread; when two fail, the error is the first failing cell's in
+// the study's order (the one a single thread meets), whichever thread got there first, and
+// nothing is written.
+TEST(MonteCarlo, PreparationOnThreadsNamesTheFirstFailingCell) {
+  const std::string dir = testing::TempDir("mc_two_bad_cells");
+  const std::string path = dir + "/two_bad.yaml";
+  std::ofstream(path) << "name: two_bad\nseed: 1\ntrials: 2\nrobot: "
+                      << testing::SourcePath("studies/robots/paper.yaml") << "\n"
+                      << "plane: {normal: [0, 1, 4.6], offset: -0.69}\n"
+                         "pool: {size: 30}\nselection: {count: 26}\n"
+                         "sweep:\n  axes:\n    - key: plane.offset\n"
+                         "      values: [-0.69, -0.7, -100, -200, -0.68]\n";
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    try {
+      RunSmall(path, dir + "/run", threads);
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("cell 'plane.offset=-100'"));
+      EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("could only accept 0 of 30"));
+    }
+    EXPECT_FALSE(fs::exists(dir + "/run/trials.sqlite"));
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadStudyTest,
     ::testing::Values(
