@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
@@ -298,6 +299,48 @@ Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const TargetedConfigura
 
 // The selected design, its σ_min and the predicted covariance at the nominal model; the
 // design's Jacobian also gives the first linearisation of every trial, computed once here.
+// CertifyDesign is a pure function of (G, the chosen rows, the criterion, the steps) and half of
+// a cell's preparation; the cells of a sweep or a sensitivity plan over noise settings share all
+// four. A process-wide memo of the last few certificates, matched on exact equality of every
+// input (no hash is trusted), returns the same bits as computing it again. Thread-safe: two
+// workers may compute the same certificate at once, and either result is the same.
+class CertificateMemo {
+ public:
+  DesignCertificate Certify(const Eigen::MatrixXd& G, const std::vector<int>& chosen,
+                            DesignCriterion criterion, int steps) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      for (const Entry& e : entries_)
+        if (e.criterion == criterion && e.steps == steps && e.chosen == chosen &&
+            e.G.rows() == G.rows() && e.G.cols() == G.cols() && e.G == G)
+          return e.certificate;
+    }
+    Entry entry{G, chosen, criterion, steps, CertifyDesign(G, chosen, criterion, steps)};
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (entries_.size() == kEntries) entries_.erase(entries_.begin());
+    entries_.push_back(std::move(entry));
+    return entries_.back().certificate;
+  }
+
+ private:
+  struct Entry {
+    Eigen::MatrixXd G;
+    std::vector<int> chosen;
+    DesignCriterion criterion;
+    int steps;
+    DesignCertificate certificate;
+  };
+  static constexpr std::size_t kEntries = 8;
+  std::mutex mutex_;
+  std::vector<Entry> entries_;
+};
+
+DesignCertificate CertifyCellDesign(const Eigen::MatrixXd& G, const std::vector<int>& chosen,
+                                    DesignCriterion criterion, int steps) {
+  static CertificateMemo memo;
+  return memo.Certify(G, chosen, criterion, steps);
+}
+
 void SelectCellDesign(const CellSettings& s, CellContext* c) {
   const Eigen::MatrixXd G =
       s.task_criterion ? TaskDesignJacobian(*c, c->pool) : CellDesignJacobian(*c, c->pool);
@@ -309,7 +352,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
     // is looser, so the efficiency stated is a lower bound that 1500 steps raise by up to 0.3 %
     // (tests/study/trial_test.cc).
     const DesignCertificate certificate =
-        CertifyDesign(G, c->design.slots, s.selection.criterion, 300);
+        CertifyCellDesign(G, c->design.slots, s.selection.criterion, 300);
     if (certificate.available) c->design_efficiency = certificate.efficiency;
   }
   const int n = c->model->num_parameters();

@@ -34,5 +34,27 @@ TEST(CellPreparation, TheStudysCertificateIsLrcalDesignsWithinItsStatedTolerance
   }
 }
 
+// Cells that differ only in noise share their design's certificate (a memo in trial.cc): each
+// cell's is still bit for bit the certificate of its own G and design, whichever cell computed it.
+TEST(CellPreparation, SharedCertificatesAreEachCellsOwn) {
+  const std::string dir = testing::TempDir("cell_certificate_memo");
+  std::ofstream(dir + "/s.yaml") << "name: c\nseed: 1\ntrials: 1\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 101}\nvalidation: {size: 5}\n"
+                                    "sweep:\n  axes:\n    - key: selection.count\n"
+                                    "      values: [30, 50]\n    - key: noise.sigma_mm\n"
+                                    "      values: [0.1, 0.3]\n    - key: pool.size\n"
+                                    "      values: [101, 120]\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  ASSERT_EQ(study.cells.size(), 8u);
+  for (const Cell& cell : study.cells) {
+    const auto c = PrepareCell(study, cell);
+    const Eigen::MatrixXd G = DesignJacobian(*c->model, c->pool, DesignScaling::kSI, 0, 0);
+    const DesignCertificate own = CertifyDesign(G, c->design.slots, DesignCriterion::kE, 300);
+    ASSERT_TRUE(own.available);
+    EXPECT_EQ(c->design_efficiency, own.efficiency) << cell.label;
+  }
+}
+
 }  // namespace
 }  // namespace lrcal
