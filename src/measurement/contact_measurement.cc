@@ -12,8 +12,6 @@ namespace lrcal {
 
 namespace {
 
-constexpr const char* kPlaneTerms[3] = {"u1", "u2", "f"};
-
 // The gnomonic coordinates of direction z in `chart` (z·t/z·n0) and, if `d` is given, their
 // derivatives with respect to z (2 × 3).
 Eigen::Vector2d Gnomonic(const NormalChart& chart, const Eigen::Vector3d& z,
@@ -131,42 +129,15 @@ ContactMeasurement::ContactMeasurement(const RobotModel& robot, ContactSetup set
       setup_(std::move(setup)),
       fixed_(fixed) {
   setup_.Validate();
-  const std::vector<std::string> plane_terms = PlaneTermNames();
+  names_ = arm_.parameter_names();
+  planes_ = EstimatedPlanes(setup_.planes, setup_.plane_terms, fixed, &names_);
+  const std::vector<std::string> plane_terms = planes_.TermNames();
   for (const std::string& name : fixed)
     if (name.rfind("plane", 0) == 0 &&
         std::find(plane_terms.begin(), plane_terms.end(), name) == plane_terms.end())
       throw InputError(source, "'" + name +
                                    "' is not a term of the contact measurement: expected a robot "
                                    "parameter, target_x … target_z, or an estimated plane term");
-  names_ = arm_.parameter_names();
-  const int np = setup_.planes.size();
-  for (int p = 0; p < np; ++p) {
-    charts_.emplace_back(setup_.planes[p].normal);
-    std::array<int, 3> columns = {-1, -1, -1};
-    for (int t = 0; t < 3; ++t) {
-      const std::string name = PlaneTermName(p, np, kPlaneTerms[t]);
-      if (std::find(plane_terms.begin(), plane_terms.end(), name) == plane_terms.end() ||
-          std::find(fixed.begin(), fixed.end(), name) != fixed.end())
-        continue;
-      columns[static_cast<std::size_t>(t)] = static_cast<int>(names_.size());
-      names_.push_back(name);
-    }
-    plane_columns_.push_back(columns);
-  }
-}
-
-std::vector<std::string> ContactMeasurement::PlaneTermNames() const {
-  std::vector<std::string> names;
-  const int np = setup_.planes.size();
-  for (int p = 0; p < np && !setup_.plane_terms.empty(); ++p) {
-    const PlaneTerms& t = setup_.plane_terms[static_cast<std::size_t>(p)];
-    if (t.normal) {
-      names.push_back(PlaneTermName(p, np, "u1"));
-      names.push_back(PlaneTermName(p, np, "u2"));
-    }
-    if (t.offset) names.push_back(PlaneTermName(p, np, "f"));
-  }
-  return names;
 }
 
 std::vector<std::string> ContactMeasurement::AllTermNames() const {
@@ -175,28 +146,15 @@ std::vector<std::string> ContactMeasurement::AllTermNames() const {
     if (std::find(InstrumentTermNames().begin(), InstrumentTermNames().end(), name) ==
         InstrumentTermNames().end())
       names.push_back(name);
-  for (const std::string& name : PlaneTermNames()) names.push_back(name);
+  for (const std::string& name : planes_.TermNames()) names.push_back(name);
   return names;
 }
 
 Eigen::VectorXd ContactMeasurement::NominalValues() const {
   Eigen::VectorXd nominal = Eigen::VectorXd::Zero(num_parameters());
   nominal.head(arm_.num_parameters()) = arm_.NominalValues();
-  for (int p = 0; p < setup_.planes.size(); ++p) {
-    const int f = plane_columns_[static_cast<std::size_t>(p)][2];
-    if (f >= 0) nominal[f] = setup_.planes[p].offset;  // u1, u2: chart origin 0
-  }
+  planes_.SetNominal(&nominal);
   return nominal;
-}
-
-ContactMeasurement::PlaneState ContactMeasurement::PlaneAt(const double* e, int k) const {
-  PlaneState s;
-  const std::array<int, 3>& columns = plane_columns_[static_cast<std::size_t>(k)];
-  for (int t = 0; t < 3; ++t) s.column[t] = columns[static_cast<std::size_t>(t)];
-  for (int a = 0; a < 2; ++a) s.u[a] = s.column[a] >= 0 ? e[s.column[a]] : 0.0;
-  charts_[static_cast<std::size_t>(k)].NormalAndJacobian(s.u[0], s.u[1], &s.normal, &s.dn_du);
-  s.offset = setup_.planes[k].offset + (s.column[2] >= 0 ? e[s.column[2]] : 0.0);
-  return s;
 }
 
 std::unique_ptr<MeasurementEvaluator> ContactMeasurement::Bind(

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/estimated_planes.h"
 #include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
@@ -77,24 +78,16 @@ class ContactMeasurement : public MeasurementKind {
 
   /// Plane k at estimate e: its normal n(u), ∂n/∂u, its offset, and e's columns of u1, u2, f
   /// (-1 where held).
-  struct PlaneState {
-    Eigen::Vector3d normal;
-    Eigen::Matrix<double, 3, 2> dn_du;
-    double offset = 0, u[2] = {0, 0};
-    int column[3] = {-1, -1, -1};
-  };
-  PlaneState PlaneAt(const double* e, int k) const;
+  using PlaneState = EstimatedPlanes::State;
+  PlaneState PlaneAt(const double* e, int k) const { return planes_.At(e, k); }
   /// The chart of plane k's normal (its nominal normal and tangent basis).
-  const NormalChart& chart(int k) const { return charts_[static_cast<std::size_t>(k)]; }
+  const NormalChart& chart(int k) const { return planes_.chart(k); }
 
  private:
-  std::vector<std::string> PlaneTermNames() const;
-
   PointMeasurement arm_;
   ContactSetup setup_;
   std::vector<std::string> fixed_, names_;
-  std::vector<NormalChart> charts_;
-  std::vector<std::array<int, 3>> plane_columns_;  // per plane: u1, u2, f in e (-1 held)
+  EstimatedPlanes planes_;
 };
 
 /// Moves the joints q (rad or m) until `robot`'s nominal tool point `tool_point` lies at signed
