@@ -22,7 +22,7 @@ sources=(core/strings core/json core/hash core/data_dir core/random core/setting
          measurement/noise_model measurement/measurement_kind measurement/averaging core/text_table
          identification/identification_options identification/prior design/design_options io/csv
          io/robot_file io/urdf io/yaml_util study/study study/stop_when study/sensitivity
-         study/truth_options io/socket_data io/robot_data)
+         study/truth_options io/socket_data io/scanner_data io/robot_data)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
   local name=$1 obj="$out/obj/${1//\//_}.o"

@@ -90,9 +90,18 @@ void AddSensorOptions(po::options_description& o) {
   o.add_options()("sensor", po::value<std::string>()->default_value("ranger"),
                   "the measurement: ranger (a distance to a plane), point (a tracker's reflector "
                   "in the instrument's frame), pose (a 6-D probe: position and orientation), "
-                  "socket (the tool point seated in fixed sockets: a CSV's socket column) or "
-                  "contact (the tool point on a plane: a CSV's plane column)");
+                  "socket (the tool point seated in fixed sockets: a CSV's socket column), "
+                  "contact (the tool point on a plane: a CSV's plane column) or scanner (a fan of "
+                  "beams, each reading its distance to the plane: a CSV's beam and h columns)");
   AddTrackerGeometryOptions(o);
+  o.add_options()("beams", po::value<int>()->default_value(1),
+                  "scanner: the number of beams in the fan (1 to 256)")(
+      "fan-deg", po::value<double>()->default_value(0.0),
+      "scanner: the fan's half angle (deg): the beams spread evenly over [-A, A] about the "
+      "scanner's z axis, in its x-z plane")(
+      "scanner", po::value<std::string>()->default_value("0,0,0,0,0,0"),
+      "scanner: its frame in the tool frame as x,y,z,roll,pitch,yaw (m, rad): the beams' origin "
+      "(terms target_x..z) and the fan's plane (terms scanner_roll, _pitch, _yaw)");
   o.add_options()("flush", po::bool_switch(),
                   "contact: every contact is flush (the tool's z axis square to the plane: two "
                   "more values per configuration), where a file has no flush column");
@@ -116,7 +125,12 @@ void AddTrackerGeometryOptions(po::options_description& o) {
 std::string ResolveSensor(const po::variables_map& vm) {
   const std::string sensor = vm["sensor"].as<std::string>();
   if (sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket" ||
-      sensor == "contact") {
+      sensor == "contact" || sensor == "scanner") {
+    if (sensor != "scanner")
+      for (const char* option : {"beams", "fan-deg", "scanner"})
+        if (vm.count(option) && !vm[option].defaulted())
+          throw InputError(std::string("--") + option,
+                           "is the scanner sensor's; --sensor " + sensor + " does not take it");
     if (sensor != "contact" && vm.count("flush") && vm["flush"].as<bool>())
       throw InputError("--flush",
                        "is the contact sensor's; --sensor " + sensor + " does not take it");
@@ -126,8 +140,8 @@ std::string ResolveSensor(const po::variables_map& vm) {
     return sensor;
   }
   throw InputError("--sensor", "'" + CellExcerpt(sensor) +
-                                   "' is not a sensor lrcal models: expected ranger, point, pose, "
-                                   "socket or contact");
+                                   "' is not a sensor lrcal models: expected ranger, scanner, "
+                                   "point, pose, socket or contact");
 }
 
 namespace {
@@ -198,8 +212,11 @@ void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
                                        "--socket-distance, --fix)"
                : sensor == "contact" ? "are the tool point and the planes: --target, --plane, "
                                        "--estimate-plane, --flush, --fix)"
-                                     : "are the instrument's frame and the targets: --instrument, "
-                                       "--target, --fix)"));
+               : sensor == "scanner"
+                   ? "are the scanner's frame and the planes: --scanner, --beams, "
+                     "--fan-deg, --plane, --estimate-plane, --fix)"
+                   : "are the instrument's frame and the targets: --instrument, "
+                     "--target, --fix)"));
 }
 
 std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) {
@@ -240,6 +257,31 @@ std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, con
   std::vector<std::string> fixed;
   if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
   return std::make_unique<ContactMeasurement>(robot, setup, fixed, "--fix");
+}
+
+std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, const PlaneSet& planes,
+                                                    const RangerSpec& range,
+                                                    const po::variables_map& vm) {
+  ScannerSetup setup;
+  setup.planes = planes;
+  setup.range = range;
+  const RigidTransform frame = ParseXyzRpy(vm["scanner"].as<std::string>(), "--scanner", false);
+  setup.origin = frame.translation;
+  setup.orientation = frame.rotation;
+  const int beams = vm["beams"].as<int>();
+  if (beams < 1 || beams > ScannerSetup::kMaxBeams)
+    throw InputError("--beams", "expected 1 to " + std::to_string(ScannerSetup::kMaxBeams) +
+                                    " beams, got " + std::to_string(beams));
+  const double half = vm["fan-deg"].as<double>();
+  if (!(half >= 0 && half < 90))
+    throw InputError("--fan-deg", "expected a half angle from 0 to below 90 deg");
+  setup.beam_angles = ScannerSetup::Fan(beams, half * M_PI / 180);
+  const PlaneTerms terms = PlaneTerms::Parse(
+      vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
+  setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);
+  std::vector<std::string> fixed;
+  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  return std::make_unique<ScannerMeasurement>(robot, setup, fixed, "--fix");
 }
 
 std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,

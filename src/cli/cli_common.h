@@ -20,11 +20,13 @@
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/robot_data.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/scanner_data.h"
 #include "lrcal/io/socket_data.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/scanner_measurement.h"
 #include "lrcal/measurement/socket_measurement.h"
 
 namespace lrcal::cli {
@@ -89,6 +91,12 @@ std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm);
 /// The socket kind on `robot` for `data` (its socket ids; the sockets' nominal positions are the
 /// nominal model's mean tool point per socket) with the tool point from --target (x,y,z, one),
 /// --socket-distance and --fix. Refuses --instrument (InputError naming it).
+/// The scanner kind of --sensor scanner on `planes` with the robot file's ranger limits `range`:
+/// --scanner (its frame in the tool frame), --beams and --fan-deg (the fan), --estimate-plane,
+/// --fix. Throws InputError naming the option.
+std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, const PlaneSet& planes,
+                                                    const RangerSpec& range,
+                                                    const po::variables_map& vm);
 std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
                                                   const po::variables_map& vm);
 /// The contact kind on `robot` and `planes` (--plane or the robot file's), flush or not, with the

@@ -253,6 +253,39 @@ int ContactSimulate(const po::variables_map& vm) {
   return 0;
 }
 
+// simulate --sensor scanner: every beam of the fan read at each configuration of the CSV
+// (q…, plane) by the true arm (the robot file's true errors) from the nominal scanner on the
+// nominal planes, each reading the mean of --repetitions with noise --sigma-mm.
+int ScannerSimulate(const po::variables_map& vm) {
+  RefuseRangerOptions(
+      vm, "scanner",
+      {"encoder-sigma-mrad", "form-sigma-mm", "outlier-fraction", "outlier-sigma-mm"});
+  const Setup setup = ResolveSetup(vm);
+  const RobotModel true_robot = setup.rig.truth.TrueRobot(setup.rig.robot);
+  const TargetedConfigurations configs =
+      ReadRobotConfigurations(vm["configs"].as<std::string>(), setup.rig.robot, &setup.planes);
+  const std::unique_ptr<ScannerMeasurement> truth =
+      MakeScannerKind(true_robot, setup.planes, setup.rig.ranger, vm);
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  MeasuredValues data;
+  std::vector<std::string> misses;
+  const int missed = SimulateMeasurements(*truth, configs, noise,
+                                          RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise),
+                                          &data, &misses);
+  const std::string path = vm["out"].as<std::string>();
+  WriteScannerData(path, data, truth->num_beams());
+  std::cerr << "lrcal simulate: " << data.size() << " scans of " << truth->num_beams()
+            << " beam(s) written to " << path;
+  if (missed > 0) {
+    const auto first =
+        std::find_if(misses.begin(), misses.end(), [](const std::string& m) { return m != "ok"; });
+    std::cerr << " (" << missed << " configuration(s) left out: " << *first << ", ...)";
+  }
+  std::cerr << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int SimulateCommand(const std::vector<std::string>& args) {
@@ -273,6 +306,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "socket") return SocketSimulate(vm);
   if (sensor == "contact") return ContactSimulate(vm);
+  if (sensor == "scanner") return ScannerSimulate(vm);
   if (vm.count("socket"))
     throw InputError("--socket",
                      "is the socket sensor's; --sensor " + sensor + " does not take it");
@@ -594,6 +628,58 @@ int ContactIdentify(const po::variables_map& vm) {
   return s.IsSolutionUsable() ? 0 : 1;
 }
 
+// identify --sensor scanner: the arm's terms, the scanner's frame and the planes' estimated terms
+// from scanner data (scanner_data.h).
+int ScannerIdentify(const po::variables_map& vm) {
+  RefuseRangerOptions(vm, "scanner",
+                      {"estimate-ranger", "estimate-base", "estimate-tool", "average", "predict-at",
+                       "holdout", "report"});
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  const Setup setup = ResolveSetup(vm);
+  const RobotFile& rig = setup.rig;
+  const std::string file = vm["data"].as<std::string>();
+  const std::unique_ptr<ScannerMeasurement> kind =
+      MakeScannerKind(rig.robot, setup.planes, rig.ranger, vm);
+  const MeasuredValues data = ReadScannerData(file, rig.robot, setup.planes, kind->num_beams());
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
+  const IdentificationSummary s = Identify(*kind, data, options);
+  if (s.termination == Termination::kInvalidInput &&
+      data.size() * kind->rows_per_configuration() < kind->num_parameters())
+    throw InputError(file, s.message);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentificationJson(s);
+    j["sensor"] = "scanner";
+    j["values_per_configuration"] = kind->rows_per_configuration();
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: scanner (" << data.size() << " scans of " << kind->num_beams()
+              << " beam(s) on " << setup.planes.size()
+              << " plane(s); lengths in m, angles in rad)\n"
+              << s.FullReport();
+  }
+  if (s.termination == Termination::kRankDeficient) {
+    std::string list;
+    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
+    std::cerr << "lrcal identify: the scanner terms are not identifiable from these "
+                 "configurations; fix the suggested ones (--fix "
+              << list << ") or pass --auto-fix\n";
+    return 3;
+  }
+  if (vm.count("write-robot") && s.IsSolutionUsable()) {
+    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
+                                *kind, data, s, options);
+    std::cerr << "lrcal identify: calibrated robot written to "
+              << vm["write-robot"].as<std::string>() << "\n";
+  }
+  if (s.IsSolutionUsable() && !s.fit.consistent) {
+    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
+              << " < 0.001); see the fit line above\n";
+    return 4;
+  }
+  return s.IsSolutionUsable() ? 0 : 1;
+}
+
 }  // namespace
 
 int IdentifyCommand(const std::vector<std::string>& args) {
@@ -608,6 +694,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "socket") return SocketIdentify(vm);
   if (sensor == "contact") return ContactIdentify(vm);
+  if (sensor == "scanner") return ScannerIdentify(vm);
   if (sensor != "ranger") return TrackerIdentify(vm, sensor);
   // A calibrated robot file that could not be written is refused before the fit, not after.
   if (vm.count("write-robot"))
@@ -753,6 +840,36 @@ int ContactIdentifiability(const po::variables_map& vm) {
   return 0;
 }
 
+// identifiability --sensor scanner: at the configurations of a CSV (q…, plane; a scanner data
+// file's rows of one configuration count once).
+int ScannerIdentifiability(const po::variables_map& vm) {
+  RefuseRangerOptions(
+      vm, "scanner", {"estimate-ranger", "estimate-base", "estimate-tool", "prior-sigma", "prior"});
+  const Setup setup = ResolveSetup(vm);
+  const std::unique_ptr<ScannerMeasurement> kind =
+      MakeScannerKind(setup.rig.robot, setup.planes, setup.rig.ranger, vm);
+  const std::string file = vm["configs"].as<std::string>();
+  const TargetedConfigurations configs =
+      ReadCsv(file).Column("beam") >= 0
+          ? ReadScannerData(file, setup.rig.robot, setup.planes, kind->num_beams()).configs
+          : ReadRobotConfigurations(file, setup.rig.robot, &setup.planes);
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  const IdentifiabilityReport r = AnalyzeIdentifiability(*kind, configs, nullptr, options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentifiabilityJson(r);
+    j["sensor"] = "scanner";
+    j["values_per_configuration"] = kind->rows_per_configuration();
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: scanner (" << kind->num_beams()
+              << " beam(s): a distance in m each per configuration; " << setup.planes.size()
+              << " plane(s))\n"
+              << r.ToString();
+  }
+  return 0;
+}
+
 }  // namespace
 
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
@@ -779,6 +896,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "socket") return SocketIdentifiability(vm);
   if (sensor == "contact") return ContactIdentifiability(vm);
+  if (sensor == "scanner") return ScannerIdentifiability(vm);
   if (sensor != "ranger") return TrackerIdentifiability(vm, sensor);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;

@@ -13,6 +13,7 @@
 #include "lrcal/core/settings.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/scanner_measurement.h"
 #include "lrcal/measurement/socket_measurement.h"
 
 namespace lrcal {
@@ -68,6 +69,8 @@ UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const MeasurementKind& k
     unfixed = std::make_unique<SocketMeasurement>(socket->robot(), socket->setup());
   } else if (const auto* contact = dynamic_cast<const ContactMeasurement*>(&kind)) {
     unfixed = std::make_unique<ContactMeasurement>(contact->robot(), contact->setup());
+  } else if (const auto* scanner = dynamic_cast<const ScannerMeasurement*>(&kind)) {
+    unfixed = std::make_unique<ScannerMeasurement>(scanner->robot(), scanner->setup());
   } else {
     const auto& point = dynamic_cast<const PointMeasurement&>(kind);
     unfixed = dynamic_cast<const PoseMeasurement*>(&kind)

@@ -32,7 +32,10 @@ class ScannerEvaluator : public MeasurementEvaluator {
     for (int i = 0; i < configs.size(); ++i) retagged_.AddFrom(configs, i, 0);
     arm_ = kind.arm().Bind(retagged_);
     origin_.resize(static_cast<std::size_t>(3 * configs.size()));
+    incidence_cosine_.resize(static_cast<std::size_t>(beams_ * configs.size()));
   }
+  /// |cos| of each row's angle between its beam and its plane's normal at the last Predict.
+  const std::vector<double>& incidence_cosines() const { return incidence_cosine_; }
   int num_rows() const override { return beams_ * configs_.size(); }
   int num_parameters() const override { return kind_.num_parameters(); }
   bool Predict(const double* e, double* y, double* J) override {
@@ -53,6 +56,7 @@ class ScannerEvaluator : public MeasurementEvaluator {
         const Eigen::Vector3d D = pose.R_BT * d_T;
         const double nD = plane.normal.dot(D);
         const int row = beams_ * i + b;
+        incidence_cosine_[static_cast<std::size_t>(row)] = std::fabs(nD);
         if (!(std::fabs(nD) > kParallel)) {
           y[row] = std::nan("");
           defined = false;
@@ -106,7 +110,7 @@ class ScannerEvaluator : public MeasurementEvaluator {
   const int beams_;
   TargetedConfigurations retagged_;
   std::unique_ptr<MeasurementEvaluator> arm_;
-  std::vector<double> origin_, arm_J_;
+  std::vector<double> origin_, arm_J_, incidence_cosine_;
   ChainPoint chain_;
   ChainFrames frames_;
 };
@@ -140,6 +144,7 @@ void ScannerSetup::Validate() const {
     throw InputError("scanner.beam_angles", "expected 1 to " + std::to_string(kMaxBeams) +
                                                 " beams, got " +
                                                 std::to_string(beam_angles.size()));
+  range.Validate();
   for (std::size_t b = 0; b < beam_angles.size(); ++b)
     if (!(std::fabs(beam_angles[b]) < M_PI / 2))
       throw InputError("scanner.beam_angles[" + std::to_string(b) + "]",
@@ -227,19 +232,30 @@ std::unique_ptr<MeasurementEvaluator> ScannerMeasurement::Bind(
 std::vector<std::string> ScannerMeasurement::MissReasons(const TargetedConfigurations& configs,
                                                          const double* e) const {
   std::vector<std::string> reasons(static_cast<std::size_t>(configs.size()), "ok");
-  const std::unique_ptr<MeasurementEvaluator> evaluator = Bind(configs);
-  std::vector<double> h(static_cast<std::size_t>(evaluator->num_rows()));
-  evaluator->Predict(e, h.data(), nullptr);
+  Bind(configs);  // checks the tags and joints
+  ScannerEvaluator evaluator(*this, configs);
+  std::vector<double> h(static_cast<std::size_t>(evaluator.num_rows()));
+  evaluator.Predict(e, h.data(), nullptr);
+  const RangerSpec& range = setup_.range;
+  const double min_cosine = std::cos(range.max_incidence);
   const int B = num_beams();
   for (int i = 0; i < configs.size(); ++i)
     for (int b = 0; b < B; ++b) {
-      const double v = h[static_cast<std::size_t>(B * i + b)];
-      if (std::isfinite(v) && v > 0) continue;
-      reasons[static_cast<std::size_t>(i)] =
-          (std::isfinite(v) ? "plane " + std::to_string(configs.target(i) + 1) + " behind beam " +
-                                  std::to_string(b + 1)
-                            : "beam " + std::to_string(b + 1) + " parallel to plane " +
-                                  std::to_string(configs.target(i) + 1));
+      const auto row = static_cast<std::size_t>(B * i + b);
+      const double v = h[row];
+      const std::string beam = "beam " + std::to_string(b + 1),
+                        plane = "plane " + std::to_string(configs.target(i) + 1);
+      std::string reason;
+      if (!std::isfinite(v))
+        reason = beam + " parallel to " + plane;
+      else if (v <= 0)
+        reason = plane + " behind " + beam;
+      else if (v < range.min_range || v > range.max_range)
+        reason = beam + " out of range (" + std::to_string(v) + " m)";
+      else if (evaluator.incidence_cosines()[row] < min_cosine)
+        reason = beam + " grazing " + plane;
+      if (reason.empty()) continue;
+      reasons[static_cast<std::size_t>(i)] = reason;
       break;
     }
   return reasons;

@@ -346,5 +346,62 @@ TEST_F(SensorCli, PlaneContactsCalibrateTheArmWithThePlanesEstimated) {
   EXPECT_THAT(out, HasSubstr("consistent with the stated noise"));
 }
 
+// A line scanner as a user meets it: five beams spread ±10° in a frame turned on the tool,
+// simulated noise-free by `simulate --sensor scanner` at the 40 configurations (those with a beam
+// out of range or grazing the plane left out, and said so); the analysis counts what the fan
+// identifies with the plane estimated; `identify --sensor scanner --auto-fix` leaves no residual
+// and finds the true errors its held terms do not touch; the data file's errors are located.
+TEST_F(SensorCli, ALineScannerCalibratesTheArmWithThePlaneEstimated) {
+  const std::string geometry =
+      " --sensor scanner --beams 5 --fan-deg 10 --scanner 0.03,-0.01,0.02,0.1,0.2,0.3";
+  const std::string scanner = geometry + " --estimate-plane normal,offset";
+  std::string out;
+  ASSERT_EQ(Run("simulate" + geometry + " --sigma-mm 0 --configs " + Path("c.csv") + " --out " +
+                    Path("scans.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, ::testing::ContainsRegex("[0-9]+ scans of 5 beam\\(s\\) written"));
+  ASSERT_EQ(
+      Run("identifiability --format json" + scanner + " --configs " + Path("scans.csv"), &out), 0)
+      << out;
+  const Json analysis = Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  EXPECT_EQ(analysis["sensor"], "scanner");
+  EXPECT_EQ(analysis["values_per_configuration"], 5);
+  EXPECT_EQ(analysis["n_params"], 25 + 3 + 3 + 3);  // arm, origin, orientation, plane
+  EXPECT_EQ(analysis["rank"], 27);
+  ASSERT_EQ(
+      Run("identify --format json --auto-fix" + scanner + " --data " + Path("scans.csv"), &out), 0)
+      << out;
+  const Json fit = Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
+  const auto at = [&](const std::string& name) {
+    for (const Json& p : fit["parameters"])
+      if (p["name"] == name) return p["delta"].get<double>();
+    ADD_FAILURE() << name << " not estimated";
+    return 0.0;
+  };
+  constexpr double kExact = 1e-9;  // studies/robots/paper.yaml's true errors, SI
+  EXPECT_NEAR(at("beta2"), 1.45e-3, kExact);
+  EXPECT_NEAR(at("alpha5"), -4.83e-3, kExact);
+
+  // A configuration without one of its beams, a beam number beyond the fan, the ranger's options.
+  std::ifstream in(Path("scans.csv"));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::ofstream(Path("short.csv")) << lines[0] << "\n" << lines[1] << "\n" << lines[2] << "\n";
+  EXPECT_EQ(Run("identify" + scanner + " --data " + Path("short.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("short.csv:2 column 'beam': the configuration starting here has no "
+                             "reading of beam 3"));
+  EXPECT_EQ(Run("identify --sensor scanner --beams 4 --data " + Path("scans.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("column 'beam': expected a beam number from 1 to 4"));
+  EXPECT_EQ(Run("identify --fan-deg 5 --data " + Path("scans.csv"), &out), 2);
+  EXPECT_THAT(out,
+              HasSubstr("--fan-deg: is the scanner sensor's; --sensor ranger does not take it"));
+  EXPECT_EQ(
+      Run("identify" + scanner + " --estimate-ranger offset --data " + Path("scans.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("are the scanner's frame and the planes"));
+}
+
 }  // namespace
 }  // namespace lrcal

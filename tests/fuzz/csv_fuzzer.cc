@@ -4,11 +4,12 @@
 
 #include "fuzz_util.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/io/scanner_data.h"
 #include "lrcal/io/socket_data.h"
 
 namespace {
 
-// A six-joint arm for the readers that check joint ranges (socket data).
+// A six-joint arm for the readers that check joint ranges (socket and scanner data).
 const lrcal::RobotModel& SixJoints() {
   static const lrcal::RobotModel robot = [] {
     std::vector<lrcal::Link> links(6);
@@ -26,5 +27,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const lrcal::RangerSpec ranger;
   lrcal::fuzz::ExpectCleanAnswer(path, [&] { lrcal::ReadMeasurements(path, 6, &ranger); });
   lrcal::fuzz::ExpectCleanAnswer(path, [&] { lrcal::ReadSocketData(path, SixJoints()); });
+  const lrcal::PlaneSet planes({lrcal::Plane::FromCoefficients(0, 0, 1, -0.5)}, {}, "fuzz");
+  lrcal::fuzz::ExpectCleanAnswer(path,
+                                 [&] { lrcal::ReadScannerData(path, SixJoints(), planes, 3); });
   return 0;
 }

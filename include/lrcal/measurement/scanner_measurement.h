@@ -15,11 +15,13 @@
 //  - the scanner's orientation: "scanner_roll", "scanner_pitch", "scanner_yaw" (rad: R_TS =
 //    R_TS0·Rz(yaw)·Ry(pitch)·Rx(roll), as the tracker's instrument);
 //  - each plane's estimated terms (estimated_planes.h).
-// Any of them can be held at nominal by name. A beam's range limits are not modelled; a beam
-// misses when it is parallel to its plane or the plane is behind it (h ≤ 0), and a configuration
-// with a missing beam has no measurement (MissReasons names the beam). The Jacobian is analytic
-// (the point kind's motion of O, ω × D for the beam's direction, the roll-pitch-yaw derivatives
-// for R_TS, the plane's chart), checked against autodiff and central differences in the tests.
+// Any of them can be held at nominal by name. A beam misses when it is parallel to its plane, the
+// plane is behind it (h ≤ 0), its reading is outside the scanner's range or it meets the plane
+// beyond the largest angle of incidence (ScannerSetup::range, the ranger's limits); a
+// configuration with a missing beam has no measurement (MissReasons names the beam). The Jacobian
+// is analytic (the point kind's motion of O, ω × D for the beam's direction, the roll-pitch-yaw
+// derivatives for R_TS, the plane's chart), checked against autodiff and central differences in the
+// tests.
 #pragma once
 
 #include <Eigen/Core>
@@ -46,12 +48,14 @@ struct ScannerSetup {
   /// Each beam's angle φ_b from S's z axis towards its x axis (rad); 1 to kMaxBeams of them.
   std::vector<double> beam_angles{0.0};
   static constexpr int kMaxBeams = 256;
+  /// Each beam's range and largest angle of incidence (the ranger's: a robot file's `ranger:`).
+  RangerSpec range{};
   /// A fan of `count` beams spread evenly over [−half_angle, half_angle] (rad; one beam: 0).
   static std::vector<double> Fan(int count, double half_angle);
   /// Throws InputError naming the field (scanner.planes, scanner.plane_terms, scanner.origin,
-  /// scanner.orientation, scanner.beam_angles[b]) unless there is a plane, plane_terms is empty
-  /// or one per plane, the origin is finite, the orientation a rotation, and there are 1 to
-  /// kMaxBeams finite beam angles within (−π/2, π/2).
+  /// scanner.orientation, scanner.beam_angles[b]; the range's SettingError) unless there is a
+  /// plane, plane_terms is empty or one per plane, the origin is finite, the orientation a
+  /// rotation, the range valid, and there are 1 to kMaxBeams finite beam angles in (−π/2, π/2).
   void Validate() const;
 };
 
@@ -77,7 +81,8 @@ class ScannerMeasurement : public MeasurementKind {
   const std::vector<std::string>& parameter_names() const override { return names_; }
   Eigen::VectorXd NominalValues() const override;
   std::unique_ptr<MeasurementEvaluator> Bind(const TargetedConfigurations& configs) const override;
-  /// "ok", or "beam B parallel to plane P" / "plane P behind beam B" (1-based numbers).
+  /// "ok", or why the first missing beam misses: "beam B parallel to plane P", "plane P behind
+  /// beam B", "beam B out of range (H m)", "beam B grazing plane P" (1-based numbers).
   std::vector<std::string> MissReasons(const TargetedConfigurations& configs,
                                        const double* e) const override;
   std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const override;
