@@ -51,6 +51,7 @@
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
+#include "lrcal/measurement/scanner_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/measurement/truth.h"
 #include "lrcal/paper/paper_case.h"
@@ -1003,43 +1004,112 @@ TargetedConfigurations ToContactConfigurations(const RobotModel& robot, const Ar
   return configs;
 }
 
-IdentifiabilityReport IdentifiabilityPy(
-    const RobotFile& rig, const Array& q, const py::object& plane_arg,
-    const std::string& estimate_plane, const py::object& fix, double rank_tolerance,
-    const py::object& plane_of, const std::string& estimate_ranger,
-    const std::string& estimate_base, const std::string& estimate_tool, const std::string& sensor,
-    const py::object& instrument, const py::object& targets, const py::object& target_of,
-    const SocketArgs& sockets, bool flush) {
+// A line scanner from Python (scanner_measurement.h): beams= and fan_deg= (the fan), scanner=
+// (its frame in the tool frame, x, y, z, roll, pitch, yaw; None: the tool frame), the ranger's
+// plane arguments, as --sensor scanner builds it (the robot file's ranger limits).
+struct ScannerArgs {
+  py::object plane, plane_of, scanner, fix;
+  std::string estimate_plane;
+  long long beams;
+  double fan_deg;
+};
+
+std::unique_ptr<ScannerMeasurement> ToScannerKind(const RobotFile& rig, const RobotModel& robot,
+                                                  const PlaneSet& planes, const ScannerArgs& a) {
+  ScannerSetup setup;
+  setup.planes = planes;
+  setup.range = rig.ranger;
+  if (!a.scanner.is_none()) {
+    const RigidTransform frame = ToXyzRpy(a.scanner, "scanner", false);
+    setup.origin = frame.translation;
+    setup.orientation = frame.rotation;
+  }
+  if (a.beams < 1 || a.beams > ScannerSetup::kMaxBeams)
+    throw InputError("beams", "expected 1 to " + std::to_string(ScannerSetup::kMaxBeams) +
+                                  " beams, got " + std::to_string(a.beams));
+  if (!(a.fan_deg >= 0 && a.fan_deg < 90))
+    throw InputError("fan_deg", "expected a half angle from 0 to below 90 deg");
+  setup.beam_angles = ScannerSetup::Fan(static_cast<int>(a.beams), a.fan_deg * M_PI / 180);
+  setup.plane_terms.assign(static_cast<std::size_t>(planes.size()),
+                           PlaneTerms::Parse(a.estimate_plane, "estimate_plane"));
+  return std::make_unique<ScannerMeasurement>(robot, setup, ToNames(a.fix), "fix");
+}
+
+// The rank analysis of `kind` at `configs` with the given rank tolerance, the GIL released.
+IdentifiabilityReport AnalyzeKindPy(const MeasurementKind& kind,
+                                    const TargetedConfigurations& configs, double rank_tolerance) {
+  IdentifiabilityOptions options;
+  options.rank_tolerance = rank_tolerance;
+  options.Validate();
+  py::gil_scoped_release release;
+  return AnalyzeIdentifiability(kind, configs, nullptr, options);
+}
+
+// identifiability(sensor='contact' or 'scanner'): the kinds that see the ranger's planes (a's
+// plane, plane_of, estimate_plane and fix; a contact's tool point and flush).
+IdentifiabilityReport PlaneKindIdentifiabilityPy(const RobotFile& rig, const Array& q,
+                                                 const std::string& sensor,
+                                                 const py::object& tool_point, bool flush,
+                                                 const ScannerArgs& a, double rank_tolerance) {
+  const PlaneSet planes = ResolvePlanes(rig, a.plane);
+  const TargetedConfigurations configs =
+      ToContactConfigurations(rig.robot, q, a.plane_of, planes.size());
+  if (sensor == "contact")
+    return AnalyzeKindPy(
+        *ToContactKind(rig.robot, planes,
+                       {a.plane, a.plane_of, tool_point, a.fix, a.estimate_plane, flush}),
+        configs, rank_tolerance);
+  return AnalyzeKindPy(*ToScannerKind(rig, rig.robot, planes, a), configs, rank_tolerance);
+}
+
+// identifiability(): the arguments of a sensor other than `sensor`, refused by name (contact and
+// scanner arguments first; the sockets' when the sensor is the ranger or a tracker).
+void RefuseOtherSensorsArguments(const std::string& sensor, const SocketArgs& sockets, bool flush,
+                                 const ScannerArgs& scanner) {
   if (sensor != "contact" && flush)
     throw InputError("flush", "is the contact sensor's: give sensor='contact'");
-  if (sensor == "contact") {
-    RefuseRangerArguments(sensor, {{"estimate_ranger", estimate_ranger != "none"},
-                                   {"estimate_base", estimate_base != "none"},
-                                   {"estimate_tool", estimate_tool != "none"},
-                                   {"instrument", !instrument.is_none()},
-                                   {"targets", !targets.is_none()},
-                                   {"target_of", !target_of.is_none()},
-                                   {"socket_of", !sockets.socket_of.is_none()},
-                                   {"socket_distances", !sockets.distances.is_none()}});
-    const PlaneSet planes = ResolvePlanes(rig, plane_arg);
-    const std::unique_ptr<ContactMeasurement> kind = ToContactKind(
-        rig.robot, planes, {plane_arg, plane_of, sockets.tool_point, fix, estimate_plane, flush});
-    const TargetedConfigurations configs =
-        ToContactConfigurations(rig.robot, q, plane_of, planes.size());
-    IdentifiabilityOptions options;
-    options.rank_tolerance = rank_tolerance;
-    options.Validate();
-    py::gil_scoped_release release;
-    return AnalyzeIdentifiability(*kind, configs, nullptr, options);
-  }
-  if (sensor != "socket" &&
-      !(sockets.socket_of.is_none() && sockets.distances.is_none() && sockets.tool_point.is_none()))
+  if (sensor != "scanner" &&
+      !(scanner.scanner.is_none() && scanner.beams == 1 && scanner.fan_deg == 0))
+    throw InputError(!scanner.scanner.is_none() ? "scanner"
+                     : scanner.beams != 1       ? "beams"
+                                                : "fan_deg",
+                     "is the scanner sensor's: give sensor='scanner'");
+  if (sensor == "socket" || sensor == "contact" || sensor == "scanner") return;
+  if (!(sockets.socket_of.is_none() && sockets.distances.is_none() && sockets.tool_point.is_none()))
     throw InputError(!sockets.socket_of.is_none()   ? "socket_of"
                      : !sockets.distances.is_none() ? "socket_distances"
                                                     : "tool_point",
                      sockets.socket_of.is_none() && sockets.distances.is_none()
                          ? "is a constraint sensor's: give sensor='socket' or sensor='contact'"
                          : "is the socket sensor's: give sensor='socket'");
+}
+
+IdentifiabilityReport IdentifiabilityPy(
+    const RobotFile& rig, const Array& q, const py::object& plane_arg,
+    const std::string& estimate_plane, const py::object& fix, double rank_tolerance,
+    const py::object& plane_of, const std::string& estimate_ranger,
+    const std::string& estimate_base, const std::string& estimate_tool, const std::string& sensor,
+    const py::object& instrument, const py::object& targets, const py::object& target_of,
+    const SocketArgs& sockets, bool flush, const ScannerArgs& scanner) {
+  RefuseOtherSensorsArguments(sensor, sockets, flush, scanner);
+  if (sensor == "contact" || sensor == "scanner") {
+    RefuseRangerArguments(sensor,
+                          {{"estimate_ranger", estimate_ranger != "none"},
+                           {"estimate_base", estimate_base != "none"},
+                           {"estimate_tool", estimate_tool != "none"},
+                           {"instrument", !instrument.is_none()},
+                           {"targets", !targets.is_none()},
+                           {"target_of", !target_of.is_none()},
+                           {"socket_of", !sockets.socket_of.is_none()},
+                           {"socket_distances", !sockets.distances.is_none()},
+                           {"tool_point", sensor == "scanner" && !sockets.tool_point.is_none()}});
+    ScannerArgs a = scanner;
+    a.plane = plane_arg;
+    a.plane_of = plane_of;
+    a.fix = fix;
+    a.estimate_plane = estimate_plane;
+    return PlaneKindIdentifiabilityPy(rig, q, sensor, sockets.tool_point, flush, a, rank_tolerance);
+  }
   if (sensor == "socket") {
     RefuseRangerArguments(sensor, {{"plane", !plane_arg.is_none()},
                                    {"plane_of", !plane_of.is_none()},
@@ -1429,6 +1499,27 @@ set, the candidate evaluations spent, and the pool rows rejected because their b
       });
 }
 
+// Identification.linearisation: the check as identify's JSON has it; None when not computed.
+py::object LinearisationDict(const IdentificationSummary& s) {
+  const LinearisationCheck& c = s.linearisation;
+  if (c.num_parameters == 0) return py::none();
+  py::dict d;
+  d["computed"] = c.computed;
+  d["excess"] = c.excess;
+  d["relative_excess"] = c.RelativeExcess();
+  d["holds"] = c.Holds();
+  d["pairs"] = c.pairs;
+  d["message"] = c.message;
+  if (c.computed) {
+    py::dict direction;
+    for (std::size_t k = 0; k < s.names.size(); ++k)
+      direction[py::str(s.names[k])] = c.worst_direction[static_cast<Eigen::Index>(k)];
+    d["worst_direction"] = direction;
+    d["worst_direction_sigma"] = c.worst_direction_sigma;
+  }
+  return d;
+}
+
 void DefineIdentification(py::module_& m) {
   using S = IdentificationSummary;
   py::class_<S>(m, "Identification", py::dynamic_attr(), R"doc(
@@ -1496,26 +1587,7 @@ str() gives the full text report; repr() the one-line summary.)doc")
           "grouped by configuration labels; test says which check decided `consistent`: chi2, "
           "or robust_scale with a robust loss (robust_scale and robust_p_value).")
       .def_property_readonly(
-          "linearisation",
-          [](const S& s) -> py::object {
-            const LinearisationCheck& c = s.linearisation;
-            if (c.num_parameters == 0) return py::none();
-            py::dict d;
-            d["computed"] = c.computed;
-            d["excess"] = c.excess;
-            d["relative_excess"] = c.RelativeExcess();
-            d["holds"] = c.Holds();
-            d["pairs"] = c.pairs;
-            d["message"] = c.message;
-            if (c.computed) {
-              py::dict direction;
-              for (std::size_t k = 0; k < s.names.size(); ++k)
-                direction[py::str(s.names[k])] = c.worst_direction[static_cast<Eigen::Index>(k)];
-              d["worst_direction"] = direction;
-              d["worst_direction_sigma"] = c.worst_direction_sigma;
-            }
-            return d;
-          },
+          "linearisation", &LinearisationDict,
           "The linearisation check (lrcal/identification/linearisation_check.h), as identify's "
           "JSON 'linearisation': excess (what the model's curvature adds to the expected "
           "chi2(n) of the estimate's error), relative_excess (excess/n), holds (computed and "
@@ -1746,11 +1818,13 @@ void DefineIdentifiability(py::module_& m) {
          const std::string& estimate_base, const std::string& estimate_tool,
          const std::string& sensor, const py::object& instrument, const py::object& targets,
          const py::object& target_of, const py::object& socket_of,
-         const py::object& socket_distances, const py::object& tool_point, bool flush) {
-        return IdentifiabilityPy(rig, q, plane, estimate_plane, fix, rank_tolerance, plane_of,
-                                 estimate_ranger, estimate_base, estimate_tool, sensor, instrument,
-                                 targets, target_of, {socket_of, socket_distances, tool_point},
-                                 flush);
+         const py::object& socket_distances, const py::object& tool_point, bool flush,
+         long long beams, double fan_deg, const py::object& scanner) {
+        return IdentifiabilityPy(
+            rig, q, plane, estimate_plane, fix, rank_tolerance, plane_of, estimate_ranger,
+            estimate_base, estimate_tool, sensor, instrument, targets, target_of,
+            {socket_of, socket_distances, tool_point}, flush,
+            {py::none(), py::none(), scanner, py::none(), "none", beams, fan_deg});
       },
       py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("fix") = py::none(),
@@ -1761,7 +1835,8 @@ void DefineIdentifiability(py::module_& m) {
       py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
       py::arg("targets") = py::none(), py::arg("target_of") = py::none(),
       py::arg("socket_of") = py::none(), py::arg("socket_distances") = py::none(),
-      py::arg("tool_point") = py::none(), py::arg("flush") = false, R"doc(
+      py::arg("tool_point") = py::none(), py::arg("flush") = false, py::arg("beams") = 1,
+      py::arg("fan_deg") = 0.0, py::arg("scanner") = py::none(), R"doc(
 What the configurations q (N, joints) can identify of the parameter set (plane, plane_of,
 estimate_plane, estimate_ranger, estimate_base, estimate_tool, fix as in identify: several
 planes too), at the nominal model. Returns an lrcal.Identifiability; str() gives the report of
@@ -1773,7 +1848,8 @@ each row sees, fix= as above. sensor='socket' analyses seatings in sockets (`--s
 socket_of (N socket ids), socket_distances=[(a, b, metres), ...], tool_point=(x, y, z).
 sensor='contact' analyses contacts with planes (`--sensor contact`): plane, plane_of,
 estimate_plane and fix as for the ranger, tool_point=(x, y, z) in the tool frame, flush=True for
-flush contacts (two tilt rows each).)doc");
+flush contacts (two tilt rows each). sensor='scanner' analyses a line scanner's fan (`--sensor
+scanner`): beams=, fan_deg= (half angle), scanner=(x, y, z, roll, pitch, yaw) in the tool frame.)doc");
 }
 
 // The trackers' simulation and fit (point_measurement.h, pose_measurement.h); their
@@ -2040,11 +2116,109 @@ contact's tilt rows weigh (sigma_mm/sigma_mrad)^2) and solver as in identify_tra
 lrcal.Identification.)doc");
 }
 
+// simulate_scanner: as simulate --sensor scanner.
+py::dict SimulateScannerPy(const RobotFile& rig, const Array& q, const ScannerArgs& a,
+                           double sigma_mm, long long repetitions, long long seed) {
+  const PlaneSet planes = ResolvePlanes(rig, a.plane);
+  const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
+  const std::unique_ptr<ScannerMeasurement> truth = ToScannerKind(rig, true_robot, planes, a);
+  NoiseModel noise;
+  noise.sigma = sigma_mm * 1e-3;
+  if (repetitions < 1 || repetitions > 1000000)
+    throw InputError("repetitions", "expected 1 to 1,000,000 readings per beam");
+  noise.repetitions = static_cast<int>(repetitions);
+  MeasuredValues data;
+  std::vector<std::string> misses;
+  SimulateMeasurements(*truth, ToContactConfigurations(rig.robot, q, a.plane_of, planes.size()),
+                       noise, RandomStream(ToSeed(seed), 0, 0, RandomPurpose::kNoise), &data,
+                       &misses);
+  py::array_t<double> h(
+      {static_cast<py::ssize_t>(data.size()), static_cast<py::ssize_t>(truth->num_beams())});
+  std::copy(data.y.begin(), data.y.end(), h.mutable_data());
+  py::dict out;
+  out["q"] = ToArray(data.configs);
+  out["plane_of"] = PlaneNumbers(data.configs);
+  out["h"] = h;
+  out["repetitions"] = data.repetitions;
+  out["misses"] = misses;
+  return out;
+}
+
+// identify_scanner: as identify --sensor scanner; h (N, beams).
+IdentificationSummary IdentifyScannerPy(const RobotFile& rig, const Array& q, const Array& h,
+                                        ScannerArgs a, const py::object& repetitions, bool auto_fix,
+                                        double sigma_mm, const std::string& solver) {
+  if (h.ndim() != 2)
+    throw InputError("h", "expected an (N, beams) array of readings (m), one column per beam");
+  a.beams = static_cast<long long>(h.shape(1));
+  const PlaneSet planes = ResolvePlanes(rig, a.plane);
+  const std::unique_ptr<ScannerMeasurement> kind = ToScannerKind(rig, rig.robot, planes, a);
+  MeasuredValues data{ToContactConfigurations(rig.robot, q, a.plane_of, planes.size()), {}, {}};
+  data.y = ToRows(h, kind->num_beams(), data.size(), "h");
+  data.repetitions.assign(static_cast<std::size_t>(data.size()), 1);
+  if (!repetitions.is_none()) data.repetitions = repetitions.cast<std::vector<int>>();
+  if (static_cast<int>(data.repetitions.size()) != data.size())
+    throw InputError("repetitions", "expected one count per row of q");
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
+  options.sigma = sigma_mm * 1e-3;
+  options.fix_dependent_parameters = auto_fix;
+  options.check_linearisation = true;  // as lrcal identify
+  options.Validate();
+  py::gil_scoped_release release;
+  return Identify(*kind, data, options);
+}
+
+// The scanner kind (scanner_measurement.h): simulation and fit.
+void DefineScanners(py::module_& m) {
+  m.def(
+      "simulate_scanner",
+      [](const RobotFile& rig, const Array& q, const py::object& plane, const py::object& plane_of,
+         long long beams, double fan_deg, const py::object& scanner, double sigma_mm,
+         long long repetitions, long long seed) {
+        return SimulateScannerPy(rig, q,
+                                 {plane, plane_of, scanner, py::none(), "none", beams, fan_deg},
+                                 sigma_mm, repetitions, seed);
+      },
+      py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
+      py::arg("plane_of") = py::none(), py::arg("beams") = 1, py::arg("fan_deg") = 0.0,
+      py::arg("scanner") = py::none(), py::arg("sigma_mm") = 0.2, py::arg("repetitions") = 1,
+      py::arg("seed") = 1, R"doc(
+A line scanner's readings by the true arm (nominal + the robot file's true errors): `lrcal
+simulate --sensor scanner`. beams= beams spread over +-fan_deg (deg) in the x-z plane of the
+scanner's frame, scanner=(x, y, z, roll, pitch, yaw) in the tool frame (m, rad; None: the tool
+frame), each beam reading its distance to plane plane_of[i] (from 1; plane= as in identify) with
+noise sigma_mm, the mean of `repetitions`. Configurations with a beam out of the robot file's
+ranger limits are left out. Returns a dict: q, plane_of, h (N, beams; m), repetitions, misses (a
+reason per configuration of q).)doc");
+  m.def(
+      "identify_scanner",
+      [](const RobotFile& rig, const Array& q, const Array& h, const py::object& plane,
+         const py::object& plane_of, double fan_deg, const py::object& scanner,
+         const std::string& estimate_plane, const py::object& repetitions, const py::object& fix,
+         bool auto_fix, double sigma_mm, const std::string& solver) {
+        return IdentifyScannerPy(rig, q, h,
+                                 {plane, plane_of, scanner, fix, estimate_plane, 1, fan_deg},
+                                 repetitions, auto_fix, sigma_mm, solver);
+      },
+      py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
+      py::arg("plane_of") = py::none(), py::arg("fan_deg") = 0.0, py::arg("scanner") = py::none(),
+      py::arg("estimate_plane") = "none", py::arg("repetitions") = py::none(),
+      py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
+      py::arg("solver") = "lm", R"doc(
+The arm's link values, the scanner's frame (target_x..z, scanner_roll, _pitch, _yaw) and the
+planes' estimated terms from a line scanner's readings h (N, beams; m, one column per beam, the
+fan as in simulate_scanner): `lrcal identify --sensor scanner`. q, plane, plane_of,
+estimate_plane, repetitions, fix, auto_fix, sigma_mm and solver as in identify_contacts. Returns
+an lrcal.Identification.)doc");
+}
+
 void DefineCalibration(py::module_& m) {
   DefineIdentifiability(m);
   DefineTrackers(m);
   DefineSockets(m);
   DefineContacts(m);
+  DefineScanners(m);
   DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

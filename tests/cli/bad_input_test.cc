@@ -683,10 +683,10 @@ const std::vector<BadInputCase>& Cases() {
         "got 1"}},
       {"SensorUnknown",
        {{"c.csv", kConfigs}},
-       "identifiability --configs c.csv --sensor scanner",
+       "identifiability --configs c.csv --sensor lidar",
        2,
-       {"--sensor: 'scanner' is not a sensor lrcal models: expected ranger, point, pose, socket "
-        "or contact"}},
+       {"--sensor: 'lidar' is not a sensor lrcal models: expected ranger, scanner, point, pose, "
+        "socket or contact"}},
       {"SocketColumnMissing",
        {{"c.csv", kConfigs}},
        "identifiability --configs c.csv --sensor socket",

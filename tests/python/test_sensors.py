@@ -205,3 +205,49 @@ def test_contacts_simulate_and_identify_as_the_program(tmp_path, cli, paper):
     with pytest.raises(lrcal.InputError, match="socket_of: is the contact sensor's|socket_of"):
         lrcal.identifiability(paper, sim["q"], sensor="contact", plane=PLANES,
                               plane_of=sim["plane_of"], socket_of=sim["plane_of"])
+
+
+def test_scanner_simulate_identify_and_identifiability_as_the_program(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    starts = tmp_path / "c.csv"
+    with open(starts, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)])
+        writer.writerows([[repr(v) for v in row] for row in q])
+    frame = (0.03, -0.01, 0.02, 0.1, 0.2, 0.3)
+    geometry = ["--sensor", "scanner", "--beams", "5", "--fan-deg", "10",
+                "--scanner", ",".join(repr(v) for v in frame)]
+    cli("simulate", *geometry, "--configs", starts, "--sigma-mm", "0.05", "--repetitions", "3",
+        "--seed", "4", "--out", tmp_path / "scans.csv")
+    sim = lrcal.simulate_scanner(paper, q, beams=5, fan_deg=10, scanner=frame, sigma_mm=0.05,
+                                 repetitions=3, seed=4)
+    with open(tmp_path / "scans.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 5 * len(sim["q"])
+    np.testing.assert_array_equal(sim["h"].ravel(), [float(r["h"]) for r in rows])
+    assert sim["repetitions"] == [3] * len(sim["q"])
+    assert len(sim["misses"]) == 40
+    assert sum(m == "ok" for m in sim["misses"]) == len(sim["q"])
+
+    fit = lrcal.identify_scanner(paper, sim["q"], sim["h"], fan_deg=10, scanner=frame,
+                                 estimate_plane="normal,offset", repetitions=sim["repetitions"],
+                                 auto_fix=True, sigma_mm=0.05)
+    done = cli("identify", *geometry, "--data", tmp_path / "scans.csv", "--estimate-plane",
+               "normal,offset", "--auto-fix", "--sigma-mm", "0.05", "--format", "json")
+    program = json.loads(done.stdout)
+    assert fit.names == [p["name"] for p in program["parameters"]]
+    np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
+                               rtol=0, atol=1e-12)
+    assert fit.linearisation["holds"] == program["linearisation"]["holds"]
+
+    analysis = lrcal.identifiability(paper, sim["q"], sensor="scanner", beams=5, fan_deg=10,
+                                     scanner=frame, estimate_plane="normal,offset")
+    done = cli("identifiability", *geometry, "--configs", tmp_path / "scans.csv",
+               "--estimate-plane", "normal,offset", "--format", "json")
+    program = json.loads(done.stdout)
+    assert (analysis.rank, len(analysis.names)) == (program["rank"], program["n_params"])
+    assert analysis.suggested_fixed == program["suggested_fixed"]
+    with pytest.raises(lrcal.InputError, match="beams: is the scanner sensor's"):
+        lrcal.identifiability(paper, sim["q"], beams=5)
+    with pytest.raises(lrcal.InputError, match="h: expected an \\(N, beams\\) array"):
+        lrcal.identify_scanner(paper, sim["q"], sim["h"].ravel())
