@@ -469,6 +469,59 @@ namespace {
 
 // identify --sensor point|pose: the tracker's terms from its measurement file (tracker_data.h).
 // A pose's orientation rows weigh (σ/σ_angle)² per reading against its positions.
+// What every identify of a kind other than the ranger does after its fit (`lrcal identify
+// --sensor point|pose|socket|contact|scanner`): too few values for the terms is the data file's
+// error; the report (text after `heading`, or JSON with the sensor, its values per configuration
+// and `extra`); the rank advice (exit 3); the calibrated robot file; the fit check against the
+// stated noise (`noise`: the options it names; exit 4).
+struct KindFit {
+  const RobotFile& rig;
+  const MeasurementKind& kind;
+  const MeasuredValues& data;
+  const std::string& file;
+  std::string sensor, heading, noise = "--sigma-mm";
+  Json extra = Json::object();
+};
+
+int ReportKindFit(const po::variables_map& vm, const KindFit& f, const IdentificationSummary& s,
+                  const IdentificationOptions& options) {
+  if (s.termination == Termination::kInvalidInput &&
+      f.data.size() * f.kind.rows_per_configuration() < f.kind.num_parameters())
+    throw InputError(f.file, s.message);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentificationJson(s);
+    j["sensor"] = f.sensor;
+    j["values_per_configuration"] = f.kind.rows_per_configuration();
+    for (const auto& [key, value] : f.extra.items()) j[key] = value;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: " << f.sensor << " (" << f.heading << "; lengths in m, angles in rad)\n"
+              << s.FullReport();
+  }
+  if (s.termination == Termination::kRankDeficient) {
+    std::string list;
+    for (const auto& name : s.identifiability.suggested_fixed)
+      list += (list.empty() ? "" : ",") + name;
+    std::cerr << "lrcal identify: the " << f.sensor
+              << " terms are not identifiable from these configurations; fix the suggested ones "
+                 "(--fix "
+              << list << ") or pass --auto-fix\n";
+    return 3;
+  }
+  if (vm.count("write-robot") && s.IsSolutionUsable()) {
+    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(f.file),
+                                f.rig, f.kind, f.data, s, options);
+    std::cerr << "lrcal identify: calibrated robot written to "
+              << vm["write-robot"].as<std::string>() << "\n";
+  }
+  if (s.IsSolutionUsable() && !s.fit.consistent) {
+    std::cerr << "lrcal identify: the fit is inconsistent with " << f.noise
+              << " (p = " << s.fit.p_value << " < 0.001); see the fit line above\n";
+    return 4;
+  }
+  return s.IsSolutionUsable() ? 0 : 1;
+}
+
 int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
   RefuseRangerOptions(vm, sensor,
                       {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
@@ -485,40 +538,12 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
                    ResolveSigmaAngle(vm, false), &data);
   const IdentificationSummary s = Identify(*kind, data, options);
-  if (s.termination == Termination::kInvalidInput && data.size() * 3 < kind->num_parameters())
-    throw InputError(file, s.message);
-  if (ResolveFormat(vm) == Format::kJson) {
-    Json j = IdentificationJson(s);
-    j["sensor"] = sensor;
-    j["values_per_configuration"] = kind->rows_per_configuration();
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << "sensor: " << sensor << " (" << data.size() << " measurements of "
-              << kind->setup().targets.size() << " target(s); lengths in m, angles in rad)\n"
-              << s.FullReport();
-  }
-  if (s.termination == Termination::kRankDeficient) {
-    std::string list;
-    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
-    std::cerr << "lrcal identify: the " << sensor
-              << " terms are not identifiable from these configurations; fix the suggested ones "
-                 "(--fix "
-              << list << ") or pass --auto-fix\n";
-    return 3;
-  }
-  if (vm.count("write-robot") && s.IsSolutionUsable()) {
-    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
-                                *kind, data, s, options);
-    std::cerr << "lrcal identify: calibrated robot written to "
-              << vm["write-robot"].as<std::string>() << "\n";
-  }
-  if (s.IsSolutionUsable() && !s.fit.consistent) {
-    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm"
-              << (sensor == "pose" ? " and --sigma-mrad" : "") << " (p = " << s.fit.p_value
-              << " < 0.001); see the fit line above\n";
-    return 4;
-  }
-  return s.IsSolutionUsable() ? 0 : 1;
+  return ReportKindFit(vm,
+                       {rig, *kind, data, file, sensor,
+                        std::to_string(data.size()) + " measurements of " +
+                            std::to_string(kind->setup().targets.size()) + " target(s)",
+                        sensor == "pose" ? "--sigma-mm and --sigma-mrad" : "--sigma-mm"},
+                       s, options);
 }
 
 // identify --sensor socket: the arm's terms, the tool point and the sockets from socket data
@@ -535,41 +560,12 @@ int SocketIdentify(const po::variables_map& vm) {
   const std::unique_ptr<SocketMeasurement> kind = MakeSocketKind(rig.robot, data, vm);
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
   const IdentificationSummary s = Identify(*kind, data.values, options);
-  if (s.termination == Termination::kInvalidInput &&
-      data.values.size() * 3 < kind->num_parameters())
-    throw InputError(file, s.message);
-  if (ResolveFormat(vm) == Format::kJson) {
-    Json j = IdentificationJson(s);
-    j["sensor"] = "socket";
-    j["values_per_configuration"] = 3;
-    j["sockets"] = data.ids;
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << "sensor: socket (" << data.values.size() << " seatings in " << data.ids.size()
-              << " socket(s); lengths in m, angles in rad)\n"
-              << s.FullReport();
-  }
-  if (s.termination == Termination::kRankDeficient) {
-    std::string list;
-    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
-    std::cerr << "lrcal identify: the socket terms are not identifiable from these "
-                 "configurations; fix the suggested ones (--fix "
-              << list << ") or pass --auto-fix\n";
-    return 3;
-  }
-  if (vm.count("write-robot") && s.IsSolutionUsable()) {
-    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
-                                *kind, data.values, s, options);
-    std::cerr << "lrcal identify: calibrated robot written to "
-              << vm["write-robot"].as<std::string>() << "\n";
-  }
-  if (s.IsSolutionUsable() && !s.fit.consistent) {
-    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (the play in the "
-                 "sockets; p = "
-              << s.fit.p_value << " < 0.001); see the fit line above\n";
-    return 4;
-  }
-  return s.IsSolutionUsable() ? 0 : 1;
+  return ReportKindFit(vm,
+                       {rig, *kind, data.values, file, "socket",
+                        std::to_string(data.values.size()) + " seatings in " +
+                            std::to_string(data.ids.size()) + " socket(s)",
+                        "--sigma-mm, the play in the sockets", Json{{"sockets", data.ids}}},
+                       s, options);
 }
 
 // identify --sensor contact: the arm's terms, the tool point and the planes' estimated terms
@@ -591,41 +587,12 @@ int ContactIdentify(const po::variables_map& vm) {
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
                    ResolveSigmaAngle(vm, false), &data.values);
   const IdentificationSummary s = Identify(*kind, data.values, options);
-  if (s.termination == Termination::kInvalidInput &&
-      data.values.size() * kind->rows_per_configuration() < kind->num_parameters())
-    throw InputError(file, s.message);
-  if (ResolveFormat(vm) == Format::kJson) {
-    Json j = IdentificationJson(s);
-    j["sensor"] = "contact";
-    j["values_per_configuration"] = kind->rows_per_configuration();
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << "sensor: contact (" << data.values.size() << (data.flush ? " flush" : "")
-              << " contacts on " << setup.planes.size()
-              << " plane(s); lengths in m, angles in rad)\n"
-              << s.FullReport();
-  }
-  if (s.termination == Termination::kRankDeficient) {
-    std::string list;
-    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
-    std::cerr << "lrcal identify: the contact terms are not identifiable from these "
-                 "configurations; fix the suggested ones (--fix "
-              << list << ") or pass --auto-fix\n";
-    return 3;
-  }
-  if (vm.count("write-robot") && s.IsSolutionUsable()) {
-    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
-                                *kind, data.values, s, options);
-    std::cerr << "lrcal identify: calibrated robot written to "
-              << vm["write-robot"].as<std::string>() << "\n";
-  }
-  if (s.IsSolutionUsable() && !s.fit.consistent) {
-    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm"
-              << (data.flush ? " and --sigma-mrad" : "") << " (p = " << s.fit.p_value
-              << " < 0.001); see the fit line above\n";
-    return 4;
-  }
-  return s.IsSolutionUsable() ? 0 : 1;
+  return ReportKindFit(vm,
+                       {rig, *kind, data.values, file, "contact",
+                        std::to_string(data.values.size()) + (data.flush ? " flush" : "") +
+                            " contacts on " + std::to_string(setup.planes.size()) + " plane(s)",
+                        data.flush ? "--sigma-mm and --sigma-mrad" : "--sigma-mm"},
+                       s, options);
 }
 
 // identify --sensor scanner: the arm's terms, the scanner's frame and the planes' estimated terms
@@ -644,40 +611,12 @@ int ScannerIdentify(const po::variables_map& vm) {
   const MeasuredValues data = ReadScannerData(file, rig.robot, setup.planes, kind->num_beams());
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
   const IdentificationSummary s = Identify(*kind, data, options);
-  if (s.termination == Termination::kInvalidInput &&
-      data.size() * kind->rows_per_configuration() < kind->num_parameters())
-    throw InputError(file, s.message);
-  if (ResolveFormat(vm) == Format::kJson) {
-    Json j = IdentificationJson(s);
-    j["sensor"] = "scanner";
-    j["values_per_configuration"] = kind->rows_per_configuration();
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << "sensor: scanner (" << data.size() << " scans of " << kind->num_beams()
-              << " beam(s) on " << setup.planes.size()
-              << " plane(s); lengths in m, angles in rad)\n"
-              << s.FullReport();
-  }
-  if (s.termination == Termination::kRankDeficient) {
-    std::string list;
-    for (const auto& f : s.identifiability.suggested_fixed) list += (list.empty() ? "" : ",") + f;
-    std::cerr << "lrcal identify: the scanner terms are not identifiable from these "
-                 "configurations; fix the suggested ones (--fix "
-              << list << ") or pass --auto-fix\n";
-    return 3;
-  }
-  if (vm.count("write-robot") && s.IsSolutionUsable()) {
-    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(file), rig,
-                                *kind, data, s, options);
-    std::cerr << "lrcal identify: calibrated robot written to "
-              << vm["write-robot"].as<std::string>() << "\n";
-  }
-  if (s.IsSolutionUsable() && !s.fit.consistent) {
-    std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
-              << " < 0.001); see the fit line above\n";
-    return 4;
-  }
-  return s.IsSolutionUsable() ? 0 : 1;
+  return ReportKindFit(
+      vm,
+      {rig, *kind, data, file, "scanner",
+       std::to_string(data.size()) + " scans of " + std::to_string(kind->num_beams()) +
+           " beam(s) on " + std::to_string(setup.planes.size()) + " plane(s)"},
+      s, options);
 }
 
 }  // namespace

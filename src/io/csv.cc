@@ -166,6 +166,20 @@ bool NamesAnotherJoint(const std::string& name, int num_joints) {
 
 std::vector<int> JointColumns(const CsvTable& t, int num_joints) {
   std::vector<int> cols;
+  if (static_cast<int>(t.joint_columns.size()) == num_joints) {
+    for (const std::string& name : t.joint_columns) {
+      const int c = t.Column(name);
+      if (c < 0)
+        throw InputError(Location(t.path, 1) + " column '" + CellExcerpt(name) + "'",
+                         "missing: the file names joints by the robot's joint names, so each of "
+                         "its " +
+                             std::to_string(num_joints) +
+                             " joints needs its column (or give q1..q" +
+                             std::to_string(num_joints) + ")");
+      cols.push_back(c);
+    }
+    return cols;
+  }
   for (int j = 1; j <= num_joints; ++j) {
     int c = t.Column("q" + std::to_string(j));
     if (c < 0)
@@ -270,7 +284,11 @@ TargetedConfigurations ReadTargetConfigurations(const std::string& path, int num
 
 TargetedConfigurations ReadConfigurations(const std::string& path, int num_joints,
                                           const PlaneSet* planes) {
-  CsvTable t = ReadCsv(path);
+  return Configurations(ReadCsv(path), num_joints, planes);
+}
+
+TargetedConfigurations Configurations(const CsvTable& t, int num_joints, const PlaneSet* planes) {
+  const std::string& path = t.path;
   std::vector<int> cols = JointColumns(t, num_joints);
   if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
   const std::vector<int> plane = PlaneColumn(t, planes);
@@ -280,7 +298,11 @@ TargetedConfigurations ReadConfigurations(const std::string& path, int num_joint
 }
 
 ConfigurationSet ReadPoses(const std::string& path, int num_joints) {
-  CsvTable t = ReadCsv(path);
+  return Poses(ReadCsv(path), num_joints);
+}
+
+ConfigurationSet Poses(const CsvTable& t, int num_joints) {
+  const std::string& path = t.path;
   std::vector<int> cols = JointColumns(t, num_joints);
   if (t.rows.empty()) throw InputError(path, "no configurations (only a header)");
   ConfigurationSet out(num_joints);
@@ -290,7 +312,12 @@ ConfigurationSet ReadPoses(const std::string& path, int num_joints) {
 
 MeasurementSet ReadMeasurements(const std::string& path, int num_joints, const RangerSpec* ranger,
                                 const PlaneSet* planes, const Averaging& average) {
-  CsvTable t = ReadCsv(path);
+  return Measurements(ReadCsv(path), num_joints, ranger, planes, average);
+}
+
+MeasurementSet Measurements(const CsvTable& t, int num_joints, const RangerSpec* ranger,
+                            const PlaneSet* planes, const Averaging& average) {
+  const std::string& path = t.path;
   std::vector<int> cols = JointColumns(t, num_joints);
   const int hc = t.Column("h");
   if (hc < 0)

@@ -1,5 +1,7 @@
 #include "lrcal/io/robot_data.h"
 
+#include <algorithm>
+
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/csv.h"
@@ -16,36 +18,53 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
       const bool prismatic = link.joint == JointType::kPrismatic;
       throw InputError(
           path + " configuration " + std::to_string(i + 1) + " column 'q" + std::to_string(j + 1) +
-              "'",
+              "'" + (link.joint_name.empty() ? "" : " (joint '" + link.joint_name + "')"),
           FormatExact(q) + " is outside the joint's range [" + FormatExact(link.q_min) + ", " +
               FormatExact(link.q_max) + "] (the robot file's q_min, q_max); joint values are in " +
               (prismatic ? "m: were they written in mm?" : "rad: were they written in degrees?"));
     }
 }
 
+CsvTable ReadRobotCsv(const std::string& path, const RobotModel& robot) {
+  CsvTable t = ReadCsv(path);
+  if (t.Column("q1") >= 0 || robot.num_links() == 0) return t;
+  std::vector<std::string> names;
+  for (const Link& link : robot.links()) {
+    if (link.joint_name.empty()) return t;
+    names.push_back(link.joint_name);
+  }
+  if (std::any_of(names.begin(), names.end(),
+                  [&](const std::string& name) { return t.Column(name) >= 0; }))
+    t.joint_columns = names;  // JointColumns names the first one missing
+  return t;
+}
+
 TargetedConfigurations ReadRobotConfigurations(const std::string& path, const RobotModel& robot,
                                                const PlaneSet* planes) {
-  TargetedConfigurations configs = ReadConfigurations(path, robot.num_links(), planes);
+  TargetedConfigurations configs =
+      Configurations(ReadRobotCsv(path, robot), robot.num_links(), planes);
   CheckJointRanges(configs, robot, path);
   return configs;
 }
 
 TargetedConfigurations ReadRobotTargetConfigurations(const std::string& path,
                                                      const RobotModel& robot, int num_targets) {
-  TargetedConfigurations configs = ReadTargetConfigurations(path, robot.num_links(), num_targets);
+  TargetedConfigurations configs =
+      TargetConfigurations(ReadRobotCsv(path, robot), robot.num_links(), num_targets);
   CheckJointRanges(configs, robot, path);
   return configs;
 }
 
 ConfigurationSet ReadRobotPoses(const std::string& path, const RobotModel& robot) {
-  ConfigurationSet poses = ReadPoses(path, robot.num_links());
+  ConfigurationSet poses = Poses(ReadRobotCsv(path, robot), robot.num_links());
   CheckJointRanges(poses, robot, path);
   return poses;
 }
 
 MeasurementSet ReadRobotMeasurements(const std::string& path, const RobotFile& rig,
                                      const PlaneSet* planes, const Averaging& average) {
-  MeasurementSet data = ReadMeasurements(path, rig.robot.num_links(), &rig.ranger, planes, average);
+  MeasurementSet data = Measurements(ReadRobotCsv(path, rig.robot), rig.robot.num_links(),
+                                     &rig.ranger, planes, average);
   CheckJointRanges(data.configs, rig.robot, path);
   return data;
 }

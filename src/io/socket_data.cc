@@ -19,7 +19,7 @@ constexpr int kMaxSocketReadingsPerRow = 1000000;
 }  // namespace
 
 SocketData ReadSocketData(const std::string& path, const RobotModel& robot) {
-  const CsvTable t = ReadCsv(path);
+  const CsvTable t = ReadRobotCsv(path, robot);
   const TargetedConfigurations joints = TargetConfigurations(t, robot.num_links(), 1);
   CheckJointRanges(joints, robot, path);
   const int column = t.Column("socket");

@@ -39,8 +39,8 @@ Eigen::Vector3d QuaternionOrientationValue(const PoseMeasurement& pose,
 }
 
 MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasurement& kind) {
-  const CsvTable t = ReadCsv(path);
   const RobotModel& robot = kind.robot();
+  const CsvTable t = ReadRobotCsv(path, robot);
   const int num_targets = static_cast<int>(kind.setup().targets.size());
   MeasuredValues data{TargetConfigurations(t, robot.num_links(), num_targets), {}, {}};
   CheckJointRanges(data.configs, robot, path);

@@ -206,6 +206,7 @@ RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_lin
                                    "joints, not floating, planar or unknown ones");
     }
     JointRange(*joint, path, &axis);
+    axis.name = joint->name;
     axis.point = pose.translation;
     axis.direction = pose.rotation * Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
     if (!(axis.direction.norm() > 1e-12))

@@ -122,6 +122,7 @@ RobotModel RobotFromJointAxes(const std::string& name, const std::vector<JointAx
     links[i].joint = unit[i].joint;
     links[i].q_min = unit[i].q_min;
     links[i].q_max = unit[i].q_max;
+    links[i].joint_name = unit[i].name;
     if (i + 1 < unit.size())
       LinkToNextAxis(frame, unit[i + 1], parallel_tolerance, &links[i]);
     else

@@ -26,6 +26,9 @@ struct CsvTable {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;
   std::vector<int> lines;  ///< 1-based line of each row
+  /// The joints' column names when they are not q1..qN (a robot's own joint names: robot_data.h
+  /// ReadRobotCsv); empty: q1..qN.
+  std::vector<std::string> joint_columns{};
   /// Index of a column, or -1.
   int Column(const std::string& name) const;
   /// Cell (row, column) as a finite number; InputError naming file:line and the column.
@@ -58,6 +61,13 @@ TargetedConfigurations TargetConfigurations(const CsvTable& t, int num_joints, i
 /// Arm configurations only (validation poses, which need no reading): a `plane` column, if
 /// any, is not read.
 ConfigurationSet ReadPoses(const std::string& path, int num_joints);
+/// The same three readers from a table already read (ReadRobotCsv in robot_data.h: a robot's
+/// joint names as column names).
+TargetedConfigurations Configurations(const CsvTable& t, int num_joints,
+                                      const PlaneSet* planes = nullptr);
+ConfigurationSet Poses(const CsvTable& t, int num_joints);
+MeasurementSet Measurements(const CsvTable& t, int num_joints, const RangerSpec* ranger = nullptr,
+                            const PlaneSet* planes = nullptr, const Averaging& average = {});
 /// Readings grouped by configuration (and plane, as ReadConfigurations). With a `ranger`, a
 /// reading outside its range is an error naming the line (and suggesting the likely unit
 /// mistake: readings are in metres). A configuration's readings become its value by `average`

@@ -1,4 +1,5 @@
-// A robot's data files: configuration and measurement CSVs (io/csv.h) read for a given robot,
+// A robot's data files: configuration and measurement CSVs (io/csv.h) read for a given robot (its
+// q1..qN columns or, for a robot whose joints have names, those names),
 // every joint value checked against the robot's joint range and every reading against its
 // ranger's range, so that a unit mistake (degrees for rad, mm for m) is an error naming the file,
 // the configuration and the joint, never a silently wrong calibration.
@@ -6,6 +7,7 @@
 
 #include <string>
 
+#include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/targeted_configurations.h"
@@ -16,6 +18,12 @@ namespace lrcal {
 /// the first joint value of `configs` outside `robot`'s joint range (q_min, q_max, ±1e-9).
 void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
                       const std::string& path);
+
+/// A CSV file read for `robot` (io/csv.h ReadCsv): when its header has no `q1` column, the
+/// robot's joints have names (a URDF's) and the header has any of them, the joints' columns are
+/// those names (CsvTable::joint_columns), so a file logged with the robot's own joint names is
+/// read as it is; the readers then name the first joint whose column is missing.
+CsvTable ReadRobotCsv(const std::string& path, const RobotModel& robot);
 
 /// A configurations CSV for `robot`, joint ranges checked; its optional `plane` column is
 /// resolved against `planes`.

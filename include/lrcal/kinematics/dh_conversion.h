@@ -37,6 +37,7 @@ struct JointAxis {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< unit; positive q turns right-handed
   double q_min = -3.141592653589793;                     ///< joint range (rad, or m)
   double q_max = 3.141592653589793;
+  std::string name{};  ///< the joint's name (a URDF's), carried to Link::joint_name
 };
 
 /// Angle (rad) below which consecutive axes are treated as parallel (Hayati's β link): 1°.

@@ -54,6 +54,9 @@ struct Link {
   /// Joint range used when sampling configurations (rad, or m for a prismatic joint).
   double q_min = -3.141592653589793;
   double q_max = 3.141592653589793;
+  /// The joint's name in the robot's description (a URDF's joint name), "" if it has none. Data
+  /// files may name the joint's column so instead of q<k> (robot_data.h ReadRobotCsv).
+  std::string joint_name{};
 };
 
 class RobotModel {
