@@ -15,7 +15,9 @@ PreparedCell PreparedCell::Prepare(const Study& study, const Cell& cell) {
 
 const TargetedConfigurations& PreparedCell::pool() const { return context_->pool; }
 const ConfigurationSet& PreparedCell::validation() const { return context_->validation; }
-int PreparedCell::num_parameters() const { return context_->model->num_parameters(); }
+int PreparedCell::num_parameters() const {
+  return static_cast<int>(context_->parameter_names.size());
+}
 const std::vector<std::string>& PreparedCell::parameter_names() const {
   return context_->parameter_names;
 }

@@ -70,6 +70,8 @@ const Json& StudyDefaults() {
                        "on_rank_deficient": "fail",
                        "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none",
                        "prior_sigma": "none", "errors_in_variables": false},
+    "sensor": {"kind": "ranger", "instrument": null, "target": [0, 0, 0], "sigma_mrad": 0.2,
+               "cost_per_reading": 1, "budget": null},
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
@@ -572,6 +574,129 @@ void ParsePriorsAndErrorsInVariables(const Json& s, const KeyLocator& where, Cel
         c->noise.encoder_sigma / std::sqrt(c->noise.EffectiveReadings());
 }
 
+// sensor.instrument / sensor.target: a list of 3 (x, y, z in m) or 6 numbers (and roll, pitch,
+// yaw in rad) as a transform.
+RigidTransform SensorFrame(const Json& s, const std::string& key, const KeyLocator& where,
+                           bool allow_three) {
+  const Json& v = At(s, key);
+  const char* expected = allow_three ? "[x, y, z] (m) or [x, y, z, roll, pitch, yaw] (m, rad)"
+                                     : "[x, y, z, roll, pitch, yaw] (m, rad)";
+  bool ok = v.is_array() && (v.size() == 6 || (allow_three && v.size() == 3));
+  for (std::size_t k = 0; ok && k < v.size(); ++k)
+    ok = v[k].is_number() && std::isfinite(v[k].get<double>());
+  if (!ok)
+    throw InputError(where(key), std::string("expected ") + expected + ", got " +
+                                     (v.is_null() ? "nothing" : v.dump()));
+  double x[6] = {0, 0, 0, 0, 0, 0};
+  for (std::size_t k = 0; k < v.size(); ++k) x[k] = v[k].get<double>();
+  return RigidTransform::FromXyzRpy(Eigen::Vector3d(x[0], x[1], x[2]),
+                                    Eigen::Vector3d(x[3], x[4], x[5]));
+}
+
+// A tracker cell: the ranger's settings it cannot take are refused by key, not ignored.
+void RefuseRangerSettings(const Json& s, const KeyLocator& where, const CellSettings& c) {
+  const std::string kind = c.sensor.kind;
+  const auto refuse = [&](const std::string& key, const std::string& why) {
+    throw InputError(where(key), "sensor.kind " + kind + ": " + why);
+  };
+  if (Str(s, "identification.estimate_plane", where) != "none")
+    refuse("identification.estimate_plane", "a tracker reads no plane; expected none");
+  if (c.ranger_terms.offset || c.ranger_terms.scale)
+    refuse("identification.estimate_ranger", "a tracker has no ranger; expected none");
+  if (c.noise.DisturbsGeometry() || c.noise.outlier_fraction > 0)
+    refuse(c.noise.encoder_sigma > 0 ? "noise.encoder_sigma_mrad"
+           : c.noise.form_sigma > 0  ? "noise.form_sigma_mm"
+                                     : "noise.outlier_fraction",
+           "the rig's disturbances are modelled for the ranger only; expected 0");
+  if (c.task_criterion)
+    refuse("selection.criterion", "the task criterion (I) is the ranger's; expected E, D, A or O*");
+  if (c.pool_redraw || c.selection_redraw)
+    refuse(c.pool_redraw ? "pool.redraw" : "selection.redraw",
+           "a tracker cell keeps one pool and one design; expected false");
+  if (c.coverage) refuse("validation.coverage", "coverage is the ranger's so far; expected false");
+  if (!c.identification.priors.empty() || c.identification.encoder_sigma > 0)
+    refuse(c.identification.priors.empty() ? "identification.errors_in_variables"
+                                           : "identification.prior_sigma",
+           "priors and errors in variables are the ranger's in studies; expected none/false");
+  if (c.identification.loss != RobustLoss::kNone)
+    refuse("identification.loss", "a robust loss takes one value per configuration; expected none");
+  if (c.paper_case != 0) refuse("paper_case", "the paper's cases are the ranger's; expected 0");
+}
+
+// The sensor section with every default key (a sweep value may give only some).
+Json FullSensorSection(const Json& settings) {
+  Json full = StudyDefaults()["sensor"];
+  const auto given = settings.find("sensor");
+  if (given == settings.end() || !given->is_object()) return full;
+  for (auto it = given->begin(); it != given->end(); ++it) full[it.key()] = it.value();
+  return full;
+}
+
+// sensor came after studies were run: at its defaults (the ranger) it is left out of the resolved
+// settings, so that earlier studies' tables and run directories stay as they were; otherwise it
+// is written in full.
+void NormaliseSensor(Json* settings) {
+  if (!settings->contains("sensor") || !(*settings)["sensor"].is_object()) return;
+  const Json full = FullSensorSection(*settings);
+  if (full == StudyDefaults()["sensor"])
+    settings->erase("sensor");
+  else
+    (*settings)["sensor"] = full;
+}
+
+// sensor: the kind, a tracker's frames and orientation noise, the cost of a reading and the
+// campaign's budget (which sets selection.count).
+void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c) {
+  const Json s = {{"sensor", FullSensorSection(settings)}};
+  StudySensor& sensor = c->sensor;
+  sensor.kind = Str(s, "sensor.kind", where);
+  if (sensor.kind != "ranger" && sensor.kind != "point" && sensor.kind != "pose")
+    throw InputError(where("sensor.kind"),
+                     "expected ranger, point or pose, got '" + sensor.kind +
+                         "' (the scanner, contact and socket kinds are the calibration "
+                         "commands' so far, not the studies')");
+  sensor.cost_per_reading = Num(s, "sensor.cost_per_reading", where);
+  if (!(sensor.cost_per_reading > 0) || !std::isfinite(sensor.cost_per_reading))
+    throw InputError(where("sensor.cost_per_reading"),
+                     "expected a cost > 0 per reading (in the study's own unit)");
+  if (!At(s, "sensor.budget").is_null()) {
+    const double budget = Num(s, "sensor.budget", where);
+    const double count = std::floor(budget / (sensor.cost_per_reading * c->noise.repetitions));
+    if (!(count >= 1) || !std::isfinite(budget))
+      throw InputError(where("sensor.budget"),
+                       "expected a budget of at least one configuration's cost (cost_per_reading "
+                       "× noise.repetitions = " +
+                           Json(sensor.cost_per_reading * c->noise.repetitions).dump() + ")");
+    if (count > c->pool_size && c->pool_file.empty())
+      throw InputError(where("sensor.budget"), "buys " + Json(count).dump() +
+                                                   " configurations: more than pool.size = " +
+                                                   std::to_string(c->pool_size));
+    sensor.budget = budget;
+    c->select_count = static_cast<int>(count);
+  }
+  const double sigma_mrad = Num(s, "sensor.sigma_mrad", where);
+  if (!(sigma_mrad >= 0) || !std::isfinite(sigma_mrad))
+    throw InputError(where("sensor.sigma_mrad"), "expected a standard deviation ≥ 0 mrad");
+  sensor.sigma_angle = sigma_mrad * 1e-3;
+  // The ranger takes no instrument or target: a study may set them once and sweep the kind.
+  if (sensor.IsRanger()) return;
+  if (At(s, "sensor.instrument").is_null())
+    throw InputError(where("sensor.instrument"),
+                     "sensor.kind " + sensor.kind +
+                         " needs the instrument's frame in the base frame: [x, y, z, roll, "
+                         "pitch, yaw] (m, rad)");
+  sensor.tracker.instrument = SensorFrame(s, "sensor.instrument", where, false);
+  const RigidTransform target = SensorFrame(s, "sensor.target", where, true);
+  sensor.tracker.targets = {target.translation};
+  if (sensor.kind == "pose") {
+    sensor.tracker.target_orientations = {target.rotation};
+  } else if (!target.rotation.isIdentity(0)) {
+    throw InputError(where("sensor.target"),
+                     "sensor.kind point reads positions only: give [x, y, z], or use pose");
+  }
+  RefuseRangerSettings(settings, where, *c);
+}
+
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   CellSettings c;
   c.robot = Str(s, "robot", where);
@@ -586,6 +711,7 @@ CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   ParsePriorsAndErrorsInVariables(s, where, &c);
   c.paper_case = Int(s, "paper_case", where, 0);
   if (c.paper_case > 2) throw InputError(where("paper_case"), "expected 0 (none), 1 or 2");
+  ParseSensor(s, where, &c);
   return c;
 }
 
@@ -760,6 +886,7 @@ Json ResolveBase(const Json& given, const KeyLocator& where, const std::string& 
   // settings, so that earlier studies' tables stay as they were.
   if (base["noise"].is_object() && base["noise"].value("average", Json()) == Averaging{}.Name())
     base["noise"].erase("average");
+  NormaliseSensor(&base);
   HashRobotFile(&base, where, folder);
   ParseCell(base, where);  // the base itself must be valid
   return base;
@@ -1082,11 +1209,14 @@ Cell MakeCell(const Json& base, const std::vector<Axis>& axes, const std::vector
   }
   if (cell.label.empty()) cell.label = "base";
   KeepOneLossScale(axes, combo, path, lines, &cell.settings);
+  NormaliseSensor(&cell.settings);
   const std::string folder = std::filesystem::path(path).parent_path().string();
   HashRobotFile(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
   HashConfigurationFiles(&cell.settings, KeyLocator{path, &lines, context, ""}, folder);
   CheckUnknownKeys(cell.settings, StudyDefaults(), "", KeyLocator{path, &lines, context, ""});
   cell.typed = ParseCell(cell.settings, KeyLocator{path, &lines, context, ""});
+  // sensor.budget sets the count: the resolved settings (and the tables) show the count bought.
+  if (cell.typed.sensor.budget) cell.settings["selection"]["count"] = cell.typed.select_count;
   cell.id = HashHex(CellIdentity(cell.settings).dump());
   return cell;
 }
@@ -1147,6 +1277,8 @@ Json CellIdentity(const Json& settings) {
     if (ident.value("loss", Json()) == "none") ident.erase("loss_scale_mm");
   }
   DropNeutralKeys(&id);
+  // sensor came with the tracker kinds: the ranger's default section is left out.
+  if (id.contains("sensor") && id["sensor"] == StudyDefaults()["sensor"]) id.erase("sensor");
   // tool_link came with URDF robots: left out when empty (as if not given).
   if (id.contains("tool_link") && id["tool_link"] == "") id.erase("tool_link");
   for (const char* section : {"pool", "validation"})

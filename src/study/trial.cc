@@ -29,12 +29,9 @@ std::array<double, 12> Flatten(const PoseErrorStats& s) {
   return a;
 }
 
-namespace {
-
 // ---------------------------------------------------------------------------------------------
-// Steps shared by the cell and the trial.
+// Steps shared by the cell and the trial (and by tracker_trial.cc).
 
-// Stream id of a draw family: a hash of the settings it depends on.
 std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> keys) {
   Json identity = CellIdentity(settings);
   // The ranger's errors do not change which beams hit the plane: cells that differ only in
@@ -63,6 +60,13 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
     truth.errors = c.file_true_errors * s.truth.scale;
   }
   truth.values = robot.nominal_values() + truth.errors;
+  if (c.kind) {  // a tracker's terms: the arm's errors; the instrument and target as nominal
+    truth.delta.setZero(static_cast<Eigen::Index>(c.kind_link_values.size()));
+    for (std::size_t k = 0; k < c.kind_link_values.size(); ++k)
+      if (c.kind_link_values[k] >= 0)
+        truth.delta[static_cast<Eigen::Index>(k)] = truth.errors[c.kind_link_values[k]];
+    return truth;
+  }
   const ParameterSet& ps = c.model->parameters();
   truth.delta.setZero(ps.size());
   for (int k = 0; k < ps.num_robot(); ++k) truth.delta[k] = truth.errors[ps.robot_values[k]];
@@ -70,6 +74,8 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
   if (ps.ranger_scale_index >= 0) truth.delta[ps.ranger_scale_index] = c.ranger_scale;
   return truth;
 }
+
+namespace {
 
 // G of a candidate pool at the nominal model, scaled as the cell's selection says (the paper:
 // SI). Expected-error scaling uses the truth's prior σ (truth.angle_sigma_mrad,
@@ -150,6 +156,10 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
     c->planes = s.planes;
   } else if (file.planes) {
     c->planes = *file.planes;
+  } else if (!s.sensor.IsRanger()) {
+    // A tracker reads no plane: the horizontal plane through the base only tags the sampled
+    // configurations and completes the arm's model; nothing is measured on it.
+    c->planes = PlaneSet(Plane{});
   } else {
     throw InputError("plane", "the robot file has no plane; give plane: in the study");
   }
@@ -168,9 +178,8 @@ void BuildParameterSet(const CellSettings& s, CellContext* c) {
                                             " parameters: need at least as many");
 }
 
-// A study's configuration file (pool.file, validation.file), read for the cell's robot.
-// `planes`: the cell's planes, against which a pool's plane column is resolved; null for a
-// validation file (poses: a plane column is not read).
+}  // namespace
+
 TargetedConfigurations ReadStudyConfigurations(const Study& study, const std::string& file,
                                                const std::string& key, const RobotModel& robot,
                                                const PlaneSet* planes) {
@@ -182,6 +191,8 @@ TargetedConfigurations ReadStudyConfigurations(const Study& study, const std::st
     throw InputError(key, e.what());
   }
 }
+
+namespace {
 
 // The candidates of a pool file whose beam hits the plane (nominal model, and the fixed truth
 // when there is one); the others are reported like a drawn pool's rejections.
@@ -451,7 +462,8 @@ void AddPoseBlock(const Eigen::MatrixXd& E, const Eigen::MatrixXd* H, PartSums* 
 // data part.
 FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Eigen::MatrixXd& C,
                                     const Eigen::MatrixXd& held) {
-  const int n = c.model->num_parameters(), m = c.validation.size();
+  const auto n = static_cast<int>(c.parameter_names.size());
+  const int m = c.validation.size();
   const auto k = static_cast<int>(held.cols());
   FirstOrderDraws out;
   out.data = out.held = out.total = Eigen::MatrixXd::Constant(draws, 12, std::nan(""));
@@ -472,8 +484,7 @@ FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Eigen
   // applied to the draws a block of poses at a time: memory per validation pose stays about
   // 1 KB, not 6 × draws doubles. Each draw's sums run over the poses in order, so the bits do not
   // depend on the block.
-  const std::vector<double> zero(n, 0.0);
-  const Eigen::MatrixXd J6 = PoseJacobian(*c.model, zero.data(), c.validation);
+  const Eigen::MatrixXd J6 = ValidationPoseJacobian(c);
   constexpr int kPosesPerBlock = 256;
   PartSums data(draws), held_part(draws), total(draws);
   for (int j0 = 0; j0 < m; j0 += kPosesPerBlock) {
@@ -491,6 +502,14 @@ FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Eigen
 
 Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
   return LinearisedPartDraws(c, draws, c.predicted_covariance, Eigen::MatrixXd()).data;
+}
+
+// The accuracy planner (accuracy_plan.h) states the ranger's totals: a tracker cell is refused.
+void RefuseTrackerPlan(const CellContext& c) {
+  if (c.kind)
+    throw InputError("sensor.kind", std::string("the accuracy planner models the ranger's "
+                                                "campaigns; this cell's sensor is ") +
+                                        c.kind->name());
 }
 
 // The cell's settings with `repetitions` readings per configuration (InputError below 1).
@@ -533,6 +552,8 @@ UnestimatedTerms DesignHeldTerms(const CellSettings& s, const CellContext& c) {
                               c.tolerances.OverriddenBy(s.identification.priors));
 }
 
+}  // namespace
+
 // The first-order prediction of the validation metrics' means, the planner's estimate: the
 // covariance predicted at the nominal model propagated to the validation poses through their
 // Jacobian (linear in the parameter errors), then each metric's mean over 4000 Gaussian draws
@@ -546,6 +567,8 @@ void PredictValidation(CellContext* c) {
     for (int k = 0; k < 12; ++k) sum[k] += draws(d, k);
   for (int k = 0; k < 12; ++k) c->predicted_validation[k] = sum[k] / kDraws;
 }
+
+namespace {
 
 // What a calibration of this cell states at its validation poses at the nominal model, for the
 // estimate's covariance C (SI): the data part and the total with the terms held at nominal
@@ -725,6 +748,10 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
   const CellSettings& s = cell.typed;
   try {
     LoadRig(study, s, c.get());
+    if (!s.sensor.IsRanger()) {
+      PrepareTrackerCell(study, s, c.get());
+      return c;
+    }
     BuildParameterSet(s, c.get());
     DrawCellConfigurations(study, s, c.get());
     CheckIdentifiability(s, c.get());
@@ -758,6 +785,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
           ? ComparePoses(*c.robot, truth.values, c.robot->nominal_values(), c.validation).stats
           : c.nominal_validation);
   if (c.rank_deficient) return finish(TrialStatus::kRankDeficient);
+  if (c.kind) return finish(RunTrackerTrial(c, trial, truth, &rec, details));
 
   TrialDesign redrawn;
   const TrialDesign* design = nullptr;
@@ -817,6 +845,7 @@ Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws) {
 }
 
 FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int repetitions) {
+  RefuseTrackerPlan(c);
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
   const Eigen::MatrixXd C = DesignCovariance(s, c);
   Eigen::MatrixXd held;
@@ -828,6 +857,7 @@ FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int r
 }
 
 std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c, int repetitions) {
+  RefuseTrackerPlan(c);
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
   const Eigen::MatrixXd C = DesignCovariance(s, c);
   if (C.size() == 0 || !C.allFinite()) return std::nullopt;

@@ -22,6 +22,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <array>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,6 +34,7 @@
 #include "lrcal/identification/prior.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/kinematics/pose_errors.h"
+#include "lrcal/measurement/point_measurement.h"
 #include "lrcal/study/prepared_cell.h"
 #include "lrcal/study/study.h"
 #include "lrcal/study/trial.h"
@@ -118,10 +120,45 @@ struct CellContext {
   /// The robot file's `tolerances:` (robot_file.h), its planes' only when the cell's planes are
   /// the file's: the held terms' σ in the stated total, as `identify` uses them.
   PriorSigmas tolerances;
+  /// A tracker cell (sensor.kind point or pose; tracker_trial.cc): its kind on the nominal arm
+  /// with every term (the truth's template), the kind estimated (after any terms fixed for rank),
+  /// and per estimated term its link value index (-1: the instrument's or the target's). `model`
+  /// then holds the arm's link terms only (the validation poses' Jacobian). Null for the ranger.
+  std::unique_ptr<PointMeasurement> tracker;
+  std::unique_ptr<MeasurementKind> kind;
+  std::vector<int> kind_link_values;
+  /// A tracker cell's fixed truth: the true arm and the tracker on it.
+  std::shared_ptr<const RobotModel> true_robot;
+  std::unique_ptr<PointMeasurement> true_tracker;
   TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;
 };
+
+// Steps of trial.cc that the tracker cells' pipeline (tracker_trial.cc) shares.
+
+/// The stream id of a draw family: a hash of the settings `keys` it depends on.
+std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> keys);
+/// The truth of trial `trial`: the robot file's errors × scale, or errors drawn per trial.
+TrialTruth DrawTruth(const CellContext& c, long long trial);
+/// A study's configuration file (pool.file, validation.file) read for the cell's robot;
+/// `planes`: a pool's plane column resolved against them (null: configurations only).
+TargetedConfigurations ReadStudyConfigurations(const Study& study, const std::string& file,
+                                               const std::string& key, const RobotModel& robot,
+                                               const PlaneSet* planes);
+/// The first-order prediction of the validation metrics' means (predicted_validation).
+void PredictValidation(CellContext* c);
+
+/// A tracker cell's preparation after its rig is loaded: the kind, the pool (no beam to hit),
+/// the validation poses, identifiability, the block selection (block_selection.h), the
+/// predicted covariance and the truth's cache.
+void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* c);
+/// A tracker cell's trial after the truth and the nominal validation are in `rec`.
+TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
+                            TrialRecord* rec, TrialDetails* details);
+/// The validation poses' Jacobian ∂(pose)/∂e at the nominal model in the cell's estimate layout
+/// (6 rows per pose: position, then orientation).
+Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
 
 /// Builds the context of a cell. Throws InputError (naming the study and the cell) when the cell
 /// cannot run at all: no pool can be sampled, fewer configurations than parameters, ...

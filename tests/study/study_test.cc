@@ -35,6 +35,8 @@ void ExpectDocumented(const Json& defaults, const YAML::Node& doc, const std::st
     const Json& value = it.value();
     if (value.is_object()) {
       ExpectDocumented(value, node, key);
+    } else if (value.is_null()) {
+      EXPECT_TRUE(node.IsNull()) << key;
     } else if (value.is_array()) {
       EXPECT_TRUE(node.IsSequence() && node.size() == value.size()) << key;
     } else if (value.is_string()) {

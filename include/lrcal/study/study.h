@@ -24,10 +24,32 @@
 #include "lrcal/measurement/noise_model.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/point_measurement.h"
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/truth_options.h"
 
 namespace lrcal {
+
+/// sensor: what a cell's campaign measures with (docs/STUDIES.md, "Sensors"). The ranger is
+/// the paper's set-up and lrcal's default; a tracker's point or pose (point_measurement.h,
+/// pose_measurement.h) reads a target on the tool in an instrument's frame, whose six terms and
+/// the target's are estimated with the arm's.
+struct StudySensor {
+  std::string kind = "ranger";  ///< ranger, point or pose
+  PointSetup tracker;           ///< point, pose: the instrument's frame in B and the one target
+  double sigma_angle = 0;       ///< rad, pose: σ of each orientation component of a reading
+  /// The campaign cost of one reading, in the study's own unit (sensor.cost_per_reading); a
+  /// cell's campaign costs selection.count × noise.repetitions × this.
+  double cost_per_reading = 1;
+  /// sensor.budget: when given, the cell's selection.count is ⌊budget / (cost_per_reading ×
+  /// noise.repetitions)⌋, so that cells of different sensors compare at equal campaign cost.
+  std::optional<double> budget;
+  bool IsRanger() const { return kind == "ranger"; }
+  /// The campaign's cost: configurations × repetitions × cost_per_reading.
+  double CampaignCost(int configurations, int repetitions) const {
+    return configurations * static_cast<double>(repetitions) * cost_per_reading;
+  }
+};
 
 /// The typed settings of one cell (all SI except where a name says otherwise), parsed from the
 /// resolved settings JSON. The defaults live in one place, StudyDefaults(); the initial values
@@ -81,6 +103,8 @@ struct CellSettings {
   std::vector<std::string> fixed;
   bool fix_dependent = false;  ///< on rank deficiency: fix the suggested parameters (else fail)
   IdentificationOptions identification;
+  /// sensor: the ranger (the default) or a tracker's point or pose.
+  StudySensor sensor;
   /// Which of the paper's cases this cell reproduces (1, 2; 0 = none): its report places the
   /// published numbers in our distributions.
   int paper_case = 0;

@@ -1,0 +1,255 @@
+// The trial pipeline of a tracker cell (sensor.kind point or pose): the ranger's steps
+// (trial_pipeline.h) with the measurement kind of point_measurement.h and pose_measurement.h in
+// place of the ranger's model. Per cell: the pool is drawn over the workspace (a tracker sees its
+// target anywhere: no beam has to hit), the terms the pool cannot separate are fixed or the cell
+// is marked rank deficient, the design is a block selection (block_selection.h: a configuration
+// brings 3 or 6 values), the covariance σ²(GᵀWG)⁻¹ is predicted at the nominal model (W: the
+// repetitions, and (σ/σ_angle)² on a pose's angle rows). Per trial: the tracker on the true arm
+// reads the design (SimulateMeasurements), Identify(kind) fits it, and the identified arm is
+// judged on the validation poses as the ranger's is.
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lrcal/core/error.h"
+#include "lrcal/design/block_selection.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/measurement/pose_measurement.h"
+#include "study/trial_pipeline.h"
+
+namespace lrcal {
+
+namespace {
+
+// The arm with `values` (5N link values, SI) as its nominal values: a trial's true arm.
+std::shared_ptr<const RobotModel> ArmWithValues(const RobotModel& robot,
+                                                const Eigen::VectorXd& values) {
+  std::vector<Link> links = robot.links();
+  for (int index = 0; index < robot.num_values(); ++index)
+    links[index / kValuesPerLink].nominal[index % kValuesPerLink] = values[index];
+  auto arm = std::make_shared<RobotModel>(robot.name(), std::move(links), robot.source,
+                                          robot.base(), robot.tool());
+  arm->source = robot.source;
+  return arm;
+}
+
+void BuildTrackerKind(const CellSettings& s, CellContext* c) {
+  const std::string source = "identification.fix";
+  if (s.sensor.kind == "pose")
+    c->tracker = std::make_unique<PoseMeasurement>(*c->robot, s.sensor.tracker, s.fixed, source);
+  else
+    c->tracker = std::make_unique<PointMeasurement>(*c->robot, s.sensor.tracker, s.fixed, source);
+  c->kind = c->tracker->Without({});
+  // The arm's link terms alone: the validation poses' Jacobian (ValidationPoseJacobian).
+  c->model = std::make_unique<MeasurementModel>(
+      *c->robot, c->planes,
+      MakeParameterSet(*c->robot, std::vector<PlaneTerms>(c->planes.size()), {}, source));
+}
+
+void MapLinkValues(CellContext* c) {
+  c->parameter_names = c->kind->parameter_names();
+  c->kind_link_values.clear();
+  for (const std::string& name : c->parameter_names)
+    c->kind_link_values.push_back(c->robot->FindValue(name));
+}
+
+// The pool: configurations over the workspace (only σ_min of the arm's Jacobian is asked), or
+// a pool file's; and the validation poses, drawn from the same stream as a ranger cell's of the
+// same robot and validation settings (common poses across sensors).
+void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellContext* c) {
+  c->pool_stream =
+      StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "pool", "truth", "sensor"});
+  c->validation_stream =
+      StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "validation", "pool"});
+  c->selection_seed = s.pool_file.empty() ? study.seed : 0;
+  if (!s.truth.random) c->fixed_truth = DrawTruth(*c, 0);
+  SamplingOptions o;
+  o.ranger = c->ranger;
+  o.min_jacobian_singular_value = s.min_singular_value;
+  o.require_beam_hit = false;
+  const Plane tag = c->planes[0];  // targets are tagged 0: the one target
+  if (!s.pool_file.empty()) {
+    c->pool = ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, nullptr);
+    c->pool_report.requested = c->pool_report.accepted = c->pool_report.attempts = c->pool.size();
+    if (c->pool.size() < s.select_count)
+      throw InputError("pool.file", "'" + s.pool_file + "' has " + std::to_string(c->pool.size()) +
+                                        " configurations: fewer than selection.count = " +
+                                        std::to_string(s.select_count));
+  } else {
+    c->pool = SampleConfigurations(*c->robot, tag, s.pool_size,
+                                   RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),
+                                   o, &c->pool_report);
+  }
+  if (!s.validation_file.empty()) {
+    c->validation =
+        ReadStudyConfigurations(study, s.validation_file, "validation.file", *c->robot, nullptr);
+    return;
+  }
+  c->validation = SampleConfigurations(
+      *c->robot, tag, s.validation_size,
+      RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), o);
+}
+
+// Identifiability on the pool: the terms it cannot separate (d1 with the instrument's height,
+// ...) are fixed when the cell says so, else every trial fails as rank deficient.
+void CheckTrackerIdentifiability(const CellSettings& s, CellContext* c) {
+  const IdentifiabilityReport rep = AnalyzeIdentifiability(*c->kind, c->pool);
+  if (rep.full_rank()) return;
+  if (!s.fix_dependent) {
+    c->rank_deficient = true;
+    c->rank_message = rep.ToString();
+    return;
+  }
+  c->fixed_for_rank = rep.suggested_fixed;
+  c->kind = c->kind->Without(rep.suggested_fixed);
+}
+
+// Each measured value's weight: the effective readings, times (σ/σ_angle)² on an angle row.
+Eigen::VectorXd RowWeights(const CellSettings& s, const MeasurementKind& kind, int m) {
+  const int k = kind.rows_per_configuration();
+  Eigen::VectorXd w(static_cast<Eigen::Index>(m) * k);
+  const double ratio = s.noise.sigma / s.sensor.sigma_angle;
+  for (int i = 0; i < m; ++i)
+    for (int r = 0; r < k; ++r)
+      w[static_cast<Eigen::Index>(i) * k + r] =
+          s.noise.EffectiveReadings() * (kind.RowIsAngle(r) ? ratio * ratio : 1.0);
+  return w;
+}
+
+void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
+  const Eigen::MatrixXd G =
+      DesignJacobian(*c->kind, c->pool, s.scaling, s.truth.angle_sigma, s.truth.length_sigma);
+  const RandomStream stream(c->selection_seed, c->pool_stream, 0, RandomPurpose::kSelection);
+  c->design.slots =
+      SelectBlocks(G, c->kind->rows_per_configuration(), s.select_count, s.selection, stream)
+          .indices;
+  c->design.configs = c->pool.Subset(c->design.slots);
+  c->design_efficiency = std::nan("");  // no certificate for blocks
+  const int n = c->kind->num_parameters(), m = c->design.configs.size();
+  const Eigen::MatrixXd Gd = MeasurementJacobian(*c->kind, c->design.configs);
+  c->design.sigma_min = CriterionScore(Gd.transpose() * Gd, m, DesignCriterion::kE);
+  const IdentifiabilityReport design_report =
+      c->rank_deficient ? IdentifiabilityReport{}
+                        : AnalyzeIdentifiability(*c->kind, c->design.configs);
+  if (!c->rank_deficient && design_report.full_rank()) {
+    const Eigen::VectorXd w = RowWeights(s, *c->kind, m);
+    c->predicted_covariance =
+        ParameterCovariance(Gd.transpose() * w.asDiagonal() * Gd, s.noise.sigma);
+    c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
+    return;
+  }
+  if (!c->rank_deficient) c->rank_message = design_report.ToString();
+  c->rank_deficient = true;
+  c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
+}
+
+void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
+  if (s.truth.random) return;
+  c->true_robot = ArmWithValues(*c->robot, c->fixed_truth.values);
+  c->true_tracker = TrackerKindOn(*c->true_robot, *c->tracker);
+  c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
+  c->nominal_validation =
+      ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
+          .stats;
+}
+
+// The noisy values the tracker on the true arm reads at the design (each the mean of the
+// cell's repetitions, drawn directly), with its angle rows weighed.
+void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTruth& truth,
+                           MeasuredValues* values) {
+  const CellSettings& s = c.cell->typed;
+  NoiseModel noise = s.noise;
+  noise.draw_mean = true;
+  noise.sigma_angle = s.sensor.sigma_angle;
+  const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
+  if (!s.truth.random) {
+    SimulateMeasurements(*c.true_tracker, c.design.configs, noise, stream, values);
+    return;
+  }
+  const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
+  SimulateMeasurements(*TrackerKindOn(*arm, *c.tracker), c.design.configs, noise, stream, values);
+}
+
+}  // namespace
+
+void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* c) {
+  BuildTrackerKind(s, c);
+  MapLinkValues(c);
+  DrawTrackerConfigurations(study, s, c);
+  CheckTrackerIdentifiability(s, c);
+  MapLinkValues(c);
+  if (s.select_count * c->kind->rows_per_configuration() < c->kind->num_parameters())
+    throw InputError("selection.count", std::to_string(s.select_count) + " configurations of " +
+                                            std::to_string(c->kind->rows_per_configuration()) +
+                                            " values for " +
+                                            std::to_string(c->kind->num_parameters()) +
+                                            " terms: need at least as many values as terms");
+  if (!s.truth.random) c->fixed_truth = DrawTruth(*c, 0);  // in the reduced layout
+  SelectTrackerDesign(s, c);
+  CacheTrackerTruth(s, c);
+  PredictValidation(c);
+}
+
+TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
+                            TrialRecord* rec, TrialDetails* details) {
+  const CellSettings& s = c.cell->typed;
+  MeasuredValues values;
+  SimulateTrackerValues(c, trial, truth, &values);
+  IdentificationOptions options = s.identification;
+  options.robust_fit_check = false;  // a trial records no fit verdict
+  const IdentificationSummary summary = Identify(*c.kind, values, options);
+  rec->iterations = summary.iterations;
+  rec->residual_rms = summary.residual_rms;
+  rec->sigma_hat = std::isfinite(summary.sigma_hat) ? summary.sigma_hat : 0.0;
+  switch (summary.termination) {
+    case Termination::kConverged:
+      break;
+    case Termination::kRankDeficient:
+      return TrialStatus::kRankDeficient;
+    case Termination::kMaxIterations:
+      return TrialStatus::kNotConverged;
+    default:
+      return TrialStatus::kNumericalFailure;
+  }
+  const auto n = static_cast<Eigen::Index>(c.parameter_names.size());
+  rec->errors.resize(static_cast<std::size_t>(n));
+  Eigen::VectorXd identified = c.robot->nominal_values();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    rec->errors[static_cast<std::size_t>(k)] = summary.delta[k] - truth.delta[k];
+    const int v = c.kind_link_values[static_cast<std::size_t>(k)];
+    if (v >= 0) identified[v] += summary.delta[k];
+  }
+  const PoseErrors validation =
+      s.truth.random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
+                     : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation);
+  rec->validation = Flatten(validation.stats);
+  if (details) {  // a tracker has no distance errors: the poses only
+    const Eigen::VectorXd& nominal = c.robot->nominal_values();
+    details->distance_error_nominal.clear();
+    details->distance_error_identified.clear();
+    details->measurement_nominal = ComparePoses(*c.robot, truth.values, nominal, values.configs);
+    details->measurement_identified =
+        ComparePoses(*c.robot, truth.values, identified, values.configs);
+    details->validation_nominal = ComparePoses(*c.robot, truth.values, nominal, c.validation);
+    details->validation_identified = validation;
+  }
+  return TrialStatus::kOk;
+}
+
+Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
+  const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
+  const Eigen::MatrixXd arm = PoseJacobian(*c.model, zero.data(), c.validation);
+  if (!c.kind) return arm;
+  // The tracker's link terms are columns of the arm's; its instrument and target move no pose.
+  const ParameterSet& ps = c.model->parameters();
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(arm.rows(), c.kind->num_parameters());
+  for (std::size_t k = 0; k < c.kind_link_values.size(); ++k)
+    for (int j = 0; j < ps.num_robot(); ++j)
+      if (ps.robot_values[static_cast<std::size_t>(j)] == c.kind_link_values[k])
+        J.col(static_cast<Eigen::Index>(k)) = arm.col(j);
+  return J;
+}
+
+}  // namespace lrcal

@@ -1,0 +1,183 @@
+// Studies with a tracker (sensor.kind point or pose): a tracker cell recovers a truth it can see
+// to within its noise, the covariance it predicts holds over its trials (Monte Carlo), the budget
+// buys the configurations it says, sensors share their validation poses, the ranger's cells keep
+// their names, and a tracker cell refuses the ranger's settings at their line.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "lrcal/core/error.h"
+#include "lrcal/study/study.h"
+#include "study/trial_pipeline.h"
+#include "test_util.h"
+
+namespace lrcal {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+constexpr const char* kTracker = "instrument: [2.5, 0.3, 0.2, 0, 0, 3]";
+
+// The paper's robot file with its true errors kept on links 2 to 5 only: every term a tracker
+// cannot separate (d1 and θ1 against the tracker's frame, the last link's against the target)
+// is then true at nominal, so a fit that holds them there can recover the truth exactly.
+std::string RobotSeenByATracker(const std::string& dir) {
+  std::ifstream in(testing::SourcePath("studies/robots/paper.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string robot = text.str();
+  robot = std::regex_replace(robot, std::regex(R"(- \{theta: -7\.23[^}]*\})"),
+                             "- {theta: 0, alpha: 0, a: 0, d: 0}");
+  robot = std::regex_replace(robot, std::regex(R"(- \{theta: -0\.34[^}]*\})"),
+                             "- {theta: 0, alpha: 0, a: 0, d: 0, beta: 0}");
+  const std::string path = dir + "/robot.yaml";
+  std::ofstream(path) << robot;
+  return path;
+}
+
+std::string WriteStudy(const std::string& name, const std::string& robot, const std::string& body,
+                       int trials = 3) {
+  const std::string path = testing::TempDir("tracker_study_" + name) + "/s.yaml";
+  std::ofstream(path) << "name: s\nseed: 5\ntrials: " << trials << "\nrobot: " << robot << "\n"
+                      << "pool: {size: 60}\nvalidation: {size: 10}\n"
+                      << "identification: {on_rank_deficient: fix}\n"
+                      << body;
+  return path;
+}
+
+std::string LoadError(const std::string& name, const std::string& body) {
+  try {
+    LoadStudy(WriteStudy(name, "paper", body));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(TrackerStudy, ATrackerCellRecoversATruthItCanSeeToWithinItsNoise) {
+  // Noise of 1e-9 mm and 1e-9 mrad: the estimate is the truth to 1e-9 of a term's size.
+  constexpr double kRecovered = 1e-9;
+  const std::string dir = testing::TempDir("tracker_study_truth");
+  const std::string robot = RobotSeenByATracker(dir);
+  for (const char* kind : {"point", "pose"}) {
+    SCOPED_TRACE(kind);
+    const Study study = LoadStudy(WriteStudy(
+        std::string("truth_") + kind, robot,
+        "noise: {sigma_mm: 1e-9, repetitions: 1}\nselection: {count: 30}\nsensor: {kind: " +
+            std::string(kind) + ", sigma_mrad: 1e-9, " + kTracker + "}\n"));
+    const auto c = PrepareCell(study, study.cells.at(0));
+    ASSERT_FALSE(c->rank_deficient) << c->rank_message;
+    TrialWorkspace ws;
+    const TrialRecord r = RunTrial(*c, 0, &ws);
+    ASSERT_EQ(r.status, TrialStatus::kOk);
+    ASSERT_EQ(r.errors.size(), c->parameter_names.size());
+    for (std::size_t k = 0; k < r.errors.size(); ++k)
+      EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
+    for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, kRecovered) << a;
+    EXPECT_GT(r.nominal[0], 1e-4);  // the nominal arm is off by millimetres
+  }
+}
+
+TEST(TrackerStudy, ThePredictedCovarianceHoldsOverTheTrials) {
+  // truth.scale 0: the true arm is the nominal one, so the terms held at nominal are true and the
+  // estimate's error is the noise's alone: its Mahalanobis distance δᵀΣ⁻¹δ averages n over the
+  // trials (χ²(n)), within 4 standard errors of that mean (√(2n/N)).
+  constexpr int kTrials = 300;
+  for (const char* kind : {"point", "pose"}) {
+    SCOPED_TRACE(kind);
+    const Study study = LoadStudy(WriteStudy(
+        std::string("coverage_") + kind, "paper",
+        "truth: {scale: 0}\nnoise: {sigma_mm: 0.05, repetitions: 4}\nselection: {count: 30}\n"
+        "sensor: {kind: " +
+            std::string(kind) + ", sigma_mrad: 0.3, " + kTracker + "}\n",
+        kTrials));
+    const auto c = PrepareCell(study, study.cells.at(0));
+    ASSERT_FALSE(c->rank_deficient) << c->rank_message;
+    const Eigen::LDLT<Eigen::MatrixXd> inverse(c->predicted_covariance);
+    const auto n = static_cast<double>(c->parameter_names.size());
+    double sum = 0;
+    TrialWorkspace ws;
+    for (int t = 0; t < kTrials; ++t) {
+      const TrialRecord r = RunTrial(*c, t, &ws);
+      ASSERT_EQ(r.status, TrialStatus::kOk) << t;
+      const Eigen::Map<const Eigen::VectorXd> d(r.errors.data(),
+                                                static_cast<Eigen::Index>(r.errors.size()));
+      sum += d.dot(inverse.solve(d));
+    }
+    const double mean = sum / kTrials;
+    EXPECT_NEAR(mean, n, 4 * std::sqrt(2 * n / kTrials)) << "n = " << n;
+  }
+}
+
+TEST(TrackerStudy, TheBudgetBuysTheCountAndSensorsShareTheirValidationPoses) {
+  const Study study = LoadStudy(
+      WriteStudy("budget", "paper",
+                 "noise: {repetitions: 5}\nsensor: {budget: 200, " + std::string(kTracker) +
+                     "}\nsweep:\n  axes:\n    - key: .\n      values:\n"
+                     "        - {sensor: {kind: ranger}}\n"
+                     "        - {sensor: {kind: point, cost_per_reading: 2}}\n"
+                     "        - {sensor: {kind: pose, cost_per_reading: 4}}\n"));
+  ASSERT_EQ(study.cells.size(), 3u);
+  const int expected[] = {40, 20, 10};  // ⌊200 / (cost × 5)⌋
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(study.cells[i].typed.select_count, expected[i]);
+    EXPECT_EQ(study.cells[i].settings["selection"]["count"], expected[i]);
+  }
+  const auto ranger = PrepareCell(study, study.cells[0]);
+  const auto point = PrepareCell(study, study.cells[1]);
+  ASSERT_EQ(ranger->validation.size(), point->validation.size());
+  for (int j = 0; j < ranger->validation.size(); ++j)
+    for (int q = 0; q < 6; ++q) EXPECT_EQ(ranger->validation.q(j)[q], point->validation.q(j)[q]);
+  EXPECT_EQ(point->design.configs.size(), 20);
+}
+
+TEST(TrackerStudy, TheRangersCellsKeepTheirNames) {
+  // A study without a sensor section and the same study with the ranger's defaults spelled out
+  // have the same cell: the section is left out of the identity at its defaults.
+  const Study plain = LoadStudy(WriteStudy("plain", "paper", ""));
+  const Study spelled = LoadStudy(WriteStudy(
+      "spelled", "paper", "sensor: {kind: ranger, cost_per_reading: 1, sigma_mrad: 0.2}\n"));
+  EXPECT_EQ(plain.cells.at(0).id, spelled.cells.at(0).id);
+  EXPECT_FALSE(CellIdentity(plain.cells.at(0).settings).contains("sensor"));
+}
+
+TEST(TrackerStudy, BadSensorSettingsAreErrorsAtTheirLine) {
+  EXPECT_THAT(
+      LoadError("kind", "sensor: {kind: sonar}\n"),
+      AllOf(HasSubstr("s.yaml:8 key 'sensor.kind'"), HasSubstr("expected ranger, point or pose")));
+  EXPECT_THAT(
+      LoadError("no_instrument", "sensor: {kind: point}\n"),
+      AllOf(HasSubstr("key 'sensor.instrument'"), HasSubstr("[x, y, z, roll, pitch, yaw]")));
+  EXPECT_THAT(LoadError("short_instrument", "sensor: {kind: pose, instrument: [1, 2, 3]}\n"),
+              AllOf(HasSubstr("key 'sensor.instrument'"), HasSubstr("got [1,2,3]")));
+  EXPECT_THAT(LoadError("point_orientation", "sensor: {kind: point, " + std::string(kTracker) +
+                                                 ", target: [0, 0, 0, 0.1, 0, 0]}\n"),
+              AllOf(HasSubstr("key 'sensor.target'"), HasSubstr("positions only")));
+  EXPECT_THAT(LoadError("cost", "sensor: {cost_per_reading: 0}\n"),
+              AllOf(HasSubstr("key 'sensor.cost_per_reading'"), HasSubstr("expected a cost > 0")));
+  EXPECT_THAT(LoadError("small_budget", "noise: {repetitions: 10}\nsensor: {budget: 5}\n"),
+              AllOf(HasSubstr("key 'sensor.budget'"), HasSubstr("at least one configuration")));
+  EXPECT_THAT(LoadError("large_budget", "sensor: {budget: 1e6}\n"),
+              AllOf(HasSubstr("key 'sensor.budget'"), HasSubstr("more than pool.size = 60")));
+  const std::string tracker = "sensor: {kind: point, " + std::string(kTracker) + "}\n";
+  const auto swept = [](const std::string& key, const std::string& value) {
+    return "sweep:\n  axes:\n    - key: " + key + "\n      values: [" + value + "]\n";
+  };
+  EXPECT_THAT(LoadError("plane", tracker + swept("identification.estimate_plane", "offset")),
+              AllOf(HasSubstr("key 'identification.estimate_plane'"),
+                    HasSubstr("sensor.kind point: a tracker reads no plane")));
+  EXPECT_THAT(LoadError("coverage", tracker + swept("validation.coverage", "true")),
+              AllOf(HasSubstr("s.yaml:12"), HasSubstr("key 'validation.coverage'"),
+                    HasSubstr("sensor.kind point")));
+  EXPECT_THAT(LoadError("encoder", tracker + "noise: {encoder_sigma_mrad: 0.1}\n"),
+              AllOf(HasSubstr("key 'noise.encoder_sigma_mrad'"), HasSubstr("ranger only")));
+  EXPECT_THAT(LoadError("task", tracker + "selection: {criterion: I}\n"),
+              HasSubstr("key 'selection.criterion'"));
+}
+
+}  // namespace
+}  // namespace lrcal
