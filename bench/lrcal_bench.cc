@@ -261,36 +261,34 @@ void BM_Case2TrialThreePlanes(benchmark::State& state) {
 BENCHMARK(BM_Case2TrialThreePlanes)->Unit(benchmark::kMicrosecond);
 
 // A tracker's trial on the paper's arm (issue 27 asks for each within 1.5x BM_Case2Trial per
-// configuration): 100 configurations, each the mean of 10 readings drawn as the study draws them
-// (draw_mean), of a reflector (point: 25 link terms + 6 instrument + 3 target, 27 identifiable)
-// or a 6-D probe (pose: + 3 probe orientation terms, 30 identifiable), identified by lrcal's LM
-// on the identifiable terms (what the analysis suggests fixing is fixed once, as a study's cell
-// does). The ranger's trial also validates at 20 poses; this one does not.
+// configuration), as a study's tracker cell runs it (sensor.kind point or pose, tracker_trial.cc):
+// 100 of a pool of 101 configurations, each the mean of 10 readings, of a reflector (point: 25
+// link terms + 6 instrument + 3 target, 27 identifiable) or a 6-D probe (pose: + 3 probe
+// orientation terms, 30 identifiable), identified by lrcal's LM on the identifiable terms and
+// validated at 20 poses, like the ranger's case-2 trial.
 void BM_TrackerTrial(benchmark::State& state) {
   const bool pose = state.range(0) == 1;
-  static const RobotFile rig = LoadRobotFile(PaperRobotPath());
-  PointSetup setup;
-  setup.instrument =
-      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.5, 0.3, 0.2), Eigen::Vector3d(0, 0, 3));
-  const TargetedConfigurations configs(WorkspacePoses(rig.robot, 100, 7));
-  std::unique_ptr<PointMeasurement> full;
-  if (pose)
-    full = std::make_unique<PoseMeasurement>(rig.robot, setup);
-  else
-    full = std::make_unique<PointMeasurement>(rig.robot, setup);
-  const std::unique_ptr<MeasurementKind> kind =
-      full->Without(AnalyzeIdentifiability(*full, configs).suggested_fixed);
-  NoiseModel noise;
-  noise.draw_mean = true;
-  MeasuredValues data;
-  std::uint64_t t = 0;
-  for (auto _ : state) {
-    SimulateMeasurements(*kind, configs, noise, RandomStream(1, 0, t++, RandomPurpose::kNoise),
-                         &data);
-    benchmark::DoNotOptimize(Identify(*kind, data));
+  static std::map<bool, std::unique_ptr<Fixture>> cache;
+  auto& f = cache[pose];
+  if (!f) {
+    const fs::path path = fs::temp_directory_path() / "lrcal_bench" /
+                          (std::string("s_tracker_") + (pose ? "pose" : "point") + ".yaml");
+    fs::create_directories(path.parent_path());
+    std::ofstream(path) << "name: bench\nseed: 1\ntrials: 1000\nrobot: " << PaperRobotPath()
+                        << "\nnoise: {sigma_mm: 0.05, repetitions: 10}\npool: {size: 101}"
+                           "\nselection: {count: 100, method: backward}"
+                           "\nidentification: {on_rank_deficient: fix}"
+                           "\nsensor: {kind: "
+                        << (pose ? "pose" : "point")
+                        << ", instrument: [2.5, 0.3, 0.2, 0, 0, 3]}\n";
+    f = std::make_unique<Fixture>(path.string());
   }
+  const CellContext& c = *f->context;
+  TrialWorkspace ws;
+  long long t = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(RunTrial(c, t++, &ws));
   state.SetLabel(pose ? "pose" : "point");
-  state.counters["terms"] = kind->num_parameters();
+  state.counters["terms"] = static_cast<double>(c.parameter_names.size());
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_TrackerTrial)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);

@@ -1,6 +1,7 @@
 #include "lrcal/measurement/measurement_kind.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "lrcal/core/error.h"
 
@@ -36,13 +37,26 @@ int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurati
                          const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
                          std::vector<std::string>* misses) {
   CheckNoiseFitsKind(truth, noise);
-  const int k = truth.rows_per_configuration(), R = noise.repetitions;
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(truth.num_parameters());
   std::unique_ptr<MeasurementEvaluator> evaluator = truth.Bind(configs);
   std::vector<double> exact(evaluator->num_rows());
   evaluator->Predict(zero.data(), exact.data(), nullptr);
   const std::vector<std::string> reasons = truth.MissReasons(configs, zero.data());
   if (misses) *misses = reasons;
+  return AddMeasurementNoise(truth, exact, reasons, configs, noise, stream, data);
+}
+
+int AddMeasurementNoise(const MeasurementKind& truth, const std::vector<double>& exact,
+                        const std::vector<std::string>& reasons,
+                        const TargetedConfigurations& configs, const NoiseModel& noise,
+                        const RandomStream& stream, MeasuredValues* data) {
+  CheckNoiseFitsKind(truth, noise);
+  const int k = truth.rows_per_configuration(), R = noise.repetitions;
+  if (exact.size() != static_cast<std::size_t>(configs.size()) * k ||
+      reasons.size() != static_cast<std::size_t>(configs.size()))
+    throw std::invalid_argument(
+        "AddMeasurementNoise: exact values or reasons do not match the "
+        "configurations");
   *data = MeasuredValues{TargetedConfigurations(configs.num_joints()), {}, {}};
   // Each component's σ, and its weight in single readings of σ (an angle's (σ/σ_angle)² per
   // reading: the variance ratio, measurement_kind.h MeasuredValues::weights).

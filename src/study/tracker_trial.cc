@@ -134,6 +134,12 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->kind, c->design.configs);
   if (!c->rank_deficient && design_report.full_rank()) {
+    // The first linearisation of every trial's fit (the design is the cell's own).
+    c->design_nominal.h.resize(static_cast<std::size_t>(Gd.rows()));
+    const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
+    c->design_nominal.G = Gd;
+    c->kind->Bind(c->design.configs)->Predict(zero.data(), c->design_nominal.h.data(), nullptr);
+    c->design_nominal.Factorize();
     const Eigen::VectorXd w = RowWeights(s, *c->kind, m);
     c->predicted_covariance =
         ParameterCovariance(Gd.transpose() * w.asDiagonal() * Gd, s.noise.sigma);
@@ -149,6 +155,12 @@ void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
   if (s.truth.random) return;
   c->true_robot = ArmWithValues(*c->robot, c->fixed_truth.values);
   c->true_tracker = TrackerKindOn(*c->true_robot, *c->tracker);
+  const std::vector<double> zero(static_cast<std::size_t>(c->true_tracker->num_parameters()), 0.0);
+  c->design_true_values.resize(static_cast<std::size_t>(c->design.configs.size() *
+                                                        c->true_tracker->rows_per_configuration()));
+  c->true_tracker->Bind(c->design.configs)
+      ->Predict(zero.data(), c->design_true_values.data(), nullptr);
+  c->design_true_reasons = c->true_tracker->MissReasons(c->design.configs, zero.data());
   c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
   c->nominal_validation =
       ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
@@ -165,7 +177,8 @@ void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTru
   noise.sigma_angle = s.sensor.sigma_angle;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
   if (!s.truth.random) {
-    SimulateMeasurements(*c.true_tracker, c.design.configs, noise, stream, values);
+    AddMeasurementNoise(*c.true_tracker, c.design_true_values, c.design_true_reasons,
+                        c.design.configs, noise, stream, values);
     return;
   }
   const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
@@ -192,18 +205,66 @@ void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* 
   PredictValidation(c);
 }
 
-TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
-                            TrialRecord* rec, TrialDetails* details) {
+namespace {
+
+struct TrackerFit {
+  Termination termination = Termination::kInvalidInput;
+  int iterations = 0;
+  double residual_rms = 0, sigma_hat = 0;  ///< m
+};
+
+// The fit of a trial's values into ws->e. lrcal's LM runs on the cell's evaluator from the cell's
+// nominal linearisation: the cell checked identifiability on its design once, so the trial does
+// not repeat Identify()'s rank analysis and statistics (which cost two thirds of a tracker
+// trial). Ceres goes through Identify(kind).
+TrackerFit FitTrackerTrial(const CellContext& c, TrialWorkspace* ws) {
   const CellSettings& s = c.cell->typed;
-  MeasuredValues values;
-  SimulateTrackerValues(c, trial, truth, &values);
+  const MeasuredValues& values = ws->values;
   IdentificationOptions options = s.identification;
   options.robust_fit_check = false;  // a trial records no fit verdict
-  const IdentificationSummary summary = Identify(*c.kind, values, options);
-  rec->iterations = summary.iterations;
-  rec->residual_rms = summary.residual_rms;
-  rec->sigma_hat = std::isfinite(summary.sigma_hat) ? summary.sigma_hat : 0.0;
-  switch (summary.termination) {
+  TrackerFit fit;
+  if (options.solver == IdentificationOptions::Solver::kCeres) {
+    const IdentificationSummary summary = Identify(*c.kind, values, options);
+    ws->e = summary.delta;
+    fit.termination = summary.termination;
+    fit.iterations = summary.iterations;
+    fit.residual_rms = summary.residual_rms;
+    fit.sigma_hat = std::isfinite(summary.sigma_hat) ? summary.sigma_hat : 0.0;
+    return fit;
+  }
+  if (ws->evaluator_cell != &c) {
+    ws->evaluator = c.kind->Bind(c.design.configs);
+    ws->evaluator_cell = &c;
+  }
+  const int k = c.kind->rows_per_configuration(), n = c.kind->num_parameters();
+  const std::vector<double> weights = values.RowWeights(k);
+  const LevenbergMarquardt::Result r = ws->solver.Solve(
+      *ws->evaluator, values.y.data(), weights.data(), options, &ws->e, &c.design_nominal);
+  fit.termination = r.termination;
+  fit.iterations = r.iterations;
+  const auto rows = static_cast<int>(values.y.size());
+  std::vector<double> y(values.y.size());
+  if (ws->evaluator->Predict(ws->e.data(), y.data(), nullptr)) {
+    double ss = 0;
+    for (int i = 0; i < rows; ++i) ss += (values.y[i] - y[i]) * (values.y[i] - y[i]);
+    fit.residual_rms = std::sqrt(ss / rows);
+  }
+  fit.sigma_hat = rows > n ? std::sqrt(2 * r.final_cost / (rows - n)) : 0.0;
+  return fit;
+}
+
+}  // namespace
+
+TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
+                            TrialRecord* rec, TrialDetails* details, TrialWorkspace* ws) {
+  const CellSettings& s = c.cell->typed;
+  MeasuredValues& values = ws->values;
+  SimulateTrackerValues(c, trial, truth, &values);
+  const TrackerFit fit = FitTrackerTrial(c, ws);
+  rec->iterations = fit.iterations;
+  rec->residual_rms = fit.residual_rms;
+  rec->sigma_hat = fit.sigma_hat;
+  switch (fit.termination) {
     case Termination::kConverged:
       break;
     case Termination::kRankDeficient:
@@ -217,9 +278,9 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
   rec->errors.resize(static_cast<std::size_t>(n));
   Eigen::VectorXd identified = c.robot->nominal_values();
   for (Eigen::Index k = 0; k < n; ++k) {
-    rec->errors[static_cast<std::size_t>(k)] = summary.delta[k] - truth.delta[k];
+    rec->errors[static_cast<std::size_t>(k)] = ws->e[k] - truth.delta[k];
     const int v = c.kind_link_values[static_cast<std::size_t>(k)];
-    if (v >= 0) identified[v] += summary.delta[k];
+    if (v >= 0) identified[v] += ws->e[k];
   }
   const PoseErrors validation =
       s.truth.random ? ComparePoses(*c.robot, truth.values, identified, c.validation)

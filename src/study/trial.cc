@@ -785,7 +785,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
           ? ComparePoses(*c.robot, truth.values, c.robot->nominal_values(), c.validation).stats
           : c.nominal_validation);
   if (c.rank_deficient) return finish(TrialStatus::kRankDeficient);
-  if (c.kind) return finish(RunTrackerTrial(c, trial, truth, &rec, details));
+  if (c.kind) return finish(RunTrackerTrial(c, trial, truth, &rec, details, ws));
 
   TrialDesign redrawn;
   const TrialDesign* design = nullptr;

@@ -130,6 +130,10 @@ struct CellContext {
   /// A tracker cell's fixed truth: the true arm and the tracker on it.
   std::shared_ptr<const RobotModel> true_robot;
   std::unique_ptr<PointMeasurement> true_tracker;
+  /// The fixed truth's exact values at the design and why none misses ("ok"): each trial adds
+  /// its noise (AddMeasurementNoise).
+  std::vector<double> design_true_values;
+  std::vector<std::string> design_true_reasons;
   TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;
@@ -154,8 +158,9 @@ void PredictValidation(CellContext* c);
 /// predicted covariance and the truth's cache.
 void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* c);
 /// A tracker cell's trial after the truth and the nominal validation are in `rec`.
+struct TrialWorkspace;
 TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
-                            TrialRecord* rec, TrialDetails* details);
+                            TrialRecord* rec, TrialDetails* details, TrialWorkspace* ws);
 /// The validation poses' Jacobian ∂(pose)/∂e at the nominal model in the cell's estimate layout
 /// (6 rows per pose: position, then orientation).
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
@@ -172,6 +177,11 @@ struct TrialWorkspace {
   std::vector<double> weights;
   std::vector<double> exact_h;
   std::vector<BeamMiss> exact_miss;
+  /// A tracker cell's evaluator, bound to the design of `evaluator_cell` (rebound when the thread
+  /// moves to another cell), and its measured values.
+  const CellContext* evaluator_cell = nullptr;
+  std::unique_ptr<MeasurementEvaluator> evaluator;
+  MeasuredValues values;
 };
 
 TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace,

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "lrcal/core/error.h"
+#include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "test_util.h"
@@ -62,6 +63,40 @@ TEST(SimulateMeasurements, AConfigurationsNoiseDoesNotDependOnTheOthers) {
   SimulateMeasurements(kind, first, noise, stream, &b);
   ASSERT_EQ(b.size(), 4);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(a.y[i], b.y[i]) << i;
+}
+
+// AddMeasurementNoise on exact values computed once (a study's fixed truth) gives the values
+// SimulateMeasurements computes from the truth each time, bit for bit: with a pose's angle rows
+// and their weights, with the mean drawn directly and with every reading drawn.
+TEST(SimulateMeasurements, NoiseOnCachedExactValuesIsTheSameBits) {
+  const RobotModel& robot = testing::PaperRobot();
+  PointSetup setup;
+  setup.instrument =
+      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.5, 0.3, 0.2), Eigen::Vector3d(0, 0, 3));
+  const PoseMeasurement kind(robot, setup);
+  const TargetedConfigurations configs(testing::PaperHittingConfigurations(7, 2));
+  const std::vector<double> zero(static_cast<std::size_t>(kind.num_parameters()), 0.0);
+  std::vector<double> exact(static_cast<std::size_t>(configs.size()) * 6);
+  kind.Bind(configs)->Predict(zero.data(), exact.data(), nullptr);
+  const std::vector<std::string> reasons = kind.MissReasons(configs, zero.data());
+  for (bool draw_mean : {true, false}) {
+    NoiseModel noise;
+    noise.repetitions = 3;
+    noise.sigma_angle = 0.3e-3;
+    noise.draw_mean = draw_mean;
+    const RandomStream stream(4, 0, 1, RandomPurpose::kNoise);
+    MeasuredValues simulated, cached;
+    SimulateMeasurements(kind, configs, noise, stream, &simulated);
+    AddMeasurementNoise(kind, exact, reasons, configs, noise, stream, &cached);
+    EXPECT_EQ(simulated.y, cached.y) << draw_mean;
+    EXPECT_EQ(simulated.weights, cached.weights);
+    EXPECT_EQ(simulated.repetitions, cached.repetitions);
+  }
+  MeasuredValues unused;
+  EXPECT_THROW(AddMeasurementNoise(kind, std::vector<double>(exact.begin(), exact.end() - 1),
+                                   reasons, configs, NoiseModel{},
+                                   RandomStream(4, 0, 1, RandomPurpose::kNoise), &unused),
+               std::invalid_argument);
 }
 
 TEST(SimulateMeasurements, OutOfRangeNoiseIsRefused) {

@@ -113,6 +113,33 @@ TEST(TrackerStudy, ThePredictedCovarianceHoldsOverTheTrials) {
   }
 }
 
+TEST(TrackerStudy, TheTrialsLeanFitIsIdentifysFit) {
+  // A trial fits with lrcal's LM on the cell's evaluator from the cell's nominal linearisation,
+  // without Identify()'s per-fit rank analysis and statistics: the same estimate as Identify on
+  // the same values, to the solvers' stopping tolerance (1e-9 of a term's σ is far below it).
+  constexpr double kSameEstimate = 1e-10;
+  for (const char* kind : {"point", "pose"}) {
+    SCOPED_TRACE(kind);
+    const Study study = LoadStudy(WriteStudy(
+        std::string("lean_") + kind, "paper",
+        "noise: {sigma_mm: 0.05, repetitions: 4}\nselection: {count: 30}\nsensor: {kind: " +
+            std::string(kind) + ", sigma_mrad: 0.3, " + kTracker + "}\n"));
+    const auto c = PrepareCell(study, study.cells.at(0));
+    TrialWorkspace ws;
+    for (int t = 0; t < 3; ++t) {
+      const TrialRecord r = RunTrial(*c, t, &ws);
+      ASSERT_EQ(r.status, TrialStatus::kOk);
+      const IdentificationSummary s =
+          Identify(*c->kind, ws.values, study.cells[0].typed.identification);
+      ASSERT_TRUE(s.IsSolutionUsable());
+      for (Eigen::Index k = 0; k < s.delta.size(); ++k)
+        EXPECT_NEAR(ws.e[k], s.delta[k], kSameEstimate)
+            << c->parameter_names[static_cast<std::size_t>(k)];
+      EXPECT_NEAR(r.residual_rms, s.residual_rms, 1e-12);
+    }
+  }
+}
+
 TEST(TrackerStudy, TheBudgetBuysTheCountAndSensorsShareTheirValidationPoses) {
   const Study study = LoadStudy(
       WriteStudy("budget", "paper",

@@ -125,6 +125,15 @@ int SimulateMeasurements(const MeasurementKind& truth, const TargetedConfigurati
                          const NoiseModel& noise, const RandomStream& stream, MeasuredValues* data,
                          std::vector<std::string>* misses = nullptr);
 
+/// The noise half of SimulateMeasurements: the truth's exact values `exact` at `configs`
+/// (rows_per_configuration per configuration, SI) and its MissReasons `reasons` given, computed
+/// once for many noise draws (a study's fixed truth). SimulateMeasurements is this on the truth's
+/// own predictions, bit for bit. Throws std::invalid_argument when the sizes do not match.
+int AddMeasurementNoise(const MeasurementKind& truth, const std::vector<double>& exact,
+                        const std::vector<std::string>& reasons,
+                        const TargetedConfigurations& configs, const NoiseModel& noise,
+                        const RandomStream& stream, MeasuredValues* data);
+
 /// The Jacobian ∂y/∂e (num_rows × num_parameters) of `kind` at `configs` and estimate e
 /// (nullptr: nominal). Throws InputError when a prediction is undefined there.
 Eigen::MatrixXd MeasurementJacobian(const MeasurementKind& kind,
