@@ -268,14 +268,8 @@ std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, con
   const RigidTransform frame = ParseXyzRpy(vm["scanner"].as<std::string>(), "--scanner", false);
   setup.origin = frame.translation;
   setup.orientation = frame.rotation;
-  const int beams = vm["beams"].as<int>();
-  if (beams < 1 || beams > ScannerSetup::kMaxBeams)
-    throw InputError("--beams", "expected 1 to " + std::to_string(ScannerSetup::kMaxBeams) +
-                                    " beams, got " + std::to_string(beams));
-  const double half = vm["fan-deg"].as<double>();
-  if (!(half >= 0 && half < 90))
-    throw InputError("--fan-deg", "expected a half angle from 0 to below 90 deg");
-  setup.beam_angles = ScannerSetup::Fan(beams, half * M_PI / 180);
+  setup.beam_angles = ScannerSetup::FanOf(vm["beams"].as<int>(), vm["fan-deg"].as<double>(),
+                                          "--beams", "--fan-deg");
   const PlaneTerms terms = PlaneTerms::Parse(
       vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
   setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);

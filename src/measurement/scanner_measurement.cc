@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "lrcal/core/error.h"
 #include "lrcal/kinematics/chain.h"
@@ -127,6 +128,21 @@ std::vector<double> ScannerSetup::Fan(int count, double half_angle) {
   for (int b = 0; b < count; ++b)
     angles.push_back(count == 1 ? 0.0 : -half_angle + 2 * half_angle * b / (count - 1));
   return angles;
+}
+
+std::vector<double> ScannerSetup::FanOf(long long count, double half_angle_deg,
+                                        const std::string& count_source,
+                                        const std::string& angle_source) {
+  if (count < 1 || count > kMaxBeams)
+    throw InputError(count_source, "expected 1 to " + std::to_string(kMaxBeams) + " beams, got " +
+                                       std::to_string(count));
+  if (!(half_angle_deg >= 0 && half_angle_deg < 90)) {
+    std::ostringstream got;
+    got << half_angle_deg;
+    throw InputError(angle_source,
+                     "expected a half angle from 0 to below 90 deg, got " + got.str());
+  }
+  return Fan(static_cast<int>(count), half_angle_deg * M_PI / 180);
 }
 
 void ScannerSetup::Validate() const {

@@ -1024,12 +1024,7 @@ std::unique_ptr<ScannerMeasurement> ToScannerKind(const RobotFile& rig, const Ro
     setup.origin = frame.translation;
     setup.orientation = frame.rotation;
   }
-  if (a.beams < 1 || a.beams > ScannerSetup::kMaxBeams)
-    throw InputError("beams", "expected 1 to " + std::to_string(ScannerSetup::kMaxBeams) +
-                                  " beams, got " + std::to_string(a.beams));
-  if (!(a.fan_deg >= 0 && a.fan_deg < 90))
-    throw InputError("fan_deg", "expected a half angle from 0 to below 90 deg");
-  setup.beam_angles = ScannerSetup::Fan(static_cast<int>(a.beams), a.fan_deg * M_PI / 180);
+  setup.beam_angles = ScannerSetup::FanOf(a.beams, a.fan_deg, "beams", "fan_deg");
   setup.plane_terms.assign(static_cast<std::size_t>(planes.size()),
                            PlaneTerms::Parse(a.estimate_plane, "estimate_plane"));
   return std::make_unique<ScannerMeasurement>(robot, setup, ToNames(a.fix), "fix");

@@ -251,3 +251,16 @@ def test_scanner_simulate_identify_and_identifiability_as_the_program(tmp_path, 
         lrcal.identifiability(paper, sim["q"], beams=5)
     with pytest.raises(lrcal.InputError, match="h: expected an \\(N, beams\\) array"):
         lrcal.identify_scanner(paper, sim["q"], sim["h"].ravel())
+
+
+def test_scanner_geometry_out_of_range_is_an_error_naming_the_argument(paper):
+    q = lrcal.sample_configurations(paper, 5, seed=3)
+    with pytest.raises(lrcal.InputError, match="beams: expected 1 to 256 beams, got 0"):
+        lrcal.simulate_scanner(paper, q, beams=0)
+    with pytest.raises(lrcal.InputError, match="beams: expected 1 to 256 beams, got 257"):
+        lrcal.identifiability(paper, q, sensor="scanner", beams=257)
+    with pytest.raises(lrcal.InputError,
+                       match="fan_deg: expected a half angle from 0 to below 90 deg, got 90"):
+        lrcal.simulate_scanner(paper, q, beams=3, fan_deg=90)
+    with pytest.raises(lrcal.InputError, match="fan_deg: .* got -1"):
+        lrcal.identifiability(paper, q, sensor="scanner", beams=3, fan_deg=-1)

@@ -52,6 +52,12 @@ struct ScannerSetup {
   RangerSpec range{};
   /// A fan of `count` beams spread evenly over [−half_angle, half_angle] (rad; one beam: 0).
   static std::vector<double> Fan(int count, double half_angle);
+  /// The same for a user's request: `count` beams (1 to kMaxBeams) over ±`half_angle_deg`
+  /// (degrees, 0 to below 90). Throws InputError naming `count_source` or `angle_source` (the
+  /// option or argument the user wrote: "--beams", "fan_deg") with the value given.
+  static std::vector<double> FanOf(long long count, double half_angle_deg,
+                                   const std::string& count_source,
+                                   const std::string& angle_source);
   /// Throws InputError naming the field (scanner.planes, scanner.plane_terms, scanner.origin,
   /// scanner.orientation, scanner.beam_angles[b]; the range's SettingError) unless there is a
   /// plane, plane_terms is empty or one per plane, the origin is finite, the orientation a
