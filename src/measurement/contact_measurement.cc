@@ -45,7 +45,7 @@ class ContactEvaluator : public MeasurementEvaluator {
     arm_J_.resize(J ? static_cast<std::size_t>(point_.size()) * arm_terms : 0);
     if (!arm_->Predict(e, point_.data(), J ? arm_J_.data() : nullptr)) return false;
     if (J) std::fill(J, J + static_cast<std::size_t>(m) * n, 0.0);
-    if (k_ == 3) PrepareChainPoint(kind_.robot(), LinkValues(e).data(), &chain_);
+    if (k_ == 3) PrepareChainPoint(kind_.robot(), kind_.arm().LinkValuesAt(e).data(), &chain_);
     for (int i = 0; i < configs_.size(); ++i) {
       const int k = configs_.target(i);
       const ContactMeasurement::PlaneState plane = kind_.PlaneAt(e, k);
@@ -58,12 +58,6 @@ class ContactEvaluator : public MeasurementEvaluator {
   }
 
  private:
-  Eigen::VectorXd LinkValues(const double* e) const {
-    Eigen::VectorXd values = kind_.robot().nominal_values();
-    const std::vector<int>& robot_values = kind_.arm().robot_values();
-    for (std::size_t c = 0; c < robot_values.size(); ++c) values[robot_values[c]] += e[c];
-    return values;
-  }
   // Row k·i: n·∂P/∂e for the arm's terms, Pᵀ·∂n/∂u and 1 for the plane's.
   void DistanceRow(const ContactMeasurement::PlaneState& plane, const Eigen::Vector3d& P, int i,
                    int m, int arm_terms, double* J) const {
@@ -159,15 +153,7 @@ Eigen::VectorXd ContactMeasurement::NominalValues() const {
 
 std::unique_ptr<MeasurementEvaluator> ContactMeasurement::Bind(
     const TargetedConfigurations& configs) const {
-  if (configs.num_targets_referenced() > setup_.planes.size())
-    throw InputError("configurations", "a configuration touches plane " +
-                                           std::to_string(configs.num_targets_referenced()) +
-                                           " but the set-up has " +
-                                           std::to_string(setup_.planes.size()) + " plane(s)");
-  if (configs.num_joints() != robot().num_links())
-    throw InputError("configurations", "the robot has " + std::to_string(robot().num_links()) +
-                                           " joints, the configurations " +
-                                           std::to_string(configs.num_joints()));
+  planes_.CheckConfigurations(configs, robot().num_links(), "touches");
   return std::make_unique<ContactEvaluator>(*this, configs);
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "lrcal/core/error.h"
+
 namespace lrcal {
 
 namespace {
@@ -58,6 +60,19 @@ void EstimatedPlanes::SetNominal(Eigen::VectorXd* nominal) const {
     const int f = columns_[static_cast<std::size_t>(p)][2];
     if (f >= 0) (*nominal)[f] = planes_[p].offset;
   }
+}
+
+void EstimatedPlanes::CheckConfigurations(const TargetedConfigurations& configs, int num_joints,
+                                          const std::string& verb) const {
+  if (configs.num_targets_referenced() > planes_.size())
+    throw InputError("configurations", "a configuration " + verb + " plane " +
+                                           std::to_string(configs.num_targets_referenced()) +
+                                           " but the set-up has " + std::to_string(planes_.size()) +
+                                           " plane(s)");
+  if (configs.num_joints() != num_joints)
+    throw InputError("configurations", "the robot has " + std::to_string(num_joints) +
+                                           " joints, the configurations " +
+                                           std::to_string(configs.num_joints()));
 }
 
 }  // namespace lrcal

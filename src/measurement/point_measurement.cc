@@ -242,9 +242,14 @@ Eigen::VectorXd PointMeasurement::NominalValues() const {
   return nominal;
 }
 
+Eigen::VectorXd PointMeasurement::LinkValuesAt(const double* e) const {
+  Eigen::VectorXd values = robot_->nominal_values();
+  for (std::size_t k = 0; k < robot_values_.size(); ++k) values[robot_values_[k]] += e[k];
+  return values;
+}
+
 void PointMeasurement::StateAt(const double* e, State* s) const {
-  s->link_values = robot_->nominal_values();
-  for (std::size_t k = 0; k < robot_values_.size(); ++k) s->link_values[robot_values_[k]] += e[k];
+  s->link_values = LinkValuesAt(e);
   double d[6];
   for (int k = 0; k < 6; ++k) d[k] = instrument_columns_[k] >= 0 ? e[instrument_columns_[k]] : 0.0;
   s->R_BI0 = setup_.instrument.rotation;

@@ -44,7 +44,7 @@ class ScannerEvaluator : public MeasurementEvaluator {
     arm_J_.resize(J ? origin_.size() * static_cast<std::size_t>(kind_.arm().num_parameters()) : 0);
     if (!arm_->Predict(e, origin_.data(), J ? arm_J_.data() : nullptr)) return false;
     if (J) std::fill(J, J + static_cast<std::size_t>(m) * n, 0.0);
-    PrepareChainPoint(kind_.robot(), LinkValues(e).data(), &chain_);
+    PrepareChainPoint(kind_.robot(), kind_.arm().LinkValuesAt(e).data(), &chain_);
     Eigen::Matrix3d dR_TS[3];
     const Eigen::Matrix3d R_TS = kind_.OrientationAt(e, dR_TS);
     bool defined = true;
@@ -72,12 +72,6 @@ class ScannerEvaluator : public MeasurementEvaluator {
   }
 
  private:
-  Eigen::VectorXd LinkValues(const double* e) const {
-    Eigen::VectorXd values = kind_.robot().nominal_values();
-    const std::vector<int>& robot_values = kind_.arm().robot_values();
-    for (std::size_t c = 0; c < robot_values.size(); ++c) values[robot_values[c]] += e[c];
-    return values;
-  }
   // ∂h = −(n·∂O + h·n·∂D + ∂n·(O + h·D) + ∂f)/(n·D): ∂O from the arm's kind (link values and the
   // origin's terms), ∂D = ω × D per link value, R_BT·∂R_TS·d_b per scanner angle.
   void BeamRow(const EstimatedPlanes::State& plane, const Pose<double>& pose,
@@ -233,22 +227,14 @@ Eigen::Matrix3d ScannerMeasurement::OrientationAt(const double* e, Eigen::Matrix
 
 std::unique_ptr<MeasurementEvaluator> ScannerMeasurement::Bind(
     const TargetedConfigurations& configs) const {
-  if (configs.num_targets_referenced() > setup_.planes.size())
-    throw InputError("configurations", "a configuration is aimed at plane " +
-                                           std::to_string(configs.num_targets_referenced()) +
-                                           " but the set-up has " +
-                                           std::to_string(setup_.planes.size()) + " plane(s)");
-  if (configs.num_joints() != robot().num_links())
-    throw InputError("configurations", "the robot has " + std::to_string(robot().num_links()) +
-                                           " joints, the configurations " +
-                                           std::to_string(configs.num_joints()));
+  planes_.CheckConfigurations(configs, robot().num_links(), "is aimed at");
   return std::make_unique<ScannerEvaluator>(*this, configs);
 }
 
 std::vector<std::string> ScannerMeasurement::MissReasons(const TargetedConfigurations& configs,
                                                          const double* e) const {
   std::vector<std::string> reasons(static_cast<std::size_t>(configs.size()), "ok");
-  Bind(configs);  // checks the tags and joints
+  planes_.CheckConfigurations(configs, robot().num_links(), "is aimed at");
   ScannerEvaluator evaluator(*this, configs);
   std::vector<double> h(static_cast<std::size_t>(evaluator.num_rows()));
   evaluator.Predict(e, h.data(), nullptr);

@@ -145,6 +145,15 @@ std::unique_ptr<ContactMeasurement> TrueContactKind(const ContactMeasurement& ki
   return true_kind;
 }
 
+TEST(ContactMeasurement, ConfigurationsOnPlanesItDoesNotHaveAreRefused) {
+  const ContactMeasurement kind(testing::PaperRobot(), TwoPlanes(false));
+  TargetedConfigurations third_plane(6);
+  third_plane.Add(std::vector<double>(6, 0.1), 2);
+  EXPECT_THAT([&] { kind.Bind(third_plane); },
+              ::testing::ThrowsMessage<InputError>(
+                  HasSubstr("a configuration touches plane 3 but the set-up has 2 plane(s)")));
+}
+
 TEST(ContactMeasurement, SeatingPutsTheToolPointOnItsPlaneWithTheStatedPlay) {
   const RobotModel& robot = testing::PaperRobot();
   const ContactMeasurement kind(robot, TwoPlanes(false));

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <functional>
 
 #include "lrcal/core/error.h"
 #include "lrcal/identification/identifiability.h"
@@ -271,6 +272,23 @@ TEST(ScannerMeasurement, MissesAndBadSetUpsAreNamed) {
   ASSERT_EQ(reasons.size(), 2u);
   EXPECT_EQ(reasons[0], "ok");
   EXPECT_THAT(reasons[1], HasSubstr("plane 1 behind beam 1"));
+}
+
+TEST(ScannerMeasurement, ConfigurationsItCannotMeasureAreRefusedByBindAndMissReasons) {
+  const ScannerMeasurement kind(testing::PaperRobot(), FanSetup());  // one plane
+  TargetedConfigurations second_plane(6), five_joints(5);
+  second_plane.Add(std::vector<double>(6, 0.1), 1);
+  five_joints.Add(std::vector<double>(5, 0.1), 0);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kind.num_parameters());
+  for (const auto& call : std::vector<std::function<void(const TargetedConfigurations&)>>{
+           [&](const TargetedConfigurations& c) { kind.Bind(c); },
+           [&](const TargetedConfigurations& c) { kind.MissReasons(c, zero.data()); }}) {
+    EXPECT_THAT([&] { call(second_plane); },
+                ::testing::ThrowsMessage<InputError>(HasSubstr(
+                    "a configuration is aimed at plane 2 but the set-up has 1 plane(s)")));
+    EXPECT_THAT([&] { call(five_joints); }, ::testing::ThrowsMessage<InputError>(HasSubstr(
+                                                "the robot has 6 joints, the configurations 5")));
+  }
 }
 
 }  // namespace

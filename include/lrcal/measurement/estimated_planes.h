@@ -11,6 +11,7 @@
 
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
@@ -40,6 +41,11 @@ class EstimatedPlanes {
   /// Writes each estimated offset's nominal value into `nominal` (u: the chart origin, 0).
   void SetNominal(Eigen::VectorXd* nominal) const;
   const NormalChart& chart(int k) const { return charts_[static_cast<std::size_t>(k)]; }
+  /// Throws InputError ("configurations") unless `configs` have `num_joints` joints and name
+  /// only planes of this set: "a configuration <verb> plane 3 but the set-up has 2 plane(s)"
+  /// (verb: "touches", "is aimed at").
+  void CheckConfigurations(const TargetedConfigurations& configs, int num_joints,
+                           const std::string& verb) const;
 
  private:
   PlaneSet planes_;

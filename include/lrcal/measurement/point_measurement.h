@@ -92,9 +92,12 @@ class PointMeasurement : public MeasurementKind {
     std::vector<Eigen::Matrix3d> R_TM, target_Ry, target_Rx;
   };
   void StateAt(const double* e, State* state) const;
-  /// Where the terms are in e (-1 when fixed): link value index → column, the instrument's six
-  /// (x, y, z, roll, pitch, yaw) and each target's three.
+  /// Where the terms are in e: the link value index (into the robot's 5N) of each of the first
+  /// robot_values().size() columns; the instrument's six columns (x, y, z, roll, pitch, yaw) and
+  /// each target's three (-1 when fixed).
   const std::vector<int>& robot_values() const { return robot_values_; }
+  /// The robot's link values at estimate e (5N, SI): nominal, plus e on the estimated ones.
+  Eigen::VectorXd LinkValuesAt(const double* e) const;
   int instrument_column(int k) const { return instrument_columns_[k]; }
   int target_column(int target, int axis) const { return target_columns_[3 * target + axis]; }
   /// The pose kind's target orientation terms (roll, pitch, yaw: k = 0, 1, 2); -1 when fixed or
