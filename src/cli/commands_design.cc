@@ -5,7 +5,9 @@
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/design_choice.h"
+#include "lrcal/identification/identifiability.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/measurement/point_measurement.h"
 
 namespace lrcal::cli {
 
@@ -32,7 +34,12 @@ void AddDesignOptions(po::options_description& o) {
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
       "fix", po::value<std::string>(), "parameters left out, comma-separated")(
-      "out", po::value<std::string>(), "write the chosen configurations (CSV)");
+      "out", po::value<std::string>(), "write the chosen configurations (CSV)")(
+      "sensor", po::value<std::string>()->default_value("ranger"),
+      "ranger (a distance to the plane), or a tracker: point (a reflector) or pose (a 6-D "
+      "probe), its configurations chosen as blocks of 3 or 6 values, anywhere in the workspace, "
+      "the terms the pool cannot separate held at nominal");
+  AddTrackerGeometryOptions(o);
   AddFrameTermOptions(o);
   AddSettingOptions(o, SelectionOptions::Settings(), {"samples", "restarts"});
   AddSettingOptions(o, DesignRequest::Settings());
@@ -45,8 +52,9 @@ struct ResolvedPool {
 };
 
 // The candidate pool (generated, or read and filtered by the nominal beam), with what was
-// rejected and why.
-ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::uint64_t seed) {
+// rejected and why. A tracker (`beam` false) sees its target anywhere: no beam has to hit.
+ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::uint64_t seed,
+                         bool beam) {
   const RobotModel& robot = setup.rig.robot;
   if (vm.count("pool") == vm.count("generate"))
     throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
@@ -57,6 +65,7 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
       throw InputError("--generate", "expected 1 to 100,000 candidates, got " + std::to_string(n));
     SamplingOptions sampling;
     sampling.ranger = setup.rig.ranger;
+    sampling.require_beam_hit = beam;
     pool.configs = SampleConfigurations(
         robot, setup.planes, std::vector<int>(setup.planes.size(), n),
         RandomStream(seed, 0, 0, RandomPurpose::kPool), sampling, &pool.report);
@@ -64,6 +73,12 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
     return pool;
   }
   const std::string path = vm["pool"].as<std::string>();
+  if (!beam) {
+    pool.configs = ReadRobotConfigurations(path, robot, nullptr);
+    pool.source = path + ": " + std::to_string(pool.configs.size()) + " configurations";
+    if (pool.configs.size() == 0) throw InputError("--pool", "no candidate configurations");
+    return pool;
+  }
   CandidatePool usable = UsableCandidates(robot, setup.planes, setup.rig.ranger,
                                           ReadRobotConfigurations(path, robot, &setup.planes));
   for (std::size_t i = 0; i < usable.misses.size(); ++i)
@@ -108,6 +123,22 @@ DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel
 
 }  // namespace
 
+// --sensor: the ranger or a tracker; a tracker takes none of the ranger's terms.
+std::string DesignSensor(const po::variables_map& vm) {
+  const std::string sensor = vm["sensor"].as<std::string>();
+  if (sensor != "ranger" && sensor != "point" && sensor != "pose")
+    throw InputError("--sensor", "'" + CellExcerpt(sensor) +
+                                     "': lrcal design chooses for ranger, point or pose (the "
+                                     "scanner, contact and socket kinds are not designed yet)");
+  if (sensor != "ranger")
+    RefuseRangerOptions(vm, sensor,
+                        {"estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool"});
+  else if ((vm.count("instrument") && !vm["instrument"].defaulted()) || vm.count("target"))
+    throw InputError(vm.count("target") ? "--target" : "--instrument",
+                     "is a tracker's; give --sensor point or pose");
+  return sensor;
+}
+
 int DesignCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal design options");
   AddDesignOptions(o);
@@ -118,11 +149,22 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (vm.count("out")) CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const Setup setup = ResolveSetup(vm);
   const std::uint64_t seed = ParseSeed(vm);
-  const ResolvedPool pool = ResolvePool(vm, setup, seed);
+  const std::string sensor = DesignSensor(vm);
+  const bool tracker = sensor != "ranger";
+  const ResolvedPool pool = ResolvePool(vm, setup, seed, !tracker);
   MeasurementModel model(setup.rig.robot, setup.planes,
-                         ResolveParameterSet(setup.rig.robot, vm, setup.planes.size()));
+                         tracker ? MakeParameterSet(setup.rig.robot, PlaneTerms{})
+                                 : ResolveParameterSet(setup.rig.robot, vm, setup.planes.size()));
   const DesignRequest request = ResolveRequest(vm, model, seed);
-  const DesignChoice choice = ChooseDesign(model, pool.configs, request);
+  std::vector<std::string> held;
+  DesignChoice choice;
+  if (tracker) {
+    const std::unique_ptr<PointMeasurement> full = MakeTrackerKind(setup.rig.robot, sensor, vm);
+    held = AnalyzeIdentifiability(*full, pool.configs).suggested_fixed;
+    choice = ChooseDesign(*full->Without(held), pool.configs, request);
+  } else {
+    choice = ChooseDesign(model, pool.configs, request);
+  }
   if (vm.count("out"))
     WriteConfigurations(vm["out"].as<std::string>(), pool.configs.Subset(choice.chosen.indices));
   if (ResolveFormat(vm) == Format::kJson) {
@@ -132,11 +174,19 @@ int DesignCommand(const std::vector<std::string>& args) {
                  {"rejected", pool.report.rejected},
                  {"tried", pool.report.attempts}};
     j.update(DesignChoiceJson(request, choice));
+    j["sensor"] = sensor;
+    j["held_at_nominal"] = held;
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  std::cout << "candidate pool: " << pool.source << "\n"
-            << DesignChoiceText(request, choice, setup.planes, pool.configs.size());
+  std::cout << "candidate pool: " << pool.source << "\n";
+  if (tracker) {
+    std::cout << "sensor: " << sensor << " (" << (sensor == "pose" ? 6 : 3)
+              << " values per configuration); held at nominal, the pool cannot separate them:";
+    for (const std::string& name : held) std::cout << " " << name;
+    std::cout << (held.empty() ? " none\n" : "\n");
+  }
+  std::cout << DesignChoiceText(request, choice, setup.planes, pool.configs.size());
   if (vm.count("out")) std::cout << "wrote " << vm["out"].as<std::string>() << "\n";
   return 0;
 }

@@ -9,6 +9,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/random.h"
 #include "lrcal/core/text_table.h"
+#include "lrcal/design/block_selection.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/random_baseline.h"
 #include "lrcal/measurement/ranger_measurement.h"
@@ -42,11 +43,7 @@ void DesignRequest::Validate() const {
 DesignChoice ChooseDesign(const MeasurementKind& kind, const TargetedConfigurations& pool,
                           const DesignRequest& request) {
   request.Validate();
-  if (kind.rows_per_configuration() != 1)
-    throw InputError("design", std::string("a ") + kind.name() + " measurement has " +
-                                   std::to_string(kind.rows_per_configuration()) +
-                                   " values per configuration; design chooses configurations "
-                                   "of one value (a ranger's reading) only so far");
+  const int rows = kind.rows_per_configuration();
   SelectionOptions options = request.selection;
   const bool task = request.task.count > 0;
   if (task) options.criterion = DesignCriterion::kA;  // I is A on the task-weighted G
@@ -55,13 +52,19 @@ DesignChoice ChooseDesign(const MeasurementKind& kind, const TargetedConfigurati
                                                   request.expected_angle, request.expected_length);
   DesignChoice out;
   const auto t0 = std::chrono::steady_clock::now();
-  out.chosen = SelectConfigurations(G, request.count, options,
-                                    RandomStream(request.seed, 1, 0, RandomPurpose::kSelection));
+  out.chosen = SelectBlocks(G, rows, request.count, options,
+                            RandomStream(request.seed, 1, 0, RandomPurpose::kSelection));
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.baseline = CompareWithRandomDesigns(G, out.chosen.indices, request.baseline, request.seed);
-  out.certificate = CertifyDesign(G, out.chosen.indices, options.criterion);
-  out.certificate_statement =
-      out.certificate.ToString(options.criterion, request.count, static_cast<int>(pool.size()));
+  out.baseline =
+      CompareWithRandomDesigns(G, out.chosen.indices, request.baseline, request.seed, rows);
+  if (rows == 1) {
+    out.certificate = CertifyDesign(G, out.chosen.indices, options.criterion);
+    out.certificate_statement =
+        out.certificate.ToString(options.criterion, request.count, static_cast<int>(pool.size()));
+  } else {  // the relaxation weighs single rows, not a configuration's block of them
+    out.certificate_statement = "no certificate for configurations of " + std::to_string(rows) +
+                                " values (the relaxation bound weighs single rows)";
+  }
   out.per_plane.assign(static_cast<std::size_t>(std::max(pool.num_targets_referenced(), 1)), 0);
   for (int i : out.chosen.indices) ++out.per_plane[static_cast<std::size_t>(pool.target(i))];
   if (task)

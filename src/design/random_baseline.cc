@@ -1,6 +1,7 @@
 #include "lrcal/design/random_baseline.h"
 
 #include "lrcal/core/random.h"
+#include "lrcal/design/block_selection.h"
 
 namespace lrcal {
 
@@ -33,22 +34,32 @@ const SettingSpec& RandomBaselineSetting() {
 
 std::vector<BaselineIndex> CompareWithRandomDesigns(const Eigen::MatrixXd& G,
                                                     const std::vector<int>& chosen, int count,
-                                                    std::uint64_t seed) {
+                                                    std::uint64_t seed,
+                                                    int rows_per_configuration) {
   RandomBaselineSetting().Check(count);
   const int k = static_cast<int>(chosen.size());
   constexpr std::size_t kCriteria = std::size(kBaselineCriteria);
   std::vector<std::vector<double>> random_scores(kCriteria);
   SelectionOptions random_options;
   random_options.method = SelectionMethod::kRandom;
+  // The rows of configurations `configs` (all rows_per_configuration of each).
+  const auto rows_of = [&](const std::vector<int>& configs) {
+    if (rows_per_configuration == 1) return configs;
+    std::vector<int> rows;
+    for (int i : configs)
+      for (int r = 0; r < rows_per_configuration; ++r)
+        rows.push_back(i * rows_per_configuration + r);
+    return rows;
+  };
   for (int b = 0; b < count; ++b) {
-    const SelectionResult r = SelectConfigurations(
-        G, k, random_options,
+    const SelectionResult r = SelectBlocks(
+        G, rows_per_configuration, k, random_options,
         RandomStream(seed, 2, static_cast<std::uint64_t>(b), RandomPurpose::kSelection));
-    const Eigen::MatrixXd A = NormalMatrixOfRows(G, r.indices);
+    const Eigen::MatrixXd A = NormalMatrixOfRows(G, rows_of(r.indices));
     for (std::size_t c = 0; c < kCriteria; ++c)
       random_scores[c].push_back(CriterionScore(A, k, kBaselineCriteria[c]));
   }
-  const Eigen::MatrixXd A_chosen = NormalMatrixOfRows(G, chosen);
+  const Eigen::MatrixXd A_chosen = NormalMatrixOfRows(G, rows_of(chosen));
   std::vector<BaselineIndex> out(kCriteria);
   for (std::size_t c = 0; c < kCriteria; ++c) {
     out[c].criterion = kBaselineCriteria[c];

@@ -405,3 +405,45 @@ TEST_F(SensorCli, ALineScannerCalibratesTheArmWithThePlaneEstimated) {
 
 }  // namespace
 }  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// `lrcal design --sensor point|pose`: a tracker's configurations chosen as blocks, anywhere in
+// the workspace (a pool of c.csv's configurations, none filtered by a beam), with the terms the
+// pool cannot separate held at nominal and named; the chosen CSV is what `simulate --sensor`
+// reads; the ranger's options are refused for a tracker and a tracker's for the ranger.
+TEST(SensorDesignCli, ATrackersDesignIsChosenAsBlocksAndNamesWhatItHolds) {
+  const std::string dir = testing::TempDir("sensor_design");
+  std::string out;
+  ASSERT_EQ(
+      testing::RunCommand(
+          testing::LrcalBinary() + " sample --count 60 --seed 3 --out " + dir + "/c.csv", &out),
+      0)
+      << out;
+  const std::string design = testing::LrcalBinary() + " design --pool " + dir +
+                             "/c.csv --select 12 --method backward --baseline 50" +
+                             " --instrument 2.5,0.3,0.2,0,0,3";
+  ASSERT_EQ(
+      testing::RunCommand(design + " --sensor pose --format json --out " + dir + "/d.csv", &out), 0)
+      << out;
+  const Json j = Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  EXPECT_EQ(j["sensor"], "pose");
+  EXPECT_EQ(j["held_at_nominal"].size(), 7u);  // 37 terms, rank 30
+  EXPECT_EQ(j["pool"]["size"], 60);
+  ASSERT_EQ(
+      testing::RunCommand(testing::LrcalBinary() + " simulate --sensor pose --configs " + dir +
+                              "/d.csv --instrument 2.5,0.3,0.2,0,0,3 --out " + dir + "/p.csv",
+                          &out),
+      0)
+      << out;
+  EXPECT_EQ(testing::RunCommand(design + " --sensor point --estimate-plane offset", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--estimate-plane: is the ranger's"));
+  EXPECT_EQ(testing::RunCommand(design + " --sensor scanner", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("lrcal design chooses for ranger, point or pose"));
+  EXPECT_EQ(testing::RunCommand(design, &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--instrument: is a tracker's"));
+}
+
+}  // namespace
+}  // namespace lrcal

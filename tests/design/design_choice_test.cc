@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "lrcal/core/random.h"
+#include "lrcal/design/block_selection.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/measurement/parameter_set.h"
@@ -131,11 +132,46 @@ TEST_F(DesignChoiceTest, AnyKindsJacobianScalesAndWeighsByItsOwnTerms) {
           << names[k];
   }
   EXPECT_EQ(std::count(names.begin(), names.end(), "instrument_x"), 1);
+}
+
+// A tracker's configurations are chosen as blocks of their three values: what SelectBlocks
+// chooses on the same Jacobian, the baseline's random designs of as many configurations (their
+// scores from the blocks' rows, computed here), and no certificate.
+TEST_F(DesignChoiceTest, ATrackersConfigurationsAreChosenAsBlocks) {
+  PointSetup setup;
+  setup.instrument =
+      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.0, -0.4, 0.3), Eigen::Vector3d(0.1, -0.2, 2.8));
+  const PointMeasurement full(model_.robot(), setup);
+  const std::unique_ptr<MeasurementKind> tracker =
+      full.Without(AnalyzeIdentifiability(full, pool_).suggested_fixed);
   DesignRequest request;
-  request.count = 20;
-  EXPECT_THAT([&] { ChooseDesign(tracker, pool_, request); },
-              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(
-                  "a point measurement has 3 values per configuration; design chooses")));
+  request.count = 15;
+  request.baseline = 30;
+  request.seed = 6;
+  request.selection.criterion = DesignCriterion::kE;
+  request.selection.method = SelectionMethod::kBackward;
+  const DesignChoice choice = ChooseDesign(*tracker, pool_, request);
+  const Eigen::MatrixXd G = DesignJacobian(*tracker, pool_, DesignScaling::kSI, 1e-3, 1e-3);
+  const SelectionResult direct =
+      SelectBlocks(G, 3, 15, request.selection, RandomStream(6, 1, 0, RandomPurpose::kSelection));
+  EXPECT_EQ(choice.chosen.indices, direct.indices);
+  EXPECT_GT(choice.chosen.score, 0);
+  EXPECT_FALSE(choice.certificate.available);
+  EXPECT_THAT(choice.certificate_statement,
+              ::testing::HasSubstr("no certificate for configurations of 3 values"));
+  Eigen::MatrixXd chosen_rows(45, G.cols());
+  for (int t = 0; t < 15; ++t)
+    chosen_rows.middleRows(3 * t, 3) = G.middleRows(3 * choice.chosen.indices[t], 3);
+  const Eigen::MatrixXd A = chosen_rows.transpose() * chosen_rows;
+  ASSERT_EQ(choice.baseline[0].criterion, DesignCriterion::kE);
+  EXPECT_NEAR(choice.baseline[0].chosen, CriterionScore(A, 15, DesignCriterion::kE),
+              1e-12 * choice.baseline[0].chosen);
+  EXPECT_EQ(choice.baseline[0].random.n, 30);
+  EXPECT_GT(choice.baseline[0].percentile, 50);  // the E-optimal design beats most random ones
+  request.selection.method = SelectionMethod::kExhaustive;
+  EXPECT_THAT([&] { ChooseDesign(*tracker, pool_, request); },
+              ::testing::ThrowsMessage<InputError>(
+                  ::testing::HasSubstr("for 3 values per configuration use backward")));
 }
 
 }  // namespace

@@ -56,9 +56,11 @@ struct DesignChoice {
 };
 
 /// Chooses request.count of `pool` for measurements of `kind` (at its nominal terms); per_plane
-/// counts the chosen configurations per target. Throws InputError for an impossible request
-/// (count above the pool, below the terms) and for a kind of more than one row per
-/// configuration (choosing blocks of rows is not done yet: see DesignJacobian).
+/// counts the chosen configurations per target. A kind of several values per configuration (a
+/// tracker's 3 or 6) is chosen by blocks (block_selection.h; exhaustive refused there), its
+/// baseline of random designs of as many configurations, and has no certificate (the relaxation
+/// weighs single rows). Throws InputError for an impossible request (count above the pool, too
+/// few values for the terms).
 DesignChoice ChooseDesign(const MeasurementKind& kind, const TargetedConfigurations& pool,
                           const DesignRequest& request);
 /// The ranger's: ChooseDesign of RangerMeasurement(model), per_plane over the model's planes.

@@ -131,8 +131,8 @@ Eigen::MatrixXd TaskWeightedJacobian(const Eigen::MatrixXd& G,
 /// (MeasurementJacobian, rows_per_configuration rows per candidate), columns scaled as
 /// `scaling` says (expected errors `angle` rad and `length` m for kExpectedErrors): what design
 /// selects from, for any measurement kind. SelectConfigurations chooses rows, so a kind of one
-/// row per configuration (the ranger) is selected by configuration; choosing blocks of rows (a
-/// tracker's three) is not done here yet (ChooseDesign refuses it).
+/// row per configuration (the ranger) is selected by configuration; blocks of rows (a tracker's
+/// three) are chosen by SelectBlocks (block_selection.h).
 Eigen::MatrixXd DesignJacobian(const MeasurementKind& kind, const TargetedConfigurations& pool,
                                DesignScaling scaling, double angle, double length);
 /// The ranger's: the same for RangerMeasurement(model) (the bits of the identification's

@@ -29,11 +29,13 @@ struct BaselineIndex {
 /// The number of random designs (`baseline.count`: --baseline, baseline=): 1 to 1,000,000.
 const SettingSpec& RandomBaselineSetting();
 
-/// Every index of rows `chosen` of G (N×n) against `count` random designs of as many rows,
-/// drawn from `seed`'s selection stream 2 (design b is draw b). Throws SettingError for a count
-/// out of range.
+/// Every index of configurations `chosen` of G (rows_per_configuration rows each, N·k × n)
+/// against `count` random designs of as many configurations, drawn from `seed`'s selection
+/// stream 2 (design b is draw b; SelectBlocks' random method). With one row per configuration
+/// this is the ranger's baseline, bit for bit. Throws SettingError for a count out of range.
 std::vector<BaselineIndex> CompareWithRandomDesigns(const Eigen::MatrixXd& G,
                                                     const std::vector<int>& chosen, int count,
-                                                    std::uint64_t seed);
+                                                    std::uint64_t seed,
+                                                    int rows_per_configuration = 1);
 
 }  // namespace lrcal
