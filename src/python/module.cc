@@ -261,6 +261,8 @@ struct Design {
   std::string criterion, method, scaling;
   std::vector<std::pair<int, std::string>> rejected;  ///< pool rows whose beam misses
   std::string json;  ///< `lrcal design --format json`'s fields (DesignChoiceJson)
+  std::string sensor = "ranger";
+  std::vector<std::string> held;  ///< a tracker's terms held at nominal (the pool cannot see them)
 };
 
 // --- functions ------------------------------------------------------------------------------
@@ -1187,6 +1189,8 @@ struct DesignArgs {
   double expected_angle_mrad, expected_length_mm;
   py::object plane_of = py::none();      // with several planes, each candidate's plane (from 1)
   std::string estimate_ranger = "none";  // as --estimate-ranger
+  std::string sensor = "ranger";         // or a tracker: point, pose (as --sensor)
+  py::object instrument = py::none(), targets = py::none();
 };
 
 DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model, int k) {
@@ -1222,8 +1226,44 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
   return request;
 }
 
+// A tracker's design (sensor point or pose): blocks of its values from the whole pool (no beam
+// to hit), the terms the pool cannot separate held at nominal, as `lrcal design --sensor`.
+Design TrackerDesignPy(const RobotFile& rig, const Array& pool_q, int k,
+                       const std::string& estimate_plane, const py::object& fix,
+                       const DesignArgs& a) {
+  const RobotModel& robot = rig.robot;
+  for (const auto& [name, value] :
+       {std::pair<const char*, const std::string*>{"estimate_plane", &estimate_plane},
+        {"estimate_ranger", &a.estimate_ranger}})
+    if (*value != "none")
+      throw InputError(name, "is the ranger's; sensor='" + a.sensor + "' does not take it");
+  const std::unique_ptr<PointMeasurement> full =
+      ToTrackerKind(robot, a.sensor, a.instrument, a.targets, fix);
+  const MeasurementModel arm(robot, rig.planes ? *rig.planes : PlaneSet(Plane{}),
+                             MakeParameterSet(robot, PlaneTerms{}));
+  const DesignRequest request = ToDesignRequest(a, arm, k);
+  const TargetedConfigurations pool(ToConfigurations(pool_q, robot.num_links(), "pool"));
+  Design out;
+  out.sensor = a.sensor;
+  {
+    py::gil_scoped_release release;
+    out.held = AnalyzeIdentifiability(*full, pool).suggested_fixed;
+    out.choice = ChooseDesign(*full->Without(out.held), pool, request);
+  }
+  out.indices = out.choice.chosen.indices;
+  out.criterion = request.CriterionName();
+  out.method = SelectionMethodName(request.selection.method);
+  out.scaling = DesignScalingName(request.scaling);
+  out.json = DesignChoiceJson(request, out.choice).dump();
+  return out;
+}
+
 Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const py::object& plane_arg,
                 const std::string& estimate_plane, const py::object& fix, const DesignArgs& a) {
+  if (a.sensor != "ranger") return TrackerDesignPy(rig, pool_q, k, estimate_plane, fix, a);
+  if (!a.instrument.is_none() || !a.targets.is_none())
+    throw InputError(a.instrument.is_none() ? "targets" : "instrument",
+                     "is a tracker's; give sensor='point' or 'pose'");
   const RobotModel& robot = rig.robot;
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
   const MeasurementModel model(
@@ -1455,6 +1495,8 @@ and the parameters to fix for a full-rank set (suggested_fixed). str() gives the
 A chosen design: indices (rows of the pool given, ascending), the criterion's score of the chosen
 set, the candidate evaluations spent, and the pool rows rejected because their beam misses.)doc")
       .def_readonly("indices", &Design::indices)
+      .def_readonly("sensor", &Design::sensor)
+      .def_readonly("held_at_nominal", &Design::held)
       .def_property_readonly("score", [](const Design& d) { return d.choice.chosen.score; })
       .def_property_readonly("evaluations",
                              [](const Design& d) { return d.choice.chosen.evaluations; })
@@ -2238,13 +2280,13 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
          const py::object& expected_length, int restarts, int samples, long long seed,
          const py::object& plane, const std::string& estimate_plane, const py::object& fix,
          const py::object& poses, int workspace, int baseline, double expected_angle_mrad,
-         double expected_length_mm, const py::object& plane_of,
-         const std::string& estimate_ranger) {
+         double expected_length_mm, const py::object& plane_of, const std::string& estimate_ranger,
+         const std::string& sensor, const py::object& instrument, const py::object& targets) {
         return DesignPy(
             rig, pool, k, plane, estimate_plane, fix,
             DesignArgs{criterion, method, scaling, expected_angle, expected_length, restarts,
                        samples, seed, poses, workspace, baseline, expected_angle_mrad,
-                       expected_length_mm, plane_of, estimate_ranger});
+                       expected_length_mm, plane_of, estimate_ranger, sensor, instrument, targets});
       },
       py::arg("robot"), py::arg("pool"), py::arg("k"), py::arg("criterion") = "E",
       py::arg("method") = "exchange", py::arg("scaling") = "si",
@@ -2263,7 +2305,9 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
           FindSetting(DesignRequest::Settings(), "expected_angle_mrad")->Default(),
       py::arg("expected_length_mm") =
           FindSetting(DesignRequest::Settings(), "expected_length_mm")->Default(),
-      py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none", R"doc(
+      py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
+      py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
+      py::arg("targets") = py::none(), R"doc(
 Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
 identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
 (design/design_choice.h), numbers and checks.
@@ -2277,7 +2321,11 @@ nominal beam misses the plane are left out (Design.rejected). Returns an lrcal.D
 indices are rows of `pool`; Design.json holds `lrcal design --format json`'s fields.
 plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
 lrcal.Plane; with several planes plane_of gives each candidate's plane (from 1, the pool CSV's
-plane column). estimate_ranger: the ranger terms estimated (as --estimate-ranger).)doc");
+plane column). estimate_ranger: the ranger terms estimated (as --estimate-ranger).
+sensor='point' or 'pose' (with instrument= and targets= as in identifiability) chooses a tracker's
+configurations as blocks of 3 or 6 values from the whole pool (no beam to hit), holds the terms
+the pool cannot separate at nominal (Design.held_at_nominal) and has no certificate, as
+`lrcal design --sensor`.)doc");
 }
 
 void DefineStudy(py::module_& m) {

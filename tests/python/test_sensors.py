@@ -264,3 +264,28 @@ def test_scanner_geometry_out_of_range_is_an_error_naming_the_argument(paper):
         lrcal.simulate_scanner(paper, q, beams=3, fan_deg=90)
     with pytest.raises(lrcal.InputError, match="fan_deg: .* got -1"):
         lrcal.identifiability(paper, q, sensor="scanner", beams=3, fan_deg=-1)
+
+
+def test_tracker_design_is_the_programs(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 60, seed=3)
+    pool = tmp_path / "c.csv"
+    with open(pool, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)])
+        writer.writerows([[repr(v) for v in row] for row in q])
+    frame = (2.5, 0.3, 0.2, 0.0, 0.0, 3.0)
+    design = lrcal.design(paper, q, 12, method="backward", baseline=50, sensor="pose",
+                          instrument=frame)
+    done = cli("design", "--pool", pool, "--select", "12", "--method", "backward",
+               "--baseline", "50", "--sensor", "pose", "--instrument",
+               ",".join(repr(v) for v in frame), "--format", "json")
+    program = json.loads(done.stdout)
+    assert design.sensor == "pose"
+    assert design.held_at_nominal == program["held_at_nominal"]
+    assert len(design.held_at_nominal) == 7
+    assert design.indices == program["selected"]
+    assert design.efficiency is None
+    with pytest.raises(lrcal.InputError, match="estimate_plane: is the ranger's"):
+        lrcal.design(paper, q, 12, sensor="point", instrument=frame, estimate_plane="offset")
+    with pytest.raises(lrcal.InputError, match="instrument: is a tracker's"):
+        lrcal.design(paper, q, 12, instrument=frame)
