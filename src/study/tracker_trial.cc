@@ -61,8 +61,7 @@ void MapLinkValues(CellContext* c) {
 void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellContext* c) {
   c->pool_stream =
       StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "pool", "truth", "sensor"});
-  c->validation_stream =
-      StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "validation", "pool"});
+  c->validation_stream = ValidationStreamId(c->cell->settings);
   c->selection_seed = s.pool_file.empty() ? study.seed : 0;
   if (!s.truth.random) c->fixed_truth = DrawTruth(*c, 0);
   SamplingOptions o;

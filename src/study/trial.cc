@@ -43,6 +43,10 @@ std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> 
   return Fnv1a(part.dump());
 }
 
+std::uint64_t ValidationStreamId(const Json& settings) {
+  return StreamId(settings, {"robot", "robot_file_fnv1a", "validation", "pool"});
+}
+
 // The truth of a trial: the robot file's errors × scale, or errors drawn per trial.
 TrialTruth DrawTruth(const CellContext& c, long long trial) {
   const CellSettings& s = c.cell->typed;
@@ -232,8 +236,7 @@ TargetedConfigurations UsablePoolFromFile(const Study& study, const CellSettings
 void DrawCellConfigurations(const Study& study, const CellSettings& s, CellContext* c) {
   c->pool_stream =
       StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "plane", "pool", "truth"});
-  c->validation_stream =
-      StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "validation", "pool"});
+  c->validation_stream = ValidationStreamId(c->cell->settings);
   // With the pool from a file, the selection's random draws (sampled, exchange, random) do not
   // depend on the seed: with the validation set from a file too, another seed changes only the
   // noise (and a drawn truth).

@@ -143,6 +143,9 @@ struct CellContext {
 
 /// The stream id of a draw family: a hash of the settings `keys` it depends on.
 std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> keys);
+/// The validation set's stream: a function of the robot, the validation and the pool settings
+/// only, so that cells of every sensor (and noise, selection, ...) judge on the same poses.
+std::uint64_t ValidationStreamId(const Json& settings);
 /// The truth of trial `trial`: the robot file's errors × scale, or errors drawn per trial.
 TrialTruth DrawTruth(const CellContext& c, long long trial);
 /// A study's configuration file (pool.file, validation.file) read for the cell's robot;

@@ -13,6 +13,18 @@ TRACKER = (2.5, 0.3, 0.2, 0.0, 0.0, 3.0)
 TRACKER_ARG = "2.5,0.3,0.2,0,0,3"
 
 
+def write_configurations(path, q, column=None, values=()):
+    """Writes configurations q (N, 6) as the program reads them, exactly (repr), with an optional
+    extra column (socket, plane) of one value per configuration."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([f"q{j + 1}" for j in range(6)] + ([column] if column else []))
+        if column:
+            writer.writerows([[repr(v) for v in row] + [x] for row, x in zip(q, values)])
+        else:
+            writer.writerows([[repr(v) for v in row] for row in q])
+
+
 def test_identifiability_counts_the_slides_and_everetts_terms(paper):
     q = lrcal.sample_configurations(paper, 40, seed=3)
     assert lrcal.identifiability(paper, q).rank == 25
@@ -29,10 +41,7 @@ def test_identifiability_counts_the_slides_and_everetts_terms(paper):
 def test_simulated_values_match_the_program_bit_for_bit_and_calibrate(tmp_path, cli, paper):
     q = lrcal.sample_configurations(paper, 40, seed=3)
     configs = tmp_path / "c.csv"
-    with open(configs, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([f"q{j + 1}" for j in range(6)])
-        writer.writerows([[repr(v) for v in row] for row in q])
+    write_configurations(configs, q)
     cli("simulate", "--sensor", "pose", "--configs", configs, "--instrument", TRACKER_ARG,
         "--sigma-mm", "0.05", "--sigma-mrad", "0.1", "--repetitions", "3", "--seed", "9",
         "--out", tmp_path / "m.csv")
@@ -96,10 +105,7 @@ def test_sockets_simulate_identify_and_judge_as_the_program(tmp_path, cli, paper
     q = lrcal.sample_configurations(paper, 40, seed=3)
     socket_of = [i % 2 for i in range(40)]
     starts = tmp_path / "s.csv"
-    with open(starts, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([f"q{j + 1}" for j in range(6)] + ["socket"])
-        writer.writerows([[repr(v) for v in row] + [s] for row, s in zip(q, socket_of)])
+    write_configurations(starts, q, "socket", socket_of)
     cli("simulate", "--sensor", "socket", "--configs", starts, "--socket", "0.8,0.3,0.4",
         "--socket", "0.8,0.35,0.4", "--sigma-mm", "0.1", "--seed", "4",
         "--out", tmp_path / "seated.csv")
@@ -146,10 +152,7 @@ def test_contacts_simulate_and_identify_as_the_program(tmp_path, cli, paper):
     q = lrcal.sample_configurations(paper, 40, seed=3)
     plane_of = [1 + i % 2 for i in range(40)]
     starts = tmp_path / "s.csv"
-    with open(starts, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([f"q{j + 1}" for j in range(6)] + ["plane"])
-        writer.writerows([[repr(v) for v in row] + [p] for row, p in zip(q, plane_of)])
+    write_configurations(starts, q, "plane", plane_of)
     planes = ["--plane", "0.1,0.2,1,-0.3", "--plane", "1,0,0.2,-0.9"]
     cli("simulate", "--sensor", "contact", "--flush", "--configs", starts, *planes,
         "--sigma-mm", "0.02", "--sigma-mrad", "0.1", "--seed", "4",
@@ -182,11 +185,7 @@ def test_contacts_simulate_and_identify_as_the_program(tmp_path, cli, paper):
     # What the contacts identify, as `lrcal identifiability --sensor contact` says (the seated
     # postures without the flush column for point contacts).
     point_contacts = tmp_path / "point.csv"
-    with open(point_contacts, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([f"q{j + 1}" for j in range(6)] + ["plane"])
-        writer.writerows([[repr(v) for v in row] + [p] for row, p in zip(sim["q"],
-                                                                         sim["plane_of"])])
+    write_configurations(point_contacts, sim["q"], "plane", sim["plane_of"])
     counts = []
     for flush, data in ((False, point_contacts), (True, tmp_path / "contacts.csv")):
         analysis = lrcal.identifiability(paper, sim["q"], sensor="contact", plane=PLANES,
@@ -210,10 +209,7 @@ def test_contacts_simulate_and_identify_as_the_program(tmp_path, cli, paper):
 def test_scanner_simulate_identify_and_identifiability_as_the_program(tmp_path, cli, paper):
     q = lrcal.sample_configurations(paper, 40, seed=3)
     starts = tmp_path / "c.csv"
-    with open(starts, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([f"q{j + 1}" for j in range(6)])
-        writer.writerows([[repr(v) for v in row] for row in q])
+    write_configurations(starts, q)
     frame = (0.03, -0.01, 0.02, 0.1, 0.2, 0.3)
     geometry = ["--sensor", "scanner", "--beams", "5", "--fan-deg", "10",
                 "--scanner", ",".join(repr(v) for v in frame)]
@@ -269,16 +265,12 @@ def test_scanner_geometry_out_of_range_is_an_error_naming_the_argument(paper):
 def test_tracker_design_is_the_programs(tmp_path, cli, paper):
     q = lrcal.sample_configurations(paper, 60, seed=3)
     pool = tmp_path / "c.csv"
-    with open(pool, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([f"q{j + 1}" for j in range(6)])
-        writer.writerows([[repr(v) for v in row] for row in q])
-    frame = (2.5, 0.3, 0.2, 0.0, 0.0, 3.0)
+    write_configurations(pool, q)
     design = lrcal.design(paper, q, 12, method="backward", baseline=50, sensor="pose",
-                          instrument=frame)
+                          instrument=TRACKER)
     done = cli("design", "--pool", pool, "--select", "12", "--method", "backward",
-               "--baseline", "50", "--sensor", "pose", "--instrument",
-               ",".join(repr(v) for v in frame), "--format", "json")
+               "--baseline", "50", "--sensor", "pose", "--instrument", TRACKER_ARG,
+               "--format", "json")
     program = json.loads(done.stdout)
     assert design.sensor == "pose"
     assert design.held_at_nominal == program["held_at_nominal"]
@@ -286,6 +278,6 @@ def test_tracker_design_is_the_programs(tmp_path, cli, paper):
     assert design.indices == program["selected"]
     assert design.efficiency is None
     with pytest.raises(lrcal.InputError, match="estimate_plane: is the ranger's"):
-        lrcal.design(paper, q, 12, sensor="point", instrument=frame, estimate_plane="offset")
+        lrcal.design(paper, q, 12, sensor="point", instrument=TRACKER, estimate_plane="offset")
     with pytest.raises(lrcal.InputError, match="instrument: is a tracker's"):
-        lrcal.design(paper, q, 12, instrument=frame)
+        lrcal.design(paper, q, 12, instrument=TRACKER)
