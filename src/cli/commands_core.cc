@@ -467,6 +467,19 @@ void AddIdentifyOptions(po::options_description& o) {
 
 namespace {
 
+// The start of identify for a kind other than the ranger: the ranger's options refused by name
+// (a kind that reads no plane refuses --plane and --estimate-plane too), and a calibrated robot
+// file that could not be written refused before the fit, not after.
+void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
+  std::vector<std::string> refused = {"estimate-ranger", "estimate-base", "estimate-tool",
+                                      "average",         "predict-at",    "holdout",
+                                      "report"};
+  if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
+  RefuseRangerOptions(vm, sensor, refused);
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+}
+
 // identify --sensor point|pose: the tracker's terms from its measurement file (tracker_data.h).
 // A pose's orientation rows weigh (σ/σ_angle)² per reading against its positions.
 // What every identify of a kind other than the ranger does after its fit (`lrcal identify
@@ -523,12 +536,7 @@ int ReportKindFit(const po::variables_map& vm, const KindFit& f, const Identific
 }
 
 int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
-  RefuseRangerOptions(vm, sensor,
-                      {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
-                       "estimate-tool", "average", "predict-at", "holdout", "report"});
-  // A calibrated robot file that could not be written is refused before the fit, not after.
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  StartKindIdentify(vm, sensor, false);
   const RobotFile rig = LoadRobot(vm);
   const std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
   const std::string file = vm["data"].as<std::string>();
@@ -549,11 +557,7 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
 // identify --sensor socket: the arm's terms, the tool point and the sockets from socket data
 // (socket_data.h); the sockets' nominal positions are the nominal model's mean tool points.
 int SocketIdentify(const po::variables_map& vm) {
-  RefuseRangerOptions(vm, "socket",
-                      {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
-                       "estimate-tool", "average", "predict-at", "holdout", "report"});
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  StartKindIdentify(vm, "socket", false);
   const RobotFile rig = LoadRobot(vm);
   const std::string file = vm["data"].as<std::string>();
   const SocketData data = ReadSocketData(file, rig.robot);
@@ -571,11 +575,7 @@ int SocketIdentify(const po::variables_map& vm) {
 // identify --sensor contact: the arm's terms, the tool point and the planes' estimated terms
 // from contact data (contact_data.h); a flush contact's tilt rows weigh (σ/σ_angle)².
 int ContactIdentify(const po::variables_map& vm) {
-  RefuseRangerOptions(vm, "contact",
-                      {"estimate-ranger", "estimate-base", "estimate-tool", "average", "predict-at",
-                       "holdout", "report"});
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  StartKindIdentify(vm, "contact", true);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const std::string file = vm["data"].as<std::string>();
@@ -598,11 +598,7 @@ int ContactIdentify(const po::variables_map& vm) {
 // identify --sensor scanner: the arm's terms, the scanner's frame and the planes' estimated terms
 // from scanner data (scanner_data.h).
 int ScannerIdentify(const po::variables_map& vm) {
-  RefuseRangerOptions(vm, "scanner",
-                      {"estimate-ranger", "estimate-base", "estimate-tool", "average", "predict-at",
-                       "holdout", "report"});
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  StartKindIdentify(vm, "scanner", true);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const std::string file = vm["data"].as<std::string>();
