@@ -255,6 +255,27 @@ std::string DesignEfficiency(const CellSummary& s) {
          DesignCriterion(Json::parse(s.cell.settings)) + " bound";
 }
 
+// A cell's sensor and its campaign (the sensor section, shown when a study has one): the kind,
+// configurations × readings, and their cost (sensor.cost_per_reading each).
+std::vector<std::string> SensorColumns(const Json& settings) {
+  const Json sensor = settings.value("sensor", Json::object());
+  const int count = settings.value("/selection/count"_json_pointer, 0);
+  const int readings = settings.value("/noise/repetitions"_json_pointer, 1);
+  const double cost = sensor.value("cost_per_reading", 1.0);
+  std::ostringstream campaign;
+  campaign << count * static_cast<double>(readings) * cost;
+  return {sensor.value("kind", std::string("ranger")),
+          std::to_string(count) + " × " + std::to_string(readings), campaign.str()};
+}
+
+// The terms a cell estimates and those it holds at nominal because its configurations cannot
+// separate them (identification.on_rank_deficient: fix).
+std::vector<std::string> TermColumns(const CellSummary& s) {
+  std::string held;
+  for (const std::string& name : s.cell.fixed_for_rank) held += (held.empty() ? "" : " ") + name;
+  return {std::to_string(s.cell.parameter_names.size()), held.empty() ? "—" : held};
+}
+
 Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
   std::vector<std::string> columns = {
       "cell", "id", "trials", "ok", "failed", "sigma_min(G) of the design", "design efficiency"};
@@ -262,6 +283,18 @@ Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
     for (const char* c :
          {"stopped", "worst relative SE of a mean", "worst p95 relative half-width"})
       columns.push_back(c);
+  // Shown only when a cell measures with a sensor section or holds terms, so that the tables of
+  // studies without them stay as they were.
+  bool sensors = false, held = false;
+  for (const auto& s : cells) {
+    sensors = sensors || Json::parse(s.cell.settings).contains("sensor");
+    held = held || !s.cell.fixed_for_rank.empty();
+  }
+  if (sensors)
+    for (const char* c : {"sensor", "configurations × readings", "campaign cost"})
+      columns.push_back(c);
+  if (sensors || held)
+    for (const char* c : {"terms estimated", "held at nominal (rank)"}) columns.push_back(c);
   Table t(columns);
   for (const auto& s : cells) {
     std::string failed;
@@ -282,6 +315,10 @@ Table CellsTable(const std::vector<CellSummary>& cells, const StopWhen& rule) {
                                     DesignEfficiency(s)};
     if (rule.enabled())
       for (auto& c : StopColumns(s)) row.push_back(std::move(c));
+    if (sensors)
+      for (auto& c : SensorColumns(Json::parse(s.cell.settings))) row.push_back(std::move(c));
+    if (sensors || held)
+      for (auto& c : TermColumns(s)) row.push_back(std::move(c));
     t.AddRow(row);
   }
   return t;

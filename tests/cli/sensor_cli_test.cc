@@ -447,3 +447,36 @@ TEST(SensorDesignCli, ATrackersDesignIsChosenAsBlocksAndNamesWhatItHolds) {
 
 }  // namespace
 }  // namespace lrcal
+
+namespace lrcal {
+namespace {
+
+// A study with a sensor section as a user runs it (`lrcal run`): the cells table names each
+// cell's sensor, its campaign (configurations × readings bought by the budget, and their cost),
+// the terms it estimates (the rank analysis: 25 for the ranger, 27 for a reflector, 30 for a
+// probe) and the terms it holds at nominal.
+TEST(SensorStudyCli, TheCellsTableStatesEachSensorsCampaignAndTerms) {
+  const std::string dir = testing::TempDir("sensor_study");
+  std::ofstream(dir + "/s.yaml")
+      << "name: s\nseed: 3\ntrials: 20\nrobot: paper\nnoise: {sigma_mm: 0.1, repetitions: 5}\n"
+         "pool: {size: 60}\nvalidation: {size: 8}\nidentification: {on_rank_deficient: fix}\n"
+         "sensor: {budget: 200, instrument: [2.5, 0.3, 0.2, 0, 0, 3]}\n"
+         "sweep:\n  axes:\n    - key: sensor.kind\n      values: [ranger, point, pose]\n";
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(testing::LrcalBinary() + " run " + dir + "/s.yaml --out " + dir +
+                                    "/run --threads 2",
+                                &out),
+            0)
+      << out;
+  const std::string summary = testing::ReadFile(dir + "/run/tables/summary.md");
+  EXPECT_THAT(summary, ::testing::HasSubstr("| sensor | configurations × readings | campaign "
+                                            "cost | terms estimated | held at nominal (rank) |"));
+  EXPECT_THAT(summary, ::testing::ContainsRegex("\\| ranger \\| 40 × 5 \\| 200 \\| 25 \\| — \\|"));
+  EXPECT_THAT(summary,
+              ::testing::ContainsRegex("\\| point \\| 40 × 5 \\| 200 \\| 27 \\| [a-z0-9_ ]+ \\|"));
+  EXPECT_THAT(summary,
+              ::testing::ContainsRegex("\\| pose \\| 40 × 5 \\| 200 \\| 30 \\| [a-z0-9_ ]+ \\|"));
+}
+
+}  // namespace
+}  // namespace lrcal
