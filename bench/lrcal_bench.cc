@@ -279,8 +279,7 @@ void BM_TrackerTrial(benchmark::State& state) {
                            "\nselection: {count: 100, method: backward}"
                            "\nidentification: {on_rank_deficient: fix}"
                            "\nsensor: {kind: "
-                        << (pose ? "pose" : "point")
-                        << ", instrument: [2.5, 0.3, 0.2, 0, 0, 3]}\n";
+                        << (pose ? "pose" : "point") << ", instrument: [2.5, 0.3, 0.2, 0, 0, 3]}\n";
     f = std::make_unique<Fixture>(path.string());
   }
   const CellContext& c = *f->context;

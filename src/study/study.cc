@@ -70,8 +70,8 @@ const Json& StudyDefaults() {
                        "on_rank_deficient": "fail",
                        "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none",
                        "prior_sigma": "none", "errors_in_variables": false},
-    "sensor": {"kind": "ranger", "instrument": null, "target": [0, 0, 0], "sigma_mrad": 0.2,
-               "cost_per_reading": 1, "budget": null},
+    "sensor": {"kind": "ranger", "instrument": null, "target": [0, 0, 0], "flush": false,
+               "sigma_mrad": 0.2, "cost_per_reading": 1, "budget": null},
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
@@ -593,16 +593,17 @@ RigidTransform SensorFrame(const Json& s, const std::string& key, const KeyLocat
                                     Eigen::Vector3d(x[3], x[4], x[5]));
 }
 
-// A tracker cell: the ranger's settings it cannot take are refused by key, not ignored.
+// A tracker or contact cell: the ranger's settings it cannot take are refused by key, not
+// ignored.
 void RefuseRangerSettings(const Json& s, const KeyLocator& where, const CellSettings& c) {
   const std::string kind = c.sensor.kind;
   const auto refuse = [&](const std::string& key, const std::string& why) {
     throw InputError(where(key), "sensor.kind " + kind + ": " + why);
   };
-  if (Str(s, "identification.estimate_plane", where) != "none")
+  if (kind != "contact" && Str(s, "identification.estimate_plane", where) != "none")
     refuse("identification.estimate_plane", "a tracker reads no plane; expected none");
   if (c.ranger_terms.offset || c.ranger_terms.scale)
-    refuse("identification.estimate_ranger", "a tracker has no ranger; expected none");
+    refuse("identification.estimate_ranger", "it has no ranger; expected none");
   if (c.noise.DisturbsGeometry() || c.noise.outlier_fraction > 0)
     refuse(c.noise.encoder_sigma > 0 ? "noise.encoder_sigma_mrad"
            : c.noise.form_sigma > 0  ? "noise.form_sigma_mm"
@@ -612,7 +613,7 @@ void RefuseRangerSettings(const Json& s, const KeyLocator& where, const CellSett
     refuse("selection.criterion", "the task criterion (I) is the ranger's; expected E, D, A or O*");
   if (c.pool_redraw || c.selection_redraw)
     refuse(c.pool_redraw ? "pool.redraw" : "selection.redraw",
-           "a tracker cell keeps one pool and one design; expected false");
+           "its cell keeps one pool and one design; expected false");
   if (c.coverage) refuse("validation.coverage", "coverage is the ranger's so far; expected false");
   if (!c.identification.priors.empty() || c.identification.encoder_sigma > 0)
     refuse(c.identification.priors.empty() ? "identification.errors_in_variables"
@@ -650,11 +651,12 @@ void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c)
   const Json s = {{"sensor", FullSensorSection(settings)}};
   StudySensor& sensor = c->sensor;
   sensor.kind = Str(s, "sensor.kind", where);
-  if (sensor.kind != "ranger" && sensor.kind != "point" && sensor.kind != "pose")
+  if (sensor.kind != "ranger" && sensor.kind != "point" && sensor.kind != "pose" &&
+      sensor.kind != "contact")
     throw InputError(where("sensor.kind"),
-                     "expected ranger, point or pose, got '" + sensor.kind +
-                         "' (the scanner, contact and socket kinds are the calibration "
-                         "commands' so far, not the studies')");
+                     "expected ranger, point, pose or contact, got '" + sensor.kind +
+                         "' (the scanner and socket kinds are the calibration commands' so far, "
+                         "not the studies')");
   sensor.cost_per_reading = Num(s, "sensor.cost_per_reading", where);
   if (!(sensor.cost_per_reading > 0) || !std::isfinite(sensor.cost_per_reading))
     throw InputError(where("sensor.cost_per_reading"),
@@ -678,8 +680,23 @@ void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c)
   if (!(sigma_mrad >= 0) || !std::isfinite(sigma_mrad))
     throw InputError(where("sensor.sigma_mrad"), "expected a standard deviation ≥ 0 mrad");
   sensor.sigma_angle = sigma_mrad * 1e-3;
+  if (!At(s, "sensor.flush").is_boolean())
+    throw InputError(where("sensor.flush"), "expected true or false");
+  sensor.flush = At(s, "sensor.flush").get<bool>();
+  if (sensor.flush && sensor.kind != "contact")
+    throw InputError(where("sensor.flush"),
+                     "is the contact sensor's; sensor.kind is " + sensor.kind);
   // The ranger takes no instrument or target: a study may set them once and sweep the kind.
   if (sensor.IsRanger()) return;
+  if (sensor.kind == "contact") {  // the tool point touches the cell's planes
+    const RigidTransform point = SensorFrame(s, "sensor.target", where, true);
+    if (!point.rotation.isIdentity(0))
+      throw InputError(where("sensor.target"),
+                       "sensor.kind contact touches with a point: give [x, y, z] (m, tool frame)");
+    sensor.tracker.targets = {point.translation};
+    RefuseRangerSettings(settings, where, *c);
+    return;
+  }
   if (At(s, "sensor.instrument").is_null())
     throw InputError(where("sensor.instrument"),
                      "sensor.kind " + sensor.kind +

@@ -1,12 +1,14 @@
-// The trial pipeline of a tracker cell (sensor.kind point or pose): the ranger's steps
-// (trial_pipeline.h) with the measurement kind of point_measurement.h and pose_measurement.h in
-// place of the ranger's model. Per cell: the pool is drawn over the workspace (a tracker sees its
-// target anywhere: no beam has to hit), the terms the pool cannot separate are fixed or the cell
-// is marked rank deficient, the design is a block selection (block_selection.h: a configuration
-// brings 3 or 6 values), the covariance σ²(GᵀWG)⁻¹ is predicted at the nominal model (W: the
-// repetitions, and (σ/σ_angle)² on a pose's angle rows). Per trial: the tracker on the true arm
-// reads the design (SimulateMeasurements), Identify(kind) fits it, and the identified arm is
-// judged on the validation poses as the ranger's is.
+// The trial pipeline of a tracker cell (sensor.kind point or pose) and of a contact cell: the
+// ranger's steps (trial_pipeline.h) with a measurement kind (point_measurement.h,
+// pose_measurement.h, contact_measurement.h) in place of the ranger's model. Per cell: the pool is
+// drawn over the workspace (a tracker sees its target anywhere: no beam has to hit) or, for
+// contacts, aimed at the planes and seated on the nominal arm; the terms the pool cannot separate
+// are fixed or the cell is marked rank deficient; the design is a block selection
+// (block_selection.h: a configuration brings 1, 3 or 6 values); the covariance σ²(GᵀWG)⁻¹ is
+// predicted at the nominal model (W: the repetitions, and (σ/σ_angle)² on angle rows). Per trial:
+// the tracker on the true arm reads the design (its exact values cached for a fixed truth), or
+// each contact is seated on the true arm with the trial's play; lrcal's LM fits the values on
+// the kind's evaluator; the identified arm is judged on the validation poses as the ranger's is.
 #include <cmath>
 #include <memory>
 #include <string>
@@ -16,6 +18,7 @@
 #include "lrcal/design/block_selection.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/pose_accuracy.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/pose_measurement.h"
 #include "study/trial_pipeline.h"
 
@@ -37,11 +40,19 @@ std::shared_ptr<const RobotModel> ArmWithValues(const RobotModel& robot,
 
 void BuildTrackerKind(const CellSettings& s, CellContext* c) {
   const std::string source = "identification.fix";
-  if (s.sensor.kind == "pose")
+  if (s.sensor.kind == "contact") {
+    ContactSetup setup;
+    setup.planes = c->planes;
+    setup.plane_terms = CellPlaneTerms(s, c->planes.size());
+    setup.tool_point = s.sensor.tracker.targets.at(0);
+    setup.flush = s.sensor.flush;
+    c->contact = std::make_unique<ContactMeasurement>(*c->robot, setup, s.fixed, source);
+    c->kind = c->contact->Without({});
+  } else if (s.sensor.kind == "pose")
     c->tracker = std::make_unique<PoseMeasurement>(*c->robot, s.sensor.tracker, s.fixed, source);
   else
     c->tracker = std::make_unique<PointMeasurement>(*c->robot, s.sensor.tracker, s.fixed, source);
-  c->kind = c->tracker->Without({});
+  if (c->tracker) c->kind = c->tracker->Without({});
   // The arm's link terms alone: the validation poses' Jacobian (ValidationPoseJacobian).
   c->model = std::make_unique<MeasurementModel>(
       *c->robot, c->planes,
@@ -69,7 +80,19 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
   o.min_jacobian_singular_value = s.min_singular_value;
   o.require_beam_hit = false;
   const Plane tag = c->planes[0];  // targets are tagged 0: the one target
-  if (!s.pool_file.empty()) {
+  if (c->contact) {
+    // Starts aimed at their planes (the ranger's pool: the tool faces the plane within reach),
+    // moved until the nominal tool point touches: the design is chosen where contacts are.
+    SamplingOptions aimed = o;
+    aimed.require_beam_hit = true;
+    const TargetedConfigurations starts =
+        !s.pool_file.empty()
+            ? ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, &c->planes)
+            : SampleConfigurations(*c->robot, c->planes, PerPlaneCounts(s, c->planes, s.pool_size),
+                                   RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),
+                                   aimed, &c->pool_report);
+    c->pool = c->contact->LinearisationConfigurations(starts);
+  } else if (!s.pool_file.empty()) {
     c->pool = ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, nullptr);
     c->pool_report.requested = c->pool_report.accepted = c->pool_report.attempts = c->pool.size();
     if (c->pool.size() < s.select_count)
@@ -86,8 +109,9 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
         ReadStudyConfigurations(study, s.validation_file, "validation.file", *c->robot, nullptr);
     return;
   }
+  // The ranger cell's call (the planes' shares, no beam to hit): the same poses.
   c->validation = SampleConfigurations(
-      *c->robot, tag, s.validation_size,
+      *c->robot, c->planes, PerPlaneCounts(s, c->planes, s.validation_size),
       RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), o);
 }
 
@@ -133,7 +157,8 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
       c->rank_deficient ? IdentifiabilityReport{}
                         : AnalyzeIdentifiability(*c->kind, c->design.configs);
   if (!c->rank_deficient && design_report.full_rank()) {
-    // The first linearisation of every trial's fit (the design is the cell's own).
+    // The first linearisation of every tracker trial's fit (the design is the cell's own; a
+    // contact trial's configurations are where the true arm touched, its own each trial).
     c->design_nominal.h.resize(static_cast<std::size_t>(Gd.rows()));
     const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
     c->design_nominal.G = Gd;
@@ -153,6 +178,14 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
 void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
   if (s.truth.random) return;
   c->true_robot = ArmWithValues(*c->robot, c->fixed_truth.values);
+  c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
+  c->nominal_validation =
+      ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
+          .stats;
+  if (c->contact) {
+    c->true_contact = std::make_unique<ContactMeasurement>(*c->true_robot, c->contact->setup());
+    return;
+  }
   c->true_tracker = TrackerKindOn(*c->true_robot, *c->tracker);
   const std::vector<double> zero(static_cast<std::size_t>(c->true_tracker->num_parameters()), 0.0);
   c->design_true_values.resize(static_cast<std::size_t>(c->design.configs.size() *
@@ -160,10 +193,6 @@ void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
   c->true_tracker->Bind(c->design.configs)
       ->Predict(zero.data(), c->design_true_values.data(), nullptr);
   c->design_true_reasons = c->true_tracker->MissReasons(c->design.configs, zero.data());
-  c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
-  c->nominal_validation =
-      ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
-          .stats;
 }
 
 // The noisy values the tracker on the true arm reads at the design (each the mean of the
@@ -175,6 +204,16 @@ void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTru
   noise.draw_mean = true;
   noise.sigma_angle = s.sensor.sigma_angle;
   const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
+  if (c.contact) {  // seated on the true arm with the play of the noise, each trial anew
+    if (!s.truth.random) {
+      SimulateContactMeasurements(*c.true_contact, c.design.configs, noise, stream, values);
+      return;
+    }
+    const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
+    SimulateContactMeasurements(ContactMeasurement(*arm, c.contact->setup()), c.design.configs,
+                                noise, stream, values);
+    return;
+  }
   if (!s.truth.random) {
     AddMeasurementNoise(*c.true_tracker, c.design_true_values, c.design_true_reasons,
                         c.design.configs, noise, stream, values);
@@ -231,14 +270,18 @@ TrackerFit FitTrackerTrial(const CellContext& c, TrialWorkspace* ws) {
     fit.sigma_hat = std::isfinite(summary.sigma_hat) ? summary.sigma_hat : 0.0;
     return fit;
   }
-  if (ws->evaluator_cell != &c) {
+  if (c.contact) {  // the contacts are where the true arm touched: this trial's own
+    ws->evaluator = c.kind->Bind(values.configs);
+    ws->evaluator_cell = nullptr;
+  } else if (ws->evaluator_cell != &c) {
     ws->evaluator = c.kind->Bind(c.design.configs);
     ws->evaluator_cell = &c;
   }
   const int k = c.kind->rows_per_configuration(), n = c.kind->num_parameters();
   const std::vector<double> weights = values.RowWeights(k);
-  const LevenbergMarquardt::Result r = ws->solver.Solve(
-      *ws->evaluator, values.y.data(), weights.data(), options, &ws->e, &c.design_nominal);
+  const LevenbergMarquardt::Result r =
+      ws->solver.Solve(*ws->evaluator, values.y.data(), weights.data(), options, &ws->e,
+                       c.contact ? nullptr : &c.design_nominal);
   fit.termination = r.termination;
   fit.iterations = r.iterations;
   const auto rows = static_cast<int>(values.y.size());
@@ -259,6 +302,9 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
   const CellSettings& s = c.cell->typed;
   MeasuredValues& values = ws->values;
   SimulateTrackerValues(c, trial, truth, &values);
+  rec->missed_configurations = c.design.configs.size() - values.size();
+  if (static_cast<int>(values.y.size()) < c.kind->num_parameters())
+    return TrialStatus::kBeamMissed;  // too few contacts could be seated
   const TrackerFit fit = FitTrackerTrial(c, ws);
   rec->iterations = fit.iterations;
   rec->residual_rms = fit.residual_rms;

@@ -89,8 +89,8 @@ Eigen::MatrixXd CellDesignJacobian(const CellContext& c, const TargetedConfigura
   return DesignJacobian(*c.model, pool, s.scaling, s.truth.angle_sigma, s.truth.length_sigma);
 }
 
-// `total` configurations split over the planes by their shares (largest remainders, ties to the
-// earlier plane), so that every plane gets its part and the parts add up to `total`.
+}  // namespace
+
 std::vector<int> PerPlaneCounts(const CellSettings& s, const PlaneSet& planes, int total) {
   const int np = planes.size();
   std::vector<double> share(np, 1.0);
@@ -110,6 +110,8 @@ std::vector<int> PerPlaneCounts(const CellSettings& s, const PlaneSet& planes, i
   for (int k = 0; given < total; ++k, ++given) ++counts[remainders[k % np].second];
   return counts;
 }
+
+namespace {
 
 TargetedConfigurations SamplePool(const CellContext& c, long long trial,
                                   const Eigen::VectorXd& truth, SamplingReport* report) {
@@ -160,7 +162,7 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
     c->planes = s.planes;
   } else if (file.planes) {
     c->planes = *file.planes;
-  } else if (!s.sensor.IsRanger()) {
+  } else if (s.sensor.kind == "point" || s.sensor.kind == "pose") {
     // A tracker reads no plane: the horizontal plane through the base only tags the sampled
     // configurations and completes the arm's model; nothing is measured on it.
     c->planes = PlaneSet(Plane{});
@@ -169,10 +171,19 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   }
 }
 
-void BuildParameterSet(const CellSettings& s, CellContext* c) {
-  std::vector<PlaneTerms> terms(c->planes.size(), s.plane_terms);
+}  // namespace
+
+std::vector<PlaneTerms> CellPlaneTerms(const CellSettings& s, int num_planes) {
+  std::vector<PlaneTerms> terms(static_cast<std::size_t>(num_planes), s.plane_terms);
   for (std::size_t p = 0; p < s.plane_estimate.size() && p < terms.size(); ++p)
     if (!s.plane_estimate[p].empty()) terms[p] = PlaneTerms::Parse(s.plane_estimate[p], "plane");
+  return terms;
+}
+
+namespace {
+
+void BuildParameterSet(const CellSettings& s, CellContext* c) {
+  const std::vector<PlaneTerms> terms = CellPlaneTerms(s, c->planes.size());
   ParameterSet ps =
       MakeParameterSet(*c->robot, terms, s.fixed, "identification.fix", s.ranger_terms);
   c->model = std::make_unique<MeasurementModel>(*c->robot, c->planes, ps);

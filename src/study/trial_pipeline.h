@@ -34,6 +34,7 @@
 #include "lrcal/identification/prior.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/kinematics/pose_errors.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/point_measurement.h"
 #include "lrcal/study/prepared_cell.h"
 #include "lrcal/study/study.h"
@@ -125,11 +126,14 @@ struct CellContext {
   /// and per estimated term its link value index (-1: the instrument's or the target's). `model`
   /// then holds the arm's link terms only (the validation poses' Jacobian). Null for the ranger.
   std::unique_ptr<PointMeasurement> tracker;
+  /// A contact cell's kind with every term (its truth's template); `kind` as for a tracker.
+  std::unique_ptr<ContactMeasurement> contact;
   std::unique_ptr<MeasurementKind> kind;
   std::vector<int> kind_link_values;
   /// A tracker cell's fixed truth: the true arm and the tracker on it.
   std::shared_ptr<const RobotModel> true_robot;
   std::unique_ptr<PointMeasurement> true_tracker;
+  std::unique_ptr<ContactMeasurement> true_contact;
   /// The fixed truth's exact values at the design and why none misses ("ok"): each trial adds
   /// its noise (AddMeasurementNoise).
   std::vector<double> design_true_values;
@@ -148,6 +152,11 @@ std::uint64_t StreamId(const Json& settings, std::initializer_list<const char*> 
 std::uint64_t ValidationStreamId(const Json& settings);
 /// The truth of trial `trial`: the robot file's errors × scale, or errors drawn per trial.
 TrialTruth DrawTruth(const CellContext& c, long long trial);
+/// `total` configurations split over the planes by the cell's shares (largest remainders, ties
+/// to the earlier plane): every plane gets its part and the parts add up to `total`.
+std::vector<int> PerPlaneCounts(const CellSettings& s, const PlaneSet& planes, int total);
+/// Each plane's estimated terms: identification.estimate_plane, or the plane's own entry.
+std::vector<PlaneTerms> CellPlaneTerms(const CellSettings& s, int num_planes);
 /// A study's configuration file (pool.file, validation.file) read for the cell's robot;
 /// `planes`: a pool's plane column resolved against them (null: configurations only).
 TargetedConfigurations ReadStudyConfigurations(const Study& study, const std::string& file,

@@ -33,11 +33,15 @@ namespace lrcal {
 /// sensor: what a cell's campaign measures with (docs/STUDIES.md, "Sensors"). The ranger is
 /// the paper's set-up and lrcal's default; a tracker's point or pose (point_measurement.h,
 /// pose_measurement.h) reads a target on the tool in an instrument's frame, whose six terms and
-/// the target's are estimated with the arm's.
+/// the target's are estimated with the arm's; a contact (contact_measurement.h) seats a tool point
+/// on the cell's planes and reads nothing.
 struct StudySensor {
-  std::string kind = "ranger";  ///< ranger, point or pose
-  PointSetup tracker;           ///< point, pose: the instrument's frame in B and the one target
-  double sigma_angle = 0;       ///< rad, pose: σ of each orientation component of a reading
+  std::string kind = "ranger";  ///< ranger, point, pose or contact
+  /// point, pose: the instrument's frame in B and the one target; contact: targets[0] is the
+  /// tool point that touches the cell's planes (m, tool frame).
+  PointSetup tracker;
+  bool flush = false;      ///< contact: every contact flush (two more values each)
+  double sigma_angle = 0;  ///< rad, pose: σ of each orientation component of a reading
   /// The campaign cost of one reading, in the study's own unit (sensor.cost_per_reading); a
   /// cell's campaign costs selection.count × noise.repetitions × this.
   double cost_per_reading = 1;
