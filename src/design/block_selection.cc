@@ -14,12 +14,12 @@ namespace lrcal {
 
 namespace {
 
-constexpr double kMinusInf = -std::numeric_limits<double>::infinity();
+constexpr double kNoBlockScore = -std::numeric_limits<double>::infinity();
 
 // The candidates' information blocks B_iᵀB_i and their scoring.
-class Blocks {
+class BlockInformation {
  public:
-  Blocks(const Eigen::MatrixXd& G, int rows, DesignCriterion criterion)
+  BlockInformation(const Eigen::MatrixXd& G, int rows, DesignCriterion criterion)
       : n_(static_cast<int>(G.cols())), criterion_(criterion) {
     const auto N = static_cast<int>(G.rows() / rows);
     info_.reserve(static_cast<std::size_t>(N));
@@ -60,13 +60,13 @@ std::vector<int> RandomBlocks(int N, int k, const RandomStream& stream, std::uin
   return p;
 }
 
-std::vector<int> Backward(const Blocks& b, int k, long long* evaluations) {
+std::vector<int> BackwardBlocks(const BlockInformation& b, int k, long long* evaluations) {
   std::vector<int> design(static_cast<std::size_t>(b.size()));
   std::iota(design.begin(), design.end(), 0);
   Eigen::MatrixXd A = b.Sum(design);
   while (static_cast<int>(design.size()) > k) {
     const int m = static_cast<int>(design.size()) - 1;
-    double best = kMinusInf;
+    double best = kNoBlockScore;
     std::size_t drop = 0;
     for (std::size_t p = 0; p < design.size(); ++p) {
       const double score = b.Score(A - b[design[p]], m, evaluations);
@@ -88,7 +88,7 @@ double RidgedLogDet(const Eigen::MatrixXd& A, double ridge, long long* evaluatio
   return (eig.eigenvalues().array().max(0.0) + ridge).log().sum();
 }
 
-std::vector<int> Forward(const Blocks& b, int k, long long* evaluations) {
+std::vector<int> ForwardBlocks(const BlockInformation& b, int k, long long* evaluations) {
   const int N = b.size(), n = b.num_parameters();
   std::vector<int> all(static_cast<std::size_t>(N));
   std::iota(all.begin(), all.end(), 0);
@@ -99,7 +99,7 @@ std::vector<int> Forward(const Blocks& b, int k, long long* evaluations) {
   bool singular = true;
   while (static_cast<int>(design.size()) < k) {
     const int m = static_cast<int>(design.size()) + 1;
-    double best = kMinusInf;
+    double best = kNoBlockScore;
     int add = -1;
     for (int i = 0; i < N; ++i) {
       if (in[static_cast<std::size_t>(i)]) continue;
@@ -124,7 +124,8 @@ std::vector<int> Forward(const Blocks& b, int k, long long* evaluations) {
 }
 
 // Best single swaps from `design` until none raises the score by more than 1e-12 (relative).
-std::vector<int> Exchange(const Blocks& b, std::vector<int> design, long long* evaluations) {
+std::vector<int> ExchangeBlocks(const BlockInformation& b, std::vector<int> design,
+                                long long* evaluations) {
   const int N = b.size(), k = static_cast<int>(design.size());
   Eigen::MatrixXd A = b.Sum(design);
   double current = b.Score(A, k, evaluations);
@@ -178,10 +179,10 @@ SelectionResult SelectBlocks(const Eigen::MatrixXd& G, int rows_per_configuratio
   if (rows_per_configuration == 1) return SelectConfigurations(G, k, options, stream);
   options.Validate();
   CheckBlockSelection(G, rows_per_configuration, k);
-  const Blocks blocks(G, rows_per_configuration, options.criterion);
+  const BlockInformation blocks(G, rows_per_configuration, options.criterion);
   const int N = blocks.size();
   SelectionResult out;
-  out.score = kMinusInf;
+  out.score = kNoBlockScore;
   switch (options.method) {
     case SelectionMethod::kRandom:
       out.indices = RandomBlocks(N, k, stream, 0);
@@ -199,15 +200,15 @@ SelectionResult SelectBlocks(const Eigen::MatrixXd& G, int rows_per_configuratio
       }
       break;
     case SelectionMethod::kGreedy:
-      out.indices = Forward(blocks, k, &out.evaluations);
+      out.indices = ForwardBlocks(blocks, k, &out.evaluations);
       break;
     case SelectionMethod::kBackward:
-      out.indices = Backward(blocks, k, &out.evaluations);
+      out.indices = BackwardBlocks(blocks, k, &out.evaluations);
       break;
     case SelectionMethod::kExchange: {
-      std::vector<int> start = Backward(blocks, k, &out.evaluations);
+      std::vector<int> start = BackwardBlocks(blocks, k, &out.evaluations);
       out.start_score = CriterionScore(blocks.Sum(start), k, options.criterion);
-      out.indices = Exchange(blocks, std::move(start), &out.evaluations);
+      out.indices = ExchangeBlocks(blocks, std::move(start), &out.evaluations);
       break;
     }
     case SelectionMethod::kExhaustive:

@@ -130,7 +130,7 @@ void CheckTrackerIdentifiability(const CellSettings& s, CellContext* c) {
 }
 
 // Each measured value's weight: the effective readings, times (σ/σ_angle)² on an angle row.
-Eigen::VectorXd RowWeights(const CellSettings& s, const MeasurementKind& kind, int m) {
+Eigen::VectorXd TrackerRowWeights(const CellSettings& s, const MeasurementKind& kind, int m) {
   const int k = kind.rows_per_configuration();
   Eigen::VectorXd w(static_cast<Eigen::Index>(m) * k);
   const double ratio = s.noise.sigma / s.sensor.sigma_angle;
@@ -164,7 +164,7 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
     c->design_nominal.G = Gd;
     c->kind->Bind(c->design.configs)->Predict(zero.data(), c->design_nominal.h.data(), nullptr);
     c->design_nominal.Factorize();
-    const Eigen::VectorXd w = RowWeights(s, *c->kind, m);
+    const Eigen::VectorXd w = TrackerRowWeights(s, *c->kind, m);
     c->predicted_covariance =
         ParameterCovariance(Gd.transpose() * w.asDiagonal() * Gd, s.noise.sigma);
     c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();

@@ -19,10 +19,10 @@ namespace {
 using ::testing::ElementsAreArray;
 using ::testing::HasSubstr;
 
-constexpr int kRows = 3;  // a tracker's point
+constexpr int kBlockRows = 3;  // a tracker's point
 constexpr double kScoreTolerance = 1e-12;
 
-Eigen::MatrixXd RandomMatrix(int rows, int cols, unsigned seed) {
+Eigen::MatrixXd RandomBlockMatrix(int rows, int cols, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal;  // test data only
   Eigen::MatrixXd G(rows, cols);
@@ -33,10 +33,10 @@ Eigen::MatrixXd RandomMatrix(int rows, int cols, unsigned seed) {
 
 // E-criterion score of the chosen blocks, computed here from the stacked rows themselves.
 double StackedScore(const Eigen::MatrixXd& G, const std::vector<int>& chosen) {
-  Eigen::MatrixXd S(static_cast<Eigen::Index>(chosen.size()) * kRows, G.cols());
+  Eigen::MatrixXd S(static_cast<Eigen::Index>(chosen.size()) * kBlockRows, G.cols());
   for (std::size_t t = 0; t < chosen.size(); ++t)
-    S.middleRows(static_cast<Eigen::Index>(t) * kRows, kRows) =
-        G.middleRows(chosen[t] * kRows, kRows);
+    S.middleRows(static_cast<Eigen::Index>(t) * kBlockRows, kBlockRows) =
+        G.middleRows(chosen[t] * kBlockRows, kBlockRows);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S.transpose() * S);
   return std::sqrt(eig.eigenvalues()[0]);
 }
@@ -54,7 +54,7 @@ double BruteForceBest(const Eigen::MatrixXd& G, int N, int k) {
   return best;
 }
 
-SelectionOptions Method(SelectionMethod method) {
+SelectionOptions BlockMethod(SelectionMethod method) {
   SelectionOptions o;
   o.criterion = DesignCriterion::kE;
   o.method = method;
@@ -64,7 +64,7 @@ SelectionOptions Method(SelectionMethod method) {
 
 TEST(SelectBlocks, EveryMethodScoresItsChoiceAndNoneBeatsTheBruteForce) {
   constexpr int N = 12, n = 5, k = 4;
-  const Eigen::MatrixXd G = RandomMatrix(N * kRows, n, 7);
+  const Eigen::MatrixXd G = RandomBlockMatrix(N * kBlockRows, n, 7);
   const double best = BruteForceBest(G, N, k);
   const RandomStream stream(3, 1, 0, RandomPurpose::kSelection);
   double backward = 0;
@@ -72,7 +72,7 @@ TEST(SelectBlocks, EveryMethodScoresItsChoiceAndNoneBeatsTheBruteForce) {
        {SelectionMethod::kRandom, SelectionMethod::kSampled, SelectionMethod::kGreedy,
         SelectionMethod::kBackward, SelectionMethod::kExchange}) {
     SCOPED_TRACE(SelectionMethodName(m));
-    const SelectionResult r = SelectBlocks(G, kRows, k, Method(m), stream);
+    const SelectionResult r = SelectBlocks(G, kBlockRows, k, BlockMethod(m), stream);
     ASSERT_EQ(r.indices.size(), static_cast<std::size_t>(k));
     EXPECT_TRUE(std::is_sorted(r.indices.begin(), r.indices.end()));
     EXPECT_NEAR(r.score, StackedScore(G, r.indices), kScoreTolerance);
@@ -90,8 +90,8 @@ TEST(SelectBlocks, EveryMethodScoresItsChoiceAndNoneBeatsTheBruteForce) {
 
 TEST(SelectBlocks, TheExchangesEndIsALocalOptimum) {
   constexpr int N = 14, n = 6, k = 5;
-  const Eigen::MatrixXd G = RandomMatrix(N * kRows, n, 11);
-  const SelectionResult r = SelectBlocks(G, kRows, k, Method(SelectionMethod::kExchange),
+  const Eigen::MatrixXd G = RandomBlockMatrix(N * kBlockRows, n, 11);
+  const SelectionResult r = SelectBlocks(G, kBlockRows, k, BlockMethod(SelectionMethod::kExchange),
                                          RandomStream(1, 1, 0, RandomPurpose::kSelection));
   for (int p = 0; p < k; ++p)
     for (int j = 0; j < N; ++j) {
@@ -106,42 +106,43 @@ TEST(SelectBlocks, GreedyReachesFullRankFromTooFewValuesPerBlock) {
   // Blocks of three values, six parameters: two blocks can be enough, the greedy must find a pair
   // that is (the ridge phase), then go on by the criterion.
   constexpr int N = 10, n = 6, k = 3;
-  const Eigen::MatrixXd G = RandomMatrix(N * kRows, n, 5);
-  const SelectionResult r = SelectBlocks(G, kRows, k, Method(SelectionMethod::kGreedy),
+  const Eigen::MatrixXd G = RandomBlockMatrix(N * kBlockRows, n, 5);
+  const SelectionResult r = SelectBlocks(G, kBlockRows, k, BlockMethod(SelectionMethod::kGreedy),
                                          RandomStream(1, 1, 0, RandomPurpose::kSelection));
   EXPECT_GT(r.score, 0);
 }
 
 TEST(SelectBlocks, OneValuePerConfigurationIsTheRangersSelection) {
-  const Eigen::MatrixXd G = RandomMatrix(30, 5, 2);
+  const Eigen::MatrixXd G = RandomBlockMatrix(30, 5, 2);
   const RandomStream stream(9, 1, 0, RandomPurpose::kSelection);
   for (SelectionMethod m :
        {SelectionMethod::kBackward, SelectionMethod::kExchange, SelectionMethod::kSampled}) {
-    const SelectionResult a = SelectBlocks(G, 1, 8, Method(m), stream);
-    const SelectionResult b = SelectConfigurations(G, 8, Method(m), stream);
+    const SelectionResult a = SelectBlocks(G, 1, 8, BlockMethod(m), stream);
+    const SelectionResult b = SelectConfigurations(G, 8, BlockMethod(m), stream);
     EXPECT_THAT(a.indices, ElementsAreArray(b.indices));
     EXPECT_EQ(a.score, b.score);
   }
 }
 
 TEST(SelectBlocks, RefusesWhatItCannotChoose) {
-  const Eigen::MatrixXd G = RandomMatrix(12 * kRows, 5, 1);
+  const Eigen::MatrixXd G = RandomBlockMatrix(12 * kBlockRows, 5, 1);
   const RandomStream stream(1, 1, 0, RandomPurpose::kSelection);
   const auto message = [&](int rows, int k, SelectionMethod m, const Eigen::MatrixXd& g) {
     try {
-      SelectBlocks(g, rows, k, Method(m), stream);
+      SelectBlocks(g, rows, k, BlockMethod(m), stream);
     } catch (const InputError& e) {
       return std::string(e.what());
     }
     return std::string("no error");
   };
-  EXPECT_THAT(message(kRows, 4, SelectionMethod::kExhaustive, G),
+  EXPECT_THAT(message(kBlockRows, 4, SelectionMethod::kExhaustive, G),
               HasSubstr("for 3 values per configuration use backward"));
-  EXPECT_THAT(message(kRows, 13, SelectionMethod::kBackward, G), HasSubstr("cannot select 13"));
-  EXPECT_THAT(message(kRows, 1, SelectionMethod::kBackward, G),
+  EXPECT_THAT(message(kBlockRows, 13, SelectionMethod::kBackward, G),
+              HasSubstr("cannot select 13"));
+  EXPECT_THAT(message(kBlockRows, 1, SelectionMethod::kBackward, G),
               HasSubstr("need at least as many values as parameters"));
   EXPECT_THAT(message(5, 4, SelectionMethod::kBackward, G), HasSubstr("not whole configurations"));
-  EXPECT_THAT(message(kRows, 1, SelectionMethod::kBackward, Eigen::MatrixXd(0, 5)),
+  EXPECT_THAT(message(kBlockRows, 1, SelectionMethod::kBackward, Eigen::MatrixXd(0, 5)),
               HasSubstr("empty"));
 }
 

@@ -39,8 +39,8 @@ std::string RobotSeenByATracker(const std::string& dir) {
   return path;
 }
 
-std::string WriteStudy(const std::string& name, const std::string& robot, const std::string& body,
-                       int trials = 3) {
+std::string WriteTrackerStudy(const std::string& name, const std::string& robot,
+                              const std::string& body, int trials = 3) {
   const std::string path = testing::TempDir("tracker_study_" + name) + "/s.yaml";
   std::ofstream(path) << "name: s\nseed: 5\ntrials: " << trials << "\nrobot: " << robot << "\n"
                       << "pool: {size: 60}\nvalidation: {size: 10}\n"
@@ -49,9 +49,9 @@ std::string WriteStudy(const std::string& name, const std::string& robot, const 
   return path;
 }
 
-std::string LoadError(const std::string& name, const std::string& body) {
+std::string TrackerStudyError(const std::string& name, const std::string& body) {
   try {
-    LoadStudy(WriteStudy(name, "paper", body));
+    LoadStudy(WriteTrackerStudy(name, "paper", body));
   } catch (const InputError& e) {
     return e.what();
   }
@@ -65,7 +65,7 @@ TEST(TrackerStudy, ATrackerCellRecoversATruthItCanSeeToWithinItsNoise) {
   const std::string robot = RobotSeenByATracker(dir);
   for (const char* kind : {"point", "pose"}) {
     SCOPED_TRACE(kind);
-    const Study study = LoadStudy(WriteStudy(
+    const Study study = LoadStudy(WriteTrackerStudy(
         std::string("truth_") + kind, robot,
         "noise: {sigma_mm: 1e-9, repetitions: 1}\nselection: {count: 30}\nsensor: {kind: " +
             std::string(kind) + ", sigma_mrad: 1e-9, " + kTracker + "}\n"));
@@ -95,7 +95,7 @@ TEST(TrackerStudy, ThePredictedCovarianceHoldsOverTheTrials) {
                                                        {"flush", "contact, flush: true"}};
   for (const auto& [name, kind] : kinds) {
     SCOPED_TRACE(name);
-    const Study study = LoadStudy(WriteStudy(
+    const Study study = LoadStudy(WriteTrackerStudy(
         std::string("coverage_") + name, "paper",
         "truth: {scale: 0}\nnoise: {sigma_mm: 0.05, repetitions: 4}\nselection: {count: 30}\n"
         "sensor: {kind: " +
@@ -126,7 +126,7 @@ TEST(TrackerStudy, TheTrialsLeanFitIsIdentifysFit) {
   constexpr double kSameEstimate = 1e-10;
   for (const char* kind : {"point", "pose"}) {
     SCOPED_TRACE(kind);
-    const Study study = LoadStudy(WriteStudy(
+    const Study study = LoadStudy(WriteTrackerStudy(
         std::string("lean_") + kind, "paper",
         "noise: {sigma_mm: 0.05, repetitions: 4}\nselection: {count: 30}\nsensor: {kind: " +
             std::string(kind) + ", sigma_mrad: 0.3, " + kTracker + "}\n"));
@@ -148,12 +148,12 @@ TEST(TrackerStudy, TheTrialsLeanFitIsIdentifysFit) {
 
 TEST(TrackerStudy, TheBudgetBuysTheCountAndSensorsShareTheirValidationPoses) {
   const Study study = LoadStudy(
-      WriteStudy("budget", "paper",
-                 "noise: {repetitions: 5}\nsensor: {budget: 200, " + std::string(kTracker) +
-                     "}\nsweep:\n  axes:\n    - key: .\n      values:\n"
-                     "        - {sensor: {kind: ranger}}\n"
-                     "        - {sensor: {kind: point, cost_per_reading: 2}}\n"
-                     "        - {sensor: {kind: pose, cost_per_reading: 4}}\n"));
+      WriteTrackerStudy("budget", "paper",
+                        "noise: {repetitions: 5}\nsensor: {budget: 200, " + std::string(kTracker) +
+                            "}\nsweep:\n  axes:\n    - key: .\n      values:\n"
+                            "        - {sensor: {kind: ranger}}\n"
+                            "        - {sensor: {kind: point, cost_per_reading: 2}}\n"
+                            "        - {sensor: {kind: pose, cost_per_reading: 4}}\n"));
   ASSERT_EQ(study.cells.size(), 3u);
   const int expected[] = {40, 20, 10};  // ⌊200 / (cost × 5)⌋
   for (std::size_t i = 0; i < 3; ++i) {
@@ -171,54 +171,57 @@ TEST(TrackerStudy, TheBudgetBuysTheCountAndSensorsShareTheirValidationPoses) {
 TEST(TrackerStudy, TheRangersCellsKeepTheirNames) {
   // A study without a sensor section and the same study with the ranger's defaults spelled out
   // have the same cell: the section is left out of the identity at its defaults.
-  const Study plain = LoadStudy(WriteStudy("plain", "paper", ""));
-  const Study spelled = LoadStudy(WriteStudy(
+  const Study plain = LoadStudy(WriteTrackerStudy("plain", "paper", ""));
+  const Study spelled = LoadStudy(WriteTrackerStudy(
       "spelled", "paper", "sensor: {kind: ranger, cost_per_reading: 1, sigma_mrad: 0.2}\n"));
   EXPECT_EQ(plain.cells.at(0).id, spelled.cells.at(0).id);
   EXPECT_FALSE(CellIdentity(plain.cells.at(0).settings).contains("sensor"));
 }
 
 TEST(TrackerStudy, BadSensorSettingsAreErrorsAtTheirLine) {
-  EXPECT_THAT(LoadError("kind", "sensor: {kind: sonar}\n"),
+  EXPECT_THAT(TrackerStudyError("kind", "sensor: {kind: sonar}\n"),
               AllOf(HasSubstr("s.yaml:8 key 'sensor.kind'"),
                     HasSubstr("expected ranger, point, pose or contact")));
   EXPECT_THAT(
-      LoadError("no_instrument", "sensor: {kind: point}\n"),
+      TrackerStudyError("no_instrument", "sensor: {kind: point}\n"),
       AllOf(HasSubstr("key 'sensor.instrument'"), HasSubstr("[x, y, z, roll, pitch, yaw]")));
-  EXPECT_THAT(LoadError("short_instrument", "sensor: {kind: pose, instrument: [1, 2, 3]}\n"),
-              AllOf(HasSubstr("key 'sensor.instrument'"), HasSubstr("got [1,2,3]")));
-  EXPECT_THAT(LoadError("point_orientation", "sensor: {kind: point, " + std::string(kTracker) +
+  EXPECT_THAT(
+      TrackerStudyError("short_instrument", "sensor: {kind: pose, instrument: [1, 2, 3]}\n"),
+      AllOf(HasSubstr("key 'sensor.instrument'"), HasSubstr("got [1,2,3]")));
+  EXPECT_THAT(
+      TrackerStudyError("point_orientation", "sensor: {kind: point, " + std::string(kTracker) +
                                                  ", target: [0, 0, 0, 0.1, 0, 0]}\n"),
-              AllOf(HasSubstr("key 'sensor.target'"), HasSubstr("positions only")));
-  EXPECT_THAT(LoadError("cost", "sensor: {cost_per_reading: 0}\n"),
+      AllOf(HasSubstr("key 'sensor.target'"), HasSubstr("positions only")));
+  EXPECT_THAT(TrackerStudyError("cost", "sensor: {cost_per_reading: 0}\n"),
               AllOf(HasSubstr("key 'sensor.cost_per_reading'"), HasSubstr("expected a cost > 0")));
-  EXPECT_THAT(LoadError("small_budget", "noise: {repetitions: 10}\nsensor: {budget: 5}\n"),
+  EXPECT_THAT(TrackerStudyError("small_budget", "noise: {repetitions: 10}\nsensor: {budget: 5}\n"),
               AllOf(HasSubstr("key 'sensor.budget'"), HasSubstr("at least one configuration")));
-  EXPECT_THAT(LoadError("large_budget", "sensor: {budget: 1e6}\n"),
+  EXPECT_THAT(TrackerStudyError("large_budget", "sensor: {budget: 1e6}\n"),
               AllOf(HasSubstr("key 'sensor.budget'"), HasSubstr("more than pool.size = 60")));
   const std::string tracker = "sensor: {kind: point, " + std::string(kTracker) + "}\n";
   const auto swept = [](const std::string& key, const std::string& value) {
     return "sweep:\n  axes:\n    - key: " + key + "\n      values: [" + value + "]\n";
   };
-  EXPECT_THAT(LoadError("plane", tracker + swept("identification.estimate_plane", "offset")),
-              AllOf(HasSubstr("key 'identification.estimate_plane'"),
-                    HasSubstr("sensor.kind point: a tracker reads no plane")));
-  EXPECT_THAT(LoadError("coverage", tracker + swept("validation.coverage", "true")),
+  EXPECT_THAT(
+      TrackerStudyError("plane", tracker + swept("identification.estimate_plane", "offset")),
+      AllOf(HasSubstr("key 'identification.estimate_plane'"),
+            HasSubstr("sensor.kind point: a tracker reads no plane")));
+  EXPECT_THAT(TrackerStudyError("coverage", tracker + swept("validation.coverage", "true")),
               AllOf(HasSubstr("s.yaml:12"), HasSubstr("key 'validation.coverage'"),
                     HasSubstr("sensor.kind point")));
-  EXPECT_THAT(LoadError("encoder", tracker + "noise: {encoder_sigma_mrad: 0.1}\n"),
+  EXPECT_THAT(TrackerStudyError("encoder", tracker + "noise: {encoder_sigma_mrad: 0.1}\n"),
               AllOf(HasSubstr("key 'noise.encoder_sigma_mrad'"), HasSubstr("ranger only")));
-  EXPECT_THAT(LoadError("task", tracker + "selection: {criterion: I}\n"),
+  EXPECT_THAT(TrackerStudyError("task", tracker + "selection: {criterion: I}\n"),
               HasSubstr("key 'selection.criterion'"));
-  EXPECT_THAT(
-      LoadError("flush", "sensor: {kind: point, flush: true, " + std::string(kTracker) + "}\n"),
-      AllOf(HasSubstr("key 'sensor.flush'"), HasSubstr("is the contact sensor's")));
-  EXPECT_THAT(LoadError("contact_orientation",
-                        "sensor: {kind: contact, target: [0, 0, 0.05, 0.1, 0, 0]}\n"),
+  EXPECT_THAT(TrackerStudyError(
+                  "flush", "sensor: {kind: point, flush: true, " + std::string(kTracker) + "}\n"),
+              AllOf(HasSubstr("key 'sensor.flush'"), HasSubstr("is the contact sensor's")));
+  EXPECT_THAT(TrackerStudyError("contact_orientation",
+                                "sensor: {kind: contact, target: [0, 0, 0.05, 0.1, 0, 0]}\n"),
               AllOf(HasSubstr("key 'sensor.target'"), HasSubstr("touches with a point")));
-  EXPECT_EQ(LoadError("contact_plane",
-                      "sensor: {kind: contact}\nsweep:\n  axes:\n    - key: "
-                      "identification.estimate_plane\n      values: [offset]\n"),
+  EXPECT_EQ(TrackerStudyError("contact_plane",
+                              "sensor: {kind: contact}\nsweep:\n  axes:\n    - key: "
+                              "identification.estimate_plane\n      values: [offset]\n"),
             "no error");  // a contact estimates its planes' terms as the ranger does
 }
 
