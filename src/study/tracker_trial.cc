@@ -74,7 +74,6 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
       StreamId(c->cell->settings, {"robot", "robot_file_fnv1a", "pool", "truth", "sensor"});
   c->validation_stream = ValidationStreamId(c->cell->settings);
   c->selection_seed = s.pool_file.empty() ? study.seed : 0;
-  if (!s.truth.random) c->fixed_truth = DrawTruth(*c, 0);
   SamplingOptions o;
   o.ranger = c->ranger;
   o.min_jacobian_singular_value = s.min_singular_value;
@@ -151,7 +150,11 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
   c->design.configs = c->pool.Subset(c->design.slots);
   c->design_efficiency = std::nan("");  // no certificate for blocks
   const int n = c->kind->num_parameters(), m = c->design.configs.size();
-  const Eigen::MatrixXd Gd = MeasurementJacobian(*c->kind, c->design.configs);
+  // The design's values and Jacobian at the nominal model, from one evaluation.
+  const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
+  std::vector<double> h(static_cast<std::size_t>(m * c->kind->rows_per_configuration()));
+  Eigen::MatrixXd Gd(static_cast<Eigen::Index>(h.size()), n);
+  c->kind->Bind(c->design.configs)->Predict(zero.data(), h.data(), Gd.data());
   c->design.sigma_min = CriterionScore(Gd.transpose() * Gd, m, DesignCriterion::kE);
   const IdentifiabilityReport design_report =
       c->rank_deficient ? IdentifiabilityReport{}
@@ -159,11 +162,11 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
   if (!c->rank_deficient && design_report.full_rank()) {
     // The first linearisation of every tracker trial's fit (the design is the cell's own; a
     // contact trial's configurations are where the true arm touched, its own each trial).
-    c->design_nominal.h.resize(static_cast<std::size_t>(Gd.rows()));
-    const std::vector<double> zero(static_cast<std::size_t>(n), 0.0);
-    c->design_nominal.G = Gd;
-    c->kind->Bind(c->design.configs)->Predict(zero.data(), c->design_nominal.h.data(), nullptr);
-    c->design_nominal.Factorize();
+    if (!c->contact) {
+      c->design_nominal.h = h;
+      c->design_nominal.G = Gd;
+      c->design_nominal.Factorize();
+    }
     const Eigen::VectorXd w = TrackerRowWeights(s, *c->kind, m);
     c->predicted_covariance =
         ParameterCovariance(Gd.transpose() * w.asDiagonal() * Gd, s.noise.sigma);

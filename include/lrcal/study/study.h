@@ -49,10 +49,6 @@ struct StudySensor {
   /// noise.repetitions)⌋, so that cells of different sensors compare at equal campaign cost.
   std::optional<double> budget;
   bool IsRanger() const { return kind == "ranger"; }
-  /// The campaign's cost: configurations × repetitions × cost_per_reading.
-  double CampaignCost(int configurations, int repetitions) const {
-    return configurations * static_cast<double>(repetitions) * cost_per_reading;
-  }
 };
 
 /// The typed settings of one cell (all SI except where a name says otherwise), parsed from the
