@@ -121,30 +121,6 @@ INSTANTIATE_TEST_SUITE_P(Terms, ContactJacobianTest,
                                                                     "plane2_u1", "plane1_f",
                                                                     "target_y", "theta2"})));
 
-// The kind a campaign reads from when `kind`'s terms are off nominal by `truth`.
-std::unique_ptr<ContactMeasurement> TrueContactKind(const ContactMeasurement& kind,
-                                                    const Eigen::VectorXd& truth,
-                                                    RobotModel* true_robot) {
-  const RobotModel& robot = kind.robot();
-  Truth errors;
-  errors.link_errors = Eigen::VectorXd::Zero(robot.num_values());
-  for (std::size_t c = 0; c < kind.arm().robot_values().size(); ++c)
-    errors.link_errors[kind.arm().robot_values()[c]] = truth[static_cast<Eigen::Index>(c)];
-  *true_robot = errors.TrueRobot(robot);
-  PointMeasurement::State arm;
-  kind.arm().StateAt(truth.data(), &arm);
-  ContactSetup setup = kind.setup();
-  setup.tool_point = arm.targets[0];
-  for (int p = 0; p < setup.planes.size(); ++p) {
-    const ContactMeasurement::PlaneState plane = kind.PlaneAt(truth.data(), p);
-    setup.planes[p].normal = plane.normal;
-    setup.planes[p].offset = plane.offset;
-  }
-  // The true kind measures tilts in the nominal planes' charts, as the data are recorded.
-  auto true_kind = std::make_unique<ContactMeasurement>(*true_robot, setup, kind.fixed());
-  return true_kind;
-}
-
 TEST(ContactMeasurement, ConfigurationsOnPlanesItDoesNotHaveAreRefused) {
   const ContactMeasurement kind(testing::PaperRobot(), TwoPlanes(false));
   TargetedConfigurations third_plane(6);
@@ -217,7 +193,8 @@ TEST(ContactMeasurement, NoiseFreeIdentificationRecoversTheTruth) {
     const auto& kind = dynamic_cast<const ContactMeasurement&>(*reduced);
     const Eigen::VectorXd truth = testing::SomeTruth(kind, 6);
     RobotModel true_robot;
-    const std::unique_ptr<ContactMeasurement> true_kind = TrueContactKind(kind, truth, &true_robot);
+    const std::unique_ptr<ContactMeasurement> true_kind =
+        testing::TrueContactKind(kind, truth, &true_robot);
     MeasuredValues data;
     SimulateContactMeasurements(*true_kind, Starts(160, 8), exact,
                                 RandomStream(1, 0, 0, RandomPurpose::kNoise), &data);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "lrcal/identification/identification.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/point_measurement.h"
 #include "lrcal/measurement/pose_measurement.h"
@@ -90,6 +91,30 @@ inline std::unique_ptr<PointMeasurement> TrueTrackerKind(const PointMeasurement&
     return true_kind;
   }
   return std::make_unique<PointMeasurement>(*true_robot, setup, kind.fixed());
+}
+
+/// The contact kind a campaign reads from when `kind`'s terms are off nominal by `truth` (its
+/// layout): the true arm (`*true_robot`, which must outlive it), tool point and planes; tilts are
+/// measured in the nominal planes' charts, as the data are recorded.
+inline std::unique_ptr<ContactMeasurement> TrueContactKind(const ContactMeasurement& kind,
+                                                           const Eigen::VectorXd& truth,
+                                                           RobotModel* true_robot) {
+  const RobotModel& robot = kind.robot();
+  Truth errors;
+  errors.link_errors = Eigen::VectorXd::Zero(robot.num_values());
+  for (std::size_t c = 0; c < kind.arm().robot_values().size(); ++c)
+    errors.link_errors[kind.arm().robot_values()[c]] = truth[static_cast<Eigen::Index>(c)];
+  *true_robot = errors.TrueRobot(robot);
+  PointMeasurement::State arm;
+  kind.arm().StateAt(truth.data(), &arm);
+  ContactSetup setup = kind.setup();
+  setup.tool_point = arm.targets[0];
+  for (int p = 0; p < setup.planes.size(); ++p) {
+    const ContactMeasurement::PlaneState plane = kind.PlaneAt(truth.data(), p);
+    setup.planes[p].normal = plane.normal;
+    setup.planes[p].offset = plane.offset;
+  }
+  return std::make_unique<ContactMeasurement>(*true_robot, setup, kind.fixed());
 }
 
 /// Every term of `kind` off nominal by 1–3 mm or 1–3 mrad, alternating in sign.
