@@ -102,6 +102,9 @@ void AddSensorOptions(po::options_description& o) {
       "scanner", po::value<std::string>()->default_value("0,0,0,0,0,0"),
       "scanner: its frame in the tool frame as x,y,z,roll,pitch,yaw (m, rad): the beams' origin "
       "(terms target_x..z) and the fan's plane (terms scanner_roll, _pitch, _yaw)");
+  o.add_options()("probe", po::value<std::string>(),
+                  "mixed sensors: the tool point of the contacts or sockets as x,y,z (m, tool "
+                  "frame) when --target is the tracker's (--sensor point,contact)");
   o.add_options()("flush", po::bool_switch(),
                   "contact: every contact is flush (the tool's z axis square to the plane: two "
                   "more values per configuration), where a file has no flush column");
@@ -122,26 +125,51 @@ void AddTrackerGeometryOptions(po::options_description& o) {
       "1); default: one target at the tool frame's origin");
 }
 
+namespace {
+
+bool IsSensorName(const std::string& sensor) {
+  return sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket" ||
+         sensor == "contact" || sensor == "scanner";
+}
+
+}  // namespace
+
+std::vector<std::string> ResolveSensors(const po::variables_map& vm) {
+  const std::string text = vm["sensor"].as<std::string>();
+  const std::vector<std::string> sensors = SplitList(text);
+  if (sensors.empty())
+    throw InputError("--sensor",
+                     "expected ranger, scanner, point, pose, socket or contact, or a "
+                     "list of them (one per --data file)");
+  for (const std::string& sensor : sensors)
+    if (!IsSensorName(sensor))
+      throw InputError("--sensor", "'" + CellExcerpt(sensor) +
+                                       "' is not a sensor lrcal models: expected ranger, scanner, "
+                                       "point, pose, socket or contact");
+  const auto has = [&](const char* kind) {
+    return std::find(sensors.begin(), sensors.end(), kind) != sensors.end();
+  };
+  const std::string named = sensors.size() == 1 ? "--sensor " + sensors[0] : "--sensor " + text;
+  if (!has("scanner"))
+    for (const char* option : {"beams", "fan-deg", "scanner"})
+      if (vm.count(option) && !vm[option].defaulted())
+        throw InputError(std::string("--") + option,
+                         "is the scanner sensor's; " + named + " does not take it");
+  if (!has("contact") && vm.count("flush") && vm["flush"].as<bool>())
+    throw InputError("--flush", "is the contact sensor's; " + named + " does not take it");
+  if (!has("socket") && vm.count("socket-distance"))
+    throw InputError("--socket-distance", "is the socket sensor's; " + named + " does not take it");
+  if (sensors.size() == 1 && vm.count("probe"))
+    throw InputError("--probe",
+                     "is the probe's tip when contacts or sockets are mixed with a "
+                     "tracker; alone, " +
+                         named + " takes its tool point from --target");
+  return sensors;
+}
+
 std::string ResolveSensor(const po::variables_map& vm) {
-  const std::string sensor = vm["sensor"].as<std::string>();
-  if (sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket" ||
-      sensor == "contact" || sensor == "scanner") {
-    if (sensor != "scanner")
-      for (const char* option : {"beams", "fan-deg", "scanner"})
-        if (vm.count(option) && !vm[option].defaulted())
-          throw InputError(std::string("--") + option,
-                           "is the scanner sensor's; --sensor " + sensor + " does not take it");
-    if (sensor != "contact" && vm.count("flush") && vm["flush"].as<bool>())
-      throw InputError("--flush",
-                       "is the contact sensor's; --sensor " + sensor + " does not take it");
-    if (sensor != "socket" && vm.count("socket-distance"))
-      throw InputError("--socket-distance",
-                       "is the socket sensor's; --sensor " + sensor + " does not take it");
-    return sensor;
-  }
-  throw InputError("--sensor", "'" + CellExcerpt(sensor) +
-                                   "' is not a sensor lrcal models: expected ranger, scanner, "
-                                   "point, pose, socket or contact");
+  const std::vector<std::string> sensors = ResolveSensors(vm);
+  return sensors.size() == 1 ? sensors[0] : "mixed";
 }
 
 namespace {
@@ -184,11 +212,21 @@ PointSetup ResolvePointSetup(const po::variables_map& vm) {
   return setup;
 }
 
+namespace {
+
+// --fix as a list, or none in a mixed run (the mixed kind holds them: a name may be another
+// kind's).
+std::vector<std::string> FixedTerms(const po::variables_map& vm, bool in_mix) {
+  if (in_mix || !vm.count("fix")) return {};
+  return SplitList(vm["fix"].as<std::string>());
+}
+
+}  // namespace
+
 std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
                                                   const std::string& sensor,
-                                                  const po::variables_map& vm) {
-  std::vector<std::string> fixed;
-  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+                                                  const po::variables_map& vm, bool in_mix) {
+  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
   PointSetup setup = ResolvePointSetup(vm);
   if (sensor == "pose") return std::make_unique<PoseMeasurement>(robot, setup, fixed, "--fix");
   for (std::size_t k = 0; k < setup.target_orientations.size(); ++k)
@@ -229,8 +267,20 @@ std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) 
 
 namespace {
 
-// The one tool point of --target for a constraint kind (socket, contact).
-Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string& sensor) {
+// The one tool point of --target for a constraint kind (socket, contact); in a mixed run --probe
+// if given, else --target unless a tracker's terms take it.
+Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string& sensor,
+                                 bool in_mix) {
+  if (in_mix && vm.count("probe"))
+    return ParseXyzRpy(vm["probe"].as<std::string>(), "--probe", true).translation;
+  if (in_mix) {
+    const std::vector<std::string> sensors = ResolveSensors(vm);
+    for (const char* tracker : {"point", "pose"})
+      if (std::find(sensors.begin(), sensors.end(), tracker) != sensors.end())
+        throw InputError("--probe", "missing: with --sensor " + vm["sensor"].as<std::string>() +
+                                        " --target is the tracker's; give the " + sensor +
+                                        "s' tool point as --probe x,y,z (m, tool frame)");
+  }
   if (vm.count("instrument") && !vm["instrument"].defaulted())
     throw InputError("--instrument", "--sensor " + sensor +
                                          " has no instrument: the tool touches fixed things "
@@ -246,22 +296,22 @@ Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string&
 }  // namespace
 
 std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, const PlaneSet& planes,
-                                                    bool flush, const po::variables_map& vm) {
+                                                    bool flush, const po::variables_map& vm,
+                                                    bool in_mix) {
   ContactSetup setup;
   setup.planes = planes;
-  setup.tool_point = ResolveToolPoint(vm, "contact");
+  setup.tool_point = ResolveToolPoint(vm, "contact", in_mix);
   setup.flush = flush;
   const PlaneTerms terms = PlaneTerms::Parse(
       vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
   setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);
-  std::vector<std::string> fixed;
-  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
   return std::make_unique<ContactMeasurement>(robot, setup, fixed, "--fix");
 }
 
 std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, const PlaneSet& planes,
                                                     const RangerSpec& range,
-                                                    const po::variables_map& vm) {
+                                                    const po::variables_map& vm, bool in_mix) {
   ScannerSetup setup;
   setup.planes = planes;
   setup.range = range;
@@ -273,16 +323,14 @@ std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, con
   const PlaneTerms terms = PlaneTerms::Parse(
       vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
   setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);
-  std::vector<std::string> fixed;
-  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
   return std::make_unique<ScannerMeasurement>(robot, setup, fixed, "--fix");
 }
 
 std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
-                                                  const po::variables_map& vm) {
-  const Eigen::Vector3d tool_point = ResolveToolPoint(vm, "socket");
-  std::vector<std::string> fixed;
-  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+                                                  const po::variables_map& vm, bool in_mix) {
+  const Eigen::Vector3d tool_point = ResolveToolPoint(vm, "socket", in_mix);
+  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
   return std::make_unique<SocketMeasurement>(
       robot,
       SocketSetupFromData(robot, data.ids, data.values.configs, tool_point,
@@ -307,12 +355,11 @@ double ResolveSigmaAngle(const po::variables_map& vm, bool allow_zero) {
 }
 
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
-                                 int num_planes) {
+                                 int num_planes, bool in_mix) {
   PlaneTerms terms;
   if (vm.count("estimate-plane"))
     terms = PlaneTerms::Parse(vm["estimate-plane"].as<std::string>(), "--estimate-plane");
-  std::vector<std::string> fixed;
-  if (vm.count("fix")) fixed = SplitList(vm["fix"].as<std::string>());
+  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
   RangerTerms ranger;
   if (vm.count("estimate-ranger"))
     ranger = RangerTerms::Parse(vm["estimate-ranger"].as<std::string>(), "--estimate-ranger");

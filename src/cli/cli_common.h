@@ -67,9 +67,10 @@ struct Setup {
 };
 Setup ResolveSetup(const po::variables_map& vm);
 /// --estimate-plane (for every plane), --estimate-ranger, --estimate-base, --estimate-tool and
-/// --fix, for `num_planes` planes.
+/// --fix, for `num_planes` planes. In a mixed run (`in_mix`) --fix is not applied: the mixed
+/// kind holds the named terms (a name may be another kind's).
 ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_map& vm,
-                                 int num_planes = 1);
+                                 int num_planes = 1, bool in_mix = false);
 /// --estimate-base and --estimate-tool (parameter_set.h FrameTerms), read by ResolveParameterSet.
 void AddFrameTermOptions(po::options_description& o);
 
@@ -78,14 +79,21 @@ void AddFrameTermOptions(po::options_description& o);
 void AddSensorOptions(po::options_description& o);
 /// --instrument and --target alone (what `accuracy --measured` registers).
 void AddTrackerGeometryOptions(po::options_description& o);
-/// The --sensor value, checked (InputError naming --sensor and the kinds available).
+/// The --sensor value, checked (InputError naming --sensor and the kinds available), or "mixed"
+/// for a list of kinds (ResolveSensors).
 std::string ResolveSensor(const po::variables_map& vm);
+/// --sensor as a list (point,contact: one kind per --data or --configs file, a mixed run),
+/// checked: each a kind lrcal models, a kind's own options (--flush, --beams, --socket-distance,
+/// ...) only with that kind in the list, --probe only in a mix.
+std::vector<std::string> ResolveSensors(const po::variables_map& vm);
 /// The tracker's nominal geometry from --instrument and --target (InputError naming the option).
 PointSetup ResolvePointSetup(const po::variables_map& vm);
 /// The point or pose kind (`sensor`) on `robot` with --instrument, --target and --fix.
+/// The kinds made here take `in_mix` for a mixed run: --fix is then left to the mixed kind, and
+/// a contact's or socket's tool point is --probe (or --target when no tracker is mixed in).
 std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
                                                   const std::string& sensor,
-                                                  const po::variables_map& vm);
+                                                  const po::variables_map& vm, bool in_mix = false);
 /// --socket-distance A,B=METRES (repeatable): the known distances between sockets.
 std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm);
 /// The socket kind on `robot` for `data` (its socket ids; the sockets' nominal positions are the
@@ -96,14 +104,16 @@ std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm);
 /// --fix. Throws InputError naming the option.
 std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, const PlaneSet& planes,
                                                     const RangerSpec& range,
-                                                    const po::variables_map& vm);
+                                                    const po::variables_map& vm,
+                                                    bool in_mix = false);
 std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
-                                                  const po::variables_map& vm);
+                                                  const po::variables_map& vm, bool in_mix = false);
 /// The contact kind on `robot` and `planes` (--plane or the robot file's), flush or not, with the
 /// tool point from --target (x,y,z, one), the planes' terms from --estimate-plane and --fix.
 /// Refuses --instrument (InputError naming it).
 std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, const PlaneSet& planes,
-                                                    bool flush, const po::variables_map& vm);
+                                                    bool flush, const po::variables_map& vm,
+                                                    bool in_mix = false);
 /// --sigma-mrad: the standard deviation of one reading of a pose's orientation component.
 void AddOrientationNoiseOption(po::options_description& o);
 /// --sigma-mrad in rad (InputError naming it unless finite and > 0, or ≥ 0 with `allow_zero`:

@@ -20,6 +20,7 @@
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
+#include "lrcal/measurement/mixed_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "lrcal/measurement/truth.h"
@@ -29,6 +30,20 @@
 namespace lrcal::cli {
 
 namespace {
+
+// The one file of a repeatable file option (--data, --configs) for a single kind.
+std::string SingleFile(const po::variables_map& vm, const char* option) {
+  const auto& files = vm[option].as<std::vector<std::string>>();
+  if (files.size() != 1)
+    throw InputError(std::string("--") + option,
+                     "given " + std::to_string(files.size()) +
+                         " times: for several files name one kind per file in --sensor "
+                         "(--sensor point,contact --" +
+                         option + " a.csv --" + option + " b.csv)");
+  return files[0];
+}
+
+std::string DataFile(const po::variables_map& vm) { return SingleFile(vm, "data"); }
 
 // --prior (the robot file's tolerances:) and --prior-sigma (over them): the priors to use.
 PriorSigmas ResolvePriors(const po::variables_map& vm, const RobotFile& rig) {
@@ -304,6 +319,11 @@ int SimulateCommand(const std::vector<std::string>& args) {
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const std::string sensor = ResolveSensor(vm);
+  if (sensor == "mixed")
+    throw InputError("--sensor",
+                     "simulate writes one kind's file: run it once per kind, then "
+                     "calibrate from all of them with identify --sensor " +
+                         vm["sensor"].as<std::string>() + " and one --data per kind");
   if (sensor == "socket") return SocketSimulate(vm);
   if (sensor == "contact") return ContactSimulate(vm);
   if (sensor == "scanner") return ScannerSimulate(vm);
@@ -404,8 +424,7 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const RobotFile& rig, const MeasurementModel& model,
                             const MeasurementSet& data, const IdentificationSummary& s,
                             const IdentificationOptions& options, const UnestimatedTerms& held) {
-  CalibrationReportInputs in{
-      DataSource::File(vm["data"].as<std::string>()), &rig, &model, &data, &s, options};
+  CalibrationReportInputs in{DataSource::File(DataFile(vm)), &rig, &model, &data, &s, options};
   in.held = held;
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
   WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
@@ -422,8 +441,10 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
 // identify's options (its settings from the schema are added by the command).
 void AddIdentifyOptions(po::options_description& o) {
   AddCommonOptions(o);
-  o.add_options()("data", po::value<std::string>()->required(),
-                  "measurement CSV (q1..qN, h in m; rows with equal q are averaged)")(
+  o.add_options()("data", po::value<std::vector<std::string>>()->required()->composing(),
+                  "measurement CSV (q1..qN, h in m; rows with equal q are averaged); repeat it "
+                  "with one kind per file in --sensor to calibrate from several kinds at once "
+                  "(--sensor point,contact --data p.csv --data c.csv)")(
       "estimate-ranger", po::value<std::string>()->default_value("none"),
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
@@ -539,7 +560,7 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
   StartKindIdentify(vm, sensor, false);
   const RobotFile rig = LoadRobot(vm);
   const std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
-  const std::string file = vm["data"].as<std::string>();
+  const std::string file = DataFile(vm);
   MeasuredValues data = ReadTrackerMeasurements(file, *kind);
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
   if (sensor == "pose")
@@ -559,7 +580,7 @@ int TrackerIdentify(const po::variables_map& vm, const std::string& sensor) {
 int SocketIdentify(const po::variables_map& vm) {
   StartKindIdentify(vm, "socket", false);
   const RobotFile rig = LoadRobot(vm);
-  const std::string file = vm["data"].as<std::string>();
+  const std::string file = DataFile(vm);
   const SocketData data = ReadSocketData(file, rig.robot);
   const std::unique_ptr<SocketMeasurement> kind = MakeSocketKind(rig.robot, data, vm);
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
@@ -578,7 +599,7 @@ int ContactIdentify(const po::variables_map& vm) {
   StartKindIdentify(vm, "contact", true);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
-  const std::string file = vm["data"].as<std::string>();
+  const std::string file = DataFile(vm);
   ContactData data = ReadContactData(file, rig.robot, setup.planes, vm["flush"].as<bool>());
   const std::unique_ptr<ContactMeasurement> kind =
       MakeContactKind(rig.robot, setup.planes, data.flush, vm);
@@ -601,7 +622,7 @@ int ScannerIdentify(const po::variables_map& vm) {
   StartKindIdentify(vm, "scanner", true);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
-  const std::string file = vm["data"].as<std::string>();
+  const std::string file = DataFile(vm);
   const std::unique_ptr<ScannerMeasurement> kind =
       MakeScannerKind(rig.robot, setup.planes, rig.ranger, vm);
   const MeasuredValues data = ReadScannerData(file, rig.robot, setup.planes, kind->num_beams());
@@ -613,6 +634,212 @@ int ScannerIdentify(const po::variables_map& vm) {
        std::to_string(data.size()) + " scans of " + std::to_string(kind->num_beams()) +
            " beam(s) on " + std::to_string(setup.planes.size()) + " plane(s)"},
       s, options);
+}
+
+// One file of a mixed run (--sensor point,contact --data p.csv --data c.csv): its kind, made
+// without --fix (the mixed kind holds the named terms), and its values.
+struct MixedFile {
+  std::string sensor, file;
+  std::shared_ptr<const MeasurementKind> kind;
+  MeasuredValues values;
+};
+
+// `configs` with zero values: the configurations of an identifiability question.
+MeasuredValues ZeroValues(const MeasurementKind& kind, TargetedConfigurations configs) {
+  MeasuredValues v{std::move(configs), {}, {}};
+  v.y.assign(static_cast<std::size_t>(v.size()) * kind.rows_per_configuration(), 0.0);
+  v.repetitions.assign(static_cast<std::size_t>(v.size()), 1);
+  return v;
+}
+
+// Reads `file` as `sensor`'s data (the same readers and columns as --sensor alone);
+// `configs_only`: the configurations of an identifiability question (a tracker's or ranger's file
+// needs no measured columns).
+MixedFile LoadMixedFile(const po::variables_map& vm, const Setup& setup, const std::string& sensor,
+                        const std::string& file, bool configs_only) {
+  const RobotModel& robot = setup.rig.robot;
+  MixedFile f{sensor, file, nullptr, {}};
+  if (sensor == "point" || sensor == "pose") {
+    std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(robot, sensor, vm, true);
+    f.values =
+        configs_only
+            ? ZeroValues(*kind, ReadRobotTargetConfigurations(
+                                    file, robot, static_cast<int>(kind->setup().targets.size())))
+            : ReadTrackerMeasurements(file, *kind);
+    f.kind = std::move(kind);
+  } else if (sensor == "socket") {
+    const SocketData data = ReadSocketData(file, robot);
+    f.kind = MakeSocketKind(robot, data, vm, true);
+    f.values = data.values;
+  } else if (sensor == "contact") {
+    const ContactData data = ReadContactData(file, robot, setup.planes, vm["flush"].as<bool>());
+    f.kind = MakeContactKind(robot, setup.planes, data.flush, vm, true);
+    f.values = data.values;
+  } else if (sensor == "scanner") {
+    std::unique_ptr<ScannerMeasurement> kind =
+        MakeScannerKind(robot, setup.planes, setup.rig.ranger, vm, true);
+    f.values = configs_only && ReadCsv(file).Column("beam") < 0
+                   ? ZeroValues(*kind, ReadRobotConfigurations(file, robot, &setup.planes))
+                   : ReadScannerData(file, robot, setup.planes, kind->num_beams());
+    f.kind = std::move(kind);
+  } else {
+    auto kind = std::make_shared<RangerMeasurement>(
+        MeasurementModel(robot, setup.planes,
+                         ResolveParameterSet(robot, vm, setup.planes.size(), true)),
+        setup.rig.ranger);
+    f.values = configs_only ? ZeroValues(*kind, ReadRobotConfigurations(file, robot, &setup.planes))
+                            : ToMeasuredValues(ReadRobotMeasurements(
+                                  file, setup.rig, &setup.planes,
+                                  Averaging::Parse(vm["average"].as<std::string>())));
+    f.kind = std::move(kind);
+  }
+  return f;
+}
+
+// The files of a mixed run, one per kind of --sensor, read; the options no kind in the list takes
+// refused by name.
+std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& setup,
+                                      const char* option, bool configs_only) {
+  const std::vector<std::string> sensors = ResolveSensors(vm);
+  const auto& files = vm[option].as<std::vector<std::string>>();
+  if (files.size() != sensors.size())
+    throw InputError(std::string("--") + option,
+                     "given " + std::to_string(files.size()) + " time(s) for the " +
+                         std::to_string(sensors.size()) + " kinds of --sensor " +
+                         vm["sensor"].as<std::string>() + ": expected one file per kind, in order");
+  const auto has = [&](std::initializer_list<const char*> kinds) {
+    for (const char* kind : kinds)
+      if (std::find(sensors.begin(), sensors.end(), kind) != sensors.end()) return true;
+    return false;
+  };
+  std::vector<std::pair<std::string, bool>> refused = {
+      {"predict-at", false},
+      {"holdout", false},
+      {"report", false},
+      {"prior", false},
+      {"prior-sigma", false},
+      {"estimate-ranger", has({"ranger"})},
+      {"average", has({"ranger"})},
+      {"estimate-base", has({"ranger"})},
+      {"estimate-tool", has({"ranger"})},
+      {"plane", has({"ranger", "contact", "scanner"})},
+      {"estimate-plane", has({"ranger", "contact", "scanner"})}};
+  for (const auto& [name, taken] : refused)
+    if (!taken && vm.count(name) && !vm[name].defaulted())
+      throw InputError("--" + name, "is not taken by a calibration from several kinds (--sensor " +
+                                        vm["sensor"].as<std::string>() + ")");
+  std::vector<MixedFile> out;
+  for (std::size_t k = 0; k < files.size(); ++k)
+    out.push_back(LoadMixedFile(vm, setup, sensors[k], files[k], configs_only));
+  return out;
+}
+
+// The mixed kind of `files` (labels: the kind, numbered when a kind repeats) with --fix held.
+std::unique_ptr<MeasurementKind> MakeMixedKind(const po::variables_map& vm,
+                                               const std::vector<MixedFile>& files) {
+  std::vector<MixedPart> parts;
+  std::map<std::string, int> seen, total;
+  for (const MixedFile& f : files) ++total[f.sensor];
+  for (const MixedFile& f : files) {
+    const int n = ++seen[f.sensor];
+    parts.push_back({f.kind, total[f.sensor] > 1 ? f.sensor + std::to_string(n) : f.sensor});
+  }
+  auto mixed = std::make_unique<MixedMeasurement>(std::move(parts));
+  if (!vm.count("fix")) return mixed;
+  const std::vector<std::string> fixed = SplitList(vm["fix"].as<std::string>());
+  for (const std::string& name : fixed)
+    if (std::find(mixed->parameter_names().begin(), mixed->parameter_names().end(), name) ==
+        mixed->parameter_names().end())
+      throw InputError("--fix", "'" + CellExcerpt(name) +
+                                    "' is not a term of this calibration (a kind's own term "
+                                    "shared by name with another kind's is written with its "
+                                    "label: contact.target_x)");
+  return mixed->Without(fixed);
+}
+
+// The parts of a mixed run as JSON and in words.
+Json MixedPartsJson(const MixedMeasurement& kind, const std::vector<MixedFile>& files) {
+  Json parts = Json::array();
+  for (int p = 0; p < kind.num_parts(); ++p) {
+    const MixedFile& f = files[static_cast<std::size_t>(p)];
+    parts.push_back({{"label", kind.part(p).label},
+                     {"sensor", f.sensor},
+                     {"file", f.file},
+                     {"configurations", f.values.size()},
+                     {"values_per_configuration", kind.part(p).kind->rows_per_configuration()},
+                     {"terms", kind.part(p).kind->num_parameters()}});
+  }
+  return parts;
+}
+
+std::string MixedPartsText(const MixedMeasurement& kind, const std::vector<MixedFile>& files) {
+  std::string text;
+  for (int p = 0; p < kind.num_parts(); ++p) {
+    const MixedFile& f = files[static_cast<std::size_t>(p)];
+    text += (p ? "; " : "") + kind.part(p).label + ": " + f.file + ", " +
+            std::to_string(f.values.size()) + " configurations of " +
+            std::to_string(kind.part(p).kind->rows_per_configuration()) + " value(s)";
+  }
+  return text;
+}
+
+// identify --sensor a,b --data A.csv --data B.csv: the terms of every kind, the arm's and the
+// planes' shared (mixed_measurement.h), from all the files at once.
+int MixedIdentify(const po::variables_map& vm) {
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  const Setup setup = ResolveSetup(vm);
+  std::vector<MixedFile> files = LoadMixedFiles(vm, setup, "data", false);
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, setup.rig);
+  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
+  bool angles = false;
+  std::vector<MeasuredValues> values;
+  for (MixedFile& f : files) {
+    if (f.sensor == "pose" || (f.sensor == "contact" && f.kind->rows_per_configuration() > 1)) {
+      WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
+      angles = true;
+    }
+    values.push_back(f.values);
+  }
+  const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, files);
+  const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
+  const MeasuredValues data = mixed.Combine(values);
+  const IdentificationSummary s = Identify(mixed, data, options);
+  std::string sources;
+  for (const MixedFile& f : files) sources += (sources.empty() ? "" : " + ") + f.file;
+  return ReportKindFit(
+      vm,
+      {setup.rig, mixed, data, sources, "mixed",
+       MixedPartsText(mixed, files) + "; one entry per measured value",
+       angles ? "--sigma-mm and --sigma-mrad" : "--sigma-mm",
+       Json{{"parts", MixedPartsJson(mixed, files)}, {"values_per_configuration", nullptr}}},
+      s, options);
+}
+
+// identifiability --sensor a,b --configs A.csv --configs B.csv: the rank of every kind's terms
+// together at their configurations.
+int MixedIdentifiability(const po::variables_map& vm) {
+  const Setup setup = ResolveSetup(vm);
+  const std::vector<MixedFile> files = LoadMixedFiles(vm, setup, "configs", true);
+  std::vector<MeasuredValues> values;
+  for (const MixedFile& f : files) values.push_back(f.values);
+  const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, files);
+  const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  const IdentifiabilityReport r =
+      AnalyzeIdentifiability(mixed, mixed.Combine(values).configs, nullptr, options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentifiabilityJson(r);
+    j["sensor"] = "mixed";
+    j["parts"] = MixedPartsJson(mixed, files);
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "sensor: mixed (" << MixedPartsText(mixed, files)
+              << "; one entry per measured value)\n"
+              << r.ToString();
+  }
+  return 0;
 }
 
 }  // namespace
@@ -627,6 +854,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   const std::string sensor = ResolveSensor(vm);
+  if (sensor == "mixed") return MixedIdentify(vm);
   if (sensor == "socket") return SocketIdentify(vm);
   if (sensor == "contact") return ContactIdentify(vm);
   if (sensor == "scanner") return ScannerIdentify(vm);
@@ -638,14 +866,13 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const PlaneSet& planes = setup.planes;
-  const MeasurementSet data =
-      ReadRobotMeasurements(vm["data"].as<std::string>(), rig, &planes,
-                            Averaging::Parse(vm["average"].as<std::string>()));
+  const MeasurementSet data = ReadRobotMeasurements(
+      DataFile(vm), rig, &planes, Averaging::Parse(vm["average"].as<std::string>()));
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
   const IdentificationSummary s = Identify(model, data, options);
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
-    throw InputError(vm["data"].as<std::string>(), s.message);
+    throw InputError(DataFile(vm), s.message);
 
   const UnestimatedTerms held =
       s.IsSolutionUsable()
@@ -664,8 +891,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
     return 3;
   }
   if (vm.count("write-robot") && s.IsSolutionUsable())
-    WriteRobot(vm["write-robot"].as<std::string>(), vm["data"].as<std::string>(), rig, model, s,
-               options, held);
+    WriteRobot(vm["write-robot"].as<std::string>(), DataFile(vm), rig, model, s, options, held);
   if (vm.count("report"))
     WriteCalibrationReport(vm["report"].as<std::string>(), vm, rig, model, data, s, options, held);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
@@ -700,7 +926,7 @@ int TrackerIdentifiability(const po::variables_map& vm, const std::string& senso
   const RobotFile rig = LoadRobot(vm);
   const std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
   const TargetedConfigurations configs = ReadRobotTargetConfigurations(
-      vm["configs"].as<std::string>(), rig.robot, static_cast<int>(kind->setup().targets.size()));
+      SingleFile(vm, "configs"), rig.robot, static_cast<int>(kind->setup().targets.size()));
   IdentifiabilityOptions options;
   ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
   const IdentifiabilityReport r = AnalyzeIdentifiability(*kind, configs, nullptr, options);
@@ -725,7 +951,7 @@ int SocketIdentifiability(const po::variables_map& vm) {
                       {"plane", "estimate-ranger", "estimate-plane", "estimate-base",
                        "estimate-tool", "prior-sigma", "prior"});
   const RobotFile rig = LoadRobot(vm);
-  const SocketData data = ReadSocketData(vm["configs"].as<std::string>(), rig.robot);
+  const SocketData data = ReadSocketData(SingleFile(vm, "configs"), rig.robot);
   const std::unique_ptr<SocketMeasurement> kind = MakeSocketKind(rig.robot, data, vm);
   IdentifiabilityOptions options;
   ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
@@ -753,8 +979,8 @@ int ContactIdentifiability(const po::variables_map& vm) {
   RefuseRangerOptions(
       vm, "contact", {"estimate-ranger", "estimate-base", "estimate-tool", "prior-sigma", "prior"});
   const Setup setup = ResolveSetup(vm);
-  const ContactData data = ReadContactData(vm["configs"].as<std::string>(), setup.rig.robot,
-                                           setup.planes, vm["flush"].as<bool>());
+  const ContactData data = ReadContactData(SingleFile(vm, "configs"), setup.rig.robot, setup.planes,
+                                           vm["flush"].as<bool>());
   const std::unique_ptr<ContactMeasurement> kind =
       MakeContactKind(setup.rig.robot, setup.planes, data.flush, vm);
   IdentifiabilityOptions options;
@@ -783,7 +1009,7 @@ int ScannerIdentifiability(const po::variables_map& vm) {
   const Setup setup = ResolveSetup(vm);
   const std::unique_ptr<ScannerMeasurement> kind =
       MakeScannerKind(setup.rig.robot, setup.planes, setup.rig.ranger, vm);
-  const std::string file = vm["configs"].as<std::string>();
+  const std::string file = SingleFile(vm, "configs");
   const TargetedConfigurations configs =
       ReadCsv(file).Column("beam") >= 0
           ? ReadScannerData(file, setup.rig.robot, setup.planes, kind->num_beams()).configs
@@ -810,7 +1036,9 @@ int ScannerIdentifiability(const po::variables_map& vm) {
 int IdentifiabilityCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identifiability options");
   AddCommonOptions(o);
-  o.add_options()("configs", po::value<std::string>()->required(), "configurations CSV")(
+  o.add_options()("configs", po::value<std::vector<std::string>>()->required()->composing(),
+                  "configurations CSV; repeat it with one kind per file in --sensor for the "
+                  "terms several kinds identify together (--sensor point,contact)")(
       "estimate-ranger", po::value<std::string>()->default_value("none"),
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
@@ -829,6 +1057,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
   const std::string sensor = ResolveSensor(vm);
+  if (sensor == "mixed") return MixedIdentifiability(vm);
   if (sensor == "socket") return SocketIdentifiability(vm);
   if (sensor == "contact") return ContactIdentifiability(vm);
   if (sensor == "scanner") return ScannerIdentifiability(vm);
@@ -838,7 +1067,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   const RobotModel& robot = rig.robot;
   const PlaneSet& planes = setup.planes;
   const TargetedConfigurations configs =
-      ReadRobotConfigurations(vm["configs"].as<std::string>(), robot, &planes);
+      ReadRobotConfigurations(SingleFile(vm, "configs"), robot, &planes);
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   IdentifiabilityOptions options;
   ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);

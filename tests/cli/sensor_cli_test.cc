@@ -478,5 +478,95 @@ TEST(SensorStudyCli, TheCellsTableStatesEachSensorsCampaignAndTerms) {
               ::testing::ContainsRegex("\\| pose \\| 40 × 5 \\| 200 \\| 30 \\| [a-z0-9_ ]+ \\|"));
 }
 
+// Several kinds at once, as a user meets it: a tracker's reflector and flush plane contacts of the
+// same true arm, each simulated on its own (`simulate --sensor point`, `--sensor contact`), then
+// `identifiability` and `identify --sensor point,contact` with one file per kind: the union sees
+// more than either alone, the flush probe's in-plane offset is named as unseen, and noise-free the
+// fit leaves no residual and finds the true errors (studies/robots/paper.yaml) to 1e-9.
+TEST_F(SensorCli, ATrackerAndPlaneContactsCalibrateTheArmTogether) {
+  std::ifstream in(Path("c.csv"));
+  std::ostringstream tagged;
+  std::string line;
+  std::getline(in, line);
+  tagged << line << ",plane\n";
+  for (int i = 0; std::getline(in, line); ++i) tagged << line << "," << 1 + i % 2 << "\n";
+  std::ofstream(Path("starts.csv")) << tagged.str();
+  const std::string planes = " --plane 0.1,0.2,1,-0.3 --plane 1,0,0.2,-0.9";
+  const std::string tracker = " --instrument 2.5,0.3,0.2,0,0,3";
+  std::string out;
+  ASSERT_EQ(Run("simulate --sensor point --sigma-mm 0 --configs " + Path("c.csv") + tracker +
+                    " --out " + Path("points.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("simulate --sensor contact --flush --sigma-mm 0 --sigma-mrad 0 --target "
+                "0.01,0,0.1 --configs " +
+                    Path("starts.csv") + planes + " --out " + Path("contacts.csv"),
+                &out),
+            0)
+      << out;
+  const std::string both = " --sensor point,contact" + tracker + planes +
+                           " --probe 0.01,0,0.1 --estimate-plane normal,offset --format json";
+  const auto json = [](const std::string& text) {
+    return Json::parse(text.substr(text.find('{'), text.rfind('}') - text.find('{') + 1));
+  };
+  ASSERT_EQ(Run("identifiability" + both + " --configs " + Path("c.csv") + " --configs " +
+                    Path("contacts.csv"),
+                &out),
+            0)
+      << out;
+  const Json analysis = json(out);
+  EXPECT_EQ(analysis["sensor"], "mixed");
+  ASSERT_EQ(analysis["parts"].size(), 2u);
+  EXPECT_EQ(analysis["parts"][1]["sensor"], "contact");
+  EXPECT_EQ(analysis["parts"][1]["values_per_configuration"], 3);
+  // The arm's 25 terms once, the tracker's 6 + 3, the probe's 3, the planes' 6.
+  EXPECT_EQ(analysis["n_params"], 25 + 9 + 3 + 6);
+  const Json points_alone = Identifiability("--sensor point" + tracker);
+  EXPECT_GT(analysis["rank"].get<int>(), points_alone["rank"].get<int>());
+  std::vector<std::string> unseen = analysis["unidentifiable"];
+  EXPECT_THAT(unseen, ::testing::ElementsAre("contact.target_x", "contact.target_y"));
+
+  ASSERT_EQ(Run("identify --auto-fix" + both + " --data " + Path("points.csv") + " --data " +
+                    Path("contacts.csv"),
+                &out),
+            0)
+      << out;
+  const Json fit = json(out);
+  EXPECT_EQ(fit["sensor"], "mixed");
+  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
+  const auto at = [&](const std::string& name) {
+    for (const Json& p : fit["parameters"])
+      if (p["name"] == name) return p["delta"].get<double>();
+    ADD_FAILURE() << name << " not estimated";
+    return 0.0;
+  };
+  constexpr double kExact = 1e-9;  // studies/robots/paper.yaml's true errors, SI
+  EXPECT_NEAR(at("beta2"), 1.45e-3, kExact);
+  EXPECT_NEAR(at("alpha5"), -4.83e-3, kExact);
+  EXPECT_NEAR(at("d4"), 1.35e-3, kExact);
+
+  // What a mixed run refuses, by option.
+  const std::string files = " --data " + Path("points.csv") + " --data " + Path("contacts.csv");
+  EXPECT_EQ(Run("identify --sensor point,contact" + tracker + planes + files, &out), 2);
+  EXPECT_THAT(out, HasSubstr("--probe: missing: with --sensor point,contact --target is the "
+                             "tracker's"));
+  EXPECT_EQ(Run("identify" + both + " --data " + Path("points.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("--data: given 1 time(s) for the 2 kinds of --sensor point,contact"));
+  EXPECT_EQ(Run("identify" + both + files + " --fix target_x", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--fix: 'target_x' is not a term of this calibration"));
+  EXPECT_EQ(Run("identify" + both + files + " --holdout 5", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--holdout: is not taken by a calibration from several kinds"));
+  EXPECT_EQ(Run("identify --sensor point" + tracker + files, &out), 2);
+  EXPECT_THAT(out, HasSubstr("--data: given 2 times"));
+  EXPECT_EQ(
+      Run("simulate --sensor point,contact --configs " + Path("c.csv") + " --out " + Path("x.csv"),
+          &out),
+      2);
+  EXPECT_THAT(out, HasSubstr("simulate writes one kind's file"));
+  EXPECT_EQ(Run("identify --sensor point,laser" + files, &out), 2);
+  EXPECT_THAT(out, HasSubstr("--sensor: 'laser' is not a sensor lrcal models"));
+}
+
 }  // namespace
 }  // namespace lrcal
