@@ -17,8 +17,10 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -48,6 +50,7 @@
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
+#include "lrcal/measurement/mixed_measurement.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
@@ -2250,12 +2253,187 @@ estimate_plane, repetitions, fix, auto_fix, sigma_mm and solver as in identify_c
 an lrcal.Identification.)doc");
 }
 
+// One part of identify_mixed: the dict's "sensor" and that kind's arguments (as its own identify_*
+// takes them), made without fix (the mixed kind holds the named terms).
+struct MixedPy {
+  std::shared_ptr<const MeasurementKind> kind;
+  MeasuredValues values;
+};
+
+py::object PartArg(const py::dict& d, const char* key) {
+  return d.contains(key) ? py::reinterpret_borrow<py::object>(d[key]) : py::none();
+}
+
+// The repetitions of a part (None: 1 per row of q).
+std::vector<int> PartRepetitions(const py::dict& d, int rows) {
+  const py::object r = PartArg(d, "repetitions");
+  std::vector<int> out = r.is_none() ? std::vector<int>(static_cast<std::size_t>(rows), 1)
+                                     : r.cast<std::vector<int>>();
+  if (static_cast<int>(out.size()) != rows)
+    throw InputError("repetitions", "expected one count per row of q");
+  for (int v : out)
+    if (v < 1) throw InputError("repetitions", "expected counts of at least 1");
+  return out;
+}
+
+const std::set<std::string>& MixedPartKeys(const std::string& sensor) {
+  static const std::map<std::string, std::set<std::string>> keys = {
+      {"point", {"sensor", "q", "xyz", "instrument", "targets", "target_of", "repetitions"}},
+      {"pose",
+       {"sensor", "q", "xyz", "quaternion", "instrument", "targets", "target_of", "repetitions"}},
+      {"socket", {"sensor", "q", "socket_of", "tool_point", "distances", "repetitions"}},
+      {"contact",
+       {"sensor", "q", "plane", "plane_of", "tool_point", "flush", "estimate_plane",
+        "repetitions"}},
+      {"scanner",
+       {"sensor", "q", "h", "plane", "plane_of", "fan_deg", "scanner", "estimate_plane",
+        "repetitions"}}};
+  const auto it = keys.find(sensor);
+  if (it == keys.end())
+    throw InputError("sensor", "'" + CellExcerpt(sensor) +
+                                   "' is not a kind identify_mixed takes: expected point, pose, "
+                                   "socket, contact or scanner");
+  return it->second;
+}
+
+MixedPy ToMixedPart(const RobotFile& rig, const py::dict& d, double sigma, double sigma_angle) {
+  if (!d.contains("sensor")) throw InputError("sensor", "missing: the part's kind");
+  const std::string sensor = d["sensor"].cast<std::string>();
+  const std::set<std::string>& allowed = MixedPartKeys(sensor);
+  for (const auto& item : d) {
+    const std::string key = item.first.cast<std::string>();
+    if (!allowed.count(key)) throw InputError(key, "is not an argument of a " + sensor + " part");
+  }
+  if (!d.contains("q")) throw InputError("q", "missing: the part's configurations (N, joints)");
+  const Array q = d["q"].cast<Array>();
+  const std::string estimate_plane =
+      d.contains("estimate_plane") ? d["estimate_plane"].cast<std::string>() : std::string("none");
+  MixedPy out;
+  if (sensor == "point" || sensor == "pose") {
+    std::unique_ptr<PointMeasurement> kind = ToTrackerKind(
+        rig.robot, sensor, PartArg(d, "instrument"), PartArg(d, "targets"), py::none());
+    if (!d.contains("xyz")) throw InputError("xyz", "missing: the measured points (N, 3), m");
+    TrackerFitArgs a{PartArg(d, "quaternion"),
+                     py::none(),
+                     py::none(),
+                     py::none(),
+                     PartArg(d, "repetitions"),
+                     py::none(),
+                     false,
+                     0,
+                     0,
+                     "lm"};
+    out.values =
+        ToTrackerValues(*kind,
+                        ToTrackerConfigurations(rig.robot, q, PartArg(d, "target_of"),
+                                                static_cast<int>(kind->setup().targets.size())),
+                        d["xyz"].cast<Array>(), a);
+    if (sensor == "pose") WeighAngleRows(*kind, sigma, sigma_angle, &out.values);
+    out.kind = std::move(kind);
+  } else if (sensor == "socket") {
+    const SocketData data =
+        ToSocketData(rig.robot, q, PartArg(d, "socket_of"), PartArg(d, "repetitions"));
+    out.kind = ToSocketKind(rig.robot, data, PartArg(d, "tool_point"), PartArg(d, "distances"),
+                            py::none());
+    out.values = data.values;
+  } else if (sensor == "contact") {
+    const PlaneSet planes = ResolvePlanes(rig, PartArg(d, "plane"));
+    const bool flush = d.contains("flush") && d["flush"].cast<bool>();
+    std::unique_ptr<ContactMeasurement> kind =
+        ToContactKind(rig.robot, planes,
+                      {PartArg(d, "plane"), PartArg(d, "plane_of"), PartArg(d, "tool_point"),
+                       py::none(), estimate_plane, flush});
+    out.values = MeasuredValues{
+        ToContactConfigurations(rig.robot, q, PartArg(d, "plane_of"), planes.size()), {}, {}};
+    out.values.y.assign(
+        static_cast<std::size_t>(kind->rows_per_configuration() * out.values.size()), 0.0);
+    out.values.repetitions = PartRepetitions(d, out.values.size());
+    if (flush) WeighAngleRows(*kind, sigma, sigma_angle, &out.values);
+    out.kind = std::move(kind);
+  } else {
+    if (!d.contains("h")) throw InputError("h", "missing: the readings (N, beams), m");
+    const Array h = d["h"].cast<Array>();
+    if (h.ndim() != 2)
+      throw InputError("h", "expected an (N, beams) array of readings (m), one column per beam");
+    const PlaneSet planes = ResolvePlanes(rig, PartArg(d, "plane"));
+    std::unique_ptr<ScannerMeasurement> kind =
+        ToScannerKind(rig, rig.robot, planes,
+                      {PartArg(d, "plane"), PartArg(d, "plane_of"), PartArg(d, "scanner"),
+                       py::none(), estimate_plane, static_cast<long long>(h.shape(1)),
+                       d.contains("fan_deg") ? d["fan_deg"].cast<double>() : 0.0});
+    out.values = MeasuredValues{
+        ToContactConfigurations(rig.robot, q, PartArg(d, "plane_of"), planes.size()), {}, {}};
+    out.values.y = ToRows(h, kind->num_beams(), out.values.size(), "h");
+    out.values.repetitions = PartRepetitions(d, out.values.size());
+    out.kind = std::move(kind);
+  }
+  return out;
+}
+
+// identify_mixed: as identify --sensor a,b with one data set per kind.
+IdentificationSummary IdentifyMixedPy(const RobotFile& rig, const py::list& parts,
+                                      const py::object& fix, bool auto_fix, double sigma_mm,
+                                      double sigma_mrad, const std::string& solver) {
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
+  options.sigma = sigma_mm * 1e-3;
+  options.fix_dependent_parameters = auto_fix;
+  options.check_linearisation = true;  // as lrcal identify
+  options.Validate();
+  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
+  std::vector<MixedPart> kinds;
+  std::vector<MeasuredValues> values;
+  std::vector<py::dict> dicts;
+  std::map<std::string, int> seen, total;
+  for (const py::handle part : parts) {
+    dicts.push_back(part.cast<py::dict>());
+    if (dicts.back().contains("sensor")) ++total[dicts.back()["sensor"].cast<std::string>()];
+  }
+  for (std::size_t k = 0; k < dicts.size(); ++k) {
+    const py::dict& d = dicts[k];
+    try {
+      MixedPy p = ToMixedPart(rig, d, sigma, sigma_mrad * 1e-3);
+      const std::string sensor = d["sensor"].cast<std::string>();
+      const int n = ++seen[sensor];
+      kinds.push_back({p.kind, total[sensor] > 1 ? sensor + std::to_string(n) : sensor});
+      values.push_back(std::move(p.values));
+    } catch (const InputError& e) {
+      throw InputError("parts[" + std::to_string(k) + "]." + e.where(),
+                       std::string(e.what()).substr(e.where().empty() ? 0 : e.where().size() + 2));
+    }
+  }
+  const MixedMeasurement mixed(std::move(kinds));
+  const std::vector<std::string> fixed = ToNames(fix);
+  const std::unique_ptr<MeasurementKind> kind = mixed.Without(fixed);
+  const MeasuredValues data = mixed.Combine(values);
+  py::gil_scoped_release release;
+  return Identify(*kind, data, options);
+}
+
+void DefineMixed(py::module_& m) {
+  m.def("identify_mixed", &IdentifyMixedPy, py::arg("robot"), py::arg("parts"),
+        py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
+        py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm", R"doc(
+Several kinds of data of one arm identified together: `lrcal identify --sensor a,b --data ...`.
+parts is a list of dicts, one per kind, each with "sensor" ("point", "pose", "socket", "contact"
+or "scanner") and that kind's arguments as its own identify_* function takes them (point/pose: q,
+xyz, quaternion, instrument, targets, target_of; socket: q, socket_of, tool_point, distances;
+contact: q, plane, plane_of, tool_point, flush, estimate_plane; scanner: q, h, plane, plane_of,
+fan_deg, scanner, estimate_plane; every kind: repetitions). The arm's link values, base/tool
+frame terms and plane terms are shared; a kind's own term whose name another kind also has is
+named with its kind ("point.target_x", "contact.target_x"; a kind given twice: "point1",
+"point2"), and fix takes those names. auto_fix, sigma_mm, sigma_mrad (pose and flush-contact
+orientation rows weigh (sigma_mm/sigma_mrad)^2) and solver as in identify_tracker. Returns an
+lrcal.Identification; its configurations count the measured values, one entry each.)doc");
+}
+
 void DefineCalibration(py::module_& m) {
   DefineIdentifiability(m);
   DefineTrackers(m);
   DefineSockets(m);
   DefineContacts(m);
   DefineScanners(m);
+  DefineMixed(m);
   DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

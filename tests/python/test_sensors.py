@@ -281,3 +281,62 @@ def test_tracker_design_is_the_programs(tmp_path, cli, paper):
         lrcal.design(paper, q, 12, sensor="point", instrument=TRACKER, estimate_plane="offset")
     with pytest.raises(lrcal.InputError, match="instrument: is a tracker's"):
         lrcal.design(paper, q, 12, instrument=TRACKER)
+
+
+def test_mixed_kinds_identify_as_the_program_and_recover_the_truth(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    plane_of = [1 + i % 2 for i in range(40)]
+    configs, starts = tmp_path / "c.csv", tmp_path / "s.csv"
+    write_configurations(configs, q)
+    write_configurations(starts, q, "plane", plane_of)
+    planes = ["--plane", "0.1,0.2,1,-0.3", "--plane", "1,0,0.2,-0.9"]
+    cli("simulate", "--sensor", "pose", "--configs", configs, "--instrument", TRACKER_ARG,
+        "--sigma-mm", "0.05", "--sigma-mrad", "0.1", "--repetitions", "3", "--seed", "9",
+        "--out", tmp_path / "poses.csv")
+    cli("simulate", "--sensor", "contact", "--flush", "--configs", starts, *planes,
+        "--target", "0.01,0,0.1", "--sigma-mm", "0.05", "--sigma-mrad", "0.1", "--seed", "4",
+        "--out", tmp_path / "contacts.csv")
+    poses = lrcal.simulate_tracker(paper, q, sensor="pose", instrument=TRACKER, sigma_mm=0.05,
+                                   sigma_mrad=0.1, repetitions=3, seed=9)
+    contacts = lrcal.simulate_contacts(paper, q, plane=PLANES, plane_of=plane_of, flush=True,
+                                       tool_point=[0.01, 0, 0.1], sigma_mm=0.05,
+                                       sigma_mrad=0.1, seed=4)
+    parts = [dict(sensor="pose", q=poses["q"], xyz=poses["xyz"],
+                  quaternion=poses["quaternion"], instrument=TRACKER,
+                  repetitions=poses["repetitions"]),
+             dict(sensor="contact", q=contacts["q"], plane=PLANES,
+                  plane_of=contacts["plane_of"], tool_point=[0.01, 0, 0.1], flush=True,
+                  estimate_plane="normal,offset")]
+    fit = lrcal.identify_mixed(paper, parts, auto_fix=True, sigma_mm=0.05, sigma_mrad=0.1)
+    done = cli("identify", "--sensor", "pose,contact", "--data", tmp_path / "poses.csv",
+               "--data", tmp_path / "contacts.csv", "--instrument", TRACKER_ARG, *planes,
+               "--probe", "0.01,0,0.1", "--estimate-plane", "normal,offset", "--auto-fix",
+               "--sigma-mm", "0.05", "--sigma-mrad", "0.1", "--format", "json")
+    program = json.loads(done.stdout)
+    assert program["sensor"] == "mixed"
+    assert [p["sensor"] for p in program["parts"]] == ["pose", "contact"]
+    assert fit.names == [p["name"] for p in program["parameters"]]
+    assert "contact.target_z" in fit.names
+    np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
+                               rtol=0, atol=1e-12)
+
+    # Noise-free, the union returns the robot file's true errors.
+    exact = lrcal.simulate_tracker(paper, q, sensor="point", instrument=TRACKER, sigma_mm=0)
+    seated = lrcal.simulate_contacts(paper, q, plane=PLANES, plane_of=plane_of, flush=True,
+                                     tool_point=[0.01, 0, 0.1], sigma_mm=0, sigma_mrad=0)
+    fit = lrcal.identify_mixed(
+        paper,
+        [dict(sensor="point", q=exact["q"], xyz=exact["xyz"], instrument=TRACKER),
+         dict(sensor="contact", q=seated["q"], plane=PLANES, plane_of=seated["plane_of"],
+              tool_point=[0.01, 0, 0.1], flush=True)],
+        auto_fix=True)
+    delta = dict(zip(fit.names, fit.delta))
+    assert delta["beta2"] == pytest.approx(1.45e-3, abs=1e-9)
+    assert delta["alpha5"] == pytest.approx(-4.83e-3, abs=1e-9)
+
+    with pytest.raises(lrcal.InputError, match=r"parts\[1\]\.h: missing"):
+        lrcal.identify_mixed(paper, [parts[0], dict(sensor="scanner", q=q)])
+    with pytest.raises(lrcal.InputError, match=r"parts\[0\]\.plane_of: is not an argument"):
+        lrcal.identify_mixed(paper, [dict(parts[0], plane_of=plane_of)])
+    with pytest.raises(lrcal.InputError, match="'laser' is not a kind identify_mixed takes"):
+        lrcal.identify_mixed(paper, [dict(sensor="laser", q=q)])
