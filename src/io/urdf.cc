@@ -276,6 +276,202 @@ std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& values) {
   return t;
 }
 
+namespace {
+
+// A joint of the chain from the root to the tool link, in order.
+struct ChainJoint {
+  urdf::JointConstSharedPtr joint;
+  TiXmlElement* element = nullptr;  // its <joint> in the document
+  bool movable() const { return joint->type != urdf::Joint::FIXED; }
+};
+
+// Sets (or adds) the joint's <origin> to `t`.
+void SetOrigin(TiXmlElement* joint, const RigidTransform& t) {
+  TiXmlElement* origin = joint->FirstChildElement("origin");
+  if (!origin) {
+    TiXmlElement added("origin");
+    origin = joint->FirstChild() ? joint->InsertBeforeChild(joint->FirstChild(), added)->ToElement()
+                                 : joint->InsertEndChild(added)->ToElement();
+  }
+  const Eigen::Vector3d rpy = t.Rpy();
+  origin->SetAttribute("xyz", FileNumber(t.translation.x()) + " " + FileNumber(t.translation.y()) +
+                                  " " + FileNumber(t.translation.z()));
+  origin->SetAttribute("rpy",
+                       FileNumber(rpy.x()) + " " + FileNumber(rpy.y()) + " " + FileNumber(rpy.z()));
+}
+
+// The largest distance (m) and turn (rad) between the tool of `a` at `va` and of `b` at `vb` at
+// the zero configuration and eight others spread over the joint ranges.
+double LargestToolDifference(const RobotModel& a, const double* va, const RobotModel& b,
+                             const double* vb) {
+  double largest = 0;
+  std::vector<double> q(static_cast<std::size_t>(a.num_links()), 0.0);
+  for (int c = 0; c <= 8; ++c) {
+    for (int k = 0; c > 0 && k < a.num_links(); ++k) {
+      const Link& link = a.links()[static_cast<std::size_t>(k)];
+      const double f = 0.5 + 0.4 * std::sin(1.7 * c + 2.3 * k);  // in (0.1, 0.9)
+      q[static_cast<std::size_t>(k)] = link.q_min + f * (link.q_max - link.q_min);
+    }
+    const Pose<double> x = ForwardKinematics<double>(a, va, q.data());
+    const Pose<double> y = ForwardKinematics<double>(b, vb, q.data());
+    const Eigen::AngleAxisd turn(x.R_BT.transpose() * y.R_BT);
+    largest = std::max({largest, (x.p_BT - y.p_BT).norm(), std::abs(turn.angle())});
+  }
+  return largest;
+}
+
+}  // namespace
+
+namespace {
+
+// The joints from the root to `tool` in order, each with its element of `doc`.
+std::vector<ChainJoint> ChainToTool(const urdf::ModelInterface& model, const std::string& tool,
+                                    TiXmlDocument* doc) {
+  std::map<std::string, TiXmlElement*> elements;
+  for (TiXmlElement* j = doc->RootElement()->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint"))
+    if (j->Attribute("name")) elements.emplace(j->Attribute("name"), j);
+  std::vector<ChainJoint> chain;
+  for (urdf::LinkConstSharedPtr link = model.getLink(tool); link && link->parent_joint;
+       link = model.getLink(link->parent_joint->parent_link_name))
+    chain.insert(chain.begin(), {link->parent_joint, elements[link->parent_joint->name]});
+  return chain;
+}
+
+// The model must be of the URDF's chain (`mine`, its own model): as many movable joints, of the
+// same kinds, its tool near the URDF's.
+void CheckModelOfChain(const RobotModel& mine, const RobotModel& robot,
+                       const Eigen::VectorXd& link_values, const std::string& original,
+                       const std::string& tool) {
+  if (mine.num_links() != robot.num_links())
+    throw InputError(original, "the chain to '" + tool + "' has " +
+                                   std::to_string(mine.num_links()) +
+                                   " movable joints but the model has " +
+                                   std::to_string(robot.num_links()) + " links");
+  for (int k = 0; k < robot.num_links(); ++k)
+    if (mine.links()[static_cast<std::size_t>(k)].joint !=
+        robot.links()[static_cast<std::size_t>(k)].joint)
+      throw InputError(original, "joint '" + mine.links()[static_cast<std::size_t>(k)].joint_name +
+                                     "' is not of the kind of the model's link " +
+                                     std::to_string(k + 1) + " (revolute or prismatic)");
+  const double off =
+      LargestToolDifference(mine, mine.nominal_values().data(), robot, link_values.data());
+  if (!(off <= kUrdfLikeMismatch))
+    throw InputError(original, "the model's tool is " + FileNumber(off * 1e3) +
+                                   " mm (or mrad) from this URDF's own '" + tool +
+                                   "': is the model a calibration of this robot and tool link?");
+}
+
+// Each movable joint's frame keeps its place on the model's frame before it: D_k = P_k⁻¹·J_k at
+// the URDF's own model `mine` (P_k the D-H frame k-1, its z on joint k's axis; J_k the URDF's
+// joint frame; both at q = 0) is a slide along and a turn about that axis.
+std::vector<RigidTransform> JointSlides(const std::vector<ChainJoint>& chain,
+                                        const RobotModel& mine) {
+  std::vector<RigidTransform> slides;
+  RigidTransform urdf_frame, dh_frame = mine.base();
+  int k = 0;
+  for (const ChainJoint& c : chain) {
+    urdf_frame = urdf_frame * FromUrdfPose(c.joint->parent_to_joint_origin_transform);
+    if (!c.movable()) continue;
+    slides.push_back(dh_frame.Inverse() * urdf_frame);
+    dh_frame = dh_frame * LinkRigidTransform(mine.nominal_values().data() + kValuesPerLink * k++);
+  }
+  return slides;
+}
+
+// Where the chain's origins go (UrdfLikeText): J_k = P_k·D_k at the calibrated model too, so
+// O_k = F⁻¹·D_{k-1}⁻¹·A_{k-1}·D_k (F the fixed joints between; O_1 = F⁻¹·base·D_1), and the first
+// fixed joint after the last movable one carries D_N⁻¹·A_N·tool·(the fixed joints after it)⁻¹.
+class ChainOrigins {
+ public:
+  ChainOrigins(const RobotModel& robot, const Eigen::VectorXd& values,
+               std::vector<RigidTransform> slides)
+      : robot_(robot), values_(values), slides_(std::move(slides)) {}
+
+  void Set(std::vector<ChainJoint>* chain, const std::string& original, const std::string& tool) {
+    RigidTransform fixed, tail_rest;
+    ChainJoint* tail = nullptr;  // the first fixed joint after the last movable one
+    int k = 0;
+    for (ChainJoint& c : *chain) {
+      const RigidTransform origin = FromUrdfPose(c.joint->parent_to_joint_origin_transform);
+      if (c.movable()) {
+        SetOrigin(c.element, fixed.Inverse() * Before(k) * slides_[static_cast<std::size_t>(k)]);
+        last_ = &c;
+        last_fixed_ = fixed;
+        fixed = RigidTransform();
+        ++k;
+      } else if (k < robot_.num_links()) {
+        fixed = fixed * origin;
+      } else if (!tail) {
+        tail = &c;
+      } else {
+        tail_rest = tail_rest * origin;
+      }
+    }
+    const RigidTransform tool_on_last = Link(robot_.num_links() - 1) * robot_.tool();
+    if (tail)
+      SetOrigin(tail->element, slides_.back().Inverse() * tool_on_last * tail_rest.Inverse());
+    else
+      SetLastOnTool(tool_on_last, original, tool);
+  }
+
+ private:
+  RigidTransform Link(int i) const {
+    return LinkRigidTransform(values_.data() + kValuesPerLink * i);
+  }
+  // The model's frame before joint k's slide, seen from the frame after joint k-1's motion.
+  RigidTransform Before(int k) const {
+    return k == 0 ? robot_.base()
+                  : slides_[static_cast<std::size_t>(k - 1)].Inverse() * Link(k - 1);
+  }
+  // The tool link is the last joint's own: the model's tool must lie on that joint's axis (z of
+  // the D-H frame before it) and turn z onto the URDF's axis; D_N is then the tool itself.
+  void SetLastOnTool(const RigidTransform& tool_on_last, const std::string& original,
+                     const std::string& tool) {
+    const Eigen::Vector3d axis =
+        Eigen::Vector3d(last_->joint->axis.x, last_->joint->axis.y, last_->joint->axis.z)
+            .normalized();
+    const double off = std::max(tool_on_last.translation.head<2>().norm(),
+                                (tool_on_last.rotation.transpose().col(2) - axis).norm());
+    if (off > 1e-12)
+      throw InputError(original,
+                       "the tool link '" + tool +
+                           "' is the last movable joint's own child, so its frame turns about "
+                           "that joint's axis, and the model's tool is off it by " +
+                           FileNumber(off * 1e3) +
+                           " mm (or mrad): choose a tool link behind a fixed joint (a flange), "
+                           "whose origin can carry the calibrated tool");
+    SetOrigin(last_->element,
+              last_fixed_.Inverse() * Before(robot_.num_links() - 1) * tool_on_last);
+  }
+
+  const RobotModel& robot_;
+  const Eigen::VectorXd& values_;
+  std::vector<RigidTransform> slides_;
+  ChainJoint* last_ = nullptr;  // the last movable joint, and the fixed joints before it
+  RigidTransform last_fixed_;
+};
+
+}  // namespace
+
+std::string UrdfLikeText(const std::string& original, const std::string& tool_link,
+                         const RobotModel& robot, const Eigen::VectorXd& link_values) {
+  const RobotFile own = LoadUrdfRobotFile(original, tool_link);  // the checks of any URDF
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(original);
+  if (!model) throw InputError(original, "not a URDF that urdfdom can read (its message is above)");
+  const std::string tool = ChooseToolLink(*model, original, tool_link);
+  TiXmlDocument doc;
+  if (!doc.LoadFile(original.c_str()) || !doc.RootElement())
+    throw InputError(original, std::string("not XML that TinyXML can read: ") + doc.ErrorDesc());
+  std::vector<ChainJoint> chain = ChainToTool(*model, tool, &doc);
+  CheckModelOfChain(own.robot, robot, link_values, original, tool);
+  ChainOrigins(robot, link_values, JointSlides(chain, own.robot)).Set(&chain, original, tool);
+  TiXmlPrinter printer;
+  printer.SetIndent("  ");
+  doc.Accept(&printer);
+  return printer.Str();
+}
+
 std::string DhTableText(const RobotModel& robot, const Eigen::VectorXd& values) {
   std::string t = "# D-H + beta table of " + robot.name() +
                   " (lrcal export): A_i = Rz(theta0 + q) Tz(d) Tx(a) Rx(alpha) Ry(beta)\n";

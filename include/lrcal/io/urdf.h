@@ -39,6 +39,29 @@ RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_lin
 /// significant digits.
 std::string UrdfText(const RobotModel& robot, const Eigen::VectorXd& link_values);
 
+/// The most a model may differ from the URDF it is written into by UrdfLikeText, at the tool link
+/// over the configurations it checks (m; rad for the orientation): even a poorly conditioned
+/// calibration moves the tool by centimetres, a model of another robot or tool link by more.
+inline constexpr double kUrdfLikeMismatch = 0.5;
+
+/// The user's own URDF (`original`) with the chain from its root to `tool_link` (empty: its only
+/// end link) set to `robot` at `link_values` (5N, SI; the calibrated model of that chain, with its
+/// base and tool transforms): every element of the file is kept — names, the tree, other
+/// branches, meshes, inertials, limits, continuous and mimic joints, comments — and only the
+/// `<origin>` of the chain's movable joints and of the first fixed joint after the last movable
+/// one (which carries the tool) changes. Each joint keeps its `<axis>`, and its frame keeps its
+/// place relative to the model's frame before it (a slide along and a turn about the joint's axis,
+/// taken from the URDF's own model), so link frames, meshes and inertials move only by what the
+/// calibration moved. Forward kinematics from
+/// the root to the tool link then equals `robot`'s at `link_values` (tests: 1e-12); numbers are
+/// written with 17 significant digits. Throws InputError naming the file when the chain's movable
+/// joints differ from the robot's links in number or kind, when the tool link is the last movable
+/// joint's own child and the model's tool is off that joint's axis (a fixed joint is needed to
+/// carry it), or when the model's tool is more than kUrdfLikeMismatch from the URDF's own at the
+/// zero configuration or at eight others (a model of another robot or tool link).
+std::string UrdfLikeText(const std::string& original, const std::string& tool_link,
+                         const RobotModel& robot, const Eigen::VectorXd& link_values);
+
 /// The D-H table of `robot` at `link_values` as CSV: one row per link (link, joint, theta0_rad,
 /// d_m, a_m, alpha_rad, beta_rad, q_min, q_max, parameters), preceded by `#` comment lines with
 /// the base and tool transforms (xyz m, rpy rad).
