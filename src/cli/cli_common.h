@@ -197,6 +197,7 @@ int AggregateCommand(const std::vector<std::string>& args);
 int TrialCommand(const std::vector<std::string>& args);
 int AccuracyCommand(const std::vector<std::string>& args);
 int ExportCommand(const std::vector<std::string>& args);
+int CompensateCommand(const std::vector<std::string>& args);
 /// Runs `python3 -m lrcal.report ARGUMENTS` (the report pages, src/python/lrcal/report) with
 /// Debian's /usr/bin/python3 (where python3-pandas and python3-matplotlib are; LRCAL_PYTHON
 /// overrides) and lrcal's own Python package first on its path: next to this program in the build

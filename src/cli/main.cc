@@ -43,6 +43,8 @@ const std::vector<Command>& Commands() {
        AccuracyCommand},
       {"export", "write a robot (a calibrated one) as URDF, a D-H table or a robot YAML file",
        ExportCommand},
+      {"compensate", "joint commands that reach the nominal plan's tool poses on a calibrated arm",
+       CompensateCommand},
   };
   return commands;
 }

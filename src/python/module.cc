@@ -47,6 +47,7 @@
 #include "lrcal/io/socket_data.h"
 #include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
+#include "lrcal/kinematics/compensation.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
@@ -2427,6 +2428,93 @@ orientation rows weigh (sigma_mm/sigma_mrad)^2) and solver as in identify_tracke
 lrcal.Identification; its configurations count the measured values, one entry each.)doc");
 }
 
+// compensate's targets: xyz (N, 3) with quaternion (N, 4) or not, or nominal's tool poses at q.
+std::vector<Pose<double>> CompensationGoals(const RobotFile& rig, const ConfigurationSet& plans,
+                                            const py::object& xyz, const py::object& quaternion,
+                                            const py::object& nominal) {
+  std::vector<Pose<double>> goals;
+  if (!xyz.is_none()) {
+    const std::vector<double> p = ToRows(xyz.cast<Array>(), 3, plans.size(), "xyz");
+    const std::vector<double> r =
+        quaternion.is_none() ? std::vector<double>{}
+                             : ToRows(quaternion.cast<Array>(), 4, plans.size(), "quaternion");
+    for (int i = 0; i < plans.size(); ++i) {
+      Pose<double> pose;
+      pose.p_BT = Eigen::Map<const Eigen::Vector3d>(&p[static_cast<std::size_t>(3 * i)]);
+      if (!r.empty()) {
+        const auto k = static_cast<std::size_t>(4 * i);
+        const Eigen::Quaterniond rotation(r[k + 3], r[k], r[k + 1], r[k + 2]);
+        if (!(std::abs(rotation.norm() - 1) < 1e-6))
+          throw InputError("quaternion[" + std::to_string(i) + "]",
+                           "expected a unit quaternion (qx, qy, qz, qw)");
+        pose.R_BT = rotation.normalized().toRotationMatrix();
+      }
+      goals.push_back(pose);
+    }
+  } else {
+    if (!quaternion.is_none()) throw InputError("quaternion", "needs xyz, the target positions");
+    if (nominal.is_none())
+      throw InputError("nominal",
+                       "missing: without xyz the targets are the nominal model's tool "
+                       "poses at q: give that model");
+    const RobotFile& plan_model = nominal.cast<const RobotFile&>();
+    if (plan_model.robot.num_links() != rig.robot.num_links())
+      throw InputError("nominal", "has another number of joints than robot");
+    for (int i = 0; i < plans.size(); ++i)
+      goals.push_back(ForwardKinematics<double>(
+          plan_model.robot, plan_model.robot.nominal_values().data(), plans.q(i)));
+  }
+  return goals;
+}
+
+// compensate: as lrcal compensate.
+py::dict CompensatePy(const RobotFile& rig, const Array& q, const py::object& xyz,
+                      const py::object& quaternion, const py::object& nominal) {
+  const ConfigurationSet plans = ToConfigurations(q, rig.robot.num_links(), "q");
+  CheckJointRanges(plans, rig.robot, "q");
+  const std::vector<Pose<double>> goals = CompensationGoals(rig, plans, xyz, quaternion, nominal);
+  const bool orientation = xyz.is_none() || !quaternion.is_none();
+  std::vector<Compensation> results;
+  {
+    py::gil_scoped_release release;
+    for (int i = 0; i < plans.size(); ++i)
+      results.push_back(
+          Compensate(rig.robot, goals[static_cast<std::size_t>(i)], plans.q(i), orientation));
+  }
+  const int n = rig.robot.num_links();
+  py::array_t<double> out({plans.size(), n});
+  std::vector<double> position, turn;
+  std::vector<bool> converged, within;
+  for (int i = 0; i < plans.size(); ++i) {
+    const Compensation& c = results[static_cast<std::size_t>(i)];
+    for (int j = 0; j < n; ++j) out.mutable_at(i, j) = c.q[static_cast<std::size_t>(j)];
+    position.push_back(c.position_error * 1e3);
+    turn.push_back(c.orientation_error * 1e3);
+    converged.push_back(c.converged);
+    within.push_back(c.within_limits);
+  }
+  py::dict d;
+  d["q"] = out;
+  d["position_error_mm"] = ToArray(position);
+  d["orientation_error_mrad"] = ToArray(turn);
+  d["converged"] = converged;
+  d["within_limits"] = within;
+  return d;
+}
+
+void DefineCompensate(py::module_& m) {
+  m.def("compensate", &CompensatePy, py::arg("robot"), py::arg("q"), py::arg("xyz") = py::none(),
+        py::arg("quaternion") = py::none(), py::arg("nominal") = py::none(), R"doc(
+Joint commands that reach planned tool poses on a calibrated arm: `lrcal compensate`. robot is
+the calibrated robot (a robot file written by identify, or a calibrated URDF); q (N, joints) the
+commands planned on the nominal model; the targets are xyz (N, 3; m, base frame) with optionally
+quaternion (N, 4; qx, qy, qz, qw), or, without xyz, the tool poses of nominal (the robot the
+plans were made on) at q. Damped least squares from q, the least joint motion reaching each
+target. Returns a dict: q (N, joints) the compensated commands, position_error_mm and
+orientation_error_mrad (what remains on the calibrated model), converged and within_limits (per
+row).)doc");
+}
+
 void DefineCalibration(py::module_& m) {
   DefineIdentifiability(m);
   DefineTrackers(m);
@@ -2434,6 +2522,7 @@ void DefineCalibration(py::module_& m) {
   DefineContacts(m);
   DefineScanners(m);
   DefineMixed(m);
+  DefineCompensate(m);
   DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

@@ -28,13 +28,15 @@ class DeployCli : public ::testing::Test {
   int Run(const std::string& args, std::string* out) const {
     return testing::RunCommand(testing::LrcalBinary() + " " + args, out);
   }
-  // The tool poses `lrcal kinematics` gives for `robot` at the held-out placement's configurations.
-  Json ToolPoses(const std::string& robot) const {
+  // The tool poses `lrcal kinematics` gives for `robot` at `configs` (default: the held-out
+  // placement's configurations).
+  Json ToolPoses(const std::string& robot, const std::string& configs = "") const {
     std::string out;
-    EXPECT_EQ(Run("kinematics --format json --plane 0,0,1,-5 --configs " +
-                      Example("panda_1_right.csv") + " --robot " + robot,
-                  &out),
-              0)
+    EXPECT_EQ(
+        Run("kinematics --format json --plane 0,0,1,-5 --configs " +
+                (configs.empty() ? Example("panda_1_right.csv") : configs) + " --robot " + robot,
+            &out),
+        0)
         << out;
     return Json::parse(out.substr(out.find('['), out.rfind(']') - out.find('[') + 1));
   }
@@ -90,6 +92,73 @@ TEST_F(DeployCli, ACalibratedPandaGoesIntoTheUsersOwnUrdf) {
       Run("export --robot paper --like " + Example("panda.urdf") + " --tool-link ball_link", &out),
       2);
   EXPECT_THAT(out, HasSubstr("has 7 movable joints but the model has 6 links"));
+}
+
+// Compensation as a controller would use it: the held-out placement's commands, planned on the
+// nominal URDF, corrected for the calibrated Panda; the calibrated model's tool poses at the
+// corrected commands (lrcal kinematics) are the nominal plan's to 1e-9.
+TEST_F(DeployCli, CompensatedCommandsReachTheNominalPlansPoses) {
+  std::string out;
+  ASSERT_EQ(Run("identify --sensor socket --robot " + Example("panda.urdf") +
+                    " --tool-link ball_link --socket-distance 0,1=0.05 --fix "
+                    "target_x,target_y,target_z --auto-fix --sigma-mm 0.3 --prior-sigma "
+                    "theta=10mrad,alpha=10mrad,a=2mm,d=2mm --data " +
+                    Example("panda_1_front.csv") + " --write-robot " + Path("cal.yaml"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("compensate --robot " + Path("cal.yaml") + " --nominal " + Example("panda.urdf") +
+                    " --tool-link ball_link --targets " + Example("panda_1_right.csv") + " --out " +
+                    Path("commands.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("60 targets (tool poses)"));
+  EXPECT_THAT(out, HasSubstr("60 reached"));
+  // The compensated commands as a configurations file for lrcal kinematics.
+  std::ifstream in(Path("commands.csv"));
+  std::string line;
+  std::getline(in, line);
+  std::ofstream configs(Path("q.csv"));
+  configs << "q1,q2,q3,q4,q5,q6,q7\n";
+  int rows = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 12u) << line;
+    EXPECT_EQ(cells[9], "1") << line;   // converged
+    EXPECT_EQ(cells[10], "1") << line;  // within_limits
+    for (int j = 0; j < 7; ++j) configs << (j ? "," : "") << cells[static_cast<std::size_t>(j)];
+    configs << "\n";
+    ++rows;
+  }
+  configs.close();
+  EXPECT_EQ(rows, 60);
+  const Json reached = ToolPoses(Path("cal.yaml"), Path("q.csv"));
+  const Json planned =
+      ToolPoses(Example("panda.urdf") + " --tool-link ball_link", Example("panda_1_right.csv"));
+  ASSERT_EQ(reached.size(), planned.size());
+  constexpr double kReached = testing::tolerance::kRoundTrip;  // m
+  for (std::size_t i = 0; i < reached.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(reached[i]["position"][c].get<double>(), planned[i]["position"][c].get<double>(),
+                  kReached);
+      for (int r = 0; r < 3; ++r)
+        EXPECT_NEAR(reached[i]["rotation"][r][c].get<double>(),
+                    planned[i]["rotation"][r][c].get<double>(), kReached);
+    }
+
+  EXPECT_EQ(
+      Run("compensate --robot " + Path("cal.yaml") + " --targets " + Example("panda_1_right.csv"),
+          &out),
+      2);
+  EXPECT_THAT(out, HasSubstr("--nominal: missing"));
+  std::ofstream(Path("bad.csv")) << "q1,q2,q3,q4,q5,q6,q7,x,y,z,qx,qy,qz,qw\n"
+                                 << "0,0,0,-1,0,1,0,0.3,0,0.5,0,0,0,2\n";
+  EXPECT_EQ(Run("compensate --robot " + Path("cal.yaml") + " --targets " + Path("bad.csv"), &out),
+            2);
+  EXPECT_THAT(out, HasSubstr("bad.csv:2 columns qx, qy, qz, qw: expected a unit quaternion"));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 identify_tracker) against the program's `--sensor point|pose`: the same counts, the same
 simulated values bit for bit, the same fit."""
 import csv
+import os
 import json
 
 import numpy as np
@@ -340,3 +341,37 @@ def test_mixed_kinds_identify_as_the_program_and_recover_the_truth(tmp_path, cli
         lrcal.identify_mixed(paper, [dict(parts[0], plane_of=plane_of)])
     with pytest.raises(lrcal.InputError, match="'laser' is not a kind identify_mixed takes"):
         lrcal.identify_mixed(paper, [dict(sensor="laser", q=q)])
+
+
+def test_compensate_as_the_program_and_reaches_the_plans(tmp_path, cli):
+    panda = "examples/mukca/panda.urdf"
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+    urdf = os.path.join(root, panda)
+    cli("identify", "--sensor", "socket", "--robot", urdf, "--tool-link", "ball_link",
+        "--socket-distance", "0,1=0.05", "--fix", "target_x,target_y,target_z", "--auto-fix",
+        "--sigma-mm", "0.3", "--prior-sigma", "theta=10mrad,alpha=10mrad,a=2mm,d=2mm",
+        "--data", os.path.join(root, "examples/mukca/panda_1_front.csv"),
+        "--write-robot", tmp_path / "cal.yaml")
+    targets = os.path.join(root, "examples/mukca/panda_1_right.csv")
+    cli("compensate", "--robot", tmp_path / "cal.yaml", "--nominal", urdf, "--tool-link",
+        "ball_link", "--targets", targets, "--out", tmp_path / "c.csv")
+    calibrated = lrcal.Robot.load(str(tmp_path / "cal.yaml"))
+    nominal = lrcal.Robot.load(urdf, tool_link="ball_link")
+    with open(targets) as f:
+        q = np.array([[float(r[f"q{j + 1}"]) for j in range(7)] for r in csv.DictReader(f)])
+    got = lrcal.compensate(calibrated, q, nominal=nominal)
+    with open(tmp_path / "c.csv") as f:
+        rows = list(csv.DictReader(f))
+    program = np.array([[float(r[f"q{j + 1}"]) for j in range(7)] for r in rows])
+    np.testing.assert_allclose(got["q"], program, rtol=0, atol=1e-12)
+    assert all(got["converged"]) and all(got["within_limits"])
+    # The calibrated model at the compensated commands is where the nominal plan meant to be.
+    reached = lrcal.forward_kinematics(calibrated, got["q"])
+    planned = lrcal.forward_kinematics(nominal, q)
+    np.testing.assert_allclose(reached, planned, rtol=0, atol=1e-9)
+    # Position targets alone: three rows of the task.
+    pos = lrcal.compensate(calibrated, q, xyz=planned[:, :3, 3])
+    assert np.all(pos["orientation_error_mrad"] == 0)
+    assert np.max(pos["position_error_mm"]) < 1e-6
+    with pytest.raises(lrcal.InputError, match="nominal: missing"):
+        lrcal.compensate(calibrated, q)
