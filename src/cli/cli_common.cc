@@ -212,13 +212,59 @@ PointSetup ResolvePointSetup(const po::variables_map& vm) {
   return setup;
 }
 
+void AddEstimatePresetOption(po::options_description& o) {
+  o.add_options()("estimate", po::value<std::string>()->default_value("all"),
+                  "which of the arm's terms to estimate: all, offsets (each joint's zero offset: "
+                  "theta, or d for a prismatic joint; what most controllers take) or lengths (a "
+                  "and d); --fix holds more (a class such as alpha holds every alpha)");
+}
+
+std::vector<std::string> FixList(const po::variables_map& vm, const RobotModel& robot) {
+  std::vector<std::string> out;
+  const auto hold = [&](const std::string& name) {
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+  };
+  const auto each_parameter = [&](const std::function<bool(int link, int value)>& held) {
+    for (int k : robot.parameter_indices())
+      if (held(k / kValuesPerLink, k % kValuesPerLink)) hold(robot.ValueName(k));
+  };
+  if (vm.count("fix"))
+    for (const std::string& name : SplitList(vm["fix"].as<std::string>())) {
+      int value = -1;
+      for (int v = 0; v < kValuesPerLink; ++v)
+        if (name == LinkValueName(v)) value = v;
+      if (value < 0)
+        hold(name);
+      else  // a class: every parameter of it ("alpha": alpha1 ... alphaN)
+        each_parameter([&](int, int v) { return v == value; });
+    }
+  const std::string preset =
+      vm.count("estimate") ? vm["estimate"].as<std::string>() : std::string("all");
+  if (preset == "offsets") {
+    // Keep each joint's own offset: θ of a revolute joint, d of a prismatic one.
+    each_parameter([&](int link, int v) {
+      const bool prismatic =
+          robot.links()[static_cast<std::size_t>(link)].joint == JointType::kPrismatic;
+      return v != (prismatic ? kD : kTheta);
+    });
+  } else if (preset == "lengths") {
+    each_parameter([](int, int v) { return v != kA && v != kD; });
+  } else if (preset != "all") {
+    throw InputError("--estimate", "'" + CellExcerpt(preset) +
+                                       "' is not a preset: expected offsets (the joints' zero "
+                                       "offsets), lengths (a and d) or all");
+  }
+  return out;
+}
+
 namespace {
 
 // --fix as a list, or none in a mixed run (the mixed kind holds them: a name may be another
 // kind's).
-std::vector<std::string> FixedTerms(const po::variables_map& vm, bool in_mix) {
-  if (in_mix || !vm.count("fix")) return {};
-  return SplitList(vm["fix"].as<std::string>());
+std::vector<std::string> FixedTerms(const po::variables_map& vm, const RobotModel& robot,
+                                    bool in_mix) {
+  if (in_mix) return {};
+  return FixList(vm, robot);
 }
 
 }  // namespace
@@ -226,7 +272,7 @@ std::vector<std::string> FixedTerms(const po::variables_map& vm, bool in_mix) {
 std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
                                                   const std::string& sensor,
                                                   const po::variables_map& vm, bool in_mix) {
-  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
+  const std::vector<std::string> fixed = FixedTerms(vm, robot, in_mix);
   PointSetup setup = ResolvePointSetup(vm);
   if (sensor == "pose") return std::make_unique<PoseMeasurement>(robot, setup, fixed, "--fix");
   for (std::size_t k = 0; k < setup.target_orientations.size(); ++k)
@@ -305,7 +351,7 @@ std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, con
   const PlaneTerms terms = PlaneTerms::Parse(
       vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
   setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);
-  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
+  const std::vector<std::string> fixed = FixedTerms(vm, robot, in_mix);
   return std::make_unique<ContactMeasurement>(robot, setup, fixed, "--fix");
 }
 
@@ -323,14 +369,14 @@ std::unique_ptr<ScannerMeasurement> MakeScannerKind(const RobotModel& robot, con
   const PlaneTerms terms = PlaneTerms::Parse(
       vm.count("estimate-plane") ? vm["estimate-plane"].as<std::string>() : "none");
   setup.plane_terms.assign(static_cast<std::size_t>(planes.size()), terms);
-  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
+  const std::vector<std::string> fixed = FixedTerms(vm, robot, in_mix);
   return std::make_unique<ScannerMeasurement>(robot, setup, fixed, "--fix");
 }
 
 std::unique_ptr<SocketMeasurement> MakeSocketKind(const RobotModel& robot, const SocketData& data,
                                                   const po::variables_map& vm, bool in_mix) {
   const Eigen::Vector3d tool_point = ResolveToolPoint(vm, "socket", in_mix);
-  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
+  const std::vector<std::string> fixed = FixedTerms(vm, robot, in_mix);
   return std::make_unique<SocketMeasurement>(
       robot,
       SocketSetupFromData(robot, data.ids, data.values.configs, tool_point,
@@ -359,7 +405,7 @@ ParameterSet ResolveParameterSet(const RobotModel& robot, const po::variables_ma
   PlaneTerms terms;
   if (vm.count("estimate-plane"))
     terms = PlaneTerms::Parse(vm["estimate-plane"].as<std::string>(), "--estimate-plane");
-  const std::vector<std::string> fixed = FixedTerms(vm, in_mix);
+  const std::vector<std::string> fixed = FixedTerms(vm, robot, in_mix);
   RangerTerms ranger;
   if (vm.count("estimate-ranger"))
     ranger = RangerTerms::Parse(vm["estimate-ranger"].as<std::string>(), "--estimate-ranger");

@@ -124,6 +124,14 @@ double ResolveSigmaAngle(const po::variables_map& vm, bool allow_zero);
 void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
                          const std::vector<std::string>& options);
 
+/// The terms to hold at nominal: --fix's names, where a link value's class ("theta", "alpha", "a",
+/// "d", "beta") stands for every parameter of that class on `robot`, and what --estimate's preset
+/// holds (offsets: all but each joint's own offset, θ of a revolute joint or d of a prismatic one;
+/// lengths: all but a and d; all: none). InputError naming --estimate for another preset.
+std::vector<std::string> FixList(const po::variables_map& vm, const RobotModel& robot);
+/// --estimate offsets|lengths|all (identify, identifiability).
+void AddEstimatePresetOption(po::options_description& o);
+
 /// --seed: a non-negative integer.
 std::uint64_t ParseSeed(const po::variables_map& vm);
 

@@ -735,7 +735,7 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
 }
 
 // The mixed kind of `files` (labels: the kind, numbered when a kind repeats) with --fix held.
-std::unique_ptr<MeasurementKind> MakeMixedKind(const po::variables_map& vm,
+std::unique_ptr<MeasurementKind> MakeMixedKind(const po::variables_map& vm, const RobotModel& robot,
                                                const std::vector<MixedFile>& files) {
   std::vector<MixedPart> parts;
   std::map<std::string, int> seen, total;
@@ -745,8 +745,8 @@ std::unique_ptr<MeasurementKind> MakeMixedKind(const po::variables_map& vm,
     parts.push_back({f.kind, total[f.sensor] > 1 ? f.sensor + std::to_string(n) : f.sensor});
   }
   auto mixed = std::make_unique<MixedMeasurement>(std::move(parts));
-  if (!vm.count("fix")) return mixed;
-  const std::vector<std::string> fixed = SplitList(vm["fix"].as<std::string>());
+  const std::vector<std::string> fixed = FixList(vm, robot);
+  if (fixed.empty()) return mixed;
   for (const std::string& name : fixed)
     if (std::find(mixed->parameter_names().begin(), mixed->parameter_names().end(), name) ==
         mixed->parameter_names().end())
@@ -801,7 +801,7 @@ int MixedIdentify(const po::variables_map& vm) {
     }
     values.push_back(f.values);
   }
-  const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, files);
+  const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, setup.rig.robot, files);
   const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
   const MeasuredValues data = mixed.Combine(values);
   const IdentificationSummary s = Identify(mixed, data, options);
@@ -823,7 +823,7 @@ int MixedIdentifiability(const po::variables_map& vm) {
   const std::vector<MixedFile> files = LoadMixedFiles(vm, setup, "configs", true);
   std::vector<MeasuredValues> values;
   for (const MixedFile& f : files) values.push_back(f.values);
-  const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, files);
+  const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, setup.rig.robot, files);
   const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
   IdentifiabilityOptions options;
   ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
@@ -847,6 +847,7 @@ int MixedIdentifiability(const po::variables_map& vm) {
 int IdentifyCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal identify options");
   AddIdentifyOptions(o);
+  AddEstimatePresetOption(o);
   AddSettingOptions(o, IdentificationOptions::Settings(),
                     {"loss_scale_mm", "loss_scale_sigma", "sigma_mm"});
   AddSensorOptions(o);
@@ -1052,6 +1053,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
       "the same with the robot file's tolerances: (--prior-sigma entries replace the same keys)");
   AddFrameTermOptions(o);
   AddSensorOptions(o);
+  AddEstimatePresetOption(o);
   AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
   AddSettingOptions(o, IdentifiabilityOptions::Settings(), {"rank_tolerance"});
   po::variables_map vm;

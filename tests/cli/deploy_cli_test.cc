@@ -161,5 +161,31 @@ TEST_F(DeployCli, CompensatedCommandsReachTheNominalPlansPoses) {
   EXPECT_THAT(out, HasSubstr("bad.csv:2 columns qx, qy, qz, qw: expected a unit quaternion"));
 }
 
+// The presets and classes a controller's user asks for instead of typing names: --estimate
+// offsets is each joint's zero offset (θ1 … θ6 on the paper's arm), lengths a and d, --fix alpha
+// every α; a preset lrcal does not have is refused by name.
+TEST_F(DeployCli, PresetsAndClassesNameTheTermsForTheUser) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 40 --seed 3 --out " + Path("c.csv"), &out), 0) << out;
+  const auto terms = [&](const std::string& options) {
+    std::string text;
+    EXPECT_EQ(
+        Run("identifiability --format json --configs " + Path("c.csv") + " " + options, &text), 0)
+        << text;
+    const Json j = Json::parse(text.substr(text.find('{'), text.rfind('}') - text.find('{') + 1));
+    return j["parameters"].get<std::vector<std::string>>();
+  };
+  EXPECT_THAT(terms("--estimate offsets"),
+              ::testing::ElementsAre("theta1", "theta2", "theta3", "theta4", "theta5", "theta6"));
+  for (const std::string& name : terms("--estimate lengths"))
+    EXPECT_TRUE(name[0] == 'a' || name[0] == 'd') << name;
+  const std::vector<std::string> all = terms(""), no_alpha = terms("--fix alpha,d1");
+  EXPECT_EQ(all.size(), 25u);
+  EXPECT_EQ(no_alpha.size(), 25u - 6 - 1);
+  for (const std::string& name : no_alpha) EXPECT_NE(name.rfind("alpha", 0), 0u) << name;
+  EXPECT_EQ(Run("identifiability --estimate joints --configs " + Path("c.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("--estimate: 'joints' is not a preset"));
+}
+
 }  // namespace
 }  // namespace lrcal
