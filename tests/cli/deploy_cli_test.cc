@@ -187,5 +187,44 @@ TEST_F(DeployCli, PresetsAndClassesNameTheTermsForTheUser) {
   EXPECT_THAT(out, HasSubstr("--estimate: 'joints' is not a preset"));
 }
 
+// Joint offsets for a controller that takes nothing else: the calibrated Panda against its URDF,
+// one offset per joint by name, and the error of that simplification stated beside the nominal
+// model's (smaller, not zero: a calibration is more than offsets).
+TEST_F(DeployCli, JointOffsetsStateWhatTheSimplificationCosts) {
+  std::string out;
+  ASSERT_EQ(Run("identify --sensor socket --robot " + Example("panda.urdf") +
+                    " --tool-link ball_link --socket-distance 0,1=0.05 --fix "
+                    "target_x,target_y,target_z --auto-fix --sigma-mm 0.3 --prior-sigma "
+                    "theta=10mrad,alpha=10mrad,a=2mm,d=2mm --data " +
+                    Example("panda_1_front.csv") + " --write-robot " + Path("cal.yaml"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("export --format joint-offsets --robot " + Path("cal.yaml") + " --nominal " +
+                    Example("panda.urdf") + " --tool-link ball_link --count 300 --out " +
+                    Path("offsets.csv"),
+                &out),
+            0)
+      << out;
+  std::ifstream in(Path("offsets.csv"));
+  std::string line, error_line;
+  std::vector<std::string> rows;
+  while (std::getline(in, line)) {
+    if (line.rfind("# The simplification's error", 0) == 0) error_line = line;
+    if (!line.empty() && line[0] != '#') rows.push_back(line);
+  }
+  ASSERT_EQ(rows.size(), 8u);
+  EXPECT_EQ(rows[0], "joint,name,offset,unit");
+  EXPECT_EQ(rows[4].rfind("4,panda_joint4,", 0), 0u) << rows[4];
+  const auto number_after = [&](const std::string& label) {
+    return std::stod(error_line.substr(error_line.find(label) + label.size()));
+  };
+  const double rms = number_after("tool position RMS "), nominal = number_after("alone: RMS ");
+  EXPECT_GT(rms, 0.01);
+  EXPECT_LT(rms, nominal / 2);
+  EXPECT_EQ(Run("export --format joint-offsets --robot " + Path("cal.yaml"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("--nominal: missing"));
+}
+
 }  // namespace
 }  // namespace lrcal
