@@ -388,10 +388,106 @@ void PredictAt(const std::string& file, const MeasurementModel& model,
   *text = AccuracyPredictionText(*predicted);
 }
 
+// identify --only-significant K: the corrections smaller than K standard deviations, held at
+// nominal and the rest refitted; their possible deviation (δ² + std² from the full fit) is then
+// a held term's tolerance in every accuracy statement, and the full and filtered models' predicted
+// tool position errors at the measured configurations are stated side by side.
+struct SignificanceFilter {
+  double k = 0;
+  struct Held {
+    std::string name;
+    double delta = 0, sd = 0;  // SI, from the full fit: the estimate and its standard deviation
+  };
+  std::vector<Held> held;
+  double full_rms = std::nan(""), filtered_rms = std::nan("");  // m
+  int configurations = 0;
+
+  ::lrcal::Json Json() const {
+    ::lrcal::Json list = ::lrcal::Json::array();
+    for (const Held& h : held)
+      list.push_back({{"name", h.name},
+                      {"delta", h.delta},
+                      {"std", h.sd},
+                      {"ratio", std::abs(h.delta) / h.sd}});
+    return {{"k", k},
+            {"held", list},
+            {"predicted_rms_full_mm", full_rms * 1e3},
+            {"predicted_rms_filtered_mm", filtered_rms * 1e3},
+            {"configurations", configurations}};
+  }
+  std::string Text() const {
+    std::ostringstream out;
+    out << "only significant corrections (|delta| >= " << k << " std): ";
+    if (held.empty()) {
+      out << "every correction is significant; nothing held\n";
+      return out.str();
+    }
+    out << "held at nominal and the rest refitted:";
+    for (const Held& h : held)
+      out << " " << h.name << " (" << Fixed(std::abs(h.delta) / h.sd, 2) << " std)";
+    out << "\npredicted tool position error at the " << configurations
+        << " measured configurations (RMS; readings' noise, and the held terms' possible "
+           "deviation from the full fit): full model "
+        << Fixed(full_rms * 1e3, 4) << " mm, only significant " << Fixed(filtered_rms * 1e3, 4)
+        << " mm\n";
+    return out.str();
+  }
+};
+
+// The RMS of the predicted total tool position error of fit `s` on `model` at the measured
+// configurations (NaN when the covariance is undefined).
+double PredictedRmsAtData(const MeasurementModel& model, const IdentificationSummary& s,
+                          const IdentificationOptions& options, const MeasurementSet& data,
+                          const PriorSigmas& known) {
+  const UnestimatedTerms held =
+      FindUnestimatedTerms(SolvedModel(model, s), s, data, options, known);
+  const std::optional<AccuracyPrediction> p =
+      PredictAccuracyAfterFit(model, s, options, held, data.configs);
+  return p ? p->rms_position_total : std::nan("");
+}
+
+std::optional<SignificanceFilter> FilterInsignificant(
+    const po::variables_map& vm, const MeasurementSet& data, const IdentificationOptions& options,
+    MeasurementModel* model, IdentificationSummary* s, PriorSigmas* known) {
+  if (!vm.count("only-significant")) return std::nullopt;
+  SignificanceFilter f;
+  f.k = vm["only-significant"].as<double>();
+  if (!(f.k > 0) || !std::isfinite(f.k))
+    throw InputError(
+        "--only-significant",
+        "expected a positive number of standard deviations (e.g. 2), got " + FormatExact(f.k));
+  if (!s->IsSolutionUsable()) return f;
+  const Eigen::MatrixXd& covariance = FitCovariance(*s, options);
+  std::vector<std::string> names;
+  PriorSigmas possible;
+  for (std::size_t k = 0; k < s->names.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    const double sd = std::sqrt(covariance(i, i));
+    if (!(std::abs(s->delta[i]) < f.k * sd)) continue;
+    f.held.push_back({s->names[k], s->delta[i], sd});
+    names.push_back(s->names[k]);
+    possible.entries.push_back({s->names[k], std::hypot(s->delta[i], sd)});
+  }
+  f.configurations = data.size();
+  f.full_rms = PredictedRmsAtData(*model, *s, options, data, *known);
+  if (names.empty()) {
+    f.filtered_rms = f.full_rms;
+    return f;
+  }
+  *model = MeasurementModel(
+      model->robot(), model->nominal_planes(),
+      WithoutParameters(model->robot(), SolvedModel(*model, *s).parameters(), names));
+  *s = Identify(*model, data, options);
+  *known = known->OverriddenBy(possible);
+  if (s->IsSolutionUsable()) f.filtered_rms = PredictedRmsAtData(*model, *s, options, data, *known);
+  return f;
+}
+
 // identify's output: the fit, and what --predict-at and --holdout add, as text or JSON.
 void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& model,
                           const MeasurementSet& data, const IdentificationSummary& s,
-                          const IdentificationOptions& options, const UnestimatedTerms& held) {
+                          const IdentificationOptions& options, const UnestimatedTerms& held,
+                          const std::optional<SignificanceFilter>& filter) {
   Json accuracy;
   std::string accuracy_text;
   if (vm.count("predict-at") && s.IsSolutionUsable())
@@ -405,6 +501,7 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
     Json j = IdentificationJson(s);
     if (!accuracy.is_null()) j["accuracy"] = accuracy;
     if (cv) j["holdout"] = CrossValidationJson(*cv);
+    if (filter) j["only_significant"] = filter->Json();
     j["average"] = average;
     std::cout << j.dump(2) << "\n";
   } else {
@@ -414,6 +511,7 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
                 << Fixed(data.variance_factor.front(), 3) << " for " << data.repetitions.front()
                 << " readings: the variance of the " << average << " relative to a mean)\n";
     std::cout << s.FullReport();
+    if (filter) std::cout << filter->Text();
     std::cout << accuracy_text << (cv ? cv->ToString() : "");
   }
 }
@@ -450,6 +548,9 @@ void AddIdentifyOptions(po::options_description& o) {
       "estimate-plane", po::value<std::string>()->default_value("none"),
       "plane terms to estimate: none, normal, offset, normal,offset")(
       "fix", po::value<std::string>(), "parameters to keep at nominal, comma-separated")(
+      "only-significant", po::value<double>(),
+      "hold at nominal the corrections smaller than K standard deviations, refit the rest and "
+      "state both models' predicted accuracy (e.g. --only-significant 2)")(
       "auto-fix", po::bool_switch(),
       "if the set is rank-deficient, fix the suggested parameters and go on")(
       "prior-sigma", po::value<std::string>(),
@@ -492,9 +593,9 @@ namespace {
 // (a kind that reads no plane refuses --plane and --estimate-plane too), and a calibrated robot
 // file that could not be written refused before the fit, not after.
 void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
-  std::vector<std::string> refused = {"estimate-ranger", "estimate-base", "estimate-tool",
-                                      "average",         "predict-at",    "holdout",
-                                      "report"};
+  std::vector<std::string> refused = {"estimate-ranger", "estimate-base",   "estimate-tool",
+                                      "average",         "predict-at",      "holdout",
+                                      "report",          "only-significant"};
   if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
   RefuseRangerOptions(vm, sensor, refused);
   if (vm.count("write-robot"))
@@ -716,6 +817,7 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
       {"predict-at", false},
       {"holdout", false},
       {"report", false},
+      {"only-significant", false},
       {"prior", false},
       {"prior-sigma", false},
       {"estimate-ranger", has({"ranger"})},
@@ -871,15 +973,17 @@ int IdentifyCommand(const std::vector<std::string>& args) {
       DataFile(vm), rig, &planes, Averaging::Parse(vm["average"].as<std::string>()));
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
   const IdentificationOptions options = ResolveIdentificationOptions(vm, rig);
-  const IdentificationSummary s = Identify(model, data, options);
+  IdentificationSummary s = Identify(model, data, options);
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
     throw InputError(DataFile(vm), s.message);
+  PriorSigmas known = KnownTolerances(vm, rig);
+  const std::optional<SignificanceFilter> filter =
+      FilterInsignificant(vm, data, options, &model, &s, &known);
 
   const UnestimatedTerms held =
-      s.IsSolutionUsable()
-          ? FindUnestimatedTerms(SolvedModel(model, s), s, data, options, KnownTolerances(vm, rig))
-          : UnestimatedTerms{};
-  PrintIdentifyResults(vm, model, data, s, options, held);
+      s.IsSolutionUsable() ? FindUnestimatedTerms(SolvedModel(model, s), s, data, options, known)
+                           : UnestimatedTerms{};
+  PrintIdentifyResults(vm, model, data, s, options, held, filter);
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "
                  "configurations; fix the suggested parameters (--fix "

@@ -226,5 +226,32 @@ TEST_F(DeployCli, JointOffsetsStateWhatTheSimplificationCosts) {
   EXPECT_THAT(out, HasSubstr("--nominal: missing"));
 }
 
+// identify --only-significant K: the corrections within K standard deviations of zero are held at
+// nominal and the rest refitted, and both models' predicted accuracy is stated.
+TEST_F(DeployCli, OnlySignificantCorrectionsAreKept) {
+  std::string out;
+  ASSERT_EQ(Run("sample --count 40 --seed 3 --out " + Path("c.csv"), &out), 0) << out;
+  ASSERT_EQ(Run("simulate --configs " + Path("c.csv") + " --out " + Path("m.csv"), &out), 0) << out;
+  ASSERT_EQ(
+      Run("identify --format json --sigma-mm 0.2 --only-significant 2 --data " + Path("m.csv"),
+          &out),
+      0)
+      << out;
+  const Json fit = Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  const Json& filter = fit["only_significant"];
+  ASSERT_FALSE(filter["held"].empty());
+  std::vector<std::string> estimated;
+  for (const Json& p : fit["parameters"]) estimated.push_back(p["name"]);
+  for (const Json& h : filter["held"]) {
+    EXPECT_LT(h["ratio"].get<double>(), 2.0);
+    EXPECT_THAT(estimated, ::testing::Not(::testing::Contains(h["name"].get<std::string>())));
+  }
+  EXPECT_EQ(estimated.size() + filter["held"].size(), 25u);
+  EXPECT_GT(filter["predicted_rms_filtered_mm"].get<double>(), 0);
+  EXPECT_GT(filter["predicted_rms_full_mm"].get<double>(), 0);
+  EXPECT_EQ(Run("identify --only-significant -1 --data " + Path("m.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("--only-significant: expected a positive number"));
+}
+
 }  // namespace
 }  // namespace lrcal
