@@ -14,6 +14,7 @@
 #include "lrcal/design/identifiability_remedies.h"
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/significance.h"
 #include "lrcal/io/calibration_record.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/kinematics_report.h"
@@ -388,28 +389,23 @@ void PredictAt(const std::string& file, const MeasurementModel& model,
   *text = AccuracyPredictionText(*predicted);
 }
 
-// identify --only-significant K: the corrections smaller than K standard deviations, held at
-// nominal and the rest refitted; their possible deviation (δ² + std² from the full fit) is then
-// a held term's tolerance in every accuracy statement, and the full and filtered models' predicted
-// tool position errors at the measured configurations are stated side by side.
+// identify --only-significant K (identification/significance.h): the corrections within K
+// standard deviations held at nominal and the rest refitted, their possible deviation a held
+// term's tolerance in every accuracy statement; both models' predicted tool position error at the
+// measured configurations stated side by side.
 struct SignificanceFilter {
-  double k = 0;
-  struct Held {
-    std::string name;
-    double delta = 0, sd = 0;  // SI, from the full fit: the estimate and its standard deviation
-  };
-  std::vector<Held> held;
+  InsignificantCorrections held;
   double full_rms = std::nan(""), filtered_rms = std::nan("");  // m
   int configurations = 0;
 
   ::lrcal::Json Json() const {
     ::lrcal::Json list = ::lrcal::Json::array();
-    for (const Held& h : held)
+    for (const InsignificantCorrections::Term& h : held.terms)
       list.push_back({{"name", h.name},
                       {"delta", h.delta},
                       {"std", h.sd},
                       {"ratio", std::abs(h.delta) / h.sd}});
-    return {{"k", k},
+    return {{"k", held.k},
             {"held", list},
             {"predicted_rms_full_mm", full_rms * 1e3},
             {"predicted_rms_filtered_mm", filtered_rms * 1e3},
@@ -417,13 +413,13 @@ struct SignificanceFilter {
   }
   std::string Text() const {
     std::ostringstream out;
-    out << "only significant corrections (|delta| >= " << k << " std): ";
-    if (held.empty()) {
+    out << "only significant corrections (|delta| >= " << held.k << " std): ";
+    if (held.terms.empty()) {
       out << "every correction is significant; nothing held\n";
       return out.str();
     }
     out << "held at nominal and the rest refitted:";
-    for (const Held& h : held)
+    for (const InsignificantCorrections::Term& h : held.terms)
       out << " " << h.name << " (" << Fixed(std::abs(h.delta) / h.sd, 2) << " std)";
     out << "\npredicted tool position error at the " << configurations
         << " measured configurations (RMS; readings' noise, and the held terms' possible "
@@ -450,35 +446,26 @@ std::optional<SignificanceFilter> FilterInsignificant(
     const po::variables_map& vm, const MeasurementSet& data, const IdentificationOptions& options,
     MeasurementModel* model, IdentificationSummary* s, PriorSigmas* known) {
   if (!vm.count("only-significant")) return std::nullopt;
-  SignificanceFilter f;
-  f.k = vm["only-significant"].as<double>();
-  if (!(f.k > 0) || !std::isfinite(f.k))
+  const double k = vm["only-significant"].as<double>();
+  if (!(k > 0) || !std::isfinite(k))
     throw InputError(
         "--only-significant",
-        "expected a positive number of standard deviations (e.g. 2), got " + FormatExact(f.k));
+        "expected a positive number of standard deviations (e.g. 2), got " + FormatExact(k));
+  SignificanceFilter f;
+  f.held.k = k;
   if (!s->IsSolutionUsable()) return f;
-  const Eigen::MatrixXd& covariance = FitCovariance(*s, options);
-  std::vector<std::string> names;
-  PriorSigmas possible;
-  for (std::size_t k = 0; k < s->names.size(); ++k) {
-    const auto i = static_cast<Eigen::Index>(k);
-    const double sd = std::sqrt(covariance(i, i));
-    if (!(std::abs(s->delta[i]) < f.k * sd)) continue;
-    f.held.push_back({s->names[k], s->delta[i], sd});
-    names.push_back(s->names[k]);
-    possible.entries.push_back({s->names[k], std::hypot(s->delta[i], sd)});
-  }
+  f.held = FindInsignificantCorrections(*s, options, k);
   f.configurations = data.size();
   f.full_rms = PredictedRmsAtData(*model, *s, options, data, *known);
-  if (names.empty()) {
+  if (f.held.terms.empty()) {
     f.filtered_rms = f.full_rms;
     return f;
   }
   *model = MeasurementModel(
       model->robot(), model->nominal_planes(),
-      WithoutParameters(model->robot(), SolvedModel(*model, *s).parameters(), names));
+      WithoutParameters(model->robot(), SolvedModel(*model, *s).parameters(), f.held.Names()));
   *s = Identify(*model, data, options);
-  *known = known->OverriddenBy(possible);
+  *known = known->OverriddenBy(f.held.Tolerances());
   if (s->IsSolutionUsable()) f.filtered_rms = PredictedRmsAtData(*model, *s, options, data, *known);
   return f;
 }

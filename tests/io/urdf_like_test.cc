@@ -26,7 +26,7 @@ namespace {
 using ::testing::HasSubstr;
 constexpr double kLikeTolerance = testing::tolerance::kUrdf;  // m, rad
 
-std::string Panda() { return testing::SourcePath("examples/mukca/panda.urdf"); }
+std::string PandaUrdf() { return testing::SourcePath("examples/mukca/panda.urdf"); }
 
 // The URDF's own forward kinematics, root → tool link: each joint's origin, then its motion.
 Eigen::Isometry3d ComposeUrdf(const std::string& path, const std::string& tool_link,
@@ -60,7 +60,7 @@ struct Calibrated {
   Eigen::VectorXd values;
 };
 Calibrated CalibratedPanda(const std::string& tool_link, bool move_tool = true) {
-  const RobotFile own = LoadRobotFile(Panda(), tool_link);
+  const RobotFile own = LoadRobotFile(PandaUrdf(), tool_link);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> size(1e-3, 3e-3);
   Calibrated c{own.robot, own.robot.nominal_values()};
@@ -77,7 +77,7 @@ Calibrated CalibratedPanda(const std::string& tool_link, bool move_tool = true) 
 
 std::string WriteLike(const std::string& name, const std::string& tool_link, const Calibrated& c) {
   const std::string path = testing::TempDir("urdf_like") + "/" + name;
-  std::ofstream(path) << UrdfLikeText(Panda(), tool_link, c.robot, c.values);
+  std::ofstream(path) << UrdfLikeText(PandaUrdf(), tool_link, c.robot, c.values);
   return path;
 }
 
@@ -138,7 +138,7 @@ TEST(UrdfLike, ThePandaKeepsEverythingOffTheChainAndTakesTheCalibration) {
   EXPECT_LT((a.p_BT - b.p_BT).norm(), kLikeTolerance);
 
   TiXmlDocument original, written;
-  ASSERT_TRUE(original.LoadFile(Panda().c_str()));
+  ASSERT_TRUE(original.LoadFile(PandaUrdf().c_str()));
   ASSERT_TRUE(written.LoadFile(path.c_str()));
   std::set<std::string> changed;
   const TiXmlNode* x = original.FirstChild();
@@ -155,10 +155,10 @@ TEST(UrdfLike, ThePandaKeepsEverythingOffTheChainAndTakesTheCalibration) {
 // The URDF's own model written into it gives it back: every joint frame keeps its place (so a
 // calibration moves link frames, meshes and inertials only by what it moved), not just the tool.
 TEST(UrdfLike, TheUrdfsOwnModelGivesEveryJointOriginBack) {
-  const RobotFile own = LoadRobotFile(Panda(), "ball_link");
+  const RobotFile own = LoadRobotFile(PandaUrdf(), "ball_link");
   const Calibrated nominal{own.robot, own.robot.nominal_values()};
   const std::string path = WriteLike("own.urdf", "ball_link", nominal);
-  const urdf::ModelInterfaceSharedPtr a = urdf::parseURDFFile(Panda());
+  const urdf::ModelInterfaceSharedPtr a = urdf::parseURDFFile(PandaUrdf());
   const urdf::ModelInterfaceSharedPtr b = urdf::parseURDFFile(path);
   ASSERT_TRUE(a && b);
   ASSERT_EQ(a->joints_.size(), b->joints_.size());
@@ -178,27 +178,27 @@ TEST(UrdfLike, TheUrdfsOwnModelGivesEveryJointOriginBack) {
 
 TEST(UrdfLike, AToolLinkThatTurnsWithTheLastJointTakesOnlyAToolOnItsAxis) {
   // The URDF's own model, tool link panda_link7: the joint's frame slides along its axis.
-  const RobotFile own = LoadRobotFile(Panda(), "panda_link7");
+  const RobotFile own = LoadRobotFile(PandaUrdf(), "panda_link7");
   const Calibrated nominal{own.robot, own.robot.nominal_values()};
   ExpectModelKinematics(nominal, WriteLike("link7.urdf", "panda_link7", nominal), "panda_link7");
   // A calibrated last link puts the tool off the axis: there is no element to carry it.
   const Calibrated c = CalibratedPanda("panda_link7");
-  EXPECT_THAT([&] { UrdfLikeText(Panda(), "panda_link7", c.robot, c.values); },
+  EXPECT_THAT([&] { UrdfLikeText(PandaUrdf(), "panda_link7", c.robot, c.values); },
               ::testing::ThrowsMessage<InputError>(
                   HasSubstr("'panda_link7' is the last movable joint's own child")));
 }
 
 TEST(UrdfLike, AModelOfAnotherChainIsRefused) {
   const RobotModel& paper = testing::PaperRobot();
-  EXPECT_THAT([&] { UrdfLikeText(Panda(), "ball_link", paper, paper.nominal_values()); },
+  EXPECT_THAT([&] { UrdfLikeText(PandaUrdf(), "ball_link", paper, paper.nominal_values()); },
               ::testing::ThrowsMessage<InputError>(
                   HasSubstr("the chain to 'ball_link' has 7 movable joints but the model has 6")));
   Calibrated far = CalibratedPanda("ball_link");
   far.values[kValuesPerLink * 3 + kD] += 1.0;  // a metre: not a calibration of this arm
-  EXPECT_THAT([&] { UrdfLikeText(Panda(), "ball_link", far.robot, far.values); },
+  EXPECT_THAT([&] { UrdfLikeText(PandaUrdf(), "ball_link", far.robot, far.values); },
               ::testing::ThrowsMessage<InputError>(
                   HasSubstr("is the model a calibration of this robot and tool link?")));
-  EXPECT_THAT([&] { UrdfLikeText(Panda(), "no_link", far.robot, far.values); },
+  EXPECT_THAT([&] { UrdfLikeText(PandaUrdf(), "no_link", far.robot, far.values); },
               ::testing::ThrowsMessage<InputError>(HasSubstr("no link named 'no_link'")));
 }
 
