@@ -40,19 +40,24 @@ class DeployCli : public ::testing::Test {
         << out;
     return Json::parse(out.substr(out.find('['), out.rfind(']') - out.find('[') + 1));
   }
+  // cal.yaml: the Panda calibrated from MUKCa's front placement (README "Sockets").
+  void CalibratePanda() const {
+    std::string out;
+    ASSERT_EQ(Run("identify --sensor socket --robot " + Example("panda.urdf") +
+                      " --tool-link ball_link --socket-distance 0,1=0.05 --fix "
+                      "target_x,target_y,target_z --auto-fix --sigma-mm 0.3 --prior-sigma "
+                      "theta=10mrad,alpha=10mrad,a=2mm,d=2mm --data " +
+                      Example("panda_1_front.csv") + " --write-robot " + Path("cal.yaml"),
+                  &out),
+              0)
+        << out;
+  }
   std::string dir_;
 };
 
 TEST_F(DeployCli, ACalibratedPandaGoesIntoTheUsersOwnUrdf) {
   std::string out;
-  ASSERT_EQ(Run("identify --sensor socket --robot " + Example("panda.urdf") +
-                    " --tool-link ball_link --socket-distance 0,1=0.05 --fix "
-                    "target_x,target_y,target_z --auto-fix --sigma-mm 0.3 --prior-sigma "
-                    "theta=10mrad,alpha=10mrad,a=2mm,d=2mm --data " +
-                    Example("panda_1_front.csv") + " --write-robot " + Path("cal.yaml"),
-                &out),
-            0)
-      << out;
+  ASSERT_NO_FATAL_FAILURE(CalibratePanda());
   ASSERT_EQ(Run("export --robot " + Path("cal.yaml") + " --like " + Example("panda.urdf") +
                     " --tool-link ball_link --out " + Path("panda_calibrated.urdf"),
                 &out),
@@ -99,14 +104,7 @@ TEST_F(DeployCli, ACalibratedPandaGoesIntoTheUsersOwnUrdf) {
 // corrected commands (lrcal kinematics) are the nominal plan's to 1e-9.
 TEST_F(DeployCli, CompensatedCommandsReachTheNominalPlansPoses) {
   std::string out;
-  ASSERT_EQ(Run("identify --sensor socket --robot " + Example("panda.urdf") +
-                    " --tool-link ball_link --socket-distance 0,1=0.05 --fix "
-                    "target_x,target_y,target_z --auto-fix --sigma-mm 0.3 --prior-sigma "
-                    "theta=10mrad,alpha=10mrad,a=2mm,d=2mm --data " +
-                    Example("panda_1_front.csv") + " --write-robot " + Path("cal.yaml"),
-                &out),
-            0)
-      << out;
+  ASSERT_NO_FATAL_FAILURE(CalibratePanda());
   ASSERT_EQ(Run("compensate --robot " + Path("cal.yaml") + " --nominal " + Example("panda.urdf") +
                     " --tool-link ball_link --targets " + Example("panda_1_right.csv") + " --out " +
                     Path("commands.csv"),
@@ -192,14 +190,7 @@ TEST_F(DeployCli, PresetsAndClassesNameTheTermsForTheUser) {
 // model's (smaller, not zero: a calibration is more than offsets).
 TEST_F(DeployCli, JointOffsetsStateWhatTheSimplificationCosts) {
   std::string out;
-  ASSERT_EQ(Run("identify --sensor socket --robot " + Example("panda.urdf") +
-                    " --tool-link ball_link --socket-distance 0,1=0.05 --fix "
-                    "target_x,target_y,target_z --auto-fix --sigma-mm 0.3 --prior-sigma "
-                    "theta=10mrad,alpha=10mrad,a=2mm,d=2mm --data " +
-                    Example("panda_1_front.csv") + " --write-robot " + Path("cal.yaml"),
-                &out),
-            0)
-      << out;
+  ASSERT_NO_FATAL_FAILURE(CalibratePanda());
   ASSERT_EQ(Run("export --format joint-offsets --robot " + Path("cal.yaml") + " --nominal " +
                     Example("panda.urdf") + " --tool-link ball_link --count 300 --out " +
                     Path("offsets.csv"),

@@ -19,6 +19,7 @@
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "test_util.h"
+#include "urdf_kinematics.h"
 
 namespace lrcal {
 namespace {
@@ -27,31 +28,6 @@ using ::testing::HasSubstr;
 constexpr double kLikeTolerance = testing::tolerance::kUrdf;  // m, rad
 
 std::string PandaUrdf() { return testing::SourcePath("examples/mukca/panda.urdf"); }
-
-// The URDF's own forward kinematics, root → tool link: each joint's origin, then its motion.
-Eigen::Isometry3d ComposeUrdf(const std::string& path, const std::string& tool_link,
-                              const std::vector<double>& q) {
-  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
-  EXPECT_TRUE(model) << path;
-  std::vector<urdf::JointConstSharedPtr> chain;
-  for (urdf::LinkConstSharedPtr link = model->getLink(tool_link); link->parent_joint;
-       link = model->getLink(link->parent_joint->parent_link_name))
-    chain.insert(chain.begin(), link->parent_joint);
-  Eigen::Isometry3d x = Eigen::Isometry3d::Identity();
-  std::size_t k = 0;
-  for (const auto& joint : chain) {
-    const urdf::Pose& o = joint->parent_to_joint_origin_transform;
-    x = x * Eigen::Translation3d(o.position.x, o.position.y, o.position.z) *
-        Eigen::Quaterniond(o.rotation.w, o.rotation.x, o.rotation.y, o.rotation.z);
-    const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-    if (joint->type == urdf::Joint::FIXED) continue;
-    if (joint->type == urdf::Joint::PRISMATIC)
-      x = x * Eigen::Translation3d(q.at(k++) * axis);
-    else
-      x = x * Eigen::AngleAxisd(q.at(k++), axis.normalized());
-  }
-  return x;
-}
 
 // The Panda's chain to `tool_link` with every link value 1–3 mm or mrad off, and its base and
 // tool transforms moved too: a calibrated model.
@@ -89,7 +65,7 @@ void ExpectModelKinematics(const Calibrated& c, const std::string& path,
     for (const Link& link : c.robot.links())
       q.push_back(std::uniform_real_distribution<double>(link.q_min, link.q_max)(rng));
     const Pose<double> model = ForwardKinematics<double>(c.robot, c.values.data(), q.data());
-    const Eigen::Isometry3d urdf = ComposeUrdf(path, tool_link, q);
+    const Eigen::Isometry3d urdf = testing::UrdfForwardKinematics(path, tool_link, q);
     EXPECT_LT((model.p_BT - urdf.translation()).norm(), kLikeTolerance);
     EXPECT_THAT(model.R_BT, testing::EigenNear(urdf.linear(), kLikeTolerance));
   }

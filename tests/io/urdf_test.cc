@@ -16,39 +16,13 @@
 #include "lrcal/kinematics/chain.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "test_util.h"
+#include "urdf_kinematics.h"
 
 namespace lrcal {
 namespace {
 
 // Chains of O(1 m) and O(1) rotations composed in two different ways: rounding only.
 constexpr double kTolerance = testing::tolerance::kUrdf;  // m, rad
-
-// The URDF's forward kinematics: root → tool link, each joint its origin then its motion
-// (rotation about / translation along its axis by q), the movable joints taking q in order.
-Eigen::Isometry3d UrdfForwardKinematics(const std::string& path, const std::string& tool_link,
-                                        const std::vector<double>& q) {
-  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
-  EXPECT_TRUE(model) << path;
-  std::vector<urdf::JointConstSharedPtr> chain;
-  for (urdf::LinkConstSharedPtr link = model->getLink(tool_link); link->parent_joint;
-       link = model->getLink(link->parent_joint->parent_link_name))
-    chain.insert(chain.begin(), link->parent_joint);
-  Eigen::Isometry3d x = Eigen::Isometry3d::Identity();
-  std::size_t k = 0;
-  for (const auto& joint : chain) {
-    const urdf::Pose& o = joint->parent_to_joint_origin_transform;
-    x = x * Eigen::Translation3d(o.position.x, o.position.y, o.position.z) *
-        Eigen::Quaterniond(o.rotation.w, o.rotation.x, o.rotation.y, o.rotation.z);
-    const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-    if (joint->type == urdf::Joint::FIXED) continue;
-    if (joint->type == urdf::Joint::PRISMATIC)
-      x = x * Eigen::Translation3d(q.at(k++) * axis);
-    else
-      x = x * Eigen::AngleAxisd(q.at(k++), axis.normalized());
-  }
-  EXPECT_EQ(k, q.size());
-  return x;
-}
 
 std::vector<double> RandomConfiguration(const RobotModel& robot, std::mt19937* rng) {
   std::vector<double> q;
@@ -66,7 +40,7 @@ void ExpectSameKinematics(const RobotModel& robot, const std::string& urdf,
   PrepareChainPoint(robot, robot.nominal_values().data(), &point);
   for (int trial = 0; trial < 200; ++trial) {
     const std::vector<double> q = RandomConfiguration(robot, &rng);
-    const Eigen::Isometry3d expected = UrdfForwardKinematics(urdf, tool_link, q);
+    const Eigen::Isometry3d expected = testing::UrdfForwardKinematics(urdf, tool_link, q);
     const Pose<double> ref =
         ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
     TargetedConfigurations one(robot.num_links());
@@ -132,7 +106,7 @@ TEST(Urdf, PaperArmExportedMatchesAndReadsBack) {
   for (int trial = 0; trial < 20; ++trial) {
     const std::vector<double> q = RandomConfiguration(paper, &rng);
     const Pose<double> pose = ForwardKinematics<double>(paper, truth.data(), q.data());
-    const Eigen::Isometry3d urdf = UrdfForwardKinematics(path, "tool", q);
+    const Eigen::Isometry3d urdf = testing::UrdfForwardKinematics(path, "tool", q);
     EXPECT_LT((pose.p_BT - urdf.translation()).norm(), kTolerance);
     EXPECT_THAT(pose.R_BT, testing::EigenNear(urdf.linear(), kTolerance));
   }
@@ -147,8 +121,8 @@ TEST(Urdf, RoundTripKeepsTheKinematics) {
   std::mt19937 rng(23);
   for (int trial = 0; trial < 200; ++trial) {
     const std::vector<double> q = RandomConfiguration(rig.robot, &rng);
-    const Eigen::Isometry3d a = UrdfForwardKinematics(original, "ranger", q);
-    const Eigen::Isometry3d b = UrdfForwardKinematics(written, "tool", q);
+    const Eigen::Isometry3d a = testing::UrdfForwardKinematics(original, "ranger", q);
+    const Eigen::Isometry3d b = testing::UrdfForwardKinematics(written, "tool", q);
     EXPECT_LT((a.translation() - b.translation()).norm(), kTolerance);
     EXPECT_THAT(a.linear(), testing::EigenNear(b.linear(), kTolerance));
   }
