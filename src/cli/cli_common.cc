@@ -137,6 +137,8 @@ bool IsSensorName(const std::string& sensor) {
 std::vector<std::string> ResolveSensors(const po::variables_map& vm) {
   const std::string text = vm["sensor"].as<std::string>();
   const std::vector<std::string> sensors = SplitList(text);
+  // "mixed": each --data file says its rows' kinds in a sensor column (csv.h SplitBySensor).
+  if (sensors.size() == 1 && sensors[0] == "mixed") return sensors;
   if (sensors.empty())
     throw InputError("--sensor",
                      "expected ranger, scanner, point, pose, socket or contact, or a "
@@ -169,7 +171,7 @@ std::vector<std::string> ResolveSensors(const po::variables_map& vm) {
 
 std::string ResolveSensor(const po::variables_map& vm) {
   const std::vector<std::string> sensors = ResolveSensors(vm);
-  return sensors.size() == 1 ? sensors[0] : "mixed";
+  return sensors.size() == 1 ? sensors[0] : "mixed";  // "mixed" itself too
 }
 
 namespace {
@@ -321,11 +323,13 @@ Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string&
     return ParseXyzRpy(vm["probe"].as<std::string>(), "--probe", true).translation;
   if (in_mix) {
     const std::vector<std::string> sensors = ResolveSensors(vm);
-    for (const char* tracker : {"point", "pose"})
-      if (std::find(sensors.begin(), sensors.end(), tracker) != sensors.end())
-        throw InputError("--probe", "missing: with --sensor " + vm["sensor"].as<std::string>() +
-                                        " --target is the tracker's; give the " + sensor +
-                                        "s' tool point as --probe x,y,z (m, tool frame)");
+    const bool tracker = std::find(sensors.begin(), sensors.end(), "point") != sensors.end() ||
+                         std::find(sensors.begin(), sensors.end(), "pose") != sensors.end() ||
+                         (vm.count("instrument") && !vm["instrument"].defaulted());
+    if (tracker)
+      throw InputError("--probe", "missing: with --sensor " + vm["sensor"].as<std::string>() +
+                                      " --target is the tracker's; give the " + sensor +
+                                      "s' tool point as --probe x,y,z (m, tool frame)");
   }
   if (vm.count("instrument") && !vm["instrument"].defaulted())
     throw InputError("--instrument", "--sensor " + sensor +

@@ -529,7 +529,8 @@ void AddIdentifyOptions(po::options_description& o) {
   o.add_options()("data", po::value<std::vector<std::string>>()->required()->composing(),
                   "measurement CSV (q1..qN, h in m; rows with equal q are averaged); repeat it "
                   "with one kind per file in --sensor to calibrate from several kinds at once "
-                  "(--sensor point,contact --data p.csv --data c.csv)")(
+                  "(--sensor point,contact --data p.csv --data c.csv), or give --sensor mixed and "
+                  "files whose sensor column says each row's kind")(
       "estimate-ranger", po::value<std::string>()->default_value("none"),
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"),
@@ -740,45 +741,56 @@ MeasuredValues ZeroValues(const MeasurementKind& kind, TargetedConfigurations co
   return v;
 }
 
-// Reads `file` as `sensor`'s data (the same readers and columns as --sensor alone);
-// `configs_only`: the configurations of an identifiability question (a tracker's or ranger's file
-// needs no measured columns).
-MixedFile LoadMixedFile(const po::variables_map& vm, const Setup& setup, const std::string& sensor,
-                        const std::string& file, bool configs_only) {
+// Reads the table `t` (a file, or a mixed file's rows of one kind) as `sensor`'s data, with the
+// same readers and columns as --sensor alone; `configs_only`: the configurations of an
+// identifiability question (a tracker's or ranger's rows need no measured columns).
+MixedFile LoadMixedTable(const po::variables_map& vm, const Setup& setup, const std::string& sensor,
+                         const CsvTable& t, bool configs_only) {
   const RobotModel& robot = setup.rig.robot;
-  MixedFile f{sensor, file, nullptr, {}};
+  const int n = robot.num_links();
+  MixedFile f{sensor, t.path, nullptr, {}};
   if (sensor == "point" || sensor == "pose") {
     std::unique_ptr<PointMeasurement> kind = MakeTrackerKind(robot, sensor, vm, true);
-    f.values =
-        configs_only
-            ? ZeroValues(*kind, ReadRobotTargetConfigurations(
-                                    file, robot, static_cast<int>(kind->setup().targets.size())))
-            : ReadTrackerMeasurements(file, *kind);
+    if (configs_only) {
+      f.values = ZeroValues(
+          *kind, TargetConfigurations(t, n, static_cast<int>(kind->setup().targets.size())));
+      CheckJointRanges(f.values.configs, robot, t.path);
+    } else {
+      f.values = TrackerMeasurementsFromTable(t, *kind);
+    }
     f.kind = std::move(kind);
   } else if (sensor == "socket") {
-    const SocketData data = ReadSocketData(file, robot);
+    const SocketData data = SocketDataFromTable(t, robot);
     f.kind = MakeSocketKind(robot, data, vm, true);
     f.values = data.values;
   } else if (sensor == "contact") {
-    const ContactData data = ReadContactData(file, robot, setup.planes, vm["flush"].as<bool>());
+    const ContactData data = ContactDataFromTable(t, robot, setup.planes, vm["flush"].as<bool>());
     f.kind = MakeContactKind(robot, setup.planes, data.flush, vm, true);
     f.values = data.values;
   } else if (sensor == "scanner") {
     std::unique_ptr<ScannerMeasurement> kind =
         MakeScannerKind(robot, setup.planes, setup.rig.ranger, vm, true);
-    f.values = configs_only && ReadCsv(file).Column("beam") < 0
-                   ? ZeroValues(*kind, ReadRobotConfigurations(file, robot, &setup.planes))
-                   : ReadScannerData(file, robot, setup.planes, kind->num_beams());
+    if (configs_only && t.Column("beam") < 0) {
+      f.values = ZeroValues(*kind, Configurations(t, n, &setup.planes));
+      CheckJointRanges(f.values.configs, robot, t.path);
+    } else {
+      f.values = ScannerDataFromTable(t, robot, setup.planes, kind->num_beams());
+    }
     f.kind = std::move(kind);
   } else {
     auto kind = std::make_shared<RangerMeasurement>(
         MeasurementModel(robot, setup.planes,
                          ResolveParameterSet(robot, vm, setup.planes.size(), true)),
         setup.rig.ranger);
-    f.values = configs_only ? ZeroValues(*kind, ReadRobotConfigurations(file, robot, &setup.planes))
-                            : ToMeasuredValues(ReadRobotMeasurements(
-                                  file, setup.rig, &setup.planes,
-                                  Averaging::Parse(vm["average"].as<std::string>())));
+    if (configs_only) {
+      f.values = ZeroValues(*kind, Configurations(t, n, &setup.planes));
+      CheckJointRanges(f.values.configs, robot, t.path);
+    } else {
+      MeasurementSet data = Measurements(t, n, &setup.rig.ranger, &setup.planes,
+                                         Averaging::Parse(vm["average"].as<std::string>()));
+      CheckJointRanges(data.configs, robot, t.path);
+      f.values = ToMeasuredValues(data);
+    }
     f.kind = std::move(kind);
   }
   return f;
@@ -788,12 +800,24 @@ MixedFile LoadMixedFile(const po::variables_map& vm, const Setup& setup, const s
 // refused by name.
 std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& setup,
                                       const char* option, bool configs_only) {
-  const std::vector<std::string> sensors = ResolveSensors(vm);
+  const std::vector<std::string> listed = ResolveSensors(vm);
   const auto& files = vm[option].as<std::vector<std::string>>();
-  if (files.size() != sensors.size())
+  // --sensor mixed: every file's rows say their kind (a sensor column); else one kind per file.
+  std::vector<std::pair<std::string, CsvTable>> tables;
+  if (listed.size() == 1 && listed[0] == "mixed") {
+    for (const std::string& file : files)
+      for (auto& group : SplitBySensor(ReadRobotCsv(file, setup.rig.robot)))
+        tables.push_back(std::move(group));
+  } else if (files.size() == listed.size()) {
+    for (std::size_t k = 0; k < files.size(); ++k)
+      tables.emplace_back(listed[k], ReadRobotCsv(files[k], setup.rig.robot));
+  }
+  std::vector<std::string> sensors;
+  for (const auto& table : tables) sensors.push_back(table.first);
+  if (tables.empty())
     throw InputError(std::string("--") + option,
                      "given " + std::to_string(files.size()) + " time(s) for the " +
-                         std::to_string(sensors.size()) + " kinds of --sensor " +
+                         std::to_string(listed.size()) + " kinds of --sensor " +
                          vm["sensor"].as<std::string>() + ": expected one file per kind, in order");
   const auto has = [&](std::initializer_list<const char*> kinds) {
     for (const char* kind : kinds)
@@ -818,8 +842,8 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
       throw InputError("--" + name, "is not taken by a calibration from several kinds (--sensor " +
                                         vm["sensor"].as<std::string>() + ")");
   std::vector<MixedFile> out;
-  for (std::size_t k = 0; k < files.size(); ++k)
-    out.push_back(LoadMixedFile(vm, setup, sensors[k], files[k], configs_only));
+  for (const auto& [sensor, table] : tables)
+    out.push_back(LoadMixedTable(vm, setup, sensor, table, configs_only));
   return out;
 }
 

@@ -18,9 +18,14 @@ constexpr int kMaxContactReadingsPerRow = 1000000;
 
 ContactData ReadContactData(const std::string& path, const RobotModel& robot,
                             const PlaneSet& planes, bool flush_default) {
+  return ContactDataFromTable(ReadRobotCsv(path, robot), robot, planes, flush_default);
+}
+
+ContactData ContactDataFromTable(const CsvTable& t, const RobotModel& robot, const PlaneSet& planes,
+                                 bool flush_default) {
   ContactData data;
-  data.values.configs = ReadRobotConfigurations(path, robot, &planes);
-  const CsvTable t = ReadCsv(path);
+  data.values.configs = Configurations(t, robot.num_links(), &planes);
+  CheckJointRanges(data.values.configs, robot, t.path);
   const int flush = t.Column("flush"), readings = t.Column("readings");
   data.flush = flush_default;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {

@@ -1,9 +1,11 @@
 #include "lrcal/io/csv.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -115,6 +117,37 @@ void CheckHeader(const CsvTable& t, int line) {
 }
 
 }  // namespace
+
+std::vector<std::pair<std::string, CsvTable>> SplitBySensor(const CsvTable& t) {
+  const int column = t.Column("sensor");
+  if (column < 0)
+    throw InputError(Location(t.path, 1) + " column 'sensor'",
+                     "missing: a file of several kinds says each row's kind (ranger, scanner, "
+                     "point, pose, socket or contact)");
+  std::vector<std::pair<std::string, CsvTable>> groups;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    const std::string& kind = t.rows[r][static_cast<std::size_t>(column)];
+    if (kind != "ranger" && kind != "scanner" && kind != "point" && kind != "pose" &&
+        kind != "socket" && kind != "contact")
+      throw InputError(Location(t.path, t.lines[r]) + " column 'sensor'",
+                       "'" + CellExcerpt(kind) +
+                           "' is not a kind lrcal models: expected ranger, scanner, point, pose, "
+                           "socket or contact");
+    auto it =
+        std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == kind; });
+    if (it == groups.end()) {
+      CsvTable part;
+      part.path = t.path;
+      part.header = t.header;
+      part.joint_columns = t.joint_columns;
+      groups.emplace_back(kind, std::move(part));
+      it = std::prev(groups.end());
+    }
+    it->second.rows.push_back(t.rows[r]);
+    it->second.lines.push_back(t.lines[r]);
+  }
+  return groups;
+}
 
 CsvTable ReadCsv(const std::string& path) {
   const std::string text = ReadWholeFile(path);

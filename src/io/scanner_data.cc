@@ -86,8 +86,14 @@ void ReadScan(const CsvTable& t, const TargetedConfigurations& rows, std::size_t
 
 MeasuredValues ReadScannerData(const std::string& path, const RobotModel& robot,
                                const PlaneSet& planes, int num_beams) {
-  const TargetedConfigurations rows = ReadRobotConfigurations(path, robot, &planes);
-  const CsvTable t = ReadCsv(path);
+  return ScannerDataFromTable(ReadRobotCsv(path, robot), robot, planes, num_beams);
+}
+
+MeasuredValues ScannerDataFromTable(const CsvTable& t, const RobotModel& robot,
+                                    const PlaneSet& planes, int num_beams) {
+  const std::string& path = t.path;
+  const TargetedConfigurations rows = Configurations(t, robot.num_links(), &planes);
+  CheckJointRanges(rows, robot, path);
   if (t.Column("beam") < 0)
     throw InputError(
         Location(path, 1) + " column 'beam'",

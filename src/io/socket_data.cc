@@ -19,7 +19,11 @@ constexpr int kMaxSocketReadingsPerRow = 1000000;
 }  // namespace
 
 SocketData ReadSocketData(const std::string& path, const RobotModel& robot) {
-  const CsvTable t = ReadRobotCsv(path, robot);
+  return SocketDataFromTable(ReadRobotCsv(path, robot), robot);
+}
+
+SocketData SocketDataFromTable(const CsvTable& t, const RobotModel& robot) {
+  const std::string& path = t.path;
   const TargetedConfigurations joints = TargetConfigurations(t, robot.num_links(), 1);
   CheckJointRanges(joints, robot, path);
   const int column = t.Column("socket");

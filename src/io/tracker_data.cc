@@ -39,8 +39,12 @@ Eigen::Vector3d QuaternionOrientationValue(const PoseMeasurement& pose,
 }
 
 MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasurement& kind) {
+  return TrackerMeasurementsFromTable(ReadRobotCsv(path, kind.robot()), kind);
+}
+
+MeasuredValues TrackerMeasurementsFromTable(const CsvTable& t, const PointMeasurement& kind) {
   const RobotModel& robot = kind.robot();
-  const CsvTable t = ReadRobotCsv(path, robot);
+  const std::string& path = t.path;
   const int num_targets = static_cast<int>(kind.setup().targets.size());
   MeasuredValues data{TargetConfigurations(t, robot.num_links(), num_targets), {}, {}};
   CheckJointRanges(data.configs, robot, path);

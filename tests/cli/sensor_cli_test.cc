@@ -566,6 +566,52 @@ TEST_F(SensorCli, ATrackerAndPlaneContactsCalibrateTheArmTogether) {
   EXPECT_THAT(out, HasSubstr("simulate writes one kind's file"));
   EXPECT_EQ(Run("identify --sensor point,laser" + files, &out), 2);
   EXPECT_THAT(out, HasSubstr("--sensor: 'laser' is not a sensor lrcal models"));
+
+  // One file of both kinds, each row's kind in its sensor column (--sensor mixed): the same fit.
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) out.push_back(cell);
+    if (!line.empty() && line.back() == ',') out.emplace_back();
+    return out;
+  };
+  std::ifstream points_in(Path("points.csv")), contacts_in(Path("contacts.csv"));
+  std::getline(points_in, line);  // q1..q6,x,y,z,readings
+  ASSERT_EQ(cells(line).size(), 10u) << line;
+  std::getline(contacts_in, line);  // q1..q6,plane,flush,readings
+  ASSERT_EQ(cells(line).size(), 9u) << line;
+  std::ofstream mixed(Path("mixed.csv"));
+  mixed << "sensor,q1,q2,q3,q4,q5,q6,x,y,z,readings,plane,flush\n";
+  while (std::getline(points_in, line)) mixed << "point," << line << ",,\n";
+  while (std::getline(contacts_in, line)) {
+    const std::vector<std::string> c = cells(line);
+    mixed << "contact";
+    for (int j = 0; j < 6; ++j) mixed << "," << c[static_cast<std::size_t>(j)];
+    mixed << ",,,," << c[8] << "," << c[6] << "," << c[7] << "\n";
+  }
+  mixed << "laser,0,0,0,0,0,0,,,,1,,\n";
+  mixed.close();
+  const std::string one_file = " --sensor mixed" + tracker + planes +
+                               " --probe 0.01,0,0.1 --estimate-plane normal,offset --format json";
+  EXPECT_EQ(Run("identify --auto-fix" + one_file + " --data " + Path("mixed.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("mixed.csv:82 column 'sensor': 'laser' is not a kind lrcal models"));
+  {
+    std::ifstream in(Path("mixed.csv"));
+    std::ostringstream kept;
+    for (std::string l; std::getline(in, l);)
+      if (l.rfind("laser", 0) != 0) kept << l << "\n";
+    std::ofstream(Path("mixed.csv")) << kept.str();
+  }
+  ASSERT_EQ(Run("identify --auto-fix" + one_file + " --data " + Path("mixed.csv"), &out), 0) << out;
+  const Json from_one = json(out);
+  ASSERT_EQ(from_one["parameters"].size(), fit["parameters"].size());
+  for (std::size_t k = 0; k < fit["parameters"].size(); ++k) {
+    EXPECT_EQ(from_one["parameters"][k]["name"], fit["parameters"][k]["name"]);
+    EXPECT_NEAR(from_one["parameters"][k]["delta"].get<double>(),
+                fit["parameters"][k]["delta"].get<double>(), 1e-15);
+  }
+  EXPECT_EQ(Run("identify --auto-fix" + one_file + " --data " + Path("points.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("points.csv:1 column 'sensor': missing"));
 }
 
 }  // namespace

@@ -17,6 +17,8 @@
 
 namespace lrcal {
 
+struct CsvTable;  // csv.h
+
 struct ContactData {
   /// Configurations tagged by plane, their zero values (one per row, three when flush) and
   /// their `readings` as repetitions.
@@ -32,6 +34,9 @@ struct ContactData {
 /// `readings` cell that is not a whole number from 1 to 1,000,000.
 ContactData ReadContactData(const std::string& path, const RobotModel& robot,
                             const PlaneSet& planes, bool flush_default);
+/// The same from a table already read (ReadRobotCsv; a mixed file's rows of one kind).
+ContactData ContactDataFromTable(const CsvTable& t, const RobotModel& robot, const PlaneSet& planes,
+                                 bool flush_default);
 
 /// Writes `data` at full precision: q1..qN, plane (1-based), flush, readings. Written whole or
 /// not at all (StorageError naming the file).

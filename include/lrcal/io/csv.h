@@ -11,6 +11,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lrcal/core/strings.h"  // CellExcerpt
@@ -39,6 +40,13 @@ struct CsvTable {
 /// a 7-joint arm, some 4 GB in memory. `lrcal simulate` writes no more rows than this.
 inline constexpr long long kMaxCsvBytes = 256LL << 20;
 inline constexpr long long kMaxCsvRows = 2000000;
+
+/// A table's rows grouped by their `sensor` column (a file mixing measurement kinds: ranger,
+/// scanner, point, pose, socket, contact), each group a table of its own with the same path,
+/// header and joint columns and its rows' own lines, in the order the kinds first appear.
+/// InputError naming the file and line for a missing column, an empty cell or a kind lrcal does
+/// not model.
+std::vector<std::pair<std::string, CsvTable>> SplitBySensor(const CsvTable& t);
 
 /// Reads a CSV file with a header line (see the file comment). InputError naming the file and
 /// line for a folder, an empty file, a NUL byte, repeated column names, a ragged row, or a file

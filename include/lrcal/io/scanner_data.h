@@ -17,6 +17,8 @@
 
 namespace lrcal {
 
+struct CsvTable;  // csv.h
+
 /// The scanner data at `path` for a fan of `num_beams` beams on `planes`, joint ranges checked
 /// against `robot`: configurations tagged by plane, B values each (beam order), their `readings`
 /// as repetitions. Throws InputError naming the file, line and column for a beam outside 1..B or
@@ -25,6 +27,9 @@ namespace lrcal {
 /// not one of `planes`.
 MeasuredValues ReadScannerData(const std::string& path, const RobotModel& robot,
                                const PlaneSet& planes, int num_beams);
+/// The same from a table already read (ReadRobotCsv; a mixed file's rows of one kind).
+MeasuredValues ScannerDataFromTable(const CsvTable& t, const RobotModel& robot,
+                                    const PlaneSet& planes, int num_beams);
 
 /// Writes `data` (B values per configuration) at full precision: q1..qN, plane (1-based), beam,
 /// h, readings. Written whole or not at all (StorageError naming the file).

@@ -17,6 +17,8 @@
 
 namespace lrcal {
 
+struct CsvTable;  // csv.h
+
 struct SocketData {
   /// The socket ids found in the file, ascending; configuration i's tag is its socket's index
   /// here (SocketSetup::ids takes this list).
@@ -30,6 +32,8 @@ struct SocketData {
 /// from 0 to 1,000,000,000, a joint cell that is not a finite number, or a `readings` cell that
 /// is not a whole number from 1 to 1,000,000.
 SocketData ReadSocketData(const std::string& path, const RobotModel& robot);
+/// The same from a table already read (ReadRobotCsv; a mixed file's rows of one kind).
+SocketData SocketDataFromTable(const CsvTable& t, const RobotModel& robot);
 
 /// Socket data from configurations and each one's socket id (≥ 0) and weight (repetitions ≥ 1):
 /// ids sorted and tagged as ReadSocketData does. Throws InputError (where = `source`) for an id

@@ -18,12 +18,17 @@
 
 namespace lrcal {
 
+struct CsvTable;  // csv.h
+
 /// The measured values of `kind` in the file at `path`, joint ranges checked against the kind's
 /// robot. A pose's quaternion becomes its three orientation rows (PoseMeasurement::
 /// OrientationValue). Throws InputError naming the file, line and column for a missing column,
 /// a cell that is not a finite number, a target out of range, a quaternion whose norm is not 1
 /// within 1e-6, or a `readings` cell that is not a whole number from 1 to 1,000,000.
 MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasurement& kind);
+/// The same from a table already read (ReadRobotCsv; a mixed file's rows of one kind, csv.h
+/// SplitBySensor): errors name the table's file and lines.
+MeasuredValues TrackerMeasurementsFromTable(const CsvTable& t, const PointMeasurement& kind);
 
 /// A pose's three orientation rows (PoseMeasurement::OrientationValue) at configuration i of
 /// `configs` from its measured unit quaternion `xyzw` (qx, qy, qz, qw). Throws InputError at
