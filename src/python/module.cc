@@ -2288,12 +2288,15 @@ const std::set<std::string>& MixedPartKeys(const std::string& sensor) {
         "repetitions"}},
       {"scanner",
        {"sensor", "q", "h", "plane", "plane_of", "fan_deg", "scanner", "estimate_plane",
+        "repetitions"}},
+      {"ranger",
+       {"sensor", "q", "h", "plane", "plane_of", "estimate_plane", "estimate_ranger",
         "repetitions"}}};
   const auto it = keys.find(sensor);
   if (it == keys.end())
     throw InputError("sensor", "'" + CellExcerpt(sensor) +
-                                   "' is not a kind identify_mixed takes: expected point, pose, "
-                                   "socket, contact or scanner");
+                                   "' is not a kind identify_mixed takes: expected ranger, point, "
+                                   "pose, socket, contact or scanner");
   return it->second;
 }
 
@@ -2350,6 +2353,23 @@ MixedPy ToMixedPart(const RobotFile& rig, const py::dict& d, double sigma, doubl
         static_cast<std::size_t>(kind->rows_per_configuration() * out.values.size()), 0.0);
     out.values.repetitions = PartRepetitions(d, out.values.size());
     if (flush) WeighAngleRows(*kind, sigma, sigma_angle, &out.values);
+    out.kind = std::move(kind);
+  } else if (sensor == "ranger") {
+    if (!d.contains("h")) throw InputError("h", "missing: the readings (N), m");
+    const PlaneSet planes = ResolvePlanes(rig, PartArg(d, "plane"));
+    const std::string ranger_terms =
+        d.contains("estimate_ranger") ? d["estimate_ranger"].cast<std::string>() : "none";
+    auto kind = std::make_shared<RangerMeasurement>(
+        MeasurementModel(rig.robot, planes,
+                         ResolveParameters(rig.robot, planes.size(), estimate_plane,
+                                           OtherTerms(ranger_terms), py::none())),
+        rig.ranger);
+    out.values = MeasuredValues{
+        ToContactConfigurations(rig.robot, q, PartArg(d, "plane_of"), planes.size()), {}, {}};
+    out.values.y = ToVector(d["h"].cast<Array>(), "h");
+    if (static_cast<int>(out.values.y.size()) != out.values.size())
+      throw InputError("h", "expected one reading (m) per row of q");
+    out.values.repetitions = PartRepetitions(d, out.values.size());
     out.kind = std::move(kind);
   } else {
     if (!d.contains("h")) throw InputError("h", "missing: the readings (N, beams), m");
@@ -2416,8 +2436,9 @@ void DefineMixed(py::module_& m) {
         py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
         py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm", R"doc(
 Several kinds of data of one arm identified together: `lrcal identify --sensor a,b --data ...`.
-parts is a list of dicts, one per kind, each with "sensor" ("point", "pose", "socket", "contact"
-or "scanner") and that kind's arguments as its own identify_* function takes them (point/pose: q,
+parts is a list of dicts, one per kind, each with "sensor" ("ranger", "point", "pose", "socket",
+"contact" or "scanner") and that kind's arguments as its own identify_* function takes them
+(ranger: q, h, plane, plane_of, estimate_plane, estimate_ranger; point/pose: q,
 xyz, quaternion, instrument, targets, target_of; socket: q, socket_of, tool_point, distances;
 contact: q, plane, plane_of, tool_point, flush, estimate_plane; scanner: q, h, plane, plane_of,
 fan_deg, scanner, estimate_plane; every kind: repetitions). The arm's link values, base/tool

@@ -375,3 +375,34 @@ def test_compensate_as_the_program_and_reaches_the_plans(tmp_path, cli):
     assert np.max(pos["position_error_mm"]) < 1e-6
     with pytest.raises(lrcal.InputError, match="nominal: missing"):
         lrcal.compensate(calibrated, q)
+
+
+def test_mixed_with_the_ranger_as_the_program(tmp_path, cli, paper):
+    q = lrcal.sample_configurations(paper, 40, seed=3)
+    configs = tmp_path / "c.csv"
+    write_configurations(configs, q)
+    cli("simulate", "--configs", configs, "--repetitions", "1", "--seed", "5",
+        "--out", tmp_path / "r.csv")
+    cli("simulate", "--sensor", "point", "--configs", configs, "--instrument", TRACKER_ARG,
+        "--seed", "6", "--out", tmp_path / "p.csv")
+    with open(tmp_path / "r.csv") as f:
+        ranger = list(csv.DictReader(f))
+    with open(tmp_path / "p.csv") as f:
+        points = list(csv.DictReader(f))
+    joints = [f"q{j + 1}" for j in range(6)]
+    parts = [dict(sensor="ranger", q=np.array([[float(r[c]) for c in joints] for r in ranger]),
+                  h=np.array([float(r["h"]) for r in ranger])),
+             dict(sensor="point", q=np.array([[float(r[c]) for c in joints] for r in points]),
+                  xyz=np.array([[float(r[c]) for c in "xyz"] for r in points]),
+                  repetitions=[int(r["readings"]) for r in points], instrument=TRACKER)]
+    fit = lrcal.identify_mixed(paper, parts, auto_fix=True, sigma_mm=0.2)
+    done = cli("identify", "--sensor", "ranger,point", "--data", tmp_path / "r.csv", "--data",
+               tmp_path / "p.csv", "--instrument", TRACKER_ARG, "--auto-fix", "--sigma-mm",
+               "0.2", "--format", "json")
+    program = json.loads(done.stdout)
+    assert fit.names == [p["name"] for p in program["parameters"]]
+    np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
+                               rtol=0, atol=1e-12)
+    assert "plane_f" not in fit.names  # the plane's terms only with estimate_plane
+    with pytest.raises(lrcal.InputError, match=r"parts\[0\]\.h: expected one reading"):
+        lrcal.identify_mixed(paper, [dict(parts[0], h=parts[0]["h"][:5])])
