@@ -2300,6 +2300,117 @@ const std::set<std::string>& MixedPartKeys(const std::string& sensor) {
   return it->second;
 }
 
+// A part's arguments besides the dict: the robot, its q, the plane terms asked for, the noise
+// that weighs orientation rows.
+struct MixedPartInput {
+  const RobotFile& rig;
+  const py::dict& d;
+  Array q;
+  std::string estimate_plane;
+  double sigma, sigma_angle;
+};
+
+MixedPy TrackerPart(const std::string& sensor, const MixedPartInput& in) {
+  const py::dict& d = in.d;
+  std::unique_ptr<PointMeasurement> kind = ToTrackerKind(
+      in.rig.robot, sensor, PartArg(d, "instrument"), PartArg(d, "targets"), py::none());
+  if (!d.contains("xyz")) throw InputError("xyz", "missing: the measured points (N, 3), m");
+  const TrackerFitArgs a{PartArg(d, "quaternion"),
+                         py::none(),
+                         py::none(),
+                         py::none(),
+                         PartArg(d, "repetitions"),
+                         py::none(),
+                         false,
+                         0,
+                         0,
+                         "lm"};
+  MixedPy out;
+  out.values =
+      ToTrackerValues(*kind,
+                      ToTrackerConfigurations(in.rig.robot, in.q, PartArg(d, "target_of"),
+                                              static_cast<int>(kind->setup().targets.size())),
+                      d["xyz"].cast<Array>(), a);
+  if (sensor == "pose") WeighAngleRows(*kind, in.sigma, in.sigma_angle, &out.values);
+  out.kind = std::move(kind);
+  return out;
+}
+
+MixedPy SocketPart(const MixedPartInput& in) {
+  const SocketData data =
+      ToSocketData(in.rig.robot, in.q, PartArg(in.d, "socket_of"), PartArg(in.d, "repetitions"));
+  MixedPy out;
+  out.kind = ToSocketKind(in.rig.robot, data, PartArg(in.d, "tool_point"),
+                          PartArg(in.d, "distances"), py::none());
+  out.values = data.values;
+  return out;
+}
+
+// Configurations on planes (plane_of) with their repetitions, the values to be filled.
+MeasuredValues OnPlanes(const MixedPartInput& in, const PlaneSet& planes) {
+  MeasuredValues v{
+      ToContactConfigurations(in.rig.robot, in.q, PartArg(in.d, "plane_of"), planes.size()),
+      {},
+      {}};
+  v.repetitions = PartRepetitions(in.d, v.size());
+  return v;
+}
+
+MixedPy ContactPart(const MixedPartInput& in) {
+  const py::dict& d = in.d;
+  const PlaneSet planes = ResolvePlanes(in.rig, PartArg(d, "plane"));
+  const bool flush = d.contains("flush") && d["flush"].cast<bool>();
+  std::unique_ptr<ContactMeasurement> kind =
+      ToContactKind(in.rig.robot, planes,
+                    {PartArg(d, "plane"), PartArg(d, "plane_of"), PartArg(d, "tool_point"),
+                     py::none(), in.estimate_plane, flush});
+  MixedPy out;
+  out.values = OnPlanes(in, planes);
+  out.values.y.assign(static_cast<std::size_t>(kind->rows_per_configuration() * out.values.size()),
+                      0.0);
+  if (flush) WeighAngleRows(*kind, in.sigma, in.sigma_angle, &out.values);
+  out.kind = std::move(kind);
+  return out;
+}
+
+MixedPy RangerPart(const MixedPartInput& in) {
+  const py::dict& d = in.d;
+  if (!d.contains("h")) throw InputError("h", "missing: the readings (N), m");
+  const PlaneSet planes = ResolvePlanes(in.rig, PartArg(d, "plane"));
+  const std::string ranger_terms =
+      d.contains("estimate_ranger") ? d["estimate_ranger"].cast<std::string>() : "none";
+  MixedPy out;
+  out.kind = std::make_shared<RangerMeasurement>(
+      MeasurementModel(in.rig.robot, planes,
+                       ResolveParameters(in.rig.robot, planes.size(), in.estimate_plane,
+                                         OtherTerms(ranger_terms), py::none())),
+      in.rig.ranger);
+  out.values = OnPlanes(in, planes);
+  out.values.y = ToVector(d["h"].cast<Array>(), "h");
+  if (static_cast<int>(out.values.y.size()) != out.values.size())
+    throw InputError("h", "expected one reading (m) per row of q");
+  return out;
+}
+
+MixedPy ScannerPart(const MixedPartInput& in) {
+  const py::dict& d = in.d;
+  if (!d.contains("h")) throw InputError("h", "missing: the readings (N, beams), m");
+  const Array h = d["h"].cast<Array>();
+  if (h.ndim() != 2)
+    throw InputError("h", "expected an (N, beams) array of readings (m), one column per beam");
+  const PlaneSet planes = ResolvePlanes(in.rig, PartArg(d, "plane"));
+  std::unique_ptr<ScannerMeasurement> kind =
+      ToScannerKind(in.rig, in.rig.robot, planes,
+                    {PartArg(d, "plane"), PartArg(d, "plane_of"), PartArg(d, "scanner"), py::none(),
+                     in.estimate_plane, static_cast<long long>(h.shape(1)),
+                     d.contains("fan_deg") ? d["fan_deg"].cast<double>() : 0.0});
+  MixedPy out;
+  out.values = OnPlanes(in, planes);
+  out.values.y = ToRows(h, kind->num_beams(), out.values.size(), "h");
+  out.kind = std::move(kind);
+  return out;
+}
+
 MixedPy ToMixedPart(const RobotFile& rig, const py::dict& d, double sigma, double sigma_angle) {
   if (!d.contains("sensor")) throw InputError("sensor", "missing: the part's kind");
   const std::string sensor = d["sensor"].cast<std::string>();
@@ -2309,86 +2420,18 @@ MixedPy ToMixedPart(const RobotFile& rig, const py::dict& d, double sigma, doubl
     if (!allowed.count(key)) throw InputError(key, "is not an argument of a " + sensor + " part");
   }
   if (!d.contains("q")) throw InputError("q", "missing: the part's configurations (N, joints)");
-  const Array q = d["q"].cast<Array>();
-  const std::string estimate_plane =
-      d.contains("estimate_plane") ? d["estimate_plane"].cast<std::string>() : std::string("none");
-  MixedPy out;
-  if (sensor == "point" || sensor == "pose") {
-    std::unique_ptr<PointMeasurement> kind = ToTrackerKind(
-        rig.robot, sensor, PartArg(d, "instrument"), PartArg(d, "targets"), py::none());
-    if (!d.contains("xyz")) throw InputError("xyz", "missing: the measured points (N, 3), m");
-    TrackerFitArgs a{PartArg(d, "quaternion"),
-                     py::none(),
-                     py::none(),
-                     py::none(),
-                     PartArg(d, "repetitions"),
-                     py::none(),
-                     false,
-                     0,
-                     0,
-                     "lm"};
-    out.values =
-        ToTrackerValues(*kind,
-                        ToTrackerConfigurations(rig.robot, q, PartArg(d, "target_of"),
-                                                static_cast<int>(kind->setup().targets.size())),
-                        d["xyz"].cast<Array>(), a);
-    if (sensor == "pose") WeighAngleRows(*kind, sigma, sigma_angle, &out.values);
-    out.kind = std::move(kind);
-  } else if (sensor == "socket") {
-    const SocketData data =
-        ToSocketData(rig.robot, q, PartArg(d, "socket_of"), PartArg(d, "repetitions"));
-    out.kind = ToSocketKind(rig.robot, data, PartArg(d, "tool_point"), PartArg(d, "distances"),
-                            py::none());
-    out.values = data.values;
-  } else if (sensor == "contact") {
-    const PlaneSet planes = ResolvePlanes(rig, PartArg(d, "plane"));
-    const bool flush = d.contains("flush") && d["flush"].cast<bool>();
-    std::unique_ptr<ContactMeasurement> kind =
-        ToContactKind(rig.robot, planes,
-                      {PartArg(d, "plane"), PartArg(d, "plane_of"), PartArg(d, "tool_point"),
-                       py::none(), estimate_plane, flush});
-    out.values = MeasuredValues{
-        ToContactConfigurations(rig.robot, q, PartArg(d, "plane_of"), planes.size()), {}, {}};
-    out.values.y.assign(
-        static_cast<std::size_t>(kind->rows_per_configuration() * out.values.size()), 0.0);
-    out.values.repetitions = PartRepetitions(d, out.values.size());
-    if (flush) WeighAngleRows(*kind, sigma, sigma_angle, &out.values);
-    out.kind = std::move(kind);
-  } else if (sensor == "ranger") {
-    if (!d.contains("h")) throw InputError("h", "missing: the readings (N), m");
-    const PlaneSet planes = ResolvePlanes(rig, PartArg(d, "plane"));
-    const std::string ranger_terms =
-        d.contains("estimate_ranger") ? d["estimate_ranger"].cast<std::string>() : "none";
-    auto kind = std::make_shared<RangerMeasurement>(
-        MeasurementModel(rig.robot, planes,
-                         ResolveParameters(rig.robot, planes.size(), estimate_plane,
-                                           OtherTerms(ranger_terms), py::none())),
-        rig.ranger);
-    out.values = MeasuredValues{
-        ToContactConfigurations(rig.robot, q, PartArg(d, "plane_of"), planes.size()), {}, {}};
-    out.values.y = ToVector(d["h"].cast<Array>(), "h");
-    if (static_cast<int>(out.values.y.size()) != out.values.size())
-      throw InputError("h", "expected one reading (m) per row of q");
-    out.values.repetitions = PartRepetitions(d, out.values.size());
-    out.kind = std::move(kind);
-  } else {
-    if (!d.contains("h")) throw InputError("h", "missing: the readings (N, beams), m");
-    const Array h = d["h"].cast<Array>();
-    if (h.ndim() != 2)
-      throw InputError("h", "expected an (N, beams) array of readings (m), one column per beam");
-    const PlaneSet planes = ResolvePlanes(rig, PartArg(d, "plane"));
-    std::unique_ptr<ScannerMeasurement> kind =
-        ToScannerKind(rig, rig.robot, planes,
-                      {PartArg(d, "plane"), PartArg(d, "plane_of"), PartArg(d, "scanner"),
-                       py::none(), estimate_plane, static_cast<long long>(h.shape(1)),
-                       d.contains("fan_deg") ? d["fan_deg"].cast<double>() : 0.0});
-    out.values = MeasuredValues{
-        ToContactConfigurations(rig.robot, q, PartArg(d, "plane_of"), planes.size()), {}, {}};
-    out.values.y = ToRows(h, kind->num_beams(), out.values.size(), "h");
-    out.values.repetitions = PartRepetitions(d, out.values.size());
-    out.kind = std::move(kind);
-  }
-  return out;
+  const MixedPartInput in{
+      rig,
+      d,
+      d["q"].cast<Array>(),
+      d.contains("estimate_plane") ? d["estimate_plane"].cast<std::string>() : std::string("none"),
+      sigma,
+      sigma_angle};
+  if (sensor == "point" || sensor == "pose") return TrackerPart(sensor, in);
+  if (sensor == "socket") return SocketPart(in);
+  if (sensor == "contact") return ContactPart(in);
+  if (sensor == "ranger") return RangerPart(in);
+  return ScannerPart(in);
 }
 
 // identify_mixed: as identify --sensor a,b with one data set per kind.
