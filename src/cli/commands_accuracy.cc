@@ -27,20 +27,8 @@ int MeasuredAccuracyCommand(const po::variables_map& vm) {
       ReadTrackerMeasurements(file, RegistrationKind(rig.robot, tracker->setup()));
   const MeasuredAccuracy r = AccuracyAtMeasuredPoints(rig.robot, tracker->setup(), points);
   if (ResolveFormat(vm) == Format::kJson) {
-    Json j;
-    j["measured"] = file;
-    j["points"] = r.num_points;
-    j["rms"] = r.rms;
-    j["worst"] = r.worst;
-    j["worst_point"] = r.worst_index + 1;
-    j["registered"] = r.registered;
-    j["instrument"] = {{"xyz", ToJson(Eigen::VectorXd(r.instrument.translation))},
-                       {"rpy", ToJson(Eigen::VectorXd(r.instrument.Rpy()))}};
-    Json errors = Json::array(), targets = Json::array();
-    for (const Eigen::Vector3d& e : r.errors) errors.push_back({e.x(), e.y(), e.z()});
-    for (const Eigen::Vector3d& t : r.targets) targets.push_back({t.x(), t.y(), t.z()});
-    j["errors"] = errors;
-    j["targets"] = targets;
+    Json j = {{"measured", file}};
+    j.update(MeasuredAccuracyJson(r));
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "measured points: " << file << " (model " << rig.path << ")\n" << r.ToString();

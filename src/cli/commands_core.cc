@@ -14,6 +14,7 @@
 #include "lrcal/design/identifiability_remedies.h"
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/measured_accuracy.h"
 #include "lrcal/identification/significance.h"
 #include "lrcal/io/calibration_record.h"
 #include "lrcal/io/csv.h"
@@ -511,6 +512,14 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const IdentificationOptions& options, const UnestimatedTerms& held) {
   CalibrationReportInputs in{DataSource::File(DataFile(vm)), &rig, &model, &data, &s, options};
   in.held = held;
+  MeasuredValues measured;
+  if (vm.count("measured")) {
+    in.measured_setup = ResolvePointSetup(vm);
+    in.measured_file = vm["measured"].as<std::string>();
+    measured =
+        ReadTrackerMeasurements(in.measured_file, RegistrationKind(rig.robot, in.measured_setup));
+    in.measured = &measured;
+  }
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
   WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
   if (s.IsSolutionUsable())
@@ -571,7 +580,10 @@ void AddIdentifyOptions(po::options_description& o) {
       "report", po::value<std::string>(),
       "write a calibration report into this folder: report.html (fit check, residuals, "
       "parameters, correlation, identifiability, cross-validation, accuracy over the "
-      "workspace), calibration.json and the calibrated robot file");
+      "workspace), calibration.json and the calibrated robot file")(
+      "measured", po::value<std::string>(),
+      "--report: points a tracker measured, not used in the fit (accuracy --measured's file, "
+      "with --instrument and --target): the calibrated model's error at each in the report");
   AddFrameTermOptions(o);
 }
 
@@ -581,9 +593,9 @@ namespace {
 // (a kind that reads no plane refuses --plane and --estimate-plane too), and a calibrated robot
 // file that could not be written refused before the fit, not after.
 void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
-  std::vector<std::string> refused = {"estimate-ranger", "estimate-base",   "estimate-tool",
-                                      "average",         "predict-at",      "holdout",
-                                      "report",          "only-significant"};
+  std::vector<std::string> refused = {"estimate-ranger", "estimate-base",    "estimate-tool",
+                                      "average",         "predict-at",       "holdout",
+                                      "report",          "only-significant", "measured"};
   if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
   RefuseRangerOptions(vm, sensor, refused);
   if (vm.count("write-robot"))
@@ -829,6 +841,7 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
       {"holdout", false},
       {"report", false},
       {"only-significant", false},
+      {"measured", false},
       {"prior", false},
       {"prior-sigma", false},
       {"estimate-ranger", has({"ranger"})},
@@ -955,6 +968,17 @@ int MixedIdentifiability(const po::variables_map& vm) {
   return 0;
 }
 
+// What the ranger's identify writes, checked before the fit (not after): a calibrated robot file
+// that could not be written, and measured points with no report to put them in.
+void CheckRangerIdentifyOutputs(const po::variables_map& vm) {
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  if (vm.count("measured") && !vm.count("report"))
+    throw InputError("--measured",
+                     "goes into the calibration report: give --report DIR too "
+                     "(or judge a robot file with lrcal accuracy --measured)");
+}
+
 }  // namespace
 
 int IdentifyCommand(const std::vector<std::string>& args) {
@@ -973,9 +997,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (sensor == "contact") return ContactIdentify(vm);
   if (sensor == "scanner") return ScannerIdentify(vm);
   if (sensor != "ranger") return TrackerIdentify(vm, sensor);
-  // A calibrated robot file that could not be written is refused before the fit, not after.
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  CheckRangerIdentifyOutputs(vm);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;

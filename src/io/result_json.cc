@@ -120,6 +120,23 @@ ResultJson FitJson(const FitCheck& f) {
 
 }  // namespace
 
+ResultJson MeasuredAccuracyJson(const MeasuredAccuracy& r) {
+  ResultJson j;
+  j["points"] = r.num_points;
+  j["rms"] = r.rms;
+  j["worst"] = r.worst;
+  j["worst_point"] = r.worst_index + 1;
+  j["registered"] = r.registered;
+  j["instrument"] = {{"xyz", ToJson(Eigen::VectorXd(r.instrument.translation))},
+                     {"rpy", ToJson(Eigen::VectorXd(r.instrument.Rpy()))}};
+  ResultJson errors = ResultJson::array(), targets = ResultJson::array();
+  for (const Eigen::Vector3d& e : r.errors) errors.push_back({e.x(), e.y(), e.z()});
+  for (const Eigen::Vector3d& t : r.targets) targets.push_back({t.x(), t.y(), t.z()});
+  j["errors"] = errors;
+  j["targets"] = targets;
+  return j;
+}
+
 ResultJson IdentificationJson(const IdentificationSummary& s) {
   ResultJson j;
   j["parameters"] = ParametersJson(s);

@@ -7,6 +7,7 @@
 #include "lrcal/core/json.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/design/configuration_sampling.h"
+#include "lrcal/identification/measured_accuracy.h"
 #include "lrcal/io/calibration_record.h"
 #include "lrcal/io/result_json.h"
 #include "lrcal/io/urdf.h"
@@ -67,6 +68,11 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
                          in.options, in.held);
     const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
     AddWorkspaceAccuracy(in, calibrated, &j);
+    if (in.measured) {
+      j["measured_points"] = MeasuredAccuracyJson(
+          AccuracyAtMeasuredPoints(calibrated.robot, in.measured_setup, *in.measured));
+      j["measured_points"]["file"] = in.measured_file;
+    }
     j["calibrated_robot"] = "calibrated.yaml";
     // The same model as URDF, from the file just written (what lrcal export would write).
     WriteFileAtomically(dir + "/calibrated.urdf",

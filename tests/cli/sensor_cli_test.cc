@@ -200,6 +200,34 @@ TEST_F(SensorCli, MeasuredPointsJudgeARangerCalibration) {
 
   ASSERT_EQ(Run("accuracy --robot paper" + measured, &out), 0);
   EXPECT_THAT(out, HasSubstr("error at the measured points: RMS"));
+
+  // The same judgement in the calibration report (identify --report --measured), with noise.
+  ASSERT_EQ(
+      Run("simulate --configs " + Path("c.csv") + " --seed 4 --out " + Path("noisy.csv"), &out), 0);
+  ASSERT_EQ(Run("identify --data " + Path("noisy.csv") + " --sigma-mm 0.2 --report " +
+                    Path("cal_report") + measured,
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(
+      Run("accuracy --robot " + Path("cal_report/calibrated.yaml") + " --format json" + measured,
+          &out),
+      0)
+      << out;
+  const Json judged = Json::parse(out);
+  std::ifstream report_json(Path("cal_report/calibration.json"));
+  const Json report = Json::parse(report_json);
+  ASSERT_TRUE(report.contains("measured_points"));
+  EXPECT_EQ(report["measured_points"]["rms"].get<double>(), judged["rms"].get<double>());
+  EXPECT_EQ(report["measured_points"]["points"], 30);
+  EXPECT_GT(judged["rms"].get<double>(), 0);
+  std::ifstream page_in(Path("cal_report/report.html"));
+  const std::string page((std::istreambuf_iterator<char>(page_in)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_THAT(page, HasSubstr("<h2>Measured points</h2>"));
+  EXPECT_THAT(page, HasSubstr("30 points a tracker measured, not used in the fit"));
+  EXPECT_EQ(Run("identify --data " + Path("noisy.csv") + measured, &out), 2);
+  EXPECT_THAT(out, HasSubstr("--measured: goes into the calibration report: give --report"));
 }
 
 // Sockets as a user meets them: the 40 configurations, alternately in two sockets 50 mm apart, are

@@ -12,6 +12,7 @@
 #include "lrcal/design/identifiability_remedies.h"
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/measured_accuracy.h"
 #include "lrcal/identification/total_accuracy.h"
 
 namespace lrcal {
@@ -32,6 +33,9 @@ ResultJson RemediesJson(const RemedyReport& r);
 /// An identification: parameters with their standard deviations, covariance, correlation, fit
 /// check (suspects 1-based) and termination.
 ResultJson IdentificationJson(const IdentificationSummary& s);
+/// `lrcal accuracy --measured`'s numbers (SI): points, rms, worst, worst_point (1-based),
+/// registered, instrument {xyz, rpy}, errors and targets.
+ResultJson MeasuredAccuracyJson(const MeasuredAccuracy& r);
 /// What readings tell against priors (`lrcal identifiability --prior-sigma`): sigma (m), per term
 /// prior_sigma, posterior_sigma (null where unbounded), posterior_to_prior (null without a
 /// prior), then set_by_prior and defined.

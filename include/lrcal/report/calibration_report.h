@@ -8,6 +8,7 @@
 
 #include "lrcal/core/settings.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/identification/measured_accuracy.h"
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/calibration_record.h"
 #include "lrcal/io/robot_file.h"
@@ -27,6 +28,13 @@ struct CalibrationReportInputs {
   UnestimatedTerms held{};
   /// Cross-validation folds (2 or more); 0: min(5, configurations).
   int holdout = 0;
+  /// Points a tracker measured, not used in the fit (a point kind's values, as
+  /// ReadTrackerMeasurements gives them for RegistrationKind): the calibrated model's error at
+  /// each, its instrument registered (measured_accuracy.h), in calibration.json's
+  /// `measured_points`; none when null.
+  const MeasuredValues* measured = nullptr;
+  PointSetup measured_setup{};
+  std::string measured_file{};
   int workspace_poses = 500;         ///< poses of the accuracy map over the joint ranges
   std::uint64_t workspace_seed = 1;  ///< their seed
 };

@@ -309,6 +309,28 @@ def accuracy_text(data):
     return text
 
 
+def measured_text(data):
+    m = data.get("measured_points")
+    if not m:
+        return ("<p>None given (identify --measured FILE with --report: points a tracker "
+                "measured, not used in the fit).</p>")
+    xyz = m["instrument"]["xyz"]
+    rows = "".join(
+        f"<tr><td>{i + 1}</td><td>{e[0] * 1e3:.4f}</td><td>{e[1] * 1e3:.4f}</td>"
+        f"<td>{e[2] * 1e3:.4f}</td><td>{sum(c * c for c in e) ** 0.5 * 1e3:.4f}</td></tr>"
+        for i, e in enumerate(m["errors"][:50]))
+    more = (f"<p>The first 50 of {len(m['errors'])} points; calibration.json has them all.</p>"
+            if len(m["errors"]) > 50 else "")
+    return (f"<p><code>{html.escape(str(m.get('file', '?')))}</code>: {m['points']} points a "
+            f"tracker measured, not used in the fit. With the instrument registered (its frame "
+            f"at ({xyz[0]:.4f}, {xyz[1]:.4f}, {xyz[2]:.4f}) m in the base frame; "
+            f"{len(m['registered'])} terms: {html.escape(', '.join(m['registered']))}), the "
+            f"calibrated model's error is <b>{m['rms'] * 1e3:.4f} mm RMS</b>, worst "
+            f"{m['worst'] * 1e3:.4f} mm at point {m['worst_point']}.</p>"
+            "<table><tr><th>point</th><th>x (mm)</th><th>y (mm)</th><th>z (mm)</th>"
+            "<th>|error| (mm)</th></tr>" + rows + "</table>" + more)
+
+
 def prior_text(source):
     name, sigma = source["name"], source["prior_sigma"]
     if name == "ranger_scale":
@@ -339,7 +361,8 @@ def build(folder):
              "<h2>Parameters</h2>", parameter_table(data),
              "<h2>Identifiability</h2>", identifiability_text(data),
              "<h2>Cross-validation</h2>", holdout_text(data),
-             "<h2>Accuracy over the workspace</h2>", accuracy_text(data), "<h2>Figures</h2>"]
+             "<h2>Accuracy over the workspace</h2>", accuracy_text(data),
+             "<h2>Measured points</h2>", measured_text(data), "<h2>Figures</h2>"]
     parts.extend(figure_html(png, caption, folder) for png, caption in figures)
     parts.append("<h2>Calibrated files</h2>")
     if data.get("calibrated_robot"):
