@@ -8,6 +8,7 @@
 #include "lrcal/core/strings.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_data.h"
+#include "lrcal/io/tracker_data.h"
 
 namespace lrcal {
 
@@ -32,13 +33,9 @@ CompensationTargets ReadCompensationTargets(const std::string& path, const Robot
     Pose<double> pose;
     pose.p_BT = Eigen::Vector3d(t.Number(r, x), t.Number(r, y), t.Number(r, z));
     if (out.orientation) {
-      const Eigen::Quaterniond q(t.Number(r, qw), t.Number(r, qx), t.Number(r, qy),
-                                 t.Number(r, qz));
-      if (!(std::abs(q.norm() - 1) < 1e-6))
-        throw InputError(
-            Location(t.path, t.lines[r]) + " columns qx, qy, qz, qw",
-            "expected a unit quaternion (norm 1 within 1e-6), got norm " + FileNumber(q.norm()));
-      pose.R_BT = q.normalized().toRotationMatrix();
+      const double xyzw[4] = {t.Number(r, qx), t.Number(r, qy), t.Number(r, qz), t.Number(r, qw)};
+      pose.R_BT =
+          UnitQuaternionRotation(xyzw, Location(t.path, t.lines[r]) + " columns qx, qy, qz, qw");
     }
     out.poses.push_back(pose);
   }

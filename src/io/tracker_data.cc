@@ -28,14 +28,19 @@ int RequiredColumn(const CsvTable& t, const std::string& name, const std::string
 
 }  // namespace
 
-Eigen::Vector3d QuaternionOrientationValue(const PoseMeasurement& pose,
-                                           const TargetedConfigurations& configs, int i,
-                                           const double* xyzw, const std::string& where) {
+Eigen::Matrix3d UnitQuaternionRotation(const double* xyzw, const std::string& where) {
   const Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
   if (!(std::fabs(q.norm() - 1) <= kUnitQuaternionTolerance))
     throw InputError(where, "expected a unit quaternion (norm 1 within 1e-6), got norm " +
                                 FormatExact(q.norm()));
-  return pose.OrientationValue(configs.q(i), configs.target(i), q.normalized().toRotationMatrix());
+  return q.normalized().toRotationMatrix();
+}
+
+Eigen::Vector3d QuaternionOrientationValue(const PoseMeasurement& pose,
+                                           const TargetedConfigurations& configs, int i,
+                                           const double* xyzw, const std::string& where) {
+  return pose.OrientationValue(configs.q(i), configs.target(i),
+                               UnitQuaternionRotation(xyzw, where));
 }
 
 MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasurement& kind) {

@@ -70,6 +70,19 @@ class MixedEvaluator : public MeasurementEvaluator {
 
 }  // namespace
 
+std::vector<MixedPart> PartsLabelledByKind(
+    const std::vector<std::shared_ptr<const MeasurementKind>>& kinds) {
+  std::map<std::string, int> seen, total;
+  for (const auto& kind : kinds) ++total[kind->name()];
+  std::vector<MixedPart> parts;
+  for (const auto& kind : kinds) {
+    const std::string name = kind->name();
+    const int n = ++seen[name];
+    parts.push_back({kind, total[name] > 1 ? name + std::to_string(n) : name});
+  }
+  return parts;
+}
+
 bool MixedMeasurement::IsSharedTerm(const std::string& name) {
   constexpr int kAnyLinks = 1000;  // link value names are theta<k>, a<k>, …: any chain length
   return LinkValueIndex(name, kAnyLinks) >= 0 || StartsWith(name, "base_") ||

@@ -857,6 +857,18 @@ py::dict SimulateTrackerPy(const RobotFile& rig, const Array& q, const std::stri
   return out;
 }
 
+// The options of every kind's identify_* function: the solver by name, sigma_mm (0: none given),
+// auto_fix, and the linearisation check lrcal identify makes.
+IdentificationOptions KindFitOptions(const std::string& solver, double sigma_mm, bool auto_fix) {
+  IdentificationOptions options;
+  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
+  options.sigma = sigma_mm * 1e-3;
+  options.fix_dependent_parameters = auto_fix;
+  options.check_linearisation = true;  // as lrcal identify
+  options.Validate();
+  return options;
+}
+
 // identify_tracker's arguments besides the robot, q, xyz and the sensor.
 struct TrackerFitArgs {
   py::object quaternion, instrument, targets, target_of, repetitions, fix;
@@ -914,12 +926,7 @@ IdentificationSummary IdentifyTrackerPy(const RobotFile& rig, const Array& q, co
                       ToTrackerConfigurations(rig.robot, q, a.target_of,
                                               static_cast<int>(kind->setup().targets.size())),
                       xyz, a);
-  IdentificationOptions options;
-  options.solver = ParseName(kSolverNames, a.solver, "solver", "solver");
-  options.sigma = a.sigma_mm * 1e-3;
-  options.fix_dependent_parameters = a.auto_fix;
-  options.check_linearisation = true;  // as lrcal identify
-  options.Validate();
+  const IdentificationOptions options = KindFitOptions(a.solver, a.sigma_mm, a.auto_fix);
   if (sensor == "pose")
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
                    a.sigma_mrad * 1e-3, &data);
@@ -1988,12 +1995,7 @@ IdentificationSummary IdentifySocketsPy(const RobotFile& rig, const Array& q,
   const SocketData data = ToSocketData(rig.robot, q, socket_of, repetitions);
   const std::unique_ptr<SocketMeasurement> kind =
       ToSocketKind(rig.robot, data, tool_point, distances, fix);
-  IdentificationOptions options;
-  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
-  options.sigma = sigma_mm * 1e-3;
-  options.fix_dependent_parameters = auto_fix;
-  options.check_linearisation = true;  // as lrcal identify
-  options.Validate();
+  const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
   py::gil_scoped_release release;
   return Identify(*kind, data.values, options);
 }
@@ -2102,12 +2104,7 @@ IdentificationSummary IdentifyContactsPy(const RobotFile& rig, const Array& q, c
   if (!repetitions.is_none()) data.repetitions = repetitions.cast<std::vector<int>>();
   if (static_cast<int>(data.repetitions.size()) != data.size())
     throw InputError("repetitions", "expected one count per row of q");
-  IdentificationOptions options;
-  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
-  options.sigma = sigma_mm * 1e-3;
-  options.fix_dependent_parameters = auto_fix;
-  options.check_linearisation = true;  // as lrcal identify
-  options.Validate();
+  const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
   if (a.flush)
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma, sigma_mrad * 1e-3,
                    &data);
@@ -2200,12 +2197,7 @@ IdentificationSummary IdentifyScannerPy(const RobotFile& rig, const Array& q, co
   if (!repetitions.is_none()) data.repetitions = repetitions.cast<std::vector<int>>();
   if (static_cast<int>(data.repetitions.size()) != data.size())
     throw InputError("repetitions", "expected one count per row of q");
-  IdentificationOptions options;
-  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
-  options.sigma = sigma_mm * 1e-3;
-  options.fix_dependent_parameters = auto_fix;
-  options.check_linearisation = true;  // as lrcal identify
-  options.Validate();
+  const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
   py::gil_scoped_release release;
   return Identify(*kind, data, options);
 }
@@ -2438,35 +2430,21 @@ MixedPy ToMixedPart(const RobotFile& rig, const py::dict& d, double sigma, doubl
 IdentificationSummary IdentifyMixedPy(const RobotFile& rig, const py::list& parts,
                                       const py::object& fix, bool auto_fix, double sigma_mm,
                                       double sigma_mrad, const std::string& solver) {
-  IdentificationOptions options;
-  options.solver = ParseName(kSolverNames, solver, "solver", "solver");
-  options.sigma = sigma_mm * 1e-3;
-  options.fix_dependent_parameters = auto_fix;
-  options.check_linearisation = true;  // as lrcal identify
-  options.Validate();
+  const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
   const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
-  std::vector<MixedPart> kinds;
+  std::vector<std::shared_ptr<const MeasurementKind>> kinds;
   std::vector<MeasuredValues> values;
-  std::vector<py::dict> dicts;
-  std::map<std::string, int> seen, total;
-  for (const py::handle part : parts) {
-    dicts.push_back(part.cast<py::dict>());
-    if (dicts.back().contains("sensor")) ++total[dicts.back()["sensor"].cast<std::string>()];
-  }
-  for (std::size_t k = 0; k < dicts.size(); ++k) {
-    const py::dict& d = dicts[k];
+  for (std::size_t k = 0; k < parts.size(); ++k) {
     try {
-      MixedPy p = ToMixedPart(rig, d, sigma, sigma_mrad * 1e-3);
-      const std::string sensor = d["sensor"].cast<std::string>();
-      const int n = ++seen[sensor];
-      kinds.push_back({p.kind, total[sensor] > 1 ? sensor + std::to_string(n) : sensor});
+      MixedPy p = ToMixedPart(rig, parts[k].cast<py::dict>(), sigma, sigma_mrad * 1e-3);
+      kinds.push_back(p.kind);
       values.push_back(std::move(p.values));
     } catch (const InputError& e) {
       throw InputError("parts[" + std::to_string(k) + "]." + e.where(),
                        std::string(e.what()).substr(e.where().empty() ? 0 : e.where().size() + 2));
     }
   }
-  const MixedMeasurement mixed(std::move(kinds));
+  const MixedMeasurement mixed(PartsLabelledByKind(kinds));
   const std::vector<std::string> fixed = ToNames(fix);
   const std::unique_ptr<MeasurementKind> kind = mixed.Without(fixed);
   const MeasuredValues data = mixed.Combine(values);
@@ -2506,12 +2484,8 @@ std::vector<Pose<double>> CompensationGoals(const RobotFile& rig, const Configur
       Pose<double> pose;
       pose.p_BT = Eigen::Map<const Eigen::Vector3d>(&p[static_cast<std::size_t>(3 * i)]);
       if (!r.empty()) {
-        const auto k = static_cast<std::size_t>(4 * i);
-        const Eigen::Quaterniond rotation(r[k + 3], r[k], r[k + 1], r[k + 2]);
-        if (!(std::abs(rotation.norm() - 1) < 1e-6))
-          throw InputError("quaternion[" + std::to_string(i) + "]",
-                           "expected a unit quaternion (qx, qy, qz, qw)");
-        pose.R_BT = rotation.normalized().toRotationMatrix();
+        pose.R_BT = UnitQuaternionRotation(&r[static_cast<std::size_t>(4 * i)],
+                                           "quaternion[" + std::to_string(i) + "]");
       }
       goals.push_back(pose);
     }

@@ -30,6 +30,11 @@ MeasuredValues ReadTrackerMeasurements(const std::string& path, const PointMeasu
 /// SplitBySensor): errors name the table's file and lines.
 MeasuredValues TrackerMeasurementsFromTable(const CsvTable& t, const PointMeasurement& kind);
 
+/// The rotation of a measured unit quaternion `xyzw` (qx, qy, qz, qw). Throws InputError at
+/// `where` unless its norm is 1 within 1e-6. What every reader of measured orientations shares
+/// (tracker files, compensation targets, Python's arrays).
+Eigen::Matrix3d UnitQuaternionRotation(const double* xyzw, const std::string& where);
+
 /// A pose's three orientation rows (PoseMeasurement::OrientationValue) at configuration i of
 /// `configs` from its measured unit quaternion `xyzw` (qx, qy, qz, qw). Throws InputError at
 /// `where` unless the quaternion's norm is 1 within 1e-6. What the file reader and Python's

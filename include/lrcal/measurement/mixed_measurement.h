@@ -40,6 +40,11 @@ struct MixedPart {
   std::string label{};
 };
 
+/// `kinds` as parts labelled by their names, numbered where a kind appears more than once
+/// ("point1", "point2"): how the command line and Python label the files or dicts they are given.
+std::vector<MixedPart> PartsLabelledByKind(
+    const std::vector<std::shared_ptr<const MeasurementKind>>& kinds);
+
 class MixedMeasurement : public MeasurementKind {
  public:
   /// Throws InputError (where = "sensor") for no parts, an empty kind, repeated labels, or a
