@@ -15,6 +15,7 @@
 
 #include "lrcal/core/data_dir.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/io/urdf.h"
 
 namespace lrcal::cli {
 
@@ -64,6 +65,20 @@ RobotFile LoadRobot(const po::variables_map& vm) {
   robot_defaulted = vm["robot"].defaulted();
   return LoadRobot(vm["robot"].as<std::string>(),
                    vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "");
+}
+
+RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm) {
+  return LoadRobot(
+      path, IsUrdfPath(path) && vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "");
+}
+
+RobotFile LoadNominalRobot(const po::variables_map& vm, const RobotFile& calibrated) {
+  RobotFile nominal = LoadRobotWithToolLink(vm["nominal"].as<std::string>(), vm);
+  if (nominal.robot.num_links() != calibrated.robot.num_links())
+    throw InputError("--nominal", "has " + std::to_string(nominal.robot.num_links()) +
+                                      " joints but --robot has " +
+                                      std::to_string(calibrated.robot.num_links()));
+  return nominal;
 }
 
 PlaneSet ResolvePlanes(const RobotFile& rig, const po::variables_map& vm) {

@@ -52,6 +52,12 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
 /// --robot and --tool-link.
 RobotFile LoadRobot(const po::variables_map& vm);
+/// The robot at `path`, with --tool-link when it is a URDF: what a command reading two robots
+/// (one may be a YAML file, one a URDF) gives each (export --like, joint-offsets; compensate).
+RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm);
+/// --nominal (LoadRobotWithToolLink), the robot `calibrated` was calibrated from: InputError
+/// naming --nominal when their numbers of joints differ.
+RobotFile LoadNominalRobot(const po::variables_map& vm, const RobotFile& calibrated);
 /// Whether the last LoadRobot(vm) used --robot's default (the paper's arm) because none was
 /// given: an input error then says so, since a forgotten --robot shows as joint values out of
 /// range or a wrong number of joints rather than as itself.

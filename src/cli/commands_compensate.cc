@@ -130,18 +130,9 @@ int CompensateCommand(const std::vector<std::string>& args) {
     return 0;
   if (vm.count("out")) CheckOutputFile(vm["out"].as<std::string>(), "--out");
   // --tool-link names the link of whichever of --robot and --nominal is a URDF.
-  const std::string robot = vm["robot"].as<std::string>();
-  const RobotFile calibrated = IsUrdfPath(robot) ? LoadRobot(vm) : LoadRobot(robot, "");
-  const std::string tool_link = vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "";
+  const RobotFile calibrated = LoadRobotWithToolLink(vm["robot"].as<std::string>(), vm);
   std::optional<RobotFile> nominal;
-  if (vm.count("nominal")) {
-    const std::string path = vm["nominal"].as<std::string>();
-    nominal = LoadRobot(path, IsUrdfPath(path) ? tool_link : "");
-  }
-  if (nominal && nominal->robot.num_links() != calibrated.robot.num_links())
-    throw InputError("--nominal", "has " + std::to_string(nominal->robot.num_links()) +
-                                      " joints but --robot has " +
-                                      std::to_string(calibrated.robot.num_links()));
+  if (vm.count("nominal")) nominal = LoadNominalRobot(vm, calibrated);
   const std::string file = vm["targets"].as<std::string>();
   const CompensationTargets targets =
       ReadCompensationTargets(file, nominal ? nominal->robot : calibrated.robot);

@@ -393,7 +393,8 @@ void PredictAt(const std::string& file, const MeasurementModel& model,
 // identify --only-significant K (identification/significance.h): the corrections within K
 // standard deviations held at nominal and the rest refitted, their possible deviation a held
 // term's tolerance in every accuracy statement; both models' predicted tool position error at the
-// measured configurations stated side by side.
+// measured configurations stated side by side (the filtered one set by identify from the held
+// terms it finds anyway; the full one when nothing is held).
 struct SignificanceFilter {
   InsignificantCorrections held;
   double full_rms = std::nan(""), filtered_rms = std::nan("");  // m
@@ -431,13 +432,11 @@ struct SignificanceFilter {
   }
 };
 
-// The RMS of the predicted total tool position error of fit `s` on `model` at the measured
-// configurations (NaN when the covariance is undefined).
+// The RMS of the predicted total tool position error of fit `s` on `model`, with the terms it
+// holds `held`, at the measured configurations (NaN when the covariance is undefined).
 double PredictedRmsAtData(const MeasurementModel& model, const IdentificationSummary& s,
-                          const IdentificationOptions& options, const MeasurementSet& data,
-                          const PriorSigmas& known) {
-  const UnestimatedTerms held =
-      FindUnestimatedTerms(SolvedModel(model, s), s, data, options, known);
+                          const IdentificationOptions& options, const UnestimatedTerms& held,
+                          const MeasurementSet& data) {
   const std::optional<AccuracyPrediction> p =
       PredictAccuracyAfterFit(model, s, options, held, data.configs);
   return p ? p->rms_position_total : std::nan("");
@@ -457,17 +456,15 @@ std::optional<SignificanceFilter> FilterInsignificant(
   if (!s->IsSolutionUsable()) return f;
   f.held = FindInsignificantCorrections(*s, options, k);
   f.configurations = data.size();
-  f.full_rms = PredictedRmsAtData(*model, *s, options, data, *known);
-  if (f.held.terms.empty()) {
-    f.filtered_rms = f.full_rms;
-    return f;
-  }
+  f.full_rms = PredictedRmsAtData(
+      *model, *s, options, FindUnestimatedTerms(SolvedModel(*model, *s), *s, data, options, *known),
+      data);
+  if (f.held.terms.empty()) return f;
   *model = MeasurementModel(
       model->robot(), model->nominal_planes(),
       WithoutParameters(model->robot(), SolvedModel(*model, *s).parameters(), f.held.Names()));
   *s = Identify(*model, data, options);
   *known = known->OverriddenBy(f.held.Tolerances());
-  if (s->IsSolutionUsable()) f.filtered_rms = PredictedRmsAtData(*model, *s, options, data, *known);
   return f;
 }
 
@@ -863,14 +860,9 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
 // The mixed kind of `files` (labels: the kind, numbered when a kind repeats) with --fix held.
 std::unique_ptr<MeasurementKind> MakeMixedKind(const po::variables_map& vm, const RobotModel& robot,
                                                const std::vector<MixedFile>& files) {
-  std::vector<MixedPart> parts;
-  std::map<std::string, int> seen, total;
-  for (const MixedFile& f : files) ++total[f.sensor];
-  for (const MixedFile& f : files) {
-    const int n = ++seen[f.sensor];
-    parts.push_back({f.kind, total[f.sensor] > 1 ? f.sensor + std::to_string(n) : f.sensor});
-  }
-  auto mixed = std::make_unique<MixedMeasurement>(std::move(parts));
+  std::vector<std::shared_ptr<const MeasurementKind>> kinds;
+  for (const MixedFile& f : files) kinds.push_back(f.kind);
+  auto mixed = std::make_unique<MixedMeasurement>(PartsLabelledByKind(kinds));
   const std::vector<std::string> fixed = FixList(vm, robot);
   if (fixed.empty()) return mixed;
   for (const std::string& name : fixed)
@@ -921,10 +913,12 @@ int MixedIdentify(const po::variables_map& vm) {
   bool angles = false;
   std::vector<MeasuredValues> values;
   for (MixedFile& f : files) {
-    if (f.sensor == "pose" || (f.sensor == "contact" && f.kind->rows_per_configuration() > 1)) {
-      WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
-      angles = true;
-    }
+    for (int c = 0; c < f.kind->rows_per_configuration(); ++c)
+      if (f.kind->RowIsAngle(c)) {
+        WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
+        angles = true;
+        break;
+      }
     values.push_back(f.values);
   }
   const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, setup.rig.robot, files);
@@ -1010,12 +1004,14 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   if (s.termination == Termination::kInvalidInput && data.size() < model.num_parameters())
     throw InputError(DataFile(vm), s.message);
   PriorSigmas known = KnownTolerances(vm, rig);
-  const std::optional<SignificanceFilter> filter =
+  std::optional<SignificanceFilter> filter =
       FilterInsignificant(vm, data, options, &model, &s, &known);
 
   const UnestimatedTerms held =
       s.IsSolutionUsable() ? FindUnestimatedTerms(SolvedModel(model, s), s, data, options, known)
                            : UnestimatedTerms{};
+  if (filter && s.IsSolutionUsable())
+    filter->filtered_rms = PredictedRmsAtData(model, s, options, held, data);
   PrintIdentifyResults(vm, model, data, s, options, held, filter);
   if (s.termination == Termination::kRankDeficient) {
     std::cerr << "lrcal identify: the parameter set is not identifiable from these "

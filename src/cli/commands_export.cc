@@ -1,26 +1,18 @@
 // lrcal export: a robot (a calibrated robot file, a URDF, a shipped robot) written for the
 // robot's software: URDF, a D-H table (CSV) or a robot YAML file.
-#include <iomanip>
 #include <iostream>
-#include <sstream>
 
 #include "cli_common.h"
 #include "lrcal/core/json.h"
-#include "lrcal/core/random.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/core/text_table.h"
+#include "lrcal/design/configuration_sampling.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/joint_offsets.h"
 
 namespace lrcal::cli {
 
 namespace {
-
-// A value in the unit of a comment line, four decimals.
-std::string Fixed4(double v) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(4) << v;
-  return out.str();
-}
 
 // Writes `text` to --out (atomically) or standard output.
 void Emit(const po::variables_map& vm, const std::string& text) {
@@ -33,7 +25,7 @@ void Emit(const po::variables_map& vm, const std::string& text) {
 }
 
 // export --format joint-offsets: the offsets that make --nominal approximate --robot, fitted and
-// judged at --count configurations uniform in the joint ranges.
+// judged at --count configurations drawn over the joint ranges (WorkspacePoses).
 int ExportJointOffsets(const po::variables_map& vm) {
   for (const char* option : {"like", "plane"})
     if (vm.count(option))
@@ -42,31 +34,17 @@ int ExportJointOffsets(const po::variables_map& vm) {
     throw InputError("--nominal",
                      "missing: joint offsets are against the model the controller "
                      "runs; name it (a robot file, or a URDF with --tool-link)");
-  const std::string tool_link = vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "";
   const std::string robot_path = vm["robot"].as<std::string>();
   const std::string nominal_path = vm["nominal"].as<std::string>();
-  const RobotFile calibrated = LoadRobot(robot_path, IsUrdfPath(robot_path) ? tool_link : "");
-  const RobotFile nominal = LoadRobot(nominal_path, IsUrdfPath(nominal_path) ? tool_link : "");
+  const RobotFile calibrated = LoadRobotWithToolLink(robot_path, vm);
+  const RobotFile nominal = LoadNominalRobot(vm, calibrated);
   const int n = nominal.robot.num_links();
-  if (calibrated.robot.num_links() != n)
-    throw InputError("--nominal", "has " + std::to_string(n) + " joints but --robot has " +
-                                      std::to_string(calibrated.robot.num_links()));
   const int count = vm["count"].as<int>();
-  if (count < 1 || count > 1000000)
+  if (count < 1 || count > 100000)  // WorkspacePosesSetting's range
     throw InputError("--count",
-                     "expected 1 to 1000000 configurations, got " + std::to_string(count));
-  const RandomStream stream(ParseSeed(vm), 0, 0, RandomPurpose::kValidation);
-  ConfigurationSet configs(n);
-  std::vector<double> q(static_cast<std::size_t>(n));
-  for (int i = 0; i < count; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const Link& link = nominal.robot.links()[static_cast<std::size_t>(j)];
-      q[static_cast<std::size_t>(j)] =
-          link.q_min +
-          (link.q_max - link.q_min) * stream.Uniform(static_cast<std::uint64_t>(i) * n + j);
-    }
-    configs.Add(q.data());
-  }
+                     "expected 1 to 100000 configurations, got " + std::to_string(count));
+  const ConfigurationSet configs =
+      WorkspacePoses(nominal.robot, count, static_cast<std::uint64_t>(ParseSeed(vm)));
   const JointOffsetFit fit = FitJointOffsets(nominal.robot, calibrated.robot, configs);
   std::string text =
       "# Joint offsets of " + robot_path + " against " + nominal_path +
@@ -75,12 +53,12 @@ int ExportJointOffsets(const po::variables_map& vm) {
       "a joint reading before the nominal model uses it; subtract it from a command planned on the "
       "nominal model).\n# Fitted to the calibrated model's tool poses (positions, and orientations "
       "weighed as points 0.1 m from the tool origin) at " +
-      std::to_string(count) + " configurations uniform in the joint ranges (seed " +
+      std::to_string(count) + " configurations drawn over the joint ranges (seed " +
       std::to_string(ParseSeed(vm)) + ").\n# The simplification's error there: tool position RMS " +
-      Fixed4(fit.rms * 1e3) + " mm, worst " + Fixed4(fit.worst * 1e3) + " mm; orientation RMS " +
-      Fixed4(fit.orientation_rms * 1e3) + " mrad, worst " + Fixed4(fit.orientation_worst * 1e3) +
-      " mrad (the nominal model alone: RMS " + Fixed4(fit.nominal_rms * 1e3) + " mm, worst " +
-      Fixed4(fit.nominal_worst * 1e3) + " mm).\njoint,name,offset,unit\n";
+      Fixed(fit.rms * 1e3) + " mm, worst " + Fixed(fit.worst * 1e3) + " mm; orientation RMS " +
+      Fixed(fit.orientation_rms * 1e3) + " mrad, worst " + Fixed(fit.orientation_worst * 1e3) +
+      " mrad (the nominal model alone: RMS " + Fixed(fit.nominal_rms * 1e3) + " mm, worst " +
+      Fixed(fit.nominal_worst * 1e3) + " mm).\njoint,name,offset,unit\n";
   for (int j = 0; j < n; ++j) {
     const Link& link = nominal.robot.links()[static_cast<std::size_t>(j)];
     text += std::to_string(j + 1) + "," + link.joint_name + "," + FileNumber(fit.offsets[j]) + "," +
@@ -110,10 +88,10 @@ int ExportCommand(const std::vector<std::string>& args) {
       "joint-offsets: the robot (file or URDF, with --tool-link) the controller runs; the offsets "
       "make it approximate --robot")(
       "count", po::value<int>()->default_value(1000),
-      "joint-offsets: configurations, uniform in the joint ranges, the offsets are fitted and "
-      "judged at")("seed", po::value<long long>()->default_value(1),
-                   "joint-offsets: their random seed")("out", po::value<std::string>(),
-                                                       "file to write (default: standard output)");
+      "joint-offsets: configurations drawn over the joint ranges (non-singular, as accuracy "
+      "--workspace draws them) the offsets are fitted and judged at")(
+      "seed", po::value<long long>()->default_value(1), "joint-offsets: their random seed")(
+      "out", po::value<std::string>(), "file to write (default: standard output)");
   po::variables_map vm;
   if (!Parse("export",
              "--robot R --format urdf|dh-table|yaml|joint-offsets [--like USER.urdf] [--nominal N] "
@@ -126,9 +104,8 @@ int ExportCommand(const std::vector<std::string>& args) {
   if (vm.count("like") && vm.count("plane"))
     throw InputError("--plane", "a URDF holds no planes; --like writes the arm only");
   // With --like, --tool-link names the link of that URDF (and of --robot if it is a URDF too).
-  const RobotFile rig = vm.count("like") && !IsUrdfPath(vm["robot"].as<std::string>())
-                            ? LoadRobot(vm["robot"].as<std::string>(), "")
-                            : LoadRobot(vm);
+  const RobotFile rig =
+      vm.count("like") ? LoadRobotWithToolLink(vm["robot"].as<std::string>(), vm) : LoadRobot(vm);
   const std::string text =
       vm.count("like")
           ? UrdfLikeText(vm["like"].as<std::string>(),
