@@ -44,6 +44,9 @@ void AddCommonOptions(po::options_description& options) {
                         "robot file (YAML or URDF) or shipped robot name")(
       "tool-link", po::value<std::string>(),
       "URDF robots: the link whose frame is the ranger's (default: the URDF's only end link)")(
+      "base-link", po::value<std::string>(),
+      "URDF robots: the link the chain starts from, its frame the base frame (default: the "
+      "root); the path may run up the tree against the URDF, as from a foot to a hand")(
       "plane", po::value<std::vector<std::string>>()->composing(),
       "plane n.p + f = 0 as nx,ny,nz,f: the normal in the base frame (normalised) and f in m; "
       "repeat for several planes (a CSV's plane column numbers them from 1 in this order); "
@@ -61,15 +64,22 @@ bool robot_defaulted = false;
 
 bool RobotWasDefaulted() { return robot_defaulted; }
 
+namespace {
+std::string OptionalString(const po::variables_map& vm, const char* option) {
+  return vm.count(option) ? vm[option].as<std::string>() : "";
+}
+}  // namespace
+
 RobotFile LoadRobot(const po::variables_map& vm) {
   robot_defaulted = vm["robot"].defaulted();
-  return LoadRobot(vm["robot"].as<std::string>(),
-                   vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "");
+  return LoadRobotFile(ResolveRobotPath(vm["robot"].as<std::string>()),
+                       OptionalString(vm, "tool-link"), OptionalString(vm, "base-link"));
 }
 
 RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm) {
-  return LoadRobot(
-      path, IsUrdfPath(path) && vm.count("tool-link") ? vm["tool-link"].as<std::string>() : "");
+  if (!IsUrdfPath(path)) return LoadRobot(path);
+  return LoadRobotFile(ResolveRobotPath(path), OptionalString(vm, "tool-link"),
+                       OptionalString(vm, "base-link"));
 }
 
 RobotFile LoadNominalRobot(const po::variables_map& vm, const RobotFile& calibrated) {

@@ -50,7 +50,7 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 
 /// --robot: a path (robot YAML or URDF) or a shipped name ("paper"); `tool_link` for a URDF.
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
-/// --robot and --tool-link.
+/// --robot, --tool-link and --base-link.
 RobotFile LoadRobot(const po::variables_map& vm);
 /// The robot at `path`, with --tool-link when it is a URDF: what a command reading two robots
 /// (one may be a YAML file, one a URDF) gives each (export --like, joint-offsets; compensate).

@@ -116,6 +116,7 @@ int CompensateCommand(const std::vector<std::string>& args) {
   o.add_options()("robot", po::value<std::string>()->required(),
                   "the calibrated robot file (identify --write-robot), or a calibrated URDF")(
       "tool-link", po::value<std::string>(), "URDF robots: the tool link")(
+      "base-link", po::value<std::string>(), "URDF robots: the chain's base link (default: root)")(
       "nominal", po::value<std::string>(),
       "the robot file or URDF the commands were planned on: its tool poses at them are the "
       "targets when --targets gives no x, y, z")(

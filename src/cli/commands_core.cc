@@ -22,6 +22,7 @@
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/tracker_data.h"
 #include "lrcal/io/urdf.h"
+#include "lrcal/measurement/chain_measurement.h"
 #include "lrcal/measurement/mixed_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
@@ -805,6 +806,34 @@ MixedFile LoadMixedTable(const po::variables_map& vm, const Setup& setup, const 
   return f;
 }
 
+// The options a calibration of several parts (kinds, or a tree's chains) does not take, and the
+// kinds' own options when no part is of that kind, refused by name.
+void RefuseOptionsOfOneKind(const po::variables_map& vm, const std::vector<std::string>& sensors,
+                            const std::string& what) {
+  const auto has = [&](std::initializer_list<const char*> kinds) {
+    for (const char* kind : kinds)
+      if (std::find(sensors.begin(), sensors.end(), kind) != sensors.end()) return true;
+    return false;
+  };
+  std::vector<std::pair<std::string, bool>> refused = {
+      {"predict-at", false},
+      {"holdout", false},
+      {"report", false},
+      {"only-significant", false},
+      {"measured", false},
+      {"prior", false},
+      {"prior-sigma", false},
+      {"estimate-ranger", has({"ranger"})},
+      {"average", has({"ranger"})},
+      {"estimate-base", has({"ranger"})},
+      {"estimate-tool", has({"ranger"})},
+      {"plane", has({"ranger", "contact", "scanner"})},
+      {"estimate-plane", has({"ranger", "contact", "scanner"})}};
+  for (const auto& [name, taken] : refused)
+    if (!taken && vm.count(name) && !vm[name].defaulted())
+      throw InputError("--" + name, "is not taken by a calibration from " + what);
+}
+
 // The files of a mixed run, one per kind of --sensor, read; the options no kind in the list takes
 // refused by name.
 std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& setup,
@@ -828,29 +857,8 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
                      "given " + std::to_string(files.size()) + " time(s) for the " +
                          std::to_string(listed.size()) + " kinds of --sensor " +
                          vm["sensor"].as<std::string>() + ": expected one file per kind, in order");
-  const auto has = [&](std::initializer_list<const char*> kinds) {
-    for (const char* kind : kinds)
-      if (std::find(sensors.begin(), sensors.end(), kind) != sensors.end()) return true;
-    return false;
-  };
-  std::vector<std::pair<std::string, bool>> refused = {
-      {"predict-at", false},
-      {"holdout", false},
-      {"report", false},
-      {"only-significant", false},
-      {"measured", false},
-      {"prior", false},
-      {"prior-sigma", false},
-      {"estimate-ranger", has({"ranger"})},
-      {"average", has({"ranger"})},
-      {"estimate-base", has({"ranger"})},
-      {"estimate-tool", has({"ranger"})},
-      {"plane", has({"ranger", "contact", "scanner"})},
-      {"estimate-plane", has({"ranger", "contact", "scanner"})}};
-  for (const auto& [name, taken] : refused)
-    if (!taken && vm.count(name) && !vm[name].defaulted())
-      throw InputError("--" + name, "is not taken by a calibration from several kinds (--sensor " +
-                                        vm["sensor"].as<std::string>() + ")");
+  RefuseOptionsOfOneKind(vm, sensors,
+                         "several kinds (--sensor " + vm["sensor"].as<std::string>() + ")");
   std::vector<MixedFile> out;
   for (const auto& [sensor, table] : tables)
     out.push_back(LoadMixedTable(vm, setup, sensor, table, configs_only));
@@ -859,10 +867,16 @@ std::vector<MixedFile> LoadMixedFiles(const po::variables_map& vm, const Setup& 
 
 // The mixed kind of `files` (labels: the kind, numbered when a kind repeats) with --fix held.
 std::unique_ptr<MeasurementKind> MakeMixedKind(const po::variables_map& vm, const RobotModel& robot,
-                                               const std::vector<MixedFile>& files) {
+                                               const std::vector<MixedFile>& files,
+                                               const std::vector<std::string>& labels = {}) {
   std::vector<std::shared_ptr<const MeasurementKind>> kinds;
   for (const MixedFile& f : files) kinds.push_back(f.kind);
-  auto mixed = std::make_unique<MixedMeasurement>(PartsLabelledByKind(kinds));
+  std::vector<MixedPart> parts = PartsLabelledByKind(kinds);
+  for (std::size_t p = 0; p < labels.size(); ++p) {
+    parts[p].label = labels[p];  // a tree's chains: their terms named by ChainMeasurement
+    parts[p].names_are_shared = true;
+  }
+  auto mixed = std::make_unique<MixedMeasurement>(std::move(parts));
   const std::vector<std::string> fixed = FixList(vm, robot);
   if (fixed.empty()) return mixed;
   for (const std::string& name : fixed)
@@ -962,6 +976,165 @@ int MixedIdentifiability(const po::variables_map& vm) {
   return 0;
 }
 
+// A tree's run (--tool-link a,b: several tool links of one URDF): each chain's file read for its
+// chain's robot by its kind's reader (one --sensor for every chain, or one per chain), its
+// configurations made the whole robot's (chain_measurement.h), the parts labelled by their tool
+// links.
+struct TreeRun {
+  UrdfChains tree;
+  std::vector<std::unique_ptr<Setup>> setups;  // per chain; its kind refers to its robot
+  std::vector<MixedFile> files;
+  std::vector<std::string> labels;
+};
+
+std::string JoinComma(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+bool IsTreeRun(const po::variables_map& vm) {
+  return vm.count("tool-link") && SplitList(vm["tool-link"].as<std::string>()).size() > 1;
+}
+
+TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool configs_only) {
+  const std::string path = ResolveRobotPath(vm["robot"].as<std::string>());
+  if (!IsUrdfPath(path))
+    throw InputError("--tool-link",
+                     "several tool links are a tree's chains: --robot must be a "
+                     "URDF, not '" +
+                         path + "'");
+  TreeRun run;
+  run.labels = SplitList(vm["tool-link"].as<std::string>());
+  run.tree = LoadUrdfChains(path, run.labels,
+                            vm.count("base-link") ? vm["base-link"].as<std::string>() : "");
+  std::vector<std::string> sensors = ResolveSensors(vm);
+  if (sensors.size() == 1 && sensors[0] != "mixed") sensors.assign(run.labels.size(), sensors[0]);
+  if (sensors.size() != run.labels.size())
+    throw InputError("--sensor",
+                     "expected one kind for every chain, or one per tool link of "
+                     "--tool-link (" +
+                         std::to_string(run.labels.size()) + "), got " +
+                         vm["sensor"].as<std::string>());
+  const auto& files = vm[option].as<std::vector<std::string>>();
+  if (files.size() != run.labels.size())
+    throw InputError(std::string("--") + option,
+                     "given " + std::to_string(files.size()) + " time(s) for the " +
+                         std::to_string(run.labels.size()) +
+                         " chains of --tool-link: expected one file per tool link, in order");
+  RefuseOptionsOfOneKind(vm, sensors,
+                         "a tree's chains (--tool-link " + vm["tool-link"].as<std::string>() + ")");
+  if (vm.count("write-robot"))
+    throw InputError("--write-robot",
+                     "writes one chain's robot file; a tree's chains are "
+                     "calibrated together but not yet written (identify each "
+                     "chain's file from the JSON estimate)");
+  for (std::size_t c = 0; c < files.size(); ++c) {
+    const RobotFile& chain = run.tree.chains[c];
+    auto& setup = run.setups.emplace_back(std::make_unique<Setup>(Setup{chain, PlaneSet{}}));
+    if (sensors[c] != "point" && sensors[c] != "pose" && sensors[c] != "socket")
+      setup->planes = ResolvePlanes(chain, vm);  // the kinds that see planes
+    MixedFile f =
+        LoadMixedTable(vm, *setup, sensors[c], ReadRobotCsv(files[c], chain.robot), configs_only);
+    const auto part = std::make_shared<ChainMeasurement>(f.kind, run.tree.placements[c]);
+    f.values.configs = part->RobotConfigurations(
+        f.values.configs, std::vector<double>(run.tree.joint_names.size(), 0.0));
+    f.kind = part;
+    run.files.push_back(std::move(f));
+  }
+  return run;
+}
+
+// The terms the chains share (unlabelled) and each chain's own, as JSON.
+Json TreeJson(const TreeRun& run, const MixedMeasurement& kind) {
+  Json shared = Json::array(), own = Json::object();
+  for (const std::string& name : kind.parameter_names()) {
+    const auto dot = name.find('.');
+    if (dot == std::string::npos)
+      shared.push_back(name);
+    else
+      own[name.substr(0, dot)].push_back(name);
+  }
+  return {{"tool_links", run.labels},
+          {"joints", run.tree.joint_names},
+          {"shared_terms", shared},
+          {"own_terms", own}};
+}
+
+std::string TreeText(const TreeRun& run, const MixedMeasurement& kind) {
+  const Json j = TreeJson(run, kind);
+  std::string text =
+      "tree: " + std::to_string(run.labels.size()) + " chains (" + JoinComma(run.labels) +
+      ") over " + std::to_string(run.tree.joint_names.size()) +
+      " joints; terms shared by every chain: " + std::to_string(j["shared_terms"].size());
+  for (const auto& [label, names] : j["own_terms"].items())
+    text += "; " + label + "'s own: " + std::to_string(names.size());
+  const std::vector<std::string> shared = j["shared_terms"].get<std::vector<std::string>>();
+  return text + "\nshared: " + (shared.empty() ? "none" : JoinComma(shared)) + "\n";
+}
+
+// identify --tool-link a,b --data A.csv --data B.csv: the chains' terms together, the shared
+// joints' once.
+int TreeIdentify(const po::variables_map& vm) {
+  TreeRun run = LoadTreeRun(vm, "data", false);
+  const RobotFile& first = run.tree.chains[0];
+  const IdentificationOptions options = ResolveIdentificationOptions(vm, first);
+  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
+  bool angles = false;
+  std::vector<MeasuredValues> values;
+  for (MixedFile& f : run.files) {
+    for (int c = 0; c < f.kind->rows_per_configuration(); ++c)
+      if (f.kind->RowIsAngle(c)) {
+        WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
+        angles = true;
+        break;
+      }
+    values.push_back(f.values);
+  }
+  const std::unique_ptr<MeasurementKind> kind =
+      MakeMixedKind(vm, first.robot, run.files, run.labels);
+  const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
+  const MeasuredValues data = mixed.Combine(values);
+  const IdentificationSummary s = Identify(mixed, data, options);
+  std::string sources;
+  for (const MixedFile& f : run.files) sources += (sources.empty() ? "" : " + ") + f.file;
+  if (ResolveFormat(vm) != Format::kJson) std::cout << TreeText(run, mixed);
+  return ReportKindFit(vm,
+                       {first, mixed, data, sources, "mixed",
+                        MixedPartsText(mixed, run.files) + "; one entry per measured value",
+                        angles ? "--sigma-mm and --sigma-mrad" : "--sigma-mm",
+                        Json{{"parts", MixedPartsJson(mixed, run.files)},
+                             {"tree", TreeJson(run, mixed)},
+                             {"values_per_configuration", nullptr}}},
+                       s, options);
+}
+
+// identifiability --tool-link a,b --configs A.csv --configs B.csv.
+int TreeIdentifiability(const po::variables_map& vm) {
+  const TreeRun run = LoadTreeRun(vm, "configs", true);
+  std::vector<MeasuredValues> values;
+  for (const MixedFile& f : run.files) values.push_back(f.values);
+  const std::unique_ptr<MeasurementKind> kind =
+      MakeMixedKind(vm, run.tree.chains[0].robot, run.files, run.labels);
+  const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  const IdentifiabilityReport r =
+      AnalyzeIdentifiability(mixed, mixed.Combine(values).configs, nullptr, options);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j = IdentifiabilityJson(r);
+    j["sensor"] = "mixed";
+    j["parts"] = MixedPartsJson(mixed, run.files);
+    j["tree"] = TreeJson(run, mixed);
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << TreeText(run, mixed) << "sensor: mixed (" << MixedPartsText(mixed, run.files)
+              << "; one entry per measured value)\n"
+              << r.ToString();
+  }
+  return 0;
+}
+
 // What the ranger's identify writes, checked before the fit (not after): a calibrated robot file
 // that could not be written, and measured points with no report to put them in.
 void CheckRangerIdentifyOutputs(const po::variables_map& vm) {
@@ -971,6 +1144,19 @@ void CheckRangerIdentifyOutputs(const po::variables_map& vm) {
     throw InputError("--measured",
                      "goes into the calibration report: give --report DIR too "
                      "(or judge a robot file with lrcal accuracy --measured)");
+}
+
+// identify with a tree's chains, several kinds or one kind other than the ranger; nothing for
+// the ranger's own calibration, which IdentifyCommand does.
+std::optional<int> IdentifyOtherThanOneRanger(const po::variables_map& vm) {
+  if (IsTreeRun(vm)) return TreeIdentify(vm);
+  const std::string sensor = ResolveSensor(vm);
+  if (sensor == "mixed") return MixedIdentify(vm);
+  if (sensor == "socket") return SocketIdentify(vm);
+  if (sensor == "contact") return ContactIdentify(vm);
+  if (sensor == "scanner") return ScannerIdentify(vm);
+  if (sensor != "ranger") return TrackerIdentify(vm, sensor);
+  return std::nullopt;
 }
 
 }  // namespace
@@ -985,12 +1171,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   AddOrientationNoiseOption(o);
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
-  const std::string sensor = ResolveSensor(vm);
-  if (sensor == "mixed") return MixedIdentify(vm);
-  if (sensor == "socket") return SocketIdentify(vm);
-  if (sensor == "contact") return ContactIdentify(vm);
-  if (sensor == "scanner") return ScannerIdentify(vm);
-  if (sensor != "ranger") return TrackerIdentify(vm, sensor);
+  if (const std::optional<int> done = IdentifyOtherThanOneRanger(vm)) return *done;
   CheckRangerIdentifyOutputs(vm);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
@@ -1191,6 +1372,7 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   AddSettingOptions(o, IdentifiabilityOptions::Settings(), {"rank_tolerance"});
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
+  if (IsTreeRun(vm)) return TreeIdentifiability(vm);
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "mixed") return MixedIdentifiability(vm);
   if (sensor == "socket") return SocketIdentifiability(vm);

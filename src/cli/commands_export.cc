@@ -77,6 +77,8 @@ int ExportCommand(const std::vector<std::string>& args) {
                   "written (a calibrated file's are the estimates)")(
       "tool-link", po::value<std::string>(),
       "URDF robots: the ranger's link; with --like, the tool link of that URDF")(
+      "base-link", po::value<std::string>(),
+      "URDF robots: the link the chain starts from (default: the root)")(
       "like", po::value<std::string>(),
       "urdf: write the calibration into this URDF (the user's own): every element kept, only "
       "the origins of the chain's joints to --tool-link changed")(
@@ -101,6 +103,11 @@ int ExportCommand(const std::vector<std::string>& args) {
   if (vm["format"].as<std::string>() == "joint-offsets") return ExportJointOffsets(vm);
   if (vm.count("like") && vm["format"].as<std::string>() != "urdf")
     throw InputError("--like", "writes into a URDF: give --format urdf (the default)");
+  if (vm.count("like") && vm.count("base-link"))
+    throw InputError("--base-link",
+                     "--like writes a chain from the URDF's root link into it; a "
+                     "chain from another link is exported with --format urdf or "
+                     "dh-table");
   if (vm.count("like") && vm.count("plane"))
     throw InputError("--plane", "a URDF holds no planes; --like writes the arm only");
   // With --like, --tool-link names the link of that URDF (and of --robot if it is a URDF too).

@@ -497,12 +497,18 @@ PriorSigmas PriorsFor(const RobotFile& rig, bool use_tolerances, const std::stri
   return priors;
 }
 
-RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link) {
-  if (IsUrdfPath(path)) return LoadUrdfRobotFile(path, tool_link);
+RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link,
+                        const std::string& base_link) {
+  if (IsUrdfPath(path)) return LoadUrdfRobotFile(path, tool_link, base_link);
   if (!tool_link.empty())
     throw SettingError(SettingSpec::Named("setup", "tool_link", "tool_link", "the ranger's link"),
                        "applies to a URDF robot; '" + path +
                            "' is a robot YAML file (its last frame is the tool)");
+  if (!base_link.empty())
+    throw SettingError(
+        SettingSpec::Named("setup", "base_link", "base_link", "the chain's base link"),
+        "applies to a URDF robot; '" + path +
+            "' is a robot YAML file (its base frame is the chain's first)");
   YAML::Node root = yaml::LoadFile(path);
   yaml::CheckKeys(root,
                   {"name", "description", "links", "base", "tool", "true_errors", "tolerances",

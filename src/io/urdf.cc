@@ -58,7 +58,7 @@ std::vector<std::string> LeafLinks(const urdf::ModelInterface& model) {
 }
 
 std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string& path,
-                           const std::string& tool_link) {
+                           const std::string& tool_link, const std::string& base_link) {
   if (!tool_link.empty()) {
     if (!model.getLink(tool_link)) {
       std::vector<urdf::LinkSharedPtr> links;
@@ -72,7 +72,8 @@ std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string&
     }
     return tool_link;
   }
-  const std::vector<std::string> leaves = LeafLinks(model);
+  std::vector<std::string> leaves = LeafLinks(model);
+  leaves.erase(std::remove(leaves.begin(), leaves.end(), base_link), leaves.end());
   if (leaves.size() != 1)
     throw InputError(path, "the URDF has " + std::to_string(leaves.size()) + " end links (" +
                                JoinList(leaves) +
@@ -171,56 +172,193 @@ void JointRange(const urdf::Joint& joint, const std::string& path, JointAxis* ax
 
 }  // namespace
 
-RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link) {
+namespace {
+
+// A link by name, or an InputError naming the option (and study key) that gave it and every link.
+urdf::LinkConstSharedPtr NamedLink(const urdf::ModelInterface& model, const std::string& path,
+                                   const std::string& name, const std::string& option) {
+  if (urdf::LinkConstSharedPtr link = model.getLink(name)) return link;
+  std::vector<urdf::LinkSharedPtr> links;
+  model.getLinks(links);
+  std::vector<std::string> names;
+  for (const auto& l : links) names.push_back(l->name);
+  std::sort(names.begin(), names.end());
+  throw InputError(path, "no link named '" + name + "' (--" + option + ", or a study's " +
+                             std::string(option == "base-link" ? "base_link" : "tool_link") +
+                             "); the links are " + JoinList(names));
+}
+
+// The joints from the root down to `link`, root first.
+std::vector<urdf::JointConstSharedPtr> JointsFromRoot(const urdf::ModelInterface& model,
+                                                      urdf::LinkConstSharedPtr link) {
+  std::vector<urdf::JointConstSharedPtr> joints;
+  for (; link && link->parent_joint; link = model.getLink(link->parent_joint->parent_link_name))
+    joints.push_back(link->parent_joint);
+  std::reverse(joints.begin(), joints.end());
+  return joints;
+}
+
+// The link's pose in the root frame at the zero configuration.
+RigidTransform RootPoseAtZero(const std::vector<urdf::JointConstSharedPtr>& from_root) {
+  RigidTransform pose;
+  for (const auto& joint : from_root)
+    pose = pose * FromUrdfPose(joint->parent_to_joint_origin_transform);
+  return pose;
+}
+
+// One joint of the path from the base link to the tool link: traversed from parent to child
+// (`reversed` false) or against the URDF's direction, from its child up to its parent.
+struct PathJoint {
+  urdf::JointConstSharedPtr joint;
+  bool reversed = false;
+};
+
+// The path from `base` to `tool` through the tree: up from the base to the links' last common
+// ancestor (each joint reversed, the base's own joint first), then down to the tool.
+std::vector<PathJoint> PathBetween(const std::vector<urdf::JointConstSharedPtr>& root_to_base,
+                                   const std::vector<urdf::JointConstSharedPtr>& root_to_tool) {
+  std::size_t common = 0;
+  while (common < root_to_base.size() && common < root_to_tool.size() &&
+         root_to_base[common] == root_to_tool[common])
+    ++common;
+  std::vector<PathJoint> path;
+  for (std::size_t k = root_to_base.size(); k > common; --k)
+    path.push_back({root_to_base[k - 1], true});
+  for (std::size_t k = common; k < root_to_tool.size(); ++k)
+    path.push_back({root_to_tool[k], false});
+  return path;
+}
+
+// A movable joint of the path as lrcal's joint axis in the base link's frame at q = 0: its line
+// through the joint's frame (its child link's origin), its direction the URDF's axis, turned
+// round for a joint traversed from child to parent (a positive joint value then moves the rest of
+// the chain the other way: the product of exponentials of the inverse). Its value and range stay
+// the URDF's.
+JointAxis PathJointAxis(const urdf::ModelInterface& model, const PathJoint& step,
+                        const RigidTransform& base_inverse, const std::string& path) {
+  const urdf::Joint& joint = *step.joint;
+  if (joint.mimic)
+    throw InputError(path,
+                     "joint '" + joint.name + "' mimics another; lrcal needs independent joints");
+  JointAxis axis;
+  switch (joint.type) {
+    case urdf::Joint::REVOLUTE:
+    case urdf::Joint::CONTINUOUS:
+      axis.joint = JointType::kRevolute;
+      break;
+    case urdf::Joint::PRISMATIC:
+      axis.joint = JointType::kPrismatic;
+      break;
+    default:
+      throw InputError(path, "joint '" + joint.name +
+                                 "': lrcal handles revolute, continuous, prismatic and fixed "
+                                 "joints, not floating, planar or unknown ones");
+  }
+  JointRange(joint, path, &axis);
+  axis.name = joint.name;
+  const RigidTransform frame =
+      base_inverse * RootPoseAtZero(JointsFromRoot(model, model.getLink(joint.child_link_name)));
+  axis.point = frame.translation;
+  axis.direction = frame.rotation * Eigen::Vector3d(joint.axis.x, joint.axis.y, joint.axis.z);
+  if (step.reversed) axis.direction = -axis.direction;
+  if (!(axis.direction.norm() > 1e-12))
+    throw InputError(path, "joint '" + joint.name + "': the axis is zero");
+  return axis;
+}
+
+}  // namespace
+
+RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link,
+                            const std::string& base_link) {
   if (!PathExists(path)) throw InputError(path, "no such file");
   CheckUrdfTree(path);
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
   if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
-  const std::string tool = ChooseToolLink(*model, path, tool_link);
-  // The joints from the root to the tool link.
-  std::vector<urdf::JointConstSharedPtr> chain;
-  for (urdf::LinkConstSharedPtr link = model->getLink(tool); link && link->parent_joint;
-       link = model->getLink(link->parent_joint->parent_link_name))
-    chain.push_back(link->parent_joint);
-  std::reverse(chain.begin(), chain.end());
+  const std::string base = base_link.empty() ? model->getRoot()->name : base_link;
+  const urdf::LinkConstSharedPtr base_of_chain = NamedLink(*model, path, base, "base-link");
+  const std::string tool = ChooseToolLink(*model, path, tool_link, base);
+  if (tool == base)
+    throw InputError(path, "the base link and the tool link are both '" + base +
+                               "' (--base-link, --tool-link): a chain joins two links");
+  const std::vector<urdf::JointConstSharedPtr> root_to_base = JointsFromRoot(*model, base_of_chain);
+  const std::vector<urdf::JointConstSharedPtr> root_to_tool =
+      JointsFromRoot(*model, model->getLink(tool));
+  const RigidTransform base_inverse = RootPoseAtZero(root_to_base).Inverse();
   std::vector<JointAxis> axes;
-  RigidTransform pose;  // of the current link in the root frame, at q = 0
-  for (const auto& joint : chain) {
-    pose = pose * FromUrdfPose(joint->parent_to_joint_origin_transform);
-    if (joint->type == urdf::Joint::FIXED) continue;
-    if (joint->mimic)
-      throw InputError(
-          path, "joint '" + joint->name + "' mimics another; lrcal needs independent joints");
-    JointAxis axis;
-    switch (joint->type) {
-      case urdf::Joint::REVOLUTE:
-      case urdf::Joint::CONTINUOUS:
-        axis.joint = JointType::kRevolute;
-        break;
-      case urdf::Joint::PRISMATIC:
-        axis.joint = JointType::kPrismatic;
-        break;
-      default:
-        throw InputError(path, "joint '" + joint->name +
-                                   "': lrcal handles revolute, continuous, prismatic and fixed "
-                                   "joints, not floating, planar or unknown ones");
-    }
-    JointRange(*joint, path, &axis);
-    axis.name = joint->name;
-    axis.point = pose.translation;
-    axis.direction = pose.rotation * Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-    if (!(axis.direction.norm() > 1e-12))
-      throw InputError(path, "joint '" + joint->name + "': the axis is zero");
-    axes.push_back(axis);
-  }
+  for (const PathJoint& step : PathBetween(root_to_base, root_to_tool))
+    if (step.joint->type != urdf::Joint::FIXED)
+      axes.push_back(PathJointAxis(*model, step, base_inverse, path));
   if (axes.empty())
-    throw InputError(path, "no movable joint between the root link '" + model->getRoot()->name +
+    throw InputError(path, "no movable joint between the " +
+                               std::string(base_link.empty() ? "root" : "base") + " link '" + base +
                                "' and the tool link '" + tool + "'");
   RobotFile file;
-  file.robot = RobotFromJointAxes(model->getName(), axes, pose, path);
+  file.robot =
+      RobotFromJointAxes(model->getName(), axes, base_inverse * RootPoseAtZero(root_to_tool), path);
   file.path = path;
   file.robot.source = path;
   return file;
+}
+
+namespace {
+
+std::vector<std::string> ChainJointNames(const RobotModel& robot) {
+  std::vector<std::string> names;
+  for (const Link& link : robot.links()) names.push_back(link.joint_name);
+  return names;
+}
+
+// Whether chains a and b have the same joints 0 … k + 1 (link k, from joint k to joint k + 1, is
+// then the same D-H link in both; a chain's last link reaches its own tool).
+bool ShareLink(const std::vector<std::string>& a, const std::vector<std::string>& b,
+               std::size_t k) {
+  return k + 1 < a.size() && k + 1 < b.size() &&
+         std::equal(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(k + 2), b.begin());
+}
+
+std::vector<std::string> LinkLabels(const std::vector<std::vector<std::string>>& joints,
+                                    const std::vector<std::string>& labels, std::size_t c) {
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < joints[c].size(); ++k) {
+    std::size_t first = c, sharing = 0;
+    for (std::size_t d = 0; d < joints.size(); ++d)
+      if (d == c || ShareLink(joints[c], joints[d], k)) {
+        ++sharing;
+        first = std::min(first, d);
+      }
+    out.push_back(sharing == joints.size() ? "" : labels[first]);
+  }
+  return out;
+}
+
+}  // namespace
+
+UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string>& tool_links,
+                          const std::string& base_link) {
+  if (tool_links.empty()) throw InputError(path, "expected at least one tool link (--tool-link)");
+  UrdfChains out;
+  std::vector<std::vector<std::string>> joints;
+  for (const std::string& tool : tool_links) {
+    if (std::count(tool_links.begin(), tool_links.end(), tool) > 1)
+      throw InputError(path, "the tool link '" + tool + "' is named twice (--tool-link)");
+    out.chains.push_back(LoadUrdfRobotFile(path, tool, base_link));
+    joints.push_back(ChainJointNames(out.chains.back().robot));
+    for (const std::string& name : joints.back())
+      if (std::find(out.joint_names.begin(), out.joint_names.end(), name) == out.joint_names.end())
+        out.joint_names.push_back(name);
+  }
+  for (std::size_t c = 0; c < tool_links.size(); ++c) {
+    ChainOfTree placement;
+    placement.label = tool_links[c];
+    for (const std::string& name : joints[c])
+      placement.joints.push_back(
+          static_cast<int>(std::find(out.joint_names.begin(), out.joint_names.end(), name) -
+                           out.joint_names.begin()));
+    placement.link_labels = LinkLabels(joints, tool_links, c);
+    placement.robot_joints = static_cast<int>(out.joint_names.size());
+    out.placements.push_back(std::move(placement));
+  }
+  return out;
 }
 
 namespace {
@@ -459,7 +597,7 @@ std::string UrdfLikeText(const std::string& original, const std::string& tool_li
   const RobotFile own = LoadUrdfRobotFile(original, tool_link);  // the checks of any URDF
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(original);
   if (!model) throw InputError(original, "not a URDF that urdfdom can read (its message is above)");
-  const std::string tool = ChooseToolLink(*model, original, tool_link);
+  const std::string tool = ChooseToolLink(*model, original, tool_link, "");
   TiXmlDocument doc;
   if (!doc.LoadFile(original.c_str()) || !doc.RootElement())
     throw InputError(original, std::string("not XML that TinyXML can read: ") + doc.ErrorDesc());

@@ -83,10 +83,13 @@ std::vector<MixedPart> PartsLabelledByKind(
   return parts;
 }
 
-bool MixedMeasurement::IsSharedTerm(const std::string& name) {
+bool MixedMeasurement::IsSharedTerm(const std::string& full_name) {
   constexpr int kAnyLinks = 1000;  // link value names are theta<k>, a<k>, …: any chain length
-  return LinkValueIndex(name, kAnyLinks) >= 0 || StartsWith(name, "base_") ||
-         StartsWith(name, "tool_") || StartsWith(name, "plane");
+  // A tree's chain labels its own links and tool ("left_tool.theta4", chain_measurement.h): the
+  // chains that have that link or tool share it by that name.
+  const std::string name = full_name.substr(full_name.rfind('.') + 1);
+  return LinkValueIndex(name, kAnyLinks) >= 0 || StartsWith(name, "tool_") ||
+         (name == full_name && (StartsWith(name, "base_") || StartsWith(name, "plane")));
 }
 
 MixedMeasurement::MixedMeasurement(std::vector<MixedPart> parts)
@@ -105,6 +108,7 @@ std::map<std::string, int> CountOwnTerms(std::vector<MixedPart>* parts) {
     if (!labels.insert(p.label).second)
       throw InputError("sensor", "two parts of a mixed measurement are labelled '" + p.label +
                                      "': give each its own label");
+    if (p.names_are_shared) continue;
     for (const std::string& name : p.kind->parameter_names())
       if (!MixedMeasurement::IsSharedTerm(name)) ++own_count[name];
   }
@@ -307,7 +311,7 @@ std::unique_ptr<MeasurementKind> MixedMeasurement::Without(
     parts.push_back({held.empty()
                          ? part(p).kind
                          : std::shared_ptr<const MeasurementKind>(part(p).kind->Without(held)),
-                     part(p).label});
+                     part(p).label, part(p).names_are_shared});
   }
   for (const std::string& name : names)
     if (!found.count(name))

@@ -120,7 +120,7 @@ bool ParameterSet::EstimatesFrames() const {
 }
 
 DisplayUnit DisplayUnitOf(const std::string& name) {
-  if (name == "ranger_scale") return {"ppm", 1e6};
+  if (name.substr(name.rfind('.') + 1) == "ranger_scale") return {"ppm", 1e6};
   return IsAngularName(name) ? DisplayUnit{"mrad", 1e3} : DisplayUnit{"mm", 1e3};
 }
 
@@ -177,7 +177,10 @@ bool ParsePlaneTermName(const std::string& name, int* plane, std::string* term) 
 
 }  // namespace
 
-bool IsAngularName(const std::string& name) {
+bool IsAngularName(const std::string& full_name) {
+  // A part's or a chain's own term carries its label ("left_tool.theta4", "point.target_x"): the
+  // unit is the term's.
+  const std::string name = full_name.substr(full_name.rfind('.') + 1);
   for (const char* prefix : {"theta", "alpha", "beta"})
     if (name.rfind(prefix, 0) == 0) return true;
   // A frame's rotation terms (a tracker's instrument_roll, ...).

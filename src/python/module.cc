@@ -271,8 +271,9 @@ struct Design {
 
 // --- functions ------------------------------------------------------------------------------
 
-RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link) {
-  return LoadRobotFile(ResolveRobotPath(name_or_path), tool_link);
+RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link,
+                    const std::string& base_link) {
+  return LoadRobotFile(ResolveRobotPath(name_or_path), tool_link, base_link);
 }
 
 PlaneSet ResolvePlanes(const RobotFile& rig, const py::object& planes);
@@ -1392,9 +1393,13 @@ limits), its measurement plane if the file gives one, and the ranger's limits.
 Load one with Robot.load(path_or_name): a YAML robot file, a URDF (with tool_link the ranger's
 link), or a shipped name ("paper").
 Link values are ordered theta, alpha, a, d, beta per link (SI: rad and m).)doc")
-      .def_static("load", &LoadRobot, py::arg("path"), py::arg("tool_link") = "", R"doc(
+      .def_static("load", &LoadRobot, py::arg("path"), py::arg("tool_link") = "",
+                  py::arg("base_link") = "", R"doc(
 Loads a robot file (YAML) or a URDF (path ending in .urdf; tool_link: the link whose frame is
-the ranger's, default the URDF's only end link) by path, or a shipped robot by name ("paper").
+the ranger's, default the URDF's only end link other than base_link; base_link: the chain's
+first link, its frame the base frame, default the root — the path may run up the tree, a
+joint passed from child to parent keeping its name and value) by path, or a shipped robot by
+name ("paper").
 Raises lrcal.InputError naming the file, line and key of anything wrong.)doc")
       .def_property_readonly("name", [](const RobotFile& r) { return r.robot.name(); })
       .def_readonly("path", &RobotFile::path, "Where the file was read from.")

@@ -234,10 +234,10 @@ void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string
     const std::string p = Join(path, it.key());
     // plane: checked by the typed parser; the robot file's hash is lrcal's own. pool.file and
     // validation.file (with lrcal's hash of them) are optional keys without a default.
-    // tool_link (URDF robots) is optional without a default, so that earlier studies' settings
-    // and tables stay as they were.
-    if (path.empty() &&
-        (it.key() == "plane" || it.key() == "robot_file_fnv1a" || it.key() == "tool_link"))
+    // tool_link and base_link (URDF robots) are optional without a default, so that earlier
+    // studies' settings and tables stay as they were.
+    if (path.empty() && (it.key() == "plane" || it.key() == "robot_file_fnv1a" ||
+                         it.key() == "tool_link" || it.key() == "base_link"))
       continue;
     if ((path == "pool" || path == "validation") &&
         (it.key() == "file" || it.key() == "file_fnv1a"))
@@ -718,9 +718,13 @@ CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   CellSettings c;
   c.robot = Str(s, "robot", where);
   if (s.contains("tool_link")) c.tool_link = Str(s, "tool_link", where);
-  if (!c.tool_link.empty() && !IsUrdfPath(c.robot))
-    throw InputError(where("tool_link"), "applies to a URDF robot (robot: arm.urdf); '" + c.robot +
-                                             "' is a robot YAML file or a shipped name");
+  if (s.contains("base_link")) c.base_link = Str(s, "base_link", where);
+  const std::pair<const char*, const std::string*> links[] = {{"tool_link", &c.tool_link},
+                                                              {"base_link", &c.base_link}};
+  for (const auto& [key, value] : links)
+    if (!value->empty() && !IsUrdfPath(c.robot))
+      throw InputError(where(key), "applies to a URDF robot (robot: arm.urdf); '" + c.robot +
+                                       "' is a robot YAML file or a shipped name");
   ParsePlane(s, where, &c);
   ParseTruthAndNoise(s, where, &c);
   ParsePoolAndSelection(s, where, &c);
@@ -1296,8 +1300,9 @@ Json CellIdentity(const Json& settings) {
   DropNeutralKeys(&id);
   // sensor came with the tracker kinds: the ranger's default section is left out.
   if (id.contains("sensor") && id["sensor"] == StudyDefaults()["sensor"]) id.erase("sensor");
-  // tool_link came with URDF robots: left out when empty (as if not given).
-  if (id.contains("tool_link") && id["tool_link"] == "") id.erase("tool_link");
+  // tool_link and base_link came with URDF robots: left out when empty (as if not given).
+  for (const char* key : {"tool_link", "base_link"})
+    if (id.contains(key) && id[key] == "") id.erase(key);
   for (const char* section : {"pool", "validation"})
     if (id.contains(section) && id[section].is_object()) id[section].erase("file");
   if (id.contains("robot") && id["robot"].is_string() &&

@@ -147,7 +147,8 @@ double DesignSigmaMin(const Eigen::MatrixXd& GtG, int m) {
 // The cell's steps.
 
 void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
-  RobotFile file = LoadRobotFile(ResolveRobotPath(s.robot, study.folder()), s.tool_link);
+  RobotFile file =
+      LoadRobotFile(ResolveRobotPath(s.robot, study.folder()), s.tool_link, s.base_link);
   c->robot = std::make_shared<RobotModel>(std::move(file.robot));
   c->ranger = file.ranger;
   const double scale = s.truth.random ? 1.0 : s.truth.scale;

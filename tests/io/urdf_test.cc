@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "lrcal/core/error.h"
@@ -238,6 +239,107 @@ TEST(Urdf, BytesThatAreNotUtf8AreRefusedNamingTheLine) {
                    "", "no movable joint between the root link 'a'");
 }
 
+// Issue 30: a chain between any two links of a tree, against the URDF's pose of the tool link
+// relative to the base link composed from the root here, at random configurations.
+void ExpectSameKinematicsBetween(const RobotModel& robot, const std::string& urdf,
+                                 const std::string& base_link, const std::string& tool_link) {
+  std::mt19937 rng(29);
+  ChainPoint point;
+  PrepareChainPoint(robot, robot.nominal_values().data(), &point);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::vector<double> q = RandomConfiguration(robot, &rng);
+    std::map<std::string, double> by_name;
+    for (int i = 0; i < robot.num_links(); ++i) by_name[robot.links()[i].joint_name] = q[i];
+    const Eigen::Isometry3d expected =
+        testing::UrdfPoseBetween(urdf, base_link, tool_link, by_name);
+    const Pose<double> ref =
+        ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
+    TargetedConfigurations one(robot.num_links());
+    one.Add(q);
+    const Pose<double> fast = ToolPose(point, one, 0);
+    for (const Pose<double>* pose : {&ref, &fast}) {
+      EXPECT_LT((pose->p_BT - expected.translation()).norm(), kTolerance) << tool_link;
+      EXPECT_THAT(pose->R_BT, testing::EigenNear(expected.linear(), kTolerance)) << tool_link;
+    }
+  }
+}
+
+std::vector<std::string> JointNames(const RobotModel& robot) {
+  std::vector<std::string> names;
+  for (const Link& link : robot.links()) names.push_back(link.joint_name);
+  return names;
+}
+
+TEST(Urdf, AFootToHandChainRunsUpTheLegAgainstTheUrdf) {
+  const std::string urdf = Example("humanoid_like.urdf");
+  const RobotFile rig = LoadRobotFile(urdf, "left_gripper", "left_sole");
+  // Up the leg from the ankle (each joint reversed), the torso, down the arm: 6 + 2 + 6 joints.
+  EXPECT_THAT(
+      JointNames(rig.robot),
+      ::testing::ElementsAre("left_ankle_roll", "left_ankle_pitch", "left_knee", "left_hip_pitch",
+                             "left_hip_roll", "left_hip_yaw", "torso_yaw", "torso_pitch",
+                             "left_shoulder_pitch", "left_shoulder_roll", "left_shoulder_yaw",
+                             "left_elbow", "left_wrist_yaw", "left_wrist_pitch"));
+  // A reversed joint keeps its URDF range (the knee bends 0 … 2.2 rad).
+  EXPECT_EQ(rig.robot.links()[2].q_min, 0.0);
+  EXPECT_EQ(rig.robot.links()[2].q_max, 2.2);
+  ExpectSameKinematicsBetween(rig.robot, urdf, "left_sole", "left_gripper");
+  // From one sole to the other (the walking robot's swap of ends), from a hand to the other hand,
+  // a chain that only climbs (a gripper to the pelvis) and one that starts inside the tree.
+  for (const auto& [base, tool] :
+       std::vector<std::pair<std::string, std::string>>{{"right_sole", "left_sole"},
+                                                        {"left_gripper", "right_gripper"},
+                                                        {"left_gripper", "pelvis"},
+                                                        {"torso", "right_gripper"},
+                                                        {"left_sole", "right_finger_a"}}) {
+    const RobotFile chain = LoadRobotFile(urdf, tool, base);
+    ExpectSameKinematicsBetween(chain.robot, urdf, base, tool);
+  }
+  // Without a base link the chain starts at the root, as before: the same model as the root named.
+  EXPECT_EQ(LoadRobotFile(urdf, "left_gripper").robot.nominal_values(),
+            LoadRobotFile(urdf, "left_gripper", "pelvis").robot.nominal_values());
+}
+
+TEST(Urdf, TheDualArmsChainsShareTheTorsosLinks) {
+  const std::string urdf = Example("dual_arm_torso.urdf");
+  const RobotFile left = LoadRobotFile(urdf, "left_tool");
+  const RobotFile right = LoadRobotFile(urdf, "right_tool");
+  ExpectSameKinematicsBetween(left.robot, urdf, "base_link", "left_tool");
+  ExpectSameKinematicsBetween(right.robot, urdf, "base_link", "right_tool");
+  // The head's mimic joint is off both chains; the torso's links before the branch (joints 1 and
+  // 2 to the next axis) are the same D-H links in both.
+  EXPECT_TRUE(left.robot.base().translation.isApprox(right.robot.base().translation));
+  for (int i = 0; i < 2; ++i)
+    EXPECT_EQ(left.robot.links()[i].nominal, right.robot.links()[i].nominal) << "link " << i + 1;
+  EXPECT_NE(left.robot.links()[2].nominal, right.robot.links()[2].nominal);
+}
+
+TEST(Urdf, BadChainEndsAreNamed) {
+  const std::string urdf = Example("humanoid_like.urdf");
+  const auto message = [&](const std::string& tool, const std::string& base) {
+    try {
+      LoadRobotFile(urdf, tool, base);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(message("left_gripper", "left_heel"),
+              ::testing::HasSubstr("no link named 'left_heel' (--base-link, or a study's "
+                                   "base_link); the links are "));
+  EXPECT_THAT(message("torso", "torso"),
+              ::testing::HasSubstr("the base link and the tool link are both 'torso'"));
+  EXPECT_THAT(message("left_foot", "left_sole"),
+              ::testing::HasSubstr("no movable joint between the base link 'left_sole' and the "
+                                   "tool link 'left_foot'"));
+  // Several end links other than the base: the tool link must be named.
+  EXPECT_THAT(message("", "left_sole"),
+              ::testing::HasSubstr("5 end links (left_finger_a, left_finger_b, right_finger_a"));
+  // A mimic joint on the chain is refused by name (off the chain it is not read).
+  EXPECT_THAT(message("left_finger_b", "left_sole"),
+              ::testing::HasSubstr("joint 'left_finger_b_joint' mimics another"));
+}
+
 TEST(Urdf, ToolLinkIsForUrdfsOnly) {
   try {
     LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"), "ranger");
@@ -246,6 +348,12 @@ TEST(Urdf, ToolLinkIsForUrdfsOnly) {
     EXPECT_EQ(e.where(), "setup.tool_link");
     EXPECT_EQ(e.Respelled(Frontend::kCommandLine).where(), "--tool-link");
     EXPECT_EQ(e.Respelled(Frontend::kPython).where(), "tool_link=");
+  }
+  try {
+    LoadRobotFile(testing::SourcePath("studies/robots/paper.yaml"), "", "world");
+    ADD_FAILURE() << "no error";
+  } catch (const SettingError& e) {
+    EXPECT_EQ(e.Respelled(Frontend::kCommandLine).where(), "--base-link");
   }
 }
 

@@ -65,11 +65,13 @@ struct RobotFile {
 PriorSigmas PriorsFor(const RobotFile& rig, bool use_tolerances, const std::string& prior_sigma,
                       const std::string& tolerances_option, const std::string& prior_sigma_option);
 
-/// Reads a robot YAML file, or a URDF (a path ending in .urdf: io/urdf.h, with `tool_link` the
-/// ranger's link, empty for the URDF's only end link). Throws InputError naming the file, line
-/// and key on any problem, and for a `tool_link` given with a YAML file. A `calibration:`
-/// mapping (written by WriteCalibratedRobotFile) is read into `calibration`, not into the model.
-RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link = "");
+/// Reads a robot YAML file, or a URDF (a path ending in .urdf: io/urdf.h, the chain from
+/// `base_link` — empty: the root — to `tool_link`, the ranger's link, empty for the URDF's only
+/// end link). Throws InputError naming the file, line and key on any problem, and for a
+/// `tool_link` or `base_link` given with a YAML file. A `calibration:` mapping (written by
+/// WriteCalibratedRobotFile) is read into `calibration`, not into the model.
+RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link = "",
+                        const std::string& base_link = "");
 
 /// The robot YAML text of `rig` with `link_values` (5N, SI) as its nominal values, named `name`:
 /// links, base and tool transforms, `planes` if given, the ranger's limits and `record` if given.

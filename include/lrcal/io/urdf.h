@@ -19,6 +19,7 @@
 
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/chain_measurement.h"
 
 namespace lrcal {
 
@@ -29,11 +30,39 @@ bool IsUrdfPath(const std::string& path);
 /// that is its own parent, at most this many links).
 inline constexpr int kMaxUrdfLinks = 1000;
 
-/// Reads a URDF's chain from its root link to `tool_link` (empty: the URDF's only leaf link).
-/// Revolute, continuous (range ±π), prismatic and fixed joints; anything else, a mimic joint, an
-/// unknown or ambiguous tool link, a cycle among the joints, a joint whose parent is its child
-/// and more than kMaxUrdfLinks links are InputErrors naming the file and the joint or link.
-RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link = "");
+/// Reads a URDF's chain from `base_link` (empty: the root link) to `tool_link` (empty: the URDF's
+/// only leaf link other than the base link). The chain is the path through the tree: up from the
+/// base link to the two links' last common ancestor, then down to the tool link. A joint passed
+/// against the URDF's direction (child to parent: a humanoid's leg from the sole up) keeps its
+/// name, value and range, and turns the rest of the chain the other way (its axis reversed in the
+/// D-H + β model), so forward kinematics equals the URDF's pose of the tool link relative to the
+/// base link at every configuration (tests: 1e-12); the base link's frame is the model's base
+/// frame B. Revolute, continuous (range ±π), prismatic and fixed joints; anything else, a mimic
+/// joint, an unknown or ambiguous link, the same link at both ends, a cycle among the joints, a
+/// joint whose parent is its child and more than kMaxUrdfLinks links are InputErrors naming the
+/// file and the joint or link.
+RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link = "",
+                            const std::string& base_link = "");
+
+/// A tree robot's chains from one base link to several tool links: two arms on a torso, a leg and
+/// each arm of a humanoid.
+struct UrdfChains {
+  /// The robot's joints on any of the chains, each once: the first chain's in its order, then
+  /// each later chain's joints the earlier ones lack. A configuration of the whole robot is a
+  /// value per joint in this order.
+  std::vector<std::string> joint_names;
+  std::vector<RobotFile> chains;        ///< per tool link, the chain LoadUrdfRobotFile reads
+  std::vector<ChainOfTree> placements;  ///< per tool link, where its chain sits (label: the link)
+};
+
+/// The chains of `path` from `base_link` (empty: the root) to each of `tool_links` (at least one,
+/// each once). A link of chain c (from its joint k to joint k + 1) is the same D-H link in every
+/// chain with the same joints 1 … k + 1: its values are labelled "" when every chain has it, else
+/// with the first such chain's tool link (ChainOfTree::link_labels); a chain's last link and tool
+/// are its own. Throws InputError naming the file for what LoadUrdfRobotFile refuses and for a
+/// repeated tool link.
+UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string>& tool_links,
+                          const std::string& base_link = "");
 
 /// A URDF document for `robot` with `link_values` (5N, SI) as its geometry; numbers with 17
 /// significant digits.

@@ -38,6 +38,9 @@ namespace lrcal {
 struct MixedPart {
   std::shared_ptr<const MeasurementKind> kind;
   std::string label{};
+  /// A tree's chain (chain_measurement.h): its own terms are already labelled where they are
+  /// its own, so a name it has in common with another such part (a tracker's frame) is one term.
+  bool names_are_shared = false;
 };
 
 /// `kinds` as parts labelled by their names, numbered where a kind appears more than once
@@ -55,7 +58,8 @@ class MixedMeasurement : public MeasurementKind {
   const MixedPart& part(int p) const { return parts_[static_cast<std::size_t>(p)]; }
   /// Part p's terms as columns of the mixed estimate (one per term of the part, in its order).
   const std::vector<int>& columns(int p) const { return columns_[static_cast<std::size_t>(p)]; }
-  /// True for a term shared between parts by name (link values, base/tool frame, planes).
+  /// True for a term shared between parts by name (link values, base/tool frame, planes; a tree
+  /// chain's labelled link and tool values, "left_tool.theta4", between the chains that have it).
   static bool IsSharedTerm(const std::string& name);
 
   /// The tag of component `component` of a configuration of part `part` measured on its target

@@ -129,6 +129,7 @@ ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
 
 /// True for names of quantities in rad (theta*, alpha*, beta*, plane*_u*, a frame's *_roll,
 /// *_pitch, *_yaw); false for metres (and for the dimensionless ranger_scale: see DisplayUnitOf).
+/// A label before a dot ("left_tool.theta4": a chain's or a mixed part's own term) is skipped.
 bool IsAngularName(const std::string& name);
 
 /// How a quantity is shown to users: "mrad" (×1e3 from rad), "mm" (×1e3 from m) or, for the

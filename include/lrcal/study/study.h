@@ -57,6 +57,7 @@ struct StudySensor {
 struct CellSettings {
   std::string robot;             ///< robot file path (YAML or URDF) or shipped name
   std::string tool_link;         ///< URDF robots: the ranger's link (empty: the only end link)
+  std::string base_link;         ///< URDF robots: the chain's first link (empty: the root)
   bool plane_from_robot = true;  ///< plane: robot
   PlaneSet planes;               ///< when !plane_from_robot: one plane or several
   /// Several planes: each one's share of the pool and validation draws (empty: equal shares).

@@ -1,0 +1,141 @@
+// Issue 30 as a user meets it: `lrcal identify` and `identifiability` on a tree — the dual-arm
+// robot's two arms sharing its torso (--tool-link left_tool,right_tool, one file per arm) and a
+// humanoid's chain from its sole up the leg to a gripper (--base-link left_sole). The truths are
+// the URDFs with every joint origin moved (a physical robot), simulated by `lrcal simulate`;
+// configurations are logged as a robot logs them, every joint by its URDF name.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "test_util.h"
+#include "urdf_kinematics.h"
+
+namespace lrcal {
+namespace {
+
+using ::testing::HasSubstr;
+using Json = nlohmann::json;
+
+class TreeCli : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = testing::TempDir("TreeCli"); }
+  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
+  int Run(const std::string& args, std::string* out) const {
+    return testing::RunCommand(testing::LrcalBinary() + " " + args, out);
+  }
+  static Json JsonOf(const std::string& text) {
+    return Json::parse(text.substr(text.find('{'), text.rfind('}') - text.find('{') + 1));
+  }
+  std::string dir_;
+};
+
+const char kDualArm[] = "examples/urdf/dual_arm_torso.urdf";
+const char kTracker[] = " --sensor point --instrument 2.5,0.3,0.2,0,0,3";
+
+// Every joint of the dual-arm robot by name (a log of the whole robot), within its range.
+void WriteWholeRobotLog(const std::string& path, int count) {
+  const std::vector<std::string> torso = {"torso_yaw", "torso_pitch_1", "torso_pitch_2"};
+  const std::vector<std::string> arm = {"shoulder_pitch", "shoulder_roll", "shoulder_yaw",
+                                        "elbow",          "wrist_yaw",     "wrist_pitch"};
+  std::vector<std::string> names = torso;
+  for (const char* side : {"right", "left"})  // not the order the chains list them
+    for (const std::string& j : arm) names.push_back(std::string(side) + "_" + j);
+  std::ofstream out(path);
+  for (std::size_t k = 0; k < names.size(); ++k) out << (k ? "," : "") << names[k];
+  out << "\n";
+  std::mt19937 rng(3);
+  for (int i = 0; i < count; ++i) {
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      const bool elbow = names[k].find("elbow") != std::string::npos;
+      out << (k ? "," : "")
+          << std::uniform_real_distribution<double>(elbow ? -2.0 : -0.55, elbow ? 0.05 : 0.55)(rng);
+    }
+    out << "\n";
+  }
+}
+
+TEST_F(TreeCli, TwoArmsSharingATorsoAreCalibratedTogether) {
+  const std::string nominal = testing::SourcePath(kDualArm);
+  const std::string truth = testing::UrdfWithMovedOrigins(nominal, 4, Path("true.urdf"));
+  WriteWholeRobotLog(Path("log.csv"), 50);
+  std::string out;
+  for (const char* arm : {"left", "right"})
+    ASSERT_EQ(Run("simulate --robot " + truth + " --tool-link " + arm + "_tool" + kTracker +
+                      " --sigma-mm 0 --configs " + Path("log.csv") + " --out " +
+                      Path(std::string(arm) + ".csv"),
+                  &out),
+              0)
+        << out;
+  const std::string tree = " --robot " + nominal + " --tool-link left_tool,right_tool" + kTracker;
+  ASSERT_EQ(Run("identifiability" + tree + " --configs " + Path("left.csv") + " --configs " +
+                    Path("right.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("tree: 2 chains (left_tool, right_tool) over 15 joints"));
+  EXPECT_THAT(out, HasSubstr("shared: theta1, alpha1, a1, d1, theta2, alpha2, a2, beta2, "
+                             "instrument_x"));
+  ASSERT_EQ(Run("identify --auto-fix --format json" + tree + " --data " + Path("left.csv") +
+                    " --data " + Path("right.csv"),
+                &out),
+            0)
+      << out;
+  const Json fit = JsonOf(out);
+  EXPECT_EQ(fit["tree"]["tool_links"], Json::array({"left_tool", "right_tool"}));
+  EXPECT_EQ(fit["tree"]["joints"].size(), 15u);
+  EXPECT_THAT(fit["tree"]["own_terms"]["right_tool"].get<std::vector<std::string>>(),
+              ::testing::Contains("right_tool.theta3"));
+  // The union's model holds the moved robot: nothing left over.
+  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
+
+  // What a tree's run refuses, by option.
+  const std::string files = " --data " + Path("left.csv") + " --data " + Path("right.csv");
+  EXPECT_EQ(Run("identify" + tree + " --data " + Path("left.csv"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("--data: given 1 time(s) for the 2 chains of --tool-link"));
+  EXPECT_EQ(Run("identify" + tree + files + " --write-robot " + Path("cal.yaml"), &out), 2);
+  EXPECT_THAT(out, HasSubstr("--write-robot: writes one chain's robot file"));
+  EXPECT_EQ(Run("identify" + tree + files + " --holdout 5", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--holdout: is not taken by a calibration from a tree's chains"));
+  EXPECT_EQ(Run("identify --robot paper --tool-link a,b --data x.csv", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--tool-link: several tool links are a tree's chains: --robot must "
+                             "be a URDF"));
+  EXPECT_EQ(Run("identify --robot " + nominal +
+                    " --tool-link left_tool,right_tool --sensor point,pose,point" + files,
+                &out),
+            2);
+  EXPECT_THAT(out, HasSubstr("--sensor: expected one kind for every chain, or one per tool link"));
+}
+
+TEST_F(TreeCli, ASoleToGripperChainIsCalibratedUpTheLeg) {
+  const std::string nominal = testing::SourcePath("examples/urdf/humanoid_like.urdf");
+  const std::string truth = testing::UrdfWithMovedOrigins(nominal, 6, Path("true.urdf"));
+  const std::string chain = " --base-link left_sole --tool-link left_gripper";
+  std::string out;
+  ASSERT_EQ(Run("sample --robot " + nominal + chain + " --plane 0,0,1,-2 --count 60 --out " +
+                    Path("c.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("simulate --robot " + truth + chain + kTracker + " --sigma-mm 0 --configs " +
+                    Path("c.csv") + " --out " + Path("points.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identify --auto-fix --format json --robot " + nominal + chain + kTracker +
+                    " --data " + Path("points.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_LT(JsonOf(out)["residual_rms"].get<double>(), 1e-12);
+  EXPECT_EQ(Run("identify --robot " + nominal + " --base-link left_heel --tool-link left_gripper" +
+                    kTracker + " --data " + Path("points.csv"),
+                &out),
+            2);
+  EXPECT_THAT(out, HasSubstr("no link named 'left_heel' (--base-link"));
+}
+
+}  // namespace
+}  // namespace lrcal

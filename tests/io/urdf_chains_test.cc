@@ -1,0 +1,204 @@
+// Issue 30: a tree's chains in one calibration. The dual-arm robot of examples/urdf (a three-joint
+// torso, two six-joint arms) read as two chains sharing the torso: forward kinematics of each
+// against the URDF composed independently at the whole robot's configurations; a tracker on each
+// tool, the true robot a URDF whose every joint origin is moved (a physical tree, not the model's
+// own parametrisation), calibrated noise-free through the union; the union's identifiable count
+// against the chains' own.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <random>
+
+#include "lrcal/core/error.h"
+#include "lrcal/identification/identifiability.h"
+#include "lrcal/identification/identification.h"
+#include "lrcal/io/urdf.h"
+#include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/chain_measurement.h"
+#include "lrcal/measurement/mixed_measurement.h"
+#include "lrcal/measurement/point_measurement.h"
+#include "test_util.h"
+#include "tracker_fixtures.h"
+#include "urdf_kinematics.h"
+
+namespace lrcal {
+namespace {
+
+const std::vector<std::string> kArms = {"left_tool", "right_tool"};
+
+std::string DualArm() { return testing::SourcePath("examples/urdf/dual_arm_torso.urdf"); }
+
+// The whole robot's configurations: every joint uniform in its range (its first chain's).
+TargetedConfigurations RobotConfigurations(const UrdfChains& tree, int count, unsigned seed) {
+  std::vector<std::pair<double, double>> range(tree.joint_names.size());
+  for (std::size_t c = 0; c < tree.chains.size(); ++c)
+    for (std::size_t k = 0; k < tree.placements[c].joints.size(); ++k) {
+      const Link& link = tree.chains[c].robot.links()[k];
+      range[static_cast<std::size_t>(tree.placements[c].joints[k])] = {link.q_min, link.q_max};
+    }
+  std::mt19937 rng(seed);
+  TargetedConfigurations configs(static_cast<int>(range.size()));
+  for (int i = 0; i < count; ++i) {
+    std::vector<double> q;
+    for (const auto& [lo, hi] : range)
+      q.push_back(std::uniform_real_distribution<double>(lo, hi)(rng));
+    configs.Add(q);
+  }
+  return configs;
+}
+
+TEST(UrdfChains, TwoArmsOnATorsoShareItsJointsAndLinks) {
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArms);
+  ASSERT_EQ(tree.joint_names.size(), 15u);
+  EXPECT_THAT(
+      std::vector<std::string>(tree.joint_names.begin(), tree.joint_names.begin() + 4),
+      ::testing::ElementsAre("torso_yaw", "torso_pitch_1", "torso_pitch_2", "left_shoulder_pitch"));
+  EXPECT_EQ(tree.joint_names[9], "right_shoulder_pitch");
+  EXPECT_THAT(tree.placements[1].joints, ::testing::ElementsAre(0, 1, 2, 9, 10, 11, 12, 13, 14));
+  // The torso's two links between its joints are every chain's; the link from the last torso
+  // joint to the shoulder is each arm's own.
+  EXPECT_THAT(tree.placements[0].link_labels,
+              ::testing::ElementsAre("", "", "left_tool", "left_tool", "left_tool", "left_tool",
+                                     "left_tool", "left_tool", "left_tool"));
+  EXPECT_EQ(tree.placements[1].link_labels[2], "right_tool");
+  // Each chain's kinematics at the whole robot's configurations, against the URDF's.
+  const TargetedConfigurations configs = RobotConfigurations(tree, 100, 5);
+  for (std::size_t c = 0; c < kArms.size(); ++c) {
+    const RobotModel& robot = tree.chains[c].robot;
+    for (int i = 0; i < configs.size(); ++i) {
+      std::map<std::string, double> by_name;
+      for (std::size_t j = 0; j < tree.joint_names.size(); ++j)
+        by_name[tree.joint_names[j]] = configs.q(i)[j];
+      std::vector<double> q;
+      for (int j : tree.placements[c].joints) q.push_back(configs.q(i)[j]);
+      const Pose<double> pose =
+          ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
+      const Eigen::Isometry3d expected =
+          testing::UrdfPoseBetween(DualArm(), "base_link", kArms[c], by_name);
+      EXPECT_LT((pose.p_BT - expected.translation()).norm(), testing::tolerance::kUrdf);
+      EXPECT_THAT(pose.R_BT, testing::EigenNear(expected.linear(), testing::tolerance::kUrdf));
+    }
+  }
+}
+
+PointSetup OneTarget() {
+  PointSetup setup = testing::TrackerSetup();
+  setup.targets = {Eigen::Vector3d(0.02, -0.01, 0.05)};
+  return setup;
+}
+
+MixedMeasurement TrackedArms(const UrdfChains& tree) {
+  std::vector<MixedPart> parts;
+  for (std::size_t c = 0; c < tree.chains.size(); ++c)
+    parts.push_back({std::make_shared<ChainMeasurement>(
+                         std::make_shared<PointMeasurement>(tree.chains[c].robot, OneTarget()),
+                         tree.placements[c]),
+                     tree.placements[c].label, true});
+  return MixedMeasurement(parts);
+}
+
+MeasuredValues Simulated(const MixedMeasurement& truth, const TargetedConfigurations& configs) {
+  std::vector<MeasuredValues> values;
+  NoiseModel exact;
+  exact.sigma = 0;
+  for (int p = 0; p < truth.num_parts(); ++p) {
+    MeasuredValues v;
+    SimulateMeasurements(*truth.part(p).kind, configs, exact,
+                         RandomStream(1, 0, 0, RandomPurpose::kNoise), &v);
+    values.push_back(v);
+  }
+  return truth.Combine(values);
+}
+
+TEST(UrdfChains, TwoTrackedArmsSharingATorsoCalibrateToAPhysicalTree) {
+  const UrdfChains nominal = LoadUrdfChains(DualArm(), kArms);
+  const UrdfChains truth =
+      LoadUrdfChains(testing::UrdfWithMovedOrigins(
+                         DualArm(), 11, testing::TempDir("urdf_chains") + "/true_dual_arm.urdf"),
+                     kArms);
+  const MixedMeasurement full = TrackedArms(nominal);
+  const MixedMeasurement true_kind = TrackedArms(truth);
+  // Shared by name: the torso's first two links and the tracker's frame (one instrument sees both
+  // tools); each arm's links and target are its own.
+  EXPECT_THAT(full.parameter_names(), ::testing::Contains("theta1"));
+  EXPECT_THAT(full.parameter_names(), ::testing::Contains("instrument_x"));
+  EXPECT_THAT(full.parameter_names(), ::testing::Contains("left_tool.theta3"));
+  EXPECT_THAT(full.parameter_names(), ::testing::Contains("right_tool.target_x"));
+  const TargetedConfigurations configs = RobotConfigurations(nominal, 60, 7);
+  const MeasuredValues data = Simulated(true_kind, configs);
+  const IdentifiabilityReport report = AnalyzeIdentifiability(full, data.configs);
+  const std::unique_ptr<MeasurementKind> reduced = full.Without(report.suggested_fixed);
+  for (auto solver : {IdentificationOptions::Solver::kLevenbergMarquardt,
+                      IdentificationOptions::Solver::kCeres}) {
+    IdentificationOptions options;
+    options.solver = solver;
+    const IdentificationSummary s = Identify(*reduced, data, options);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.message;
+    // The union's model holds the physical tree exactly: no residual, and at configurations it
+    // was not fitted on, every tool point where the true robot puts it.
+    EXPECT_LT(s.residual_rms, 1e-12) << s.solver;
+    const TargetedConfigurations validation = RobotConfigurations(nominal, 30, 8);
+    const MeasuredValues expected = Simulated(true_kind, validation);
+    std::vector<double> y(expected.y.size()), nominal_y(expected.y.size());
+    reduced->Bind(expected.configs)->Predict(s.delta.data(), y.data(), nullptr);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(reduced->num_parameters());
+    reduced->Bind(expected.configs)->Predict(zero.data(), nominal_y.data(), nullptr);
+    double nominal_error = 0;
+    for (std::size_t r = 0; r < y.size(); ++r) {
+      EXPECT_NEAR(y[r], expected.y[r], testing::tolerance::kRoundTrip) << "value " << r;
+      nominal_error = std::max(nominal_error, std::abs(nominal_y[r] - expected.y[r]));
+    }
+    EXPECT_GT(nominal_error, 5e-3) << "the moved origins move the tools by millimetres";
+  }
+}
+
+TEST(UrdfChains, TheUnionSeesWhatTheArmsShareOnce) {
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArms);
+  const MixedMeasurement both = TrackedArms(tree);
+  const TargetedConfigurations configs = RobotConfigurations(tree, 60, 9);
+  const MeasuredValues data = Simulated(both, configs);
+  const int union_rank = AnalyzeIdentifiability(both, data.configs).rank;
+  // Each arm alone, and each arm with the shared terms held: what the arm sees of the torso.
+  std::vector<std::string> shared;
+  for (const std::string& name : both.parameter_names())
+    if (name.find('.') == std::string::npos) shared.push_back(name);
+  ASSERT_FALSE(shared.empty());
+  int sum = 0, shared_seen = -1;
+  for (int p = 0; p < 2; ++p) {
+    const MixedMeasurement alone({both.part(p)});
+    const MeasuredValues own = Simulated(alone, configs);
+    const int rank = AnalyzeIdentifiability(alone, own.configs).rank;
+    const int without_shared = AnalyzeIdentifiability(*alone.Without(shared), own.configs).rank;
+    sum += rank;
+    if (shared_seen >= 0) {
+      EXPECT_EQ(rank - without_shared, shared_seen);
+    }
+    shared_seen = rank - without_shared;
+  }
+  EXPECT_GT(shared_seen, 0);
+  EXPECT_EQ(union_rank, sum - shared_seen);
+}
+
+TEST(UrdfChains, BadChainListsAreNamed) {
+  EXPECT_THAT(
+      [] {
+        LoadUrdfChains(DualArm(), {"left_tool", "left_tool"});
+      },
+      ::testing::ThrowsMessage<InputError>(
+          ::testing::HasSubstr("the tool link 'left_tool' is named twice")));
+  EXPECT_THAT([] { LoadUrdfChains(DualArm(), {}); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("at least one tool link")));
+  // A chain's configurations must be the whole robot's.
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArms);
+  const ChainMeasurement left(std::make_shared<PointMeasurement>(tree.chains[0].robot, OneTarget()),
+                              tree.placements[0]);
+  TargetedConfigurations chain_only(9);
+  chain_only.Add(std::vector<double>(9, 0.0));
+  EXPECT_THAT([&] { left.Bind(chain_only); }, ::testing::ThrowsMessage<InputError>(
+                                                  ::testing::HasSubstr("expected the robot's 15")));
+}
+
+}  // namespace
+}  // namespace lrcal
