@@ -76,6 +76,21 @@ RobotFile LoadRobot(const po::variables_map& vm) {
                        OptionalString(vm, "tool-link"), OptionalString(vm, "base-link"));
 }
 
+bool IsTreeRun(const po::variables_map& vm) {
+  return vm.count("tool-link") && SplitList(vm["tool-link"].as<std::string>()).size() > 1;
+}
+
+UrdfChains LoadTreeChains(const po::variables_map& vm) {
+  const std::string path = ResolveRobotPath(vm["robot"].as<std::string>());
+  if (!IsUrdfPath(path))
+    throw InputError("--tool-link",
+                     "several tool links are a tree's chains: --robot must be a "
+                     "URDF, not '" +
+                         path + "'");
+  return LoadUrdfChains(path, SplitList(vm["tool-link"].as<std::string>()),
+                        OptionalString(vm, "base-link"));
+}
+
 RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm) {
   if (!IsUrdfPath(path)) return LoadRobot(path);
   return LoadRobotFile(ResolveRobotPath(path), OptionalString(vm, "tool-link"),

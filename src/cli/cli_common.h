@@ -22,6 +22,7 @@
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/scanner_data.h"
 #include "lrcal/io/socket_data.h"
+#include "lrcal/io/urdf.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/parameter_set.h"
@@ -52,6 +53,10 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
 /// --robot, --tool-link and --base-link.
 RobotFile LoadRobot(const po::variables_map& vm);
+/// True when --tool-link lists several links: a tree's chains (io/urdf.h LoadUrdfChains).
+bool IsTreeRun(const po::variables_map& vm);
+/// The chains of --robot (a URDF) from --base-link to each link of --tool-link.
+UrdfChains LoadTreeChains(const po::variables_map& vm);
 /// The robot at `path`, with --tool-link when it is a URDF: what a command reading two robots
 /// (one may be a YAML file, one a URDF) gives each (export --like, joint-offsets; compensate).
 RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm);

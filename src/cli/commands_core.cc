@@ -993,21 +993,10 @@ std::string JoinComma(const std::vector<std::string>& names) {
   return out;
 }
 
-bool IsTreeRun(const po::variables_map& vm) {
-  return vm.count("tool-link") && SplitList(vm["tool-link"].as<std::string>()).size() > 1;
-}
-
 TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool configs_only) {
-  const std::string path = ResolveRobotPath(vm["robot"].as<std::string>());
-  if (!IsUrdfPath(path))
-    throw InputError("--tool-link",
-                     "several tool links are a tree's chains: --robot must be a "
-                     "URDF, not '" +
-                         path + "'");
   TreeRun run;
+  run.tree = LoadTreeChains(vm);
   run.labels = SplitList(vm["tool-link"].as<std::string>());
-  run.tree = LoadUrdfChains(path, run.labels,
-                            vm.count("base-link") ? vm["base-link"].as<std::string>() : "");
   std::vector<std::string> sensors = ResolveSensors(vm);
   if (sensors.size() == 1 && sensors[0] != "mixed") sensors.assign(run.labels.size(), sensors[0]);
   if (sensors.size() != run.labels.size())

@@ -8,6 +8,8 @@
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/ranger_measurement.h"
+#include "lrcal/measurement/tree_measurement.h"
 
 namespace lrcal::cli {
 
@@ -93,7 +95,8 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
 }
 
 // The request of the options: criterion I weighs by --poses, else by --workspace poses.
-DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel& model,
+// `model` null: a tree's design, which refuses I before.
+DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel* model,
                              std::uint64_t seed) {
   DesignRequest request;
   request.count = vm["select"].as<int>();
@@ -110,10 +113,10 @@ DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel
   } else if (vm.count("poses")) {
     const std::string file = vm["poses"].as<std::string>();
     request.task = TaskPosesAt(
-        model, ReadRobotConfigurations(file, model.robot(), &model.nominal_planes()), file);
+        *model, ReadRobotConfigurations(file, model->robot(), &model->nominal_planes()), file);
   } else {
     request.task =
-        TaskPosesAt(model, WorkspacePoses(model.robot(), request.workspace, seed), "workspace");
+        TaskPosesAt(*model, WorkspacePoses(model->robot(), request.workspace, seed), "workspace");
   }
   request.selection.method = ParseSelectionMethod(vm["method"].as<std::string>(), "--method");
   ReadSettingOptions(vm, SelectionOptions::Settings(), &request.selection);
@@ -139,6 +142,116 @@ std::string DesignSensor(const po::variables_map& vm) {
   return sensor;
 }
 
+namespace {
+
+// A tree's chains measured together (tree_measurement.h), each by the ranger or a tracker.
+std::unique_ptr<MeasurementKind> TreeKind(const po::variables_map& vm, const UrdfChains& tree,
+                                          const std::string& sensor, const PlaneSet& planes) {
+  std::vector<std::shared_ptr<const ChainMeasurement>> chains;
+  for (std::size_t c = 0; c < tree.chains.size(); ++c) {
+    const RobotFile& chain = tree.chains[c];
+    std::shared_ptr<const MeasurementKind> kind;
+    if (sensor == "ranger")
+      kind = std::make_shared<RangerMeasurement>(
+          MeasurementModel(chain.robot, planes,
+                           ResolveParameterSet(chain.robot, vm, planes.size(), true)),
+          chain.ranger);
+    else
+      kind = MakeTrackerKind(chain.robot, sensor, vm, true);
+    chains.push_back(std::make_shared<ChainMeasurement>(kind, tree.placements[c]));
+  }
+  auto full = std::make_unique<TreeMeasurement>(chains);
+  const std::vector<std::string> fixed =
+      vm.count("fix") ? SplitList(vm["fix"].as<std::string>()) : std::vector<std::string>{};
+  for (const std::string& name : fixed)
+    if (std::find(full->parameter_names().begin(), full->parameter_names().end(), name) ==
+        full->parameter_names().end())
+      throw InputError("--fix", "'" + CellExcerpt(name) +
+                                    "' is not a term of the tree's chains (a chain's own term is "
+                                    "written with its tool link: left_tool.theta4)");
+  if (fixed.empty()) return full;
+  return full->Without(fixed);
+}
+
+// The tree's candidates: a whole-robot CSV (every joint by name) or uniform draws over the
+// joints' ranges, those where some chain misses its plane left out.
+ResolvedPool TreePool(const po::variables_map& vm, const UrdfChains& tree,
+                      const MeasurementKind& kind, const PlaneSet& planes, std::uint64_t seed) {
+  if (vm.count("pool") == vm.count("generate"))
+    throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
+  ResolvedPool pool{TargetedConfigurations(static_cast<int>(tree.joint_names.size())), {}, ""};
+  TargetedConfigurations drawn;
+  if (vm.count("generate")) {
+    const int n = vm["generate"].as<int>();
+    if (n < 1 || n > 100000)
+      throw InputError("--generate", "expected 1 to 100,000 candidates, got " + std::to_string(n));
+    drawn = UniformTreeConfigurations(tree, n, RandomStream(seed, 0, 0, RandomPurpose::kPool));
+    if (planes.size() > 1) {  // the planes in turn
+      TargetedConfigurations turned(drawn.num_joints());
+      for (int i = 0; i < drawn.size(); ++i) turned.AddFrom(drawn, i, i % planes.size());
+      drawn = std::move(turned);
+    }
+    pool.source = "generated: " + std::to_string(n) +
+                  " whole-robot configurations, every joint "
+                  "uniform in its range";
+  } else {
+    const std::string path = vm["pool"].as<std::string>();
+    drawn = ReadTreeConfigurations(path, tree, planes.size() ? &planes : nullptr);
+    pool.source = path;
+  }
+  const std::vector<std::string> reasons = kind.MissReasons(drawn, nullptr);
+  std::vector<int> kept;
+  for (int i = 0; i < drawn.size(); ++i)
+    if (reasons[static_cast<std::size_t>(i)] == "ok") kept.push_back(i);
+  pool.configs = drawn.Subset(kept);
+  pool.source += "; " + std::to_string(kept.size()) + " where every chain measures";
+  if (pool.configs.size() == 0) throw InputError("--pool", "no usable candidate configurations");
+  return pool;
+}
+
+// design --tool-link a,b: configurations of the whole robot, every chain measured at each.
+int TreeDesign(const po::variables_map& vm) {
+  const UrdfChains tree = LoadTreeChains(vm);
+  const std::uint64_t seed = ParseSeed(vm);
+  const std::string sensor = DesignSensor(vm);
+  if (vm["criterion"].as<std::string>() == "I")
+    throw InputError("--criterion",
+                     "I weighs one chain's tool poses; a tree's design takes E, D, "
+                     "A or O1..O5");
+  const PlaneSet planes = sensor == "ranger" ? ResolvePlanes(tree.chains[0], vm) : PlaneSet{};
+  const std::unique_ptr<MeasurementKind> full = TreeKind(vm, tree, sensor, planes);
+  const ResolvedPool pool = TreePool(vm, tree, *full, planes, seed);
+  const std::vector<std::string> held = AnalyzeIdentifiability(*full, pool.configs).suggested_fixed;
+  const DesignRequest request = ResolveRequest(vm, nullptr, seed);
+  const DesignChoice choice = ChooseDesign(*full->Without(held), pool.configs, request);
+  if (vm.count("out"))
+    WriteConfigurations(vm["out"].as<std::string>(), pool.configs.Subset(choice.chosen.indices),
+                        tree.joint_names);
+  if (ResolveFormat(vm) == Format::kJson) {
+    Json j;
+    j["pool"] = {{"size", pool.configs.size()}, {"source", pool.source}};
+    j.update(DesignChoiceJson(request, choice));
+    j["sensor"] = sensor;
+    j["tree"] = {{"tool_links", SplitList(vm["tool-link"].as<std::string>())},
+                 {"joints", tree.joint_names},
+                 {"values_per_configuration", full->rows_per_configuration()}};
+    j["held_at_nominal"] = held;
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "candidate pool: " << pool.source << "\n"
+            << "tree: " << tree.chains.size() << " chains over " << tree.joint_names.size()
+            << " joints, each measured at every configuration (" << full->rows_per_configuration()
+            << " values); held at nominal, the pool cannot separate them:";
+  for (const std::string& name : held) std::cout << " " << name;
+  std::cout << (held.empty() ? " none\n" : "\n")
+            << DesignChoiceText(request, choice, planes, pool.configs.size());
+  if (vm.count("out")) std::cout << "wrote " << vm["out"].as<std::string>() << "\n";
+  return 0;
+}
+
+}  // namespace
+
 int DesignCommand(const std::vector<std::string>& args) {
   po::options_description o("lrcal design options");
   AddDesignOptions(o);
@@ -147,6 +260,7 @@ int DesignCommand(const std::vector<std::string>& args) {
              &vm))
     return 0;
   if (vm.count("out")) CheckOutputFile(vm["out"].as<std::string>(), "--out");
+  if (IsTreeRun(vm)) return TreeDesign(vm);
   const Setup setup = ResolveSetup(vm);
   const std::uint64_t seed = ParseSeed(vm);
   const std::string sensor = DesignSensor(vm);
@@ -155,7 +269,7 @@ int DesignCommand(const std::vector<std::string>& args) {
   MeasurementModel model(setup.rig.robot, setup.planes,
                          tracker ? MakeParameterSet(setup.rig.robot, PlaneTerms{})
                                  : ResolveParameterSet(setup.rig.robot, vm, setup.planes.size()));
-  const DesignRequest request = ResolveRequest(vm, model, seed);
+  const DesignRequest request = ResolveRequest(vm, &model, seed);
   std::vector<std::string> held;
   DesignChoice choice;
   if (tracker) {

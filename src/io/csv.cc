@@ -399,10 +399,14 @@ void CheckOutputFile(const std::string& path, const std::string& option) {
         option, "cannot write '" + path + "': the folder '" + parent.string() + "' does not exist");
 }
 
-void WriteConfigurations(const std::string& path, const TargetedConfigurations& configs) {
+void WriteConfigurations(const std::string& path, const TargetedConfigurations& configs,
+                         const std::vector<std::string>& joint_names) {
   std::ostringstream out;
   const bool planes = configs.num_targets_referenced() > 1;
-  for (int j = 0; j < configs.num_joints(); ++j) out << (j ? "," : "") << "q" << j + 1;
+  for (int j = 0; j < configs.num_joints(); ++j)
+    out << (j ? "," : "")
+        << (joint_names.empty() ? "q" + std::to_string(j + 1)
+                                : joint_names[static_cast<std::size_t>(j)]);
   out << (planes ? ",plane\n" : "\n");
   for (int i = 0; i < configs.size(); ++i) {
     for (int j = 0; j < configs.num_joints(); ++j)

@@ -17,6 +17,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/io/csv.h"
 #include "lrcal/kinematics/dh_conversion.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 
@@ -358,7 +359,52 @@ UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string
     placement.robot_joints = static_cast<int>(out.joint_names.size());
     out.placements.push_back(std::move(placement));
   }
+  out.q_min.assign(out.joint_names.size(), 0.0);
+  out.q_max.assign(out.joint_names.size(), 0.0);
+  for (std::size_t c = 0; c < out.chains.size(); ++c)
+    for (std::size_t k = 0; k < out.placements[c].joints.size(); ++k) {
+      const Link& link = out.chains[c].robot.links()[k];
+      const auto j = static_cast<std::size_t>(out.placements[c].joints[k]);
+      out.q_min[j] = link.q_min;
+      out.q_max[j] = link.q_max;
+    }
   return out;
+}
+
+TargetedConfigurations ReadTreeConfigurations(const std::string& path, const UrdfChains& tree,
+                                              const PlaneSet* planes) {
+  CsvTable t = ReadCsv(path);
+  t.joint_columns = tree.joint_names;
+  const int n = static_cast<int>(tree.joint_names.size());
+  TargetedConfigurations configs = Configurations(t, n, planes);
+  for (int i = 0; i < configs.size(); ++i)
+    for (int j = 0; j < n; ++j) {
+      const double q = configs.q(i)[j];
+      const auto u = static_cast<std::size_t>(j);
+      if (q >= tree.q_min[u] - 1e-9 && q <= tree.q_max[u] + 1e-9) continue;
+      throw InputError(Location(path, t.lines[static_cast<std::size_t>(i)]) + " column '" +
+                           tree.joint_names[u] + "'",
+                       FormatExact(q) + " is outside the joint's range [" +
+                           FormatExact(tree.q_min[u]) + ", " + FormatExact(tree.q_max[u]) +
+                           "] (the URDF's limits); joint values are in rad (m for a prismatic "
+                           "joint): were they written in degrees or mm?");
+    }
+  return configs;
+}
+
+TargetedConfigurations UniformTreeConfigurations(const UrdfChains& tree, int count,
+                                                 const RandomStream& stream) {
+  const std::size_t n = tree.joint_names.size();
+  TargetedConfigurations configs(static_cast<int>(n));
+  configs.Reserve(count);
+  std::vector<double> q(n);
+  for (int i = 0; i < count; ++i) {
+    for (std::size_t j = 0; j < n; ++j)
+      q[j] = tree.q_min[j] + (tree.q_max[j] - tree.q_min[j]) *
+                                 stream.Uniform(static_cast<std::uint64_t>(i) * n + j);
+    configs.Add(q);
+  }
+  return configs;
 }
 
 namespace {

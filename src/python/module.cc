@@ -49,6 +49,7 @@
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/compensation.h"
 #include "lrcal/kinematics/forward_kinematics.h"
+#include "lrcal/measurement/chain_measurement.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/measurement_set.h"
 #include "lrcal/measurement/mixed_measurement.h"
@@ -2475,6 +2476,86 @@ orientation rows weigh (sigma_mm/sigma_mrad)^2) and solver as in identify_tracke
 lrcal.Identification; its configurations count the measured values, one entry each.)doc");
 }
 
+// identify_tree: as identify --tool-link a,b with one data set per chain.
+IdentificationSummary IdentifyTreePy(const UrdfChains& tree, const py::list& parts,
+                                     const py::object& fix, bool auto_fix, double sigma_mm,
+                                     double sigma_mrad, const std::string& solver) {
+  if (parts.size() != tree.chains.size())
+    throw InputError("parts", "expected one dict per chain of the tree (" +
+                                  std::to_string(tree.chains.size()) + "), got " +
+                                  std::to_string(parts.size()));
+  const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
+  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
+  std::vector<MixedPart> chains;
+  std::vector<MeasuredValues> values;
+  const std::vector<double> rest(tree.joint_names.size(), 0.0);
+  for (std::size_t c = 0; c < parts.size(); ++c) {
+    try {
+      MixedPy p = ToMixedPart(tree.chains[c], parts[c].cast<py::dict>(), sigma, sigma_mrad * 1e-3);
+      auto chain = std::make_shared<ChainMeasurement>(p.kind, tree.placements[c]);
+      p.values.configs = chain->RobotConfigurations(p.values.configs, rest);
+      chains.push_back({chain, tree.placements[c].label, true});
+      values.push_back(std::move(p.values));
+    } catch (const InputError& e) {
+      throw InputError("parts[" + std::to_string(c) + "]." + e.where(),
+                       std::string(e.what()).substr(e.where().empty() ? 0 : e.where().size() + 2));
+    }
+  }
+  const MixedMeasurement mixed(std::move(chains));
+  const std::unique_ptr<MeasurementKind> kind = mixed.Without(ToNames(fix));
+  const MeasuredValues data = mixed.Combine(values);
+  py::gil_scoped_release release;
+  return Identify(*kind, data, options);
+}
+
+void DefineTree(py::module_& m) {
+  py::class_<UrdfChains>(m, "Tree", R"doc(
+A tree robot's chains from one base link to several tool links (a URDF's two arms on a torso, a
+humanoid's leg and arms): Tree.load(path, tool_links, base_link=""). Each chain is an
+lrcal.Robot (chains), the tree's joints are joint_names (the first chain's, then each later
+chain's new ones), and link_labels says, per chain and link, the label its terms carry in a
+joint fit ("" where every chain has the link).)doc")
+      .def_static(
+          "load",
+          [](const std::string& path, const std::vector<std::string>& tool_links,
+             const std::string& base_link) {
+            return LoadUrdfChains(ResolveRobotPath(path), tool_links, base_link);
+          },
+          py::arg("path"), py::arg("tool_links"), py::arg("base_link") = "", R"doc(
+Reads the chains of the URDF at path from base_link (default: the root) to each of tool_links:
+`lrcal identify --tool-link a,b`. Raises lrcal.InputError naming the file and link.)doc")
+      .def_readonly("joint_names", &UrdfChains::joint_names, "The tree's joints, each once.")
+      .def_property_readonly(
+          "chains", [](const UrdfChains& t) { return t.chains; }, "Each chain as an lrcal.Robot.")
+      .def_property_readonly(
+          "tool_links",
+          [](const UrdfChains& t) {
+            std::vector<std::string> labels;
+            for (const ChainOfTree& c : t.placements) labels.push_back(c.label);
+            return labels;
+          },
+          "The chains' tool links, in order.")
+      .def_property_readonly(
+          "link_labels",
+          [](const UrdfChains& t) {
+            std::vector<std::vector<std::string>> labels;
+            for (const ChainOfTree& c : t.placements) labels.push_back(c.link_labels);
+            return labels;
+          },
+          "Per chain, per link: the label of its terms in a joint fit (\"\": shared by all).");
+  m.def("identify_tree", &IdentifyTreePy, py::arg("tree"), py::arg("parts"),
+        py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
+        py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm", R"doc(
+A tree's chains identified together: `lrcal identify --tool-link a,b --data A --data B`. tree is
+an lrcal.Tree; parts a list of dicts, one per chain in its order, each as identify_mixed takes
+a part ("sensor" and that kind's arguments; q holds the chain's own joints, in the order of
+tree.chains[c]). The links every chain has, the base frame, the planes and what is fixed in the
+world (a tracker's frame) are estimated once; a chain's own links and what its tool carries are
+named with its tool link ("left_tool.theta4", "left_tool.target_x"), and fix takes those names.
+auto_fix, sigma_mm, sigma_mrad and solver as in identify_mixed. Returns an
+lrcal.Identification.)doc");
+}
+
 // compensate's targets: xyz (N, 3) with quaternion (N, 4) or not, or nominal's tool poses at q.
 std::vector<Pose<double>> CompensationGoals(const RobotFile& rig, const ConfigurationSet& plans,
                                             const py::object& xyz, const py::object& quaternion,
@@ -2565,6 +2646,7 @@ void DefineCalibration(py::module_& m) {
   DefineContacts(m);
   DefineScanners(m);
   DefineMixed(m);
+  DefineTree(m);
   DefineCompensate(m);
   DefineIdentify(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),

@@ -91,6 +91,23 @@ TEST_F(TreeCli, TwoArmsSharingATorsoAreCalibratedTogether) {
   // The union's model holds the moved robot: nothing left over.
   EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
 
+  // A design over the whole robot: every chain measured at each chosen configuration, written by
+  // joint name, which each chain's simulate reads as its own.
+  ASSERT_EQ(Run("design --generate 150 --select 20 --method greedy --format json" + tree +
+                    " --out " + Path("chosen.csv"),
+                &out),
+            0)
+      << out;
+  const Json design = JsonOf(out);
+  EXPECT_EQ(design["tree"]["values_per_configuration"], 6);
+  EXPECT_EQ(design["selected"].size(), 20u);
+  std::ifstream chosen(Path("chosen.csv"));
+  std::string header;
+  std::getline(chosen, header);
+  EXPECT_EQ(header.substr(0, 34), "torso_yaw,torso_pitch_1,torso_pitc");
+  EXPECT_EQ(Run("design --generate 50 --select 10 --criterion I" + tree, &out), 2);
+  EXPECT_THAT(out, HasSubstr("--criterion: I weighs one chain's tool poses"));
+
   // What a tree's run refuses, by option.
   const std::string files = " --data " + Path("left.csv") + " --data " + Path("right.csv");
   EXPECT_EQ(Run("identify" + tree + " --data " + Path("left.csv"), &out), 2);

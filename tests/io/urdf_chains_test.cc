@@ -17,8 +17,10 @@
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/chain_measurement.h"
+#include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/mixed_measurement.h"
 #include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/tree_measurement.h"
 #include "test_util.h"
 #include "tracker_fixtures.h"
 #include "urdf_kinematics.h"
@@ -179,6 +181,56 @@ TEST(UrdfChains, TheUnionSeesWhatTheArmsShareOnce) {
   }
   EXPECT_GT(shared_seen, 0);
   EXPECT_EQ(union_rank, sum - shared_seen);
+}
+
+// Design's view of a tree: both arms measured at each whole-robot configuration, each chain's
+// values as its own kind gives them, bit for bit, in chain order; the terms are the joint fit's.
+TEST(UrdfChains, ChainsMeasuredTogetherAreEachChainsValuesInTurn) {
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArms);
+  std::vector<std::shared_ptr<const ChainMeasurement>> chains;
+  for (std::size_t c = 0; c < tree.chains.size(); ++c)
+    chains.push_back(std::make_shared<ChainMeasurement>(
+        std::make_shared<PointMeasurement>(tree.chains[c].robot, OneTarget()), tree.placements[c]));
+  const TreeMeasurement together(chains);
+  EXPECT_STREQ(together.name(), "point");
+  EXPECT_EQ(together.rows_per_configuration(), 6);
+  EXPECT_EQ(together.parameter_names(), TrackedArms(tree).parameter_names());
+  const TargetedConfigurations configs = RobotConfigurations(tree, 12, 13);
+  const Eigen::VectorXd e = testing::SomeTruth(together, 3);
+  const Eigen::MatrixXd J = MeasurementJacobian(together, configs, e.data());
+  std::vector<double> y(static_cast<std::size_t>(J.rows()));
+  together.Bind(configs)->Predict(e.data(), y.data(), nullptr);
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    // The chain's own estimate: its terms' columns of the joint one.
+    Eigen::VectorXd own(chains[c]->num_parameters());
+    std::vector<int> columns;
+    for (int k = 0; k < own.size(); ++k) {
+      const auto& names = together.parameter_names();
+      const auto it = std::find(names.begin(), names.end(), chains[c]->parameter_names()[k]);
+      ASSERT_NE(it, names.end());
+      columns.push_back(static_cast<int>(it - names.begin()));
+      own[k] = e[columns.back()];
+    }
+    const Eigen::MatrixXd Jc = MeasurementJacobian(*chains[c], configs, own.data());
+    std::vector<double> yc(static_cast<std::size_t>(Jc.rows()));
+    chains[c]->Bind(configs)->Predict(own.data(), yc.data(), nullptr);
+    for (int i = 0; i < configs.size(); ++i)
+      for (int r = 0; r < 3; ++r) {
+        const int row = i * 6 + 3 * static_cast<int>(c) + r;
+        EXPECT_EQ(y[static_cast<std::size_t>(row)], yc[static_cast<std::size_t>(i * 3 + r)]);
+        for (int k = 0; k < own.size(); ++k)
+          EXPECT_EQ(J(row, columns[static_cast<std::size_t>(k)]), Jc(i * 3 + r, k));
+      }
+  }
+  // Held terms keep the layout; contacts, seated chain by chain, are refused by name.
+  EXPECT_EQ(together.Without({"left_tool.theta9"})->rows_per_configuration(), 6);
+  ContactSetup table;
+  table.planes = PlaneSet(Plane::FromCoefficients(0, 0, 1, -0.2));
+  const auto contact = std::make_shared<ChainMeasurement>(
+      std::make_shared<ContactMeasurement>(tree.chains[0].robot, table), tree.placements[0]);
+  EXPECT_THAT([&] { TreeMeasurement({contact}); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(
+                  "chain 'left_tool': contact data seat each chain at configurations of its own")));
 }
 
 TEST(UrdfChains, BadChainListsAreNamed) {

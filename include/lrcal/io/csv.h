@@ -92,10 +92,12 @@ void WriteOutputFile(const std::string& path, const std::string& text);
 /// or in a folder that does not exist.
 void CheckOutputFile(const std::string& path, const std::string& option);
 
-/// Writes configurations (header q1..qN, and `plane` with the 1-based target when they refer to
+/// Writes configurations (header q1..qN, or `joint_names` when given — a tree's joints, which
+/// no q1..qN of one chain names —, and `plane` with the 1-based target when they refer to
 /// several) at full precision. The file is written whole or not at all; any failure (a full
 /// disk, a folder that cannot be written) is an InputError naming it.
-void WriteConfigurations(const std::string& path, const TargetedConfigurations& configs);
+void WriteConfigurations(const std::string& path, const TargetedConfigurations& configs,
+                         const std::vector<std::string>& joint_names = {});
 /// Poses (no target): the columns q1..qN, as WriteConfigurations writes them.
 void WritePoses(const std::string& path, const ConfigurationSet& poses);
 /// Writes single readings (header q1..qN,h,repetition): `readings` holds `repetitions` readings

@@ -17,9 +17,11 @@
 #include <optional>
 #include <string>
 
+#include "lrcal/core/random.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/chain_measurement.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal {
 
@@ -53,6 +55,7 @@ struct UrdfChains {
   std::vector<std::string> joint_names;
   std::vector<RobotFile> chains;        ///< per tool link, the chain LoadUrdfRobotFile reads
   std::vector<ChainOfTree> placements;  ///< per tool link, where its chain sits (label: the link)
+  std::vector<double> q_min, q_max;     ///< per joint of joint_names, its range (rad, or m)
 };
 
 /// The chains of `path` from `base_link` (empty: the root) to each of `tool_links` (at least one,
@@ -63,6 +66,18 @@ struct UrdfChains {
 /// repeated tool link.
 UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string>& tool_links,
                           const std::string& base_link = "");
+
+/// A whole tree's configurations CSV: a column per joint of `tree`, named as in joint_names (the
+/// order of the columns is free; other columns are ignored), and an optional `plane` column
+/// resolved against `planes`. Throws InputError naming the file, line and column for a missing
+/// joint column and, as CheckJointRanges does, for a value outside its joint's range.
+TargetedConfigurations ReadTreeConfigurations(const std::string& path, const UrdfChains& tree,
+                                              const PlaneSet* planes = nullptr);
+
+/// `count` configurations of the whole tree, each joint uniform in its range: the draws of
+/// `stream` at indices i·J + j (J joints).
+TargetedConfigurations UniformTreeConfigurations(const UrdfChains& tree, int count,
+                                                 const RandomStream& stream);
 
 /// A URDF document for `robot` with `link_values` (5N, SI) as its geometry; numbers with 17
 /// significant digits.

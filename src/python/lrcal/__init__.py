@@ -30,7 +30,8 @@ try:
                          simulate, simulate_tracker, identify_tracker, status,
                          simulate_sockets, identify_sockets, socket_consistency,
                          simulate_contacts, identify_contacts, simulate_scanner,
-                         identify_scanner, identify_mixed, compensate)
+                         identify_scanner, identify_mixed, compensate,
+                         Tree, identify_tree)
     from ._lrcal import set_data_directory as _set_data_directory
 except ModuleNotFoundError as _missing:
     # Only the Python files are installed (a build without pybind11, e.g. a sanitizer build):
@@ -70,4 +71,4 @@ __all__ = ["Design", "Dependency", "Error", "Identifiability", "Identification",
            "sample_configurations", "simulate", "simulate_tracker", "identify_tracker", "status",
            "simulate_sockets", "identify_sockets", "socket_consistency",
            "simulate_contacts", "identify_contacts", "simulate_scanner", "identify_scanner",
-           "identify_mixed", "compensate"]
+           "identify_mixed", "compensate", "Tree", "identify_tree"]
