@@ -77,7 +77,11 @@ RobotFile LoadRobot(const po::variables_map& vm) {
 }
 
 bool IsTreeRun(const po::variables_map& vm) {
-  return vm.count("tool-link") && SplitList(vm["tool-link"].as<std::string>()).size() > 1;
+  if (vm.count("tool-link") && SplitList(vm["tool-link"].as<std::string>()).size() > 1) return true;
+  // One chain with a mimic joint on it: a tree of one chain, its mimic joint a coupling.
+  const std::string path = ResolveRobotPath(vm["robot"].as<std::string>());
+  return IsUrdfPath(path) &&
+         UrdfChainIsCoupled(path, OptionalString(vm, "tool-link"), OptionalString(vm, "base-link"));
 }
 
 UrdfChains LoadTreeChains(const po::variables_map& vm) {
@@ -87,8 +91,9 @@ UrdfChains LoadTreeChains(const po::variables_map& vm) {
                      "several tool links are a tree's chains: --robot must be a "
                      "URDF, not '" +
                          path + "'");
-  return LoadUrdfChains(path, SplitList(vm["tool-link"].as<std::string>()),
-                        OptionalString(vm, "base-link"));
+  std::vector<std::string> tools = SplitList(OptionalString(vm, "tool-link"));
+  if (tools.empty()) tools.emplace_back();  // the URDF's only end link
+  return LoadUrdfChains(path, tools, OptionalString(vm, "base-link"));
 }
 
 RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm) {

@@ -53,7 +53,8 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
 /// --robot, --tool-link and --base-link.
 RobotFile LoadRobot(const po::variables_map& vm);
-/// True when --tool-link lists several links: a tree's chains (io/urdf.h LoadUrdfChains).
+/// True when --tool-link lists several links, or the URDF's one chain has a mimic joint on it: a
+/// tree's chains (io/urdf.h LoadUrdfChains).
 bool IsTreeRun(const po::variables_map& vm);
 /// The chains of --robot (a URDF) from --base-link to each link of --tool-link.
 UrdfChains LoadTreeChains(const po::variables_map& vm);

@@ -996,7 +996,7 @@ std::string JoinComma(const std::vector<std::string>& names) {
 TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool configs_only) {
   TreeRun run;
   run.tree = LoadTreeChains(vm);
-  run.labels = SplitList(vm["tool-link"].as<std::string>());
+  for (const ChainOfTree& chain : run.tree.placements) run.labels.push_back(chain.label);
   std::vector<std::string> sensors = ResolveSensors(vm);
   if (sensors.size() == 1 && sensors[0] != "mixed") sensors.assign(run.labels.size(), sensors[0]);
   if (sensors.size() != run.labels.size())
@@ -1024,7 +1024,8 @@ TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool config
     if (sensors[c] != "point" && sensors[c] != "pose" && sensors[c] != "socket")
       setup->planes = ResolvePlanes(chain, vm);  // the kinds that see planes
     MixedFile f =
-        LoadMixedTable(vm, *setup, sensors[c], ReadRobotCsv(files[c], chain.robot), configs_only);
+        LoadMixedTable(vm, *setup, sensors[c],
+                       ReadChainCsv(files[c], run.tree, static_cast<int>(c)), configs_only);
     const auto part = std::make_shared<ChainMeasurement>(f.kind, run.tree.placements[c]);
     f.values.configs = part->RobotConfigurations(
         f.values.configs, std::vector<double>(run.tree.joint_names.size(), 0.0));
@@ -1051,6 +1052,18 @@ Json TreeJson(const TreeRun& run, const MixedMeasurement& kind) {
 }
 
 std::string TreeText(const TreeRun& run, const MixedMeasurement& kind) {
+  std::string couplings;
+  for (std::size_t c = 0; c < run.tree.placements.size(); ++c)
+    for (const JointCoupling& coupling : run.tree.placements[c].couplings)
+      couplings +=
+          (couplings.empty() ? "" : ", ") +
+          run.tree.chains[c].robot.links()[static_cast<std::size_t>(coupling.link)].joint_name +
+          " = " + FormatExact(coupling.multiplier) + " x " +
+          run.tree.joint_names[static_cast<std::size_t>(coupling.joint)] + " + " +
+          FormatExact(coupling.offset);
+  if (run.labels.size() == 1)
+    return "chain to " + run.labels[0] + " over " + std::to_string(run.tree.joint_names.size()) +
+           " joints, coupled: " + couplings + "\n";
   const Json j = TreeJson(run, kind);
   std::string text =
       "tree: " + std::to_string(run.labels.size()) + " chains (" + JoinComma(run.labels) +
@@ -1059,7 +1072,8 @@ std::string TreeText(const TreeRun& run, const MixedMeasurement& kind) {
   for (const auto& [label, names] : j["own_terms"].items())
     text += "; " + label + "'s own: " + std::to_string(names.size());
   const std::vector<std::string> shared = j["shared_terms"].get<std::vector<std::string>>();
-  return text + "\nshared: " + (shared.empty() ? "none" : JoinComma(shared)) + "\n";
+  return text + "\nshared: " + (shared.empty() ? "none" : JoinComma(shared)) + "\n" +
+         (couplings.empty() ? "" : "coupled: " + couplings + "\n");
 }
 
 // identify --tool-link a,b --data A.csv --data B.csv: the chains' terms together, the shared

@@ -18,6 +18,7 @@
 #include "lrcal/core/settings.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/io/robot_data.h"
 #include "lrcal/kinematics/dh_conversion.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 
@@ -236,11 +237,14 @@ std::vector<PathJoint> PathBetween(const std::vector<urdf::JointConstSharedPtr>&
 // the chain the other way: the product of exponentials of the inverse). Its value and range stay
 // the URDF's.
 JointAxis PathJointAxis(const urdf::ModelInterface& model, const PathJoint& step,
-                        const RigidTransform& base_inverse, const std::string& path) {
+                        const RigidTransform& base_inverse, const std::string& path,
+                        bool allow_mimic) {
   const urdf::Joint& joint = *step.joint;
-  if (joint.mimic)
-    throw InputError(path,
-                     "joint '" + joint.name + "' mimics another; lrcal needs independent joints");
+  if (joint.mimic && !allow_mimic)
+    throw InputError(path, "joint '" + joint.name +
+                               "' mimics another; a chain with a coupled joint is read as a "
+                               "tree's chain, which identify, identifiability and design take "
+                               "(this command does not)");
   JointAxis axis;
   switch (joint.type) {
     case urdf::Joint::REVOLUTE:
@@ -269,8 +273,12 @@ JointAxis PathJointAxis(const urdf::ModelInterface& model, const PathJoint& step
 
 }  // namespace
 
-RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link,
-                            const std::string& base_link) {
+namespace {
+
+// The chain from base_link to tool_link (LoadUrdfRobotFile), a mimic joint on it a link of its
+// own when `allow_mimic` (LoadUrdfChains couples it), else an error.
+RobotFile LoadUrdfChain(const std::string& path, const std::string& tool_link,
+                        const std::string& base_link, bool allow_mimic) {
   if (!PathExists(path)) throw InputError(path, "no such file");
   CheckUrdfTree(path);
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
@@ -288,7 +296,7 @@ RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_lin
   std::vector<JointAxis> axes;
   for (const PathJoint& step : PathBetween(root_to_base, root_to_tool))
     if (step.joint->type != urdf::Joint::FIXED)
-      axes.push_back(PathJointAxis(*model, step, base_inverse, path));
+      axes.push_back(PathJointAxis(*model, step, base_inverse, path, allow_mimic));
   if (axes.empty())
     throw InputError(path, "no movable joint between the " +
                                std::string(base_link.empty() ? "root" : "base") + " link '" + base +
@@ -299,6 +307,22 @@ RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_lin
   file.path = path;
   file.robot.source = path;
   return file;
+}
+
+}  // namespace
+
+RobotFile LoadUrdfRobotFile(const std::string& path, const std::string& tool_link,
+                            const std::string& base_link) {
+  return LoadUrdfChain(path, tool_link, base_link, false);
+}
+
+bool UrdfChainIsCoupled(const std::string& path, const std::string& tool_link,
+                        const std::string& base_link) {
+  const RobotFile chain = LoadUrdfChain(path, tool_link, base_link, true);
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+  for (const Link& link : chain.robot.links())
+    if (model->getJoint(link.joint_name)->mimic) return true;
+  return false;
 }
 
 namespace {
@@ -334,41 +358,106 @@ std::vector<std::string> LinkLabels(const std::vector<std::vector<std::string>>&
 
 }  // namespace
 
+namespace {
+
+// The robot joint each chain link follows: its own, or for a mimic joint the joint it mimics,
+// each named once in `tree->joint_names` (a mimicked joint off every chain last, with its range).
+int RobotJoint(const urdf::ModelInterface& model, const urdf::Joint& joint, const std::string& path,
+               UrdfChains* tree) {
+  const std::string& name = joint.mimic ? joint.mimic->joint_name : joint.name;
+  const auto it = std::find(tree->joint_names.begin(), tree->joint_names.end(), name);
+  if (it != tree->joint_names.end()) return static_cast<int>(it - tree->joint_names.begin());
+  const urdf::JointConstSharedPtr followed = model.getJoint(name);
+  if (!followed || followed->mimic || followed->type == urdf::Joint::FIXED)
+    throw InputError(path, "joint '" + joint.name + "' mimics '" + name +
+                               "', which is not a movable joint of its own");
+  JointAxis range;
+  JointRange(*followed, path, &range);
+  tree->joint_names.push_back(name);
+  tree->q_min.push_back(range.q_min);
+  tree->q_max.push_back(range.q_max);
+  return static_cast<int>(tree->joint_names.size()) - 1;
+}
+
+// Chain c's place in the tree: its links' robot joints (after every chain's own joints are
+// named), its couplings, its links' labels.
+ChainOfTree PlaceChain(const urdf::ModelInterface& model, const std::string& path,
+                       const std::vector<std::vector<std::string>>& joints,
+                       const std::vector<std::string>& labels, std::size_t c, UrdfChains* tree) {
+  ChainOfTree placement;
+  placement.label = labels[c];
+  const RobotModel& robot = tree->chains[c].robot;
+  for (int k = 0; k < robot.num_links(); ++k) {
+    const urdf::Joint& joint =
+        *model.getJoint(robot.links()[static_cast<std::size_t>(k)].joint_name);
+    placement.joints.push_back(RobotJoint(model, joint, path, tree));
+    if (joint.mimic)
+      placement.couplings.push_back({k, placement.joints.back(), joint.mimic->multiplier,
+                                     joint.mimic->offset, joint.type == urdf::Joint::PRISMATIC});
+  }
+  placement.link_labels = LinkLabels(joints, labels, c);
+  return placement;
+}
+
+}  // namespace
+
 UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string>& tool_links,
                           const std::string& base_link) {
   if (tool_links.empty()) throw InputError(path, "expected at least one tool link (--tool-link)");
   UrdfChains out;
-  std::vector<std::vector<std::string>> joints;
-  for (const std::string& tool : tool_links) {
-    if (std::count(tool_links.begin(), tool_links.end(), tool) > 1)
-      throw InputError(path, "the tool link '" + tool + "' is named twice (--tool-link)");
-    out.chains.push_back(LoadUrdfRobotFile(path, tool, base_link));
-    joints.push_back(ChainJointNames(out.chains.back().robot));
-    for (const std::string& name : joints.back())
-      if (std::find(out.joint_names.begin(), out.joint_names.end(), name) == out.joint_names.end())
-        out.joint_names.push_back(name);
-  }
-  for (std::size_t c = 0; c < tool_links.size(); ++c) {
-    ChainOfTree placement;
-    placement.label = tool_links[c];
-    for (const std::string& name : joints[c])
-      placement.joints.push_back(
-          static_cast<int>(std::find(out.joint_names.begin(), out.joint_names.end(), name) -
-                           out.joint_names.begin()));
-    placement.link_labels = LinkLabels(joints, tool_links, c);
-    placement.robot_joints = static_cast<int>(out.joint_names.size());
-    out.placements.push_back(std::move(placement));
-  }
-  out.q_min.assign(out.joint_names.size(), 0.0);
-  out.q_max.assign(out.joint_names.size(), 0.0);
-  for (std::size_t c = 0; c < out.chains.size(); ++c)
-    for (std::size_t k = 0; k < out.placements[c].joints.size(); ++k) {
-      const Link& link = out.chains[c].robot.links()[k];
-      const auto j = static_cast<std::size_t>(out.placements[c].joints[k]);
-      out.q_min[j] = link.q_min;
-      out.q_max[j] = link.q_max;
+  std::vector<std::string> tools = tool_links;
+  for (std::string& tool : tools)
+    if (tool.empty()) {  // the only end link other than the base link
+      CheckUrdfTree(path);
+      const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+      if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
+      tool =
+          ChooseToolLink(*model, path, "", base_link.empty() ? model->getRoot()->name : base_link);
     }
+  std::vector<std::vector<std::string>> joints;
+  for (const std::string& tool : tools) {
+    if (std::count(tools.begin(), tools.end(), tool) > 1)
+      throw InputError(path, "the tool link '" + tool + "' is named twice (--tool-link)");
+    out.chains.push_back(LoadUrdfChain(path, tool, base_link, true));
+    joints.push_back(ChainJointNames(out.chains.back().robot));
+  }
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+  // The chains' own (not mimic) joints first, in chain order, with their ranges.
+  for (std::size_t c = 0; c < out.chains.size(); ++c)
+    for (const Link& link : out.chains[c].robot.links())
+      if (!model->getJoint(link.joint_name)->mimic &&
+          std::find(out.joint_names.begin(), out.joint_names.end(), link.joint_name) ==
+              out.joint_names.end()) {
+        out.joint_names.push_back(link.joint_name);
+        out.q_min.push_back(link.q_min);
+        out.q_max.push_back(link.q_max);
+      }
+  for (std::size_t c = 0; c < tools.size(); ++c)
+    out.placements.push_back(PlaceChain(*model, path, joints, tools, c, &out));
+  for (ChainOfTree& placement : out.placements)
+    placement.robot_joints = static_cast<int>(out.joint_names.size());
   return out;
+}
+
+CsvTable ReadChainCsv(const std::string& path, const UrdfChains& tree, int chain) {
+  const RobotFile& rig = tree.chains[static_cast<std::size_t>(chain)];
+  CsvTable t = ReadRobotCsv(path, rig.robot);
+  if (t.joint_columns.empty()) return t;  // q1..qN: every link's column, read as it is
+  for (const JointCoupling& c : tree.placements[static_cast<std::size_t>(chain)].couplings) {
+    const std::string& name = rig.robot.links()[static_cast<std::size_t>(c.link)].joint_name;
+    if (t.Column(name) >= 0) continue;
+    const std::string& followed = tree.joint_names[static_cast<std::size_t>(c.joint)];
+    const int source = t.Column(followed);
+    if (source < 0)
+      throw InputError(Location(path, 1) + " column '" + CellExcerpt(followed) + "'",
+                       "missing: the coupled joint '" + name +
+                           "' follows it, and the file has "
+                           "neither column");
+    t.header.push_back(name);
+    for (std::size_t r = 0; r < t.rows.size(); ++r)
+      t.rows[r].push_back(FormatExact(c.multiplier * t.Number(r, source) + c.offset));
+  }
+  return t;
 }
 
 TargetedConfigurations ReadTreeConfigurations(const std::string& path, const UrdfChains& tree,

@@ -120,7 +120,10 @@ bool ParameterSet::EstimatesFrames() const {
 }
 
 DisplayUnit DisplayUnitOf(const std::string& name) {
-  if (name.substr(name.rfind('.') + 1) == "ranger_scale") return {"ppm", 1e6};
+  const std::string term = name.substr(name.rfind('.') + 1);
+  // The ranger's scale and a coupling's gain (chain_measurement.h) are dimensionless.
+  if (term == "ranger_scale" || (term.size() > 5 && term.compare(term.size() - 5, 5, "_gain") == 0))
+    return {"ppm", 1e6};
   return IsAngularName(name) ? DisplayUnit{"mrad", 1e3} : DisplayUnit{"mm", 1e3};
 }
 

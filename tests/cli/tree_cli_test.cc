@@ -126,6 +126,40 @@ TEST_F(TreeCli, TwoArmsSharingATorsoAreCalibratedTogether) {
   EXPECT_THAT(out, HasSubstr("--sensor: expected one kind for every chain, or one per tool link"));
 }
 
+// The head tilts with the last torso joint (a mimic joint): a coupled link whose gain is a term.
+// The log has no head_tilt column (robots do not always log mimic joints): it follows its joint.
+TEST_F(TreeCli, AMimicJointOnAChainIsACoupledLinkWithItsGain) {
+  const std::string nominal = testing::SourcePath(kDualArm);
+  WriteWholeRobotLog(Path("log.csv"), 40);
+  const std::string tracker = std::string(kTracker) + " --target 0.05,0.02,0.1";
+  std::string out;
+  ASSERT_EQ(Run("identifiability --robot " + nominal + " --tool-link head" + tracker +
+                    " --configs " + Path("log.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("chain to head over 3 joints, coupled: head_tilt = -1 x "
+                             "torso_pitch_2 + 0"));
+  ASSERT_EQ(
+      Run("identifiability --format json --robot " + nominal +
+              " --tool-link left_tool,right_tool,head" + tracker + " --configs " + Path("log.csv") +
+              " --configs " + Path("log.csv") + " --configs " + Path("log.csv"),
+          &out),
+      0)
+      << out;
+  const Json j = JsonOf(out);
+  const auto names = j["tree"]["own_terms"]["head"].get<std::vector<std::string>>();
+  EXPECT_THAT(names, ::testing::Contains("head.coupling4_gain"));
+  EXPECT_THAT(j["suggested_fixed"].get<std::vector<std::string>>(),
+              ::testing::Not(::testing::Contains("head.coupling4_gain")));
+  // The one-chain commands refuse it by name.
+  EXPECT_EQ(Run("simulate --robot " + nominal + " --tool-link head" + tracker + " --configs " +
+                    Path("log.csv") + " --out " + Path("x.csv"),
+                &out),
+            2);
+  EXPECT_THAT(out, HasSubstr("joint 'head_tilt' mimics another; a chain with a coupled joint"));
+}
+
 TEST_F(TreeCli, ASoleToGripperChainIsCalibratedUpTheLeg) {
   const std::string nominal = testing::SourcePath("examples/urdf/humanoid_like.urdf");
   const std::string truth = testing::UrdfWithMovedOrigins(nominal, 6, Path("true.urdf"));

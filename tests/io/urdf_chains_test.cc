@@ -4,12 +4,14 @@
 // tool, the true robot a URDF whose every joint origin is moved (a physical tree, not the model's
 // own parametrisation), calibrated noise-free through the union; the union's identifiable count
 // against the chains' own.
+#include <ceres/jet.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <map>
 #include <random>
+#include <sstream>
 
 #include "lrcal/core/error.h"
 #include "lrcal/identification/identifiability.h"
@@ -19,6 +21,7 @@
 #include "lrcal/measurement/chain_measurement.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/mixed_measurement.h"
+#include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/point_measurement.h"
 #include "lrcal/measurement/tree_measurement.h"
 #include "test_util.h"
@@ -231,6 +234,136 @@ TEST(UrdfChains, ChainsMeasuredTogetherAreEachChainsValuesInTurn) {
   EXPECT_THAT([&] { TreeMeasurement({contact}); },
               ::testing::ThrowsMessage<InputError>(::testing::HasSubstr(
                   "chain 'left_tool': contact data seat each chain at configurations of its own")));
+}
+
+// A mimic joint on a chain: the dual-arm robot's head tilts with the last torso joint (multiplier
+// -1). The head's chain has the tilt as a coupled link that follows torso_pitch_2, which is not a
+// joint of its own in the robot's vector.
+const std::vector<std::string> kArmsAndHead = {"left_tool", "right_tool", "head"};
+
+TEST(UrdfChains, AMimicJointIsACoupledLinkFollowingItsJoint) {
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArmsAndHead);
+  EXPECT_EQ(tree.joint_names.size(), 15u);  // head_tilt follows torso_pitch_2
+  EXPECT_THAT(tree.placements[2].joints, ::testing::ElementsAre(0, 1, 2, 2));
+  ASSERT_EQ(tree.placements[2].couplings.size(), 1u);
+  const JointCoupling& tilt = tree.placements[2].couplings[0];
+  EXPECT_EQ(tilt.link, 3);
+  EXPECT_EQ(tilt.joint, 2);
+  EXPECT_EQ(tilt.multiplier, -1.0);
+  // The head's pose is the URDF's with the tilt at -q(torso_pitch_2).
+  const ChainMeasurement head(std::make_shared<PointMeasurement>(tree.chains[2].robot, OneTarget()),
+                              tree.placements[2]);
+  const TargetedConfigurations configs = RobotConfigurations(tree, 40, 17);
+  const TargetedConfigurations chain = head.ChainConfigurations(configs);
+  const RobotModel& robot = tree.chains[2].robot;
+  for (int i = 0; i < configs.size(); ++i) {
+    std::map<std::string, double> by_name;
+    for (std::size_t j = 0; j < tree.joint_names.size(); ++j)
+      by_name[tree.joint_names[j]] = configs.q(i)[j];
+    by_name["head_tilt"] = -by_name["torso_pitch_2"];
+    const Pose<double> pose =
+        ForwardKinematics<double>(robot, robot.nominal_values().data(), chain.q(i));
+    const Eigen::Isometry3d expected =
+        testing::UrdfPoseBetween(DualArm(), "base_link", "head", by_name);
+    EXPECT_LT((pose.p_BT - expected.translation()).norm(), testing::tolerance::kUrdf);
+  }
+  // Its gain is a term of the head's own (the tilt's link is no other chain's), in ppm.
+  EXPECT_THAT(head.parameter_names(), ::testing::Contains("head.coupling4_gain"));
+  EXPECT_STREQ(DisplayUnitOf("head.coupling4_gain").unit, "ppm");
+  EXPECT_THAT(head.Without({"head.coupling4_gain"})->parameter_names(),
+              ::testing::Not(::testing::Contains("head.coupling4_gain")));
+  // Holding the tilt's offset (a last link's θ0 depends on its target's offset) keeps the gain:
+  // the offset's column is kept, hidden, for the gain's.
+  const std::unique_ptr<MeasurementKind> held = head.Without({"head.theta4", "head.target_x"});
+  EXPECT_THAT(held->parameter_names(), ::testing::Contains("head.coupling4_gain"));
+  EXPECT_THAT(held->parameter_names(), ::testing::Not(::testing::Contains("head.theta4")));
+  EXPECT_EQ(held->num_parameters(), head.num_parameters() - 2);
+  EXPECT_EQ(held->NominalValues().size(), held->num_parameters());
+}
+
+// The gain's column against autodiff of the chain's forward kinematics through the coupled joint
+// value (m + δm)·q_j + o, and against central differences of the whole evaluator (which rebinds
+// the kind at each gain).
+TEST(UrdfChains, ACouplingsGainColumnMatchesAutodiffAndCentralDifferences) {
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArmsAndHead);
+  const PointSetup setup = OneTarget();
+  const ChainMeasurement head(std::make_shared<PointMeasurement>(tree.chains[2].robot, setup),
+                              tree.placements[2]);
+  const TargetedConfigurations configs = RobotConfigurations(tree, 20, 19);
+  const int n = head.num_parameters();
+  const int gain = n - 1;
+  ASSERT_EQ(head.parameter_names()[static_cast<std::size_t>(gain)], "head.coupling4_gain");
+  std::vector<double> e(static_cast<std::size_t>(n), 0.0);
+  e[static_cast<std::size_t>(gain)] = 0.003;
+  std::unique_ptr<MeasurementEvaluator> evaluator = head.Bind(configs);
+  const int m = evaluator->num_rows();
+  std::vector<double> y(static_cast<std::size_t>(m));
+  Eigen::MatrixXd J(m, n);
+  ASSERT_TRUE(evaluator->Predict(e.data(), y.data(), J.data()));
+  using Jet = ceres::Jet<double, 1>;
+  const RobotModel& robot = tree.chains[2].robot;
+  std::vector<Jet> values;
+  for (int k = 0; k < robot.num_values(); ++k) values.emplace_back(robot.nominal_values()[k]);
+  const JointCoupling& tilt = tree.placements[2].couplings[0];
+  for (int i = 0; i < configs.size(); ++i) {
+    // FK takes joint values as numbers: the coupled joint's value, a Jet in the gain, goes into
+    // its link's θ (θ = θ0 + q) with q = 0 there.
+    std::vector<double> q;
+    for (int j : tree.placements[2].joints) q.push_back(configs.q(i)[j]);
+    q[3] = 0;
+    std::vector<Jet> with_tilt = values;
+    with_tilt[3 * kValuesPerLink + kTheta] +=
+        (Jet(tilt.multiplier) + Jet(0.003, 0)) * configs.q(i)[tilt.joint] + tilt.offset;
+    const Pose<Jet> pose = ForwardKinematics<Jet>(robot, with_tilt.data(), q.data());
+    const Eigen::Matrix<Jet, 3, 1> p = setup.instrument.rotation.cast<Jet>().transpose() *
+                                       (pose.p_BT + pose.R_BT * setup.targets[0].cast<Jet>() -
+                                        setup.instrument.translation.cast<Jet>());
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(y[static_cast<std::size_t>(3 * i + c)], p[c].a, testing::tolerance::kUrdf);
+      EXPECT_NEAR(J(3 * i + c, gain), p[c].v[0], testing::tolerance::kAutodiff);
+    }
+  }
+  EXPECT_THAT(J, testing::EigenNear(testing::CentralDifferences(*evaluator, e),
+                                    testing::tolerance::kCentralDifference));
+}
+
+// Three chains, the head's tilt coupled to the torso: the true robot's origins moved and its
+// tilt's multiplier off by 3e-3. The joint fit returns the gain and every tool point to 1e-9.
+TEST(UrdfChains, ACoupledJointsGainIsCalibratedNoiseFree) {
+  const UrdfChains nominal = LoadUrdfChains(DualArm(), kArmsAndHead);
+  const std::string moved = testing::UrdfWithMovedOrigins(
+      DualArm(), 21, testing::TempDir("urdf_chains") + "/true_coupled.urdf");
+  {
+    std::ifstream in(moved);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string urdf = text.str();
+    const std::string mimic = "multiplier=\"-1.0\"";
+    ASSERT_NE(urdf.find(mimic), std::string::npos);
+    urdf.replace(urdf.find(mimic), mimic.size(), "multiplier=\"-1.003\"");
+    std::ofstream(moved) << urdf;
+  }
+  const UrdfChains truth = LoadUrdfChains(moved, kArmsAndHead);
+  const MixedMeasurement full = TrackedArms(nominal);
+  const MixedMeasurement true_kind = TrackedArms(truth);
+  const TargetedConfigurations configs = RobotConfigurations(nominal, 60, 23);
+  const MeasuredValues data = Simulated(true_kind, configs);
+  const IdentifiabilityReport report = AnalyzeIdentifiability(full, data.configs);
+  EXPECT_THAT(report.suggested_fixed, ::testing::Not(::testing::Contains("head.coupling4_gain")));
+  const std::unique_ptr<MeasurementKind> reduced = full.Without(report.suggested_fixed);
+  IdentificationOptions options;
+  const IdentificationSummary s = Identify(*reduced, data, options);
+  ASSERT_TRUE(s.IsSolutionUsable()) << s.message;
+  EXPECT_LT(s.residual_rms, 1e-12);
+  const auto& names = reduced->parameter_names();
+  const auto gain = std::find(names.begin(), names.end(), "head.coupling4_gain");
+  ASSERT_NE(gain, names.end());
+  EXPECT_NEAR(s.delta[gain - names.begin()], -3e-3, testing::tolerance::kRoundTrip);
+  const MeasuredValues expected = Simulated(true_kind, RobotConfigurations(nominal, 30, 29));
+  std::vector<double> y(expected.y.size());
+  reduced->Bind(expected.configs)->Predict(s.delta.data(), y.data(), nullptr);
+  for (std::size_t r = 0; r < y.size(); ++r)
+    EXPECT_NEAR(y[r], expected.y[r], testing::tolerance::kRoundTrip) << "value " << r;
 }
 
 TEST(UrdfChains, BadChainListsAreNamed) {

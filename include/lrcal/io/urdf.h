@@ -18,6 +18,7 @@
 #include <string>
 
 #include "lrcal/core/random.h"
+#include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
 #include "lrcal/kinematics/robot_model.h"
 #include "lrcal/measurement/chain_measurement.h"
@@ -58,14 +59,27 @@ struct UrdfChains {
   std::vector<double> q_min, q_max;     ///< per joint of joint_names, its range (rad, or m)
 };
 
+/// True when the chain LoadUrdfRobotFile would read has a mimic joint on it (which it refuses):
+/// such a chain is read with LoadUrdfChains, its mimic joint a coupling.
+bool UrdfChainIsCoupled(const std::string& path, const std::string& tool_link = "",
+                        const std::string& base_link = "");
+
 /// The chains of `path` from `base_link` (empty: the root) to each of `tool_links` (at least one,
-/// each once). A link of chain c (from its joint k to joint k + 1) is the same D-H link in every
-/// chain with the same joints 1 … k + 1: its values are labelled "" when every chain has it, else
-/// with the first such chain's tool link (ChainOfTree::link_labels); a chain's last link and tool
-/// are its own. Throws InputError naming the file for what LoadUrdfRobotFile refuses and for a
-/// repeated tool link.
+/// each once). A mimic joint on a chain is a coupled link (ChainOfTree::couplings: the URDF's
+/// multiplier and offset), following the joint it mimics, which is a joint of the robot's vector
+/// even when no chain passes it; mimic joints are not in joint_names. A link of chain c (from its
+/// joint k to joint k + 1) is the same D-H link in every chain with the same joints 1 … k + 1: its
+/// values are labelled "" when every chain has it, else with the first such chain's tool link
+/// (ChainOfTree::link_labels); a chain's last link and tool are its own. Throws InputError naming
+/// the file for what LoadUrdfRobotFile refuses and for a repeated tool link.
 UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string>& tool_links,
                           const std::string& base_link = "");
+
+/// Chain `chain` of `tree`'s data file as ReadRobotCsv reads it for the chain's robot (its joint
+/// columns by name, or q1..qN in the chain's order), where a coupled link's column (a mimic
+/// joint, which robots do not always log) may be missing when the file names joints: it is
+/// filled from the joint it follows (multiplier · q + offset), whose column must then be there.
+CsvTable ReadChainCsv(const std::string& path, const UrdfChains& tree, int chain);
 
 /// A whole tree's configurations CSV: a column per joint of `tree`, named as in joint_names (the
 /// order of the columns is free; other columns are ignored), and an optional `plane` column
