@@ -187,6 +187,48 @@ int TrackerSimulate(const po::variables_map& vm, const std::string& sensor) {
   return 0;
 }
 
+// simulate on a URDF chain with a mimic joint (a tree run of one chain): the tracker kinds, the
+// coupled joint's value computed from the joint it follows whatever the file says of it
+// (chain_measurement.h), written in the chain's columns. Several tool links are refused: simulate
+// writes one chain's file.
+int CoupledChainSimulate(const po::variables_map& vm, const std::string& sensor) {
+  const UrdfChains tree = LoadTreeChains(vm);
+  if (tree.chains.size() != 1)
+    throw InputError("--tool-link",
+                     "simulate writes one chain's file: run it once per tool link "
+                     "(the same --configs log serves every chain)");
+  if (sensor != "point" && sensor != "pose")
+    throw InputError("--sensor",
+                     "a chain with a coupled joint is simulated for a tracker (point "
+                     "or pose); " +
+                         sensor + " is not yet");
+  RefuseRangerOptions(
+      vm, sensor,
+      {"plane", "encoder-sigma-mrad", "form-sigma-mm", "outlier-fraction", "outlier-sigma-mm"});
+  const RobotFile& rig = tree.chains[0];
+  const std::shared_ptr<const PointMeasurement> kind = MakeTrackerKind(rig.robot, sensor, vm);
+  const ChainMeasurement chain(kind, tree.placements[0]);
+  const std::string file = vm["configs"].as<std::string>();
+  const TargetedConfigurations logged =
+      TargetConfigurations(ReadChainCsv(file, tree, 0), rig.robot.num_links(),
+                           static_cast<int>(kind->setup().targets.size()));
+  const TargetedConfigurations configs = chain.ChainConfigurations(
+      chain.RobotConfigurations(logged, std::vector<double>(tree.joint_names.size(), 0.0)));
+  CheckJointRanges(configs, rig.robot, file);
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  noise.sigma_angle = ResolveSigmaAngle(vm, true);
+  MeasuredValues data;
+  SimulateMeasurements(*kind, configs, noise,
+                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data);
+  const std::string path = vm["out"].as<std::string>();
+  WriteTrackerMeasurements(path, *kind, data);
+  std::cerr << "lrcal simulate: " << data.size() << " " << sensor
+            << " measurements (each the mean of " << noise.repetitions
+            << " readings, the coupled joints following theirs) written to " << path << "\n";
+  return 0;
+}
+
 // simulate --sensor socket: the configurations (a CSV with a socket column: where to start)
 // moved until the true arm's tool point sits in its socket (--socket x,y,z per socket id, in
 // order of the ids) plus a play of --sigma-mm per axis.
@@ -322,6 +364,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   if (!Parse("simulate", "--configs C.csv --out M.csv [options]", o, args, &vm)) return 0;
   CheckOutputFile(vm["out"].as<std::string>(), "--out");
   const std::string sensor = ResolveSensor(vm);
+  if (sensor != "mixed" && IsTreeRun(vm)) return CoupledChainSimulate(vm, sensor);
   if (sensor == "mixed")
     throw InputError("--sensor",
                      "simulate writes one kind's file: run it once per kind, then "

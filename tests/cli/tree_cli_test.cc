@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
 
 #include "test_util.h"
 #include "urdf_kinematics.h"
@@ -152,11 +153,44 @@ TEST_F(TreeCli, AMimicJointOnAChainIsACoupledLinkWithItsGain) {
   EXPECT_THAT(names, ::testing::Contains("head.coupling4_gain"));
   EXPECT_THAT(j["suggested_fixed"].get<std::vector<std::string>>(),
               ::testing::Not(::testing::Contains("head.coupling4_gain")));
-  // The one-chain commands refuse it by name.
-  EXPECT_EQ(Run("simulate --robot " + nominal + " --tool-link head" + tracker + " --configs " +
-                    Path("log.csv") + " --out " + Path("x.csv"),
+  // A tracker on the head of the true robot (origins moved, the tilt's multiplier -1.003): its
+  // simulated points are calibrated back, gain included, with nothing left over.
+  const std::string truth = testing::UrdfWithMovedOrigins(nominal, 8, Path("true.urdf"));
+  {
+    std::ifstream in(truth);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string urdf = text.str();
+    urdf.replace(urdf.find("multiplier=\"-1.0\""), 17, "multiplier=\"-1.003\"");
+    std::ofstream(truth) << urdf;
+  }
+  for (const char* chain : {"left_tool", "right_tool", "head"})
+    ASSERT_EQ(Run("simulate --robot " + truth + " --tool-link " + chain + tracker +
+                      " --sigma-mm 0 --configs " + Path("log.csv") + " --out " +
+                      Path(std::string(chain) + ".csv"),
+                  &out),
+              0)
+        << out;
+  ASSERT_EQ(Run("identify --auto-fix --format json --robot " + nominal +
+                    " --tool-link left_tool,right_tool,head" + tracker + " --data " +
+                    Path("left_tool.csv") + " --data " + Path("right_tool.csv") + " --data " +
+                    Path("head.csv"),
+                &out),
+            0)
+      << out;
+  const Json fit = JsonOf(out);
+  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
+  double gain = 0;
+  for (const Json& p : fit["parameters"])
+    if (p["name"] == "head.coupling4_gain") gain = p["delta"].get<double>();
+  EXPECT_NEAR(gain, -3e-3, 1e-9);
+  // simulate writes one chain's file; the one-chain commands refuse a coupled chain by name.
+  EXPECT_EQ(Run("simulate --robot " + nominal + " --tool-link left_tool,head" + tracker +
+                    " --configs " + Path("log.csv") + " --out " + Path("x.csv"),
                 &out),
             2);
+  EXPECT_THAT(out, HasSubstr("--tool-link: simulate writes one chain's file"));
+  EXPECT_EQ(Run("accuracy --robot " + nominal + " --tool-link head --workspace 10", &out), 2);
   EXPECT_THAT(out, HasSubstr("joint 'head_tilt' mimics another; a chain with a coupled joint"));
 }
 
