@@ -162,6 +162,25 @@ namespace {
 
 // simulate --sensor point|pose: the tracker's values of the true arm (the robot file's
 // true_errors; the instrument and targets as given), each the mean of --repetitions readings.
+// The tracker `truth` read at `configs` with the options' noise, written for `nominal` (its
+// instrument and targets) to --out.
+int SimulateTracker(const po::variables_map& vm, const std::string& sensor,
+                    const PointMeasurement& truth, const PointMeasurement& nominal,
+                    const TargetedConfigurations& configs, const std::string& note) {
+  NoiseModel noise;
+  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
+  noise.sigma_angle = ResolveSigmaAngle(vm, true);
+  MeasuredValues data;
+  SimulateMeasurements(truth, configs, noise,
+                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data);
+  const std::string path = vm["out"].as<std::string>();
+  WriteTrackerMeasurements(path, nominal, data);
+  std::cerr << "lrcal simulate: " << data.size() << " " << sensor
+            << " measurements (each the mean of " << noise.repetitions << " readings" << note
+            << ") written to " << path << "\n";
+  return 0;
+}
+
 int TrackerSimulate(const po::variables_map& vm, const std::string& sensor) {
   RefuseRangerOptions(
       vm, sensor,
@@ -173,18 +192,7 @@ int TrackerSimulate(const po::variables_map& vm, const std::string& sensor) {
   const TargetedConfigurations configs =
       ReadRobotTargetConfigurations(vm["configs"].as<std::string>(), rig.robot,
                                     static_cast<int>(nominal->setup().targets.size()));
-  NoiseModel noise;
-  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
-  noise.sigma_angle = ResolveSigmaAngle(vm, true);
-  MeasuredValues data;
-  SimulateMeasurements(*truth, configs, noise,
-                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data);
-  const std::string path = vm["out"].as<std::string>();
-  WriteTrackerMeasurements(path, *nominal, data);
-  std::cerr << "lrcal simulate: " << data.size() << " " << sensor
-            << " measurements (each the mean of " << noise.repetitions << " readings) written to "
-            << path << "\n";
-  return 0;
+  return SimulateTracker(vm, sensor, *truth, *nominal, configs, "");
 }
 
 // simulate on a URDF chain with a mimic joint (a tree run of one chain): the tracker kinds, the
@@ -215,18 +223,8 @@ int CoupledChainSimulate(const po::variables_map& vm, const std::string& sensor)
   const TargetedConfigurations configs = chain.ChainConfigurations(
       chain.RobotConfigurations(logged, std::vector<double>(tree.joint_names.size(), 0.0)));
   CheckJointRanges(configs, rig.robot, file);
-  NoiseModel noise;
-  ReadSettingOptions(vm, NoiseModel::Settings(), &noise);
-  noise.sigma_angle = ResolveSigmaAngle(vm, true);
-  MeasuredValues data;
-  SimulateMeasurements(*kind, configs, noise,
-                       RandomStream(ParseSeed(vm), 0, 0, RandomPurpose::kNoise), &data);
-  const std::string path = vm["out"].as<std::string>();
-  WriteTrackerMeasurements(path, *kind, data);
-  std::cerr << "lrcal simulate: " << data.size() << " " << sensor
-            << " measurements (each the mean of " << noise.repetitions
-            << " readings, the coupled joints following theirs) written to " << path << "\n";
-  return 0;
+  return SimulateTracker(vm, sensor, *kind, *kind, configs,
+                         ", the coupled joints following theirs");
 }
 
 // simulate --sensor socket: the configurations (a CSV with a socket column: where to start)
@@ -958,6 +956,35 @@ std::string MixedPartsText(const MixedMeasurement& kind, const std::vector<Mixed
   return text;
 }
 
+// Each file's values, a kind's angle rows weighed (σ/σ_angle)² (*angles: whether any was).
+std::vector<MeasuredValues> WeighedValues(const po::variables_map& vm,
+                                          const IdentificationOptions& options,
+                                          std::vector<MixedFile>* files, bool* angles) {
+  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
+  std::vector<MeasuredValues> values;
+  for (MixedFile& f : *files) {
+    for (int c = 0; c < f.kind->rows_per_configuration(); ++c)
+      if (f.kind->RowIsAngle(c)) {
+        WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
+        *angles = true;
+        break;
+      }
+    values.push_back(f.values);
+  }
+  return values;
+}
+
+// The rank of `mixed`'s terms at its files' configurations, with the options' tolerance.
+IdentifiabilityReport FilesIdentifiability(const po::variables_map& vm,
+                                           const MixedMeasurement& mixed,
+                                           const std::vector<MixedFile>& files) {
+  std::vector<MeasuredValues> values;
+  for (const MixedFile& f : files) values.push_back(f.values);
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  return AnalyzeIdentifiability(mixed, mixed.Combine(values).configs, nullptr, options);
+}
+
 // identify --sensor a,b --data A.csv --data B.csv: the terms of every kind, the arm's and the
 // planes' shared (mixed_measurement.h), from all the files at once.
 int MixedIdentify(const po::variables_map& vm) {
@@ -966,18 +993,8 @@ int MixedIdentify(const po::variables_map& vm) {
   const Setup setup = ResolveSetup(vm);
   std::vector<MixedFile> files = LoadMixedFiles(vm, setup, "data", false);
   const IdentificationOptions options = ResolveIdentificationOptions(vm, setup.rig);
-  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
   bool angles = false;
-  std::vector<MeasuredValues> values;
-  for (MixedFile& f : files) {
-    for (int c = 0; c < f.kind->rows_per_configuration(); ++c)
-      if (f.kind->RowIsAngle(c)) {
-        WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
-        angles = true;
-        break;
-      }
-    values.push_back(f.values);
-  }
+  const std::vector<MeasuredValues> values = WeighedValues(vm, options, &files, &angles);
   const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, setup.rig.robot, files);
   const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
   const MeasuredValues data = mixed.Combine(values);
@@ -998,14 +1015,9 @@ int MixedIdentify(const po::variables_map& vm) {
 int MixedIdentifiability(const po::variables_map& vm) {
   const Setup setup = ResolveSetup(vm);
   const std::vector<MixedFile> files = LoadMixedFiles(vm, setup, "configs", true);
-  std::vector<MeasuredValues> values;
-  for (const MixedFile& f : files) values.push_back(f.values);
   const std::unique_ptr<MeasurementKind> kind = MakeMixedKind(vm, setup.rig.robot, files);
   const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
-  IdentifiabilityOptions options;
-  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
-  const IdentifiabilityReport r =
-      AnalyzeIdentifiability(mixed, mixed.Combine(values).configs, nullptr, options);
+  const IdentifiabilityReport r = FilesIdentifiability(vm, mixed, files);
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = IdentifiabilityJson(r);
     j["sensor"] = "mixed";
@@ -1125,18 +1137,8 @@ int TreeIdentify(const po::variables_map& vm) {
   TreeRun run = LoadTreeRun(vm, "data", false);
   const RobotFile& first = run.tree.chains[0];
   const IdentificationOptions options = ResolveIdentificationOptions(vm, first);
-  const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
   bool angles = false;
-  std::vector<MeasuredValues> values;
-  for (MixedFile& f : run.files) {
-    for (int c = 0; c < f.kind->rows_per_configuration(); ++c)
-      if (f.kind->RowIsAngle(c)) {
-        WeighAngleRows(*f.kind, sigma, ResolveSigmaAngle(vm, false), &f.values);
-        angles = true;
-        break;
-      }
-    values.push_back(f.values);
-  }
+  const std::vector<MeasuredValues> values = WeighedValues(vm, options, &run.files, &angles);
   const std::unique_ptr<MeasurementKind> kind =
       MakeMixedKind(vm, first.robot, run.files, run.labels);
   const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
@@ -1158,15 +1160,10 @@ int TreeIdentify(const po::variables_map& vm) {
 // identifiability --tool-link a,b --configs A.csv --configs B.csv.
 int TreeIdentifiability(const po::variables_map& vm) {
   const TreeRun run = LoadTreeRun(vm, "configs", true);
-  std::vector<MeasuredValues> values;
-  for (const MixedFile& f : run.files) values.push_back(f.values);
   const std::unique_ptr<MeasurementKind> kind =
       MakeMixedKind(vm, run.tree.chains[0].robot, run.files, run.labels);
   const auto& mixed = dynamic_cast<const MixedMeasurement&>(*kind);
-  IdentifiabilityOptions options;
-  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
-  const IdentifiabilityReport r =
-      AnalyzeIdentifiability(mixed, mixed.Combine(values).configs, nullptr, options);
+  const IdentifiabilityReport r = FilesIdentifiability(vm, mixed, run.files);
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = IdentifiabilityJson(r);
     j["sensor"] = "mixed";

@@ -32,26 +32,37 @@ std::vector<double> RandomConfiguration(const RobotModel& robot, std::mt19937* r
   return q;
 }
 
-// lrcal's reference and fast forward kinematics of `robot` against the URDF's at 200 random
-// configurations.
-void ExpectSameKinematics(const RobotModel& robot, const std::string& urdf,
-                          const std::string& tool_link) {
-  std::mt19937 rng(17);
+// lrcal's reference and fast forward kinematics of `robot` against `expected(q)` (the URDF's,
+// composed here) at 200 random configurations.
+template <typename Expected>
+void ExpectKinematicsOf(const RobotModel& robot, unsigned seed, const Expected& expected,
+                        const std::string& what) {
+  std::mt19937 rng(seed);
   ChainPoint point;
   PrepareChainPoint(robot, robot.nominal_values().data(), &point);
   for (int trial = 0; trial < 200; ++trial) {
     const std::vector<double> q = RandomConfiguration(robot, &rng);
-    const Eigen::Isometry3d expected = testing::UrdfForwardKinematics(urdf, tool_link, q);
+    const Eigen::Isometry3d want = expected(q);
     const Pose<double> ref =
         ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
     TargetedConfigurations one(robot.num_links());
     one.Add(q);
     const Pose<double> fast = ToolPose(point, one, 0);
     for (const Pose<double>* pose : {&ref, &fast}) {
-      EXPECT_LT((pose->p_BT - expected.translation()).norm(), kTolerance) << urdf;
-      EXPECT_THAT(pose->R_BT, testing::EigenNear(expected.linear(), kTolerance)) << urdf;
+      EXPECT_LT((pose->p_BT - want.translation()).norm(), kTolerance) << what;
+      EXPECT_THAT(pose->R_BT, testing::EigenNear(want.linear(), kTolerance)) << what;
     }
   }
+}
+
+void ExpectSameKinematics(const RobotModel& robot, const std::string& urdf,
+                          const std::string& tool_link) {
+  ExpectKinematicsOf(
+      robot, 17,
+      [&](const std::vector<double>& q) {
+        return testing::UrdfForwardKinematics(urdf, tool_link, q);
+      },
+      urdf);
 }
 
 std::string Example(const std::string& name) {
@@ -243,25 +254,14 @@ TEST(Urdf, BytesThatAreNotUtf8AreRefusedNamingTheLine) {
 // relative to the base link composed from the root here, at random configurations.
 void ExpectSameKinematicsBetween(const RobotModel& robot, const std::string& urdf,
                                  const std::string& base_link, const std::string& tool_link) {
-  std::mt19937 rng(29);
-  ChainPoint point;
-  PrepareChainPoint(robot, robot.nominal_values().data(), &point);
-  for (int trial = 0; trial < 200; ++trial) {
-    const std::vector<double> q = RandomConfiguration(robot, &rng);
-    std::map<std::string, double> by_name;
-    for (int i = 0; i < robot.num_links(); ++i) by_name[robot.links()[i].joint_name] = q[i];
-    const Eigen::Isometry3d expected =
-        testing::UrdfPoseBetween(urdf, base_link, tool_link, by_name);
-    const Pose<double> ref =
-        ForwardKinematics<double>(robot, robot.nominal_values().data(), q.data());
-    TargetedConfigurations one(robot.num_links());
-    one.Add(q);
-    const Pose<double> fast = ToolPose(point, one, 0);
-    for (const Pose<double>* pose : {&ref, &fast}) {
-      EXPECT_LT((pose->p_BT - expected.translation()).norm(), kTolerance) << tool_link;
-      EXPECT_THAT(pose->R_BT, testing::EigenNear(expected.linear(), kTolerance)) << tool_link;
-    }
-  }
+  ExpectKinematicsOf(
+      robot, 29,
+      [&](const std::vector<double>& q) {
+        std::map<std::string, double> by_name;
+        for (int i = 0; i < robot.num_links(); ++i) by_name[robot.links()[i].joint_name] = q[i];
+        return testing::UrdfPoseBetween(urdf, base_link, tool_link, by_name);
+      },
+      tool_link);
 }
 
 std::vector<std::string> JointNames(const RobotModel& robot) {
