@@ -170,15 +170,6 @@ void AddTrackerGeometryOptions(po::options_description& o) {
       "1); default: one target at the tool frame's origin");
 }
 
-namespace {
-
-bool IsSensorName(const std::string& sensor) {
-  return sensor == "ranger" || sensor == "point" || sensor == "pose" || sensor == "socket" ||
-         sensor == "contact" || sensor == "scanner";
-}
-
-}  // namespace
-
 std::vector<std::string> ResolveSensors(const po::variables_map& vm) {
   const std::string text = vm["sensor"].as<std::string>();
   const std::vector<std::string> sensors = SplitList(text);
@@ -189,10 +180,10 @@ std::vector<std::string> ResolveSensors(const po::variables_map& vm) {
                      "expected ranger, scanner, point, pose, socket or contact, or a "
                      "list of them (one per --data file)");
   for (const std::string& sensor : sensors)
-    if (!IsSensorName(sensor))
+    if (!IsMeasurementKindName(sensor))
       throw InputError("--sensor", "'" + CellExcerpt(sensor) +
-                                       "' is not a sensor lrcal models: expected ranger, scanner, "
-                                       "point, pose, socket or contact");
+                                       "' is not a sensor lrcal models: expected " +
+                                       MeasurementKindNameList());
   const auto has = [&](const char* kind) {
     return std::find(sensors.begin(), sensors.end(), kind) != sensors.end();
   };

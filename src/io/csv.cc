@@ -12,6 +12,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/core/json.h"
 #include "lrcal/core/strings.h"
+#include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
@@ -122,17 +123,15 @@ std::vector<std::pair<std::string, CsvTable>> SplitBySensor(const CsvTable& t) {
   const int column = t.Column("sensor");
   if (column < 0)
     throw InputError(Location(t.path, 1) + " column 'sensor'",
-                     "missing: a file of several kinds says each row's kind (ranger, scanner, "
-                     "point, pose, socket or contact)");
+                     "missing: a file of several kinds says each row's kind (" +
+                         MeasurementKindNameList() + ")");
   std::vector<std::pair<std::string, CsvTable>> groups;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     const std::string& kind = t.rows[r][static_cast<std::size_t>(column)];
-    if (kind != "ranger" && kind != "scanner" && kind != "point" && kind != "pose" &&
-        kind != "socket" && kind != "contact")
+    if (!IsMeasurementKindName(kind))
       throw InputError(Location(t.path, t.lines[r]) + " column 'sensor'",
-                       "'" + CellExcerpt(kind) +
-                           "' is not a kind lrcal models: expected ranger, scanner, point, pose, "
-                           "socket or contact");
+                       "'" + CellExcerpt(kind) + "' is not a kind lrcal models: expected " +
+                           MeasurementKindNameList());
     auto it =
         std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == kind; });
     if (it == groups.end()) {

@@ -1,11 +1,26 @@
 #include "lrcal/measurement/measurement_kind.h"
 
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 
 #include "lrcal/core/error.h"
 
 namespace lrcal {
+
+bool IsMeasurementKindName(const std::string& name) {
+  for (const char* kind : kMeasurementKindNames)
+    if (name == kind) return true;
+  return false;
+}
+
+std::string MeasurementKindNameList() {
+  std::string out;
+  const std::size_t n = std::size(kMeasurementKindNames);
+  for (std::size_t k = 0; k < n; ++k)
+    out += (k == 0 ? "" : k + 1 == n ? " or " : ", ") + std::string(kMeasurementKindNames[k]);
+  return out;
+}
 
 namespace {
 

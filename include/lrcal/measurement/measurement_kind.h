@@ -91,6 +91,15 @@ class MeasurementKind {
   virtual std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const = 0;
 };
 
+/// The measurement kinds lrcal models, as users name them (--sensor, a file's `sensor` column,
+/// a study's sensor.kind): the one list the front ends and readers check names against.
+inline constexpr const char* kMeasurementKindNames[] = {"ranger", "scanner", "point",
+                                                        "pose",   "socket",  "contact"};
+/// True for a name of kMeasurementKindNames.
+bool IsMeasurementKindName(const std::string& name);
+/// The names for messages: "ranger, scanner, point, pose, socket or contact".
+std::string MeasurementKindNameList();
+
 /// Measured values of one kind, as the identification consumes them: configuration i has
 /// rows_per_configuration values y[i·k .. i·k + k) (SI), each the mean of repetitions[i] readings
 /// (its residual weight).
