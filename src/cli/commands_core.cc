@@ -220,8 +220,8 @@ int CoupledChainSimulate(const po::variables_map& vm, const std::string& sensor)
   const TargetedConfigurations logged =
       TargetConfigurations(ReadChainCsv(file, tree, 0), rig.robot.num_links(),
                            static_cast<int>(kind->setup().targets.size()));
-  const TargetedConfigurations configs = chain.ChainConfigurations(
-      chain.RobotConfigurations(logged, std::vector<double>(tree.joint_names.size(), 0.0)));
+  const TargetedConfigurations configs =
+      chain.ChainConfigurations(chain.RobotConfigurations(logged));
   CheckJointRanges(configs, rig.robot, file);
   return SimulateTracker(vm, sensor, *kind, *kind, configs,
                          ", the coupled joints following theirs");
@@ -1082,8 +1082,7 @@ TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool config
         LoadMixedTable(vm, *setup, sensors[c],
                        ReadChainCsv(files[c], run.tree, static_cast<int>(c)), configs_only);
     const auto part = std::make_shared<ChainMeasurement>(f.kind, run.tree.placements[c]);
-    f.values.configs = part->RobotConfigurations(
-        f.values.configs, std::vector<double>(run.tree.joint_names.size(), 0.0));
+    f.values.configs = part->RobotConfigurations(f.values.configs);
     f.kind = part;
     run.files.push_back(std::move(f));
   }

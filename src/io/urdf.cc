@@ -59,21 +59,23 @@ std::vector<std::string> LeafLinks(const urdf::ModelInterface& model) {
   return leaves;
 }
 
+// A link by name, or an InputError naming the option (and study key) that gave it and every link.
+urdf::LinkConstSharedPtr NamedLink(const urdf::ModelInterface& model, const std::string& path,
+                                   const std::string& name, const std::string& option) {
+  if (urdf::LinkConstSharedPtr link = model.getLink(name)) return link;
+  std::vector<urdf::LinkSharedPtr> links;
+  model.getLinks(links);
+  std::vector<std::string> names;
+  for (const auto& l : links) names.push_back(l->name);
+  std::sort(names.begin(), names.end());
+  throw InputError(path, "no link named '" + name + "' (--" + option + ", or a study's " +
+                             std::string(option == "base-link" ? "base_link" : "tool_link") +
+                             "); the links are " + JoinList(names));
+}
+
 std::string ChooseToolLink(const urdf::ModelInterface& model, const std::string& path,
                            const std::string& tool_link, const std::string& base_link) {
-  if (!tool_link.empty()) {
-    if (!model.getLink(tool_link)) {
-      std::vector<urdf::LinkSharedPtr> links;
-      model.getLinks(links);
-      std::vector<std::string> names;
-      for (const auto& link : links) names.push_back(link->name);
-      std::sort(names.begin(), names.end());
-      throw InputError(path, "no link named '" + tool_link +
-                                 "' (--tool-link, or a study's tool_link); the links are " +
-                                 JoinList(names));
-    }
-    return tool_link;
-  }
+  if (!tool_link.empty()) return NamedLink(model, path, tool_link, "tool-link")->name;
   std::vector<std::string> leaves = LeafLinks(model);
   leaves.erase(std::remove(leaves.begin(), leaves.end(), base_link), leaves.end());
   if (leaves.size() != 1)
@@ -162,6 +164,15 @@ void CheckUrdfTree(const std::string& path) {
   CheckNoCycle(ParentLinks(*robot, path), path);
 }
 
+// The URDF at `path`, its tree checked (CheckUrdfTree) before urdfdom builds it.
+urdf::ModelInterfaceSharedPtr ReadUrdfModel(const std::string& path) {
+  if (!PathExists(path)) throw InputError(path, "no such file");
+  CheckUrdfTree(path);
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+  if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
+  return model;
+}
+
 // The joint's range: revolute/prismatic from <limit>, continuous ±π.
 void JointRange(const urdf::Joint& joint, const std::string& path, JointAxis* axis) {
   if (joint.type == urdf::Joint::CONTINUOUS) return;  // the default ±π
@@ -170,24 +181,6 @@ void JointRange(const urdf::Joint& joint, const std::string& path, JointAxis* ax
                                "': expected <limit lower=... upper=...> with lower < upper");
   axis->q_min = joint.limits->lower;
   axis->q_max = joint.limits->upper;
-}
-
-}  // namespace
-
-namespace {
-
-// A link by name, or an InputError naming the option (and study key) that gave it and every link.
-urdf::LinkConstSharedPtr NamedLink(const urdf::ModelInterface& model, const std::string& path,
-                                   const std::string& name, const std::string& option) {
-  if (urdf::LinkConstSharedPtr link = model.getLink(name)) return link;
-  std::vector<urdf::LinkSharedPtr> links;
-  model.getLinks(links);
-  std::vector<std::string> names;
-  for (const auto& l : links) names.push_back(l->name);
-  std::sort(names.begin(), names.end());
-  throw InputError(path, "no link named '" + name + "' (--" + option + ", or a study's " +
-                             std::string(option == "base-link" ? "base_link" : "tool_link") +
-                             "); the links are " + JoinList(names));
 }
 
 // The joints from the root down to `link`, root first.
@@ -271,18 +264,11 @@ JointAxis PathJointAxis(const urdf::ModelInterface& model, const PathJoint& step
   return axis;
 }
 
-}  // namespace
-
-namespace {
-
 // The chain from base_link to tool_link (LoadUrdfRobotFile), a mimic joint on it a link of its
 // own when `allow_mimic` (LoadUrdfChains couples it), else an error.
 RobotFile LoadUrdfChain(const std::string& path, const std::string& tool_link,
                         const std::string& base_link, bool allow_mimic) {
-  if (!PathExists(path)) throw InputError(path, "no such file");
-  CheckUrdfTree(path);
-  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
-  if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
+  const urdf::ModelInterfaceSharedPtr model = ReadUrdfModel(path);
   const std::string base = base_link.empty() ? model->getRoot()->name : base_link;
   const urdf::LinkConstSharedPtr base_of_chain = NamedLink(*model, path, base, "base-link");
   const std::string tool = ChooseToolLink(*model, path, tool_link, base);
@@ -356,10 +342,6 @@ std::vector<std::string> LinkLabels(const std::vector<std::vector<std::string>>&
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 // The robot joint each chain link follows: its own, or for a mimic joint the joint it mimics,
 // each named once in `tree->joint_names` (a mimicked joint off every chain last, with its range).
 int RobotJoint(const urdf::ModelInterface& model, const urdf::Joint& joint, const std::string& path,
@@ -408,9 +390,7 @@ UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string
   std::vector<std::string> tools = tool_links;
   for (std::string& tool : tools)
     if (tool.empty()) {  // the only end link other than the base link
-      CheckUrdfTree(path);
-      const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
-      if (!model) throw InputError(path, "not a URDF that urdfdom can read (its message is above)");
+      const urdf::ModelInterfaceSharedPtr model = ReadUrdfModel(path);
       tool =
           ChooseToolLink(*model, path, "", base_link.empty() ? model->getRoot()->name : base_link);
     }
@@ -592,10 +572,6 @@ double LargestToolDifference(const RobotModel& a, const double* va, const RobotM
   }
   return largest;
 }
-
-}  // namespace
-
-namespace {
 
 // The joints from the root to `tool` in order, each with its element of `doc`.
 std::vector<ChainJoint> ChainToTool(const urdf::ModelInterface& model, const std::string& tool,

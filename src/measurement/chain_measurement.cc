@@ -1,7 +1,6 @@
 #include "lrcal/measurement/chain_measurement.h"
 
 #include <algorithm>
-#include <map>
 #include <set>
 #include <utility>
 
@@ -105,6 +104,12 @@ std::vector<double> ChainMeasurement::Gains(const double* e) const {
   return gains;
 }
 
+std::vector<bool> ChainMeasurement::CoupledLinks() const {
+  std::vector<bool> coupled(chain_.joints.size(), false);
+  for (const JointCoupling& c : chain_.couplings) coupled[static_cast<std::size_t>(c.link)] = true;
+  return coupled;
+}
+
 void ChainMeasurement::CheckJoints(const TargetedConfigurations& configs) const {
   if (configs.size() > 0 && configs.num_joints() != chain_.robot_joints)
     throw InputError("tool-link", "chain '" + chain_.label + "': configurations of " +
@@ -134,7 +139,7 @@ TargetedConfigurations ChainMeasurement::ChainConfigurations(
 
 TargetedConfigurations ChainMeasurement::RobotConfigurations(
     const TargetedConfigurations& configs, const std::vector<double>& rest) const {
-  if (static_cast<int>(rest.size()) != chain_.robot_joints)
+  if (!rest.empty() && static_cast<int>(rest.size()) != chain_.robot_joints)
     throw InputError("tool-link", "chain '" + chain_.label + "': the robot's rest vector has " +
                                       std::to_string(rest.size()) + " joints, expected " +
                                       std::to_string(chain_.robot_joints));
@@ -142,11 +147,11 @@ TargetedConfigurations ChainMeasurement::RobotConfigurations(
     throw InputError("tool-link", "chain '" + chain_.label + "': configurations of " +
                                       std::to_string(configs.num_joints()) + " joints, expected " +
                                       std::to_string(chain_.joints.size()));
-  std::vector<bool> coupled(chain_.joints.size(), false);
-  for (const JointCoupling& c : chain_.couplings) coupled[static_cast<std::size_t>(c.link)] = true;
+  const std::vector<bool> coupled = CoupledLinks();
   TargetedConfigurations out(chain_.robot_joints);
   out.Reserve(configs.size());
-  std::vector<double> q = rest;
+  std::vector<double> q =
+      rest.empty() ? std::vector<double>(static_cast<std::size_t>(chain_.robot_joints), 0.0) : rest;
   for (int i = 0; i < configs.size(); ++i) {
     for (std::size_t k = 0; k < chain_.joints.size(); ++k)
       if (!coupled[k]) q[static_cast<std::size_t>(chain_.joints[k])] = configs.q(i)[k];
@@ -240,8 +245,7 @@ TargetedConfigurations ChainMeasurement::LinearisationConfigurations(
     const TargetedConfigurations& configs) const {
   const TargetedConfigurations moved =
       kind_->LinearisationConfigurations(ChainConfigurations(configs));
-  std::vector<bool> coupled(chain_.joints.size(), false);
-  for (const JointCoupling& c : chain_.couplings) coupled[static_cast<std::size_t>(c.link)] = true;
+  const std::vector<bool> coupled = CoupledLinks();
   TargetedConfigurations out(chain_.robot_joints);
   out.Reserve(configs.size());
   for (int i = 0; i < configs.size(); ++i) {

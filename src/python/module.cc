@@ -2488,12 +2488,11 @@ IdentificationSummary IdentifyTreePy(const UrdfChains& tree, const py::list& par
   const double sigma = options.sigma > 0 ? options.sigma : NoiseModel{}.sigma;
   std::vector<MixedPart> chains;
   std::vector<MeasuredValues> values;
-  const std::vector<double> rest(tree.joint_names.size(), 0.0);
   for (std::size_t c = 0; c < parts.size(); ++c) {
     try {
       MixedPy p = ToMixedPart(tree.chains[c], parts[c].cast<py::dict>(), sigma, sigma_mrad * 1e-3);
       auto chain = std::make_shared<ChainMeasurement>(p.kind, tree.placements[c]);
-      p.values.configs = chain->RobotConfigurations(p.values.configs, rest);
+      p.values.configs = chain->RobotConfigurations(p.values.configs);
       chains.push_back({chain, tree.placements[c].label, true});
       values.push_back(std::move(p.values));
     } catch (const InputError& e) {

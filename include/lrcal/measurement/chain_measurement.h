@@ -73,14 +73,12 @@ class ChainMeasurement : public MeasurementKind {
   /// coupled link at its multiplier plus `gains` (one per coupling; empty: none).
   TargetedConfigurations ChainConfigurations(const TargetedConfigurations& configs,
                                              const std::vector<double>& gains = {}) const;
-  /// The name of coupling c's gain term as this chain names it; empty when not estimated.
-  const std::string& gain_term(int c) const { return gain_names_[static_cast<std::size_t>(c)]; }
   /// The robot's configurations of the chain's `configs`: each of the chain's joints set, every
-  /// other joint at `rest` (the robot's joint vector, robot_joints values) — how one chain's
-  /// data file, which holds its own joints, joins the others'. A coupled link's value is not
-  /// read: it follows its joint.
+  /// other joint at `rest` (the robot's joint vector, robot_joints values; empty: 0) — how one
+  /// chain's data file, which holds its own joints, joins the others'. A coupled link's value is
+  /// not read: it follows its joint.
   TargetedConfigurations RobotConfigurations(const TargetedConfigurations& configs,
-                                             const std::vector<double>& rest) const;
+                                             const std::vector<double>& rest = {}) const;
 
   const char* name() const override { return kind_->name(); }
   int rows_per_configuration() const override { return kind_->rows_per_configuration(); }
@@ -110,6 +108,7 @@ class ChainMeasurement : public MeasurementKind {
                    const std::vector<int>& held_gains, const std::vector<int>& hidden);
   void CheckChain() const;
   void CheckJoints(const TargetedConfigurations& configs) const;
+  std::vector<bool> CoupledLinks() const;  // per link: whether a coupling drives it
   std::vector<double> Gains(const double* e) const;
 
   std::shared_ptr<const MeasurementKind> kind_;

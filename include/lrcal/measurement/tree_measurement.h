@@ -26,10 +26,6 @@ class TreeMeasurement : public MeasurementKind {
   /// its own, which one joint vector of the tree cannot hold).
   explicit TreeMeasurement(const std::vector<std::shared_ptr<const ChainMeasurement>>& chains);
 
-  const MixedMeasurement& mixed() const { return mixed_; }
-  /// The mixed layout (one entry per value) of `configs`: what Bind evaluates.
-  TargetedConfigurations Expand(const TargetedConfigurations& configs) const;
-
   /// The chains' kind ("point") when they are all of one kind, else "mixed".
   const char* name() const override;
   int rows_per_configuration() const override { return rows_; }
@@ -46,6 +42,8 @@ class TreeMeasurement : public MeasurementKind {
 
  private:
   explicit TreeMeasurement(MixedMeasurement mixed);
+  // The mixed layout (one entry per value) of `configs`: what Bind evaluates.
+  TargetedConfigurations Expand(const TargetedConfigurations& configs) const;
 
   MixedMeasurement mixed_;
   int rows_ = 0;
