@@ -398,6 +398,40 @@ TEST(UrdfChains, ACoupledJointsGainIsCalibratedNoiseFree) {
     EXPECT_NEAR(y[r], expected.y[r], testing::tolerance::kRoundTrip) << "value " << r;
 }
 
+// A tree's files: a whole-robot file names every joint; a chain's log may leave out a coupled
+// joint only when it holds the joint that one follows; values out of the URDF's limits are named.
+TEST(UrdfChains, BadTreeFilesAreNamedByFileLineAndJoint) {
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArmsAndHead);
+  const std::string dir = testing::TempDir("urdf_chains_files");
+  const auto message = [](const auto& read) {
+    try {
+      read();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::ofstream(dir + "/short.csv") << "torso_yaw,torso_pitch_1\n0,0\n";
+  EXPECT_THAT(message([&] { ReadTreeConfigurations(dir + "/short.csv", tree); }),
+              ::testing::HasSubstr("short.csv:1 column 'torso_pitch_2': missing"));
+  std::string header, row;
+  for (std::size_t j = 0; j < tree.joint_names.size(); ++j) {
+    header += (j ? "," : "") + tree.joint_names[j];
+    row += std::string(j ? "," : "") + (j == 3 ? "90" : "0");
+  }
+  std::ofstream(dir + "/degrees.csv") << header << "\n" << row << "\n";
+  EXPECT_THAT(message([&] { ReadTreeConfigurations(dir + "/degrees.csv", tree); }),
+              ::testing::HasSubstr("degrees.csv:2 column 'left_shoulder_pitch': 90 is outside "
+                                   "the joint's range"));
+  std::ofstream(dir + "/head.csv") << "torso_yaw,torso_pitch_1,x\n0,0,1\n";
+  EXPECT_THAT(message([&] { ReadChainCsv(dir + "/head.csv", tree, 2); }),
+              ::testing::HasSubstr("column 'torso_pitch_2': missing"));
+  std::ofstream(dir + "/head_no_tilt.csv") << "torso_yaw,torso_pitch_1,torso_pitch_2\n0,0,0.25\n";
+  const CsvTable filled = ReadChainCsv(dir + "/head_no_tilt.csv", tree, 2);
+  ASSERT_GE(filled.Column("head_tilt"), 0);
+  EXPECT_EQ(filled.Number(0, filled.Column("head_tilt")), -0.25);
+}
+
 TEST(UrdfChains, BadChainListsAreNamed) {
   EXPECT_THAT(
       [] {
