@@ -225,6 +225,19 @@ std::string KeyList(const Json& map) {
   return keys;
 }
 
+// Keys that are settings without a default. plane: checked by the typed parser; the robot
+// file's hash is lrcal's own. pool.file and validation.file (with lrcal's hash of them) are
+// optional. tool_link and base_link (URDF robots), and validation.tool_link (tree cells), are
+// optional, so that earlier studies' settings and tables stay as they were.
+// identification.loss_scale_mm: the loss scale in mm, in place of loss_scale_sigma.
+bool IsOptionalKey(const std::string& section, const std::string& key) {
+  if (section.empty())
+    return key == "plane" || key == "robot_file_fnv1a" || key == "tool_link" || key == "base_link";
+  if (section == "pool" || section == "validation")
+    return key == "file" || key == "file_fnv1a" || (section == "validation" && key == "tool_link");
+  return section == "identification" && key == "loss_scale_mm";
+}
+
 // Every key of `given` must be a setting; a section (a mapping in the defaults) must be given as
 // a mapping: `noise:` with nothing after it, or `noise: 5`, is an error, not a silent deletion.
 void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string& path,
@@ -232,18 +245,7 @@ void CheckUnknownKeys(const Json& given, const Json& defaults, const std::string
   if (!given.is_object() || !defaults.is_object()) return;
   for (auto it = given.begin(); it != given.end(); ++it) {
     const std::string p = Join(path, it.key());
-    // plane: checked by the typed parser; the robot file's hash is lrcal's own. pool.file and
-    // validation.file (with lrcal's hash of them) are optional keys without a default.
-    // tool_link and base_link (URDF robots) are optional without a default, so that earlier
-    // studies' settings and tables stay as they were.
-    if (path.empty() && (it.key() == "plane" || it.key() == "robot_file_fnv1a" ||
-                         it.key() == "tool_link" || it.key() == "base_link"))
-      continue;
-    if ((path == "pool" || path == "validation") &&
-        (it.key() == "file" || it.key() == "file_fnv1a"))
-      continue;
-    // identification.loss_scale_mm: the loss scale in mm, in place of loss_scale_sigma.
-    if (path == "identification" && it.key() == "loss_scale_mm") continue;
+    if (IsOptionalKey(path, it.key())) continue;
     if (!defaults.contains(it.key()))
       throw InputError(where(p), "unknown key; expected one of: " + KeyList(defaults));
     const Json& d = defaults[it.key()];
@@ -456,6 +458,8 @@ void ParsePoolAndSelection(const Json& s, const KeyLocator& where, CellSettings*
                        "pool.redraw or pool.file");
   }
   if (!At(s, "validation.file").is_null()) c->validation_file = Str(s, "validation.file", where);
+  if (!At(s, "validation.tool_link").is_null())
+    c->validation_tool_link = Str(s, "validation.tool_link", where);
   c->select_count = Int(s, "selection.count", where, 1);
   // A pool from a file is checked against the count when it is read (PrepareCell).
   if (c->pool_file.empty() && c->select_count > c->pool_size)
@@ -645,6 +649,30 @@ void NormaliseSensor(Json* settings) {
     (*settings)["sensor"] = full;
 }
 
+// sensor.budget: the configurations it buys (selection.count), a configuration costing
+// cost_per_reading × noise.repetitions per tool it reads.
+void ParseBudget(const Json& s, const KeyLocator& where, CellSettings* c) {
+  StudySensor& sensor = c->sensor;
+  const double budget = Num(s, "sensor.budget", where);
+  // A tree cell reads every tool at each configuration: one reading per chain.
+  const double per_configuration =
+      sensor.cost_per_reading * c->noise.repetitions *
+      static_cast<double>(std::max<std::size_t>(1, c->ToolLinks().size()));
+  const double count = std::floor(budget / per_configuration);
+  if (!(count >= 1) || !std::isfinite(budget))
+    throw InputError(where("sensor.budget"),
+                     "expected a budget of at least one configuration's cost (cost_per_reading "
+                     "× noise.repetitions" +
+                         std::string(c->IsTree() ? " × tool links" : "") + " = " +
+                         Json(per_configuration).dump() + ")");
+  if (count > c->pool_size && c->pool_file.empty())
+    throw InputError(where("sensor.budget"),
+                     "buys " + Json(count).dump() +
+                         " configurations: more than pool.size = " + std::to_string(c->pool_size));
+  sensor.budget = budget;
+  c->select_count = static_cast<int>(count);
+}
+
 // sensor: the kind, a tracker's frames and orientation noise, the cost of a reading and the
 // campaign's budget (which sets selection.count).
 void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c) {
@@ -661,21 +689,7 @@ void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c)
   if (!(sensor.cost_per_reading > 0) || !std::isfinite(sensor.cost_per_reading))
     throw InputError(where("sensor.cost_per_reading"),
                      "expected a cost > 0 per reading (in the study's own unit)");
-  if (!At(s, "sensor.budget").is_null()) {
-    const double budget = Num(s, "sensor.budget", where);
-    const double count = std::floor(budget / (sensor.cost_per_reading * c->noise.repetitions));
-    if (!(count >= 1) || !std::isfinite(budget))
-      throw InputError(where("sensor.budget"),
-                       "expected a budget of at least one configuration's cost (cost_per_reading "
-                       "× noise.repetitions = " +
-                           Json(sensor.cost_per_reading * c->noise.repetitions).dump() + ")");
-    if (count > c->pool_size && c->pool_file.empty())
-      throw InputError(where("sensor.budget"), "buys " + Json(count).dump() +
-                                                   " configurations: more than pool.size = " +
-                                                   std::to_string(c->pool_size));
-    sensor.budget = budget;
-    c->select_count = static_cast<int>(count);
-  }
+  if (!At(s, "sensor.budget").is_null()) ParseBudget(s, where, c);
   const double sigma_mrad = Num(s, "sensor.sigma_mrad", where);
   if (!(sigma_mrad >= 0) || !std::isfinite(sigma_mrad))
     throw InputError(where("sensor.sigma_mrad"), "expected a standard deviation ≥ 0 mrad");
@@ -714,6 +728,36 @@ void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c)
   RefuseRangerSettings(settings, where, *c);
 }
 
+// tool_link's links (several: a tree cell, measured by a tracker) and validation.tool_link,
+// one of them.
+void CheckToolLinks(const KeyLocator& where, const CellSettings& c) {
+  const std::vector<std::string> links = c.ToolLinks();
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    if (links[i].empty() && links.size() > 1)
+      throw InputError(where("tool_link"), "an empty link name in '" + c.tool_link +
+                                               "'; expected links separated by commas");
+    if (std::find(links.begin(), links.begin() + static_cast<long>(i), links[i]) !=
+        links.begin() + static_cast<long>(i))
+      throw InputError(where("tool_link"), "'" + links[i] + "' is given twice");
+  }
+  if (c.IsTree()) {
+    if (c.sensor.kind != "point" && c.sensor.kind != "pose")
+      throw InputError(where("sensor.kind"),
+                       "a tree cell (several tool links) is measured by a tracker that sees "
+                       "every tool: expected point or pose, got " +
+                           c.sensor.kind);
+    if (!c.truth.random)
+      throw InputError(where("truth.mode"),
+                       "a tree cell draws its true errors (a URDF has none to read); expected "
+                       "random");
+  }
+  if (c.validation_tool_link.empty()) return;
+  if (std::find(links.begin(), links.end(), c.validation_tool_link) == links.end())
+    throw InputError(where("validation.tool_link"),
+                     "'" + c.validation_tool_link + "' is not one of tool_link (" +
+                         (c.tool_link.empty() ? std::string("none given") : c.tool_link) + ")");
+}
+
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   CellSettings c;
   c.robot = Str(s, "robot", where);
@@ -733,6 +777,7 @@ CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   c.paper_case = Int(s, "paper_case", where, 0);
   if (c.paper_case > 2) throw InputError(where("paper_case"), "expected 0 (none), 1 or 2");
   ParseSensor(s, where, &c);
+  CheckToolLinks(where, c);
   return c;
 }
 
@@ -919,7 +964,10 @@ Axis ParseAxis(const Json& ax, const std::string& ap, const KeyLocator& where) {
   Axis axis;
   if (!ax.contains("key")) throw InputError(where(ap), "missing 'key'");
   axis.key = Str(ax, "key", KeyLocator{where.file, where.lines, where.context, ap});
-  if (!KeyExists(StudyDefaults(), axis.key))
+  // The URDF links are settings without a default (CheckUnknownKeys): sweepable all the same.
+  const bool link_key =
+      axis.key == "tool_link" || axis.key == "base_link" || axis.key == "validation.tool_link";
+  if (!link_key && !KeyExists(StudyDefaults(), axis.key))
     throw InputError(where(ap + ".key"), "'" + axis.key +
                                              "' is not a study setting (e.g. "
                                              "noise.sigma_mm, selection.count, plane, '.')");
@@ -1303,6 +1351,9 @@ Json CellIdentity(const Json& settings) {
   // tool_link and base_link came with URDF robots: left out when empty (as if not given).
   for (const char* key : {"tool_link", "base_link"})
     if (id.contains(key) && id[key] == "") id.erase(key);
+  if (id.contains("validation") && id["validation"].is_object() &&
+      id["validation"].value("tool_link", Json()) == "")
+    id["validation"].erase("tool_link");
   for (const char* section : {"pool", "validation"})
     if (id.contains(section) && id[section].is_object()) id[section].erase("file");
   if (id.contains("robot") && id["robot"].is_string() &&
@@ -1310,6 +1361,8 @@ Json CellIdentity(const Json& settings) {
     id["robot"] = "file";
   return id;
 }
+
+std::vector<std::string> CellSettings::ToolLinks() const { return SplitList(tool_link); }
 
 Study LoadStudy(const std::string& path) {
   YAML::Node root = yaml::LoadFile(path);

@@ -114,6 +114,60 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
       RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), o);
 }
 
+void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
+  if (s.truth.random) return;
+  c->true_robot = ArmWithValues(*c->robot, c->fixed_truth.values);
+  c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
+  c->nominal_validation =
+      ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
+          .stats;
+  if (c->contact) {
+    c->true_contact = std::make_unique<ContactMeasurement>(*c->true_robot, c->contact->setup());
+    return;
+  }
+  c->true_tracker = TrackerKindOn(*c->true_robot, *c->tracker);
+  const std::vector<double> zero(static_cast<std::size_t>(c->true_tracker->num_parameters()), 0.0);
+  c->design_true_values.resize(static_cast<std::size_t>(c->design.configs.size() *
+                                                        c->true_tracker->rows_per_configuration()));
+  c->true_tracker->Bind(c->design.configs)
+      ->Predict(zero.data(), c->design_true_values.data(), nullptr);
+  c->design_true_reasons = c->true_tracker->MissReasons(c->design.configs, zero.data());
+}
+
+// The noisy values the tracker on the true arm reads at the design (each the mean of the
+// cell's repetitions, drawn directly), with its angle rows weighed.
+void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTruth& truth,
+                           MeasuredValues* values) {
+  const CellSettings& s = c.cell->typed;
+  NoiseModel noise = s.noise;
+  noise.draw_mean = true;
+  noise.sigma_angle = s.sensor.sigma_angle;
+  const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
+  if (c.tree) {
+    SimulateTreeValues(c, truth, noise, stream, values);
+    return;
+  }
+  if (c.contact) {  // seated on the true arm with the play of the noise, each trial anew
+    if (!s.truth.random) {
+      SimulateContactMeasurements(*c.true_contact, c.design.configs, noise, stream, values);
+      return;
+    }
+    const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
+    SimulateContactMeasurements(ContactMeasurement(*arm, c.contact->setup()), c.design.configs,
+                                noise, stream, values);
+    return;
+  }
+  if (!s.truth.random) {
+    AddMeasurementNoise(*c.true_tracker, c.design_true_values, c.design_true_reasons,
+                        c.design.configs, noise, stream, values);
+    return;
+  }
+  const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
+  SimulateMeasurements(*TrackerKindOn(*arm, *c.tracker), c.design.configs, noise, stream, values);
+}
+
+}  // namespace
+
 // Identifiability on the pool: the terms it cannot separate (d1 with the instrument's height,
 // ...) are fixed when the cell says so, else every trial fails as rank deficient.
 void CheckTrackerIdentifiability(const CellSettings& s, CellContext* c) {
@@ -128,6 +182,8 @@ void CheckTrackerIdentifiability(const CellSettings& s, CellContext* c) {
   c->kind = c->kind->Without(rep.suggested_fixed);
 }
 
+namespace {
+
 // Each measured value's weight: the effective readings, times (σ/σ_angle)² on an angle row.
 Eigen::VectorXd TrackerRowWeights(const CellSettings& s, const MeasurementKind& kind, int m) {
   const int k = kind.rows_per_configuration();
@@ -139,6 +195,8 @@ Eigen::VectorXd TrackerRowWeights(const CellSettings& s, const MeasurementKind& 
           s.noise.EffectiveReadings() * (kind.RowIsAngle(r) ? ratio * ratio : 1.0);
   return w;
 }
+
+}  // namespace
 
 void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
   const Eigen::MatrixXd G =
@@ -178,55 +236,14 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
   c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
 }
 
-void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
-  if (s.truth.random) return;
-  c->true_robot = ArmWithValues(*c->robot, c->fixed_truth.values);
-  c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
-  c->nominal_validation =
-      ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
-          .stats;
-  if (c->contact) {
-    c->true_contact = std::make_unique<ContactMeasurement>(*c->true_robot, c->contact->setup());
-    return;
-  }
-  c->true_tracker = TrackerKindOn(*c->true_robot, *c->tracker);
-  const std::vector<double> zero(static_cast<std::size_t>(c->true_tracker->num_parameters()), 0.0);
-  c->design_true_values.resize(static_cast<std::size_t>(c->design.configs.size() *
-                                                        c->true_tracker->rows_per_configuration()));
-  c->true_tracker->Bind(c->design.configs)
-      ->Predict(zero.data(), c->design_true_values.data(), nullptr);
-  c->design_true_reasons = c->true_tracker->MissReasons(c->design.configs, zero.data());
+void CheckValuesForTerms(const CellSettings& s, const CellContext& c) {
+  if (s.select_count * c.kind->rows_per_configuration() < c.kind->num_parameters())
+    throw InputError("selection.count", std::to_string(s.select_count) + " configurations of " +
+                                            std::to_string(c.kind->rows_per_configuration()) +
+                                            " values for " +
+                                            std::to_string(c.kind->num_parameters()) +
+                                            " terms: need at least as many values as terms");
 }
-
-// The noisy values the tracker on the true arm reads at the design (each the mean of the
-// cell's repetitions, drawn directly), with its angle rows weighed.
-void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTruth& truth,
-                           MeasuredValues* values) {
-  const CellSettings& s = c.cell->typed;
-  NoiseModel noise = s.noise;
-  noise.draw_mean = true;
-  noise.sigma_angle = s.sensor.sigma_angle;
-  const RandomStream stream(c.seed, 0, static_cast<std::uint64_t>(trial), RandomPurpose::kNoise);
-  if (c.contact) {  // seated on the true arm with the play of the noise, each trial anew
-    if (!s.truth.random) {
-      SimulateContactMeasurements(*c.true_contact, c.design.configs, noise, stream, values);
-      return;
-    }
-    const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
-    SimulateContactMeasurements(ContactMeasurement(*arm, c.contact->setup()), c.design.configs,
-                                noise, stream, values);
-    return;
-  }
-  if (!s.truth.random) {
-    AddMeasurementNoise(*c.true_tracker, c.design_true_values, c.design_true_reasons,
-                        c.design.configs, noise, stream, values);
-    return;
-  }
-  const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
-  SimulateMeasurements(*TrackerKindOn(*arm, *c.tracker), c.design.configs, noise, stream, values);
-}
-
-}  // namespace
 
 void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* c) {
   BuildTrackerKind(s, c);
@@ -234,12 +251,7 @@ void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* 
   DrawTrackerConfigurations(study, s, c);
   CheckTrackerIdentifiability(s, c);
   MapLinkValues(c);
-  if (s.select_count * c->kind->rows_per_configuration() < c->kind->num_parameters())
-    throw InputError("selection.count", std::to_string(s.select_count) + " configurations of " +
-                                            std::to_string(c->kind->rows_per_configuration()) +
-                                            " values for " +
-                                            std::to_string(c->kind->num_parameters()) +
-                                            " terms: need at least as many values as terms");
+  CheckValuesForTerms(s, *c);
   if (!s.truth.random) c->fixed_truth = DrawTruth(*c, 0);  // in the reduced layout
   SelectTrackerDesign(s, c);
   CacheTrackerTruth(s, c);
@@ -338,9 +350,13 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
     const Eigen::VectorXd& nominal = c.robot->nominal_values();
     details->distance_error_nominal.clear();
     details->distance_error_identified.clear();
-    details->measurement_nominal = ComparePoses(*c.robot, truth.values, nominal, values.configs);
-    details->measurement_identified =
-        ComparePoses(*c.robot, truth.values, identified, values.configs);
+    // A tree's measured configurations are the whole robot's: the judged arm's joints of them.
+    const TargetedConfigurations measured =
+        c.tree ? c.tree->chains[static_cast<std::size_t>(c.tree->judged)]->ChainConfigurations(
+                     values.configs)
+               : values.configs;
+    details->measurement_nominal = ComparePoses(*c.robot, truth.values, nominal, measured);
+    details->measurement_identified = ComparePoses(*c.robot, truth.values, identified, measured);
     details->validation_nominal = ComparePoses(*c.robot, truth.values, nominal, c.validation);
     details->validation_identified = validation;
   }

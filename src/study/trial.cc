@@ -49,6 +49,7 @@ std::uint64_t ValidationStreamId(const Json& settings) {
 
 // The truth of a trial: the robot file's errors × scale, or errors drawn per trial.
 TrialTruth DrawTruth(const CellContext& c, long long trial) {
+  if (c.tree) return DrawTreeTruth(c, trial);
   const CellSettings& s = c.cell->typed;
   const RobotModel& robot = *c.robot;
   TrialTruth truth;
@@ -762,6 +763,10 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
   c->seed = study.seed;
   const CellSettings& s = cell.typed;
   try {
+    if (s.IsTree()) {
+      PrepareTreeCell(study, s, c.get());
+      return c;
+    }
     LoadRig(study, s, c.get());
     if (!s.sensor.IsRanger()) {
       PrepareTrackerCell(study, s, c.get());

@@ -33,7 +33,9 @@
 #include "lrcal/identification/identification.h"
 #include "lrcal/identification/prior.h"
 #include "lrcal/identification/total_accuracy.h"
+#include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/pose_errors.h"
+#include "lrcal/measurement/chain_measurement.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/point_measurement.h"
 #include "lrcal/study/prepared_cell.h"
@@ -48,6 +50,23 @@ struct TrialTruth {
   Eigen::VectorXd errors;  ///< errors of the 5N link values (SI)
   Eigen::VectorXd values;  ///< nominal + errors
   Eigen::VectorXd delta;   ///< the errors in the estimate layout (robot deltas; plane terms 0)
+  /// A tree cell: every term's error in the layout of TreeCell::full (each chain's arm, shared
+  /// links once); `errors` and `values` are then the judged chain's arm.
+  Eigen::VectorXd tree_delta;
+};
+
+/// A tree cell (tool_link with several links; tree_trial.cc): every chain measured by the one
+/// tracker at each whole-robot configuration, the chains' common joints' terms shared. The
+/// cell's robot (CellContext::robot) is the judged chain's arm: the validation's poses, its
+/// records and its prediction are that tool's.
+struct TreeCell {
+  UrdfChains tree;
+  std::vector<std::shared_ptr<const ChainMeasurement>> chains;
+  std::unique_ptr<MeasurementKind> full;  ///< every term: the truth's layout
+  int judged = 0;                         ///< the chain whose tool the validation judges
+  std::vector<double> truth_sigma;        ///< per term of `full`: its true error's σ (0: nominal)
+  std::vector<int> judged_value;          ///< per term of `full`: the judged arm's value, or -1
+  std::vector<int> estimated;             ///< per term of CellContext::kind: its index in `full`
 };
 
 /// The validation metrics (draws × 12, layout of TrialRecord::validation, SI) of `draws`
@@ -141,6 +160,8 @@ struct CellContext {
   TrialTruth fixed_truth;             ///< when the truth is fixed (robot file × scale)
   PoseErrorStats nominal_validation;  ///< nominal vs truth (fixed truth)
   std::vector<std::string> parameter_names;
+  /// A tree cell's chains (null otherwise); `kind` is then their TreeMeasurement, reduced.
+  std::unique_ptr<TreeCell> tree;
 };
 
 // Steps of trial.cc that the tracker cells' pipeline (tracker_trial.cc) shares.
@@ -169,6 +190,23 @@ void PredictValidation(CellContext* c);
 /// the validation poses, identifiability, the block selection (block_selection.h), the
 /// predicted covariance and the truth's cache.
 void PrepareTrackerCell(const Study& study, const CellSettings& s, CellContext* c);
+/// A tree cell's preparation (tree_trial.cc): its chains in place of LoadRig's one arm, then a
+/// tracker cell's steps on their TreeMeasurement.
+void PrepareTreeCell(const Study& study, const CellSettings& s, CellContext* c);
+/// A tree cell's truth: every term of its chains drawn, the judged arm's values from them.
+TrialTruth DrawTreeTruth(const CellContext& c, long long trial);
+/// A tree cell's noisy values at its design: the chains' exact values at the trial's truth plus
+/// `noise` drawn from `stream`.
+void SimulateTreeValues(const CellContext& c, const TrialTruth& truth, const NoiseModel& noise,
+                        const RandomStream& stream, MeasuredValues* values);
+// A tracker cell's steps that a tree cell shares (tracker_trial.cc).
+/// Identifiability of c->kind on the pool: the terms it cannot separate fixed (identification
+/// on_rank_deficient: fix) or the cell marked rank deficient.
+void CheckTrackerIdentifiability(const CellSettings& s, CellContext* c);
+/// The design's block selection on c->kind, its σ_min, nominal linearisation and covariance.
+void SelectTrackerDesign(const CellSettings& s, CellContext* c);
+/// InputError (selection.count) when the design's values cannot outnumber c->kind's terms.
+void CheckValuesForTerms(const CellSettings& s, const CellContext& c);
 /// A tracker cell's trial after the truth and the nominal validation are in `rec`.
 struct TrialWorkspace;
 TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,

@@ -62,3 +62,30 @@ def test_identify_tree_as_the_program(tmp_path, cli):
         lrcal.identify_tree(tree, parts[:1])
     with pytest.raises(lrcal.InputError, match=r"parts\[1\]\.xyz"):
         lrcal.identify_tree(tree, [parts[0], dict(parts[1], xyz=parts[1]["xyz"][:3])])
+
+
+def test_a_tree_study_runs_from_python_as_the_program_runs_it(tmp_path, cli):
+    # The shipped dual-arm study, cut to 4 trials and smaller sets: the module and the program
+    # write the same tables, and the pair's cell estimates each arm's own terms and the torso's
+    # once.
+    study = tmp_path / "dual.yaml"
+    text = open(os.path.join(HERE, "..", "..", "studies", "dual_arm.yaml")).read()
+    text = (text.replace("trials: 1000", "trials: 4")
+                .replace("pool: {size: 200}", "pool: {size: 40}")
+                .replace("validation: {size: 100}", "validation: {size: 10}")
+                .replace("robot: ../examples", "robot: " + os.path.join(HERE, "..", "..",
+                                                                        "examples")))
+    study.write_text(text)
+    lrcal.run_study(str(study), str(tmp_path / "module"), threads=2)
+    cli("run", study, "--out", tmp_path / "program", "--threads", "1")
+    tables = ["summary.json", "parameters.csv", "validation.csv"]
+    for table in tables:
+        assert (tmp_path / "module" / "tables" / table).read_text() == (
+            tmp_path / "program" / "tables" / table).read_text(), table
+    run = lrcal.load_run(str(tmp_path / "module"))
+    summary = json.loads((tmp_path / "module" / "tables" / "summary.json").read_text())
+    assert len(summary["cells"]) == 5
+    parameters = (tmp_path / "module" / "tables" / "parameters.csv").read_text()
+    assert "right_tool.theta9" in parameters and "left_tool.theta3" in parameters
+    assert ",theta2," in parameters  # the torso's shared link, once
+    assert run.trials["cell_id"].nunique() == 5 and len(run.trials) == 20

@@ -46,7 +46,8 @@ struct StudySensor {
   /// cell's campaign costs selection.count × noise.repetitions × this.
   double cost_per_reading = 1;
   /// sensor.budget: when given, the cell's selection.count is ⌊budget / (cost_per_reading ×
-  /// noise.repetitions)⌋, so that cells of different sensors compare at equal campaign cost.
+  /// noise.repetitions × tool links)⌋ (a tree cell reads each of its tools at a configuration),
+  /// so that cells of different sensors compare at equal campaign cost.
   std::optional<double> budget;
   bool IsRanger() const { return kind == "ranger"; }
 };
@@ -55,8 +56,11 @@ struct StudySensor {
 /// resolved settings JSON. The defaults live in one place, StudyDefaults(); the initial values
 /// here are only neutral zeros.
 struct CellSettings {
-  std::string robot;             ///< robot file path (YAML or URDF) or shipped name
-  std::string tool_link;         ///< URDF robots: the ranger's link (empty: the only end link)
+  std::string robot;  ///< robot file path (YAML or URDF) or shipped name
+  /// URDF robots: the ranger's link (empty: the only end link); several, comma-separated
+  /// ("left_tool,right_tool"), make a tree cell: every chain measured at each whole-robot
+  /// configuration, their common joints' terms shared (tree_trial.cc).
+  std::string tool_link;
   std::string base_link;         ///< URDF robots: the chain's first link (empty: the root)
   bool plane_from_robot = true;  ///< plane: robot
   PlaneSet planes;               ///< when !plane_from_robot: one plane or several
@@ -94,6 +98,9 @@ struct CellSettings {
   int validation_size = 0;
   /// validation.file: the validation configurations from a CSV (as pool_file); empty: drawn.
   std::string validation_file;
+  /// A tree cell: the tool link whose poses the validation judges (validation.tool_link; empty:
+  /// the first of tool_link).
+  std::string validation_tool_link;
   /// validation.coverage: record in every trial the share of the validation poses whose true
   /// position error lies within the 95 % radius the cell's prediction states, the data part and
   /// the total (TrialRecord::coverage). Needs the cell's one design (no pool or selection redraw).
@@ -109,6 +116,11 @@ struct CellSettings {
   /// Which of the paper's cases this cell reproduces (1, 2; 0 = none): its report places the
   /// published numbers in our distributions.
   int paper_case = 0;
+
+  /// tool_link's links, in order (empty: none given).
+  std::vector<std::string> ToolLinks() const;
+  /// Several tool links: a tree cell.
+  bool IsTree() const { return ToolLinks().size() > 1; }
 };
 
 struct Cell {
