@@ -171,6 +171,7 @@ class ChainEvaluator : public MeasurementEvaluator {
       : chain_(chain),
         layout_(chain.layout()),
         robot_configs_(configs),
+        nominal_configs_(chain.ChainConfigurations(configs)),
         gains_(chain.chain().couplings.size(), 0.0),
         inner_e_(static_cast<std::size_t>(chain.kind().num_parameters()), 0.0) {
     Rebind();
@@ -212,14 +213,16 @@ class ChainEvaluator : public MeasurementEvaluator {
   }
 
  private:
+  // The values stay in the charts of the configurations at the nominal multipliers (a pose's
+  // orientation rows are measured from them): only the coupled joints move with the gains.
   void Rebind() {
     configs_ = chain_.ChainConfigurations(robot_configs_, gains_);
-    evaluator_ = chain_.kind().Bind(configs_);
+    evaluator_ = chain_.kind().BindInChartsOf(configs_, nominal_configs_);
   }
 
   const ChainMeasurement& chain_;
   const ChainMeasurement::Layout& layout_;
-  TargetedConfigurations robot_configs_, configs_;
+  TargetedConfigurations robot_configs_, nominal_configs_, configs_;
   std::vector<double> gains_, inner_e_, inner_J_;
   std::unique_ptr<MeasurementEvaluator> evaluator_;
 };

@@ -290,6 +290,17 @@ std::unique_ptr<MeasurementEvaluator> PointMeasurement::Bind(
   return std::make_unique<PointEvaluator>(*this, configs, ChartCentres(configs));
 }
 
+std::unique_ptr<MeasurementEvaluator> PointMeasurement::BindInChartsOf(
+    const TargetedConfigurations& configs, const TargetedConfigurations& chart_configs) const {
+  CheckConfigurations(configs);
+  CheckConfigurations(chart_configs);
+  if (chart_configs.size() != configs.size())
+    throw InputError("configurations", std::to_string(configs.size()) +
+                                           " configurations but charts of " +
+                                           std::to_string(chart_configs.size()));
+  return std::make_unique<PointEvaluator>(*this, configs, ChartCentres(chart_configs));
+}
+
 void PointMeasurement::CheckConfigurations(const TargetedConfigurations& configs) const {
   if (configs.num_joints() != robot_->num_links())
     throw InputError("configurations", "the robot has " + std::to_string(robot_->num_links()) +

@@ -23,6 +23,7 @@
 #include "lrcal/measurement/mixed_measurement.h"
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/tree_measurement.h"
 #include "test_util.h"
 #include "tracker_fixtures.h"
@@ -355,6 +356,27 @@ TEST(UrdfChains, ACouplingsGainColumnMatchesAutodiffAndCentralDifferences) {
       EXPECT_NEAR(J(3 * i + c, gain), p[c].v[0], testing::tolerance::kAutodiff);
     }
   }
+  EXPECT_THAT(J, testing::EigenNear(testing::CentralDifferences(*evaluator, e),
+                                    testing::tolerance::kCentralDifference));
+}
+
+TEST(UrdfChains, ACoupledPoseChainsJacobianMatchesCentralDifferencesAwayFromNominal) {
+  // A 6-D probe on the head: every column, the gain's with the orientation rows too, at an
+  // estimate away from nominal (each term 1e-3, the gain 3e-3). The orientation rows stay in the
+  // charts of the nominal multiplier's configurations as the gain moves the coupled joint (they
+  // followed it once, and the fit of a probe's orientations did not converge).
+  const UrdfChains tree = LoadUrdfChains(DualArm(), kArmsAndHead);
+  const ChainMeasurement head(std::make_shared<PoseMeasurement>(tree.chains[2].robot, OneTarget()),
+                              tree.placements[2]);
+  const TargetedConfigurations configs = RobotConfigurations(tree, 20, 23);
+  const int n = head.num_parameters();
+  ASSERT_EQ(head.parameter_names().back(), "head.coupling4_gain");
+  std::vector<double> e(static_cast<std::size_t>(n), 1e-3);
+  e.back() = 3e-3;
+  std::unique_ptr<MeasurementEvaluator> evaluator = head.Bind(configs);
+  std::vector<double> y(static_cast<std::size_t>(evaluator->num_rows()));
+  Eigen::MatrixXd J(evaluator->num_rows(), n);
+  ASSERT_TRUE(evaluator->Predict(e.data(), y.data(), J.data()));
   EXPECT_THAT(J, testing::EigenNear(testing::CentralDifferences(*evaluator, e),
                                     testing::tolerance::kCentralDifference));
 }

@@ -110,6 +110,30 @@ TEST(TreeStudy, ANoiseFreeTreeCellRecoversEveryChainsTruth) {
   }
 }
 
+TEST(TreeStudy, ACoupledChainsGainIsFittedWithItsProbesOrientations) {
+  // The head (its tilt mimics the last torso joint) with the left arm, a 6-D probe on each, noise
+  // of 1e-9: every trial converges and the coupling's gain (true at nominal) and every other
+  // term come back to 1e-9. The fit moves the tilt with the gain while the probe's orientations
+  // stay in their nominal charts.
+  constexpr double kRecovered = 1e-9;
+  TreeSections t;
+  t.tool_link = "left_tool,head";
+  t.noise = "{sigma_mm: 1e-9, repetitions: 1}";
+  t.sensor = "{kind: pose, instrument: [2.0, 0.0, 0.5, 0, 0, 3.1416], sigma_mrad: 1e-9}";
+  t.identification = "{on_rank_deficient: fix, fix: " + HeldFrames({"left_tool", "head"}) + "}";
+  const Study study = LoadStudy(WriteTreeStudy("coupled", t));
+  const auto c = PrepareCell(study, study.cells.at(0));
+  ASSERT_FALSE(c->rank_deficient) << c->rank_message;
+  ASSERT_THAT(c->parameter_names, Contains("head.coupling4_gain"));
+  TrialWorkspace ws;
+  for (int trial = 0; trial < 3; ++trial) {
+    const TrialRecord r = RunTrial(*c, trial, &ws);
+    ASSERT_EQ(r.status, TrialStatus::kOk) << trial;
+    for (std::size_t k = 0; k < r.errors.size(); ++k)
+      EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
+  }
+}
+
 TEST(TreeStudy, ThePredictedCovarianceAndValidationHoldOverTheTrials) {
   // A truth of 0.01 mrad and 0.01 mm: the model at the truth is the nominal one to first order,
   // so the estimate's error is the noise's alone and its Mahalanobis distance δᵀΣ⁻¹δ averages n

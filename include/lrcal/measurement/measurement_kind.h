@@ -72,6 +72,15 @@ class MeasurementKind {
   /// kind (a plane or target index it does not have, a wrong number of joints).
   virtual std::unique_ptr<MeasurementEvaluator> Bind(
       const TargetedConfigurations& configs) const = 0;
+  /// Bind, the values read in the frames of reference of `chart_configs` (as many as `configs`)
+  /// where the kind has any: a coupled chain's evaluator (chain_measurement.h) moves a coupled
+  /// joint with its gain while the measured orientations stay written in the charts of the
+  /// nominal configurations (pose_measurement.h). A kind without charts binds `configs`.
+  virtual std::unique_ptr<MeasurementEvaluator> BindInChartsOf(
+      const TargetedConfigurations& configs, const TargetedConfigurations& chart_configs) const {
+    (void)chart_configs;
+    return Bind(configs);
+  }
   /// Why each configuration has no measurement at estimate e ("ok" where it has one). Used by
   /// simulation: a configuration that misses is left out of the data, never filled with a NaN.
   virtual std::vector<std::string> MissReasons(const TargetedConfigurations& configs,

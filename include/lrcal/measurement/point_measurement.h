@@ -77,6 +77,11 @@ class PointMeasurement : public MeasurementKind {
   /// each target's nominal offset.
   Eigen::VectorXd NominalValues() const override;
   std::unique_ptr<MeasurementEvaluator> Bind(const TargetedConfigurations& configs) const override;
+  /// The pose kind's orientation rows centred on the charts of `chart_configs` (InputError
+  /// unless as many as `configs`).
+  std::unique_ptr<MeasurementEvaluator> BindInChartsOf(
+      const TargetedConfigurations& configs,
+      const TargetedConfigurations& chart_configs) const override;
   std::vector<std::string> MissReasons(const TargetedConfigurations& configs,
                                        const double* e) const override;
   std::unique_ptr<MeasurementKind> Without(const std::vector<std::string>& names) const override;
