@@ -1,8 +1,9 @@
-// Studies of trees (tool_link with several links): a tree cell recovers every chain's truth when
-// its noise vanishes, its predicted covariance holds over its trials (Monte Carlo), its
-// validation's first-order prediction matches the trials, sharing the torso with the other arm
-// improves the judged arm, the budget pays for every chain's reading, the tables do not depend on
-// the threads, and bad tree settings are errors at their line.
+// Studies of trees (tool_link with several links, base_link): a tree cell recovers every chain's
+// truth when its noise vanishes (a coupled chain's gain too, and a chain up a leg from a sole), its
+// predicted covariance holds over its trials (Monte Carlo), its validation's first-order prediction
+// matches the trials, sharing the torso with the other arm improves the judged arm, the budget pays
+// for every chain's reading, the tables do not depend on the threads, and bad tree settings are
+// errors at their line.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -46,6 +47,8 @@ std::string HeldFrames(const std::vector<std::string>& tools) {
 
 // A tree study's sections, each replaceable.
 struct TreeSections {
+  std::string robot = "examples/urdf/dual_arm_torso.urdf";
+  std::string base_link;  ///< empty: none given (the root)
   std::string tool_link = "left_tool,right_tool";
   std::string truth = "{mode: random, angle_sigma_mrad: 1, length_sigma_mm: 1}";
   std::string noise = "{sigma_mm: 0.05}";
@@ -61,8 +64,8 @@ struct TreeSections {
 std::string WriteTreeStudy(const std::string& name, const TreeSections& t, int trials = 3) {
   const std::string path = testing::TempDir("tree_study_" + name) + "/s.yaml";
   std::ofstream(path) << "name: s\nseed: 5\ntrials: " << trials
-                      << "\nrobot: " << testing::SourcePath("examples/urdf/dual_arm_torso.urdf")
-                      << "\n"
+                      << "\nrobot: " << testing::SourcePath(t.robot) << "\n"
+                      << (t.base_link.empty() ? "" : "base_link: " + t.base_link + "\n")
                       << "tool_link: " << t.tool_link << "\ntruth: " << t.truth
                       << "\nnoise: " << t.noise << "\npool: " << t.pool
                       << "\nselection: " << t.selection << "\nvalidation: " << t.validation
@@ -132,6 +135,33 @@ TEST(TreeStudy, ACoupledChainsGainIsFittedWithItsProbesOrientations) {
     for (std::size_t k = 0; k < r.errors.size(); ++k)
       EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
   }
+}
+
+TEST(TreeStudy, AChainFromASoleUpTheLegIsStudiedAsAnyArm) {
+  // base_link in a study: the humanoid-like robot from its left sole up the leg, the torso and
+  // the left arm to the gripper (14 joints, 6 of them passed child to parent), one tracker cell;
+  // noise-free, every term and the gripper's validation poses come back to 1e-9.
+  constexpr double kRecovered = 1e-9;
+  TreeSections t;
+  t.robot = "examples/urdf/humanoid_like.urdf";
+  t.base_link = "left_sole";
+  t.tool_link = "left_gripper";
+  t.pool = "{size: 120}";
+  t.selection = "{count: 30}";
+  t.noise = "{sigma_mm: 1e-9, repetitions: 1}";
+  t.sensor = "{kind: pose, instrument: [2.0, 0.0, 0.5, 0, 0, 3.1416], sigma_mrad: 1e-9}";
+  t.identification = "{on_rank_deficient: fix, fix: " + HeldFrames({""}) + "}";
+  const Study study = LoadStudy(WriteTreeStudy("leg", t));
+  const auto c = PrepareCell(study, study.cells.at(0));
+  ASSERT_FALSE(c->rank_deficient) << c->rank_message;
+  EXPECT_EQ(c->robot->num_links(), 14);
+  EXPECT_EQ(c->tree, nullptr);  // one chain: a tracker cell
+  TrialWorkspace ws;
+  const TrialRecord r = RunTrial(*c, 0, &ws);
+  ASSERT_EQ(r.status, TrialStatus::kOk);
+  for (std::size_t k = 0; k < r.errors.size(); ++k)
+    EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
+  for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, kRecovered) << a;
 }
 
 TEST(TreeStudy, ThePredictedCovarianceAndValidationHoldOverTheTrials) {
