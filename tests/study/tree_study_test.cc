@@ -1,9 +1,9 @@
 // Studies of trees (tool_link with several links, base_link): a tree cell recovers every chain's
-// truth when its noise vanishes (a coupled chain's gain too, and a chain up a leg from a sole), its
-// predicted covariance holds over its trials (Monte Carlo), its validation's first-order prediction
-// matches the trials, sharing the torso with the other arm improves the judged arm, the budget pays
-// for every chain's reading, the tables do not depend on the threads, and bad tree settings are
-// errors at their line.
+// truth when its noise vanishes (a coupled chain's gain too, and a chain up a leg from a sole),
+// its predicted covariance holds over its trials (Monte Carlo), its validation's first-order
+// prediction matches the trials, sharing the torso with the other arm improves the judged arm,
+// the budget pays for every chain's reading, the tables do not depend on the threads, and bad
+// tree settings are errors at their line.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
