@@ -64,11 +64,9 @@ bool robot_defaulted = false;
 
 bool RobotWasDefaulted() { return robot_defaulted; }
 
-namespace {
 std::string OptionalString(const po::variables_map& vm, const char* option) {
   return vm.count(option) ? vm[option].as<std::string>() : "";
 }
-}  // namespace
 
 RobotFile LoadRobot(const po::variables_map& vm) {
   robot_defaulted = vm["robot"].defaulted();
@@ -78,22 +76,20 @@ RobotFile LoadRobot(const po::variables_map& vm) {
 
 bool IsTreeRun(const po::variables_map& vm) {
   if (vm.count("tool-link") && SplitList(vm["tool-link"].as<std::string>()).size() > 1) return true;
-  // One chain with a mimic joint on it: a tree of one chain, its mimic joint a coupling.
+  // One chain with a coupled joint on it (a URDF's mimic joint, a robot YAML file's couple:): a
+  // tree of one chain, its coupled joint a coupling.
   const std::string path = ResolveRobotPath(vm["robot"].as<std::string>());
-  return IsUrdfPath(path) &&
-         UrdfChainIsCoupled(path, OptionalString(vm, "tool-link"), OptionalString(vm, "base-link"));
+  if (!IsUrdfPath(path) && (vm.count("tool-link") || vm.count("base-link")))
+    return false;  // refused by name where the robot is read
+  return RobotChainIsCoupled(path, OptionalString(vm, "tool-link"),
+                             OptionalString(vm, "base-link"));
 }
 
 UrdfChains LoadTreeChains(const po::variables_map& vm) {
   const std::string path = ResolveRobotPath(vm["robot"].as<std::string>());
-  if (!IsUrdfPath(path))
-    throw InputError("--tool-link",
-                     "several tool links are a tree's chains: --robot must be a "
-                     "URDF, not '" +
-                         path + "'");
   std::vector<std::string> tools = SplitList(OptionalString(vm, "tool-link"));
   if (tools.empty()) tools.emplace_back();  // the URDF's only end link
-  return LoadUrdfChains(path, tools, OptionalString(vm, "base-link"));
+  return LoadRobotChains(path, tools, OptionalString(vm, "base-link"));
 }
 
 RobotFile LoadRobotWithToolLink(const std::string& path, const po::variables_map& vm) {

@@ -51,12 +51,16 @@ bool Parse(const std::string& command, const std::string& usage, po::options_des
 
 /// --robot: a path (robot YAML or URDF) or a shipped name ("paper"); `tool_link` for a URDF.
 RobotFile LoadRobot(const std::string& name_or_path, const std::string& tool_link = "");
+/// A string option's value, or "" when it is not given.
+std::string OptionalString(const po::variables_map& vm, const char* option);
 /// --robot, --tool-link and --base-link.
 RobotFile LoadRobot(const po::variables_map& vm);
-/// True when --tool-link lists several links, or the URDF's one chain has a mimic joint on it: a
-/// tree's chains (io/urdf.h LoadUrdfChains).
+/// True when --tool-link lists several links, or the robot's one chain has a coupled joint on it
+/// (a URDF's mimic joint, a robot YAML file's couple:): a tree's chains (io/urdf.h
+/// LoadRobotChains).
 bool IsTreeRun(const po::variables_map& vm);
-/// The chains of --robot (a URDF) from --base-link to each link of --tool-link.
+/// The chains of --robot from --base-link to each link of --tool-link (a URDF), or a robot YAML
+/// file's one coupled chain.
 UrdfChains LoadTreeChains(const po::variables_map& vm);
 /// The robot at `path`, with --tool-link when it is a URDF: what a command reading two robots
 /// (one may be a YAML file, one a URDF) gives each (export --like, joint-offsets; compensate).

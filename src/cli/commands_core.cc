@@ -1067,7 +1067,7 @@ TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool config
                          std::to_string(run.labels.size()) +
                          " chains of --tool-link: expected one file per tool link, in order");
   RefuseOptionsOfOneKind(vm, sensors,
-                         "a tree's chains (--tool-link " + vm["tool-link"].as<std::string>() + ")");
+                         "a tree's chains (--tool-link " + OptionalString(vm, "tool-link") + ")");
   if (vm.count("write-robot"))
     throw InputError("--write-robot",
                      "writes one chain's robot file; a tree's chains are "

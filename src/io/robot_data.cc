@@ -27,7 +27,10 @@ void CheckJointRanges(const ConfigurationSet& configs, const RobotModel& robot,
 
 CsvTable ReadRobotCsv(const std::string& path, const RobotModel& robot) {
   CsvTable t = ReadCsv(path);
-  if (t.Column("q1") >= 0 || robot.num_links() == 0) return t;
+  // q1..qN are read by position, unless the joints are named so themselves (a robot YAML file's
+  // coupled chain, io/urdf.h LoadRobotChains: its coupled joint's column may be left out).
+  if (robot.num_links() == 0 || (t.Column("q1") >= 0 && robot.links()[0].joint_name != "q1"))
+    return t;
   std::vector<std::string> names;
   for (const Link& link : robot.links()) {
     if (link.joint_name.empty()) return t;

@@ -68,8 +68,9 @@ JointType ParseJoint(const YAML::Node& node, const std::string& path, const std:
 // links[i]: joint, the five nominal values (β defaults to 0), which are parameters, joint range.
 Link ParseLink(const YAML::Node& ln, const std::string& path, const std::string& ctx) {
   using namespace yaml;
-  CheckKeys(ln, {"joint", "theta", "alpha", "a", "d", "beta", "parameters", "q_min", "q_max"}, path,
-            ctx);
+  CheckKeys(ln,
+            {"joint", "theta", "alpha", "a", "d", "beta", "parameters", "q_min", "q_max", "couple"},
+            path, ctx);
   Link link;
   if (ln["joint"]) link.joint = ParseJoint(ln["joint"], path, ctx + ".joint");
   for (int v = 0; v < kValuesPerLink; ++v) {
@@ -497,6 +498,88 @@ PriorSigmas PriorsFor(const RobotFile& rig, bool use_tolerances, const std::stri
   return priors;
 }
 
+namespace {
+
+// links[k].couple: {joint: j (1-based link number), multiplier: m, offset: o}.
+std::vector<FileCoupling> ParseCouplings(const YAML::Node& root, const std::string& path) {
+  const YAML::Node links = root["links"];
+  const auto n = static_cast<int>(links.size());
+  std::vector<FileCoupling> out;
+  for (int k = 0; k < n; ++k) {
+    const YAML::Node c = links[static_cast<std::size_t>(k)]["couple"];
+    if (!c) continue;
+    const std::string ctx = "links[" + std::to_string(k) + "].couple";
+    if (!c.IsMap())
+      throw InputError(yaml::Where(path, c, ctx),
+                       "expected {joint: j, multiplier: m, offset: o}: the link number whose "
+                       "joint this one follows");
+    yaml::CheckKeys(c, {"joint", "multiplier", "offset"}, path, ctx);
+    if (!c["joint"]) throw InputError(yaml::Where(path, c, ctx + ".joint"), "missing");
+    FileCoupling f;
+    f.link = k;
+    const double j = yaml::Number(c["joint"], path, ctx + ".joint", false);
+    if (j != std::floor(j) || j < 1 || j > n || static_cast<int>(j) == k + 1)
+      throw InputError(yaml::Where(path, c["joint"], ctx + ".joint"),
+                       "expected the number (1 to " + std::to_string(n) +
+                           ") of another link, whose joint this one follows");
+    f.follows = static_cast<int>(j) - 1;
+    if (c["multiplier"]) f.multiplier = yaml::Number(c["multiplier"], path, ctx + ".multiplier");
+    if (c["offset"]) f.offset = yaml::Number(c["offset"], path, ctx + ".offset", true);
+    if (!std::isfinite(f.multiplier) || !std::isfinite(f.offset))
+      throw InputError(yaml::Where(path, c, ctx), "expected a finite multiplier and offset");
+    out.push_back(f);
+  }
+  for (const FileCoupling& f : out)
+    for (const FileCoupling& g : out)
+      if (g.link == f.follows)
+        throw InputError(yaml::Where(path, links[static_cast<std::size_t>(f.link)]["couple"],
+                                     "links[" + std::to_string(f.link) + "].couple.joint"),
+                         "link " + std::to_string(f.follows + 1) +
+                             " is itself coupled: follow the joint it follows");
+  return out;
+}
+
+RobotFile ReadRobotYaml(const std::string& path, bool allow_couplings) {
+  YAML::Node root = yaml::LoadFile(path);
+  yaml::CheckKeys(root,
+                  {"name", "description", "links", "base", "tool", "true_errors", "tolerances",
+                   "plane", "planes", "ranger", "calibration"},
+                  path, "");
+  if (root["calibration"] && !root["calibration"].IsMap())
+    throw InputError(yaml::Where(path, root["calibration"], "calibration"),
+                     "expected a mapping (the record lrcal identify --write-robot writes)");
+  const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
+  const std::vector<Link> links = ParseLinks(root, path);
+  RobotFile file;
+  file.couplings = ParseCouplings(root, path);
+  if (!allow_couplings && !file.couplings.empty()) {
+    const std::string ctx = "links[" + std::to_string(file.couplings[0].link) + "].couple";
+    throw InputError(yaml::Where(path, root["links"][file.couplings[0].link]["couple"], ctx),
+                     "a coupled link is calibrated as a tree of one chain (identify, "
+                     "identifiability, design, simulate --sensor point|pose and studies read it "
+                     "so); this command reads arms without couplings");
+  }
+  file.robot = RobotModel(name, links, path, ParseFixedTransform(root, path, "base"),
+                          ParseFixedTransform(root, path, "tool"));
+  file.truth.link_errors = ParseTrueErrors(root, path, links);
+  file.planes = ParsePlanes(root, path);
+  file.ranger = ParseRanger(root, path);
+  file.path = path;
+  file.robot.source = path;
+  ParseRangerErrors(root, path, &file);
+  file.tolerances = ParseTolerances(root, path, links, file.planes ? file.planes->size() : 0);
+  if (root["calibration"]) file.calibration = ParseCalibration(root["calibration"], path);
+  return file;
+}
+
+}  // namespace
+
+RobotFile LoadCoupledRobotFile(const std::string& path) {
+  if (IsUrdfPath(path))
+    throw InputError(path, "a URDF's couplings are its mimic joints (LoadUrdfChains)");
+  return ReadRobotYaml(path, true);
+}
+
 RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link,
                         const std::string& base_link) {
   if (IsUrdfPath(path)) return LoadUrdfRobotFile(path, tool_link, base_link);
@@ -509,28 +592,7 @@ RobotFile LoadRobotFile(const std::string& path, const std::string& tool_link,
         SettingSpec::Named("setup", "base_link", "base_link", "the chain's base link"),
         "applies to a URDF robot; '" + path +
             "' is a robot YAML file (its base frame is the chain's first)");
-  YAML::Node root = yaml::LoadFile(path);
-  yaml::CheckKeys(root,
-                  {"name", "description", "links", "base", "tool", "true_errors", "tolerances",
-                   "plane", "planes", "ranger", "calibration"},
-                  path, "");
-  if (root["calibration"] && !root["calibration"].IsMap())
-    throw InputError(yaml::Where(path, root["calibration"], "calibration"),
-                     "expected a mapping (the record lrcal identify --write-robot writes)");
-  const std::string name = root["name"] ? yaml::String(root["name"], path, "name") : path;
-  const std::vector<Link> links = ParseLinks(root, path);
-  RobotFile file;
-  file.robot = RobotModel(name, links, path, ParseFixedTransform(root, path, "base"),
-                          ParseFixedTransform(root, path, "tool"));
-  file.truth.link_errors = ParseTrueErrors(root, path, links);
-  file.planes = ParsePlanes(root, path);
-  file.ranger = ParseRanger(root, path);
-  file.path = path;
-  file.robot.source = path;
-  ParseRangerErrors(root, path, &file);
-  file.tolerances = ParseTolerances(root, path, links, file.planes ? file.planes->size() : 0);
-  if (root["calibration"]) file.calibration = ParseCalibration(root["calibration"], path);
-  return file;
+  return ReadRobotYaml(path, false);
 }
 
 namespace {

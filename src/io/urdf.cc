@@ -419,6 +419,67 @@ UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string
   return out;
 }
 
+UrdfChains LoadRobotChains(const std::string& path, const std::vector<std::string>& tool_links,
+                           const std::string& base_link) {
+  if (IsUrdfPath(path)) return LoadUrdfChains(path, tool_links, base_link);
+  if (tool_links.size() > 1)
+    throw InputError("--tool-link",
+                     "several tool links are a tree's chains: --robot must be a "
+                     "URDF, not '" +
+                         path + "'");
+  if (!tool_links.empty() && !tool_links[0].empty())
+    throw InputError("--tool-link", "applies to a URDF robot; '" + path +
+                                        "' is a robot YAML file (its last frame is the tool)");
+  if (!base_link.empty())
+    throw InputError("--base-link", "applies to a URDF robot; '" + path +
+                                        "' is a robot YAML file (its base frame is the chain's "
+                                        "first)");
+  RobotFile file = LoadCoupledRobotFile(path);
+  // Its joints named q<k> where the file names none: a log may then leave out a coupled joint's
+  // column (ReadChainCsv fills it from the joint it follows).
+  std::vector<Link> named = file.robot.links();
+  for (std::size_t k = 0; k < named.size(); ++k)
+    if (named[k].joint_name.empty()) named[k].joint_name = "q" + std::to_string(k + 1);
+  const std::string source = file.robot.source;
+  file.robot = RobotModel(file.robot.name(), named, path, file.robot.base(), file.robot.tool());
+  file.robot.source = source;
+  const std::vector<Link>& links = file.robot.links();
+  UrdfChains out;
+  ChainOfTree chain;
+  chain.label = "tool";
+  std::vector<int> index(links.size(), -1);
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    const bool coupled =
+        std::any_of(file.couplings.begin(), file.couplings.end(),
+                    [&](const FileCoupling& f) { return f.link == static_cast<int>(k); });
+    if (coupled) continue;
+    index[k] = static_cast<int>(out.joint_names.size());
+    out.joint_names.push_back(links[k].joint_name);
+    out.q_min.push_back(links[k].q_min);
+    out.q_max.push_back(links[k].q_max);
+  }
+  for (const FileCoupling& f : file.couplings) {
+    const auto link = static_cast<std::size_t>(f.link);
+    index[link] = index[static_cast<std::size_t>(f.follows)];
+    chain.couplings.push_back(
+        {f.link, index[link], f.multiplier, f.offset, links[link].joint == JointType::kPrismatic});
+  }
+  std::sort(chain.couplings.begin(), chain.couplings.end(),
+            [](const JointCoupling& a, const JointCoupling& b) { return a.link < b.link; });
+  chain.joints = index;
+  chain.link_labels.assign(links.size(), "");
+  chain.robot_joints = static_cast<int>(out.joint_names.size());
+  out.chains.push_back(std::move(file));
+  out.placements.push_back(std::move(chain));
+  return out;
+}
+
+bool RobotChainIsCoupled(const std::string& path, const std::string& tool_link,
+                         const std::string& base_link) {
+  if (IsUrdfPath(path)) return UrdfChainIsCoupled(path, tool_link, base_link);
+  return !LoadCoupledRobotFile(path).couplings.empty();
+}
+
 CsvTable ReadChainCsv(const std::string& path, const UrdfChains& tree, int chain) {
   const RobotFile& rig = tree.chains[static_cast<std::size_t>(chain)];
   CsvTable t = ReadRobotCsv(path, rig.robot);

@@ -2518,11 +2518,12 @@ joint fit ("" where every chain has the link).)doc")
           "load",
           [](const std::string& path, const std::vector<std::string>& tool_links,
              const std::string& base_link) {
-            return LoadUrdfChains(ResolveRobotPath(path), tool_links, base_link);
+            return LoadRobotChains(ResolveRobotPath(path), tool_links, base_link);
           },
           py::arg("path"), py::arg("tool_links"), py::arg("base_link") = "", R"doc(
 Reads the chains of the URDF at path from base_link (default: the root) to each of tool_links:
-`lrcal identify --tool-link a,b`. Raises lrcal.InputError naming the file and link.)doc")
+`lrcal identify --tool-link a,b`; or a robot YAML file's one chain whose links are coupled
+(couple:), tool_links [] or [""]. Raises lrcal.InputError naming the file and link.)doc")
       .def_readonly("joint_names", &UrdfChains::joint_names, "The tree's joints, each once.")
       .def_property_readonly(
           "chains", [](const UrdfChains& t) { return t.chains; }, "Each chain as an lrcal.Robot.")

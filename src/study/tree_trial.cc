@@ -1,7 +1,8 @@
 // The steps of a tree cell (tool_link: "left_tool,right_tool"): a tracker cell whose kind is the
 // TreeMeasurement of the URDF's chains (tree_measurement.h), so that the chains' common joints'
 // terms are estimated once from every chain's values. Per cell: the chains from the base link to
-// each tool link (io/urdf.h LoadUrdfChains); a pool and validation set of whole-robot
+// each tool link (io/urdf.h LoadRobotChains; a robot YAML file's one chain with coupled links
+// too); a pool and validation set of whole-robot
 // configurations, every joint uniform in its range (the draws of UniformTreeConfigurations), kept
 // where each chain's Jacobian (the judged chain's only, for the validation) has σ_min ≥
 // pool.min_singular_value, as a one-chain cell keeps its draws; then a tracker cell's steps on the
@@ -28,9 +29,20 @@ namespace {
 constexpr int kDrawsPerConfiguration = 20;  // uniform draws allowed per kept configuration
 
 void LoadTreeRig(const Study& study, const CellSettings& s, CellContext* c) {
+  // A tree's settings are checked when the study is read; a robot with a coupled joint on its one
+  // chain is known to be one here.
+  if (s.sensor.kind != "point" && s.sensor.kind != "pose")
+    throw InputError("sensor.kind",
+                     "a robot with a coupled joint is studied with a tracker: "
+                     "expected point or pose, got " +
+                         s.sensor.kind);
+  if (!s.truth.random)
+    throw InputError("truth.mode",
+                     "a robot with a coupled joint is studied with drawn true errors; expected "
+                     "random");
   auto tree = std::make_unique<TreeCell>();
   const std::vector<std::string> links = s.ToolLinks();
-  tree->tree = LoadUrdfChains(ResolveRobotPath(s.robot, study.folder()), links, s.base_link);
+  tree->tree = LoadRobotChains(ResolveRobotPath(s.robot, study.folder()), links, s.base_link);
   if (!s.validation_tool_link.empty())
     tree->judged = static_cast<int>(std::find(links.begin(), links.end(), s.validation_tool_link) -
                                     links.begin());

@@ -12,6 +12,7 @@
 #include "lrcal/identification/total_accuracy.h"
 #include "lrcal/io/csv.h"
 #include "lrcal/io/robot_file.h"
+#include "lrcal/io/urdf.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "study/trial_pipeline.h"
@@ -763,7 +764,8 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
   c->seed = study.seed;
   const CellSettings& s = cell.typed;
   try {
-    if (s.IsTree()) {
+    if (s.IsTree() ||
+        RobotChainIsCoupled(ResolveRobotPath(s.robot, study.folder()), s.tool_link, s.base_link)) {
       PrepareTreeCell(study, s, c.get());
       return c;
     }

@@ -16,6 +16,7 @@
 #include "lrcal/core/error.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
+#include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/chain_measurement.h"
@@ -418,6 +419,94 @@ TEST(UrdfChains, ACoupledJointsGainIsCalibratedNoiseFree) {
   reduced->Bind(expected.configs)->Predict(s.delta.data(), y.data(), nullptr);
   for (std::size_t r = 0; r < y.size(); ++r)
     EXPECT_NEAR(y[r], expected.y[r], testing::tolerance::kRoundTrip) << "value " << r;
+}
+
+// A robot YAML file's couple: (examples/robots/parallelogram_arm.yaml, q3 = -q2) is a tree of one
+// chain: five joints, link 3 following joint 2. Its points are the arm's forward kinematics with
+// q3 = -q2 composed in the test, to 1e-12; its Jacobian, the gain's column on a 6-D probe's
+// orientation rows too, matches central differences away from nominal.
+TEST(UrdfChains, ARobotFilesCoupledLinkIsAChainOfOneTree) {
+  const UrdfChains tree =
+      LoadRobotChains(testing::SourcePath("examples/robots/parallelogram_arm.yaml"), {});
+  EXPECT_EQ(tree.joint_names, (std::vector<std::string>{"q1", "q2", "q4", "q5", "q6"}));
+  const ChainOfTree& chain = tree.placements.at(0);
+  EXPECT_EQ(chain.joints, (std::vector<int>{0, 1, 1, 2, 3, 4}));
+  ASSERT_EQ(chain.couplings.size(), 1u);
+  EXPECT_EQ(chain.couplings[0].link, 2);
+  EXPECT_EQ(chain.couplings[0].joint, 1);
+  EXPECT_EQ(chain.couplings[0].multiplier, -1.0);
+  const RobotModel& robot = tree.chains[0].robot;
+  const PointSetup setup = OneTarget();
+  const ChainMeasurement points(std::make_shared<PointMeasurement>(robot, setup), chain);
+  const TargetedConfigurations configs = RobotConfigurations(tree, 20, 31);
+  std::vector<double> y(static_cast<std::size_t>(3 * configs.size()));
+  const std::vector<double> zero(static_cast<std::size_t>(points.num_parameters()), 0.0);
+  ASSERT_TRUE(points.Bind(configs)->Predict(zero.data(), y.data(), nullptr));
+  for (int i = 0; i < configs.size(); ++i) {
+    const double* q = configs.q(i);
+    const std::vector<double> full = {q[0], q[1], -q[1], q[2], q[3], q[4]};
+    const Pose<double> pose =
+        ForwardKinematics<double>(robot, robot.nominal_values().data(), full.data());
+    const Eigen::Vector3d p =
+        setup.instrument.rotation.transpose() *
+        (pose.p_BT + pose.R_BT * setup.targets[0] - setup.instrument.translation);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(y[static_cast<std::size_t>(3 * i + c)], p[c], testing::tolerance::kUrdf);
+  }
+  const ChainMeasurement probe(std::make_shared<PoseMeasurement>(robot, setup), chain);
+  ASSERT_EQ(probe.parameter_names().back(), "coupling3_gain");
+  std::vector<double> e(static_cast<std::size_t>(probe.num_parameters()), 1e-3);
+  e.back() = 3e-3;
+  std::unique_ptr<MeasurementEvaluator> evaluator = probe.Bind(configs);
+  Eigen::MatrixXd J(evaluator->num_rows(), probe.num_parameters());
+  std::vector<double> values(static_cast<std::size_t>(evaluator->num_rows()));
+  ASSERT_TRUE(evaluator->Predict(e.data(), values.data(), J.data()));
+  EXPECT_THAT(J, testing::EigenNear(testing::CentralDifferences(*evaluator, e),
+                                    testing::tolerance::kCentralDifference));
+}
+
+TEST(UrdfChains, BadCouplingsAreNamedByFileLineAndKey) {
+  const std::string dir = testing::TempDir("urdf_chains_couplings");
+  const auto message = [&](const std::string& name, const std::string& couple,
+                           const std::string& link2 = "") {
+    const std::string path = dir + "/" + name + ".yaml";
+    std::ofstream(path) << "name: c\nlinks:\n"
+                           "  - {theta: 0, alpha: 0, a: 0.3, d: 0, parameters: [theta]}\n"
+                           "  - {theta: 0, alpha: 0, a: 0.3, d: 0, parameters: [theta]"
+                        << link2
+                        << "}\n"
+                           "  - {theta: 0, alpha: 0, a: 0.3, d: 0, parameters: [theta], couple: "
+                        << couple << "}\n";
+    try {
+      LoadRobotChains(path, {});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  using ::testing::AllOf;
+  using ::testing::HasSubstr;
+  EXPECT_THAT(message("itself", "{joint: 3}"),
+              AllOf(HasSubstr("itself.yaml:5 key 'links[2].couple.joint'"),
+                    HasSubstr("expected the number (1 to 3) of another link")));
+  EXPECT_THAT(message("outside", "{joint: 4}"), HasSubstr("of another link"));
+  EXPECT_THAT(message("fraction", "{joint: 1.5}"), HasSubstr("of another link"));
+  EXPECT_THAT(
+      message("chained", "{joint: 2}", ", couple: {joint: 1}"),
+      AllOf(HasSubstr("key 'links[2].couple.joint'"), HasSubstr("link 2 is itself coupled")));
+  EXPECT_THAT(message("scalar", "2"), HasSubstr("expected {joint: j, multiplier: m, offset: o}"));
+  EXPECT_THAT(message("key", "{joint: 1, ratio: 2}"), HasSubstr("ratio"));
+  EXPECT_THAT(message("missing", "{multiplier: 2}"),
+              AllOf(HasSubstr("key 'links[2].couple.joint'"), HasSubstr("missing")));
+  EXPECT_EQ(message("good", "{joint: 1, multiplier: 0.5, offset: pi/4}"), "no error");
+  // The commands that read one uncoupled arm refuse it at its line.
+  try {
+    LoadRobotFile(dir + "/good.yaml");
+    ADD_FAILURE() << "a coupled robot file was read as an uncoupled arm";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("good.yaml:5 key 'links[2].couple'"),
+                                HasSubstr("a coupled link is calibrated as a tree of one chain")));
+  }
 }
 
 // A tree's files: a whole-robot file names every joint; a chain's log may leave out a coupled

@@ -89,3 +89,14 @@ def test_a_tree_study_runs_from_python_as_the_program_runs_it(tmp_path, cli):
     assert "right_tool.theta9" in parameters and "left_tool.theta3" in parameters
     assert ",theta2," in parameters  # the torso's shared link, once
     assert run.trials["cell_id"].nunique() == 5 and len(run.trials) == 20
+
+
+def test_a_robot_files_coupled_link_is_a_tree_of_one_chain():
+    # couple: in a robot YAML file (q3 = -q2): one chain over five joints, as the program reads it.
+    path = os.path.join(HERE, "..", "..", "examples", "robots", "parallelogram_arm.yaml")
+    tree = lrcal.Tree.load(path, [])
+    assert tree.joint_names == ["q1", "q2", "q4", "q5", "q6"]
+    assert tree.tool_links == ["tool"]
+    assert tree.chains[0].num_joints == 6
+    with pytest.raises(lrcal.InputError, match="applies to a URDF robot"):
+        lrcal.Tree.load(path, ["tool"])

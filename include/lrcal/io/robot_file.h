@@ -38,6 +38,17 @@ struct CalibrationRecord {
   Eigen::MatrixXd estimate_shift;
 };
 
+/// A robot YAML link's `couple: {joint: j, multiplier: m, offset: o}`: the link's joint has no
+/// value of its own; it turns (slides) by m·q_j + o with the joint of link j — a mimic joint, a
+/// coupled torso joint, a transmission. Its offset's error is the link's θ0 (d0), its
+/// multiplier's a term of its own (chain_measurement.h).
+struct FileCoupling {
+  int link = 0;     ///< the coupled link (0-based)
+  int follows = 0;  ///< the link whose joint it follows (0-based; itself not coupled)
+  double multiplier = 1.0;
+  double offset = 0.0;  ///< rad (m for a prismatic link)
+};
+
 /// What a robot file holds.
 struct RobotFile {
   RobotModel robot;
@@ -56,6 +67,8 @@ struct RobotFile {
   /// The record of a calibrated robot file (identify --write-robot), if it has one: what
   /// `lrcal accuracy` propagates to poses.
   std::optional<CalibrationRecord> calibration;
+  /// A robot YAML file's coupled links (LoadCoupledRobotFile only: LoadRobotFile refuses them).
+  std::vector<FileCoupling> couplings{};
 };
 
 /// The priors a calibration uses: `rig`'s tolerances when `use_tolerances` (an InputError at
@@ -64,6 +77,12 @@ struct RobotFile {
 /// --prior-sigma ...` and Python's prior=, prior_sigma= mean.
 PriorSigmas PriorsFor(const RobotFile& rig, bool use_tolerances, const std::string& prior_sigma,
                       const std::string& tolerances_option, const std::string& prior_sigma_option);
+
+/// Reads a robot YAML file whose links may be coupled (`couple:`), as LoadRobotFile reads one
+/// without: a coupled arm is calibrated as a tree of one chain (io/urdf.h LoadRobotChains).
+/// Throws InputError naming the file, line and key for a coupling of no link, of itself, of a
+/// coupled link, or with a multiplier or offset that is not a finite number.
+RobotFile LoadCoupledRobotFile(const std::string& path);
 
 /// Reads a robot YAML file, or a URDF (a path ending in .urdf: io/urdf.h, the chain from
 /// `base_link` — empty: the root — to `tool_link`, the ranger's link, empty for the URDF's only

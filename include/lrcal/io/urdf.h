@@ -88,6 +88,17 @@ CsvTable ReadChainCsv(const std::string& path, const UrdfChains& tree, int chain
 TargetedConfigurations ReadTreeConfigurations(const std::string& path, const UrdfChains& tree,
                                               const PlaneSet* planes = nullptr);
 
+/// The chains of any robot file: a URDF's (LoadUrdfChains), or a robot YAML file's one chain
+/// (`tool_links` empty or one empty name, no `base_link`) with its `couple:` links as couplings
+/// (robot_file.h FileCoupling): its label "tool", its joints those of the links that are not
+/// coupled, named as the links' joints are (q<k> for link k when the file names none).
+UrdfChains LoadRobotChains(const std::string& path, const std::vector<std::string>& tool_links,
+                           const std::string& base_link = "");
+/// True when the chain LoadRobotFile would read has a coupled joint on it (a URDF's mimic joint,
+/// a robot YAML file's couple:): such a chain is read with LoadRobotChains.
+bool RobotChainIsCoupled(const std::string& path, const std::string& tool_link = "",
+                         const std::string& base_link = "");
+
 /// `count` configurations of the whole tree, each joint uniform in its range: the draws of
 /// `stream` at indices i·J + j (J joints).
 TargetedConfigurations UniformTreeConfigurations(const UrdfChains& tree, int count,
