@@ -263,10 +263,14 @@ int DesignCommand(const std::vector<std::string>& args) {
     return 0;
   if (vm.count("out")) CheckOutputFile(vm["out"].as<std::string>(), "--out");
   if (IsTreeRun(vm)) return TreeDesign(vm);
-  const Setup setup = ResolveSetup(vm);
-  const std::uint64_t seed = ParseSeed(vm);
   const std::string sensor = DesignSensor(vm);
   const bool tracker = sensor != "ranger";
+  Setup setup{LoadRobot(vm), PlaneSet{}};
+  // A tracker reads no plane: without one, the horizontal plane through the base only tags the
+  // candidates (as a study's tracker cell does), so a URDF without planes needs no --plane.
+  setup.planes = tracker && !vm.count("plane") && !setup.rig.planes ? PlaneSet(Plane{})
+                                                                    : ResolvePlanes(setup.rig, vm);
+  const std::uint64_t seed = ParseSeed(vm);
   const ResolvedPool pool = ResolvePool(vm, setup, seed, !tracker);
   MeasurementModel model(setup.rig.robot, setup.planes,
                          tracker ? MakeParameterSet(setup.rig.robot, PlaneTerms{})

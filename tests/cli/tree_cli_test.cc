@@ -257,8 +257,9 @@ TEST_F(TreeCli, ASoleToGripperChainIsCalibratedUpTheLeg) {
   const std::string truth = testing::UrdfWithMovedOrigins(nominal, 6, Path("true.urdf"));
   const std::string chain = " --base-link left_sole --tool-link left_gripper";
   std::string out;
-  ASSERT_EQ(Run("sample --robot " + nominal + chain + " --plane 0,0,1,-2 --count 60 --out " +
-                    Path("c.csv"),
+  // The tracker's design needs no plane (the URDF has none).
+  ASSERT_EQ(Run("design --robot " + nominal + chain + kTracker +
+                    " --generate 90 --select 60 --method greedy --out " + Path("c.csv"),
                 &out),
             0)
       << out;
