@@ -92,12 +92,8 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
                                    aimed, &c->pool_report);
     c->pool = c->contact->LinearisationConfigurations(starts);
   } else if (!s.pool_file.empty()) {
-    c->pool = ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, nullptr);
-    c->pool_report.requested = c->pool_report.accepted = c->pool_report.attempts = c->pool.size();
-    if (c->pool.size() < s.select_count)
-      throw InputError("pool.file", "'" + s.pool_file + "' has " + std::to_string(c->pool.size()) +
-                                        " configurations: fewer than selection.count = " +
-                                        std::to_string(s.select_count));
+    AcceptPoolFile(s, ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, nullptr),
+                   c);
   } else {
     c->pool = SampleConfigurations(*c->robot, tag, s.pool_size,
                                    RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),
@@ -234,6 +230,15 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
   if (!c->rank_deficient) c->rank_message = design_report.ToString();
   c->rank_deficient = true;
   c->predicted_std = Eigen::VectorXd::Constant(n, std::nan(""));
+}
+
+void AcceptPoolFile(const CellSettings& s, TargetedConfigurations pool, CellContext* c) {
+  c->pool = std::move(pool);
+  c->pool_report.requested = c->pool_report.accepted = c->pool_report.attempts = c->pool.size();
+  if (c->pool.size() < s.select_count)
+    throw InputError("pool.file", "'" + s.pool_file + "' has " + std::to_string(c->pool.size()) +
+                                      " configurations: fewer than selection.count = " +
+                                      std::to_string(s.select_count));
 }
 
 void CheckValuesForTerms(const CellSettings& s, const CellContext& c) {

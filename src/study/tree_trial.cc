@@ -180,12 +180,7 @@ void DrawTreeCellConfigurations(const Study& study, const CellSettings& s, CellC
   c->validation_stream = ValidationStreamId(c->cell->settings);
   c->selection_seed = s.pool_file.empty() ? study.seed : 0;
   if (!s.pool_file.empty()) {
-    c->pool = ReadTreeFile(study, s.pool_file, "pool.file", t);
-    c->pool_report.requested = c->pool_report.accepted = c->pool_report.attempts = c->pool.size();
-    if (c->pool.size() < s.select_count)
-      throw InputError("pool.file", "'" + s.pool_file + "' has " + std::to_string(c->pool.size()) +
-                                        " configurations: fewer than selection.count = " +
-                                        std::to_string(s.select_count));
+    AcceptPoolFile(s, ReadTreeFile(study, s.pool_file, "pool.file", t), c);
   } else {
     c->pool = DrawTreeConfigurations(s, t, s.pool_size,
                                      RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),

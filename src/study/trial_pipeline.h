@@ -205,6 +205,9 @@ void SimulateTreeValues(const CellContext& c, const TrialTruth& truth, const Noi
 void CheckTrackerIdentifiability(const CellSettings& s, CellContext* c);
 /// The design's block selection on c->kind, its σ_min, nominal linearisation and covariance.
 void SelectTrackerDesign(const CellSettings& s, CellContext* c);
+/// A pool read from pool.file as the cell's (its report: all accepted); InputError (pool.file)
+/// when it holds fewer configurations than selection.count.
+void AcceptPoolFile(const CellSettings& s, TargetedConfigurations pool, CellContext* c);
 /// InputError (selection.count) when the design's values cannot outnumber c->kind's terms.
 void CheckValuesForTerms(const CellSettings& s, const CellContext& c);
 /// A tracker cell's trial after the truth and the nominal validation are in `rec`.

@@ -30,6 +30,15 @@ class TreeCli : public ::testing::Test {
   static Json JsonOf(const std::string& text) {
     return Json::parse(text.substr(text.find('{'), text.rfind('}') - text.find('{') + 1));
   }
+  // A noise-free joint fit's JSON: nothing left over, and the estimate of `term`.
+  static double ExactFitsDelta(const std::string& text, const std::string& term) {
+    const Json fit = JsonOf(text);
+    EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
+    for (const Json& p : fit["parameters"])
+      if (p["name"] == term) return p["delta"].get<double>();
+    ADD_FAILURE() << "no term " << term;
+    return 0;
+  }
   std::string dir_;
 };
 
@@ -178,12 +187,7 @@ TEST_F(TreeCli, AMimicJointOnAChainIsACoupledLinkWithItsGain) {
                 &out),
             0)
       << out;
-  const Json fit = JsonOf(out);
-  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
-  double gain = 0;
-  for (const Json& p : fit["parameters"])
-    if (p["name"] == "head.coupling4_gain") gain = p["delta"].get<double>();
-  EXPECT_NEAR(gain, -3e-3, 1e-9);
+  EXPECT_NEAR(ExactFitsDelta(out, "head.coupling4_gain"), -3e-3, 1e-9);
   // simulate writes one chain's file; the one-chain commands refuse a coupled chain by name.
   EXPECT_EQ(Run("simulate --robot " + nominal + " --tool-link left_tool,head" + tracker +
                     " --configs " + Path("log.csv") + " --out " + Path("x.csv"),
@@ -236,12 +240,7 @@ TEST_F(TreeCli, ACoupledLinkOfARobotFileIsCalibratedWithItsGain) {
                 &out),
             0)
       << out;
-  const Json fit = JsonOf(out);
-  EXPECT_LT(fit["residual_rms"].get<double>(), 1e-12);
-  double gain = 0;
-  for (const Json& p : fit["parameters"])
-    if (p["name"] == "coupling3_gain") gain = p["delta"].get<double>();
-  EXPECT_NEAR(gain, -3e-3, 1e-9);
+  EXPECT_NEAR(ExactFitsDelta(out, "coupling3_gain"), -3e-3, 1e-9);
   // The one-chain commands refuse it at its line; a YAML robot takes no tool link.
   EXPECT_EQ(Run("accuracy --robot " + nominal + " --workspace 10", &out), 2);
   EXPECT_THAT(out, HasSubstr("parallelogram_arm.yaml:14 key 'links[2].couple': a coupled link"));

@@ -13,6 +13,7 @@
 #include "lrcal/study/study.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
+#include "trial_checks.h"
 
 namespace lrcal {
 namespace {
@@ -71,14 +72,7 @@ TEST(TrackerStudy, ATrackerCellRecoversATruthItCanSeeToWithinItsNoise) {
             std::string(kind) + ", sigma_mrad: 1e-9, " + kTracker + "}\n"));
     const auto c = PrepareCell(study, study.cells.at(0));
     ASSERT_FALSE(c->rank_deficient) << c->rank_message;
-    TrialWorkspace ws;
-    const TrialRecord r = RunTrial(*c, 0, &ws);
-    ASSERT_EQ(r.status, TrialStatus::kOk);
-    ASSERT_EQ(r.errors.size(), c->parameter_names.size());
-    for (std::size_t k = 0; k < r.errors.size(); ++k)
-      EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
-    for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, kRecovered) << a;
-    EXPECT_GT(r.nominal[0], 1e-4);  // the nominal arm is off by millimetres
+    testing::ExpectTrialsRecoverTheTruth(*c, 1, kRecovered, kRecovered);
   }
 }
 
@@ -103,19 +97,9 @@ TEST(TrackerStudy, ThePredictedCovarianceHoldsOverTheTrials) {
         kTrials));
     const auto c = PrepareCell(study, study.cells.at(0));
     ASSERT_FALSE(c->rank_deficient) << c->rank_message;
-    const Eigen::LDLT<Eigen::MatrixXd> inverse(c->predicted_covariance);
     const auto n = static_cast<double>(c->parameter_names.size());
-    double sum = 0;
-    TrialWorkspace ws;
-    for (int t = 0; t < kTrials; ++t) {
-      const TrialRecord r = RunTrial(*c, t, &ws);
-      ASSERT_EQ(r.status, TrialStatus::kOk) << t;
-      const Eigen::Map<const Eigen::VectorXd> d(r.errors.data(),
-                                                static_cast<Eigen::Index>(r.errors.size()));
-      sum += d.dot(inverse.solve(d));
-    }
-    const double mean = sum / kTrials;
-    EXPECT_NEAR(mean, n, 4 * std::sqrt(2 * n / kTrials)) << "n = " << n;
+    EXPECT_NEAR(testing::MeanMahalanobis(*c, kTrials), n, 4 * std::sqrt(2 * n / kTrials))
+        << "n = " << n;
   }
 }
 

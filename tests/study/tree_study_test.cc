@@ -16,6 +16,7 @@
 #include "lrcal/study/study.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
+#include "trial_checks.h"
 
 namespace lrcal {
 namespace {
@@ -101,16 +102,7 @@ TEST(TreeStudy, ANoiseFreeTreeCellRecoversEveryChainsTruth) {
   EXPECT_THAT(c->parameter_names, Contains("left_tool.theta9"));
   EXPECT_THAT(c->parameter_names, Contains("right_tool.theta9"));
   EXPECT_THAT(c->parameter_names, Not(Contains("left_tool.theta2")));
-  TrialWorkspace ws;
-  for (int trial = 0; trial < 2; ++trial) {
-    const TrialRecord r = RunTrial(*c, trial, &ws);
-    ASSERT_EQ(r.status, TrialStatus::kOk);
-    ASSERT_EQ(r.errors.size(), c->parameter_names.size());
-    for (std::size_t k = 0; k < r.errors.size(); ++k)
-      EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
-    for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, kRecovered) << a;
-    EXPECT_GT(r.nominal[0], 1e-4);  // the nominal arm is off by millimetres
-  }
+  testing::ExpectTrialsRecoverTheTruth(*c, 2, kRecovered, kRecovered);
 }
 
 TEST(TreeStudy, ACoupledChainsGainIsFittedWithItsProbesOrientations) {
@@ -128,13 +120,7 @@ TEST(TreeStudy, ACoupledChainsGainIsFittedWithItsProbesOrientations) {
   const auto c = PrepareCell(study, study.cells.at(0));
   ASSERT_FALSE(c->rank_deficient) << c->rank_message;
   ASSERT_THAT(c->parameter_names, Contains("head.coupling4_gain"));
-  TrialWorkspace ws;
-  for (int trial = 0; trial < 3; ++trial) {
-    const TrialRecord r = RunTrial(*c, trial, &ws);
-    ASSERT_EQ(r.status, TrialStatus::kOk) << trial;
-    for (std::size_t k = 0; k < r.errors.size(); ++k)
-      EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
-  }
+  testing::ExpectTrialsRecoverTheTruth(*c, 3, kRecovered, kRecovered);
 }
 
 TEST(TreeStudy, AChainFromASoleUpTheLegIsStudiedAsAnyArm) {
@@ -156,12 +142,7 @@ TEST(TreeStudy, AChainFromASoleUpTheLegIsStudiedAsAnyArm) {
   ASSERT_FALSE(c->rank_deficient) << c->rank_message;
   EXPECT_EQ(c->robot->num_links(), 14);
   EXPECT_EQ(c->tree, nullptr);  // one chain: a tracker cell
-  TrialWorkspace ws;
-  const TrialRecord r = RunTrial(*c, 0, &ws);
-  ASSERT_EQ(r.status, TrialStatus::kOk);
-  for (std::size_t k = 0; k < r.errors.size(); ++k)
-    EXPECT_NEAR(r.errors[k], 0, kRecovered) << c->parameter_names[k];
-  for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, kRecovered) << a;
+  testing::ExpectTrialsRecoverTheTruth(*c, 1, kRecovered, kRecovered);
 }
 
 TEST(TreeStudy, ARobotFilesCoupledArmIsStudiedAsATreeOfOneChain) {
@@ -183,12 +164,7 @@ TEST(TreeStudy, ARobotFilesCoupledArmIsStudiedAsATreeOfOneChain) {
   ASSERT_NE(c->tree, nullptr);
   ASSERT_FALSE(c->rank_deficient) << c->rank_message;
   EXPECT_THAT(c->parameter_names, Contains("coupling3_gain"));
-  TrialWorkspace ws;
-  for (int trial = 0; trial < 2; ++trial) {
-    const TrialRecord r = RunTrial(*c, trial, &ws);
-    ASSERT_EQ(r.status, TrialStatus::kOk) << trial;
-    for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, kTakenUp) << a;
-  }
+  testing::ExpectTrialsRecoverTheTruth(*c, 2, -1, kTakenUp);
   TreeSections ranger = t;
   ranger.sensor = "{kind: ranger}";
   ranger.identification = "{on_rank_deficient: fix}";
@@ -209,19 +185,13 @@ TEST(TreeStudy, ThePredictedCovarianceAndValidationHoldOverTheTrials) {
   const Study study = LoadStudy(WriteTreeStudy("coverage", t, kTrials));
   const auto c = PrepareCell(study, study.cells.at(0));
   ASSERT_FALSE(c->rank_deficient) << c->rank_message;
-  const Eigen::LDLT<Eigen::MatrixXd> inverse(c->predicted_covariance);
   const auto n = static_cast<double>(c->parameter_names.size());
-  double sum = 0, rms_position = 0;
+  EXPECT_NEAR(testing::MeanMahalanobis(*c, kTrials), n, 4 * std::sqrt(2 * n / kTrials))
+      << "n = " << n;
+  double rms_position = 0;
   TrialWorkspace ws;
-  for (int trial = 0; trial < kTrials; ++trial) {
-    const TrialRecord r = RunTrial(*c, trial, &ws);
-    ASSERT_EQ(r.status, TrialStatus::kOk) << trial;
-    const Eigen::Map<const Eigen::VectorXd> d(r.errors.data(),
-                                              static_cast<Eigen::Index>(r.errors.size()));
-    sum += d.dot(inverse.solve(d));
-    rms_position += r.validation[0];
-  }
-  EXPECT_NEAR(sum / kTrials, n, 4 * std::sqrt(2 * n / kTrials)) << "n = " << n;
+  for (int trial = 0; trial < kTrials; ++trial)
+    rms_position += RunTrial(*c, trial, &ws).validation[0];
   EXPECT_NEAR(rms_position / kTrials / c->predicted_validation[0], 1.0, kPredictionTolerance);
 }
 
