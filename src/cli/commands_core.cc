@@ -1042,16 +1042,10 @@ struct TreeRun {
   std::vector<std::string> labels;
 };
 
-std::string JoinComma(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
 TreeRun LoadTreeRun(const po::variables_map& vm, const char* option, bool configs_only) {
   TreeRun run;
   run.tree = LoadTreeChains(vm);
-  for (const ChainOfTree& chain : run.tree.placements) run.labels.push_back(chain.label);
+  run.labels = run.tree.tool_links();
   std::vector<std::string> sensors = ResolveSensors(vm);
   if (sensors.size() == 1 && sensors[0] != "mixed") sensors.assign(run.labels.size(), sensors[0]);
   if (sensors.size() != run.labels.size())
@@ -1120,13 +1114,13 @@ std::string TreeText(const TreeRun& run, const MixedMeasurement& kind) {
            " joints, coupled: " + couplings + "\n";
   const Json j = TreeJson(run, kind);
   std::string text =
-      "tree: " + std::to_string(run.labels.size()) + " chains (" + JoinComma(run.labels) +
+      "tree: " + std::to_string(run.labels.size()) + " chains (" + JoinList(run.labels) +
       ") over " + std::to_string(run.tree.joint_names.size()) +
       " joints; terms shared by every chain: " + std::to_string(j["shared_terms"].size());
   for (const auto& [label, names] : j["own_terms"].items())
     text += "; " + label + "'s own: " + std::to_string(names.size());
   const std::vector<std::string> shared = j["shared_terms"].get<std::vector<std::string>>();
-  return text + "\nshared: " + (shared.empty() ? "none" : JoinComma(shared)) + "\n" +
+  return text + "\nshared: " + (shared.empty() ? "none" : JoinList(shared)) + "\n" +
          (couplings.empty() ? "" : "coupled: " + couplings + "\n");
 }
 

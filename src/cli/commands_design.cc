@@ -232,9 +232,7 @@ int TreeDesign(const po::variables_map& vm) {
     j["pool"] = {{"size", pool.configs.size()}, {"source", pool.source}};
     j.update(DesignChoiceJson(request, choice));
     j["sensor"] = sensor;
-    std::vector<std::string> tool_links;
-    for (const ChainOfTree& chain : tree.placements) tool_links.push_back(chain.label);
-    j["tree"] = {{"tool_links", tool_links},
+    j["tree"] = {{"tool_links", tree.tool_links()},
                  {"joints", tree.joint_names},
                  {"values_per_configuration", full->rows_per_configuration()}};
     j["held_at_nominal"] = held;

@@ -118,6 +118,12 @@ bool IsValidUtf8(const std::string& text) {
   return true;
 }
 
+std::string JoinList(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (std::size_t k = 0; k < items.size(); ++k) out += (k ? separator : "") + items[k];
+  return out;
+}
+
 std::vector<std::string> SplitList(const std::string& text, char separator) {
   std::vector<std::string> out;
   std::string item;

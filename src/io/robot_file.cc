@@ -637,12 +637,6 @@ std::string FixedTransformText(const RobotModel& robot) {
   return t;
 }
 
-std::string Joined(const std::vector<std::string>& names) {
-  std::string t;
-  for (std::size_t k = 0; k < names.size(); ++k) t += (k ? ", " : "") + names[k];
-  return t;
-}
-
 std::string MatrixRows(const Eigen::MatrixXd& m) {
   std::string t;
   for (Eigen::Index i = 0; i < m.rows(); ++i) {
@@ -672,11 +666,11 @@ std::string RecordText(const CalibrationRecord& r) {
     t += MatrixRows(r.covariance);
   }
   if (r.held.empty()) return t;
-  t += "  held: [" + Joined(r.held) + "]  # terms held at nominal\n  held_sigma: [";
+  t += "  held: [" + JoinList(r.held) + "]  # terms held at nominal\n  held_sigma: [";
   for (Eigen::Index k = 0; k < r.held_sigma.size(); ++k)
     t += (k ? ", " : "") + FileNumber(r.held_sigma[k]);
   t += "]  # SI, their prior standard deviations\n";
-  t += "  held_defaulted: [" + Joined(r.held_defaulted) + "]  # sigma is lrcal's default\n";
+  t += "  held_defaulted: [" + JoinList(r.held_defaulted) + "]  # sigma is lrcal's default\n";
   t += "  estimate_shift:  # d(estimate)/d(held term): rows parameters, columns held\n";
   return t + MatrixRows(r.estimate_shift);
 }

@@ -34,12 +34,6 @@ bool IsUrdfPath(const std::string& path) {
 
 namespace {
 
-std::string JoinList(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
 RigidTransform FromUrdfPose(const urdf::Pose& pose) {
   RigidTransform t;
   const urdf::Rotation& r = pose.rotation;
@@ -417,6 +411,12 @@ UrdfChains LoadUrdfChains(const std::string& path, const std::vector<std::string
   for (ChainOfTree& placement : out.placements)
     placement.robot_joints = static_cast<int>(out.joint_names.size());
   return out;
+}
+
+std::vector<std::string> UrdfChains::tool_links() const {
+  std::vector<std::string> labels;
+  for (const ChainOfTree& chain : placements) labels.push_back(chain.label);
+  return labels;
 }
 
 UrdfChains LoadRobotChains(const std::string& path, const std::vector<std::string>& tool_links,

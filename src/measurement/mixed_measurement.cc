@@ -8,6 +8,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/parameter_set.h"
 
 namespace lrcal {
 
@@ -87,7 +88,7 @@ bool MixedMeasurement::IsSharedTerm(const std::string& full_name) {
   constexpr int kAnyLinks = 1000;  // link value names are theta<k>, a<k>, …: any chain length
   // A tree's chain labels its own links and tool ("left_tool.theta4", chain_measurement.h): the
   // chains that have that link or tool share it by that name.
-  const std::string name = full_name.substr(full_name.rfind('.') + 1);
+  const std::string name = UnlabelledName(full_name);
   return LinkValueIndex(name, kAnyLinks) >= 0 || StartsWith(name, "tool_") ||
          (name == full_name && (StartsWith(name, "base_") || StartsWith(name, "plane")));
 }

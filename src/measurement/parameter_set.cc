@@ -119,8 +119,10 @@ bool ParameterSet::EstimatesFrames() const {
   return false;
 }
 
+std::string UnlabelledName(const std::string& name) { return name.substr(name.rfind('.') + 1); }
+
 DisplayUnit DisplayUnitOf(const std::string& name) {
-  const std::string term = name.substr(name.rfind('.') + 1);
+  const std::string term = UnlabelledName(name);
   // The ranger's scale and a coupling's gain (chain_measurement.h) are dimensionless.
   if (term == "ranger_scale" || (term.size() > 5 && term.compare(term.size() - 5, 5, "_gain") == 0))
     return {"ppm", 1e6};
@@ -183,7 +185,7 @@ bool ParsePlaneTermName(const std::string& name, int* plane, std::string* term) 
 bool IsAngularName(const std::string& full_name) {
   // A part's or a chain's own term carries its label ("left_tool.theta4", "point.target_x"): the
   // unit is the term's.
-  const std::string name = full_name.substr(full_name.rfind('.') + 1);
+  const std::string name = UnlabelledName(full_name);
   for (const char* prefix : {"theta", "alpha", "beta"})
     if (name.rfind(prefix, 0) == 0) return true;
   // A frame's rotation terms (a tracker's instrument_roll, ...).

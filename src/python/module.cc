@@ -2528,12 +2528,7 @@ Reads the chains of the URDF at path from base_link (default: the root) to each 
       .def_property_readonly(
           "chains", [](const UrdfChains& t) { return t.chains; }, "Each chain as an lrcal.Robot.")
       .def_property_readonly(
-          "tool_links",
-          [](const UrdfChains& t) {
-            std::vector<std::string> labels;
-            for (const ChainOfTree& c : t.placements) labels.push_back(c.label);
-            return labels;
-          },
+          "tool_links", [](const UrdfChains& t) { return t.tool_links(); },
           "The chains' tool links, in order.")
       .def_property_readonly(
           "link_labels",

@@ -10,6 +10,8 @@ namespace lrcal {
 /// Splits "a,b,c" into items, each trimmed of blanks; an empty string gives an empty list, and
 /// an empty item between two separators is kept as "" (callers report it).
 std::vector<std::string> SplitList(const std::string& text, char separator = ',');
+/// The items written one after the other with `separator` between them ("a, b, c").
+std::string JoinList(const std::vector<std::string>& items, const std::string& separator = ", ");
 
 /// True if `text` is well-formed UTF-8 (no stray continuation bytes, no overlong forms, no
 /// surrogates, nothing above U+10FFFF).

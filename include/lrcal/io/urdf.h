@@ -57,6 +57,8 @@ struct UrdfChains {
   std::vector<RobotFile> chains;        ///< per tool link, the chain LoadUrdfRobotFile reads
   std::vector<ChainOfTree> placements;  ///< per tool link, where its chain sits (label: the link)
   std::vector<double> q_min, q_max;     ///< per joint of joint_names, its range (rad, or m)
+  /// The chains' labels in order: their tool links ("tool" for a robot YAML file's chain).
+  std::vector<std::string> tool_links() const;
 };
 
 /// True when the chain LoadUrdfRobotFile would read has a mimic joint on it (which it refuses):

@@ -127,6 +127,10 @@ ParameterSet MakeParameterSet(const RobotModel& robot, const std::vector<PlaneTe
 ParameterSet WithoutParameters(const RobotModel& robot, const ParameterSet& in,
                                const std::vector<std::string>& names);
 
+/// A term's name without its label: "theta4" of "left_tool.theta4" (a chain's or a mixed part's
+/// own term, chain_measurement.h, mixed_measurement.h); a name without a dot as it is.
+std::string UnlabelledName(const std::string& name);
+
 /// True for names of quantities in rad (theta*, alpha*, beta*, plane*_u*, a frame's *_roll,
 /// *_pitch, *_yaw); false for metres (and for the dimensionless ranger_scale: see DisplayUnitOf).
 /// A label before a dot ("left_tool.theta4": a chain's or a mixed part's own term) is skipped.
