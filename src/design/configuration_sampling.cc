@@ -49,15 +49,17 @@ std::string RejectionOf(const RobotModel& robot, const ModelPoint& nominal, cons
     if (miss == BeamMiss::kNone && truth) miss = BeamOf(*truth, one, options.ranger);
     if (miss != BeamMiss::kNone) return BeamMissName(miss);
   }
-  if (options.min_jacobian_singular_value > 0) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(
-        GeometricJacobian(robot, robot.nominal_values(), one.q(0)));
-    if (svd.singularValues().minCoeff() < options.min_jacobian_singular_value) return "singular";
-  }
+  if (!IsWellConditioned(robot, one.q(0), options.min_jacobian_singular_value)) return "singular";
   return "";
 }
 
 }  // namespace
+
+bool IsWellConditioned(const RobotModel& robot, const double* q, double min_singular_value) {
+  if (!(min_singular_value > 0)) return true;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(GeometricJacobian(robot, robot.nominal_values(), q));
+  return !(svd.singularValues().minCoeff() < min_singular_value);
+}
 
 TargetedConfigurations SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
                                             const RandomStream& stream,

@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "lrcal/core/error.h"
-#include "lrcal/kinematics/chain.h"
 #include "lrcal/measurement/pose_measurement.h"
 #include "lrcal/measurement/tree_measurement.h"
 #include "study/trial_pipeline.h"
@@ -119,18 +118,14 @@ void MapTreeTerms(CellContext* c) {
   }
 }
 
-// True when every chain of `which` (all: -1) has σ_min of its Jacobian at the nominal arm ≥
-// `min_sv` at whole-robot configuration i of `robot_configs`.
+// True when every chain of `which` (all: -1) is well conditioned (IsWellConditioned) at
+// whole-robot configuration i, `per_chain` its chains' joints.
 bool WellConditioned(const TreeCell& t, const std::vector<TargetedConfigurations>& per_chain, int i,
                      int which, double min_sv) {
-  if (!(min_sv > 0)) return true;
-  for (std::size_t k = 0; k < t.chains.size(); ++k) {
-    if (which >= 0 && static_cast<int>(k) != which) continue;
-    const RobotModel& arm = t.tree.chains[k].robot;
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(
-        GeometricJacobian(arm, arm.nominal_values(), per_chain[k].q(i)));
-    if (svd.singularValues().minCoeff() < min_sv) return false;
-  }
+  for (std::size_t k = 0; k < t.chains.size(); ++k)
+    if ((which < 0 || static_cast<int>(k) == which) &&
+        !IsWellConditioned(t.tree.chains[k].robot, per_chain[k].q(i), min_sv))
+      return false;
   return true;
 }
 

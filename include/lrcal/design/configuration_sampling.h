@@ -50,6 +50,11 @@ struct SamplingReport {
   std::string ToString() const;
 };
 
+/// True when the nominal arm's geometric Jacobian at joint values `q` has no singular value below
+/// `min_singular_value` (always when it is 0 or less): the sampler's test, whose rejects it
+/// reports as "singular".
+bool IsWellConditioned(const RobotModel& robot, const double* q, double min_singular_value);
+
 /// Draws `count` accepted configurations. Throws InputError if the constraints reject so many
 /// that `count` cannot be reached within the attempt budget (a plane the beam can never hit).
 TargetedConfigurations SampleConfigurations(const RobotModel& robot, const Plane& plane, int count,
