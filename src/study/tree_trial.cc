@@ -150,9 +150,10 @@ TargetedConfigurations DrawTreeConfigurations(const CellSettings& s, const TreeC
   }
   if (static_cast<int>(kept.size()) < count)
     throw InputError(key, "only " + std::to_string(kept.size()) + " of " +
-                              std::to_string(attempts) +
-                              " whole-robot draws have every chain's Jacobian σ_min ≥ "
-                              "pool.min_singular_value; lower it or ask for fewer");
+                              std::to_string(attempts) + " whole-robot draws have " +
+                              (which < 0 ? std::string("every chain's") : "the judged chain's") +
+                              " Jacobian σ_min ≥ pool.min_singular_value; lower it or ask for "
+                              "fewer");
   return drawn.Subset(kept);
 }
 

@@ -291,6 +291,11 @@ TEST(TreeStudy, BadTreeSettingsAreErrorsAtTheirLine) {
   TreeSections nowhere;
   nowhere.tool_link = "left_tool,nowhere";
   EXPECT_THAT(TreeStudyError("link", nowhere), HasSubstr("nowhere"));
+  TreeSections singular;  // no arm's Jacobian has a singular value of 10
+  singular.pool = "{size: 80, min_singular_value: 10}";
+  EXPECT_THAT(TreeStudyError("singular", singular),
+              AllOf(HasSubstr("pool.size"), HasSubstr("only 0 of 1600 whole-robot draws have "
+                                                      "every chain's Jacobian")));
 }
 
 }  // namespace
