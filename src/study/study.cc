@@ -18,6 +18,7 @@
 #include "lrcal/io/robot_file.h"
 #include "lrcal/io/urdf.h"
 #include "lrcal/kinematics/validation_metric.h"
+#include "lrcal/measurement/scanner_measurement.h"
 #include "lrcal/study/sensitivity.h"
 
 namespace lrcal {
@@ -71,7 +72,8 @@ const Json& StudyDefaults() {
                        "loss": "none", "loss_scale_sigma": 1.345, "estimate_ranger": "none",
                        "prior_sigma": "none", "errors_in_variables": false},
     "sensor": {"kind": "ranger", "instrument": null, "target": [0, 0, 0], "flush": false,
-               "sigma_mrad": 0.2, "cost_per_reading": 1, "budget": null},
+               "sigma_mrad": 0.2, "cost_per_reading": 1, "budget": null, "beams": 1,
+               "fan_deg": 0, "sockets": [], "socket_distances": []},
     "paper_case": 0
   })");
     j["noise"] = SettingDefaults(NoiseModel::Settings());
@@ -604,8 +606,9 @@ void RefuseRangerSettings(const Json& s, const KeyLocator& where, const CellSett
   const auto refuse = [&](const std::string& key, const std::string& why) {
     throw InputError(where(key), "sensor.kind " + kind + ": " + why);
   };
-  if (kind != "contact" && Str(s, "identification.estimate_plane", where) != "none")
-    refuse("identification.estimate_plane", "a tracker reads no plane; expected none");
+  if (kind != "contact" && kind != "scanner" &&
+      Str(s, "identification.estimate_plane", where) != "none")
+    refuse("identification.estimate_plane", "it measures no plane; expected none");
   if (c.ranger_terms.offset || c.ranger_terms.scale)
     refuse("identification.estimate_ranger", "it has no ranger; expected none");
   if (c.noise.DisturbsGeometry() || c.noise.outlier_fraction > 0)
@@ -628,6 +631,14 @@ void RefuseRangerSettings(const Json& s, const KeyLocator& where, const CellSett
   if (c.paper_case != 0) refuse("paper_case", "the paper's cases are the ranger's; expected 0");
 }
 
+// The sensor section without the keys of the scanner and socket cells at their defaults.
+Json WithoutLateSensorDefaults(Json sensor) {
+  const Json& defaults = StudyDefaults()["sensor"];
+  for (const char* key : {"beams", "fan_deg", "sockets", "socket_distances"})
+    if (sensor.contains(key) && sensor[key] == defaults[key]) sensor.erase(key);
+  return sensor;
+}
+
 // The sensor section with every default key (a sweep value may give only some).
 Json FullSensorSection(const Json& settings) {
   Json full = StudyDefaults()["sensor"];
@@ -639,11 +650,12 @@ Json FullSensorSection(const Json& settings) {
 
 // sensor came after studies were run: at its defaults (the ranger) it is left out of the resolved
 // settings, so that earlier studies' tables and run directories stay as they were; otherwise it
-// is written in full.
+// is written in full, except the keys that came with the scanner and socket cells, which are
+// left out at their defaults so that earlier tracker and contact cells keep their names.
 void NormaliseSensor(Json* settings) {
   if (!settings->contains("sensor") || !(*settings)["sensor"].is_object()) return;
-  const Json full = FullSensorSection(*settings);
-  if (full == StudyDefaults()["sensor"])
+  const Json full = WithoutLateSensorDefaults(FullSensorSection(*settings));
+  if (full == WithoutLateSensorDefaults(StudyDefaults()["sensor"]))
     settings->erase("sensor");
   else
     (*settings)["sensor"] = full;
@@ -673,18 +685,83 @@ void ParseBudget(const Json& s, const KeyLocator& where, CellSettings* c) {
   c->select_count = static_cast<int>(count);
 }
 
+// sensor.beams over ±sensor.fan_deg: the scanner's beam angles (rad).
+std::vector<double> ParseFan(const Json& s, const KeyLocator& where) {
+  const Json& beams = At(s, "sensor.beams");
+  if (!beams.is_number_integer())
+    throw InputError(where("sensor.beams"), "expected a whole number of beams (1 to " +
+                                                std::to_string(ScannerSetup::kMaxBeams) +
+                                                "), got " + beams.dump());
+  return ScannerSetup::FanOf(beams.get<long long>(), Num(s, "sensor.fan_deg", where),
+                             where("sensor.beams"), where("sensor.fan_deg"));
+}
+
+// sensor.sockets (positions in B, ids 0, 1, … in order) and sensor.socket_distances ("A,B=M",
+// socket ids and metres), each distance the one the positions give.
+void ParseSockets(const Json& s, const KeyLocator& where, StudySensor* sensor) {
+  const Json& list = At(s, "sensor.sockets");
+  if (!list.is_array() || list.empty() ||
+      list.size() > static_cast<std::size_t>(SocketSetup::kMaxSockets))
+    throw InputError(where("sensor.sockets"),
+                     "sensor.kind socket needs the sockets' positions in the base frame: a list "
+                     "of 1 to " +
+                         std::to_string(SocketSetup::kMaxSockets) + " [x, y, z] (m)");
+  sensor->sockets.clear();
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const Json& p = list[k];
+    bool ok = p.is_array() && p.size() == 3;
+    for (std::size_t i = 0; ok && i < 3; ++i)
+      ok = p[i].is_number() && std::isfinite(p[i].get<double>());
+    if (!ok)
+      throw InputError(where("sensor.sockets"),
+                       "socket " + std::to_string(k) + ": expected [x, y, z] (m), got " + p.dump());
+    sensor->sockets.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  }
+  const Json& texts = At(s, "sensor.socket_distances");
+  if (!texts.is_array())
+    throw InputError(where("sensor.socket_distances"),
+                     "expected a list of \"A,B=METRES\" (socket ids, m)");
+  sensor->socket_distances.clear();
+  for (const Json& t : texts) {
+    if (!t.is_string())
+      throw InputError(where("sensor.socket_distances"),
+                       "expected \"A,B=METRES\" (socket ids, m), got " + t.dump());
+    sensor->socket_distances.push_back(
+        SocketDistance::Parse(t.get<std::string>(), where("sensor.socket_distances")));
+  }
+  SocketSetup setup;
+  setup.ids.clear();
+  for (std::size_t k = 0; k < sensor->sockets.size(); ++k) setup.ids.push_back(static_cast<int>(k));
+  setup.positions = sensor->sockets;
+  setup.tool_point = sensor->tracker.targets.at(0);
+  setup.distances = sensor->socket_distances;
+  try {
+    setup.Validate();
+  } catch (const InputError& e) {
+    throw InputError(where("sensor.socket_distances"), e.what());
+  }
+  // A known distance is the truth's: the positions must agree with it (to 1 µm).
+  for (const SocketDistance& d : sensor->socket_distances) {
+    const double given = (sensor->sockets[static_cast<std::size_t>(d.b)] -
+                          sensor->sockets[static_cast<std::size_t>(d.a)])
+                             .norm();
+    if (std::abs(given - d.metres) > 1e-6)
+      throw InputError(where("sensor.socket_distances"),
+                       "sockets " + std::to_string(d.a) + " and " + std::to_string(d.b) + " are " +
+                           Json(given).dump() + " m apart in sensor.sockets, not " +
+                           Json(d.metres).dump() + " m");
+  }
+}
+
 // sensor: the kind, a tracker's frames and orientation noise, the cost of a reading and the
 // campaign's budget (which sets selection.count).
 void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c) {
   const Json s = {{"sensor", FullSensorSection(settings)}};
   StudySensor& sensor = c->sensor;
   sensor.kind = Str(s, "sensor.kind", where);
-  if (sensor.kind != "ranger" && sensor.kind != "point" && sensor.kind != "pose" &&
-      sensor.kind != "contact")
+  if (!IsMeasurementKindName(sensor.kind))
     throw InputError(where("sensor.kind"),
-                     "expected ranger, point, pose or contact, got '" + sensor.kind +
-                         "' (the scanner and socket kinds are the calibration commands' so far, "
-                         "not the studies')");
+                     "expected " + MeasurementKindNameList() + ", got '" + sensor.kind + "'");
   sensor.cost_per_reading = Num(s, "sensor.cost_per_reading", where);
   if (!(sensor.cost_per_reading > 0) || !std::isfinite(sensor.cost_per_reading))
     throw InputError(where("sensor.cost_per_reading"),
@@ -700,14 +777,23 @@ void ParseSensor(const Json& settings, const KeyLocator& where, CellSettings* c)
   if (sensor.flush && sensor.kind != "contact")
     throw InputError(where("sensor.flush"),
                      "is the contact sensor's; sensor.kind is " + sensor.kind);
-  // The ranger takes no instrument or target: a study may set them once and sweep the kind.
+  // A kind's geometry is read by that kind only: a study may set the instrument, the sockets
+  // or the fan once and sweep the kind.
   if (sensor.IsRanger()) return;
-  if (sensor.kind == "contact") {  // the tool point touches the cell's planes
+  if (sensor.kind == "scanner") {
+    sensor.scanner_frame = SensorFrame(s, "sensor.target", where, true);
+    sensor.beam_angles = ParseFan(s, where);
+    RefuseRangerSettings(settings, where, *c);
+    return;
+  }
+  if (sensor.kind == "contact" || sensor.kind == "socket") {  // a tool point, nothing read
     const RigidTransform point = SensorFrame(s, "sensor.target", where, true);
     if (!point.rotation.isIdentity(0))
-      throw InputError(where("sensor.target"),
-                       "sensor.kind contact touches with a point: give [x, y, z] (m, tool frame)");
+      throw InputError(
+          where("sensor.target"),
+          "sensor.kind " + sensor.kind + " seats a point: give [x, y, z] (m, tool frame)");
     sensor.tracker.targets = {point.translation};
+    if (sensor.kind == "socket") ParseSockets(s, where, &sensor);
     RefuseRangerSettings(settings, where, *c);
     return;
   }
@@ -1347,7 +1433,10 @@ Json CellIdentity(const Json& settings) {
   }
   DropNeutralKeys(&id);
   // sensor came with the tracker kinds: the ranger's default section is left out.
-  if (id.contains("sensor") && id["sensor"] == StudyDefaults()["sensor"]) id.erase("sensor");
+  if (id.contains("sensor") && id["sensor"].is_object() &&
+      WithoutLateSensorDefaults(id["sensor"]) ==
+          WithoutLateSensorDefaults(StudyDefaults()["sensor"]))
+    id.erase("sensor");
   // tool_link and base_link came with URDF robots: left out when empty (as if not given).
   for (const char* key : {"tool_link", "base_link"})
     if (id.contains(key) && id[key] == "") id.erase(key);

@@ -1,14 +1,15 @@
-// The trial pipeline of a tracker cell (sensor.kind point or pose) and of a contact cell: the
-// ranger's steps (trial_pipeline.h) with a measurement kind (point_measurement.h,
-// pose_measurement.h, contact_measurement.h) in place of the ranger's model. Per cell: the pool is
-// drawn over the workspace (a tracker sees its target anywhere: no beam has to hit) or, for
-// contacts, aimed at the planes and seated on the nominal arm; the terms the pool cannot separate
-// are fixed or the cell is marked rank deficient; the design is a block selection
-// (block_selection.h: a configuration brings 1, 3 or 6 values); the covariance σ²(GᵀWG)⁻¹ is
-// predicted at the nominal model (W: the repetitions, and (σ/σ_angle)² on angle rows). Per trial:
-// the tracker on the true arm reads the design (its exact values cached for a fixed truth), or
-// each contact is seated on the true arm with the trial's play; lrcal's LM fits the values on
-// the kind's evaluator; the identified arm is judged on the validation poses as the ranger's is.
+// The trial pipeline of the cells of every sensor but the ranger (sensor.kind scanner, point,
+// pose, contact, socket): the ranger's steps (trial_pipeline.h) with a measurement kind in place
+// of the ranger's model. Per cell: the pool is drawn over the workspace (a tracker sees its target
+// anywhere: no beam has to hit), or aimed at the planes and kept where every beam of a scanner's
+// fan meets its plane, or seated on the nominal arm (contacts on the planes, a ball in its
+// sockets); the terms the pool cannot separate are fixed or the cell is marked rank deficient;
+// the design is a block selection (block_selection.h: a configuration brings its kind's rows);
+// the covariance σ²(GᵀWG)⁻¹ is predicted at the nominal model (W: the repetitions, and
+// (σ/σ_angle)² on angle rows). Per trial: the sensor on the true arm reads the design (its exact
+// values cached for a fixed truth), or each contact or ball is seated on the true arm with the
+// trial's play; lrcal's LM fits the values on the kind's evaluator; the identified arm is judged
+// on the validation poses as the ranger's is.
 #include <cmath>
 #include <memory>
 #include <string>
@@ -16,10 +17,13 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/design/block_selection.h"
+#include "lrcal/design/measurable_pool.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/scanner_measurement.h"
+#include "lrcal/measurement/socket_measurement.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal {
@@ -38,25 +42,57 @@ std::shared_ptr<const RobotModel> ArmWithValues(const RobotModel& robot,
   return arm;
 }
 
-void BuildTrackerKind(const CellSettings& s, CellContext* c) {
+// The cell's sensor on `arm` with every term but identification.fix: on the nominal arm the
+// truth's template, on a trial's true arm the sensor that simulates its values.
+std::unique_ptr<MeasurementKind> SensorKindOn(const CellSettings& s, const CellContext& c,
+                                              const RobotModel& arm) {
   const std::string source = "identification.fix";
-  if (s.sensor.kind == "contact") {
+  const StudySensor& sensor = s.sensor;
+  if (sensor.kind == "contact") {
     ContactSetup setup;
-    setup.planes = c->planes;
-    setup.plane_terms = CellPlaneTerms(s, c->planes.size());
-    setup.tool_point = s.sensor.tracker.targets.at(0);
-    setup.flush = s.sensor.flush;
-    c->contact = std::make_unique<ContactMeasurement>(*c->robot, setup, s.fixed, source);
-    c->kind = c->contact->Without({});
-  } else if (s.sensor.kind == "pose")
-    c->tracker = std::make_unique<PoseMeasurement>(*c->robot, s.sensor.tracker, s.fixed, source);
-  else
-    c->tracker = std::make_unique<PointMeasurement>(*c->robot, s.sensor.tracker, s.fixed, source);
-  if (c->tracker) c->kind = c->tracker->Without({});
+    setup.planes = c.planes;
+    setup.plane_terms = CellPlaneTerms(s, c.planes.size());
+    setup.tool_point = sensor.tracker.targets.at(0);
+    setup.flush = sensor.flush;
+    return std::make_unique<ContactMeasurement>(arm, setup, s.fixed, source);
+  }
+  if (sensor.kind == "scanner") {
+    ScannerSetup setup;
+    setup.planes = c.planes;
+    setup.plane_terms = CellPlaneTerms(s, c.planes.size());
+    setup.origin = sensor.scanner_frame.translation;
+    setup.orientation = sensor.scanner_frame.rotation;
+    setup.beam_angles = sensor.beam_angles;
+    setup.range = c.ranger;
+    return std::make_unique<ScannerMeasurement>(arm, setup, s.fixed, source);
+  }
+  if (sensor.kind == "socket") {
+    SocketSetup setup;
+    setup.ids.clear();
+    for (std::size_t k = 0; k < sensor.sockets.size(); ++k)
+      setup.ids.push_back(static_cast<int>(k));
+    setup.positions = sensor.sockets;
+    setup.tool_point = sensor.tracker.targets.at(0);
+    setup.distances = sensor.socket_distances;
+    return std::make_unique<SocketMeasurement>(arm, setup, s.fixed, source);
+  }
+  // A tracker on a true arm reads its orientations in the nominal kind's chart.
+  if (c.sensor_kind)
+    return TrackerKindOn(arm, dynamic_cast<const PointMeasurement&>(*c.sensor_kind));
+  if (sensor.kind == "pose")
+    return std::make_unique<PoseMeasurement>(arm, sensor.tracker, s.fixed, source);
+  return std::make_unique<PointMeasurement>(arm, sensor.tracker, s.fixed, source);
+}
+
+void BuildTrackerKind(const CellSettings& s, CellContext* c) {
+  c->sensor_kind = SensorKindOn(s, *c, *c->robot);
+  c->seated = s.sensor.kind == "contact" || s.sensor.kind == "socket";
+  c->kind = c->sensor_kind->Without({});
   // The arm's link terms alone: the validation poses' Jacobian (ValidationPoseJacobian).
   c->model = std::make_unique<MeasurementModel>(
       *c->robot, c->planes,
-      MakeParameterSet(*c->robot, std::vector<PlaneTerms>(c->planes.size()), {}, source));
+      MakeParameterSet(*c->robot, std::vector<PlaneTerms>(c->planes.size()), {},
+                       "identification.fix"));
 }
 
 void MapLinkValues(CellContext* c) {
@@ -79,21 +115,49 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
   o.min_jacobian_singular_value = s.min_singular_value;
   o.require_beam_hit = false;
   const Plane tag = c->planes[0];  // targets are tagged 0: the one target
-  if (c->contact) {
-    // Starts aimed at their planes (the ranger's pool: the tool faces the plane within reach),
-    // moved until the nominal tool point touches: the design is chosen where contacts are.
-    SamplingOptions aimed = o;
-    aimed.require_beam_hit = true;
-    const TargetedConfigurations starts =
-        !s.pool_file.empty()
-            ? ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, &c->planes)
-            : SampleConfigurations(*c->robot, c->planes, PerPlaneCounts(s, c->planes, s.pool_size),
-                                   RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),
-                                   aimed, &c->pool_report);
-    c->pool = c->contact->LinearisationConfigurations(starts);
-  } else if (!s.pool_file.empty()) {
-    AcceptPoolFile(s, ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot, nullptr),
-                   c);
+  // Aimed at their planes (the ranger's pool: the tool faces the plane within reach).
+  SamplingOptions aimed = o;
+  aimed.require_beam_hit = true;
+  const std::string& kind = s.sensor.kind;
+  if (!s.pool_file.empty()) {
+    TargetedConfigurations file =
+        ReadStudyConfigurations(study, s.pool_file, "pool.file", *c->robot,
+                                kind == "contact" || kind == "scanner" ? &c->planes : nullptr);
+    if (kind == "contact")  // seated on the nominal arm: the design is chosen where contacts are
+      file = SeatedConfigurations(*c->robot, *c->kind, file);
+    if (kind == "scanner") {  // where every beam meets its plane
+      const std::vector<double> zero(static_cast<std::size_t>(c->kind->num_parameters()), 0.0);
+      const std::vector<std::string> reasons = c->kind->MissReasons(file, zero.data());
+      std::vector<int> kept;
+      for (int i = 0; i < file.size(); ++i)
+        if (reasons[static_cast<std::size_t>(i)] == "ok") kept.push_back(i);
+      file = file.Subset(kept);
+    }
+    AcceptPoolFile(s, std::move(file), c);
+  } else if (kind == "contact") {
+    // Moved until the nominal tool point touches: the design is chosen where contacts are.
+    // Those that seat within the joint ranges (a start that cannot is left out).
+    SamplingReport drawn;
+    c->pool = SeatedConfigurations(
+        *c->robot, *c->kind,
+        SampleConfigurations(*c->robot, c->planes, PerPlaneCounts(s, c->planes, s.pool_size),
+                             RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool), aimed,
+                             &drawn),
+        &c->pool_report);
+    c->pool_report.attempts = drawn.attempts;
+    if (c->pool.size() < s.select_count)
+      throw InputError("pool.size", std::to_string(c->pool.size()) + " of " +
+                                        std::to_string(s.pool_size) +
+                                        " drawn configurations seat on their planes: fewer "
+                                        "than selection.count = " +
+                                        std::to_string(s.select_count));
+  } else if (kind == "scanner") {
+    c->pool = SampleScannerConfigurations(dynamic_cast<const ScannerMeasurement&>(*c->sensor_kind),
+                                          PerPlaneCounts(s, c->planes, s.pool_size), c->seed,
+                                          c->pool_stream, o, &c->pool_report);
+  } else if (kind == "socket") {
+    c->pool = SampleSocketConfigurations(dynamic_cast<const SocketMeasurement&>(*c->sensor_kind),
+                                         s.pool_size, c->seed, c->pool_stream, o, &c->pool_report);
   } else {
     c->pool = SampleConfigurations(*c->robot, tag, s.pool_size,
                                    RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),
@@ -117,21 +181,31 @@ void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
   c->nominal_validation =
       ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
           .stats;
-  if (c->contact) {
-    c->true_contact = std::make_unique<ContactMeasurement>(*c->true_robot, c->contact->setup());
-    return;
-  }
-  c->true_tracker = TrackerKindOn(*c->true_robot, *c->tracker);
-  const std::vector<double> zero(static_cast<std::size_t>(c->true_tracker->num_parameters()), 0.0);
-  c->design_true_values.resize(static_cast<std::size_t>(c->design.configs.size() *
-                                                        c->true_tracker->rows_per_configuration()));
-  c->true_tracker->Bind(c->design.configs)
+  c->true_kind = SensorKindOn(s, *c, *c->true_robot);
+  if (c->seated) return;  // seated anew in every trial
+  const std::vector<double> zero(static_cast<std::size_t>(c->true_kind->num_parameters()), 0.0);
+  c->design_true_values.resize(
+      static_cast<std::size_t>(c->design.configs.size() * c->true_kind->rows_per_configuration()));
+  c->true_kind->Bind(c->design.configs)
       ->Predict(zero.data(), c->design_true_values.data(), nullptr);
-  c->design_true_reasons = c->true_tracker->MissReasons(c->design.configs, zero.data());
+  c->design_true_reasons = c->true_kind->MissReasons(c->design.configs, zero.data());
 }
 
-// The noisy values the tracker on the true arm reads at the design (each the mean of the
-// cell's repetitions, drawn directly), with its angle rows weighed.
+// Each start seated by the sensor on the true arm (a contact or socket kind) with the play of
+// the noise.
+void SeatOnTruth(const MeasurementKind& truth, const TargetedConfigurations& starts,
+                 const NoiseModel& noise, const RandomStream& stream, MeasuredValues* values) {
+  if (const auto* socket = dynamic_cast<const SocketMeasurement*>(&truth)) {
+    SimulateSocketMeasurements(*socket, starts, noise, stream, values);
+    return;
+  }
+  SimulateContactMeasurements(dynamic_cast<const ContactMeasurement&>(truth), starts, noise, stream,
+                              values);
+}
+
+// The noisy values the sensor on the true arm reads at the design (each the mean of the cell's
+// repetitions, drawn directly), with its angle rows weighed; or, for a seated kind, the design's
+// configurations seated on the true arm with the trial's play.
 void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTruth& truth,
                            MeasuredValues* values) {
   const CellSettings& s = c.cell->typed;
@@ -143,23 +217,21 @@ void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTru
     SimulateTreeValues(c, truth, noise, stream, values);
     return;
   }
-  if (c.contact) {  // seated on the true arm with the play of the noise, each trial anew
-    if (!s.truth.random) {
-      SimulateContactMeasurements(*c.true_contact, c.design.configs, noise, stream, values);
-      return;
-    }
-    const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
-    SimulateContactMeasurements(ContactMeasurement(*arm, c.contact->setup()), c.design.configs,
-                                noise, stream, values);
+  if (!s.truth.random && c.seated) {
+    SeatOnTruth(*c.true_kind, c.design.configs, noise, stream, values);
     return;
   }
   if (!s.truth.random) {
-    AddMeasurementNoise(*c.true_tracker, c.design_true_values, c.design_true_reasons,
-                        c.design.configs, noise, stream, values);
+    AddMeasurementNoise(*c.true_kind, c.design_true_values, c.design_true_reasons, c.design.configs,
+                        noise, stream, values);
     return;
   }
   const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
-  SimulateMeasurements(*TrackerKindOn(*arm, *c.tracker), c.design.configs, noise, stream, values);
+  const std::unique_ptr<MeasurementKind> sensor = SensorKindOn(s, c, *arm);
+  if (c.seated)
+    SeatOnTruth(*sensor, c.design.configs, noise, stream, values);
+  else
+    SimulateMeasurements(*sensor, c.design.configs, noise, stream, values);
 }
 
 }  // namespace
@@ -216,7 +288,7 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
   if (!c->rank_deficient && design_report.full_rank()) {
     // The first linearisation of every tracker trial's fit (the design is the cell's own; a
     // contact trial's configurations are where the true arm touched, its own each trial).
-    if (!c->contact) {
+    if (!c->seated) {
       c->design_nominal.h = h;
       c->design_nominal.G = Gd;
       c->design_nominal.Factorize();
@@ -290,7 +362,11 @@ TrackerFit FitTrackerTrial(const CellContext& c, TrialWorkspace* ws) {
     fit.sigma_hat = std::isfinite(summary.sigma_hat) ? summary.sigma_hat : 0.0;
     return fit;
   }
-  if (c.contact) {  // the contacts are where the true arm touched: this trial's own
+  // The design's evaluator and nominal linearisation serve a trial that measured the whole
+  // design; seated configurations (where the true arm seated) and a design some of whose
+  // configurations missed (a scanner's beam off its plane on the true arm) are the trial's own.
+  const bool whole_design = !c.seated && values.configs.size() == c.design.configs.size();
+  if (!whole_design) {
     ws->evaluator = c.kind->Bind(values.configs);
     ws->evaluator_cell = nullptr;
   } else if (ws->evaluator_cell != &c) {
@@ -301,7 +377,7 @@ TrackerFit FitTrackerTrial(const CellContext& c, TrialWorkspace* ws) {
   const std::vector<double> weights = values.RowWeights(k);
   const LevenbergMarquardt::Result r =
       ws->solver.Solve(*ws->evaluator, values.y.data(), weights.data(), options, &ws->e,
-                       c.contact ? nullptr : &c.design_nominal);
+                       whole_design ? &c.design_nominal : nullptr);
   fit.termination = r.termination;
   fit.iterations = r.iterations;
   const auto rows = static_cast<int>(values.y.size());

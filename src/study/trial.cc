@@ -165,7 +165,7 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
     c->planes = s.planes;
   } else if (file.planes) {
     c->planes = *file.planes;
-  } else if (s.sensor.kind == "point" || s.sensor.kind == "pose") {
+  } else if (s.sensor.kind == "point" || s.sensor.kind == "pose" || s.sensor.kind == "socket") {
     // A tracker reads no plane: the horizontal plane through the base only tags the sampled
     // configurations and completes the arm's model; nothing is measured on it.
     c->planes = PlaneSet(Plane{});

@@ -140,19 +140,20 @@ struct CellContext {
   /// The robot file's `tolerances:` (robot_file.h), its planes' only when the cell's planes are
   /// the file's: the held terms' σ in the stated total, as `identify` uses them.
   PriorSigmas tolerances;
-  /// A tracker cell (sensor.kind point or pose; tracker_trial.cc): its kind on the nominal arm
-  /// with every term (the truth's template), the kind estimated (after any terms fixed for rank),
-  /// and per estimated term its link value index (-1: the instrument's or the target's). `model`
-  /// then holds the arm's link terms only (the validation poses' Jacobian). Null for the ranger.
-  std::unique_ptr<PointMeasurement> tracker;
-  /// A contact cell's kind with every term (its truth's template); `kind` as for a tracker.
-  std::unique_ptr<ContactMeasurement> contact;
+  /// A cell of another sensor than the ranger (tracker_trial.cc): its kind on the nominal arm
+  /// with every term but identification.fix (the truth's template), the kind estimated (after
+  /// any terms fixed for rank), and per estimated term its link value index (-1: a term of the
+  /// sensor: its instrument, target, scanner frame, plane or socket). `model` then holds the
+  /// arm's link terms only (the validation poses' Jacobian). Null for the ranger.
+  std::unique_ptr<MeasurementKind> sensor_kind;
   std::unique_ptr<MeasurementKind> kind;
   std::vector<int> kind_link_values;
-  /// A tracker cell's fixed truth: the true arm and the tracker on it.
+  /// The kind seats its configurations (contact, socket): a trial's are where the true arm
+  /// seated from the design, its own; there is no nominal linearisation to share.
+  bool seated = false;
+  /// A fixed truth: the true arm and the sensor on it.
   std::shared_ptr<const RobotModel> true_robot;
-  std::unique_ptr<PointMeasurement> true_tracker;
-  std::unique_ptr<ContactMeasurement> true_contact;
+  std::unique_ptr<MeasurementKind> true_kind;
   /// The fixed truth's exact values at the design and why none misses ("ok"): each trial adds
   /// its noise (AddMeasurementNoise).
   std::vector<double> design_true_values;

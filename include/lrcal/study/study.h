@@ -25,6 +25,7 @@
 #include "lrcal/measurement/parameter_set.h"
 #include "lrcal/measurement/plane.h"
 #include "lrcal/measurement/point_measurement.h"
+#include "lrcal/measurement/socket_measurement.h"
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/truth_options.h"
 
@@ -34,13 +35,24 @@ namespace lrcal {
 /// the paper's set-up and lrcal's default; a tracker's point or pose (point_measurement.h,
 /// pose_measurement.h) reads a target on the tool in an instrument's frame, whose six terms and
 /// the target's are estimated with the arm's; a contact (contact_measurement.h) seats a tool point
-/// on the cell's planes and reads nothing.
+/// on the cell's planes and reads nothing; a scanner (scanner_measurement.h) is a fan of ranger
+/// beams on the tool, each reading its distance to the cell's plane; a socket
+/// (socket_measurement.h) seats a tool point in fixed sockets, whose positions are estimated.
 struct StudySensor {
-  std::string kind = "ranger";  ///< ranger, point, pose or contact
-  /// point, pose: the instrument's frame in B and the one target; contact: targets[0] is the
-  /// tool point that touches the cell's planes (m, tool frame).
+  std::string kind = "ranger";  ///< ranger, scanner, point, pose, contact or socket
+  /// point, pose: the instrument's frame in B and the one target; contact, socket: targets[0]
+  /// is the tool point that touches the cell's planes or sits in its sockets (m, tool frame).
   PointSetup tracker;
-  bool flush = false;      ///< contact: every contact flush (two more values each)
+  bool flush = false;  ///< contact: every contact flush (two more values each)
+  /// scanner: its frame S in the tool frame (sensor.target: the beams' origin, and the fan in
+  /// S's x–z plane) and each beam's angle from S's z axis (rad: sensor.beams spread evenly
+  /// over ±sensor.fan_deg).
+  RigidTransform scanner_frame;
+  std::vector<double> beam_angles{0.0};
+  /// socket: the sockets' true (and nominal) positions in B (m; sensor.sockets, ids 0, 1, …
+  /// in order) and the known distances between them (sensor.socket_distances).
+  std::vector<Eigen::Vector3d> sockets;
+  std::vector<SocketDistance> socket_distances;
   double sigma_angle = 0;  ///< rad, pose: σ of each orientation component of a reading
   /// The campaign cost of one reading, in the study's own unit (sensor.cost_per_reading); a
   /// cell's campaign costs selection.count × noise.repetitions × this.
