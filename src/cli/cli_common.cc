@@ -337,6 +337,20 @@ void RefuseRangerOptions(const po::variables_map& vm, const std::string& sensor,
                      "--target, --fix)"));
 }
 
+std::vector<Eigen::Vector3d> ResolveSocketPositions(const po::variables_map& vm) {
+  std::vector<Eigen::Vector3d> positions;
+  if (!vm.count("socket")) return positions;
+  for (const std::string& text : vm["socket"].as<std::vector<std::string>>()) {
+    const std::vector<std::string> parts = SplitList(text);
+    double v[3];
+    if (parts.size() != 3 || !ParseDecimal(parts[0], &v[0]) || !ParseDecimal(parts[1], &v[1]) ||
+        !ParseDecimal(parts[2], &v[2]))
+      throw InputError("--socket", "'" + CellExcerpt(text) + "': expected x,y,z (m)");
+    positions.emplace_back(v[0], v[1], v[2]);
+  }
+  return positions;
+}
+
 std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) {
   std::vector<SocketDistance> distances;
   if (!vm.count("socket-distance")) return distances;
@@ -345,10 +359,6 @@ std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm) 
   return distances;
 }
 
-namespace {
-
-// The one tool point of --target for a constraint kind (socket, contact); in a mixed run --probe
-// if given, else --target unless a tracker's terms take it.
 Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string& sensor,
                                  bool in_mix) {
   if (in_mix && vm.count("probe"))
@@ -374,8 +384,6 @@ Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string&
                      "--sensor " + sensor + " takes one tool point as x,y,z (m, tool frame)");
   return point.targets[0];
 }
-
-}  // namespace
 
 std::unique_ptr<ContactMeasurement> MakeContactKind(const RobotModel& robot, const PlaneSet& planes,
                                                     bool flush, const po::variables_map& vm,

@@ -110,6 +110,14 @@ PointSetup ResolvePointSetup(const po::variables_map& vm);
 std::unique_ptr<PointMeasurement> MakeTrackerKind(const RobotModel& robot,
                                                   const std::string& sensor,
                                                   const po::variables_map& vm, bool in_mix = false);
+/// The one tool point of --target (x,y,z, m, tool frame) of a constraint kind (`sensor`: socket,
+/// contact); in a mixed run (`in_mix`) --probe if given, else --target unless a tracker's terms
+/// take it. Refuses --instrument (InputError naming the option).
+Eigen::Vector3d ResolveToolPoint(const po::variables_map& vm, const std::string& sensor,
+                                 bool in_mix);
+/// --socket x,y,z (repeatable; m, base frame): sockets' positions, in order of their ids
+/// (InputError naming --socket for a value that is not three numbers).
+std::vector<Eigen::Vector3d> ResolveSocketPositions(const po::variables_map& vm);
 /// --socket-distance A,B=METRES (repeatable): the known distances between sockets.
 std::vector<SocketDistance> ResolveSocketDistances(const po::variables_map& vm);
 /// The socket kind on `robot` for `data` (its socket ids; the sockets' nominal positions are the

@@ -241,23 +241,15 @@ int SocketSimulate(const po::variables_map& vm) {
                      "--sensor socket simulates sockets at known true positions: "
                      "give --socket x,y,z (m, base frame) for each socket id of the "
                      "configurations, in ascending order of id");
-  const auto& texts = vm["socket"].as<std::vector<std::string>>();
-  if (texts.size() != starts.ids.size())
+  const std::vector<Eigen::Vector3d> positions = ResolveSocketPositions(vm);
+  if (positions.size() != starts.ids.size())
     throw InputError("--socket", "the configurations name " + std::to_string(starts.ids.size()) +
-                                     " socket(s); " + std::to_string(texts.size()) +
+                                     " socket(s); " + std::to_string(positions.size()) +
                                      " --socket positions given");
   const RobotModel true_robot = rig.truth.TrueRobot(rig.robot);
   SocketSetup setup;
   setup.ids = starts.ids;
-  setup.positions.clear();
-  for (const std::string& text : texts) {
-    const std::vector<std::string> parts = SplitList(text);
-    double v[3];
-    if (parts.size() != 3 || !ParseDecimal(parts[0], &v[0]) || !ParseDecimal(parts[1], &v[1]) ||
-        !ParseDecimal(parts[2], &v[2]))
-      throw InputError("--socket", "'" + CellExcerpt(text) + "': expected x,y,z (m)");
-    setup.positions.emplace_back(v[0], v[1], v[2]);
-  }
+  setup.positions = positions;
   const PointSetup point = ResolvePointSetup(vm);
   setup.tool_point = point.targets[0];
   setup.distances = ResolveSocketDistances(vm);

@@ -5,10 +5,13 @@
 #include "lrcal/core/text_table.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/design_choice.h"
+#include "lrcal/design/measurable_pool.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/io/csv.h"
+#include "lrcal/io/socket_data.h"
 #include "lrcal/measurement/point_measurement.h"
 #include "lrcal/measurement/ranger_measurement.h"
+#include "lrcal/measurement/socket_measurement.h"
 #include "lrcal/measurement/tree_measurement.h"
 
 namespace lrcal::cli {
@@ -36,12 +39,14 @@ void AddDesignOptions(po::options_description& o) {
       "ranger terms to estimate: none, offset, scale, offset,scale (reading = (1+s) h + o)")(
       "estimate-plane", po::value<std::string>()->default_value("none"), "plane terms in the set")(
       "fix", po::value<std::string>(), "parameters left out, comma-separated")(
-      "out", po::value<std::string>(), "write the chosen configurations (CSV)")(
-      "sensor", po::value<std::string>()->default_value("ranger"),
-      "ranger (a distance to the plane), or a tracker: point (a reflector) or pose (a 6-D "
-      "probe), its configurations chosen as blocks of 3 or 6 values, anywhere in the workspace, "
-      "the terms the pool cannot separate held at nominal");
-  AddTrackerGeometryOptions(o);
+      "out", po::value<std::string>(),
+      "write the chosen configurations (CSV; a socket column for --sensor socket)");
+  // Every sensor but the ranger: its configurations chosen as blocks of its values per
+  // configuration, the terms the pool cannot separate held at nominal.
+  AddSensorOptions(o);
+  o.add_options()("socket", po::value<std::vector<std::string>>()->composing(),
+                  "--sensor socket with --generate: a socket's nominal position as x,y,z (m, "
+                  "base frame), one per socket id 0, 1, ... in order");
   AddFrameTermOptions(o);
   AddSettingOptions(o, SelectionOptions::Settings(), {"samples", "restarts"});
   AddSettingOptions(o, DesignRequest::Settings());
@@ -94,6 +99,137 @@ ResolvedPool ResolvePool(const po::variables_map& vm, const Setup& setup, std::u
   return pool;
 }
 
+// A sensor other than the ranger: its kind with every term (--fix aside) and its candidates;
+// a socket design's socket ids, which its output names.
+struct KindPool {
+  std::unique_ptr<MeasurementKind> kind;
+  ResolvedPool pool;
+  std::vector<int> socket_ids;
+};
+
+// The configurations of `drawn` where `kind` measures at its nominal terms; the others are
+// named on stderr (a pool file's line) and counted in the report.
+TargetedConfigurations Measurable(const MeasurementKind& kind, const TargetedConfigurations& drawn,
+                                  const std::string& path, SamplingReport* report) {
+  const std::vector<double> zero(static_cast<std::size_t>(kind.num_parameters()), 0.0);
+  const std::vector<std::string> reasons = kind.MissReasons(drawn, zero.data());
+  std::vector<int> kept;
+  for (int i = 0; i < drawn.size(); ++i) {
+    if (reasons[static_cast<std::size_t>(i)] == "ok") {
+      kept.push_back(i);
+      continue;
+    }
+    ++report->rejected[reasons[static_cast<std::size_t>(i)]];
+    std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
+              << ") rejected: " << reasons[static_cast<std::size_t>(i)] << "\n";
+  }
+  report->requested = report->attempts = drawn.size();
+  report->accepted = static_cast<int>(kept.size());
+  return drawn.Subset(kept);
+}
+
+// --sensor socket: the sockets of a pool file (its socket column; their nominal positions the
+// nominal arm's mean ball centre) or of --socket for --generate.
+KindPool SocketKindPool(const po::variables_map& vm, const Setup& setup, std::uint64_t seed,
+                        const SamplingOptions& sampling) {
+  const RobotModel& robot = setup.rig.robot;
+  KindPool kp;
+  if (vm.count("pool")) {
+    if (vm.count("socket"))
+      throw InputError("--socket",
+                       "the sockets of --pool are its socket column's; --socket "
+                       "places them for --generate");
+    const std::string path = vm["pool"].as<std::string>();
+    const SocketData data = ReadSocketData(path, robot);
+    kp.socket_ids = data.ids;
+    kp.kind = MakeSocketKind(robot, data, vm);
+    kp.pool.configs = SeatedConfigurations(robot, *kp.kind, data.values.configs, &kp.pool.report);
+    kp.pool.source = path + ": " + kp.pool.report.ToString() + ", seated in their sockets";
+    return kp;
+  }
+  if (!vm.count("socket"))
+    throw InputError("--socket",
+                     "--sensor socket with --generate needs the sockets' nominal "
+                     "positions: give --socket x,y,z (m, base frame) per socket");
+  SocketSetup socket;
+  socket.positions = ResolveSocketPositions(vm);
+  socket.ids.clear();
+  for (std::size_t k = 0; k < socket.positions.size(); ++k)
+    socket.ids.push_back(static_cast<int>(k));
+  socket.tool_point = ResolveToolPoint(vm, "socket", false);
+  socket.distances = ResolveSocketDistances(vm);
+  kp.socket_ids = socket.ids;
+  const auto kind = std::make_unique<SocketMeasurement>(robot, socket, FixList(vm, robot), "--fix");
+  kp.pool.configs = SampleSocketConfigurations(*kind, vm["generate"].as<int>(), seed, 0, sampling,
+                                               &kp.pool.report);
+  kp.pool.source = "generated: " + kp.pool.report.ToString() + ", seated in their sockets";
+  kp.kind = kind->Without({});
+  return kp;
+}
+
+// The kind and candidates of --sensor scanner, point, pose, contact or socket: a pool file, or
+// --generate draws (anywhere for a tracker; aimed at the planes and kept where every beam meets
+// its plane for a scanner; aimed and seated on the planes for contacts; seated in the sockets).
+KindPool ResolveKindPool(const po::variables_map& vm, const Setup& setup, const std::string& sensor,
+                         std::uint64_t seed) {
+  const RobotModel& robot = setup.rig.robot;
+  if (vm.count("pool") == vm.count("generate"))
+    throw InputError("--pool/--generate", "give exactly one: a pool CSV or a number to generate");
+  const int n = vm.count("generate") ? vm["generate"].as<int>() : 1;
+  if (n < 1 || n > 100000)
+    throw InputError("--generate", "expected 1 to 100,000 candidates, got " + std::to_string(n));
+  SamplingOptions sampling;
+  sampling.ranger = setup.rig.ranger;
+  sampling.require_beam_hit = sensor == "contact";
+  if (sensor == "socket") return SocketKindPool(vm, setup, seed, sampling);
+  KindPool kp;
+  if (sensor == "scanner")
+    kp.kind = MakeScannerKind(robot, setup.planes, setup.rig.ranger, vm);
+  else if (sensor == "contact")
+    kp.kind = MakeContactKind(robot, setup.planes, vm["flush"].as<bool>(), vm);
+  else
+    kp.kind = MakeTrackerKind(robot, sensor, vm);
+  const std::vector<int> counts(static_cast<std::size_t>(setup.planes.size()), n);
+  TargetedConfigurations drawn;
+  if (vm.count("pool")) {
+    const std::string path = vm["pool"].as<std::string>();
+    drawn = ReadRobotConfigurations(
+        path, robot, sensor == "point" || sensor == "pose" ? nullptr : &setup.planes);
+    kp.pool.configs = sensor == "contact"
+                          ? SeatedConfigurations(robot, *kp.kind, drawn, &kp.pool.report)
+                          : Measurable(*kp.kind, drawn, path, &kp.pool.report);
+    kp.pool.source = path + ": " + kp.pool.report.ToString();
+  } else if (sensor == "scanner") {
+    kp.pool.configs = SampleScannerConfigurations(dynamic_cast<const ScannerMeasurement&>(*kp.kind),
+                                                  counts, seed, 0, sampling, &kp.pool.report);
+    kp.pool.source = "generated: " + kp.pool.report.ToString() + ", every beam on its plane";
+  } else {
+    drawn = SampleConfigurations(robot, setup.planes, counts,
+                                 RandomStream(seed, 0, 0, RandomPurpose::kPool), sampling,
+                                 &kp.pool.report);
+    if (sensor == "contact")  // seated on their planes: the contacts' configurations
+      kp.pool.configs = SeatedConfigurations(robot, *kp.kind, drawn, &kp.pool.report);
+    else
+      kp.pool.configs = std::move(drawn);
+    kp.pool.source = "generated: " + kp.pool.report.ToString();
+  }
+  if (kp.pool.configs.size() == 0) throw InputError("--pool", "no usable candidate configurations");
+  return kp;
+}
+
+// The chosen configurations: q1..qN (and plane with several), or with a socket column.
+void WriteChosen(const std::string& path, const KindPool& kp,
+                 const TargetedConfigurations& chosen) {
+  if (kp.socket_ids.empty()) {
+    WriteConfigurations(path, chosen);
+    return;
+  }
+  MeasuredValues values{chosen,
+                        std::vector<double>(static_cast<std::size_t>(3 * chosen.size()), 0.0),
+                        std::vector<int>(static_cast<std::size_t>(chosen.size()), 1)};
+  WriteSocketData(path, kp.socket_ids, values);
+}
+
 // The request of the options: criterion I weighs by --poses, else by --workspace poses.
 // `model` null: a tree's design, which refuses I before.
 DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel* model,
@@ -126,19 +262,27 @@ DesignRequest ResolveRequest(const po::variables_map& vm, const MeasurementModel
 
 }  // namespace
 
-// --sensor: the ranger or a tracker; a tracker takes none of the ranger's terms.
+// --sensor: one kind (a mixed design is not chosen yet); a kind other than the ranger takes
+// none of the ranger's terms (a scanner and a contact take --estimate-plane).
 std::string DesignSensor(const po::variables_map& vm) {
-  const std::string sensor = vm["sensor"].as<std::string>();
-  if (sensor != "ranger" && sensor != "point" && sensor != "pose")
-    throw InputError("--sensor", "'" + CellExcerpt(sensor) +
-                                     "': lrcal design chooses for ranger, point or pose (the "
-                                     "scanner, contact and socket kinds are not designed yet)");
-  if (sensor != "ranger")
+  const std::vector<std::string> sensors = ResolveSensors(vm);
+  if (sensors.size() != 1 || sensors[0] == "mixed")
+    throw InputError("--sensor", "'" + CellExcerpt(vm["sensor"].as<std::string>()) +
+                                     "': lrcal design chooses for one sensor at a time (ranger, "
+                                     "scanner, point, pose, socket or contact)");
+  const std::string sensor = sensors[0];
+  if (sensor == "scanner" || sensor == "contact")
+    RefuseRangerOptions(vm, sensor, {"estimate-ranger", "estimate-base", "estimate-tool"});
+  else if (sensor != "ranger")
     RefuseRangerOptions(vm, sensor,
                         {"estimate-ranger", "estimate-plane", "estimate-base", "estimate-tool"});
   else if ((vm.count("instrument") && !vm["instrument"].defaulted()) || vm.count("target"))
     throw InputError(vm.count("target") ? "--target" : "--instrument",
-                     "is a tracker's; give --sensor point or pose");
+                     "is a tracker's, a probe's or a ball's; give --sensor point, pose, contact "
+                     "or socket");
+  if (sensor != "socket" && vm.count("socket"))
+    throw InputError("--socket",
+                     "is the socket sensor's; --sensor " + sensor + " does not take it");
   return sensor;
 }
 
@@ -263,13 +407,18 @@ int DesignCommand(const std::vector<std::string>& args) {
   if (IsTreeRun(vm)) return TreeDesign(vm);
   const std::string sensor = DesignSensor(vm);
   const bool tracker = sensor != "ranger";
+  const bool planar = sensor == "ranger" || sensor == "scanner" || sensor == "contact";
   Setup setup{LoadRobot(vm), PlaneSet{}};
-  // A tracker reads no plane: without one, the horizontal plane through the base only tags the
-  // candidates (as a study's tracker cell does), so a URDF without planes needs no --plane.
-  setup.planes = tracker && !vm.count("plane") && !setup.rig.planes ? PlaneSet(Plane{})
+  // A tracker or a socket reads no plane: without one, the horizontal plane through the base
+  // only tags the candidates (as a study's tracker cell does), so a URDF without planes needs no
+  // --plane.
+  setup.planes = !planar && !vm.count("plane") && !setup.rig.planes ? PlaneSet(Plane{})
                                                                     : ResolvePlanes(setup.rig, vm);
   const std::uint64_t seed = ParseSeed(vm);
-  const ResolvedPool pool = ResolvePool(vm, setup, seed, !tracker);
+  KindPool kind_pool;
+  if (tracker) kind_pool = ResolveKindPool(vm, setup, sensor, seed);
+  const ResolvedPool& pool =
+      tracker ? kind_pool.pool : (kind_pool.pool = ResolvePool(vm, setup, seed, true));
   MeasurementModel model(setup.rig.robot, setup.planes,
                          tracker ? MakeParameterSet(setup.rig.robot, PlaneTerms{})
                                  : ResolveParameterSet(setup.rig.robot, vm, setup.planes.size()));
@@ -277,14 +426,13 @@ int DesignCommand(const std::vector<std::string>& args) {
   std::vector<std::string> held;
   DesignChoice choice;
   if (tracker) {
-    const std::unique_ptr<PointMeasurement> full = MakeTrackerKind(setup.rig.robot, sensor, vm);
-    held = AnalyzeIdentifiability(*full, pool.configs).suggested_fixed;
-    choice = ChooseDesign(*full->Without(held), pool.configs, request);
+    held = AnalyzeIdentifiability(*kind_pool.kind, pool.configs).suggested_fixed;
+    choice = ChooseDesign(*kind_pool.kind->Without(held), pool.configs, request);
   } else {
     choice = ChooseDesign(model, pool.configs, request);
   }
   if (vm.count("out"))
-    WriteConfigurations(vm["out"].as<std::string>(), pool.configs.Subset(choice.chosen.indices));
+    WriteChosen(vm["out"].as<std::string>(), kind_pool, pool.configs.Subset(choice.chosen.indices));
   if (ResolveFormat(vm) == Format::kJson) {
     Json j;
     j["pool"] = {{"size", pool.configs.size()},
@@ -299,8 +447,9 @@ int DesignCommand(const std::vector<std::string>& args) {
   }
   std::cout << "candidate pool: " << pool.source << "\n";
   if (tracker) {
-    std::cout << "sensor: " << sensor << " (" << (sensor == "pose" ? 6 : 3)
-              << " values per configuration); held at nominal, the pool cannot separate them:";
+    const int rows = kind_pool.kind->rows_per_configuration();
+    std::cout << "sensor: " << sensor << " (" << rows << (rows == 1 ? " value" : " values")
+              << " per configuration); held at nominal, the pool cannot separate them:";
     for (const std::string& name : held) std::cout << " " << name;
     std::cout << (held.empty() ? " none\n" : "\n");
   }

@@ -467,10 +467,77 @@ TEST(SensorDesignCli, ATrackersDesignIsChosenAsBlocksAndNamesWhatItHolds) {
       << out;
   EXPECT_EQ(testing::RunCommand(design + " --sensor point --estimate-plane offset", &out), 2);
   EXPECT_THAT(out, ::testing::HasSubstr("--estimate-plane: is the ranger's"));
-  EXPECT_EQ(testing::RunCommand(design + " --sensor scanner", &out), 2);
-  EXPECT_THAT(out, ::testing::HasSubstr("lrcal design chooses for ranger, point or pose"));
+  EXPECT_EQ(testing::RunCommand(design + " --sensor ranger,pose", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("lrcal design chooses for one sensor at a time"));
   EXPECT_EQ(testing::RunCommand(design, &out), 2);
   EXPECT_THAT(out, ::testing::HasSubstr("--instrument: is a tracker's"));
+}
+
+// `lrcal design --sensor scanner|contact|socket --generate`: candidates where the kind measures
+// (every beam of the fan on the plane; the probe's tip on the plane; the ball in its socket, the
+// sockets in turn), chosen as blocks; each chosen CSV is what `simulate` and `identify` of that
+// sensor read, and the socket design keeps its socket column.
+TEST(SensorDesignCli, ScannerContactAndSocketDesignsFeedTheirCampaigns) {
+  const std::string dir = testing::TempDir("sensor_design_kinds");
+  const std::string lrcal = testing::LrcalBinary();
+  const std::string design =
+      lrcal + " design --generate 60 --select 25 --method backward --seed 4 --format json";
+  const auto json = [](const std::string& out) {
+    return Json::parse(out.substr(out.find('{'), out.rfind('}') - out.find('{') + 1));
+  };
+  std::string out;
+  const std::string scanner = " --sensor scanner --beams 5 --fan-deg 10";
+  ASSERT_EQ(testing::RunCommand(design + scanner + " --out " + dir + "/s.csv", &out), 0) << out;
+  Json j = json(out);
+  EXPECT_EQ(j["sensor"], "scanner");
+  EXPECT_EQ(j["pool"]["size"], 60);
+  EXPECT_EQ(j["selected"].size(), 25u);
+  ASSERT_EQ(testing::RunCommand(lrcal + " simulate --configs " + dir + "/s.csv" + scanner +
+                                    " --out " + dir + "/scans.csv",
+                                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("left out")));  // every beam hits
+  const std::string contact = " --sensor contact --target 0,0,0.05";
+  ASSERT_EQ(testing::RunCommand(design + contact + " --out " + dir + "/c.csv", &out), 0) << out;
+  EXPECT_EQ(json(out)["sensor"], "contact");
+  ASSERT_EQ(testing::RunCommand(lrcal + " simulate --configs " + dir + "/c.csv" + contact +
+                                    " --out " + dir + "/contacts.csv",
+                                &out),
+            0)
+      << out;
+  const std::string sockets =
+      " --sensor socket --target 0,0,0.05 --socket-distance 0,1=0.05 --socket 1,0.5,0.3 "
+      "--socket 1,0.55,0.3 --socket 0.8,-0.6,0.4";
+  ASSERT_EQ(testing::RunCommand(design + sockets + " --out " + dir + "/k.csv", &out), 0) << out;
+  j = json(out);
+  EXPECT_EQ(j["sensor"], "socket");
+  EXPECT_FALSE(j["held_at_nominal"].empty());  // the sockets turn with the arm about z1, ...
+  std::string held;
+  for (const Json& name : j["held_at_nominal"])
+    held += (held.empty() ? "" : ",") + name.get<std::string>();
+  std::string header;
+  std::getline(std::ifstream(dir + "/k.csv") >> std::ws, header);
+  EXPECT_THAT(header, ::testing::HasSubstr(",socket"));
+  ASSERT_EQ(testing::RunCommand(lrcal + " simulate --configs " + dir + "/k.csv" + sockets +
+                                    " --sigma-mm 0.01 --out " + dir + "/seated.csv",
+                                &out),
+            0)
+      << out;
+  ASSERT_EQ(testing::RunCommand(lrcal +
+                                    " identify --sensor socket --target 0,0,0.05 "
+                                    "--socket-distance 0,1=0.05 --fix " +
+                                    held + " --data " + dir + "/seated.csv",
+                                &out),
+            0)
+      << out;
+  // A socket design draws its candidates in the sockets it is given; a file's are its own.
+  EXPECT_EQ(testing::RunCommand(design + " --sensor socket --target 0,0,0.05", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--socket: --sensor socket with --generate needs"));
+  EXPECT_EQ(testing::RunCommand(design + " --sensor point --socket 1,0,0", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("--socket: is the socket sensor's"));
+  EXPECT_EQ(testing::RunCommand(design + " --sensor socket --socket 1,0", &out), 2);
+  EXPECT_THAT(out, ::testing::HasSubstr("'1,0': expected x,y,z (m)"));
 }
 
 }  // namespace
