@@ -100,7 +100,8 @@ TargetedConfigurations SampleSocketConfigurations(const SocketMeasurement& socke
 
 TargetedConfigurations SeatedConfigurations(const RobotModel& robot, const MeasurementKind& kind,
                                             const TargetedConfigurations& starts,
-                                            SamplingReport* report) {
+                                            SamplingReport* report,
+                                            std::vector<std::string>* reasons) {
   constexpr double kSeated = 1e-9;  // m or rad: SeatOnPlane and SeatToolPoint reach 1e-12
   const TargetedConfigurations moved = kind.LinearisationConfigurations(starts);
   const int k = kind.rows_per_configuration();
@@ -111,18 +112,21 @@ TargetedConfigurations SeatedConfigurations(const RobotModel& robot, const Measu
   std::vector<double> q;
   SamplingReport r;
   r.requested = r.attempts = moved.size();
+  if (reasons) reasons->assign(static_cast<std::size_t>(moved.size()), "ok");
   for (int i = 0; i < moved.size(); ++i) {
     bool seated = true;
     for (int row = 0; row < k; ++row)
       seated = seated && std::abs(y[static_cast<std::size_t>(i * k + row)]) <= kSeated;
     q.assign(moved.q(i), moved.q(i) + moved.num_joints());
-    if (!seated) {
-      ++r.rejected["not seated"];
-    } else if (!WrapIntoJointRanges(robot, q.data())) {
-      ++r.rejected["outside the joint ranges"];
-    } else {
+    const char* reason = !seated                                 ? "not seated"
+                         : !WrapIntoJointRanges(robot, q.data()) ? "outside the joint ranges"
+                                                                 : nullptr;
+    if (!reason) {
       kept.Add(q, moved.target(i));
+      continue;
     }
+    ++r.rejected[reason];
+    if (reasons) (*reasons)[static_cast<std::size_t>(i)] = reason;
   }
   r.accepted = kept.size();
   if (report) *report = r;

@@ -32,6 +32,7 @@
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/design_choice.h"
 #include "lrcal/design/experiment_design.h"
+#include "lrcal/design/measurable_pool.h"
 #include "lrcal/identification/cross_validation.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/identification.h"
@@ -1202,8 +1203,15 @@ struct DesignArgs {
   double expected_angle_mrad, expected_length_mm;
   py::object plane_of = py::none();      // with several planes, each candidate's plane (from 1)
   std::string estimate_ranger = "none";  // as --estimate-ranger
-  std::string sensor = "ranger";         // or a tracker: point, pose (as --sensor)
+  std::string sensor = "ranger";         // or point, pose, scanner, contact, socket (as --sensor)
   py::object instrument = py::none(), targets = py::none();
+  // scanner: the fan and its frame; contact, socket: the tool point (flush contacts); socket:
+  // each candidate's socket id and the known distances.
+  long long beams = 1;
+  double fan_deg = 0;
+  py::object scanner = py::none(), tool_point = py::none();
+  bool flush = false;
+  py::object socket_of = py::none(), socket_distances = py::none();
 };
 
 DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model, int k) {
@@ -1239,31 +1247,91 @@ DesignRequest ToDesignRequest(const DesignArgs& a, const MeasurementModel& model
   return request;
 }
 
-// A tracker's design (sensor point or pose): blocks of its values from the whole pool (no beam
-// to hit), the terms the pool cannot separate held at nominal, as `lrcal design --sensor`.
-Design TrackerDesignPy(const RobotFile& rig, const Array& pool_q, int k,
-                       const std::string& estimate_plane, const py::object& fix,
-                       const DesignArgs& a) {
+// The kind of a design other than the ranger's and its usable candidates: a tracker sees the
+// whole pool; a scanner's candidates keep every beam on its plane; contacts and sockets are
+// seated on the nominal arm (within the joint ranges). `kept`: the pool rows used; rows left out
+// go to `rejected` with their reason.
+struct KindCandidates {
+  std::unique_ptr<MeasurementKind> kind;
+  TargetedConfigurations configs;
+  std::vector<int> kept;
+};
+
+KindCandidates KindCandidatesPy(const RobotFile& rig, const Array& pool_q,
+                                const py::object& plane_arg, const std::string& estimate_plane,
+                                const py::object& fix, const DesignArgs& a,
+                                std::vector<std::pair<int, std::string>>* rejected) {
   const RobotModel& robot = rig.robot;
+  KindCandidates out;
+  TargetedConfigurations drawn;
+  std::vector<std::string> reasons;
+  if (a.sensor == "scanner" || a.sensor == "contact") {
+    const PlaneSet planes = ResolvePlanes(rig, plane_arg);
+    drawn = ToContactConfigurations(robot, pool_q, a.plane_of, planes.size());
+    if (a.sensor == "scanner") {
+      out.kind = ToScannerKind(
+          rig, robot, planes,
+          {plane_arg, a.plane_of, a.scanner, fix, estimate_plane, a.beams, a.fan_deg});
+      const std::vector<double> zero(static_cast<std::size_t>(out.kind->num_parameters()), 0.0);
+      reasons = out.kind->MissReasons(drawn, zero.data());
+    } else {
+      out.kind = ToContactKind(robot, planes,
+                               {plane_arg, a.plane_of, a.tool_point, fix, estimate_plane, a.flush});
+      drawn = SeatedConfigurations(robot, *out.kind, drawn, nullptr, &reasons);
+    }
+  } else if (a.sensor == "socket") {
+    const SocketData data = ToSocketData(robot, pool_q, a.socket_of, py::none());
+    out.kind = ToSocketKind(robot, data, a.tool_point, a.socket_distances, fix);
+    drawn = SeatedConfigurations(robot, *out.kind, data.values.configs, nullptr, &reasons);
+  } else {
+    out.kind = ToTrackerKind(robot, a.sensor, a.instrument, a.targets, fix);
+    out.configs = TargetedConfigurations(ToConfigurations(pool_q, robot.num_links(), "pool"));
+    for (int i = 0; i < out.configs.size(); ++i) out.kept.push_back(i);
+    return out;
+  }
+  if (a.sensor == "scanner") {  // drawn is the pool: keep the measurable rows
+    for (int i = 0; i < drawn.size(); ++i)
+      if (reasons[static_cast<std::size_t>(i)] == "ok") out.kept.push_back(i);
+    out.configs = drawn.Subset(out.kept);
+  } else {  // drawn holds the seated rows already
+    for (int i = 0; i < static_cast<int>(reasons.size()); ++i)
+      if (reasons[static_cast<std::size_t>(i)] == "ok") out.kept.push_back(i);
+    out.configs = std::move(drawn);
+  }
+  for (int i = 0; i < static_cast<int>(reasons.size()); ++i)
+    if (reasons[static_cast<std::size_t>(i)] != "ok")
+      rejected->emplace_back(i, reasons[static_cast<std::size_t>(i)]);
+  if (out.configs.size() == 0)
+    throw InputError("pool", "no usable candidate configurations (none where sensor='" + a.sensor +
+                                 "' measures)");
+  return out;
+}
+
+// A design of a sensor other than the ranger: blocks of its values from the candidates where it
+// measures, the terms the pool cannot separate held at nominal, as `lrcal design --sensor`.
+Design KindDesignPy(const RobotFile& rig, const Array& pool_q, int k, const py::object& plane_arg,
+                    const std::string& estimate_plane, const py::object& fix, const DesignArgs& a) {
+  const RobotModel& robot = rig.robot;
+  const bool planar = a.sensor == "scanner" || a.sensor == "contact";
   for (const auto& [name, value] :
        {std::pair<const char*, const std::string*>{"estimate_plane", &estimate_plane},
         {"estimate_ranger", &a.estimate_ranger}})
-    if (*value != "none")
+    if (*value != "none" && (!planar || std::string(name) == "estimate_ranger"))
       throw InputError(name, "is the ranger's; sensor='" + a.sensor + "' does not take it");
-  const std::unique_ptr<PointMeasurement> full =
-      ToTrackerKind(robot, a.sensor, a.instrument, a.targets, fix);
+  Design out;
+  out.sensor = a.sensor;
+  const KindCandidates candidates =
+      KindCandidatesPy(rig, pool_q, plane_arg, estimate_plane, fix, a, &out.rejected);
   const MeasurementModel arm(robot, rig.planes ? *rig.planes : PlaneSet(Plane{}),
                              MakeParameterSet(robot, PlaneTerms{}));
   const DesignRequest request = ToDesignRequest(a, arm, k);
-  const TargetedConfigurations pool(ToConfigurations(pool_q, robot.num_links(), "pool"));
-  Design out;
-  out.sensor = a.sensor;
   {
     py::gil_scoped_release release;
-    out.held = AnalyzeIdentifiability(*full, pool).suggested_fixed;
-    out.choice = ChooseDesign(*full->Without(out.held), pool, request);
+    out.held = AnalyzeIdentifiability(*candidates.kind, candidates.configs).suggested_fixed;
+    out.choice = ChooseDesign(*candidates.kind->Without(out.held), candidates.configs, request);
   }
-  out.indices = out.choice.chosen.indices;
+  for (int i : out.choice.chosen.indices)
+    out.indices.push_back(candidates.kept[static_cast<std::size_t>(i)]);
   out.criterion = request.CriterionName();
   out.method = SelectionMethodName(request.selection.method);
   out.scaling = DesignScalingName(request.scaling);
@@ -1271,12 +1339,36 @@ Design TrackerDesignPy(const RobotFile& rig, const Array& pool_q, int k,
   return out;
 }
 
+// The arguments of the sensors that `sensor` is not, refused by name.
+void RefuseOtherSensorsDesignArgs(const DesignArgs& a) {
+  const auto refuse = [&](const char* name, bool given, const char* whose) {
+    if (given)
+      throw InputError(name,
+                       std::string("is ") + whose + "; sensor='" + a.sensor + "' does not take it");
+  };
+  const std::string& s = a.sensor;
+  const bool tracker = s == "point" || s == "pose";
+  refuse("instrument", !tracker && !a.instrument.is_none(), "a tracker's");
+  refuse("targets", !tracker && !a.targets.is_none(), "a tracker's");
+  refuse("beams", s != "scanner" && a.beams != 1, "the scanner sensor's");
+  refuse("fan_deg", s != "scanner" && a.fan_deg != 0, "the scanner sensor's");
+  refuse("scanner", s != "scanner" && !a.scanner.is_none(), "the scanner sensor's");
+  refuse("tool_point", s != "contact" && s != "socket" && !a.tool_point.is_none(),
+         "a contact's or a socket's");
+  refuse("flush", s != "contact" && a.flush, "the contact sensor's");
+  refuse("socket_of", s != "socket" && !a.socket_of.is_none(), "the socket sensor's");
+  refuse("socket_distances", s != "socket" && !a.socket_distances.is_none(), "the socket sensor's");
+  refuse("plane_of", (tracker || s == "socket") && !a.plane_of.is_none(),
+         "the ranger's, a scanner's or a contact's");
+}
+
 Design DesignPy(const RobotFile& rig, const Array& pool_q, int k, const py::object& plane_arg,
                 const std::string& estimate_plane, const py::object& fix, const DesignArgs& a) {
-  if (a.sensor != "ranger") return TrackerDesignPy(rig, pool_q, k, estimate_plane, fix, a);
-  if (!a.instrument.is_none() || !a.targets.is_none())
-    throw InputError(a.instrument.is_none() ? "targets" : "instrument",
-                     "is a tracker's; give sensor='point' or 'pose'");
+  if (!IsMeasurementKindName(a.sensor))
+    throw InputError("sensor", "'" + a.sensor + "' is not a sensor lrcal models: expected " +
+                                   MeasurementKindNameList());
+  RefuseOtherSensorsDesignArgs(a);
+  if (a.sensor != "ranger") return KindDesignPy(rig, pool_q, k, plane_arg, estimate_plane, fix, a);
   const RobotModel& robot = rig.robot;
   const PlaneSet planes = ResolvePlanes(rig, plane_arg);
   const MeasurementModel model(
@@ -2668,12 +2760,35 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
          const py::object& plane, const std::string& estimate_plane, const py::object& fix,
          const py::object& poses, int workspace, int baseline, double expected_angle_mrad,
          double expected_length_mm, const py::object& plane_of, const std::string& estimate_ranger,
-         const std::string& sensor, const py::object& instrument, const py::object& targets) {
-        return DesignPy(
-            rig, pool, k, plane, estimate_plane, fix,
-            DesignArgs{criterion, method, scaling, expected_angle, expected_length, restarts,
-                       samples, seed, poses, workspace, baseline, expected_angle_mrad,
-                       expected_length_mm, plane_of, estimate_ranger, sensor, instrument, targets});
+         const std::string& sensor, const py::object& instrument, const py::object& targets,
+         long long beams, double fan_deg, const py::object& scanner, const py::object& tool_point,
+         bool flush, const py::object& socket_of, const py::object& socket_distances) {
+        return DesignPy(rig, pool, k, plane, estimate_plane, fix,
+                        DesignArgs{criterion,
+                                   method,
+                                   scaling,
+                                   expected_angle,
+                                   expected_length,
+                                   restarts,
+                                   samples,
+                                   seed,
+                                   poses,
+                                   workspace,
+                                   baseline,
+                                   expected_angle_mrad,
+                                   expected_length_mm,
+                                   plane_of,
+                                   estimate_ranger,
+                                   sensor,
+                                   instrument,
+                                   targets,
+                                   beams,
+                                   fan_deg,
+                                   scanner,
+                                   tool_point,
+                                   flush,
+                                   socket_of,
+                                   socket_distances});
       },
       py::arg("robot"), py::arg("pool"), py::arg("k"), py::arg("criterion") = "E",
       py::arg("method") = "exchange", py::arg("scaling") = "si",
@@ -2694,7 +2809,9 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
           FindSetting(DesignRequest::Settings(), "expected_length_mm")->Default(),
       py::arg("plane_of") = py::none(), py::arg("estimate_ranger") = "none",
       py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
-      py::arg("targets") = py::none(), R"doc(
+      py::arg("targets") = py::none(), py::arg("beams") = 1, py::arg("fan_deg") = 0.0,
+      py::arg("scanner") = py::none(), py::arg("tool_point") = py::none(), py::arg("flush") = false,
+      py::arg("socket_of") = py::none(), py::arg("socket_distances") = py::none(), R"doc(
 Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
 identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
 (design/design_choice.h), numbers and checks.
@@ -2712,7 +2829,13 @@ plane column). estimate_ranger: the ranger terms estimated (as --estimate-ranger
 sensor='point' or 'pose' (with instrument= and targets= as in identifiability) chooses a tracker's
 configurations as blocks of 3 or 6 values from the whole pool (no beam to hit), holds the terms
 the pool cannot separate at nominal (Design.held_at_nominal) and has no certificate, as
-`lrcal design --sensor`.)doc");
+`lrcal design --sensor`. The other kinds likewise, from the candidates where they measure (the
+others in Design.rejected with their reason): sensor='scanner' (beams=, fan_deg=, scanner= as in
+identifiability; plane, plane_of, estimate_plane as for the ranger) keeps candidates with every
+beam on its plane; sensor='contact' (tool_point=, flush=, the planes) and sensor='socket'
+(socket_of= each candidate's socket id, tool_point=, socket_distances=) seat each candidate on the
+nominal arm and keep those seated within the joint ranges; Design.indices are rows of `pool`,
+whose seated configurations the campaign starts from.)doc");
 }
 
 void DefineStudy(py::module_& m) {

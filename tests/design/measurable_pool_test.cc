@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "lrcal/core/error.h"
@@ -118,9 +119,11 @@ TEST(MeasurablePool, SeatedContactsTouchTheirPlaneAndAPlaneOutOfReachSeatsNone) 
   const TargetedConfigurations starts = SampleConfigurations(
       robot, setup.planes, {30}, RandomStream(2, 0, 0, RandomPurpose::kPool), aimed);
   SamplingReport report;
+  std::vector<std::string> reasons;
   const TargetedConfigurations seated =
-      SeatedConfigurations(robot, ContactMeasurement(robot, setup), starts, &report);
+      SeatedConfigurations(robot, ContactMeasurement(robot, setup), starts, &report, &reasons);
   EXPECT_GT(seated.size(), 20);
+  EXPECT_EQ(std::count(reasons.begin(), reasons.end(), "ok"), seated.size());
   EXPECT_EQ(report.accepted, seated.size());
   EXPECT_EQ(report.attempts, 30);
   const Plane& plane = setup.planes[0];

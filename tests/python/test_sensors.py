@@ -284,6 +284,47 @@ def test_tracker_design_is_the_programs(tmp_path, cli, paper):
         lrcal.design(paper, q, 12, instrument=TRACKER)
 
 
+def test_scanner_contact_and_socket_designs_are_the_programs(tmp_path, cli, paper):
+    """design(sensor=) chooses from the candidates where the kind measures, as `lrcal design
+    --sensor` does from the same pool file: the same held terms and the same rows (the
+    program's indices count its usable candidates; the module's are rows of the pool)."""
+    q = lrcal.sample_configurations(paper, 60, seed=3)
+    pool = tmp_path / "c.csv"
+    write_configurations(pool, q)
+    socket_of = [i % 2 for i in range(60)]
+    seated = lrcal.simulate_sockets(paper, q, socket_of, SOCKETS, sigma_mm=0, seed=4)
+    sockets = tmp_path / "k.csv"
+    write_configurations(sockets, seated["q"], "socket", seated["socket_of"])
+    cases = [
+        (q, pool, dict(sensor="scanner", beams=5, fan_deg=10),
+         ["--sensor", "scanner", "--beams", "5", "--fan-deg", "10"]),
+        (q, pool, dict(sensor="contact", tool_point=(0, 0, 0.05)),
+         ["--sensor", "contact", "--target", "0,0,0.05"]),
+        (seated["q"], sockets,
+         dict(sensor="socket", socket_of=seated["socket_of"], tool_point=(0, 0, 0.05),
+              socket_distances=[(0, 1, 0.05)]),
+         ["--sensor", "socket", "--target", "0,0,0.05", "--socket-distance", "0,1=0.05"]),
+    ]
+    for rows, path, kwargs, args in cases:
+        design = lrcal.design(paper, rows, 25, method="backward", baseline=50, **kwargs)
+        done = cli("design", "--pool", path, "--select", "25", "--method", "backward",
+                   "--baseline", "50", *args, "--format", "json")
+        program = json.loads(done.stdout[done.stdout.index("{"):])
+        assert design.sensor == kwargs["sensor"]
+        assert design.held_at_nominal == program["held_at_nominal"], kwargs["sensor"]
+        left_out = {row for row, _ in design.rejected}
+        kept = [i for i in range(len(rows)) if i not in left_out]
+        assert design.indices == [kept[i] for i in program["selected"]], kwargs["sensor"]
+    scanner = lrcal.design(paper, q, 25, sensor="scanner", beams=5, fan_deg=10)
+    assert scanner.rejected and all("beam" in why for _, why in scanner.rejected)
+    with pytest.raises(lrcal.InputError, match="beams: is the scanner sensor's"):
+        lrcal.design(paper, q, 12, sensor="contact", beams=5)
+    with pytest.raises(lrcal.InputError, match="socket_of: is the socket sensor's"):
+        lrcal.design(paper, q, 12, sensor="scanner", socket_of=socket_of)
+    with pytest.raises(lrcal.InputError, match="sensor: 'sonar' is not a sensor"):
+        lrcal.design(paper, q, 12, sensor="sonar")
+
+
 def test_mixed_kinds_identify_as_the_program_and_recover_the_truth(tmp_path, cli, paper):
     q = lrcal.sample_configurations(paper, 40, seed=3)
     plane_of = [1 + i % 2 for i in range(40)]

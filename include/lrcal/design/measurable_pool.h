@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "lrcal/design/configuration_sampling.h"
@@ -47,9 +48,10 @@ TargetedConfigurations SampleSocketConfigurations(const SocketMeasurement& socke
 /// constraints (every value of its measurement at the nominal terms within 1e-9 of 0: m or rad)
 /// and lies in `robot`'s joint ranges (the kind's arm) after whole turns of the revolute joints.
 /// `report` (if given) counts the starts and, by reason, those left out ("not seated", "outside the
-/// joint ranges").
+/// joint ranges"); `reasons` (if given) gets each start's ("ok" where kept).
 TargetedConfigurations SeatedConfigurations(const RobotModel& robot, const MeasurementKind& kind,
                                             const TargetedConfigurations& starts,
-                                            SamplingReport* report = nullptr);
+                                            SamplingReport* report = nullptr,
+                                            std::vector<std::string>* reasons = nullptr);
 
 }  // namespace lrcal
