@@ -624,9 +624,9 @@ namespace {
 // (a kind that reads no plane refuses --plane and --estimate-plane too), and a calibrated robot
 // file that could not be written refused before the fit, not after.
 void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
-  std::vector<std::string> refused = {"estimate-ranger", "estimate-base",    "estimate-tool",
-                                      "average",         "predict-at",       "holdout",
-                                      "report",          "only-significant", "measured"};
+  std::vector<std::string> refused = {"estimate-ranger",  "estimate-base", "estimate-tool",
+                                      "average",          "predict-at",    "report",
+                                      "only-significant", "measured"};
   if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
   RefuseRangerOptions(vm, sensor, refused);
   if (vm.count("write-robot"))
@@ -654,15 +654,21 @@ int ReportKindFit(const po::variables_map& vm, const KindFit& f, const Identific
   if (s.termination == Termination::kInvalidInput &&
       f.data.size() * f.kind.rows_per_configuration() < f.kind.num_parameters())
     throw InputError(f.file, s.message);
+  // --holdout K: each fold's configurations predicted by the fit of the others.
+  std::optional<CrossValidation> cv;
+  if (vm.count("holdout") && s.IsSolutionUsable())
+    cv = CrossValidate(f.kind, f.data, vm["holdout"].as<int>(), options);
   if (ResolveFormat(vm) == Format::kJson) {
     Json j = IdentificationJson(s);
     j["sensor"] = f.sensor;
     j["values_per_configuration"] = f.kind.rows_per_configuration();
     for (const auto& [key, value] : f.extra.items()) j[key] = value;
+    if (cv) j["holdout"] = CrossValidationJson(*cv);
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "sensor: " << f.sensor << " (" << f.heading << "; lengths in m, angles in rad)\n"
               << s.FullReport();
+    if (cv) std::cout << cv->ToString();
   }
   if (s.termination == Termination::kRankDeficient) {
     std::string list;

@@ -7,6 +7,7 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/settings.h"
+#include "lrcal/measurement/measurement_kind.h"
 
 namespace lrcal {
 
@@ -14,15 +15,34 @@ std::string CrossValidation::ToString() const {
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(4);
+  std::size_t configurations = 0;  // predictions are sorted by configuration
+  for (std::size_t i = 0; i < predictions.size(); ++i)
+    if (i == 0 || predictions[i].configuration != predictions[i - 1].configuration)
+      ++configurations;
   out << "cross-validation: " << folds << " folds (configuration i in fold i mod " << folds << "), "
-      << predictions.size() << " held-out configurations predicted";
+      << configurations << " held-out configurations predicted";
+  if (configurations != predictions.size()) out << " (" << predictions.size() << " values)";
   if (!failed_folds.empty()) out << ", " << failed_folds.size() << " fold(s) not fitted";
   out << "\n";
   for (const auto& [fold, why] : failed_folds) out << "  fold " << fold << ": " << why << "\n";
   if (predictions.empty()) return out.str();
-  out << "  held-out error RMS " << rms_error * 1e3 << " mm, predicted " << rms_predicted * 1e3
-      << " mm (ratio " << std::setprecision(3) << rms_error / rms_predicted << "); mean z^2 "
-      << mean_z2 << " (about 1 +- " << mean_z2_tolerance << " expected)\n";
+  const auto mean_z2_text = [&] {
+    out << "mean z^2 " << mean_z2 << " (about 1 +- " << mean_z2_tolerance << " expected)\n";
+  };
+  if (rms_predicted_angle > 0) {  // lengths and angles apart, then z over every value
+    if (rms_predicted > 0)
+      out << "  held-out error RMS " << rms_error * 1e3 << " mm, predicted " << rms_predicted * 1e3
+          << " mm (ratio " << std::setprecision(3) << rms_error / rms_predicted << ")\n"
+          << std::setprecision(4);
+    out << "  held-out angle error RMS " << rms_error_angle * 1e3 << " mrad, predicted "
+        << rms_predicted_angle * 1e3 << " mrad (ratio " << std::setprecision(3)
+        << rms_error_angle / rms_predicted_angle << ")\n  ";
+    mean_z2_text();
+  } else {
+    out << "  held-out error RMS " << rms_error * 1e3 << " mm, predicted " << rms_predicted * 1e3
+        << " mm (ratio " << std::setprecision(3) << rms_error / rms_predicted << "); ";
+    mean_z2_text();
+  }
   if (consistent()) {
     out << "  held-out readings are predicted as well as the fit says they are\n";
   } else {
@@ -86,38 +106,127 @@ std::string PredictFold(const MeasurementModel& model, const MeasurementSet& dat
   return "";
 }
 
+// The values of `data` in (held_out) or out of `fold`, with their weights.
+MeasuredValues FoldValues(const MeasuredValues& data, int k, int folds, int fold, bool held_out) {
+  MeasuredValues out{TargetedConfigurations(data.configs.num_joints()), {}, {}};
+  const std::vector<double> weights = data.RowWeights(k);
+  for (int i = 0; i < data.size(); ++i) {
+    if ((i % folds == fold) != held_out) continue;
+    out.configs.AddFrom(data.configs, i);
+    const auto first = static_cast<std::size_t>(i) * static_cast<std::size_t>(k);
+    out.y.insert(out.y.end(), data.y.begin() + static_cast<long>(first),
+                 data.y.begin() + static_cast<long>(first + static_cast<std::size_t>(k)));
+    out.repetitions.push_back(data.repetitions[static_cast<std::size_t>(i)]);
+    if (!data.weights.empty())
+      out.weights.insert(out.weights.end(), weights.begin() + static_cast<long>(first),
+                         weights.begin() + static_cast<long>(first + static_cast<std::size_t>(k)));
+  }
+  return out;
+}
+
+// The kind's PredictFold: every value of the held-out configurations of `fold`.
+std::string PredictKindFold(const MeasurementKind& kind, const MeasuredValues& data, int folds,
+                            int fold, const IdentificationOptions& options,
+                            std::vector<HeldOutReading>* out) {
+  IdentificationOptions fold_options = options;
+  fold_options.robust_fit_check = false;  // a fold's fit verdict is not used
+  const int k = kind.rows_per_configuration();
+  const IdentificationSummary s =
+      Identify(kind, FoldValues(data, k, folds, fold, false), fold_options);
+  if (!s.IsSolutionUsable()) return s.message.empty() ? "the fit did not converge" : s.message;
+  const bool given = options.sigma > 0;
+  const Eigen::MatrixXd& C = given ? s.covariance_given : s.covariance_residual;
+  const double sigma = given ? options.sigma : s.sigma_hat;
+  if (!C.allFinite() || !std::isfinite(sigma))
+    return "no residual degrees of freedom without this fold, and no sigma given";
+  const std::unique_ptr<MeasurementKind> solved = kind.Without(s.fixed);
+  const MeasuredValues held = FoldValues(data, k, folds, fold, true);
+  const std::vector<double> weights = held.RowWeights(k);
+  const auto rows = static_cast<Eigen::Index>(held.y.size());
+  std::vector<double> y(static_cast<std::size_t>(rows));
+  Eigen::MatrixXd J(rows, solved->num_parameters());
+  if (!solved->Bind(held.configs)->Predict(s.delta.data(), y.data(), J.data()))
+    return "a held-out value is undefined at the fold's estimate";
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const auto c = static_cast<int>(r / k);
+    HeldOutReading h;
+    h.configuration = fold + c * folds;
+    h.fold = fold;
+    h.component = static_cast<int>(r % k);
+    h.angle = kind.RowIsAngle(h.component);
+    h.error = held.y[static_cast<std::size_t>(r)] - y[static_cast<std::size_t>(r)];
+    const Eigen::VectorXd j = J.row(r).transpose();
+    h.predicted_std =
+        std::sqrt(sigma * sigma / weights[static_cast<std::size_t>(r)] + j.dot(C * j));
+    h.z = h.error / h.predicted_std;
+    out->push_back(h);
+  }
+  return "";
+}
+
+void CheckFolds(int folds, int configurations) {
+  if (folds < 2 || folds > configurations)
+    throw SettingError(
+        SettingSpec::Named("identification", "holdout", "holdout", "cross-validation folds"),
+        "expected 2 to " + std::to_string(configurations) +
+            " folds (the number of configurations), got " + std::to_string(folds));
+}
+
+// The summary of the folds' predictions (sorted by configuration, then value).
+void Summarise(CrossValidation* cv) {
+  std::stable_sort(cv->predictions.begin(), cv->predictions.end(),
+                   [](const HeldOutReading& a, const HeldOutReading& b) {
+                     return a.configuration < b.configuration;
+                   });
+  const double n = static_cast<double>(cv->predictions.size());
+  if (n == 0) return;
+  double e2[2] = {0, 0}, v[2] = {0, 0}, count[2] = {0, 0}, z2 = 0;
+  for (const auto& r : cv->predictions) {
+    const int a = r.angle ? 1 : 0;
+    e2[a] += r.error * r.error;
+    v[a] += r.predicted_std * r.predicted_std;
+    ++count[a];
+    z2 += r.z * r.z;
+    if (std::fabs(r.z) > 4 && (cv->beyond_4.empty() || cv->beyond_4.back() != r.configuration))
+      cv->beyond_4.push_back(r.configuration);
+  }
+  if (count[0] > 0) {
+    cv->rms_error = std::sqrt(e2[0] / count[0]);
+    cv->rms_predicted = std::sqrt(v[0] / count[0]);
+  }
+  if (count[1] > 0) {
+    cv->rms_error_angle = std::sqrt(e2[1] / count[1]);
+    cv->rms_predicted_angle = std::sqrt(v[1] / count[1]);
+  }
+  cv->mean_z2 = z2 / n;
+  cv->mean_z2_tolerance = 3 * std::sqrt(2 / n);
+}
+
 }  // namespace
 
 CrossValidation CrossValidate(const MeasurementModel& model, const MeasurementSet& data, int folds,
                               const IdentificationOptions& options) {
-  if (folds < 2 || folds > data.size())
-    throw SettingError(
-        SettingSpec::Named("identification", "holdout", "holdout", "cross-validation folds"),
-        "expected 2 to " + std::to_string(data.size()) +
-            " folds (the number of configurations), got " + std::to_string(folds));
+  CheckFolds(folds, data.size());
   CrossValidation cv;
   cv.folds = folds;
   for (int f = 0; f < folds; ++f) {
     const std::string why = PredictFold(model, data, folds, f, options, &cv.predictions);
     if (!why.empty()) cv.failed_folds.emplace_back(f, why);
   }
-  std::sort(cv.predictions.begin(), cv.predictions.end(),
-            [](const HeldOutReading& a, const HeldOutReading& b) {
-              return a.configuration < b.configuration;
-            });
-  const double n = static_cast<double>(cv.predictions.size());
-  if (n == 0) return cv;
-  double e2 = 0, v = 0, z2 = 0;
-  for (const auto& r : cv.predictions) {
-    e2 += r.error * r.error;
-    v += r.predicted_std * r.predicted_std;
-    z2 += r.z * r.z;
-    if (std::fabs(r.z) > 4) cv.beyond_4.push_back(r.configuration);
+  Summarise(&cv);
+  return cv;
+}
+
+CrossValidation CrossValidate(const MeasurementKind& kind, const MeasuredValues& data, int folds,
+                              const IdentificationOptions& options) {
+  CheckFolds(folds, data.size());
+  CrossValidation cv;
+  cv.folds = folds;
+  for (int f = 0; f < folds; ++f) {
+    const std::string why = PredictKindFold(kind, data, folds, f, options, &cv.predictions);
+    if (!why.empty()) cv.failed_folds.emplace_back(f, why);
   }
-  cv.rms_error = std::sqrt(e2 / n);
-  cv.rms_predicted = std::sqrt(v / n);
-  cv.mean_z2 = z2 / n;
-  cv.mean_z2_tolerance = 3 * std::sqrt(2 / n);
+  Summarise(&cv);
   return cv;
 }
 

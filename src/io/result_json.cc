@@ -201,29 +201,44 @@ ResultJson PriorInformationJson(const PriorInformation& info) {
 
 ResultJson CrossValidationJson(const CrossValidation& cv) {
   ResultJson predictions = ResultJson::array();
-  for (const auto& p : cv.predictions)
-    predictions.push_back({{"configuration", p.configuration + 1},
-                           {"fold", p.fold},
-                           {"error", p.error},
-                           {"predicted_std", p.predicted_std},
-                           {"z", p.z}});
+  bool several = false, angles = false;  // a kind of several values per configuration
+  for (const auto& p : cv.predictions) {
+    several = several || p.component > 0;
+    angles = angles || p.angle;
+  }
+  for (const auto& p : cv.predictions) {
+    ResultJson one = {{"configuration", p.configuration + 1},
+                      {"fold", p.fold},
+                      {"error", p.error},
+                      {"predicted_std", p.predicted_std},
+                      {"z", p.z}};
+    if (several) one["component"] = p.component;
+    if (angles) one["unit"] = p.angle ? "rad" : "m";
+    predictions.push_back(one);
+  }
   ResultJson failed = ResultJson::array();
   for (const auto& [fold, why] : cv.failed_folds)
     failed.push_back({{"fold", fold}, {"reason", why}});
   ResultJson beyond = ResultJson::array();
   for (int i : cv.beyond_4) beyond.push_back(i + 1);
   const bool any = !cv.predictions.empty();
-  return {{"folds", cv.folds},
-          {"assignment", "configuration i (0-based) in fold i mod K"},
-          {"predictions", predictions},
-          {"failed_folds", failed},
-          {"rms_error", any ? ResultJson(cv.rms_error) : ResultJson()},
-          {"rms_predicted", any ? ResultJson(cv.rms_predicted) : ResultJson()},
-          {"ratio", any ? ResultJson(cv.rms_error / cv.rms_predicted) : ResultJson()},
-          {"mean_z2", any ? ResultJson(cv.mean_z2) : ResultJson()},
-          {"mean_z2_tolerance", any ? ResultJson(cv.mean_z2_tolerance) : ResultJson()},
-          {"consistent", any ? ResultJson(cv.consistent()) : ResultJson()},
-          {"beyond_4", beyond}};
+  ResultJson j = {{"folds", cv.folds},
+                  {"assignment", "configuration i (0-based) in fold i mod K"},
+                  {"predictions", predictions},
+                  {"failed_folds", failed},
+                  {"rms_error", any ? ResultJson(cv.rms_error) : ResultJson()},
+                  {"rms_predicted", any ? ResultJson(cv.rms_predicted) : ResultJson()},
+                  {"ratio", any ? ResultJson(cv.rms_error / cv.rms_predicted) : ResultJson()},
+                  {"mean_z2", any ? ResultJson(cv.mean_z2) : ResultJson()},
+                  {"mean_z2_tolerance", any ? ResultJson(cv.mean_z2_tolerance) : ResultJson()},
+                  {"consistent", any ? ResultJson(cv.consistent()) : ResultJson()},
+                  {"beyond_4", beyond}};
+  if (angles) {  // rms_error and rms_predicted are then the lengths' (m)
+    j["rms_error_angle"] = cv.rms_error_angle;
+    j["rms_predicted_angle"] = cv.rms_predicted_angle;
+    j["ratio_angle"] = cv.rms_error_angle / cv.rms_predicted_angle;
+  }
+  return j;
 }
 
 ResultJson AccuracySourcesJson(const std::vector<AccuracySource>& sources) {

@@ -121,6 +121,31 @@ TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
             0)
       << out;
   EXPECT_THAT(out, HasSubstr("consistent with the stated noise"));
+  // --holdout 5: every held-out point predicted (3 values each), as the fit says it would be.
+  ASSERT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker +
+                    " --auto-fix --sigma-mm 0.05 --holdout 5 --format json",
+                &out),
+            0)
+      << out;
+  const Json cv = Json::parse(out.substr(out.find('{')))["holdout"];
+  EXPECT_EQ(cv["folds"], 5);
+  EXPECT_EQ(cv["predictions"].size(), 3u * 40u);
+  EXPECT_EQ(cv["predictions"][2]["component"], 2);
+  EXPECT_TRUE(cv["consistent"].get<bool>()) << cv.dump();
+  ASSERT_EQ(Run("simulate --sensor pose --configs " + Path("c.csv") + tracker +
+                    " --sigma-mm 0.05 --sigma-mrad 0.3 --repetitions 4 --seed 7 --out " +
+                    Path("poses.csv"),
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(Run("identify --sensor pose --data " + Path("poses.csv") + tracker +
+                    " --auto-fix --sigma-mm 0.05 --sigma-mrad 0.3 --holdout 4",
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("40 held-out configurations predicted (240 values)"));
+  EXPECT_THAT(out, HasSubstr("held-out angle error RMS"));
+  EXPECT_THAT(out, HasSubstr("predicted as well as the fit says"));
   // A ranger-only option is refused by name.
   EXPECT_EQ(
       Run("identify --sensor point --data " + Path("noisy.csv") + " --report " + Path("report"),

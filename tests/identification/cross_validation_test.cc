@@ -1,6 +1,8 @@
 // K-fold cross-validation against its closed form (leave-one-out of weighted least squares:
 // e_i = r_i/(1 − H_ii), v_i = σ²/(R_i(1 − H_ii))), and as a check a user relies on: data that
-// match the stated noise pass, understated noise and an unmodelled ranger error are flagged.
+// match the stated noise pass, understated noise and an unmodelled ranger error are flagged. The
+// kind-neutral overload gives the ranger's numbers on ranger data, and on a tracker's 6-D probe
+// passes data that match both stated noises and flags an understated orientation noise.
 #include "lrcal/identification/cross_validation.h"
 
 #include <gmock/gmock.h>
@@ -10,8 +12,11 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/identification/identifiability.h"
+#include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
 #include "test_util.h"
+#include "tracker_fixtures.h"
 
 namespace lrcal {
 namespace {
@@ -115,6 +120,72 @@ TEST(CrossValidation, ConsistentDataPassUnderstatedNoiseAndMissingTermsDoNot) {
   const CrossValidation fixed =
       CrossValidate(with_scale, Simulated(both, scaled, 3, planes), 5, stated);
   EXPECT_TRUE(fixed.consistent()) << fixed.ToString();
+}
+
+TEST(CrossValidation, TheKindsOverloadIsTheRangersOnRangerData) {
+  // The same folds, fits and predictions through the measurement interface: equal to the
+  // solvers' stopping tolerance (1e-6 of σ), the variances to 1e-6 relative.
+  const RobotModel& robot = testing::PaperRobot();
+  const MeasurementModel model(robot, testing::PaperPlane(), MakeParameterSet(robot, PlaneTerms{}));
+  NoiseModel noise;
+  noise.repetitions = 2;
+  const MeasurementSet data = Simulated(testing::PaperHittingConfigurations(50, 15), noise, 6);
+  IdentificationOptions options;
+  options.sigma = noise.sigma;
+  const CrossValidation ranger = CrossValidate(model, data, 5, options);
+  const CrossValidation kind =
+      CrossValidate(RangerMeasurement(model), ToMeasuredValues(data), 5, options);
+  ASSERT_EQ(ranger.predictions.size(), 50u) << ranger.ToString();
+  ASSERT_EQ(kind.predictions.size(), ranger.predictions.size());
+  for (std::size_t i = 0; i < kind.predictions.size(); ++i) {
+    EXPECT_EQ(kind.predictions[i].configuration, ranger.predictions[i].configuration);
+    EXPECT_NEAR(kind.predictions[i].error, ranger.predictions[i].error, 1e-6 * noise.sigma) << i;
+    EXPECT_NEAR(kind.predictions[i].predicted_std, ranger.predictions[i].predicted_std,
+                1e-6 * ranger.predictions[i].predicted_std)
+        << i;
+  }
+  EXPECT_NEAR(kind.mean_z2, ranger.mean_z2, 1e-5);
+  EXPECT_EQ(kind.rms_predicted_angle, 0.0);
+}
+
+TEST(CrossValidation, AProbesHeldOutPosesArePredictedAsItsFitSays) {
+  // A 6-D probe (two targets) read at 60 configurations with 0.05 mm and 0.3 mrad: with both
+  // noises stated the held-out positions and orientations are predicted as the fit says (mean z²
+  // over 360 values within its tolerance, 3 seeds); stating a tenth of the orientation noise
+  // weighs the orientations ten times too much and is flagged.
+  const RobotModel& robot = testing::PaperRobot();
+  const PoseMeasurement kind(robot, testing::TrackerSetup(true));
+  const TargetedConfigurations configs = testing::RandomTrackerConfigurations(6, 60, 2, 17);
+  const std::vector<std::string> fixed = AnalyzeIdentifiability(kind, configs).suggested_fixed;
+  const std::unique_ptr<MeasurementKind> reduced = kind.Without(fixed);
+  NoiseModel noise;
+  noise.sigma = 0.05e-3;
+  noise.sigma_angle = 0.3e-3;
+  noise.repetitions = 1;
+  IdentificationOptions options;
+  options.sigma = noise.sigma;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    MeasuredValues data;
+    SimulateMeasurements(kind, configs, noise, RandomStream(seed, 0, 0, RandomPurpose::kNoise),
+                         &data);
+    const CrossValidation cv = CrossValidate(*reduced, data, 5, options);
+    EXPECT_EQ(cv.predictions.size(), 360u);
+    EXPECT_TRUE(cv.failed_folds.empty());
+    EXPECT_TRUE(cv.consistent()) << cv.ToString();
+    EXPECT_NEAR(cv.rms_error_angle / cv.rms_predicted_angle, 1.0, 0.3) << cv.ToString();
+    EXPECT_THAT(cv.ToString(), ::testing::HasSubstr("mrad"));
+  }
+  MeasuredValues understated;
+  NoiseModel stated = noise;
+  stated.sigma_angle = noise.sigma_angle / 10;  // the weights of a tenth of the noise
+  SimulateMeasurements(kind, configs, noise, RandomStream(1, 0, 0, RandomPurpose::kNoise),
+                       &understated);
+  MeasuredValues weighed;
+  SimulateMeasurements(kind, configs, stated, RandomStream(1, 0, 0, RandomPurpose::kNoise),
+                       &weighed);
+  understated.weights = weighed.weights;
+  const CrossValidation low = CrossValidate(*reduced, understated, 5, options);
+  EXPECT_FALSE(low.consistent()) << low.ToString();
 }
 
 TEST(CrossValidation, FoldsOutOfRangeAndUnfittableFoldsAreReported) {

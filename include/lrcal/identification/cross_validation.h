@@ -27,9 +27,13 @@ namespace lrcal {
 struct HeldOutReading {
   int configuration = 0;     ///< 0-based, in the data's order
   int fold = 0;              ///< configuration mod K
-  double error = 0;          ///< h̄_i − ĥ_i (m)
-  double predicted_std = 0;  ///< √v_i (m)
+  double error = 0;          ///< h̄_i − ĥ_i (m; rad for an angle value)
+  double predicted_std = 0;  ///< √v_i (m; rad for an angle value)
   double z = 0;              ///< error / predicted_std
+  /// A kind of several values per configuration: which of them (0 for the ranger), and whether
+  /// it is an angle (MeasurementKind::RowIsAngle).
+  int component = 0;
+  bool angle = false;
 };
 
 struct CrossValidation {
@@ -39,9 +43,11 @@ struct CrossValidation {
   /// Folds that could not be fitted (rank-deficient without them, no residual degrees of
   /// freedom and no σ given, ...), with the reason in words.
   std::vector<std::pair<int, std::string>> failed_folds;
-  double rms_error = 0;      ///< RMS of the held-out errors (m)
+  double rms_error = 0;      ///< RMS of the held-out errors of lengths (m)
   double rms_predicted = 0;  ///< RMS of their predicted standard deviations (m)
-  double mean_z2 = 0;        ///< mean of z²: about 1 when the fit predicts as well as it says
+  /// The same over the angle values of a kind that has them (rad; 0 without any).
+  double rms_error_angle = 0, rms_predicted_angle = 0;
+  double mean_z2 = 0;  ///< mean of z²: about 1 when the fit predicts as well as it says
   /// Half-width of the range of mean z² expected by chance: 3·√(2/n) for n predictions
   /// (independent Gaussian z; the folds' fits share data, so this is a guide, not a test).
   double mean_z2_tolerance = 0;
@@ -55,6 +61,15 @@ struct CrossValidation {
 /// Runs the K-fold cross-validation (2 ≤ K ≤ number of configurations). Throws InputError
 /// (where = "--holdout") for a K out of range.
 CrossValidation CrossValidate(const MeasurementModel& model, const MeasurementSet& data, int folds,
+                              const IdentificationOptions& options);
+
+/// The same for any measurement kind (a tracker's point or pose, a scanner, contacts, sockets):
+/// each fold fitted by Identify(kind) from the others, every value of each held-out
+/// configuration predicted (one HeldOutReading per value), its variance σ²/w + jᵀCj with w its
+/// weight in `data` (MeasuredValues::RowWeights: an angle value's includes (σ/σ_angle)², so
+/// σ²/w is in its own unit) and j its Jacobian row at the fold's estimate. A constraint kind's
+/// value is the residual of the constraint (a held-out ball's offset from its socket).
+CrossValidation CrossValidate(const MeasurementKind& kind, const MeasuredValues& data, int folds,
                               const IdentificationOptions& options);
 
 }  // namespace lrcal
