@@ -2726,32 +2726,35 @@ orientation_error_mrad (what remains on the calibrated model), converged and wit
 row).)doc");
 }
 
-void DefineCalibration(py::module_& m) {
-  DefineIdentifiability(m);
-  DefineTrackers(m);
-  DefineSockets(m);
-  DefineContacts(m);
-  DefineScanners(m);
-  DefineMixed(m);
-  DefineTree(m);
-  DefineCompensate(m);
-  DefineIdentify(m);
-  m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
-        py::arg("prior_sigma") = "", py::arg("prior") = false,
-        py::arg("sigma_mm") = FindSetting(NoiseModel::Settings(), "sigma_mm")->Default(),
-        py::arg("repetitions") =
-            static_cast<long long>(FindSetting(NoiseModel::Settings(), "repetitions")->Default()),
-        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
-        py::arg("fix") = py::none(), py::arg("plane_of") = py::none(),
-        py::arg("estimate_ranger") = "none", R"doc(
-What readings at the configurations q (N, joints) would tell against priors, before any reading
-is taken: `lrcal identifiability --prior-sigma ... --sigma-mm S --repetitions R`'s table (plane,
-plane_of, estimate_plane, estimate_ranger and fix as in identify).
-prior_sigma as in identify ("theta=1mrad,a=0.5mm"); prior=True uses the robot file's
-tolerances: (prior_sigma's entries replace the same keys). sigma_mm (> 0) and repetitions: the
-noise of one reading and the readings averaged per configuration. Returns an
-lrcal.PriorInformation: names, prior_sigma, posterior_sigma (SI, inf where unbounded),
-posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the table.)doc");
+// design()'s docstring.
+constexpr const char* kDesignDoc = R"doc(
+Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
+identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
+(design/design_choice.h), numbers and checks.
+criterion: E (= O3, σ_min), D, A, O1, O2, O4, O5, or I (the task criterion: the predicted RMS
+position error at `poses` (M, joints), else at `workspace` poses drawn over the joint ranges).
+method: exhaustive, greedy, backward, exchange, sampled, random. scaling of G's columns: si (the
+paper), unit, expected (× expected_angle_mrad / expected_length_mm; expected_angle in rad and
+expected_length in m are the earlier spellings). The choice is compared with `baseline` random
+designs (Design.baseline) and certified (Design.certificate, Design.efficiency). Candidates whose
+nominal beam misses the plane are left out (Design.rejected). Returns an lrcal.Design whose
+indices are rows of `pool`; Design.json holds `lrcal design --format json`'s fields.
+plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
+lrcal.Plane; with several planes plane_of gives each candidate's plane (from 1, the pool CSV's
+plane column). estimate_ranger: the ranger terms estimated (as --estimate-ranger).
+sensor='point' or 'pose' (with instrument= and targets= as in identifiability) chooses a tracker's
+configurations as blocks of 3 or 6 values from the whole pool (no beam to hit), holds the terms
+the pool cannot separate at nominal (Design.held_at_nominal) and has no certificate, as
+`lrcal design --sensor`. The other kinds likewise, from the candidates where they measure (the
+others in Design.rejected with their reason): sensor='scanner' (beams=, fan_deg=, scanner= as in
+identifiability; plane, plane_of, estimate_plane as for the ranger) keeps candidates with every
+beam on its plane; sensor='contact' (tool_point=, flush=, the planes) and sensor='socket'
+(socket_of= each candidate's socket id, tool_point=, socket_distances=) seat each candidate on the
+nominal arm and keep those seated within the joint ranges; Design.indices are rows of `pool`,
+whose seated configurations the campaign starts from.)doc";
+
+// design(): choosing configurations for any sensor (design/design_choice.h).
+void DefineDesign(py::module_& m) {
   m.def(
       "design",
       [](const RobotFile& rig, const Array& pool, int k, const std::string& criterion,
@@ -2811,31 +2814,36 @@ posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the
       py::arg("sensor") = "ranger", py::arg("instrument") = py::none(),
       py::arg("targets") = py::none(), py::arg("beams") = 1, py::arg("fan_deg") = 0.0,
       py::arg("scanner") = py::none(), py::arg("tool_point") = py::none(), py::arg("flush") = false,
-      py::arg("socket_of") = py::none(), py::arg("socket_distances") = py::none(), R"doc(
-Chooses k of the candidate configurations pool (N, joints) by an observability criterion of the
-identification Jacobian at the nominal model: `lrcal design --pool`, the same library call
-(design/design_choice.h), numbers and checks.
-criterion: E (= O3, σ_min), D, A, O1, O2, O4, O5, or I (the task criterion: the predicted RMS
-position error at `poses` (M, joints), else at `workspace` poses drawn over the joint ranges).
-method: exhaustive, greedy, backward, exchange, sampled, random. scaling of G's columns: si (the
-paper), unit, expected (× expected_angle_mrad / expected_length_mm; expected_angle in rad and
-expected_length in m are the earlier spellings). The choice is compared with `baseline` random
-designs (Design.baseline) and certified (Design.certificate, Design.efficiency). Candidates whose
-nominal beam misses the plane are left out (Design.rejected). Returns an lrcal.Design whose
-indices are rows of `pool`; Design.json holds `lrcal design --format json`'s fields.
-plane: None (the robot file's plane or planes), an lrcal.Plane, (nx, ny, nz, f) or a list of
-lrcal.Plane; with several planes plane_of gives each candidate's plane (from 1, the pool CSV's
-plane column). estimate_ranger: the ranger terms estimated (as --estimate-ranger).
-sensor='point' or 'pose' (with instrument= and targets= as in identifiability) chooses a tracker's
-configurations as blocks of 3 or 6 values from the whole pool (no beam to hit), holds the terms
-the pool cannot separate at nominal (Design.held_at_nominal) and has no certificate, as
-`lrcal design --sensor`. The other kinds likewise, from the candidates where they measure (the
-others in Design.rejected with their reason): sensor='scanner' (beams=, fan_deg=, scanner= as in
-identifiability; plane, plane_of, estimate_plane as for the ranger) keeps candidates with every
-beam on its plane; sensor='contact' (tool_point=, flush=, the planes) and sensor='socket'
-(socket_of= each candidate's socket id, tool_point=, socket_distances=) seat each candidate on the
-nominal arm and keep those seated within the joint ranges; Design.indices are rows of `pool`,
-whose seated configurations the campaign starts from.)doc");
+      py::arg("socket_of") = py::none(), py::arg("socket_distances") = py::none(), kDesignDoc);
+}
+
+void DefineCalibration(py::module_& m) {
+  DefineIdentifiability(m);
+  DefineTrackers(m);
+  DefineSockets(m);
+  DefineContacts(m);
+  DefineScanners(m);
+  DefineMixed(m);
+  DefineTree(m);
+  DefineCompensate(m);
+  DefineIdentify(m);
+  DefineDesign(m);
+  m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
+        py::arg("prior_sigma") = "", py::arg("prior") = false,
+        py::arg("sigma_mm") = FindSetting(NoiseModel::Settings(), "sigma_mm")->Default(),
+        py::arg("repetitions") =
+            static_cast<long long>(FindSetting(NoiseModel::Settings(), "repetitions")->Default()),
+        py::arg("plane") = py::none(), py::arg("estimate_plane") = "none",
+        py::arg("fix") = py::none(), py::arg("plane_of") = py::none(),
+        py::arg("estimate_ranger") = "none", R"doc(
+What readings at the configurations q (N, joints) would tell against priors, before any reading
+is taken: `lrcal identifiability --prior-sigma ... --sigma-mm S --repetitions R`'s table (plane,
+plane_of, estimate_plane, estimate_ranger and fix as in identify).
+prior_sigma as in identify ("theta=1mrad,a=0.5mm"); prior=True uses the robot file's
+tolerances: (prior_sigma's entries replace the same keys). sigma_mm (> 0) and repetitions: the
+noise of one reading and the readings averaged per configuration. Returns an
+lrcal.PriorInformation: names, prior_sigma, posterior_sigma (SI, inf where unbounded),
+posterior_to_prior (NaN without a prior), set_by_prior, defined; str() gives the table.)doc");
 }
 
 void DefineStudy(py::module_& m) {
