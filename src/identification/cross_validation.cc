@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <sstream>
 
@@ -73,20 +74,37 @@ MeasurementSet FoldData(const MeasurementSet& data, int folds, int fold, bool he
   return out;
 }
 
+// A fold's fit options: its fit verdict is not used.
+IdentificationOptions FoldOptions(const IdentificationOptions& options) {
+  IdentificationOptions fold = options;
+  fold.robust_fit_check = false;
+  return fold;
+}
+
+// The fold fit's covariance and σ (the given ones when options.sigma > 0, else residual-based);
+// "" or why the fold cannot predict.
+std::string FoldStatistics(const IdentificationSummary& s, const IdentificationOptions& options,
+                           const Eigen::MatrixXd** C, double* sigma) {
+  if (!s.IsSolutionUsable()) return s.message.empty() ? "the fit did not converge" : s.message;
+  const bool given = options.sigma > 0;
+  *C = given ? &s.covariance_given : &s.covariance_residual;
+  *sigma = given ? options.sigma : s.sigma_hat;
+  if (!(*C)->allFinite() || !std::isfinite(*sigma))
+    return "no residual degrees of freedom without this fold, and no sigma given";
+  return "";
+}
+
 // Predicts the held-out configurations of `fold` from the fit of the others; returns "" or why
 // the fold could not be fitted.
 std::string PredictFold(const MeasurementModel& model, const MeasurementSet& data, int folds,
                         int fold, const IdentificationOptions& options,
                         std::vector<HeldOutReading>* out) {
-  IdentificationOptions fold_options = options;
-  fold_options.robust_fit_check = false;  // a fold's fit verdict is not used
-  const IdentificationSummary s = Identify(model, FoldData(data, folds, fold, false), fold_options);
-  if (!s.IsSolutionUsable()) return s.message.empty() ? "the fit did not converge" : s.message;
-  const bool given = options.sigma > 0;
-  const Eigen::MatrixXd& C = given ? s.covariance_given : s.covariance_residual;
-  const double sigma = given ? options.sigma : s.sigma_hat;
-  if (!C.allFinite() || !std::isfinite(sigma))
-    return "no residual degrees of freedom without this fold, and no sigma given";
+  const IdentificationSummary s =
+      Identify(model, FoldData(data, folds, fold, false), FoldOptions(options));
+  const Eigen::MatrixXd* C = nullptr;
+  double sigma = 0;
+  const std::string why = FoldStatistics(s, options, &C, &sigma);
+  if (!why.empty()) return why;
   const MeasurementModel solved(model.robot(), model.nominal_planes(),
                                 WithoutParameters(model.robot(), model.parameters(), s.fixed));
   ModelPoint point;
@@ -99,7 +117,7 @@ std::string PredictFold(const MeasurementModel& model, const MeasurementSet& dat
     r.configuration = i;
     r.fold = fold;
     r.error = data.mean_h[i] - h;
-    r.predicted_std = std::sqrt(sigma * sigma / data.Weight(i) + g.dot(C * g));
+    r.predicted_std = std::sqrt(sigma * sigma / data.Weight(i) + g.dot(*C * g));
     r.z = r.error / r.predicted_std;
     out->push_back(r);
   }
@@ -128,17 +146,13 @@ MeasuredValues FoldValues(const MeasuredValues& data, int k, int folds, int fold
 std::string PredictKindFold(const MeasurementKind& kind, const MeasuredValues& data, int folds,
                             int fold, const IdentificationOptions& options,
                             std::vector<HeldOutReading>* out) {
-  IdentificationOptions fold_options = options;
-  fold_options.robust_fit_check = false;  // a fold's fit verdict is not used
   const int k = kind.rows_per_configuration();
   const IdentificationSummary s =
-      Identify(kind, FoldValues(data, k, folds, fold, false), fold_options);
-  if (!s.IsSolutionUsable()) return s.message.empty() ? "the fit did not converge" : s.message;
-  const bool given = options.sigma > 0;
-  const Eigen::MatrixXd& C = given ? s.covariance_given : s.covariance_residual;
-  const double sigma = given ? options.sigma : s.sigma_hat;
-  if (!C.allFinite() || !std::isfinite(sigma))
-    return "no residual degrees of freedom without this fold, and no sigma given";
+      Identify(kind, FoldValues(data, k, folds, fold, false), FoldOptions(options));
+  const Eigen::MatrixXd* C = nullptr;
+  double sigma = 0;
+  const std::string why = FoldStatistics(s, options, &C, &sigma);
+  if (!why.empty()) return why;
   const std::unique_ptr<MeasurementKind> solved = kind.Without(s.fixed);
   const MeasuredValues held = FoldValues(data, k, folds, fold, true);
   const std::vector<double> weights = held.RowWeights(k);
@@ -157,7 +171,7 @@ std::string PredictKindFold(const MeasurementKind& kind, const MeasuredValues& d
     h.error = held.y[static_cast<std::size_t>(r)] - y[static_cast<std::size_t>(r)];
     const Eigen::VectorXd j = J.row(r).transpose();
     h.predicted_std =
-        std::sqrt(sigma * sigma / weights[static_cast<std::size_t>(r)] + j.dot(C * j));
+        std::sqrt(sigma * sigma / weights[static_cast<std::size_t>(r)] + j.dot(*C * j));
     h.z = h.error / h.predicted_std;
     out->push_back(h);
   }
@@ -202,32 +216,36 @@ void Summarise(CrossValidation* cv) {
   cv->mean_z2_tolerance = 3 * std::sqrt(2 / n);
 }
 
-}  // namespace
-
-CrossValidation CrossValidate(const MeasurementModel& model, const MeasurementSet& data, int folds,
-                              const IdentificationOptions& options) {
-  CheckFolds(folds, data.size());
+// Every fold predicted by `predict_fold(fold, &predictions)` ("" or why it could not be), then
+// summarised.
+CrossValidation RunFolds(
+    int folds, int configurations,
+    const std::function<std::string(int, std::vector<HeldOutReading>*)>& predict_fold) {
+  CheckFolds(folds, configurations);
   CrossValidation cv;
   cv.folds = folds;
   for (int f = 0; f < folds; ++f) {
-    const std::string why = PredictFold(model, data, folds, f, options, &cv.predictions);
+    const std::string why = predict_fold(f, &cv.predictions);
     if (!why.empty()) cv.failed_folds.emplace_back(f, why);
   }
   Summarise(&cv);
   return cv;
 }
 
+}  // namespace
+
+CrossValidation CrossValidate(const MeasurementModel& model, const MeasurementSet& data, int folds,
+                              const IdentificationOptions& options) {
+  return RunFolds(folds, data.size(), [&](int f, std::vector<HeldOutReading>* out) {
+    return PredictFold(model, data, folds, f, options, out);
+  });
+}
+
 CrossValidation CrossValidate(const MeasurementKind& kind, const MeasuredValues& data, int folds,
                               const IdentificationOptions& options) {
-  CheckFolds(folds, data.size());
-  CrossValidation cv;
-  cv.folds = folds;
-  for (int f = 0; f < folds; ++f) {
-    const std::string why = PredictKindFold(kind, data, folds, f, options, &cv.predictions);
-    if (!why.empty()) cv.failed_folds.emplace_back(f, why);
-  }
-  Summarise(&cv);
-  return cv;
+  return RunFolds(folds, data.size(), [&](int f, std::vector<HeldOutReading>* out) {
+    return PredictKindFold(kind, data, folds, f, options, out);
+  });
 }
 
 }  // namespace lrcal
