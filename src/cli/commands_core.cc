@@ -535,8 +535,21 @@ void PrintIdentifyResults(const po::variables_map& vm, const MeasurementModel& m
   }
 }
 
-// identify --report DIR: calibration.json and the calibrated robot (report/calibration_report.h),
-// then report.html from python3 -m lrcal.report --calibration DIR.
+// calibration.json and the calibrated robot in `dir` (report/calibration_report.h), then
+// report.html from python3 -m lrcal.report --calibration DIR.
+void WriteReportFolder(const std::string& dir, const CalibrationReportInputs& in) {
+  WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
+  if (in.summary->IsSolutionUsable())
+    std::cerr << "lrcal identify: calibrated robot written to " << dir << "/calibrated.yaml\n";
+  const int code = RunReportModule({"--calibration", dir});
+  if (code != 0)
+    throw StorageError(dir + "/report.html: python3 -m lrcal.report --calibration failed (exit " +
+                       std::to_string(code) +
+                       "); calibration.json and the calibrated robot file are written");
+  std::cerr << "lrcal identify: calibration report written to " << dir << "/report.html\n";
+}
+
+// identify --report DIR: the ranger's report, with --measured tracker points and --holdout.
 void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
                             const RobotFile& rig, const MeasurementModel& model,
                             const MeasurementSet& data, const IdentificationSummary& s,
@@ -552,15 +565,7 @@ void WriteCalibrationReport(const std::string& dir, const po::variables_map& vm,
     in.measured = &measured;
   }
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
-  WriteCalibrationReportData(dir, in);  // a SettingError names --report (main.cc)
-  if (s.IsSolutionUsable())
-    std::cerr << "lrcal identify: calibrated robot written to " << dir << "/calibrated.yaml\n";
-  const int code = RunReportModule({"--calibration", dir});
-  if (code != 0)
-    throw StorageError(dir + "/report.html: python3 -m lrcal.report --calibration failed (exit " +
-                       std::to_string(code) +
-                       "); calibration.json and the calibrated robot file are written");
-  std::cerr << "lrcal identify: calibration report written to " << dir << "/report.html\n";
+  WriteReportFolder(dir, in);
 }
 
 // identify's options (its settings from the schema are added by the command).
@@ -624,9 +629,9 @@ namespace {
 // (a kind that reads no plane refuses --plane and --estimate-plane too), and a calibrated robot
 // file that could not be written refused before the fit, not after.
 void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
-  std::vector<std::string> refused = {"estimate-ranger",  "estimate-base", "estimate-tool",
-                                      "average",          "predict-at",    "report",
-                                      "only-significant", "measured"};
+  std::vector<std::string> refused = {"estimate-ranger", "estimate-base", "estimate-tool",
+                                      "average",         "predict-at",    "only-significant",
+                                      "measured"};
   if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
   RefuseRangerOptions(vm, sensor, refused);
   if (vm.count("write-robot"))
@@ -685,6 +690,13 @@ int ReportKindFit(const po::variables_map& vm, const KindFit& f, const Identific
                                 f.rig, f.kind, f.data, s, options);
     std::cerr << "lrcal identify: calibrated robot written to "
               << vm["write-robot"].as<std::string>() << "\n";
+  }
+  if (vm.count("report")) {  // the kind's calibration report
+    CalibrationReportInputs in{DataSource::File(f.file), &f.rig, nullptr, nullptr, &s, options};
+    in.kind = &f.kind;
+    in.values = &f.data;
+    if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
+    WriteReportFolder(vm["report"].as<std::string>(), in);
   }
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with " << f.noise

@@ -24,7 +24,10 @@ void AddWorkspaceAccuracy(const CalibrationReportInputs& in, const RobotFile& ca
   if (!calibrated.calibration || calibrated.calibration->covariance.size() == 0) return;
   const ConfigurationSet poses =
       WorkspacePoses(calibrated.robot, in.workspace_poses, in.workspace_seed);
-  const PlaneSet& planes = calibrated.planes ? *calibrated.planes : in.model->nominal_planes();
+  // A tracker's arm has no plane: the horizontal plane through the base only tags the poses.
+  const PlaneSet planes = calibrated.planes ? *calibrated.planes
+                          : in.model        ? in.model->nominal_planes()
+                                            : PlaneSet(Plane{});
   (*j)["workspace_accuracy"] =
       PoseAccuracyJson(PredictCalibratedAccuracy(calibrated, planes, poses), poses);
 }
@@ -56,16 +59,28 @@ void WriteCalibrationReportData(const std::string& dir, const CalibrationReportI
                        "cannot create the folder '" + dir + "': " + ec.message());
   const IdentificationSummary& s = *in.summary;
   ResultJson j = IdentificationJson(s);
-  j["data"] = {{"file", in.data_source.name}, {"configurations", in.data->size()}};
+  const int configurations = in.kind ? in.values->size() : in.data->size();
+  j["data"] = {{"file", in.data_source.name}, {"configurations", configurations}};
+  if (in.kind) {
+    j["sensor"] = in.kind->name();
+    j["values_per_configuration"] = in.kind->rows_per_configuration();
+    j["n_values"] = in.values->y.size();
+  }
   j["robot"] = in.rig->path;
   j["sigma_given"] = in.options.sigma > 0 ? ResultJson(in.options.sigma) : ResultJson();
   j["identifiability"] = IdentifiabilityJson(s.identifiability);
   if (s.IsSolutionUsable()) {
-    const int folds = in.holdout > 0 ? in.holdout : std::min(5, in.data->size());
+    const int folds = in.holdout > 0 ? in.holdout : std::min(5, configurations);
     if (folds >= 2)
-      j["holdout"] = CrossValidationJson(CrossValidate(*in.model, *in.data, folds, in.options));
-    WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_source, *in.rig, *in.model, s,
-                         in.options, in.held);
+      j["holdout"] =
+          CrossValidationJson(in.kind ? CrossValidate(*in.kind, *in.values, folds, in.options)
+                                      : CrossValidate(*in.model, *in.data, folds, in.options));
+    if (in.kind)
+      WriteTrackerCalibratedRobot(dir + "/calibrated.yaml", in.data_source, *in.rig, *in.kind,
+                                  *in.values, s, in.options);
+    else
+      WriteCalibratedRobot(dir + "/calibrated.yaml", in.data_source, *in.rig, *in.model, s,
+                           in.options, in.held);
     const RobotFile calibrated = LoadRobotFile(dir + "/calibrated.yaml");
     AddWorkspaceAccuracy(in, calibrated, &j);
     if (in.measured) {

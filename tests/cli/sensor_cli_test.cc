@@ -146,12 +146,32 @@ TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
   EXPECT_THAT(out, HasSubstr("40 held-out configurations predicted (240 values)"));
   EXPECT_THAT(out, HasSubstr("held-out angle error RMS"));
   EXPECT_THAT(out, HasSubstr("predicted as well as the fit says"));
+  // --report DIR: the calibration report of the tracker's fit; its calibrated robot file is
+  // --write-robot's, byte for byte, and its cross-validation predicts every value.
+  ASSERT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker +
+                    " --auto-fix --sigma-mm 0.05 --report " + Path("report") + " --write-robot " +
+                    Path("written.yaml"),
+                &out),
+            0)
+      << out;
+  const auto text = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const Json report = Json::parse(text(Path("report/calibration.json")));
+  EXPECT_EQ(report["sensor"], "point");
+  EXPECT_EQ(report["values_per_configuration"], 3);
+  EXPECT_EQ(report["n_values"], 120);
+  EXPECT_EQ(report["holdout"]["predictions"].size(), 120u);
+  EXPECT_FALSE(report["workspace_accuracy"]["poses"].empty());
+  EXPECT_EQ(text(Path("report/calibrated.yaml")), text(Path("written.yaml")));
+  EXPECT_THAT(text(Path("report/report.html")), HasSubstr("over the values"));
   // A ranger-only option is refused by name.
   EXPECT_EQ(
-      Run("identify --sensor point --data " + Path("noisy.csv") + " --report " + Path("report"),
+      Run("identify --sensor point --data " + Path("noisy.csv") + " --predict-at " + Path("c.csv"),
           &out),
       2);
-  EXPECT_THAT(out, HasSubstr("--report: is the ranger's; --sensor point does not take it"));
+  EXPECT_THAT(out, HasSubstr("--predict-at: is the ranger's; --sensor point does not take it"));
 }
 
 // identify --sensor point --write-robot writes a robot file every command takes: its link values

@@ -15,7 +15,8 @@
 
 namespace lrcal {
 
-/// What the report covers.
+/// What the report covers: a ranger's fit (`model` and `data`) or the fit of any other kind
+/// (`kind` and `values`, with `model` and `data` null).
 struct CalibrationReportInputs {
   DataSource data_source;  ///< the measurement CSV the fit used (or the arrays, from Python)
   const RobotFile* rig = nullptr;
@@ -37,6 +38,11 @@ struct CalibrationReportInputs {
   std::string measured_file{};
   int workspace_poses = 500;         ///< poses of the accuracy map over the joint ranges
   std::uint64_t workspace_seed = 1;  ///< their seed
+  /// Another kind's fit (a tracker, a scanner, contacts, sockets): the kind identified (before
+  /// any rank fixes) and its values; its calibrated robot file is WriteTrackerCalibratedRobot's
+  /// (the arm's link terms alone) and its cross-validation predicts every value.
+  const MeasurementKind* kind = nullptr;
+  const MeasuredValues* values = nullptr;
 };
 
 /// The report's folder as a setting, for errors in each front end's words (--report, report=).
@@ -44,7 +50,8 @@ const SettingSpec& ReportFolderSetting();
 
 /// Writes dir/calibration.json and, when the solution is usable, dir/calibrated.yaml and
 /// dir/calibrated.urdf (what `lrcal export` would write from it). Creates `dir`. Throws
-/// SettingError (ReportFolderSetting: dir cannot be created) or StorageError.
+/// SettingError (ReportFolderSetting: dir cannot be created) or StorageError. A kind's
+/// calibration.json also names its `sensor`, `values_per_configuration` and `n_values`.
 void WriteCalibrationReportData(const std::string& dir, const CalibrationReportInputs& in);
 
 }  // namespace lrcal

@@ -74,7 +74,9 @@ def residual_figure(data, fig_dir, out):
     ax.bar(x, z, color=["#c0392b" if abs(v) > 4 else "#4a7ab5" for v in z])
     for level in (-4, 4):
         ax.axhline(level, color="#c0392b", lw=0.8, ls="--")
-    ax.set_xlabel("configuration (1-based, data order)")
+    k = data.get("values_per_configuration") or 1
+    ax.set_xlabel("configuration (1-based, data order)" if k == 1 else
+                  f"value (1-based, data order: {k} per configuration)")
     ax.set_ylabel("standardized residual")
     save(fig, fig_dir, "residuals",
          "Standardized residual of each configuration's mean reading (residual over "
@@ -226,13 +228,17 @@ def parameter_table(data):
 def before_after_table(data):
     """The readings against the nominal model (before) and the calibrated one (after): the RMS of
     √R·(h̄ − h) over the configurations, about σ for a model that explains the readings."""
-    m = data.get("n_configurations") or 0
+    # A kind of several values per configuration (a tracker's point or pose, a scanner's
+    # beams): the RMS is over its values, an orientation weighed as σ/σ_angle of a length.
+    m = data.get("n_values") or data.get("n_configurations") or 0
     if not m or data.get("initial_cost") is None or data.get("final_cost") is None:
         return ""
     before = np.sqrt(2 * data["initial_cost"] / m) * 1e3
     after = np.sqrt(2 * data["final_cost"] / m) * 1e3
     sigma = data.get("sigma_given")
-    rows = ["<table><tr><th>model</th><th>RMS of √R·(h̄ − h) (mm)</th>"
+    label = ("RMS of √w·(y − ŷ) over the values (mm; an angle weighed as σ/σ_angle)"
+             if data.get("n_values") else "RMS of √R·(h̄ − h) (mm)")
+    rows = [f"<table><tr><th>model</th><th>{label}</th>"
             + ("<th>over the stated σ</th>" if sigma else "") + "</tr>"]
     for label, value in (("nominal (before)", before), ("calibrated (after)", after)):
         rows.append(f"<tr><td>{label}</td><td>{value:.4f}</td>"
