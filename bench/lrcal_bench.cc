@@ -260,37 +260,47 @@ void BM_Case2TrialThreePlanes(benchmark::State& state) {
 }
 BENCHMARK(BM_Case2TrialThreePlanes)->Unit(benchmark::kMicrosecond);
 
-// A tracker's trial on the paper's arm (issue 27 asks for each within 1.5x BM_Case2Trial per
-// configuration), as a study's tracker cell runs it (sensor.kind point or pose, tracker_trial.cc):
-// 100 of a pool of 101 configurations, each the mean of 10 readings, of a reflector (point: 25
-// link terms + 6 instrument + 3 target, 27 identifiable) or a 6-D probe (pose: + 3 probe
-// orientation terms, 30 identifiable), identified by lrcal's LM on the identifiable terms and
-// validated at 20 poses, like the ranger's case-2 trial.
+// A trial of each sensor but the ranger on the paper's arm (issue 27 asks for the point and the
+// pose within 1.5x BM_Case2Trial per configuration), as a study's cell runs it
+// (tracker_trial.cc): 100 configurations, each the mean of 10 readings (or seatings), identified
+// by lrcal's LM on the identifiable terms and validated at 20 poses, like the ranger's case-2
+// trial. Arg: 0 a reflector (point: 25 link terms + 6 instrument + 3 target, 27 identifiable),
+// 1 a 6-D probe (pose: + 3 probe orientation terms, 30 identifiable), both from a pool of 101;
+// 2 a line scanner of 5 beams over ±10° (26 identifiable), 3 a probe's tip seated on the paper's
+// plane (contact, 22), 4 a ball seated in three sockets (socket, 29), from pools of 130 where
+// each measures.
 void BM_TrackerTrial(benchmark::State& state) {
-  const bool pose = state.range(0) == 1;
-  static std::map<bool, std::unique_ptr<Fixture>> cache;
-  auto& f = cache[pose];
+  static const char* const kKinds[] = {"point", "pose", "scanner", "contact", "socket"};
+  static const char* const kSensors[] = {
+      "kind: point", "kind: pose", "kind: scanner, beams: 5, fan_deg: 10",
+      "kind: contact, target: [0, 0, 0.05]",
+      "kind: socket, target: [0, 0, 0.05], sockets: [[1.0, 0.5, 0.3], [1.0, 0.55, 0.3], "
+      "[0.8, -0.6, 0.4]], socket_distances: ['0,1=0.05']"};
+  const auto arg = static_cast<std::size_t>(state.range(0));
+  static std::map<std::size_t, std::unique_ptr<Fixture>> cache;
+  auto& f = cache[arg];
   if (!f) {
     const fs::path path = fs::temp_directory_path() / "lrcal_bench" /
-                          (std::string("s_tracker_") + (pose ? "pose" : "point") + ".yaml");
+                          (std::string("s_tracker_") + kKinds[arg] + ".yaml");
     fs::create_directories(path.parent_path());
     std::ofstream(path) << "name: bench\nseed: 1\ntrials: 1000\nrobot: " << PaperRobotPath()
-                        << "\nnoise: {sigma_mm: 0.05, repetitions: 10}\npool: {size: 101}"
-                           "\nselection: {count: 100, method: backward}"
+                        << "\nnoise: {sigma_mm: 0.05, repetitions: 10}\npool: {size: "
+                        << (arg < 2 ? 101 : 130)
+                        << "}\nselection: {count: 100, method: backward}"
                            "\nidentification: {on_rank_deficient: fix}"
-                           "\nsensor: {kind: "
-                        << (pose ? "pose" : "point") << ", instrument: [2.5, 0.3, 0.2, 0, 0, 3]}\n";
+                           "\nsensor: {"
+                        << kSensors[arg] << ", instrument: [2.5, 0.3, 0.2, 0, 0, 3]}\n";
     f = std::make_unique<Fixture>(path.string());
   }
   const CellContext& c = *f->context;
   TrialWorkspace ws;
   long long t = 0;
   for (auto _ : state) benchmark::DoNotOptimize(RunTrial(c, t++, &ws));
-  state.SetLabel(pose ? "pose" : "point");
+  state.SetLabel(kKinds[arg]);
   state.counters["terms"] = static_cast<double>(c.parameter_names.size());
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_TrackerTrial)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TrackerTrial)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 
 // Cost against the number of configurations (pool of N+1, leave-one-out design of N).
 void BM_TrialVsConfigurations(benchmark::State& state) {

@@ -654,6 +654,23 @@ struct KindFit {
   Json extra = Json::object();
 };
 
+// --write-robot and --report of a kind's fit.
+void WriteKindFitFiles(const po::variables_map& vm, const KindFit& f,
+                       const IdentificationSummary& s, const IdentificationOptions& options) {
+  if (vm.count("write-robot") && s.IsSolutionUsable()) {
+    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(f.file),
+                                f.rig, f.kind, f.data, s, options);
+    std::cerr << "lrcal identify: calibrated robot written to "
+              << vm["write-robot"].as<std::string>() << "\n";
+  }
+  if (!vm.count("report")) return;
+  CalibrationReportInputs in{DataSource::File(f.file), &f.rig, nullptr, nullptr, &s, options};
+  in.kind = &f.kind;
+  in.values = &f.data;
+  if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
+  WriteReportFolder(vm["report"].as<std::string>(), in);
+}
+
 int ReportKindFit(const po::variables_map& vm, const KindFit& f, const IdentificationSummary& s,
                   const IdentificationOptions& options) {
   if (s.termination == Termination::kInvalidInput &&
@@ -685,19 +702,7 @@ int ReportKindFit(const po::variables_map& vm, const KindFit& f, const Identific
               << list << ") or pass --auto-fix\n";
     return 3;
   }
-  if (vm.count("write-robot") && s.IsSolutionUsable()) {
-    WriteTrackerCalibratedRobot(vm["write-robot"].as<std::string>(), DataSource::File(f.file),
-                                f.rig, f.kind, f.data, s, options);
-    std::cerr << "lrcal identify: calibrated robot written to "
-              << vm["write-robot"].as<std::string>() << "\n";
-  }
-  if (vm.count("report")) {  // the kind's calibration report
-    CalibrationReportInputs in{DataSource::File(f.file), &f.rig, nullptr, nullptr, &s, options};
-    in.kind = &f.kind;
-    in.values = &f.data;
-    if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
-    WriteReportFolder(vm["report"].as<std::string>(), in);
-  }
+  WriteKindFitFiles(vm, f, s, options);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with " << f.noise
               << " (p = " << s.fit.p_value << " < 0.001); see the fit line above\n";
