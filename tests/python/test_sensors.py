@@ -69,6 +69,25 @@ def test_simulated_values_match_the_program_bit_for_bit_and_calibrate(tmp_path, 
     assert fit.names == [p["name"] for p in program["parameters"]]
     np.testing.assert_allclose(fit.delta, [p["delta"] for p in program["parameters"]],
                                rtol=0, atol=1e-12)
+    assert fit.holdout is None
+
+    # holdout=4: the program's --holdout 4, every value of every held-out pose.
+    fit = lrcal.identify_tracker(paper, sim["q"], sim["xyz"], sensor="pose",
+                                 quaternion=sim["quaternion"], instrument=TRACKER,
+                                 repetitions=sim["repetitions"], auto_fix=True, sigma_mm=0.05,
+                                 sigma_mrad=0.1, holdout=4)
+    done = cli("identify", "--sensor", "pose", "--data", tmp_path / "m.csv", "--instrument",
+               TRACKER_ARG, "--auto-fix", "--sigma-mm", "0.05", "--sigma-mrad", "0.1",
+               "--holdout", "4", "--format", "json")
+    held_out = json.loads(done.stdout)["holdout"]
+    assert len(fit.holdout["predictions"]) == 240
+    assert [p["component"] for p in fit.holdout["predictions"][:6]] == list(range(6))
+    np.testing.assert_allclose([p["error"] for p in fit.holdout["predictions"]],
+                               [p["error"] for p in held_out["predictions"]], rtol=0, atol=1e-12)
+    assert fit.holdout["ratio_angle"] == pytest.approx(held_out["ratio_angle"], abs=1e-9)
+    with pytest.raises(lrcal.InputError, match="holdout"):
+        lrcal.identify_tracker(paper, sim["q"], sim["xyz"], sensor="pose",
+                               quaternion=sim["quaternion"], instrument=TRACKER, holdout=1)
 
 
 def test_noise_free_tracker_data_give_the_true_errors(paper):
