@@ -111,21 +111,13 @@ struct KindPool {
 // named on stderr (a pool file's line) and counted in the report.
 TargetedConfigurations Measurable(const MeasurementKind& kind, const TargetedConfigurations& drawn,
                                   const std::string& path, SamplingReport* report) {
-  const std::vector<double> zero(static_cast<std::size_t>(kind.num_parameters()), 0.0);
-  const std::vector<std::string> reasons = kind.MissReasons(drawn, zero.data());
-  std::vector<int> kept;
-  for (int i = 0; i < drawn.size(); ++i) {
-    if (reasons[static_cast<std::size_t>(i)] == "ok") {
-      kept.push_back(i);
-      continue;
-    }
-    ++report->rejected[reasons[static_cast<std::size_t>(i)]];
-    std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
-              << ") rejected: " << reasons[static_cast<std::size_t>(i)] << "\n";
-  }
-  report->requested = report->attempts = drawn.size();
-  report->accepted = static_cast<int>(kept.size());
-  return drawn.Subset(kept);
+  std::vector<std::string> reasons;
+  TargetedConfigurations kept = MeasurableConfigurations(kind, drawn, report, &reasons);
+  for (std::size_t i = 0; i < reasons.size(); ++i)
+    if (reasons[i] != "ok")
+      std::cerr << "lrcal design: " << path << " configuration " << i + 1 << " (line " << i + 2
+                << ") rejected: " << reasons[i] << "\n";
+  return kept;
 }
 
 // --sensor socket: the sockets of a pool file (its socket column; their nominal positions the

@@ -98,6 +98,27 @@ TargetedConfigurations SampleSocketConfigurations(const SocketMeasurement& socke
       report);
 }
 
+TargetedConfigurations MeasurableConfigurations(const MeasurementKind& kind,
+                                                const TargetedConfigurations& configs,
+                                                SamplingReport* report,
+                                                std::vector<std::string>* reasons) {
+  const std::vector<double> zero(static_cast<std::size_t>(kind.num_parameters()), 0.0);
+  const std::vector<std::string> why = kind.MissReasons(configs, zero.data());
+  std::vector<int> kept;
+  SamplingReport r;
+  r.requested = r.attempts = configs.size();
+  for (int i = 0; i < configs.size(); ++i) {
+    if (why[static_cast<std::size_t>(i)] == "ok")
+      kept.push_back(i);
+    else
+      ++r.rejected[why[static_cast<std::size_t>(i)]];
+  }
+  r.accepted = static_cast<int>(kept.size());
+  if (report) *report = r;
+  if (reasons) *reasons = why;
+  return configs.Subset(kept);
+}
+
 TargetedConfigurations SeatedConfigurations(const RobotModel& robot, const MeasurementKind& kind,
                                             const TargetedConfigurations& starts,
                                             SamplingReport* report,

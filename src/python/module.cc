@@ -1299,8 +1299,7 @@ KindCandidates KindCandidatesPy(const RobotFile& rig, const Array& pool_q,
       out.kind = ToScannerKind(
           rig, robot, planes,
           {plane_arg, a.plane_of, a.scanner, fix, estimate_plane, a.beams, a.fan_deg});
-      const std::vector<double> zero(static_cast<std::size_t>(out.kind->num_parameters()), 0.0);
-      reasons = out.kind->MissReasons(drawn, zero.data());
+      drawn = MeasurableConfigurations(*out.kind, drawn, nullptr, &reasons);
     } else {
       out.kind = ToContactKind(robot, planes,
                                {plane_arg, a.plane_of, a.tool_point, fix, estimate_plane, a.flush});
@@ -1316,15 +1315,10 @@ KindCandidates KindCandidatesPy(const RobotFile& rig, const Array& pool_q,
     for (int i = 0; i < out.configs.size(); ++i) out.kept.push_back(i);
     return out;
   }
-  if (a.sensor == "scanner") {  // drawn is the pool: keep the measurable rows
-    for (int i = 0; i < drawn.size(); ++i)
-      if (reasons[static_cast<std::size_t>(i)] == "ok") out.kept.push_back(i);
-    out.configs = drawn.Subset(out.kept);
-  } else {  // drawn holds the seated rows already
-    for (int i = 0; i < static_cast<int>(reasons.size()); ++i)
-      if (reasons[static_cast<std::size_t>(i)] == "ok") out.kept.push_back(i);
-    out.configs = std::move(drawn);
-  }
+  // drawn holds the kept rows; reasons says which rows of the pool they are.
+  for (int i = 0; i < static_cast<int>(reasons.size()); ++i)
+    if (reasons[static_cast<std::size_t>(i)] == "ok") out.kept.push_back(i);
+  out.configs = std::move(drawn);
   for (int i = 0; i < static_cast<int>(reasons.size()); ++i)
     if (reasons[static_cast<std::size_t>(i)] != "ok")
       rejected->emplace_back(i, reasons[static_cast<std::size_t>(i)]);

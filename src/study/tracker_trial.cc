@@ -125,14 +125,8 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
                                 kind == "contact" || kind == "scanner" ? &c->planes : nullptr);
     if (kind == "contact")  // seated on the nominal arm: the design is chosen where contacts are
       file = SeatedConfigurations(*c->robot, *c->kind, file);
-    if (kind == "scanner") {  // where every beam meets its plane
-      const std::vector<double> zero(static_cast<std::size_t>(c->kind->num_parameters()), 0.0);
-      const std::vector<std::string> reasons = c->kind->MissReasons(file, zero.data());
-      std::vector<int> kept;
-      for (int i = 0; i < file.size(); ++i)
-        if (reasons[static_cast<std::size_t>(i)] == "ok") kept.push_back(i);
-      file = file.Subset(kept);
-    }
+    if (kind == "scanner")  // where every beam meets its plane
+      file = MeasurableConfigurations(*c->kind, file);
     AcceptPoolFile(s, std::move(file), c);
   } else if (kind == "contact") {
     // Moved until the nominal tool point touches: the design is chosen where contacts are.

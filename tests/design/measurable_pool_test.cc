@@ -66,6 +66,34 @@ TEST(MeasurablePool, EveryBeamOfAScannersFanMeetsItsPlane) {
   EXPECT_NE(other.q(0)[2], pool.q(0)[2]);
 }
 
+TEST(MeasurablePool, AGivenPoolKeepsTheConfigurationsWhereEveryBeamMeetsItsPlane) {
+  // Aimed draws (the ranger's beam on the plane) of which a ±30° fan misses on some: exactly the
+  // rows MissReasons calls "ok" are kept, in order, with the others counted by reason.
+  const ScannerMeasurement scanner(testing::PaperRobot(), FanOnThePaperPlane(30));
+  SamplingOptions aimed;
+  aimed.require_beam_hit = true;
+  const TargetedConfigurations drawn =
+      SampleConfigurations(testing::PaperRobot(), scanner.setup().planes, {60},
+                           RandomStream(4, 0, 0, RandomPurpose::kPool), aimed);
+  SamplingReport report;
+  std::vector<std::string> reasons;
+  const TargetedConfigurations kept = MeasurableConfigurations(scanner, drawn, &report, &reasons);
+  ASSERT_EQ(reasons.size(), 60u);
+  int k = 0;
+  for (int i = 0; i < drawn.size(); ++i) {
+    if (reasons[static_cast<std::size_t>(i)] != "ok") continue;
+    ASSERT_LT(k, kept.size());
+    EXPECT_EQ(kept.q(k)[0], drawn.q(i)[0]);
+    ++k;
+  }
+  EXPECT_EQ(k, kept.size());
+  EXPECT_LT(kept.size(), 60);  // the fan is wide enough to miss on some
+  EXPECT_EQ(report.accepted, kept.size());
+  int rejected = 0;
+  for (const auto& [why, n] : report.rejected) rejected += n;
+  EXPECT_EQ(rejected, 60 - kept.size());
+}
+
 TEST(MeasurablePool, AFanTooWideForItsPlaneIsRefused) {
   // At 89° a beam runs along the tool's x axis: it meets a plane the tool faces only far away,
   // grazing, so no configuration has all five on the plane.

@@ -43,6 +43,14 @@ TargetedConfigurations SampleSocketConfigurations(const SocketMeasurement& socke
                                                   SamplingOptions options,
                                                   SamplingReport* report = nullptr);
 
+/// The configurations of `configs` where `kind` measures at its nominal terms (MissReasons
+/// "ok": a scanner's every beam on its plane), tags kept. `report` (if given) counts them and,
+/// by reason, those left out; `reasons` (if given) gets each configuration's.
+TargetedConfigurations MeasurableConfigurations(const MeasurementKind& kind,
+                                                const TargetedConfigurations& configs,
+                                                SamplingReport* report = nullptr,
+                                                std::vector<std::string>* reasons = nullptr);
+
 /// `starts` moved by kind.LinearisationConfigurations (a contact's or a socket's seating on the
 /// nominal arm, each to its tag's plane or socket), kept where the move satisfied the kind's
 /// constraints (every value of its measurement at the nominal terms within 1e-9 of 0: m or rad)
