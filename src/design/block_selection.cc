@@ -179,14 +179,26 @@ SelectionResult SelectBlocks(const Eigen::MatrixXd& G, int rows_per_configuratio
   if (rows_per_configuration == 1) return SelectConfigurations(G, k, options, stream);
   options.Validate();
   CheckBlockSelection(G, rows_per_configuration, k);
+  SelectionResult out;
+  if (options.method == SelectionMethod::kRandom) {
+    // One draw needs only its own blocks' information (a random baseline draws hundreds).
+    out.indices = RandomBlocks(static_cast<int>(G.rows() / rows_per_configuration), k, stream, 0);
+    out.evaluations = 1;
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+    for (int i : out.indices) {
+      const Eigen::MatrixXd B = G.middleRows(static_cast<Eigen::Index>(i) * rows_per_configuration,
+                                             rows_per_configuration);
+      const Eigen::MatrixXd information = B.transpose() * B;  // as BlockInformation's
+      A += information;
+    }
+    out.score = CriterionScore(A, k, options.criterion);
+    return out;
+  }
   const BlockInformation blocks(G, rows_per_configuration, options.criterion);
   const int N = blocks.size();
-  SelectionResult out;
   out.score = kNoBlockScore;
   switch (options.method) {
-    case SelectionMethod::kRandom:
-      out.indices = RandomBlocks(N, k, stream, 0);
-      out.evaluations = 1;
+    case SelectionMethod::kRandom:  // above
       break;
     case SelectionMethod::kSampled:
       for (int s = 0; s < options.samples; ++s) {

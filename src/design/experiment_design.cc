@@ -711,6 +711,16 @@ double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion
   return ScoreFromEigenvalues(eig.eigenvalues(), m, criterion);
 }
 
+std::vector<double> CriterionScores(const Eigen::MatrixXd& A, int m,
+                                    const std::vector<DesignCriterion>& criteria) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A, Eigen::EigenvaluesOnly);
+  std::vector<double> scores;
+  scores.reserve(criteria.size());
+  for (DesignCriterion c : criteria)
+    scores.push_back(ScoreFromEigenvalues(eig.eigenvalues(), m, c));
+  return scores;
+}
+
 Eigen::VectorXd ExpectedErrors(const ParameterSet& parameters, double angle, double length) {
   return ExpectedErrors(parameters.names, angle, length);
 }

@@ -39,6 +39,8 @@ std::vector<BaselineIndex> CompareWithRandomDesigns(const Eigen::MatrixXd& G,
   RandomBaselineSetting().Check(count);
   const int k = static_cast<int>(chosen.size());
   constexpr std::size_t kCriteria = std::size(kBaselineCriteria);
+  const std::vector<DesignCriterion> criteria(std::begin(kBaselineCriteria),
+                                              std::end(kBaselineCriteria));
   std::vector<std::vector<double>> random_scores(kCriteria);
   SelectionOptions random_options;
   random_options.method = SelectionMethod::kRandom;
@@ -55,15 +57,16 @@ std::vector<BaselineIndex> CompareWithRandomDesigns(const Eigen::MatrixXd& G,
     const SelectionResult r = SelectBlocks(
         G, rows_per_configuration, k, random_options,
         RandomStream(seed, 2, static_cast<std::uint64_t>(b), RandomPurpose::kSelection));
-    const Eigen::MatrixXd A = NormalMatrixOfRows(G, rows_of(r.indices));
-    for (std::size_t c = 0; c < kCriteria; ++c)
-      random_scores[c].push_back(CriterionScore(A, k, kBaselineCriteria[c]));
+    const std::vector<double> scores =
+        CriterionScores(NormalMatrixOfRows(G, rows_of(r.indices)), k, criteria);
+    for (std::size_t c = 0; c < kCriteria; ++c) random_scores[c].push_back(scores[c]);
   }
-  const Eigen::MatrixXd A_chosen = NormalMatrixOfRows(G, rows_of(chosen));
+  const std::vector<double> chosen_scores =
+      CriterionScores(NormalMatrixOfRows(G, rows_of(chosen)), k, criteria);
   std::vector<BaselineIndex> out(kCriteria);
   for (std::size_t c = 0; c < kCriteria; ++c) {
     out[c].criterion = kBaselineCriteria[c];
-    out[c].chosen = CriterionScore(A_chosen, k, kBaselineCriteria[c]);
+    out[c].chosen = chosen_scores[c];
     out[c].random = Describe(random_scores[c]);
     out[c].percentile = PercentileRank(random_scores[c], out[c].chosen);
   }

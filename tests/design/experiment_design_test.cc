@@ -50,6 +50,18 @@ TEST(DesignCriteria, EIsTheSmallestSingularValueOfG) {
               svd.singularValues().minCoeff(), 1e-12);
 }
 
+TEST(DesignCriteria, SeveralScoresFromOneDecompositionHaveEachScoresBits) {
+  const Eigen::MatrixXd G = RandomMatrix(40, 7, 4);
+  const Eigen::MatrixXd A = G.transpose() * G;
+  const std::vector<DesignCriterion> criteria = {DesignCriterion::kE,  DesignCriterion::kD,
+                                                 DesignCriterion::kA,  DesignCriterion::kO1,
+                                                 DesignCriterion::kO4, DesignCriterion::kO5};
+  const std::vector<double> scores = CriterionScores(A, 40, criteria);
+  ASSERT_EQ(scores.size(), criteria.size());
+  for (std::size_t c = 0; c < criteria.size(); ++c)
+    EXPECT_EQ(scores[c], CriterionScore(A, 40, criteria[c])) << DesignCriterionName(criteria[c]);
+}
+
 TEST(Selection, ExhaustiveEqualsBruteForce) {
   const Eigen::MatrixXd G = RandomMatrix(10, 3, 2);
   RandomStream stream(1, 0, 0, RandomPurpose::kSelection);

@@ -108,6 +108,11 @@ struct SelectionResult {
 /// Score of the normal matrix A = GᵀG of m configurations.
 double CriterionScore(const Eigen::MatrixXd& A, int m, DesignCriterion criterion);
 
+/// The scores of A under several criteria from one eigendecomposition: element c equals
+/// CriterionScore(A, m, criteria[c]) bit for bit.
+std::vector<double> CriterionScores(const Eigen::MatrixXd& A, int m,
+                                    const std::vector<DesignCriterion>& criteria);
+
 /// Scales the columns of G (N×n) as `scaling` says; `expected` holds each parameter's expected
 /// error magnitude (rad or m) for kExpectedErrors. Column norms are those of G itself.
 Eigen::MatrixXd ScaleColumns(const Eigen::MatrixXd& G, DesignScaling scaling,
