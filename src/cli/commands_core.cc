@@ -625,17 +625,26 @@ void AddIdentifyOptions(po::options_description& o) {
 
 namespace {
 
+// What identify writes, checked before the fit (not after): a calibrated robot file that could
+// not be written, and measured points with no report to put them in.
+void CheckIdentifyOutputs(const po::variables_map& vm) {
+  if (vm.count("write-robot"))
+    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  if (vm.count("measured") && !vm.count("report"))
+    throw InputError("--measured",
+                     "goes into the calibration report: give --report DIR too "
+                     "(or judge a robot file with lrcal accuracy --measured)");
+}
+
 // The start of identify for a kind other than the ranger: the ranger's options refused by name
 // (a kind that reads no plane refuses --plane and --estimate-plane too), and a calibrated robot
 // file that could not be written refused before the fit, not after.
 void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
   std::vector<std::string> refused = {"estimate-ranger", "estimate-base", "estimate-tool",
-                                      "average",         "predict-at",    "only-significant",
-                                      "measured"};
+                                      "average",         "predict-at",    "only-significant"};
   if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
   RefuseRangerOptions(vm, sensor, refused);
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
+  CheckIdentifyOutputs(vm);
 }
 
 // identify --sensor point|pose: the tracker's terms from its measurement file (tracker_data.h).
@@ -668,6 +677,14 @@ void WriteKindFitFiles(const po::variables_map& vm, const KindFit& f,
   in.kind = &f.kind;
   in.values = &f.data;
   if (vm.count("holdout")) in.holdout = vm["holdout"].as<int>();
+  MeasuredValues measured;
+  if (vm.count("measured")) {  // the tracker's points of --target, its frame --instrument
+    in.measured_setup = ResolvePointSetup(vm);
+    in.measured_file = vm["measured"].as<std::string>();
+    measured =
+        ReadTrackerMeasurements(in.measured_file, RegistrationKind(f.rig.robot, in.measured_setup));
+    in.measured = &measured;
+  }
   WriteReportFolder(vm["report"].as<std::string>(), in);
 }
 
@@ -1186,17 +1203,6 @@ int TreeIdentifiability(const po::variables_map& vm) {
   return 0;
 }
 
-// What the ranger's identify writes, checked before the fit (not after): a calibrated robot file
-// that could not be written, and measured points with no report to put them in.
-void CheckRangerIdentifyOutputs(const po::variables_map& vm) {
-  if (vm.count("write-robot"))
-    CheckOutputFile(vm["write-robot"].as<std::string>(), "--write-robot");
-  if (vm.count("measured") && !vm.count("report"))
-    throw InputError("--measured",
-                     "goes into the calibration report: give --report DIR too "
-                     "(or judge a robot file with lrcal accuracy --measured)");
-}
-
 // identify with a tree's chains, several kinds or one kind other than the ranger; nothing for
 // the ranger's own calibration, which IdentifyCommand does.
 std::optional<int> IdentifyOtherThanOneRanger(const po::variables_map& vm) {
@@ -1223,7 +1229,7 @@ int IdentifyCommand(const std::vector<std::string>& args) {
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
   if (const std::optional<int> done = IdentifyOtherThanOneRanger(vm)) return *done;
-  CheckRangerIdentifyOutputs(vm);
+  CheckIdentifyOutputs(vm);
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;

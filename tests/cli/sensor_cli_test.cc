@@ -148,10 +148,20 @@ TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
   EXPECT_THAT(out, HasSubstr("held-out angle error RMS"));
   EXPECT_THAT(out, HasSubstr("predicted as well as the fit says"));
   // --report DIR: the calibration report of the tracker's fit; its calibrated robot file is
-  // --write-robot's, byte for byte, and its cross-validation predicts every value.
+  // --write-robot's, byte for byte, and its cross-validation predicts every value. --measured:
+  // 30 tracker points the fit never saw, judged in the report as accuracy --measured judges them.
+  ASSERT_EQ(Run("sample --validation --count 30 --seed 5 --out " + Path("v.csv"), &out), 0);
+  ASSERT_EQ(Run("simulate --sensor point --configs " + Path("v.csv") + tracker +
+                    " --sigma-mm 0 --repetitions 1 --out " + Path("held.csv"),
+                &out),
+            0);
+  const std::string measured = " --measured " + Path("held.csv");
+  EXPECT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker + measured, &out),
+            2);
+  EXPECT_THAT(out, HasSubstr("--measured: goes into the calibration report: give --report"));
   ASSERT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker +
                     " --auto-fix --sigma-mm 0.05 --report " + Path("report") + " --write-robot " +
-                    Path("written.yaml"),
+                    Path("written.yaml") + measured,
                 &out),
             0)
       << out;
@@ -172,6 +182,17 @@ TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
   EXPECT_EQ(undated(Path("report/calibrated.yaml")), undated(Path("written.yaml")));
   EXPECT_NE(undated(Path("written.yaml")), text(Path("written.yaml")));  // a date was there
   EXPECT_THAT(text(Path("report/report.html")), HasSubstr("over the values"));
+  ASSERT_EQ(
+      Run("accuracy --robot " + Path("written.yaml") + " --format json" + measured + tracker, &out),
+      0)
+      << out;
+  ASSERT_TRUE(report.contains("measured_points"));
+  EXPECT_EQ(report["measured_points"]["points"], 30);
+  EXPECT_EQ(report["measured_points"]["rms"].get<double>(), Json::parse(out)["rms"].get<double>());
+  EXPECT_GT(report["measured_points"]["rms"].get<double>(), 0);  // the fit had noise
+  EXPECT_LT(report["measured_points"]["rms"].get<double>(), 0.2e-3);
+  EXPECT_THAT(text(Path("report/report.html")),
+              HasSubstr("30 points a tracker measured, not used in the fit"));
   // A ranger-only option is refused by name.
   EXPECT_EQ(
       Run("identify --sensor point --data " + Path("noisy.csv") + " --predict-at " + Path("c.csv"),
