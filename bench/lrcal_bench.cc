@@ -110,6 +110,29 @@ void BM_BatchDistanceAndJacobian100(benchmark::State& state) {
 }
 BENCHMARK(BM_BatchDistanceAndJacobian100)->Arg(0)->Arg(1);
 
+// The point kind's values (Arg 0) and Jacobian (Arg 1) at 100 configurations of the paper's arm
+// (25 link terms, the instrument's 6, one target's 3): the batch kernel (batch_point.h) behind
+// PointMeasurement's evaluator, the tracker trial's hot path.
+void BM_PointValuesAndJacobian100(benchmark::State& state) {
+  const CellContext& c = *Case(100).context;
+  PointSetup setup;
+  setup.instrument =
+      RigidTransform::FromXyzRpy(Eigen::Vector3d(2.5, 0.3, 0.2), Eigen::Vector3d(0, 0, 3));
+  const PointMeasurement kind(c.model->robot(), setup);
+  TargetedConfigurations configs(c.design.configs.num_joints());
+  for (int i = 0; i < c.design.configs.size(); ++i) configs.Add(c.design.configs.q(i));
+  const std::unique_ptr<MeasurementEvaluator> evaluator = kind.Bind(configs);
+  const int n = kind.num_parameters(), m = evaluator->num_rows();
+  std::vector<double> e(n, 0.0), y(m), J(static_cast<std::size_t>(m) * n);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        evaluator->Predict(e.data(), y.data(), state.range(0) ? J.data() : nullptr));
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * configs.size());
+}
+BENCHMARK(BM_PointValuesAndJacobian100)->Arg(0)->Arg(1);
+
 // Eigen's SYRK, for comparison with NormalMatrix (which lrcal uses).
 void BM_NormalEquations100x25(benchmark::State& state) {
   Eigen::MatrixXd J = Eigen::MatrixXd::Random(100, 25), A(25, 25);

@@ -25,7 +25,7 @@ sources=(core/strings core/json core/hash core/data_dir core/random core/setting
          study/truth_options io/socket_data io/scanner_data io/robot_data
          measurement/scanner_measurement measurement/socket_measurement
          measurement/point_measurement measurement/estimated_planes measurement/constraint_kinds
-         kinematics/joint_constraints kinematics/chain)
+         kinematics/joint_constraints kinematics/chain measurement/batch_point core/cpu_dispatch)
 objects=()
 build_object() {  # src/<name>.cc → build-fuzz/obj/<name>.o
   local name=$1 obj="$out/obj/${1//\//_}.o"

@@ -8,6 +8,7 @@
 #include "lrcal/kinematics/chain.h"
 #include "lrcal/kinematics/forward_kinematics.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "measurement/batch_point.h"
 
 namespace lrcal {
 
@@ -26,12 +27,18 @@ class PointEvaluator : public MeasurementEvaluator {
       : kind_(kind),
         configs_(configs),
         k_(kind.rows_per_configuration()),
-        chart_centres_(std::move(chart_centres)) {}
+        chart_centres_(std::move(chart_centres)) {
+    if (k_ == 3) batch_.SetConfigurations(configs);
+  }
   int num_rows() const override { return k_ * configs_.size(); }
   int num_parameters() const override { return kind_.num_parameters(); }
   bool Predict(const double* e, double* y, double* J) override {
     kind_.StateAt(e, &state_);
     PrepareChainPoint(kind_.robot(), state_.link_values.data(), &chain_);
+    if (k_ == 3) {  // the point kind: every configuration at once, the bits of the loop below
+      batch_.Evaluate(kind_, state_, chain_, y, J);
+      return true;
+    }
     const int m = num_rows();
     if (J) std::fill(J, J + static_cast<std::size_t>(m) * num_parameters(), 0.0);
     for (int i = 0; i < configs_.size(); ++i) {
@@ -112,6 +119,7 @@ class PointEvaluator : public MeasurementEvaluator {
   PointMeasurement::State state_;
   ChainPoint chain_;
   ChainFrames frames_;
+  BatchPointEvaluator batch_;
 };
 
 }  // namespace
