@@ -118,17 +118,23 @@ Eigen::Matrix<double, 6, Eigen::Dynamic> GeometricJacobian(const RobotModel& mod
   ConfigurationSet one(model.num_links());
   one.Add(q);
   ChainFrames frames;
-  const Pose<double> pose = ToolPose(point, one, 0, &frames);
+  ToolPose(point, one, 0, &frames);
   Eigen::Matrix<double, 6, Eigen::Dynamic> J(6, model.num_links());
+  GeometricJacobian(model, frames, &J);
+  return J;
+}
+
+void GeometricJacobian(const RobotModel& model, const ChainFrames& frames,
+                       Eigen::Matrix<double, 6, Eigen::Dynamic>* J) {
+  J->resize(6, model.num_links());
   for (int i = 0; i < model.num_links(); ++i) {
     const Eigen::Vector3d& z = frames.z_prev[i];
     if (model.links()[i].joint == JointType::kRevolute) {
-      J.col(i) << z.cross(pose.p_BT - frames.o_prev[i]), z;
+      J->col(i) << z.cross(frames.tool.p_BT - frames.o_prev[i]), z;
     } else {
-      J.col(i) << z, Eigen::Vector3d::Zero();
+      J->col(i) << z, Eigen::Vector3d::Zero();
     }
   }
-  return J;
 }
 
 }  // namespace lrcal

@@ -13,13 +13,24 @@ bool SolveJointConstraints(const RobotModel& robot, int rows, const JointConstra
   constexpr int kMaxSteps = 100;
   constexpr double kTolerance = 1e-12;  // the constraints' units: m, or ≈ rad
   constexpr double kMaxStep = 0.5;      // rad (or m)
-  const Eigen::VectorXd& values = robot.nominal_values();
   const int n = robot.num_links();
+  // The geometric Jacobian from the fast path's frames (chain.h: the chain's trig once, per step
+  // only the joints'). The pose stays the reference's: ToolPose agrees with it to rounding only,
+  // and the seated configurations feed rank analyses whose choice among exactly confounded terms
+  // follows rounding (a study's held terms would change with the last bit).
+  ChainPoint chain;
+  PrepareChainPoint(robot, robot.nominal_values().data(), &chain);
+  ConfigurationSet one(n);
+  ChainFrames frames;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> G(6, n);
   Eigen::VectorXd r(rows);
   Eigen::MatrixXd J(rows, n);
   for (int step = 0; step <= kMaxSteps; ++step) {
-    const Pose<double> pose = ForwardKinematics<double>(robot, values.data(), q);
-    const Eigen::Matrix<double, 6, Eigen::Dynamic> G = GeometricJacobian(robot, values, q);
+    one.Clear();
+    one.Add(q);
+    ToolPose(chain, one, 0, &frames);
+    GeometricJacobian(robot, frames, &G);
+    const Pose<double> pose = ForwardKinematics<double>(robot, robot.nominal_values().data(), q);
     constraints(pose, G, &r, &J);
     if (!r.allFinite()) return false;
     if (r.norm() < kTolerance) return true;

@@ -60,4 +60,9 @@ Eigen::Matrix<double, 6, Eigen::Dynamic> GeometricJacobian(const RobotModel& mod
                                                            const Eigen::VectorXd& link_values,
                                                            const double* q);
 
+/// The same from the frames of one configuration that ToolPose filled (no trig, no allocation
+/// once J has its 6×N).
+void GeometricJacobian(const RobotModel& model, const ChainFrames& frames,
+                       Eigen::Matrix<double, 6, Eigen::Dynamic>* J);
+
 }  // namespace lrcal
