@@ -143,13 +143,11 @@ KindPool SocketKindPool(const po::variables_map& vm, const Setup& setup, std::ui
     throw InputError("--socket",
                      "--sensor socket with --generate needs the sockets' nominal "
                      "positions: give --socket x,y,z (m, base frame) per socket");
-  SocketSetup socket;
-  socket.positions = ResolveSocketPositions(vm);
-  socket.ids.clear();
-  for (std::size_t k = 0; k < socket.positions.size(); ++k)
-    socket.ids.push_back(static_cast<int>(k));
-  socket.tool_point = ResolveToolPoint(vm, "socket", false);
-  socket.distances = ResolveSocketDistances(vm);
+  // In this order, so that the first bad option is the one named.
+  std::vector<Eigen::Vector3d> positions = ResolveSocketPositions(vm);
+  const Eigen::Vector3d tool_point = ResolveToolPoint(vm, "socket", false);
+  const SocketSetup socket =
+      SocketSetup::Numbered(std::move(positions), tool_point, ResolveSocketDistances(vm));
   kp.socket_ids = socket.ids;
   const auto kind = std::make_unique<SocketMeasurement>(robot, socket, FixList(vm, robot), "--fix");
   kp.pool.configs = SampleSocketConfigurations(*kind, vm["generate"].as<int>(), seed, 0, sampling,

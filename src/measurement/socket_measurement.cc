@@ -88,6 +88,18 @@ int SocketSetup::IndexOf(int id) const {
   return it == ids.end() ? -1 : static_cast<int>(it - ids.begin());
 }
 
+SocketSetup SocketSetup::Numbered(std::vector<Eigen::Vector3d> positions,
+                                  const Eigen::Vector3d& tool_point,
+                                  std::vector<SocketDistance> distances) {
+  SocketSetup setup;
+  setup.ids.resize(positions.size());
+  std::iota(setup.ids.begin(), setup.ids.end(), 0);
+  setup.positions = std::move(positions);
+  setup.tool_point = tool_point;
+  setup.distances = std::move(distances);
+  return setup;
+}
+
 namespace {
 
 // The ids, positions and tool point of `setup` (SocketSetup::Validate's first half).

@@ -729,12 +729,8 @@ void ParseSockets(const Json& s, const KeyLocator& where, StudySensor* sensor) {
     sensor->socket_distances.push_back(
         SocketDistance::Parse(t.get<std::string>(), where("sensor.socket_distances")));
   }
-  SocketSetup setup;
-  setup.ids.clear();
-  for (std::size_t k = 0; k < sensor->sockets.size(); ++k) setup.ids.push_back(static_cast<int>(k));
-  setup.positions = sensor->sockets;
-  setup.tool_point = sensor->tracker.targets.at(0);
-  setup.distances = sensor->socket_distances;
+  const SocketSetup setup = SocketSetup::Numbered(sensor->sockets, sensor->tracker.targets.at(0),
+                                                  sensor->socket_distances);
   try {
     setup.Validate();
   } catch (const InputError& e) {

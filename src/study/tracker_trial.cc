@@ -67,14 +67,11 @@ std::unique_ptr<MeasurementKind> SensorKindOn(const CellSettings& s, const CellC
     return std::make_unique<ScannerMeasurement>(arm, setup, s.fixed, source);
   }
   if (sensor.kind == "socket") {
-    SocketSetup setup;
-    setup.ids.clear();
-    for (std::size_t k = 0; k < sensor.sockets.size(); ++k)
-      setup.ids.push_back(static_cast<int>(k));
-    setup.positions = sensor.sockets;
-    setup.tool_point = sensor.tracker.targets.at(0);
-    setup.distances = sensor.socket_distances;
-    return std::make_unique<SocketMeasurement>(arm, setup, s.fixed, source);
+    return std::make_unique<SocketMeasurement>(
+        arm,
+        SocketSetup::Numbered(sensor.sockets, sensor.tracker.targets.at(0),
+                              sensor.socket_distances),
+        s.fixed, source);
   }
   // A tracker on a true arm reads its orientations in the nominal kind's chart.
   if (c.sensor_kind)

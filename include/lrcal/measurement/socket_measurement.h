@@ -67,6 +67,10 @@ struct SocketSetup {
   void Validate() const;
   /// The index of socket `id` in ids, or -1.
   int IndexOf(int id) const;
+  /// Sockets numbered 0, 1, … in the order of `positions` (not validated).
+  static SocketSetup Numbered(std::vector<Eigen::Vector3d> positions,
+                              const Eigen::Vector3d& tool_point,
+                              std::vector<SocketDistance> distances);
 };
 
 class SocketMeasurement : public MeasurementKind {
