@@ -153,6 +153,19 @@ void BM_NormalMatrixFixedLanes100x25(benchmark::State& state) {
 }
 BENCHMARK(BM_NormalMatrixFixedLanes100x25);
 
+// The normal matrix of a trial's Jacobian, rows × terms: the ranger's case-2 design (100 × 25),
+// a reflector's (300 × 27: three values a configuration) and a 6-D probe's (600 × 30). Its work
+// grows with the values, which no evaluator kernel removes (docs/PERFORMANCE.md).
+void BM_TrialNormalMatrix(benchmark::State& state) {
+  const Eigen::MatrixXd J = Eigen::MatrixXd::Random(state.range(0), state.range(1));
+  Eigen::MatrixXd A;
+  for (auto _ : state) {
+    NormalMatrix(J, &A);
+    benchmark::DoNotOptimize(A.data());
+  }
+}
+BENCHMARK(BM_TrialNormalMatrix)->Args({100, 25})->Args({300, 27})->Args({600, 30});
+
 // Choosing 50 of the paper's 101 candidates (25 parameters) with `options`; the chosen design's
 // score as a counter.
 void Select50of101(benchmark::State& state, const SelectionOptions& options, const char* label,
