@@ -641,7 +641,7 @@ void CheckIdentifyOutputs(const po::variables_map& vm) {
 // file that could not be written refused before the fit, not after.
 void StartKindIdentify(const po::variables_map& vm, const std::string& sensor, bool reads_planes) {
   std::vector<std::string> refused = {"estimate-ranger", "estimate-base", "estimate-tool",
-                                      "average",         "predict-at",    "only-significant"};
+                                      "average", "only-significant"};
   if (!reads_planes) refused.insert(refused.begin(), {"plane", "estimate-plane"});
   RefuseRangerOptions(vm, sensor, refused);
   CheckIdentifyOutputs(vm);
@@ -688,11 +688,33 @@ void WriteKindFitFiles(const po::variables_map& vm, const KindFit& f,
   WriteReportFolder(vm["report"].as<std::string>(), in);
 }
 
+// --predict-at: the calibrated arm's predicted accuracy at the poses from its record, what
+// `lrcal accuracy --robot` says of --write-robot's file (the arm's terms; the held ones at their
+// tolerances).
+void KindPredictAt(const po::variables_map& vm, const KindFit& f, const IdentificationSummary& s,
+                   const IdentificationOptions& options, Json* json, std::string* text) {
+  const RobotFile calibrated =
+      TrackerCalibratedRobot(DataSource::File(f.file), f.rig, f.kind, f.data, s, options);
+  if (!calibrated.calibration || calibrated.calibration->covariance.size() == 0)
+    throw InputError("--predict-at",
+                     "the covariance is undefined (as many values as terms); give --sigma-mm");
+  const std::string file = vm["predict-at"].as<std::string>();
+  const ConfigurationSet poses = ReadRobotPoses(file, calibrated.robot);
+  const AccuracyPrediction predicted =
+      PredictCalibratedAccuracy(calibrated, ResolveSetup(vm).planes, poses);
+  *json = PoseAccuracyJson(predicted, poses);
+  *text = AccuracyPredictionText(predicted);
+}
+
 int ReportKindFit(const po::variables_map& vm, const KindFit& f, const IdentificationSummary& s,
                   const IdentificationOptions& options) {
   if (s.termination == Termination::kInvalidInput &&
       f.data.size() * f.kind.rows_per_configuration() < f.kind.num_parameters())
     throw InputError(f.file, s.message);
+  Json accuracy;
+  std::string accuracy_text;
+  if (vm.count("predict-at") && s.IsSolutionUsable())
+    KindPredictAt(vm, f, s, options, &accuracy, &accuracy_text);
   // --holdout K: each fold's configurations predicted by the fit of the others.
   std::optional<CrossValidation> cv;
   if (vm.count("holdout") && s.IsSolutionUsable())
@@ -702,11 +724,12 @@ int ReportKindFit(const po::variables_map& vm, const KindFit& f, const Identific
     j["sensor"] = f.sensor;
     j["values_per_configuration"] = f.kind.rows_per_configuration();
     for (const auto& [key, value] : f.extra.items()) j[key] = value;
+    if (!accuracy.is_null()) j["accuracy"] = accuracy;
     if (cv) j["holdout"] = CrossValidationJson(*cv);
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "sensor: " << f.sensor << " (" << f.heading << "; lengths in m, angles in rad)\n"
-              << s.FullReport();
+              << s.FullReport() << accuracy_text;
     if (cv) std::cout << cv->ToString();
   }
   if (s.termination == Termination::kRankDeficient) {

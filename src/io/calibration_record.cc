@@ -134,12 +134,21 @@ UnestimatedTerms TrackerHeldTerms(const RobotFile& rig, const MeasurementKind& k
 
 }  // namespace
 
-void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data,
-                                 const RobotFile& rig, const MeasurementKind& kind,
-                                 const MeasuredValues& values, const IdentificationSummary& s,
-                                 const IdentificationOptions& options) {
+namespace {
+
+// A kind's fit as the arm's calibration: the estimated link values and the record of the link
+// terms alone (WriteTrackerCalibratedRobot).
+struct ArmCalibration {
+  Eigen::VectorXd link_values;
+  CalibrationRecord record;
+};
+
+ArmCalibration ArmCalibrationOf(const DataSource& data, const RobotFile& rig,
+                                const MeasurementKind& kind, const MeasuredValues& values,
+                                const IdentificationSummary& s,
+                                const IdentificationOptions& options) {
   const RobotModel& robot = rig.robot;
-  Eigen::VectorXd link_values = robot.nominal_values();
+  ArmCalibration out{robot.nominal_values(), {}};
   const UnestimatedTerms held = TrackerHeldTerms(rig, kind, values, s, options);
   const CalibrationRecord all = MakeCalibrationRecord(data, s, options, held);
   std::vector<Eigen::Index> links;
@@ -147,9 +156,10 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
     const int index = robot.FindValue(s.names[k]);
     if (index < 0) continue;  // the instrument's, the targets' and the sockets' terms
     links.push_back(static_cast<Eigen::Index>(k));
-    link_values[index] = s.estimate[static_cast<Eigen::Index>(k)];
+    out.link_values[index] = s.estimate[static_cast<Eigen::Index>(k)];
   }
-  CalibrationRecord record = all;
+  CalibrationRecord& record = out.record;
+  record = all;
   record.parameters.clear();
   record.estimate.resize(static_cast<Eigen::Index>(links.size()));
   for (std::size_t k = 0; k < links.size(); ++k) {
@@ -158,14 +168,45 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
   }
   if (all.covariance.size() > 0) record.covariance = all.covariance(links, links);
   if (all.estimate_shift.size() > 0) record.estimate_shift = all.estimate_shift(links, Eigen::all);
+  return out;
+}
+
+}  // namespace
+
+void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data,
+                                 const RobotFile& rig, const MeasurementKind& kind,
+                                 const MeasuredValues& values, const IdentificationSummary& s,
+                                 const IdentificationOptions& options) {
+  const ArmCalibration arm = ArmCalibrationOf(data, rig, kind, values, s, options);
   const std::string header =
       "# A calibrated robot: written by lrcal identify --sensor " + std::string(kind.name()) +
       " --write-robot from " + data.name +
       ".\n# Nominal values are the estimates (SI: rad, m); the record below says "
       "from what (the arm's terms; the instrument's frame, the targets and the sockets are the "
       "campaign's).\n";
-  WriteFileAtomically(path, header + RobotFileText(rig, link_values, rig.planes,
-                                                   robot.name() + " (calibrated)", &record));
+  WriteFileAtomically(path,
+                      header + RobotFileText(rig, arm.link_values, rig.planes,
+                                             rig.robot.name() + " (calibrated)", &arm.record));
+}
+
+RobotFile TrackerCalibratedRobot(const DataSource& data, const RobotFile& rig,
+                                 const MeasurementKind& kind, const MeasuredValues& values,
+                                 const IdentificationSummary& s,
+                                 const IdentificationOptions& options) {
+  ArmCalibration arm = ArmCalibrationOf(data, rig, kind, values, s, options);
+  std::vector<Link> links = rig.robot.links();
+  for (std::size_t i = 0; i < links.size(); ++i)
+    for (int v = 0; v < kValuesPerLink; ++v)
+      links[i].nominal[static_cast<std::size_t>(v)] =
+          arm.link_values[static_cast<Eigen::Index>(kValuesPerLink * i) + v];
+  RobotFile out = rig;
+  out.robot = RobotModel(rig.robot.name() + " (calibrated)", std::move(links), rig.robot.source,
+                         rig.robot.base(), rig.robot.tool());
+  out.robot.source = rig.robot.source;
+  out.calibration = std::move(arm.record);
+  out.truth = {};
+  out.tolerances = {};
+  return out;
 }
 
 void WriteCalibratedRobot(const std::string& path, const DataSource& data, const RobotFile& rig,

@@ -193,12 +193,36 @@ TEST_F(SensorCli, SimulatedTrackerDataCalibratesTheArm) {
   EXPECT_LT(report["measured_points"]["rms"].get<double>(), 0.2e-3);
   EXPECT_THAT(text(Path("report/report.html")),
               HasSubstr("30 points a tracker measured, not used in the fit"));
+  // --predict-at: the calibrated arm's predicted accuracy at poses, the numbers lrcal accuracy
+  // gives from --write-robot's file.
+  ASSERT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker +
+                    " --auto-fix --sigma-mm 0.05 --format json --predict-at " + Path("v.csv"),
+                &out),
+            0)
+      << out;
+  const Json predicted = Json::parse(out.substr(out.find('{')))["accuracy"];
+  ASSERT_EQ(
+      Run("accuracy --robot " + Path("written.yaml") + " --format json --configs " + Path("v.csv"),
+          &out),
+      0)
+      << out;
+  const Json stated = Json::parse(out.substr(out.find('{')));
+  ASSERT_EQ(predicted["poses"].size(), 30u);
+  EXPECT_EQ(predicted["poses"], stated["poses"]);
+  EXPECT_EQ(predicted["rms_position_total"], stated["rms_position_total"]);
+  EXPECT_GT(predicted["poses"][0]["position_radius_95"].get<double>(), 0);
+  ASSERT_EQ(Run("identify --sensor point --data " + Path("noisy.csv") + tracker +
+                    " --auto-fix --sigma-mm 0.05 --predict-at " + Path("v.csv"),
+                &out),
+            0)
+      << out;
+  EXPECT_THAT(out, HasSubstr("Predicted accuracy of the calibrated arm"));
   // A ranger-only option is refused by name.
   EXPECT_EQ(
-      Run("identify --sensor point --data " + Path("noisy.csv") + " --predict-at " + Path("c.csv"),
-          &out),
+      Run("identify --sensor point --data " + Path("noisy.csv") + " --only-significant 2", &out),
       2);
-  EXPECT_THAT(out, HasSubstr("--predict-at: is the ranger's; --sensor point does not take it"));
+  EXPECT_THAT(out,
+              HasSubstr("--only-significant: is the ranger's; --sensor point does not take it"));
 }
 
 // identify --sensor point --write-robot writes a robot file every command takes: its link values

@@ -48,6 +48,13 @@ void WriteTrackerCalibratedRobot(const std::string& path, const DataSource& data
                                  const MeasuredValues& values, const IdentificationSummary& s,
                                  const IdentificationOptions& options);
 
+/// The same calibrated robot in memory (what loading that file gives, for prediction: its robot
+/// at the estimated link values and its calibration record; no truth, no tolerances).
+RobotFile TrackerCalibratedRobot(const DataSource& data, const RobotFile& rig,
+                                 const MeasurementKind& kind, const MeasuredValues& values,
+                                 const IdentificationSummary& s,
+                                 const IdentificationOptions& options);
+
 /// The parameter set the calibration record `r` names: plane and ranger terms from their names,
 /// robot parameters not named are fixed, in MakeParameterSet's order. `source` names the record in
 /// errors.
