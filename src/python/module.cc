@@ -873,29 +873,47 @@ IdentificationOptions KindFitOptions(const std::string& solver, double sigma_mm,
 }
 
 // A kind's fit as Python receives it: an lrcal.Identification whose `holdout` is the K-fold
-// cross-validation of holdout=K (None when not asked for or the fit is not usable), with the keys
-// of `lrcal identify --sensor ... --holdout K --format json`.
-py::object FitKindPy(const MeasurementKind& kind, const MeasuredValues& data,
-                     const IdentificationOptions& options, const py::object& holdout) {
-  const std::optional<int> folds =
-      holdout.is_none() ? std::nullopt : std::optional<int>(holdout.cast<int>());
-  if (folds && (*folds < 2 || *folds > data.size()))  // refused before the fit, as the CLI does
+// cross-validation of holdout=K and whose `accuracy` is the calibrated arm's predicted accuracy at
+// predict_at=poses (None when not asked for or the fit is not usable), with the keys of `lrcal
+// identify --sensor ... --holdout K --predict-at F --format json`.
+py::object FitKindPy(const RobotFile& rig, const MeasurementKind& kind, const MeasuredValues& data,
+                     const IdentificationOptions& options, const py::object& holdout,
+                     const py::object& predict_at) {
+  const int folds = holdout.is_none() ? 0 : holdout.cast<int>();  // 0: not asked for
+  if (!holdout.is_none() && (folds < 2 || folds > data.size()))   // refused before the fit
     throw InputError("holdout", "expected 2 to " + std::to_string(data.size()) +
                                     " folds (the number of configurations), got " +
-                                    std::to_string(*folds));
+                                    std::to_string(folds));
+  ConfigurationSet poses;
+  if (!predict_at.is_none()) {
+    poses = ToConfigurations(predict_at.cast<Array>(), rig.robot.num_links(), "predict_at");
+    CheckJointRanges(poses, rig.robot, "predict_at");
+  }
+  const PlaneSet planes = ResolvePlanes(rig, py::none());
   IdentificationSummary summary;
   std::optional<CrossValidation> cv;
+  std::optional<AccuracyPrediction> accuracy;
   {
     py::gil_scoped_release release;
     summary = Identify(kind, data, options);
     try {
-      if (folds && summary.IsSolutionUsable()) cv = CrossValidate(kind, data, *folds, options);
+      if (folds > 0 && summary.IsSolutionUsable()) cv = CrossValidate(kind, data, folds, options);
     } catch (const SettingError& e) {
       throw e.Respelled(Frontend::kPython);
+    }
+    if (!predict_at.is_none() && summary.IsSolutionUsable()) {
+      const RobotFile calibrated = TrackerCalibratedRobot(DataSource{"Python arrays", ""}, rig,
+                                                          kind, data, summary, options);
+      if (!calibrated.calibration || calibrated.calibration->covariance.size() == 0)
+        throw InputError("predict_at",
+                         "the covariance is undefined (as many values as terms); give sigma_mm");
+      accuracy = PredictCalibratedAccuracy(calibrated, planes, poses);
     }
   }
   py::object result = py::cast(std::move(summary));
   result.attr("holdout") = cv ? FromJson(CrossValidationJson(*cv).dump()) : py::none();
+  result.attr("accuracy") =
+      accuracy ? FromJson(PoseAccuracyJson(*accuracy, poses).dump()) : py::none();
   return result;
 }
 
@@ -905,7 +923,7 @@ struct TrackerFitArgs {
   bool auto_fix;
   double sigma_mm, sigma_mrad;
   std::string solver;
-  py::object holdout = py::none();
+  py::object holdout = py::none(), predict_at = py::none();
 };
 
 // An (N, columns) array's values, row by row (InputError naming `name` for another shape).
@@ -961,7 +979,7 @@ py::object IdentifyTrackerPy(const RobotFile& rig, const Array& q, const Array& 
   if (sensor == "pose")
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma,
                    a.sigma_mrad * 1e-3, &data);
-  return FitKindPy(*kind, data, options, a.holdout);
+  return FitKindPy(rig, *kind, data, options, a.holdout, a.predict_at);
 }
 
 // identifiability(sensor='socket')'s own arguments.
@@ -2046,23 +2064,25 @@ xyz (N, 3) m in the instrument's frame, repetitions, and for a pose quaternion (
          const py::object& quaternion, const py::object& instrument, const py::object& targets,
          const py::object& target_of, const py::object& repetitions, const py::object& fix,
          bool auto_fix, double sigma_mm, double sigma_mrad, const std::string& solver,
-         const py::object& holdout) {
+         const py::object& holdout, const py::object& predict_at) {
         return IdentifyTrackerPy(rig, q, xyz, sensor,
                                  {quaternion, instrument, targets, target_of, repetitions, fix,
-                                  auto_fix, sigma_mm, sigma_mrad, solver, holdout});
+                                  auto_fix, sigma_mm, sigma_mrad, solver, holdout, predict_at});
       },
       py::arg("robot"), py::arg("q"), py::arg("xyz"), py::arg("sensor") = "point",
       py::arg("quaternion") = py::none(), py::arg("instrument") = py::none(),
       py::arg("targets") = py::none(), py::arg("target_of") = py::none(),
       py::arg("repetitions") = py::none(), py::arg("fix") = py::none(), py::arg("auto_fix") = false,
       py::arg("sigma_mm") = 0.0, py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm",
-      py::arg("holdout") = py::none(), R"doc(
+      py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(), R"doc(
 The tracker's terms (the arm's link values, the instrument's frame, the targets) from its
 values: `lrcal identify --sensor point|pose`. xyz (N, 3) m and, for sensor='pose', quaternion
 (N, 4) as simulate_tracker returns them; repetitions (N,) each row's weight (default 1);
 sigma_mm (0: unknown, judged from the residuals) and sigma_mrad weigh a pose's orientations
 against its positions. holdout=K: K-fold cross-validation of every value (as --holdout K; a pose's
-angles apart) in result.holdout (None when not asked for). Returns an lrcal.Identification.)doc");
+angles apart) in result.holdout (None when not asked for). predict_at=poses (M, joints) rad: the
+calibrated arm's predicted accuracy there (as --predict-at; every identify_* function takes it) in
+result.accuracy. Returns an lrcal.Identification.)doc");
 }
 
 // simulate_sockets: starts seated on the true arm at the true sockets, as simulate --sensor
@@ -2112,13 +2132,13 @@ py::dict SimulateSocketsPy(const RobotFile& rig, const Array& q, const py::objec
 py::object IdentifySocketsPy(const RobotFile& rig, const Array& q, const py::object& socket_of,
                              const py::object& tool_point, const py::object& distances,
                              const py::object& repetitions, const py::object& fix, bool auto_fix,
-                             double sigma_mm, const std::string& solver,
-                             const py::object& holdout) {
+                             double sigma_mm, const std::string& solver, const py::object& holdout,
+                             const py::object& predict_at) {
   const SocketData data = ToSocketData(rig.robot, q, socket_of, repetitions);
   const std::unique_ptr<SocketMeasurement> kind =
       ToSocketKind(rig.robot, data, tool_point, distances, fix);
   const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
-  return FitKindPy(*kind, data.values, options, holdout);
+  return FitKindPy(rig, *kind, data.values, options, holdout, predict_at);
 }
 
 // socket_consistency: as accuracy --sockets.
@@ -2171,13 +2191,15 @@ repetitions of the seated rows, and misses (one reason per start: "ok", "out of 
         py::arg("socket_of"), py::arg("tool_point") = py::none(),
         py::arg("socket_distances") = py::none(), py::arg("repetitions") = py::none(),
         py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
-        py::arg("solver") = "lm", py::arg("holdout") = py::none(), R"doc(
+        py::arg("solver") = "lm", py::arg("holdout") = py::none(),
+        py::arg("predict_at") = py::none(), R"doc(
 The arm's link values, the tool point and the sockets from seatings: `lrcal identify --sensor
 socket`. q (N, joints), socket_of (N socket ids); tool_point the nominal offset (None: the tool
 frame's origin); socket_distances=[(a, b, metres), ...] known distances (a tree); repetitions
 (N,) each row's weight; fix, auto_fix, sigma_mm (the play per axis; 0: judged from the
 residuals) and solver as in identify; holdout=K: K-fold cross-validation of every value (as
---holdout K) in result.holdout. Returns an lrcal.Identification.)doc");
+--holdout K) in result.holdout; predict_at as in identify_tracker. Returns an
+lrcal.Identification.)doc");
   m.def("socket_consistency", &SocketConsistencyPy, py::arg("robot"), py::arg("q"),
         py::arg("socket_of"), py::arg("tool_point") = py::none(),
         py::arg("socket_distances") = py::none(), R"doc(
@@ -2217,7 +2239,7 @@ py::dict SimulateContactsPy(const RobotFile& rig, const Array& q, const ContactA
 py::object IdentifyContactsPy(const RobotFile& rig, const Array& q, const ContactArgs& a,
                               const py::object& repetitions, bool auto_fix, double sigma_mm,
                               double sigma_mrad, const std::string& solver,
-                              const py::object& holdout) {
+                              const py::object& holdout, const py::object& predict_at) {
   const PlaneSet planes = ResolvePlanes(rig, a.plane);
   const std::unique_ptr<ContactMeasurement> kind = ToContactKind(rig.robot, planes, a);
   MeasuredValues data{ToContactConfigurations(rig.robot, q, a.plane_of, planes.size()), {}, {}};
@@ -2230,7 +2252,7 @@ py::object IdentifyContactsPy(const RobotFile& rig, const Array& q, const Contac
   if (a.flush)
     WeighAngleRows(*kind, options.sigma > 0 ? options.sigma : NoiseModel{}.sigma, sigma_mrad * 1e-3,
                    &data);
-  return FitKindPy(*kind, data, options, holdout);
+  return FitKindPy(rig, *kind, data, options, holdout, predict_at);
 }
 
 // The contact kind (contact_measurement.h): simulation and fit.
@@ -2258,21 +2280,24 @@ rows, and misses (a reason per start).)doc");
       [](const RobotFile& rig, const Array& q, const py::object& plane, const py::object& plane_of,
          const py::object& tool_point, bool flush, const std::string& estimate_plane,
          const py::object& repetitions, const py::object& fix, bool auto_fix, double sigma_mm,
-         double sigma_mrad, const std::string& solver, const py::object& holdout) {
+         double sigma_mrad, const std::string& solver, const py::object& holdout,
+         const py::object& predict_at) {
         return IdentifyContactsPy(rig, q, {plane, plane_of, tool_point, fix, estimate_plane, flush},
-                                  repetitions, auto_fix, sigma_mm, sigma_mrad, solver, holdout);
+                                  repetitions, auto_fix, sigma_mm, sigma_mrad, solver, holdout,
+                                  predict_at);
       },
       py::arg("robot"), py::arg("q"), py::arg("plane") = py::none(),
       py::arg("plane_of") = py::none(), py::arg("tool_point") = py::none(),
       py::arg("flush") = false, py::arg("estimate_plane") = "none",
       py::arg("repetitions") = py::none(), py::arg("fix") = py::none(), py::arg("auto_fix") = false,
       py::arg("sigma_mm") = 0.0, py::arg("sigma_mrad") = 0.2, py::arg("solver") = "lm",
-      py::arg("holdout") = py::none(), R"doc(
+      py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(), R"doc(
 The arm's link values, the tool point and the planes' estimated terms from contacts: `lrcal
 identify --sensor contact`. q (N, joints) on planes (plane, plane_of as in identify); flush,
 tool_point as in simulate_contacts; estimate_plane ("none", "normal", "offset",
 "normal,offset") for every plane; repetitions, fix, auto_fix, sigma_mm, sigma_mrad (a flush
-contact's tilt rows weigh (sigma_mm/sigma_mrad)^2), solver and holdout as in identify_tracker.
+contact's tilt rows weigh (sigma_mm/sigma_mrad)^2), solver, holdout and predict_at as in
+identify_tracker.
 Returns an lrcal.Identification.)doc");
 }
 
@@ -2307,7 +2332,8 @@ py::dict SimulateScannerPy(const RobotFile& rig, const Array& q, const ScannerAr
 // identify_scanner: as identify --sensor scanner; h (N, beams).
 py::object IdentifyScannerPy(const RobotFile& rig, const Array& q, const Array& h, ScannerArgs a,
                              const py::object& repetitions, bool auto_fix, double sigma_mm,
-                             const std::string& solver, const py::object& holdout) {
+                             const std::string& solver, const py::object& holdout,
+                             const py::object& predict_at) {
   if (h.ndim() != 2)
     throw InputError("h", "expected an (N, beams) array of readings (m), one column per beam");
   a.beams = static_cast<long long>(h.shape(1));
@@ -2320,7 +2346,7 @@ py::object IdentifyScannerPy(const RobotFile& rig, const Array& q, const Array& 
   if (static_cast<int>(data.repetitions.size()) != data.size())
     throw InputError("repetitions", "expected one count per row of q");
   const IdentificationOptions options = KindFitOptions(solver, sigma_mm, auto_fix);
-  return FitKindPy(*kind, data, options, holdout);
+  return FitKindPy(rig, *kind, data, options, holdout, predict_at);
 }
 
 // The scanner kind (scanner_measurement.h): simulation and fit.
@@ -2350,20 +2376,23 @@ reason per configuration of q).)doc");
       [](const RobotFile& rig, const Array& q, const Array& h, const py::object& plane,
          const py::object& plane_of, double fan_deg, const py::object& scanner,
          const std::string& estimate_plane, const py::object& repetitions, const py::object& fix,
-         bool auto_fix, double sigma_mm, const std::string& solver, const py::object& holdout) {
+         bool auto_fix, double sigma_mm, const std::string& solver, const py::object& holdout,
+         const py::object& predict_at) {
         return IdentifyScannerPy(rig, q, h,
                                  {plane, plane_of, scanner, fix, estimate_plane, 1, fan_deg},
-                                 repetitions, auto_fix, sigma_mm, solver, holdout);
+                                 repetitions, auto_fix, sigma_mm, solver, holdout, predict_at);
       },
       py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("plane") = py::none(),
       py::arg("plane_of") = py::none(), py::arg("fan_deg") = 0.0, py::arg("scanner") = py::none(),
       py::arg("estimate_plane") = "none", py::arg("repetitions") = py::none(),
       py::arg("fix") = py::none(), py::arg("auto_fix") = false, py::arg("sigma_mm") = 0.0,
-      py::arg("solver") = "lm", py::arg("holdout") = py::none(), R"doc(
+      py::arg("solver") = "lm", py::arg("holdout") = py::none(), py::arg("predict_at") = py::none(),
+      R"doc(
 The arm's link values, the scanner's frame (target_x..z, scanner_roll, _pitch, _yaw) and the
 planes' estimated terms from a line scanner's readings h (N, beams; m, one column per beam, the
 fan as in simulate_scanner): `lrcal identify --sensor scanner`. q, plane, plane_of,
-estimate_plane, repetitions, fix, auto_fix, sigma_mm, solver and holdout as in identify_contacts.
+estimate_plane, repetitions, fix, auto_fix, sigma_mm, solver, holdout and predict_at as in
+identify_contacts.
 Returns an lrcal.Identification.)doc");
 }
 

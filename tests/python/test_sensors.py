@@ -89,6 +89,24 @@ def test_simulated_values_match_the_program_bit_for_bit_and_calibrate(tmp_path, 
         lrcal.identify_tracker(paper, sim["q"], sim["xyz"], sensor="pose",
                                quaternion=sim["quaternion"], instrument=TRACKER, holdout=1)
 
+    # predict_at=poses: the program's --predict-at, the calibrated arm's accuracy at the poses.
+    poses = lrcal.sample_configurations(paper, 6, seed=8)
+    write_configurations(tmp_path / "p.csv", poses)
+    fit = lrcal.identify_tracker(paper, sim["q"], sim["xyz"], sensor="pose",
+                                 quaternion=sim["quaternion"], instrument=TRACKER,
+                                 repetitions=sim["repetitions"], auto_fix=True, sigma_mm=0.05,
+                                 sigma_mrad=0.1, predict_at=poses)
+    done = cli("identify", "--sensor", "pose", "--data", tmp_path / "m.csv", "--instrument",
+               TRACKER_ARG, "--auto-fix", "--sigma-mm", "0.05", "--sigma-mrad", "0.1",
+               "--predict-at", tmp_path / "p.csv", "--format", "json")
+    stated = json.loads(done.stdout)["accuracy"]
+    assert len(fit.accuracy["poses"]) == 6
+    for mine, theirs in zip(fit.accuracy["poses"], stated["poses"]):
+        assert mine["position_radius_95_total"] == pytest.approx(
+            theirs["position_radius_95_total"], rel=1e-9)
+        assert mine["position_radius_95"] > 0
+    assert fit.holdout is None
+
 
 def test_noise_free_tracker_data_give_the_true_errors(paper):
     q = lrcal.sample_configurations(paper, 40, seed=3)
