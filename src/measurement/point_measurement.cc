@@ -25,100 +25,27 @@ class PointEvaluator : public MeasurementEvaluator {
   PointEvaluator(const PointMeasurement& kind, const TargetedConfigurations& configs,
                  std::vector<Eigen::Matrix3d> chart_centres)
       : kind_(kind),
-        configs_(configs),
         k_(kind.rows_per_configuration()),
+        m_(configs.size()),
         chart_centres_(std::move(chart_centres)) {
-    if (k_ == 3) batch_.SetConfigurations(configs);
+    batch_.SetConfigurations(configs);
   }
-  int num_rows() const override { return k_ * configs_.size(); }
+  int num_rows() const override { return k_ * m_; }
   int num_parameters() const override { return kind_.num_parameters(); }
+  // Every configuration at once (batch_point.h).
   bool Predict(const double* e, double* y, double* J) override {
     kind_.StateAt(e, &state_);
     PrepareChainPoint(kind_.robot(), state_.link_values.data(), &chain_);
-    if (k_ == 3) {  // the point kind: every configuration at once, the bits of the loop below
-      batch_.Evaluate(kind_, state_, chain_, y, J);
-      return true;
-    }
-    const int m = num_rows();
-    if (J) std::fill(J, J + static_cast<std::size_t>(m) * num_parameters(), 0.0);
-    for (int i = 0; i < configs_.size(); ++i) {
-      const Pose<double> pose = ToolPose(chain_, configs_, i, J ? &frames_ : nullptr);
-      const int target = configs_.target(i);
-      const Eigen::Vector3d P = pose.p_BT + pose.R_BT * state_.targets[target];
-      const Eigen::Vector3d value = state_.R_BI.transpose() * (P - state_.p_BI);
-      for (int c = 0; c < 3; ++c) y[k_ * i + c] = value[c];
-      if (J) FillRows(pose, P, target, i, m, J);
-      if (k_ == 6) PredictOrientation(pose, target, i, m, y, J);
-    }
+    batch_.Evaluate(kind_, state_, chain_, k_ == 6 ? chart_centres_.data() : nullptr, y, J);
     return true;
   }
 
  private:
-  void Put(double* J, int m, int column, int row, const Eigen::Vector3d& rows) const {
-    if (column < 0) return;
-    for (int c = 0; c < 3; ++c) J[static_cast<std::size_t>(column) * m + row + c] = rows[c];
-  }
-  void FillRows(const Pose<double>& pose, const Eigen::Vector3d& P, int target, int i, int m,
-                double* J) const {
-    const int row = k_ * i;
-    const Eigen::Matrix3d Rt = state_.R_BI.transpose();
-    const std::vector<int>& values = kind_.robot_values();
-    for (int k = 0; k < static_cast<int>(values.size()); ++k)
-      Put(J, m, k, row, Rt * LinkValuePointMotion(frames_, values[k], P));
-    for (int c = 0; c < 3; ++c) Put(J, m, kind_.instrument_column(c), row, -Rt.col(c));
-    // y = Rxᵀ·Ryᵀ·Rzᵀ·v, v = R_BI0ᵀ·(P − p_BI); dR/dφ = R·[e]× for each elementary rotation.
-    const Eigen::Vector3d u2 =
-        state_.Rz.transpose() * (state_.R_BI0.transpose() * (P - state_.p_BI));
-    const Eigen::Vector3d u1 = state_.Ry.transpose() * u2;
-    const Eigen::Vector3d value = state_.Rx.transpose() * u1;
-    Put(J, m, kind_.instrument_column(3), row, -Eigen::Vector3d::UnitX().cross(value));
-    Put(J, m, kind_.instrument_column(4), row,
-        -(state_.Rx.transpose() * Eigen::Vector3d::UnitY().cross(u1)));
-    Put(J, m, kind_.instrument_column(5), row,
-        -(state_.Rx.transpose() * (state_.Ry.transpose() * Eigen::Vector3d::UnitZ().cross(u2))));
-    const Eigen::Matrix3d dy_dt = Rt * pose.R_BT;
-    for (int c = 0; c < 3; ++c) Put(J, m, kind_.target_column(target, c), row, dy_dt.col(c));
-  }
-  // Rows 3–5 of configuration i: φ = log(Cᵀ·R_IM) and, if J, J_r⁻¹(φ)·ω per term, ω the body
-  // (M-frame) rotation the term causes (pose_measurement.h).
-  void PredictOrientation(const Pose<double>& pose, int target, int i, int m, double* y,
-                          double* J) const {
-    const int row = k_ * i + 3;
-    const Eigen::Matrix3d R_BM = pose.R_BT * state_.R_TM[target];
-    const Eigen::Matrix3d R_IM = state_.R_BI.transpose() * R_BM;
-    const Eigen::Vector3d phi = RotationLog(chart_centres_[i].transpose() * R_IM);
-    for (int c = 0; c < 3; ++c) y[row + c] = phi[c];
-    if (!J) return;
-    const Eigen::Matrix3d Jinv = InverseRightJacobian(phi);
-    const Eigen::Matrix3d to_body = Jinv * R_BM.transpose();  // base-frame ω → rows
-    const std::vector<int>& values = kind_.robot_values();
-    for (int k = 0; k < static_cast<int>(values.size()); ++k)
-      Put(J, m, k, row, to_body * LinkValueRotation(frames_, values[k]));
-    // The instrument's rotations turn R_IM on the left (frame I): ω_M = −R_IMᵀ·ω_I.
-    const Eigen::Matrix3d from_instrument = -Jinv * R_IM.transpose();
-    Put(J, m, kind_.instrument_column(3), row, from_instrument * Eigen::Vector3d::UnitX());
-    Put(J, m, kind_.instrument_column(4), row,
-        from_instrument * (state_.Rx.transpose() * Eigen::Vector3d::UnitY()));
-    Put(J, m, kind_.instrument_column(5), row,
-        from_instrument *
-            (state_.Rx.transpose() * (state_.Ry.transpose() * Eigen::Vector3d::UnitZ())));
-    // The target's rotations turn R_IM on the right (frame M).
-    const Eigen::Matrix3d& Rx = state_.target_Rx[target];
-    const Eigen::Matrix3d& Ry = state_.target_Ry[target];
-    Put(J, m, kind_.target_rotation_column(target, 0), row, Jinv * Eigen::Vector3d::UnitX());
-    Put(J, m, kind_.target_rotation_column(target, 1), row,
-        Jinv * (Rx.transpose() * Eigen::Vector3d::UnitY()));
-    Put(J, m, kind_.target_rotation_column(target, 2), row,
-        Jinv * (Rx.transpose() * (Ry.transpose() * Eigen::Vector3d::UnitZ())));
-  }
-
   const PointMeasurement& kind_;
-  const TargetedConfigurations& configs_;
-  const int k_;
+  const int k_, m_;
   const std::vector<Eigen::Matrix3d> chart_centres_;
   PointMeasurement::State state_;
   ChainPoint chain_;
-  ChainFrames frames_;
   BatchPointEvaluator batch_;
 };
 
