@@ -8,14 +8,35 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <vector>
 
 #include "lrcal/kinematics/chain.h"
+#include "lrcal/measurement/targeted_configurations.h"
 
 namespace lrcal::batch {
 
 // Per link: z_prev (3), o_prev (3), x_common (3), y_twist (3), o (3).
 inline constexpr int kFrameArrays = 15;
 enum : int { kZPrev = 0, kOPrev = 3, kXCommon = 6, kYTwist = 9, kO = 12 };
+
+// The configurations' joint values and their cos/sin, one array of m per joint ([joint·m + i]):
+// what the chain's steps read.
+struct JointArrays {
+  std::vector<double> q, cq, sq;
+  void Set(const TargetedConfigurations& configs) {
+    const int m = configs.size(), joints = configs.num_joints();
+    q.resize(static_cast<std::size_t>(joints) * m);
+    cq.resize(q.size());
+    sq.resize(q.size());
+    for (int i = 0; i < m; ++i) {
+      for (int j = 0; j < joints; ++j) {
+        q[j * m + i] = configs.q(i)[j];
+        cq[j * m + i] = configs.cos_q(i)[j];
+        sq[j * m + i] = configs.sin_q(i)[j];
+      }
+    }
+  }
+};
 
 // What the chain's steps read and write: m configurations' joint values and their cos/sin
 // ([joint·m + i]) and, for the Jacobian, every link's frames ([(link·kFrameArrays + k)·m + i]).

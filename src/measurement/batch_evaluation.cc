@@ -21,16 +21,7 @@ using batch::kZPrev;
 void BatchEvaluator::SetConfigurations(const TargetedConfigurations& configs) {
   m_ = configs.size();
   joints_ = configs.num_joints();
-  q_.resize(static_cast<std::size_t>(joints_) * m_);
-  cq_.resize(q_.size());
-  sq_.resize(q_.size());
-  for (int i = 0; i < m_; ++i) {
-    for (int j = 0; j < joints_; ++j) {
-      q_[j * m_ + i] = configs.q(i)[j];
-      cq_[j * m_ + i] = configs.cos_q(i)[j];
-      sq_[j * m_ + i] = configs.sin_q(i)[j];
-    }
-  }
+  joint_arrays_.Set(configs);
   plane_.clear();
   num_targets_referenced_ = configs.num_targets_referenced();
   if (num_targets_referenced_ > 1) {
@@ -332,9 +323,9 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
   const KernelArgs args{m_,
                         &point,
                         &model.parameters(),
-                        q_.data(),
-                        cq_.data(),
-                        sq_.data(),
+                        joint_arrays_.q.data(),
+                        joint_arrays_.cq.data(),
+                        joint_arrays_.sq.data(),
                         plane_.empty() ? nullptr : plane_.data(),
                         state_.data(),
                         frames_.data(),

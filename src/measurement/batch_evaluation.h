@@ -12,6 +12,7 @@
 
 #include "core/cpu_dispatch.h"
 #include "lrcal/measurement/measurement_model.h"
+#include "measurement/batch_chain.h"
 
 namespace lrcal {
 
@@ -31,7 +32,7 @@ class BatchEvaluator {
 
  private:
   int m_ = 0, joints_ = 0, num_targets_referenced_ = 0;
-  std::vector<double> q_, cq_, sq_;  // [joint·m + i]
+  batch::JointArrays joint_arrays_;
   // Each configuration's plane; empty when every configuration is aimed at plane 0 (the
   // single-plane kernel, which keeps the plane's normal in registers).
   std::vector<int> plane_;

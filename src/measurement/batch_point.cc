@@ -11,18 +11,9 @@ namespace lrcal {
 void BatchPointEvaluator::SetConfigurations(const TargetedConfigurations& configs) {
   m_ = configs.size();
   joints_ = configs.num_joints();
-  q_.resize(static_cast<std::size_t>(joints_) * m_);
-  cq_.resize(q_.size());
-  sq_.resize(q_.size());
+  joint_arrays_.Set(configs);
   target_.resize(static_cast<std::size_t>(m_));
-  for (int i = 0; i < m_; ++i) {
-    for (int j = 0; j < joints_; ++j) {
-      q_[j * m_ + i] = configs.q(i)[j];
-      cq_[j * m_ + i] = configs.cos_q(i)[j];
-      sq_[j * m_ + i] = configs.sin_q(i)[j];
-    }
-    target_[static_cast<std::size_t>(i)] = configs.target(i);
-  }
+  for (int i = 0; i < m_; ++i) target_[static_cast<std::size_t>(i)] = configs.target(i);
   state_.resize(12 * static_cast<std::size_t>(m_));
   frames_.resize(static_cast<std::size_t>(batch::kFrameArrays) * joints_ * m_);
   scratch_.assign(kScratchArrays * static_cast<std::size_t>(m_), 0.0);
@@ -419,9 +410,9 @@ void BatchPointEvaluator::Evaluate(const PointMeasurement& kind,
                        &kind,
                        &state,
                        &chain,
-                       q_.data(),
-                       cq_.data(),
-                       sq_.data(),
+                       joint_arrays_.q.data(),
+                       joint_arrays_.cq.data(),
+                       joint_arrays_.sq.data(),
                        target_.data(),
                        state_.data(),
                        frames_.data(),

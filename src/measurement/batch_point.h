@@ -15,6 +15,7 @@
 #include "lrcal/kinematics/chain.h"
 #include "lrcal/measurement/point_measurement.h"
 #include "lrcal/measurement/targeted_configurations.h"
+#include "measurement/batch_chain.h"
 
 namespace lrcal {
 
@@ -38,8 +39,8 @@ class BatchPointEvaluator {
 
  private:
   int m_ = 0, joints_ = 0;
-  std::vector<double> q_, cq_, sq_;  // [joint·m + i]
-  std::vector<int> target_;          // each configuration's target
+  batch::JointArrays joint_arrays_;
+  std::vector<int> target_;  // each configuration's target
   // Chain state, per-link frames and the per-configuration arrays of the values' and the
   // Jacobian's steps (kScratchArrays of m).
   static constexpr int kScratchArrays = 40;
