@@ -701,7 +701,7 @@ void KindPredictAt(const po::variables_map& vm, const KindFit& f, const Identifi
   const std::string file = vm["predict-at"].as<std::string>();
   const ConfigurationSet poses = ReadRobotPoses(file, calibrated.robot);
   const AccuracyPrediction predicted =
-      PredictCalibratedAccuracy(calibrated, ResolveSetup(vm).planes, poses);
+      PredictCalibratedAccuracy(calibrated, ResolvePlanes(f.rig, vm), poses);
   *json = PoseAccuracyJson(predicted, poses);
   *text = AccuracyPredictionText(predicted);
 }
