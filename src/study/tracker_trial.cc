@@ -285,9 +285,8 @@ void SelectTrackerDesign(const CellSettings& s, CellContext* c) {
       c->design_nominal.Factorize();
     }
     const Eigen::VectorXd w = TrackerRowWeights(s, *c->kind, m);
-    c->predicted_covariance =
-        ParameterCovariance(Gd.transpose() * w.asDiagonal() * Gd, s.noise.sigma);
-    c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
+    SetPredictedCovariance(c, ParameterCovariance(Gd.transpose() * w.asDiagonal() * Gd, 1.0),
+                           s.noise.sigma);
     return;
   }
   if (!c->rank_deficient) c->rank_message = design_report.ToString();

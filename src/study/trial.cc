@@ -1,7 +1,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <mutex>
+#include <sstream>
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/hash.h"
@@ -15,6 +17,7 @@
 #include "lrcal/io/urdf.h"
 #include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/simulation.h"
+#include "study/preparation_memo.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal {
@@ -115,6 +118,73 @@ std::vector<int> PerPlaneCounts(const CellSettings& s, const PlaneSet& planes, i
 
 namespace {
 
+bool SamePlanes(const PlaneSet& a, const PlaneSet& b) {
+  if (a.size() != b.size()) return false;
+  for (int p = 0; p < a.size(); ++p)
+    if (a[p].normal != b[p].normal || a[p].offset != b[p].offset) return false;
+  return true;
+}
+
+// A random stream's address (core/random.h).
+struct StreamAddress {
+  std::uint64_t seed, stream, trial;
+  RandomPurpose purpose;
+  RandomStream Stream() const { return RandomStream(seed, stream, trial, purpose); }
+  bool operator==(const StreamAddress& o) const {
+    return seed == o.seed && stream == o.stream && trial == o.trial && purpose == o.purpose;
+  }
+};
+
+bool SameSamplingOptions(const SamplingOptions& a, const SamplingOptions& b) {
+  return a.min_jacobian_singular_value == b.min_jacobian_singular_value &&
+         a.require_beam_hit == b.require_beam_hit &&
+         a.max_attempts_per_configuration == b.max_attempts_per_configuration &&
+         a.ranger.min_range == b.ranger.min_range && a.ranger.max_range == b.ranger.max_range &&
+         a.ranger.max_incidence == b.ranger.max_incidence &&
+         a.true_link_values.has_value() == b.true_link_values.has_value() &&
+         (!a.true_link_values || SameMatrix(*a.true_link_values, *b.true_link_values)) &&
+         a.true_planes.has_value() == b.true_planes.has_value() &&
+         (!a.true_planes || SamePlanes(*a.true_planes, *b.true_planes));
+}
+
+// Every input of SampleConfigurations: the robot (by identity: LoadRigFile shares it), the
+// planes, the counts, the stream and the options.
+struct SamplingKey {
+  const RobotModel* robot;
+  PlaneSet planes;
+  std::vector<int> counts;
+  StreamAddress stream;
+  SamplingOptions options;
+  bool operator==(const SamplingKey& o) const {
+    return robot == o.robot && SamePlanes(planes, o.planes) && counts == o.counts &&
+           stream == o.stream && SameSamplingOptions(options, o.options);
+  }
+};
+
+struct SampledConfigurations {
+  TargetedConfigurations configs;
+  SamplingReport report;
+};
+
+// SampleConfigurations on the cell's robot and planes. A cell's own draws (trial 0) go through a
+// memo: the cells of a sweep over the noise draw the same pool and validation poses.
+TargetedConfigurations SampleCellConfigurations(const CellContext& c,
+                                                const std::vector<int>& counts,
+                                                const StreamAddress& stream,
+                                                const SamplingOptions& o, SamplingReport* report) {
+  const auto sample = [&] {
+    SampledConfigurations out;
+    out.configs = SampleConfigurations(*c.robot, c.planes, counts, stream.Stream(), o, &out.report);
+    return out;
+  };
+  static PreparationMemo<SamplingKey, SampledConfigurations> memo;
+  SampledConfigurations sampled =
+      stream.trial == 0 ? memo.Get(SamplingKey{c.robot.get(), c.planes, counts, stream, o}, sample)
+                        : sample();
+  if (report != nullptr) *report = sampled.report;
+  return std::move(sampled.configs);
+}
+
 TargetedConfigurations SamplePool(const CellContext& c, long long trial,
                                   const Eigen::VectorXd& truth, SamplingReport* report) {
   const CellSettings& s = c.cell->typed;
@@ -123,20 +193,44 @@ TargetedConfigurations SamplePool(const CellContext& c, long long trial,
   o.min_jacobian_singular_value = s.min_singular_value;
   o.true_link_values = truth;
   o.true_planes = c.planes;
-  const RandomStream stream(c.seed, c.pool_stream, static_cast<std::uint64_t>(trial),
-                            RandomPurpose::kPool);
-  return SampleConfigurations(*c.robot, c.planes, PerPlaneCounts(s, c.planes, s.pool_size), stream,
-                              o, report);
+  return SampleCellConfigurations(
+      c, PerPlaneCounts(s, c.planes, s.pool_size),
+      {c.seed, c.pool_stream, static_cast<std::uint64_t>(trial), RandomPurpose::kPool}, o, report);
 }
 
-// Selects the design of trial `trial` (0 for the cell's own) from a pool and its scaled G.
+// Every input of a cell's selection: the pool's scaled G, the count, the selection settings (as
+// the study spells them: CellSettings::selection is read from them alone) and the stream.
+struct SelectionKey {
+  Eigen::MatrixXd G;
+  int count;
+  std::string selection;
+  std::uint64_t seed, stream, trial;
+  bool operator==(const SelectionKey& o) const {
+    return count == o.count && seed == o.seed && stream == o.stream && trial == o.trial &&
+           selection == o.selection && SameMatrix(G, o.G);
+  }
+};
+
+// Selects the design of trial `trial` (0 for the cell's own) from a pool and its scaled G. The
+// cell's own goes through a memo (a trial's redrawn selection is its own).
 TrialDesign SelectDesign(const CellContext& c, long long trial, const TargetedConfigurations& pool,
                          const Eigen::MatrixXd& pool_G) {
   const CellSettings& s = c.cell->typed;
-  const RandomStream stream(c.selection_seed, c.pool_stream, static_cast<std::uint64_t>(trial),
-                            RandomPurpose::kSelection);
+  const auto t = static_cast<std::uint64_t>(trial);
+  const RandomStream stream(c.selection_seed, c.pool_stream, t, RandomPurpose::kSelection);
+  const auto select = [&] {
+    return SelectConfigurations(pool_G, s.select_count, s.selection, stream).indices;
+  };
   TrialDesign d;
-  d.slots = SelectConfigurations(pool_G, s.select_count, s.selection, stream).indices;
+  if (trial == 0) {
+    static PreparationMemo<SelectionKey, std::vector<int>> memo;
+    d.slots = memo.Get(
+        SelectionKey{pool_G, s.select_count, c.cell->settings.value("selection", Json()).dump(),
+                     c.selection_seed, c.pool_stream, t},
+        select);
+  } else {
+    d.slots = select();
+  }
   d.configs = pool.Subset(d.slots);
   return d;
 }
@@ -148,10 +242,39 @@ double DesignSigmaMin(const Eigen::MatrixXd& GtG, int m) {
 // ---------------------------------------------------------------------------------------------
 // The cell's steps.
 
+// A robot file as loaded, with its model shared by every cell that loads the same bytes (so the
+// configurations' memos below can match the robot by identity).
+struct LoadedRig {
+  std::shared_ptr<const RobotFile> file;
+  std::shared_ptr<const RobotModel> robot;
+};
+
+struct RigKey {
+  std::string path, tool_link, base_link, bytes;
+  bool operator==(const RigKey& o) const {
+    return path == o.path && tool_link == o.tool_link && base_link == o.base_link &&
+           bytes == o.bytes;
+  }
+};
+
+// LoadRobotFile, matched on the file's path, links and bytes (a file edited between two cells'
+// preparations is read again).
+LoadedRig LoadRigFile(const std::string& path, const CellSettings& s) {
+  static PreparationMemo<RigKey, LoadedRig, 4> memo;
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return memo.Get(RigKey{path, s.tool_link, s.base_link, bytes.str()}, [&] {
+    auto file = std::make_shared<RobotFile>(LoadRobotFile(path, s.tool_link, s.base_link));
+    auto robot = std::make_shared<const RobotModel>(file->robot);
+    return LoadedRig{std::move(file), std::move(robot)};
+  });
+}
+
 void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
-  RobotFile file =
-      LoadRobotFile(ResolveRobotPath(s.robot, study.folder()), s.tool_link, s.base_link);
-  c->robot = std::make_shared<RobotModel>(std::move(file.robot));
+  const LoadedRig rig = LoadRigFile(ResolveRobotPath(s.robot, study.folder()), s);
+  const RobotFile& file = *rig.file;
+  c->robot = rig.robot;
   c->ranger = file.ranger;
   const double scale = s.truth.random ? 1.0 : s.truth.scale;
   c->file_true_errors = file.truth.LinkErrors(*c->robot);
@@ -272,9 +395,9 @@ void DrawCellConfigurations(const Study& study, const CellSettings& s, CellConte
   vo.ranger = c->ranger;
   vo.min_jacobian_singular_value = s.min_singular_value;
   vo.require_beam_hit = false;  // validation judges poses over the whole workspace
-  c->validation = SampleConfigurations(
-      *c->robot, c->planes, PerPlaneCounts(s, c->planes, s.validation_size),
-      RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), vo);
+  c->validation = SampleCellConfigurations(
+      *c, PerPlaneCounts(s, c->planes, s.validation_size),
+      {study.seed, c->validation_stream, 0, RandomPurpose::kValidation}, vo, nullptr);
 }
 
 // Priors or errors in variables (identification.prior_sigma, errors_in_variables): the trials
@@ -327,46 +450,23 @@ Eigen::MatrixXd TaskDesignJacobian(const CellContext& c, const TargetedConfigura
 
 // The selected design, its σ_min and the predicted covariance at the nominal model; the
 // design's Jacobian also gives the first linearisation of every trial, computed once here.
-// CertifyDesign is a pure function of (G, the chosen rows, the criterion, the steps) and half of
-// a cell's preparation; the cells of a sweep or a sensitivity plan over noise settings share all
-// four. A process-wide memo of the last few certificates, matched on exact equality of every
-// input (no hash is trusted), returns the same bits as computing it again. Thread-safe: two
-// workers may compute the same certificate at once, and either result is the same.
-class CertificateMemo {
- public:
-  DesignCertificate Certify(const Eigen::MatrixXd& G, const std::vector<int>& chosen,
-                            DesignCriterion criterion, int steps) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      for (const Entry& e : entries_)
-        if (e.criterion == criterion && e.steps == steps && e.chosen == chosen &&
-            e.G.rows() == G.rows() && e.G.cols() == G.cols() && e.G == G)
-          return e.certificate;
-    }
-    Entry entry{G, chosen, criterion, steps, CertifyDesign(G, chosen, criterion, steps)};
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (entries_.size() == kEntries) entries_.erase(entries_.begin());
-    entries_.push_back(std::move(entry));
-    return entries_.back().certificate;
+// CertifyDesign is a pure function of (G, the chosen rows, the criterion, the steps), which the
+// cells of a sweep or a sensitivity plan over noise settings share (preparation_memo.h).
+struct CertificateKey {
+  Eigen::MatrixXd G;
+  std::vector<int> chosen;
+  DesignCriterion criterion;
+  int steps;
+  bool operator==(const CertificateKey& o) const {
+    return criterion == o.criterion && steps == o.steps && chosen == o.chosen && SameMatrix(G, o.G);
   }
-
- private:
-  struct Entry {
-    Eigen::MatrixXd G;
-    std::vector<int> chosen;
-    DesignCriterion criterion;
-    int steps;
-    DesignCertificate certificate;
-  };
-  static constexpr std::size_t kEntries = 8;
-  std::mutex mutex_;
-  std::vector<Entry> entries_;
 };
 
 DesignCertificate CertifyCellDesign(const Eigen::MatrixXd& G, const std::vector<int>& chosen,
                                     DesignCriterion criterion, int steps) {
-  static CertificateMemo memo;
-  return memo.Certify(G, chosen, criterion, steps);
+  static PreparationMemo<CertificateKey, DesignCertificate> memo;
+  return memo.Get(CertificateKey{G, chosen, criterion, steps},
+                  [&] { return CertifyDesign(G, chosen, criterion, steps); });
 }
 
 void SelectCellDesign(const CellSettings& s, CellContext* c) {
@@ -394,11 +494,11 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
                                          ? PosteriorOn(s, *c, c->design.configs, Gd)
                                          : PriorInformation{};
   if (posterior.defined) {
-    c->predicted_covariance = posterior.posterior_covariance;
+    SetPredictedCovariance(c, posterior.posterior_covariance, 1.0);
     c->predicted_std = posterior.posterior_sigma;
   } else if (!c->rank_deficient && !ModelledUncertainty(s) && design_report.full_rank()) {
-    c->predicted_covariance = ParameterCovariance(s.noise.EffectiveReadings() * GtG, s.noise.sigma);
-    c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
+    SetPredictedCovariance(c, ParameterCovariance(s.noise.EffectiveReadings() * GtG, 1.0),
+                           s.noise.sigma);
   } else {
     if (!c->rank_deficient) c->rank_message = design_report.ToString();
     c->rank_deficient = true;
@@ -454,10 +554,11 @@ struct PartSums {
   }
 };
 
-// Adds a block of poses' data-part errors E and, if given, held-part errors H (6 rows per pose,
-// one column per draw) to the sums of each part, in one pass.
+// Adds a block of poses' unit data-part errors E and, if given, held-part errors H (6 rows per
+// pose, one column per draw) to the sums of each part, in one pass; the total's data part is
+// scale · E.
 void AddPoseBlock(const Eigen::MatrixXd& E, const Eigen::MatrixXd* H, PartSums* data,
-                  PartSums* held, PartSums* total) {
+                  PartSums* held, PartSums* total, double scale = 1) {
   const auto poses = static_cast<int>(E.rows() / 6);
   for (Eigen::Index d = 0; d < E.cols(); ++d)
     for (int a = 0; a < 6; ++a)  // position xyz, orientation xyz
@@ -467,27 +568,37 @@ void AddPoseBlock(const Eigen::MatrixXd& E, const Eigen::MatrixXd* H, PartSums* 
         if (H == nullptr) continue;
         const double y = (*H)(6 * j + a, d);
         held->Add(d, a, y);
-        total->Add(d, a, x + y);
+        total->Add(d, a, scale * x + y);
       }
 }
 
-// The first-order draws of the validation metrics: `draws` Gaussian parameter errors from the
-// covariance C pushed through the validation poses' Jacobian (the data part) and, when `held` has
-// columns, the held terms' part M·w and the sum of both. Z (n × draws) and w (k × draws) come
-// from the validation set's prediction stream, Z first, so every call on a cell uses the same
-// normals (common random numbers). Without held columns the held part is zero and the total the
-// data part.
-FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Eigen::MatrixXd& C,
-                                    const Eigen::MatrixXd& held) {
-  const auto n = static_cast<int>(c.parameter_names.size());
+// A covariance as scale² · unit (CellContext::unit_covariance).
+struct ScaledCovariance {
+  Eigen::MatrixXd unit;
+  double scale = 1;
+  bool defined() const { return unit.size() > 0 && unit.allFinite() && std::isfinite(scale); }
+};
+
+// The factor L of a covariance (L·Lᵀ = C, from its eigendecomposition, negative eigenvalues as 0).
+Eigen::MatrixXd CovarianceFactor(const Eigen::MatrixXd& C) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(C);
+  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+}
+
+// The data part's metrics of unit draws (draws × 12): Z (n × draws) from the validation set's
+// prediction stream pushed through L (the factor of the unit covariance) and the validation poses'
+// Jacobian J6, and, when `held` has columns, the held part from the stream's next k × draws
+// normals and the total of scale · (data) + held.
+struct UnitDraws {
+  Eigen::MatrixXd data, held, total;
+};
+
+UnitDraws ComputeUnitDraws(const CellContext& c, int draws, const Eigen::MatrixXd& unit,
+                           double scale, const Eigen::MatrixXd& J6, const Eigen::MatrixXd& held) {
+  const auto n = static_cast<int>(unit.rows());
   const int m = c.validation.size();
   const auto k = static_cast<int>(held.cols());
-  FirstOrderDraws out;
-  out.data = out.held = out.total = Eigen::MatrixXd::Constant(draws, 12, std::nan(""));
-  if (c.rank_deficient || C.size() == 0 || !C.allFinite() || m == 0) return out;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(C);
-  const Eigen::MatrixXd L =
-      eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  const Eigen::MatrixXd L = CovarianceFactor(unit);
   Eigen::MatrixXd Z(n, draws);
   const RandomStream stream(0, c.validation_stream, 0, RandomPurpose::kPrediction);
   stream.Normals(0, static_cast<std::uint64_t>(n) * draws, Z.data());
@@ -501,24 +612,65 @@ FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Eigen
   // applied to the draws a block of poses at a time: memory per validation pose stays about
   // 1 KB, not 6 × draws doubles. Each draw's sums run over the poses in order, so the bits do not
   // depend on the block.
-  const Eigen::MatrixXd J6 = ValidationPoseJacobian(c);
   constexpr int kPosesPerBlock = 256;
   PartSums data(draws), held_part(draws), total(draws);
   for (int j0 = 0; j0 < m; j0 += kPosesPerBlock) {
     const int mc = std::min(kPosesPerBlock, m - j0);
-    const Eigen::MatrixXd E = J6.middleRows(6 * j0, 6 * mc) * LZ;  // 6·mc × draws
-    const Eigen::MatrixXd H =
-        k > 0 ? Eigen::MatrixXd(held.middleRows(6 * j0, 6 * mc) * W) : Eigen::MatrixXd();
-    AddPoseBlock(E, k > 0 ? &H : nullptr, &data, &held_part, &total);
+    const Eigen::MatrixXd E = J6.middleRows(6 * j0, 6 * mc) * LZ;  // 6·mc × draws, unit
+    if (k == 0) {
+      AddPoseBlock(E, nullptr, &data, nullptr, nullptr);
+      continue;
+    }
+    const Eigen::MatrixXd H = held.middleRows(6 * j0, 6 * mc) * W;
+    AddPoseBlock(E, &H, &data, &held_part, &total, scale);
   }
-  out.data = data.Metrics(m);
-  out.held = held_part.Metrics(m);
-  out.total = k > 0 ? total.Metrics(m) : out.data;
+  return {data.Metrics(m), held_part.Metrics(m), total.Metrics(m)};
+}
+
+// The unit draws without held terms (what predicts a cell's means): every input of them.
+struct UnitDrawsKey {
+  int draws;
+  std::uint64_t stream;
+  Eigen::MatrixXd unit, J6;
+  bool operator==(const UnitDrawsKey& o) const {
+    return draws == o.draws && stream == o.stream && SameMatrix(unit, o.unit) &&
+           SameMatrix(J6, o.J6);
+  }
+};
+
+// The first-order draws of the validation metrics: `draws` Gaussian parameter errors from the
+// covariance C = scale² · unit pushed through the validation poses' Jacobian (the data part) and,
+// when `held` has columns, the held terms' part M·w and the sum of both. Z (n × draws) and
+// w (k × draws) come from the validation set's prediction stream, Z first, so every call on a
+// cell uses the same normals (common random numbers). The data part is scale × the metrics of
+// the unit covariance's draws (RMS and max are homogeneous of degree 1), so cells that differ in
+// σ alone share them (UnitDrawsMemo). Without held columns the held part is zero and the total
+// the data part.
+FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const ScaledCovariance& C,
+                                    const Eigen::MatrixXd& held) {
+  FirstOrderDraws out;
+  out.data = out.held = out.total = Eigen::MatrixXd::Constant(draws, 12, std::nan(""));
+  if (c.rank_deficient || !C.defined() || c.validation.size() == 0) return out;
+  const Eigen::MatrixXd J6 = ValidationPoseJacobian(c);
+  if (held.cols() == 0) {
+    static PreparationMemo<UnitDrawsKey, Eigen::MatrixXd, 4> memo;
+    out.data = C.scale * memo.Get(UnitDrawsKey{draws, c.validation_stream, C.unit, J6}, [&] {
+      return ComputeUnitDraws(c, draws, C.unit, 1.0, J6, Eigen::MatrixXd()).data;
+    });
+    out.total = out.data;
+    out.held.setZero();
+    return out;
+  }
+  UnitDraws unit = ComputeUnitDraws(c, draws, C.unit, C.scale, J6, held);
+  out.data = C.scale * unit.data;
+  out.held = std::move(unit.held);
+  out.total = std::move(unit.total);
   return out;
 }
 
 Eigen::MatrixXd LinearisedDraws(const CellContext& c, int draws) {
-  return LinearisedPartDraws(c, draws, c.predicted_covariance, Eigen::MatrixXd()).data;
+  return LinearisedPartDraws(c, draws, {c.unit_covariance, c.covariance_scale}, Eigen::MatrixXd())
+      .data;
 }
 
 // The accuracy planner (accuracy_plan.h) states the ranger's totals: a tracker cell is refused.
@@ -539,16 +691,17 @@ CellSettings WithRepetitions(const CellSettings& s, int repetitions) {
   return out;
 }
 
-// The covariance predicted for the cell's design under settings `s` (as PrepareDesign predicts
+// The covariance predicted for the cell's design under settings `s` (as SelectCellDesign predicts
 // it for the cell's own); empty when it is undefined.
-Eigen::MatrixXd DesignCovariance(const CellSettings& s, const CellContext& c) {
+ScaledCovariance DesignCovariance(const CellSettings& s, const CellContext& c) {
   if (c.rank_deficient) return {};
   const Eigen::MatrixXd& Gd = c.design_nominal.G;
   if (ModelledUncertainty(s)) {
     const PriorInformation posterior = PosteriorOn(s, c, c.design.configs, Gd);
-    return posterior.defined ? posterior.posterior_covariance : Eigen::MatrixXd();
+    return {posterior.defined ? posterior.posterior_covariance : Eigen::MatrixXd(), 1.0};
   }
-  return ParameterCovariance(s.noise.EffectiveReadings() * (Gd.transpose() * Gd), s.noise.sigma);
+  return {ParameterCovariance(s.noise.EffectiveReadings() * (Gd.transpose() * Gd), 1.0),
+          s.noise.sigma};
 }
 
 // The terms a calibration of the cell's design under settings `s` holds at nominal, at the
@@ -576,6 +729,13 @@ UnestimatedTerms DesignHeldTerms(const CellSettings& s, const CellContext& c) {
 // Jacobian (linear in the parameter errors), then each metric's mean over 4000 Gaussian draws
 // of those linear errors (the RMS and max of correlated errors have no closed form). Draws are
 // addressed by the validation set's stream, so the prediction is a function of the settings.
+void SetPredictedCovariance(CellContext* c, Eigen::MatrixXd unit, double scale) {
+  c->predicted_covariance = (scale * scale) * unit;
+  c->predicted_std = c->predicted_covariance.diagonal().cwiseSqrt();
+  c->unit_covariance = std::move(unit);
+  c->covariance_scale = scale;
+}
+
 void PredictValidation(CellContext* c) {
   constexpr int kDraws = 4000;
   const Eigen::MatrixXd draws = LinearisedDraws(*c, kDraws);
@@ -869,9 +1029,9 @@ Eigen::MatrixXd LinearisedValidationDraws(const CellContext& c, int draws) {
 FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int repetitions) {
   RefuseTrackerPlan(c);
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
-  const Eigen::MatrixXd C = DesignCovariance(s, c);
+  const ScaledCovariance C = DesignCovariance(s, c);
   Eigen::MatrixXd held;
-  if (C.size() > 0) {
+  if (C.defined()) {
     const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
     held = HeldTermPoseColumns(*c.model, zero.data(), DesignHeldTerms(s, c), c.validation);
   }
@@ -881,9 +1041,9 @@ FirstOrderDraws LinearisedValidationDraws(const CellContext& c, int draws, int r
 std::optional<AccuracyPrediction> StatedValidationAccuracy(const CellContext& c, int repetitions) {
   RefuseTrackerPlan(c);
   const CellSettings s = WithRepetitions(c.cell->typed, repetitions);
-  const Eigen::MatrixXd C = DesignCovariance(s, c);
-  if (C.size() == 0 || !C.allFinite()) return std::nullopt;
-  return StatedAtValidation(s, c, C);
+  const ScaledCovariance C = DesignCovariance(s, c);
+  if (!C.defined()) return std::nullopt;
+  return StatedAtValidation(s, c, (C.scale * C.scale) * C.unit);
 }
 
 }  // namespace lrcal

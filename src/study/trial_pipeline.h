@@ -130,6 +130,12 @@ struct CellContext {
   double design_efficiency = 0;
   /// σ²·(GᵀWG)⁻¹ of the cell's design at the nominal model (SI; empty if rank deficient).
   Eigen::MatrixXd predicted_covariance;
+  /// predicted_covariance as covariance_scale² · unit_covariance, bit for bit: (GᵀWG)⁻¹ and σ
+  /// for least squares, a posterior's covariance and 1 with priors. The first-order draws take
+  /// the factor of unit_covariance and scale it, so cells that differ only in σ (a noise sweep,
+  /// a sensitivity plan) share them (SetPredictedCovariance).
+  Eigen::MatrixXd unit_covariance;
+  double covariance_scale = 1;
   /// First-order prediction of the mean of each validation metric of the identified model
   /// (layout of TrialRecord::validation, SI); NaN where the covariance cannot be predicted.
   std::array<double, 12> predicted_validation{};
@@ -186,6 +192,9 @@ TargetedConfigurations ReadStudyConfigurations(const Study& study, const std::st
                                                const PlaneSet* planes);
 /// The first-order prediction of the validation metrics' means (predicted_validation).
 void PredictValidation(CellContext* c);
+/// Sets predicted_covariance = (scale · scale) · unit (the bits of ParameterCovariance(A, scale)
+/// when unit is ParameterCovariance(A, 1)), its parts and predicted_std.
+void SetPredictedCovariance(CellContext* c, Eigen::MatrixXd unit, double scale);
 
 /// A tracker cell's preparation after its rig is loaded: the kind, the pool (no beam to hit),
 /// the validation poses, identifiability, the block selection (block_selection.h), the

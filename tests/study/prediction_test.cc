@@ -43,7 +43,10 @@ TEST(ValidationPrediction, BlocksOfPosesGiveTheBitsOfTheWholeProduct) {
   // The whole product, as lrcal computed it before the blocks.
   const int n = c->model->num_parameters(), m = c->validation.size();
   ASSERT_EQ(m, 700);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(c->predicted_covariance);
+  // The draws of the unit covariance, scaled by σ (CellContext::unit_covariance).
+  ASSERT_EQ(c->predicted_covariance,
+            (c->covariance_scale * c->covariance_scale) * c->unit_covariance);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(c->unit_covariance);
   const Eigen::MatrixXd L =
       eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   Eigen::MatrixXd Z(n, kDraws);
@@ -58,8 +61,8 @@ TEST(ValidationPrediction, BlocksOfPosesGiveTheBitsOfTheWholeProduct) {
         ss += E(6 * j + k, d) * E(6 * j + k, d);
         max = std::max(max, std::fabs(E(6 * j + k, d)));
       }
-      EXPECT_EQ(blocked(d, k), std::sqrt(ss / m)) << d << " " << k;
-      EXPECT_EQ(blocked(d, 6 + k), max) << d << " " << k;
+      EXPECT_EQ(blocked(d, k), c->covariance_scale * std::sqrt(ss / m)) << d << " " << k;
+      EXPECT_EQ(blocked(d, 6 + k), c->covariance_scale * max) << d << " " << k;
     }
 }
 
