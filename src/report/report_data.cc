@@ -1,5 +1,6 @@
 #include "lrcal/report/report_data.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -51,7 +52,9 @@ Json ReadReportManifest(const std::string& run_dir) {
 
 // A consistent snapshot of every store (SQLite readers do not block a running writer), and the
 // tables from it.
-void SnapshotAndTables(const std::string& run_dir, const Json& manifest, ReportData* data) {
+// Returns the ids of the cells the tables show.
+std::vector<std::string> SnapshotAndTables(const std::string& run_dir, const Json& manifest,
+                                           ReportData* data) {
   const fs::path snapshot = fs::path(data->dir) / "trials.snapshot.sqlite";
   for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(snapshot.string() + suffix);
   TrialStore snap(snapshot.string());
@@ -71,6 +74,9 @@ void SnapshotAndTables(const std::string& run_dir, const Json& manifest, ReportD
     data->expected += s.stop.trials_used;
   }
   data->complete = tables.complete;
+  std::vector<std::string> shown;
+  for (std::size_t i : tables.shown) shown.push_back(tables.cells[i].cell.id);
+  return shown;
 }
 
 Json PoseErrorsJson(const PoseErrors& nominal, const PoseErrors& identified) {
@@ -98,8 +104,9 @@ Json CellRealisation(const Study& study, const Cell& cell) {
   return cj;
 }
 
-// Every cell of the run that the study file still has; InputError when none can be recomputed.
-Json Realisation(const Json& manifest) {
+// The cells of the run that the tables show (ShownCells: every cell of a small study, a chosen
+// few of a large one) that the study file still has; InputError when none can be recomputed.
+Json Realisation(const Json& manifest, const std::vector<std::string>& shown) {
   Json realisation;
   realisation["trial"] = 0;
   realisation["units"] = "distance errors mm; position errors mm; orientation errors mrad";
@@ -108,11 +115,9 @@ Json Realisation(const Json& manifest) {
   const Study study = LoadStudy(study_file);
   if (study.seed != manifest["study"]["seed"].get<std::uint64_t>())
     throw InputError(study_file, "the study file changed since the run (seed)");
-  for (const Cell& cell : study.cells) {
-    bool in_run = false;
-    for (const auto& c : manifest["study"]["cells"]) in_run |= c["id"] == cell.id;
-    if (in_run) realisation["cells"].push_back(CellRealisation(study, cell));
-  }
+  for (const Cell& cell : study.cells)
+    if (std::find(shown.begin(), shown.end(), cell.id) != shown.end())
+      realisation["cells"].push_back(CellRealisation(study, cell));
   if (realisation["cells"].empty())
     throw InputError(study_file,
                      "none of its cells is in this run (the study file, or lrcal's "
@@ -133,11 +138,11 @@ ReportData PrepareReportData(const std::string& run_dir) {
   ReportData data;
   data.dir = (fs::path(run_dir) / "report").string();
   fs::create_directories(data.dir);
-  SnapshotAndTables(run_dir, manifest, &data);
+  const std::vector<std::string> shown = SnapshotAndTables(run_dir, manifest, &data);
   const fs::path realisation_path = fs::path(data.dir) / "realisation.json";
   fs::remove(realisation_path);
   try {
-    const Json realisation = Realisation(manifest);
+    const Json realisation = Realisation(manifest, shown);
     WriteFileAtomically(realisation_path.string(), realisation.dump(1) + "\n");
     data.realisation = true;
   } catch (const InputError& e) {

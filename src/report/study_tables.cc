@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "lrcal/core/descriptive_statistics.h"
 #include "lrcal/core/error.h"
 #include "lrcal/core/text_document.h"
 #include "lrcal/core/text_table.h"
@@ -193,6 +194,13 @@ void SummarizeCells(const TrialStore& store, const std::vector<StoredCell>& cell
 
 // ---------------------------------------------------------------------------------------------
 // The tables.
+
+// The quartile-placed cells of a large study: the index at the type-7 position p (0–100) of
+// `ranked` (cell indices in ascending order of their figure).
+std::size_t AtPercentile(const std::vector<std::size_t>& ranked, double p) {
+  const double h = static_cast<double>(ranked.size() - 1) * p / 100.0;
+  return ranked[static_cast<std::size_t>(std::lround(h))];
+}
 
 // "1.23 %", or "—" when a precision cannot be stated yet.
 std::string Percent(double x) { return std::isfinite(x) ? Fixed(100 * x, 2) + " %" : "—"; }
@@ -633,6 +641,81 @@ TextDocument ParameterSections(const std::vector<CellSummary>& cells, Table* csv
   return doc;
 }
 
+// The cells ShownCells chooses, each with why ("" for every cell of a small study).
+std::vector<std::pair<std::size_t, std::string>> ShownCellRoles(
+    const std::vector<CellSummary>& cells) {
+  std::vector<std::pair<std::size_t, std::string>> out;
+  if (cells.size() <= kCellsShownInFull) {
+    for (std::size_t i = 0; i < cells.size(); ++i) out.emplace_back(i, "");
+    return out;
+  }
+  std::vector<std::string> role(cells.size());
+  std::vector<std::size_t> ranked;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    if (PaperCaseOf(cells[i].cell) != 0) role[i] = "paper";
+    if (cells[i].ok > 0 && std::isfinite(cells[i].axis_mean[0].mean)) ranked.push_back(i);
+  }
+  // Ties in study order: the same records give the same choice.
+  std::stable_sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) {
+    return cells[a].axis_mean[0].mean < cells[b].axis_mean[0].mean;
+  });
+  if (!ranked.empty())
+    for (const auto& [p, name] : {std::pair<double, const char*>{0.0, "minimum"},
+                                  {25.0, "lower quartile"},
+                                  {50.0, "median"},
+                                  {75.0, "upper quartile"},
+                                  {100.0, "maximum"}}) {
+      std::string& r = role[AtPercentile(ranked, p)];
+      r += (r.empty() ? "" : ", ") + std::string(name);
+    }
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    if (!role[i].empty()) out.emplace_back(i, role[i]);
+  if (out.empty()) out.emplace_back(0, "first (no cell has an ok trial yet)");
+  return out;
+}
+
+// A large study's aggregate: each validation metric's cell means (identified model) over its
+// cells, as min, quartiles and max, and which cells the per-cell tables show.
+TextDocument AggregateSection(const std::vector<CellSummary>& cells) {
+  TextDocument doc;
+  const auto roles = ShownCellRoles(cells);
+  if (roles.size() == cells.size()) return doc;
+  Table t({"metric", "axis", "cells", "min", "p25", "median", "p75", "max"});
+  for (int m = 0; m < 4; ++m)
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> means;
+      for (const auto& s : cells)
+        if (s.ok > 0 && std::isfinite(s.validation[3 * m + a].mean))
+          means.push_back(s.validation[3 * m + a].mean * 1e3);
+      std::sort(means.begin(), means.end());
+      std::vector<std::string> row = {kMetricTitles[m], kAxes[a], std::to_string(means.size())};
+      for (double p : {0.0, 25.0, 50.0, 75.0, 100.0})
+        row.push_back(means.empty() ? "—" : Fixed(Percentile(means, p)));
+      t.AddRow(row);
+    }
+  doc.AddHeading("Over all " + std::to_string(cells.size()) + " cells");
+  doc.AddParagraph(
+      "Each cell's mean over its trials of each validation metric of the identified model, "
+      "over the cells (mm, mrad; type-7 quartiles).");
+  doc.AddTable(std::move(t));
+  Table shown({"shown as", "cell", "id", "mean RMS pos (mm, mean of x, y, z)"});
+  auto by_error = roles;  // in the order of the error (cells without an ok trial last)
+  std::stable_sort(by_error.begin(), by_error.end(), [&](const auto& a, const auto& b) {
+    const double x = cells[a.first].axis_mean[0].mean, y = cells[b.first].axis_mean[0].mean;
+    return (cells[a.first].ok > 0 ? x : INFINITY) < (cells[b.first].ok > 0 ? y : INFINITY);
+  });
+  for (const auto& [i, role] : by_error)
+    shown.AddRow({role, cells[i].cell.label, cells[i].cell.id,
+                  cells[i].ok > 0 ? Fixed(cells[i].axis_mean[0].mean * 1e3) : "—"});
+  doc.AddParagraph("The per-cell tables below show " + std::to_string(roles.size()) + " of the " +
+                   std::to_string(cells.size()) +
+                   " cells: the paper's, and those at the minimum, quartiles and maximum of the "
+                   "mean RMS position error. Every cell is in cells.csv, validation.csv, "
+                   "parameters.csv and summary.json (whose shown_cells lists these).");
+  doc.AddTable(std::move(shown));
+  return doc;
+}
+
 Json NullIfNan(double x) { return std::isnan(x) ? Json() : Json(x); }
 
 Json CellJson(const CellSummary& s) {
@@ -696,6 +779,9 @@ Json SummaryJson(const Json& study, const StudyTablesResult& result, const Json&
   Json cells = Json::array();
   for (const auto& s : result.cells) cells.push_back(CellJson(s));
   js["cells"] = cells;
+  Json shown = Json::array();
+  for (std::size_t i : result.shown) shown.push_back(result.cells[i].cell.id);
+  js["shown_cells"] = shown;
   if (!sensitivity.is_null()) js["sensitivity"] = sensitivity;
   return js;
 }
@@ -968,6 +1054,12 @@ std::vector<std::string> ValidationCsvColumns() {
 
 }  // namespace
 
+std::vector<std::size_t> ShownCells(const std::vector<CellSummary>& cells) {
+  std::vector<std::size_t> out;
+  for (const auto& [i, role] : ShownCellRoles(cells)) out.push_back(i);
+  return out;
+}
+
 StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
                                    const std::string& run_dir) {
   namespace fs = std::filesystem;
@@ -987,6 +1079,10 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
     for (const auto& row : rows) place.AddRow(row);
   const bool any_paper = place.num_rows() > 0;
 
+  result.shown = ShownCells(result.cells);
+  std::vector<CellSummary> shown;  // what the summary's per-cell tables show
+  for (std::size_t i : result.shown) shown.push_back(result.cells[i]);
+
   Table val(
       {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
   Table val_csv(ValidationCsvColumns());
@@ -996,12 +1092,23 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
                  "std_predicted_truth", "std_ratio_truth", "std_ratio_truth_se"});
   Table par_tex({"cell", "parameter", "unit", "bias", "SE", "std", "predicted", "ratio"},
                 "Parameter errors (estimate - truth), mm and mrad");
-  const Table cells = CellsTable(result.cells, rule);
+  TextDocument parameters = ParameterSections(result.cells, &par_csv, &par_tex);
+  Table val_shown = val;
+  if (shown.size() < result.cells.size()) {
+    val_shown = Table(val.header());
+    Table unused(ValidationCsvColumns());
+    ValidationTables(shown, &val_shown, &unused);
+    Table unused_csv(par_csv.header()), unused_tex(par_tex.header());
+    parameters = ParameterSections(shown, &unused_csv, &unused_tex);
+  }
 
+  // The headline first: the sensitivity indices of a sensitivity plan, an aggregate over the
+  // cells of a large study, then the validation errors.
   TextDocument& doc = result.document;
   doc.Append(Header(study, trials, rule, result.complete));
-  doc.AddHeading("Cells");
-  doc.AddTable(cells);
+  const SensitivityOutput sensitivity = SensitivityAnalysis(study, result.cells);
+  doc.Append(sensitivity.document);
+  doc.Append(AggregateSection(result.cells));
   doc.AddHeading("Validation errors");
   doc.AddParagraph(
       "Over the validation configurations, per base axis: mean ± its "
@@ -1010,13 +1117,13 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
       "empty where a cell has too few trials, e.g. below 72 for the upper end of p95), and the "
       "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
       "(Wilks: at least 95 % from N = 59).");
-  doc.AddTable(val);
-  const SensitivityOutput sensitivity = SensitivityAnalysis(study, result.cells);
-  doc.Append(PredictionSection(result.cells));
-  doc.Append(CoverageSection(result.cells));
-  doc.Append(PaperLayoutSection(result.cells));
-  doc.Append(sensitivity.document);
-  doc.Append(ParameterSections(result.cells, &par_csv, &par_tex));
+  doc.AddTable(val_shown);
+  doc.Append(PredictionSection(shown));
+  doc.Append(CoverageSection(shown));
+  doc.AddHeading("Cells");
+  doc.AddTable(CellsTable(shown, rule));
+  doc.Append(PaperLayoutSection(shown));
+  doc.Append(parameters);
   if (any_paper) {
     doc.AddHeading("The paper's published numbers in lrcal's distributions");
     doc.AddParagraph(

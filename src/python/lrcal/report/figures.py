@@ -86,13 +86,16 @@ class Run:
             raise RunDataError(f"{path}: not a readable CSV ({e})") from e
 
     def trial_metrics(self):
-        """One row per ok trial the tables use: cell_id, trial and the identified model's
-        validation metrics (under stop_when, only the trials before each cell's stopping
-        point)."""
+        """One row per ok trial the tables use, of the cells the figures draw (shown_cells):
+        cell_id, trial and the identified model's validation metrics (under stop_when, only the
+        trials before each cell's stopping point)."""
         if not os.path.isfile(self.snapshot):
             raise RunDataError(f"{self.snapshot}: missing (run `lrcal report RUN_DIR`, which "
                                "prepares it)")
-        trials = _StoredRun(self.dir, True, stores=[self.snapshot]).trials
+        stored = _StoredRun(self.dir, True, stores=[self.snapshot])
+        # Only the cells the figures draw are read (a large study's chosen few).
+        frames = [stored.trials_of(c["id"]) for c in self.shown_cells()]
+        trials = pd.concat(frames, ignore_index=True) if frames else stored.trials
         columns = [_column(m, a) for m, _ in METRICS for a in AXES]
         data = trials.loc[trials["status"] == "ok", ["cell_id", "trial"] + columns]
         data = data.sort_values(["cell_id", "trial"]).reset_index(drop=True)
@@ -102,18 +105,34 @@ class Run:
             data = data[data["trial"] < limit]
         return data
 
+    def chosen_cells(self):
+        """The cells the summary's per-cell tables show (summary.json's shown_cells: every cell
+        of a small study; of a large one the paper's and those at the minimum, quartiles and
+        maximum of the mean RMS position error), in study order."""
+        ids = self.summary.get("shown_cells")
+        if not isinstance(ids, list):
+            return list(self.cells)
+        chosen = set(ids)
+        return [c for c in self.cells if c["id"] in chosen]
+
     def shown_cells(self, limit=MAX_CELLS_PER_FIGURE):
-        """Paper cells first, then the others, at most `limit`."""
-        paper = [c for c in self.cells if c["settings"].get("paper_case", 0)]
-        rest = [c for c in self.cells if not c["settings"].get("paper_case", 0)]
+        """The chosen cells, paper cells first, at most `limit`."""
+        chosen = self.chosen_cells()
+        paper = [c for c in chosen if c["settings"].get("paper_case", 0)]
+        rest = [c for c in chosen if not c["settings"].get("paper_case", 0)]
         return (paper + rest)[:limit]
 
     def left_out_note(self, shown):
         """What a figure showing `shown` cells says about the others ("" when it shows all)."""
         if len(shown) >= len(self.cells):
             return ""
+        if len(self.chosen_cells()) < len(self.cells) and len(shown) == len(self.chosen_cells()):
+            return (f" {len(shown)} of the {len(self.cells)} cells are drawn: the paper's and "
+                    "those at the minimum, quartiles and maximum of the mean RMS position error "
+                    "(the summary's per-cell tables show the same; tables/*.csv have every "
+                    "cell).")
         return (f" Only the first {len(shown)} of the {len(self.cells)} cells are drawn "
-                "(paper cells first); the tables have every cell.")
+                "(paper cells first); tables/*.csv have every cell.")
 
     def parameter_unit(self, cell_id, name):
         """mm or mrad for a parameter, from parameters.csv."""
@@ -547,11 +566,13 @@ def histogram_figures(run, out_dir, limit=4):
 
 def all_figures(run, out_dir):
     """Every figure, as (png path, caption) pairs."""
+    # Figures over every cell first (the sensitivity indices, the sweeps), then the per-cell
+    # figures of the chosen cells.
     figures = []
-    figures += realisation_figures(run, out_dir)
-    figures += distribution_figure(run, out_dir)
-    figures += histogram_figures(run, out_dir)
-    figures += sensitivity_figures(run, out_dir)
     figures += global_sensitivity_figure(run, out_dir)
+    figures += sensitivity_figures(run, out_dir)
+    figures += distribution_figure(run, out_dir)
+    figures += realisation_figures(run, out_dir)
+    figures += histogram_figures(run, out_dir)
     figures += parameter_figures(run, out_dir)
     return figures

@@ -85,6 +85,22 @@ def figure_html(png, caption, base_dir):
             f"(<a href='{html.escape(svg)}'>SVG</a>)</figcaption></figure>")
 
 
+# A study's list of cells (ids and labels) is shown whole up to this many cells; a larger one is
+# in tables/cells.csv, and the page stays small.
+MAX_CELLS_LISTED = 24
+
+
+def _settings(study):
+    """The study settings as the page shows them: a long list of cells replaced by a note."""
+    cells = study.get("cells")
+    if not isinstance(cells, list) or len(cells) <= MAX_CELLS_LISTED:
+        return study
+    shown = dict(study)
+    shown["cells"] = (f"{len(cells)} cells: their ids, labels and varied settings are in "
+                      "tables/cells.csv")
+    return shown
+
+
 def build(run_dir):
     t0 = time.time()
     run = _figures.Run(run_dir)
@@ -110,9 +126,13 @@ def build(run_dir):
     parts.extend(figure_html(png, caption, run.report_dir) for png, caption in figures)
     parts.append("<h2>Tables</h2>")
     parts.append(document_html(run.document["blocks"]))
-    parts.append("<h2>Study settings</h2><pre>" + html.escape(json.dumps(study, indent=2)) + "</pre>")
+    parts.append("<h2>Study settings</h2><pre>" + html.escape(json.dumps(_settings(study),
+                                                                        indent=2)) + "</pre>")
+    manifest = dict(run.manifest)
+    if "study" in manifest:
+        manifest["study"] = "(the study settings above)"
     parts.append("<h2>Manifest</h2><details><summary>versions, commit, sessions</summary><pre>" +
-                 html.escape(json.dumps(run.manifest, indent=2)) + "</pre></details>")
+                 html.escape(json.dumps(manifest, indent=2)) + "</pre></details>")
     parts.append(f"<script>{CHECK}</script></body></html>")
     path = os.path.join(run.report_dir, "report.html")
     write_atomically(path, "\n".join(parts))
