@@ -1804,6 +1804,9 @@ void DefineRun(py::module_& m) {
                     "stopped because max_trials were computed (call again to continue)")
       .def_readonly("complete", &RunResult::complete, "every trial of the run is recorded")
       .def_readonly("tables_written", &RunResult::tables_written, "OUT/tables/ was written")
+      .def_readonly("tables_current", &RunResult::tables_current,
+                    "a rerun with nothing new left OUT/tables/ as they were: written from these "
+                    "very records by this lrcal")
       .def_readonly("seconds", &RunResult::seconds)
       .def("__repr__", [](const RunResult& r) {
         return "lrcal.RunResult(" + std::to_string(r.done_before + r.computed) + "/" +

@@ -1,10 +1,44 @@
 #include "lrcal/report/run_tables.h"
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 
 #include "lrcal/study/run_directory.h"
 
 namespace lrcal {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// What the manifest records about written tables: the records they summarise, the lrcal that
+// wrote them and their files.
+Json TablesStamp(long long trials, const std::string& run_dir) {
+  Json files = Json::array();
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(fs::path(run_dir) / "tables", ec))
+    if (entry.is_regular_file()) files.push_back(entry.path().filename().string());
+  std::sort(files.begin(), files.end());
+  return {{"trials", trials}, {"lrcal", LrcalBuildInfo()}, {"files", files}};
+}
+
+}  // namespace
+
+bool TablesAreCurrent(const std::string& run_dir) {
+  try {
+    RunDirectory dir(run_dir);
+    if (!dir.HasManifest() || !dir.RankStorePaths().empty()) return false;
+    const Json manifest = dir.ReadManifest();
+    if (!manifest.contains("tables") || !manifest.contains("finished")) return false;
+    const Json& stamp = manifest["tables"];
+    if (stamp.value("lrcal", Json()) != LrcalBuildInfo()) return false;
+    if (stamp.value("trials", -1LL) != TrialStore(dir.MainStorePath()).CountTrials()) return false;
+    return TablesStamp(stamp["trials"].get<long long>(), run_dir) == stamp;
+  } catch (const std::exception&) {
+    return false;  // anything unusual: the tables are written again
+  }
+}
 
 StudyTablesResult WriteRunTables(const std::string& run_dir) {
   const auto start = std::chrono::steady_clock::now();
@@ -12,12 +46,16 @@ StudyTablesResult WriteRunTables(const std::string& run_dir) {
   dir.Lock();
   Json manifest = dir.ReadManifest();
   StudyTablesResult tables;
+  long long trials = 0;
   {
     TrialStore store(dir.MainStorePath());
     dir.MergeRankStores(&store);  // records of an interrupted MPI job
     tables = WriteStudyTables(store, manifest["study"], run_dir);
+    trials = store.CountTrials();
   }
+  manifest.erase("tables");
   if (tables.complete) {
+    manifest["tables"] = TablesStamp(trials, run_dir);
     manifest["finished"] = UtcNow();
     if (!manifest["sessions"].empty()) {
       Json& session = manifest["sessions"].back();
@@ -35,6 +73,10 @@ RunResult RunStudyAndWriteTables(const Study& study, const RunOptions& options,
   RunResult result = RunStudy(study, options, collective, stop);
   const bool root = !collective || collective->rank() == 0;
   if (root && result.complete && options.shard_count == 1) {
+    if (result.ranks_computed == 0 && TablesAreCurrent(options.out_dir)) {
+      result.tables_written = result.tables_current = true;
+      return result;
+    }
     const auto start = std::chrono::steady_clock::now();
     WriteRunTables(options.out_dir);
     result.tables_written = true;

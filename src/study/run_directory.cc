@@ -30,13 +30,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Json BuildInfo() {
-  return {{"version", LRCAL_VERSION},
-          {"commit", LRCAL_GIT_COMMIT},
-          {"compiler", LRCAL_COMPILER},
-          {"build_type", LRCAL_BUILD_TYPE}};
-}
-
 Json Dependencies() {
   return {
       {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) +
@@ -84,6 +77,13 @@ void CheckManifest(const Json& manifest, const std::string& path) {
 }
 
 }  // namespace
+
+Json LrcalBuildInfo() {
+  return {{"version", LRCAL_VERSION},
+          {"commit", LRCAL_GIT_COMMIT},
+          {"compiler", LRCAL_COMPILER},
+          {"build_type", LRCAL_BUILD_TYPE}};
+}
 
 std::string UtcNow() {
   std::time_t t = std::time(nullptr);
@@ -235,7 +235,7 @@ Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_ind
   manifest["study"] = study.ToJson();
   manifest["seed"] = study.seed;
   manifest["shard"] = {{"index", shard_index + 1}, {"count", shard_count}};
-  manifest["lrcal"] = BuildInfo();
+  manifest["lrcal"] = LrcalBuildInfo();
   manifest["dependencies"] = Dependencies();
   manifest["random_numbers"] = kRandomNumbers;
   manifest["sessions"].push_back(

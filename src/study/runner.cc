@@ -803,7 +803,9 @@ std::string RunSummaryText(const RunResult& r, const RunOptions& options, int ra
   std::ostringstream out;
   if (r.ranks_computed == 0 && r.done_before >= r.total) {
     out << "lrcal run: nothing to compute: all " << r.total
-        << " trials of this run were already recorded\n";
+        << " trials of this run were already recorded"
+        << (r.tables_current ? "; its tables are current (lrcal aggregate DIR rewrites them)" : "")
+        << "\n";
     return out.str();
   }
   out << "lrcal run: " << r.ranks_computed << " trials computed in " << Fixed(r.seconds, 1)

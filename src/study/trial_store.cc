@@ -314,6 +314,12 @@ std::vector<long long> TrialStore::DoneTrials(const std::string& cell_id) const 
   return out;
 }
 
+long long TrialStore::CountTrials() const {
+  Statement st(db_, "SELECT COUNT(*) FROM trials");
+  st.Step();
+  return sqlite3_column_int64(st.get(), 0);
+}
+
 long long TrialStore::CountTrials(const std::string& cell_id) const {
   Statement st(db_, "SELECT COUNT(*) FROM trials WHERE cell_id = ?");
   st.Text(1, cell_id);

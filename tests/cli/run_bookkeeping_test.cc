@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -78,6 +79,44 @@ TEST(RunBookkeeping, MaxTrialsIsASliceNotAnInterruption) {
   // A short run does not print a meaningless overhead percentage.
   ASSERT_EQ(Lrcal("run quick --out " + dir + "/small --quiet --threads 2", &out), 0) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("too short to measure the runner's overhead")) << out;
+}
+
+// A rerun of a finished run leaves its tables as they are when they were written from these very
+// records by this lrcal (the manifest's "tables" stamp), so it takes a fraction of a second; a
+// table removed since, or `lrcal aggregate`, writes them again.
+TEST(RunBookkeeping, ARerunKeepsCurrentTablesAndRewritesIncompleteOnes) {
+  const std::string dir = testing::TempDir("current_tables");
+  const std::string run = dir + "/run";
+  std::string out;
+  ASSERT_EQ(Lrcal("run quick --out " + run + " --quiet", &out), 0) << out;
+  const auto manifest = nlohmann::json::parse(testing::ReadFile(run + "/manifest.json"));
+  ASSERT_TRUE(manifest.contains("tables"));
+  EXPECT_EQ(manifest["tables"]["trials"], 200);
+  EXPECT_EQ(manifest["tables"]["lrcal"], manifest["lrcal"]);
+  EXPECT_THAT(manifest["tables"]["files"], ::testing::Contains(nlohmann::json("summary.md")));
+  const std::string summary = run + "/tables/summary.md";
+  const auto written = fs::last_write_time(summary);
+  fs::last_write_time(summary, written - std::chrono::hours(1));  // marks the file
+  ASSERT_EQ(Lrcal("run quick --out " + run, &out), 0) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("its tables are current")) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("tables: " + summary)) << out;
+  EXPECT_EQ(fs::last_write_time(summary), written - std::chrono::hours(1));
+  // A table removed: written again.
+  fs::remove(run + "/tables/validation.csv");
+  ASSERT_EQ(Lrcal("run quick --out " + run, &out), 0) << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("its tables are current"))) << out;
+  EXPECT_TRUE(fs::exists(run + "/tables/validation.csv"));
+  EXPECT_NE(fs::last_write_time(summary), written - std::chrono::hours(1));
+  // A stamp that does not match the records (another lrcal, other trials): written again.
+  auto stamped = nlohmann::json::parse(testing::ReadFile(run + "/manifest.json"));
+  stamped["tables"]["trials"] = 199;
+  std::ofstream(run + "/manifest.json") << stamped.dump(1);
+  fs::last_write_time(summary, written - std::chrono::hours(1));
+  ASSERT_EQ(Lrcal("run quick --out " + run, &out), 0) << out;
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("its tables are current"))) << out;
+  EXPECT_NE(fs::last_write_time(summary), written - std::chrono::hours(1));
+  EXPECT_EQ(nlohmann::json::parse(testing::ReadFile(run + "/manifest.json"))["tables"]["trials"],
+            200);
 }
 
 // More trials later: every trial is a pure function of its index, so raising `trials` extends a

@@ -100,6 +100,39 @@ def test_load_run_without_pandas_gives_numpy_structured_arrays(tmp_path):
         run.errors("case 9")
 
 
+def test_load_run_reads_trials_by_cell_and_in_chunks(tmp_path):
+    """trials_of and iter_trials give the rows of the whole trials table, a cell or a chunk at
+    a time, without reading every trial: the trials table itself is read on first use."""
+    first = lrcal.run_study("quick", str(tmp_path / "r"), threads=2)
+    assert first.tables_written and not first.tables_current
+    again = lrcal.run_study("quick", str(tmp_path / "r"), threads=2)
+    assert again.computed == 0 and again.tables_written and again.tables_current
+    run = lrcal.load_run(tmp_path / "r")
+    assert run._trials is None and "200 trials" in repr(run)  # counted, not read
+    every = run.trials
+    case2 = run.trials_of("case 2")
+    ids = list(run.cells["cell_id"])
+    assert case2.equals(every[every["cell_id"] == ids[1]].reset_index(drop=True))
+    assert list(run.trials_of(ids[0], 10, 13)["trial"]) == [10, 11, 12]
+    chunks = list(run.iter_trials(chunk_size=30))
+    assert [len(c) for c in chunks] == [30, 30, 30, 10] * 2
+    import pandas as pd
+    assert pd.concat(chunks, ignore_index=True).equals(every)
+    assert [len(c) for c in run.iter_trials(["case 1"], chunk_size=64)] == [64, 36]
+    with pytest.raises(ValueError, match="chunk_size"):
+        next(run.iter_trials(chunk_size=0))
+    with pytest.raises(lrcal.InputError, match="no cell 'case 9'"):
+        run.trials_of("case 9")
+
+
+def test_the_report_page_lists_a_large_studys_cells_in_cells_csv():
+    from lrcal.report import page
+    study = {"name": "s", "cells": [{"id": str(i), "label": str(i)} for i in range(25)]}
+    assert page._settings(study)["cells"].startswith("25 cells: their ids, labels")
+    study["cells"] = study["cells"][:24]
+    assert page._settings(study) is study
+
+
 def test_other_python_threads_run_while_trials_run(tmp_path):
     """The GIL is released around the trials: between two progress calls (0.1 s apart) the main
     thread keeps counting. With the GIL held it could not count at all between them."""

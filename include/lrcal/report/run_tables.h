@@ -18,8 +18,14 @@ namespace lrcal {
 /// time and peak memory.
 StudyTablesResult WriteRunTables(const std::string& run_dir);
 
+/// True when RUN_DIR's tables were written (complete) from exactly the records its store holds,
+/// by this lrcal (version and commit), and every file they wrote is still there: the manifest's
+/// "tables" entry, which WriteRunTables records, says so. Never with MPI rank stores left over.
+bool TablesAreCurrent(const std::string& run_dir);
+
 /// Runs (or resumes) a study and, when the run is complete and not a shard, writes its tables
-/// (rank 0): what `lrcal run` does.
+/// (rank 0): what `lrcal run` does. A rerun that computes nothing leaves current tables as they
+/// are (RunResult::tables_current).
 RunResult RunStudyAndWriteTables(const Study& study, const RunOptions& options,
                                  Collective* collective = nullptr, StopToken* stop = nullptr);
 

@@ -96,6 +96,9 @@ Json StudyFingerprint(const Json& study);
 /// Current UTC time, ISO 8601.
 std::string UtcNow();
 
+/// What built this lrcal: version, commit, compiler and build type (a manifest's "lrcal").
+Json LrcalBuildInfo();
+
 /// Done / total per cell of a run directory, as text lines (and, for a shard, the command that
 /// finishes it).
 struct RunStatusInfo {

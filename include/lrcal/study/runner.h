@@ -88,8 +88,11 @@ struct RunResult {
   bool interrupted = false;   ///< stopped before every trial of the run was recorded
   /// Stopped because max_new_trials were computed (not by a signal): a slice, not an interruption.
   bool reached_max_trials = false;
-  bool complete = false;         ///< every trial of the run (or shard) is recorded (rank 0)
-  bool tables_written = false;   ///< set by the caller that writes the tables
+  bool complete = false;        ///< every trial of the run (or shard) is recorded (rank 0)
+  bool tables_written = false;  ///< set by the caller that writes the tables
+  /// A rerun with nothing new found the tables already written for these very records by this
+  /// lrcal (TablesAreCurrent) and left them as they were; tables_written is set too.
+  bool tables_current = false;
   double seconds = 0;            ///< wall time of the whole call
   double trial_seconds = 0;      ///< sum of the computed trials' own wall time
   double prepare_seconds = 0;    ///< wall time preparing the cells (pools, designs, covariance)

@@ -73,6 +73,7 @@ class TrialStore {
   /// Trial indices stored for a cell, ascending.
   std::vector<long long> DoneTrials(const std::string& cell_id) const;
   long long CountTrials(const std::string& cell_id) const;
+  long long CountTrials() const;  ///< of every cell
   /// The record of (cell, trial), if stored.
   std::optional<TrialRecord> GetTrial(const std::string& cell_id, long long trial) const;
   /// Every record of a cell with first <= trial < end, in trial order (the canonical order for
