@@ -135,23 +135,26 @@ struct Series {
       brackets.push_back(std::move(b));
     }
   }
-  // Narrows every target whose bracket was just passed over.
+  // Narrows every target whose bracket was just passed over. A bracket's collected values are
+  // sorted once for all its targets (a cell's quantiles and their intervals ask a dozen ranks of
+  // the same values; a selection per rank was most of a large study's tables).
   void Resolve() {
-    for (Bracket& b : brackets)
+    for (Bracket& b : brackets) {
+      if (b.collect) std::sort(b.values.begin(), b.values.end());
       for (RankTarget& t : targets)
         if (!t.done && t.prefix == b.prefix && t.bits == b.bits) {
           if (b.collect) {
-            Select(&b, &t);
+            Select(b, &t);
           } else {
             Narrow(b, &t);
           }
         }
+    }
     brackets.clear();
   }
-  // The target's value among the bracket's collected values.
-  static void Select(Bracket* b, RankTarget* t) {
-    std::nth_element(b->values.begin(), b->values.begin() + (t->within - 1), b->values.end());
-    t->value = b->values[static_cast<std::size_t>(t->within - 1)];
+  // The target's value among the bracket's collected values (sorted).
+  static void Select(const Bracket& b, RankTarget* t) {
+    t->value = b.values[static_cast<std::size_t>(t->within - 1)];
     t->done = true;
   }
   // The next bits of the target's key, from the bracket's histogram.
