@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "design/bound_order.h"
 #include "lrcal/core/error.h"
 
 namespace lrcal {
@@ -30,6 +31,7 @@ class BlockInformation {
   }
   int size() const { return static_cast<int>(info_.size()); }
   int num_parameters() const { return n_; }
+  DesignCriterion criterion() const { return criterion_; }
   const Eigen::MatrixXd& operator[](int i) const { return info_[static_cast<std::size_t>(i)]; }
   Eigen::MatrixXd Sum(const std::vector<int>& chosen) const {
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n_, n_);
@@ -60,19 +62,52 @@ std::vector<int> RandomBlocks(int N, int k, const RandomStream& stream, std::uin
   return p;
 }
 
+// E: the block whose removal keeps the largest √λ_min, found in the order of upper bounds. With
+// V the eigenvectors of A's kBoundDirections smallest eigenvalues Λ, λ_min(A − B) ≤
+// λ_min(Vᵀ(A − B)V) = λ_min(Λ − VᵀBV) (Cauchy interlacing: a compression's smallest eigenvalue is
+// at least the matrix's), a kBoundDirections² eigenproblem per candidate; widened by rounding
+// (1e-12 of A's largest eigenvalue), as the ranger's bounded selection is. The same choice as
+// scoring every candidate (ties to the lowest position): BestInBoundOrder.
+std::size_t BestEDrop(const BlockInformation& b, const Eigen::MatrixXd& A,
+                      const std::vector<int>& design, int m, long long* evaluations) {
+  constexpr int kBoundDirections = 4;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+  const int d = std::min(kBoundDirections, static_cast<int>(A.rows()));
+  const Eigen::MatrixXd V = eig.eigenvectors().leftCols(d);
+  const Eigen::MatrixXd L = eig.eigenvalues().head(d).asDiagonal();
+  const double slack = 1e-12 * std::fabs(eig.eigenvalues().maxCoeff());
+  Eigen::VectorXd bounds(static_cast<Eigen::Index>(design.size()));
+  for (std::size_t p = 0; p < design.size(); ++p) {
+    const Eigen::MatrixXd C = L - V.transpose() * b[design[p]] * V;
+    bounds[static_cast<Eigen::Index>(p)] =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(C, Eigen::EigenvaluesOnly).eigenvalues()[0];
+  }
+  const int pos = BestInBoundOrder(
+      bounds, [&](int p) { return std::sqrt(std::max(bounds[p] + slack, 0.0)); },
+      [&](int p, double) {
+        return CriterionScore(A - b[design[static_cast<std::size_t>(p)]], m, DesignCriterion::kE);
+      },
+      kNoBlockScore, evaluations);
+  return static_cast<std::size_t>(std::max(pos, 0));
+}
+
 std::vector<int> BackwardBlocks(const BlockInformation& b, int k, long long* evaluations) {
   std::vector<int> design(static_cast<std::size_t>(b.size()));
   std::iota(design.begin(), design.end(), 0);
   Eigen::MatrixXd A = b.Sum(design);
   while (static_cast<int>(design.size()) > k) {
     const int m = static_cast<int>(design.size()) - 1;
-    double best = kNoBlockScore;
     std::size_t drop = 0;
-    for (std::size_t p = 0; p < design.size(); ++p) {
-      const double score = b.Score(A - b[design[p]], m, evaluations);
-      if (score > best) {
-        best = score;
-        drop = p;
+    if (b.criterion() == DesignCriterion::kE) {
+      drop = BestEDrop(b, A, design, m, evaluations);
+    } else {
+      double best = kNoBlockScore;
+      for (std::size_t p = 0; p < design.size(); ++p) {
+        const double score = b.Score(A - b[design[p]], m, evaluations);
+        if (score > best) {
+          best = score;
+          drop = p;
+        }
       }
     }
     A -= b[design[drop]];

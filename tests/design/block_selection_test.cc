@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <array>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -85,6 +87,43 @@ TEST(SelectBlocks, EveryMethodScoresItsChoiceAndNoneBeatsTheBruteForce) {
     if (m == SelectionMethod::kSampled) {
       EXPECT_GT(r.score, 0.8 * best);  // 200 of 495 subsets
     }
+  }
+}
+
+// Backward elimination for E, written here as the definition: each step drops the block whose
+// removal keeps the largest smallest eigenvalue (ties: the first in the design).
+std::vector<int> PlainBackwardE(const Eigen::MatrixXd& G, int N, int k) {
+  std::vector<int> design(static_cast<std::size_t>(N));
+  std::iota(design.begin(), design.end(), 0);
+  while (static_cast<int>(design.size()) > k) {
+    double best = -1;
+    std::size_t drop = 0;
+    for (std::size_t p = 0; p < design.size(); ++p) {
+      std::vector<int> rest = design;
+      rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(p));
+      const double score = StackedScore(G, rest);
+      if (score > best) {
+        best = score;
+        drop = p;
+      }
+    }
+    design.erase(design.begin() + static_cast<std::ptrdiff_t>(drop));
+  }
+  return design;
+}
+
+// lrcal's backward step for E skips candidates by an upper bound on what their removal keeps
+// (block_selection.cc, BestEDrop): it must choose as the plain scan does, step by step. Pools of
+// point (3 rows) and pose (6 rows) blocks, tall and nearly square.
+TEST(SelectBlocks, BoundedBackwardChoosesAsThePlainScan) {
+  for (const auto& [N, n, k, seed] :
+       {std::array<int, 4>{40, 12, 8, 1}, {30, 25, 12, 2}, {60, 30, 20, 3}, {25, 6, 3, 4}}) {
+    SCOPED_TRACE(seed);
+    const Eigen::MatrixXd G = RandomBlockMatrix(N * kBlockRows, n, static_cast<unsigned>(seed));
+    const SelectionResult r =
+        SelectBlocks(G, kBlockRows, k, BlockMethod(SelectionMethod::kBackward),
+                     RandomStream(1, 1, 0, RandomPurpose::kSelection));
+    EXPECT_THAT(r.indices, ElementsAreArray(PlainBackwardE(G, N, k)));
   }
 }
 
