@@ -489,6 +489,44 @@ void AddCoverageCsvRows(const CellSummary& s, Table* csv) {
 }
 
 // Validation, laid out like the paper's table (rows model × axis), and its tidy CSV.
+// validation.csv's columns; issue 14's are appended after the first ones, which scripts rely on.
+std::vector<std::string> ValidationCsvColumns() {
+  return {"cell_id",
+          "cell_label",
+          "model",
+          "metric",
+          "axis",
+          "unit",
+          "n",
+          "mean",
+          "std",
+          "p5",
+          "p50",
+          "p95",
+          "max",
+          "mean_se",
+          "std_se",
+          "p5_ci_low",
+          "p5_ci_high",
+          "p50_ci_low",
+          "p50_ci_high",
+          "p95_ci_low",
+          "p95_ci_high",
+          "max_bounds_p95",
+          "mean_predicted"};
+}
+
+// parameters.csv's and parameters.tex's tables, empty.
+Table ParametersCsvTable() {
+  return Table({"cell_id", "cell_label", "parameter", "unit", "bias", "bias_se", "std_empirical",
+                "std_predicted", "std_ratio", "std_empirical_se", "std_ratio_se", "n",
+                "std_predicted_truth", "std_ratio_truth", "std_ratio_truth_se"});
+}
+Table ParametersTexTable() {
+  return Table({"cell", "parameter", "unit", "bias", "SE", "std", "predicted", "ratio"},
+               "Parameter errors (estimate - truth), mm and mrad");
+}
+
 void ValidationTables(const std::vector<CellSummary>& cells, Table* md, Table* csv) {
   for (std::size_t ci = 0; ci < cells.size(); ++ci) {
     const auto& s = cells[ci];
@@ -674,12 +712,8 @@ std::vector<std::pair<std::size_t, std::string>> ShownCellRoles(
   return out;
 }
 
-// A large study's aggregate: each validation metric's cell means (identified model) over its
-// cells, as min, quartiles and max, and which cells the per-cell tables show.
-TextDocument AggregateSection(const std::vector<CellSummary>& cells) {
-  TextDocument doc;
-  const auto roles = ShownCellRoles(cells);
-  if (roles.size() == cells.size()) return doc;
+// Each validation metric's cell means (identified model) over the cells: min, quartiles, max.
+Table CellMeansTable(const std::vector<CellSummary>& cells) {
   Table t({"metric", "axis", "cells", "min", "p25", "median", "p75", "max"});
   for (int m = 0; m < 4; ++m)
     for (int a = 0; a < 3; ++a) {
@@ -693,27 +727,78 @@ TextDocument AggregateSection(const std::vector<CellSummary>& cells) {
         row.push_back(means.empty() ? "—" : Fixed(Percentile(means, p)));
       t.AddRow(row);
     }
+  return t;
+}
+
+// The shown cells with why, in the order of their error (cells without an ok trial last).
+Table ShownCellsTable(const std::vector<CellSummary>& cells,
+                      std::vector<std::pair<std::size_t, std::string>> roles) {
+  const auto error = [&](std::size_t i) {
+    return cells[i].ok > 0 ? cells[i].axis_mean[0].mean : INFINITY;
+  };
+  std::stable_sort(roles.begin(), roles.end(),
+                   [&](const auto& a, const auto& b) { return error(a.first) < error(b.first); });
+  Table t({"shown as", "cell", "id", "mean RMS pos (mm, mean of x, y, z)"});
+  for (const auto& [i, role] : roles)
+    t.AddRow({role, cells[i].cell.label, cells[i].cell.id,
+              cells[i].ok > 0 ? Fixed(cells[i].axis_mean[0].mean * 1e3) : "—"});
+  return t;
+}
+
+// A large study's aggregate: each validation metric's cell means over its cells, and which
+// cells the per-cell tables show. Nothing for a study whose tables show every cell.
+TextDocument AggregateSection(const std::vector<CellSummary>& cells) {
+  TextDocument doc;
+  const auto roles = ShownCellRoles(cells);
+  if (roles.size() == cells.size()) return doc;
   doc.AddHeading("Over all " + std::to_string(cells.size()) + " cells");
   doc.AddParagraph(
       "Each cell's mean over its trials of each validation metric of the identified model, "
       "over the cells (mm, mrad; type-7 quartiles).");
-  doc.AddTable(std::move(t));
-  Table shown({"shown as", "cell", "id", "mean RMS pos (mm, mean of x, y, z)"});
-  auto by_error = roles;  // in the order of the error (cells without an ok trial last)
-  std::stable_sort(by_error.begin(), by_error.end(), [&](const auto& a, const auto& b) {
-    const double x = cells[a.first].axis_mean[0].mean, y = cells[b.first].axis_mean[0].mean;
-    return (cells[a.first].ok > 0 ? x : INFINITY) < (cells[b.first].ok > 0 ? y : INFINITY);
-  });
-  for (const auto& [i, role] : by_error)
-    shown.AddRow({role, cells[i].cell.label, cells[i].cell.id,
-                  cells[i].ok > 0 ? Fixed(cells[i].axis_mean[0].mean * 1e3) : "—"});
+  doc.AddTable(CellMeansTable(cells));
   doc.AddParagraph("The per-cell tables below show " + std::to_string(roles.size()) + " of the " +
                    std::to_string(cells.size()) +
                    " cells: the paper's, and those at the minimum, quartiles and maximum of the "
                    "mean RMS position error. Every cell is in cells.csv, validation.csv, "
                    "parameters.csv and summary.json (whose shown_cells lists these).");
-  doc.AddTable(std::move(shown));
+  doc.AddTable(ShownCellsTable(cells, roles));
   return doc;
+}
+
+// summary.md after its header and sensitivity section: a large study's aggregate, then the
+// validation errors, their prediction, the coverage, the cells, the paper's layout and the
+// parameter errors of the shown cells, and the paper's numbers in lrcal's distributions.
+void AppendCellSections(const std::vector<CellSummary>& cells,
+                        const std::vector<CellSummary>& shown, const StopWhen& rule,
+                        const Table& place, TextDocument* doc) {
+  doc->Append(AggregateSection(cells));
+  Table val(
+      {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
+  Table unused_val(ValidationCsvColumns()), unused_par = ParametersCsvTable(),
+                                            unused_tex = ParametersTexTable();
+  ValidationTables(shown, &val, &unused_val);
+  doc->AddHeading("Validation errors");
+  doc->AddParagraph(
+      "Over the validation configurations, per base axis: mean ± its "
+      "standard error [p5, p95] over the trials (mm, mrad). validation.csv adds the std ± SE, "
+      "95 % distribution-free confidence intervals of p5, p50 and p95 (from order statistics; "
+      "empty where a cell has too few trials, e.g. below 72 for the upper end of p95), and the "
+      "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
+      "(Wilks: at least 95 % from N = 59).");
+  doc->AddTable(val);
+  doc->Append(PredictionSection(shown));
+  doc->Append(CoverageSection(shown));
+  doc->AddHeading("Cells");
+  doc->AddTable(CellsTable(shown, rule));
+  doc->Append(PaperLayoutSection(shown));
+  doc->Append(ParameterSections(shown, &unused_par, &unused_tex));
+  if (place.num_rows() == 0) return;
+  doc->AddHeading("The paper's published numbers in lrcal's distributions");
+  doc->AddParagraph(
+      "Percentile of the "
+      "published value among lrcal's trials (0 or 100: outside every trial). Identified "
+      "errors are the published Δ minus the paper's own true Δ.");
+  doc->AddTable(place);
 }
 
 Json NullIfNan(double x) { return std::isnan(x) ? Json() : Json(x); }
@@ -1025,33 +1110,6 @@ SensitivityOutput SensitivityAnalysis(const Json& study, const std::vector<CellS
   return out;
 }
 
-// validation.csv's columns; issue 14's are appended after the first ones, which scripts rely on.
-std::vector<std::string> ValidationCsvColumns() {
-  return {"cell_id",
-          "cell_label",
-          "model",
-          "metric",
-          "axis",
-          "unit",
-          "n",
-          "mean",
-          "std",
-          "p5",
-          "p50",
-          "p95",
-          "max",
-          "mean_se",
-          "std_se",
-          "p5_ci_low",
-          "p5_ci_high",
-          "p50_ci_low",
-          "p50_ci_high",
-          "p95_ci_low",
-          "p95_ci_high",
-          "max_bounds_p95",
-          "mean_predicted"};
-}
-
 }  // namespace
 
 std::vector<std::size_t> ShownCells(const std::vector<CellSummary>& cells) {
@@ -1077,7 +1135,6 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
                "lrcal p95", "percentile of paper"});
   for (const auto& rows : placements)
     for (const auto& row : rows) place.AddRow(row);
-  const bool any_paper = place.num_rows() > 0;
 
   result.shown = ShownCells(result.cells);
   std::vector<CellSummary> shown;  // what the summary's per-cell tables show
@@ -1087,20 +1144,8 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
       {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
   Table val_csv(ValidationCsvColumns());
   ValidationTables(result.cells, &val, &val_csv);
-  Table par_csv({"cell_id", "cell_label", "parameter", "unit", "bias", "bias_se", "std_empirical",
-                 "std_predicted", "std_ratio", "std_empirical_se", "std_ratio_se", "n",
-                 "std_predicted_truth", "std_ratio_truth", "std_ratio_truth_se"});
-  Table par_tex({"cell", "parameter", "unit", "bias", "SE", "std", "predicted", "ratio"},
-                "Parameter errors (estimate - truth), mm and mrad");
-  TextDocument parameters = ParameterSections(result.cells, &par_csv, &par_tex);
-  Table val_shown = val;
-  if (shown.size() < result.cells.size()) {
-    val_shown = Table(val.header());
-    Table unused(ValidationCsvColumns());
-    ValidationTables(shown, &val_shown, &unused);
-    Table unused_csv(par_csv.header()), unused_tex(par_tex.header());
-    parameters = ParameterSections(shown, &unused_csv, &unused_tex);
-  }
+  Table par_csv = ParametersCsvTable(), par_tex = ParametersTexTable();
+  ParameterSections(result.cells, &par_csv, &par_tex);
 
   // The headline first: the sensitivity indices of a sensitivity plan, an aggregate over the
   // cells of a large study, then the validation errors.
@@ -1108,30 +1153,8 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   doc.Append(Header(study, trials, rule, result.complete));
   const SensitivityOutput sensitivity = SensitivityAnalysis(study, result.cells);
   doc.Append(sensitivity.document);
-  doc.Append(AggregateSection(result.cells));
-  doc.AddHeading("Validation errors");
-  doc.AddParagraph(
-      "Over the validation configurations, per base axis: mean ± its "
-      "standard error [p5, p95] over the trials (mm, mrad). validation.csv adds the std ± SE, "
-      "95 % distribution-free confidence intervals of p5, p50 and p95 (from order statistics; "
-      "empty where a cell has too few trials, e.g. below 72 for the upper end of p95), and the "
-      "max over the N trials with the confidence 1 − 0.95^N that it bounds the true p95 "
-      "(Wilks: at least 95 % from N = 59).");
-  doc.AddTable(val_shown);
-  doc.Append(PredictionSection(shown));
-  doc.Append(CoverageSection(shown));
-  doc.AddHeading("Cells");
-  doc.AddTable(CellsTable(shown, rule));
-  doc.Append(PaperLayoutSection(shown));
-  doc.Append(parameters);
-  if (any_paper) {
-    doc.AddHeading("The paper's published numbers in lrcal's distributions");
-    doc.AddParagraph(
-        "Percentile of the "
-        "published value among lrcal's trials (0 or 100: outside every trial). Identified "
-        "errors are the published Δ minus the paper's own true Δ.");
-    doc.AddTable(place);
-  }
+  AppendCellSections(result.cells, shown, rule, place, &doc);
+  const bool any_paper = place.num_rows() > 0;
 
   // Each file is written whole or not at all (a temporary name, checked and renamed).
   const auto write = [&](const char* name, const std::string& text) {
