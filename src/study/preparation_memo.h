@@ -24,9 +24,27 @@ inline bool SameMatrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
 }
 
+/// What every memo is to ClearPreparationMemos: it registers itself while it exists.
+class PreparationMemoBase {
+ public:
+  PreparationMemoBase(const PreparationMemoBase&) = delete;
+  PreparationMemoBase& operator=(const PreparationMemoBase&) = delete;
+  virtual void Clear() = 0;
+
+ protected:
+  PreparationMemoBase();
+  virtual ~PreparationMemoBase();
+};
+
+/// Empties every memo: the runner calls it once its cells are prepared, so a long-lived process
+/// (Python) does not keep a study's pools and draws.
+void ClearPreparationMemos();
+
 /// The last `kEntries` results of a step, keyed by `Key` (its operator== compares every input).
-template <typename Key, typename Value, std::size_t kEntries = 8>
-class PreparationMemo {
+/// A plan's cells may return to a setting after many others (a Sobol plan's matrices A, B and
+/// their mixtures), so the memos hold a few hundred entries of a few kilobytes.
+template <typename Key, typename Value, std::size_t kEntries = 256>
+class PreparationMemo : public PreparationMemoBase {
  public:
   /// The value stored for `key`, else compute() stored and returned.
   template <typename Compute>
@@ -41,6 +59,11 @@ class PreparationMemo {
     if (entries_.size() == kEntries) entries_.erase(entries_.begin());
     entries_.emplace_back(key, value);
     return value;
+  }
+
+  void Clear() override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    entries_.clear();
   }
 
  private:

@@ -26,6 +26,7 @@
 #include "lrcal/study/stopping.h"
 #include "lrcal/study/trial_store.h"
 #include "lrcal/study/work_source.h"
+#include "study/preparation_memo.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal {
@@ -379,6 +380,7 @@ class StudyRunner {
       contexts_.push_back(std::move(prepared[i]));
     }
     progress.Finish();
+    ClearPreparationMemos();  // the cells hold what they share
     result_.prepare_seconds = Seconds(start_, Clock::now());
   }
 

@@ -260,7 +260,7 @@ struct RigKey {
 // LoadRobotFile, matched on the file's path, links and bytes (a file edited between two cells'
 // preparations is read again).
 LoadedRig LoadRigFile(const std::string& path, const CellSettings& s) {
-  static PreparationMemo<RigKey, LoadedRig, 4> memo;
+  static PreparationMemo<RigKey, LoadedRig, 8> memo;
   std::ifstream in(path, std::ios::binary);
   std::ostringstream bytes;
   bytes << in.rdbuf();
@@ -653,7 +653,7 @@ FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const Scale
   if (c.rank_deficient || !C.defined() || c.validation.size() == 0) return out;
   const Eigen::MatrixXd J6 = ValidationPoseJacobian(c);
   if (held.cols() == 0) {
-    static PreparationMemo<UnitDrawsKey, Eigen::MatrixXd, 4> memo;
+    static PreparationMemo<UnitDrawsKey, Eigen::MatrixXd, 160> memo;
     out.data = C.scale * memo.Get(UnitDrawsKey{draws, c.validation_stream, C.unit, J6}, [&] {
       return ComputeUnitDraws(c, draws, C.unit, 1.0, J6, Eigen::MatrixXd()).data;
     });

@@ -41,6 +41,20 @@ TEST(PreparationMemo, ReturnsTheStoredValueForAnEqualKeyAndComputesOtherwise) {
                  std::runtime_error);
 }
 
+TEST(PreparationMemo, ClearPreparationMemosEmptiesEveryMemo) {
+  PreparationMemo<int, int> a, b;
+  int computed = 0;
+  const auto twice = [&](int key) { return ++computed, 2 * key; };
+  a.Get(1, [&] { return twice(1); });
+  b.Get(1, [&] { return twice(1); });
+  a.Get(1, [&] { return twice(1); });
+  EXPECT_EQ(computed, 2);
+  ClearPreparationMemos();
+  EXPECT_EQ(a.Get(1, [&] { return twice(1); }), 2);
+  EXPECT_EQ(b.Get(1, [&] { return twice(1); }), 2);
+  EXPECT_EQ(computed, 4);
+}
+
 TEST(SameMatrix, ComparesSizesBeforeValues) {
   EXPECT_TRUE(SameMatrix(Eigen::MatrixXd::Ones(2, 3), Eigen::MatrixXd::Ones(2, 3)));
   EXPECT_FALSE(SameMatrix(Eigen::MatrixXd::Ones(2, 3), Eigen::MatrixXd::Ones(3, 2)));
