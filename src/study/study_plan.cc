@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "lrcal/core/text_table.h"
+#include "study/preparation_memo.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal {
@@ -34,6 +35,7 @@ StudyPlan PlanStudy(const Study& study, int threads) {
     plan.estimate_seconds += c.estimate_seconds;
     plan.cells.push_back(std::move(c));
   }
+  ClearPreparationMemos();  // as a run does once its cells are prepared
   return plan;
 }
 
