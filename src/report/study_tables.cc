@@ -488,7 +488,6 @@ void AddCoverageCsvRows(const CellSummary& s, Table* csv) {
                       Fixed(95.0, 6), csv);
 }
 
-// Validation, laid out like the paper's table (rows model × axis), and its tidy CSV.
 // validation.csv's columns; issue 14's are appended after the first ones, which scripts rely on.
 std::vector<std::string> ValidationCsvColumns() {
   return {"cell_id",
@@ -527,21 +526,29 @@ Table ParametersTexTable() {
                "Parameter errors (estimate - truth), mm and mrad");
 }
 
-void ValidationTables(const std::vector<CellSummary>& cells, Table* md, Table* csv) {
+// Validation, laid out like the paper's table (rows model × axis).
+void ValidationTable(const std::vector<CellSummary>& cells, Table* md) {
   for (std::size_t ci = 0; ci < cells.size(); ++ci) {
     const auto& s = cells[ci];
     const bool show_nominal = ShowNominal(cells, ci);
     for (int model = 0; model < 2; ++model) {
+      if (model == 0 && !show_nominal) continue;
       const auto& dists = model == 0 ? s.nominal : s.validation;
       const std::string name =
           model == 0 ? "nominal" + (ci ? " (" + s.cell.label + ")" : "") : s.cell.label;
-      for (int a = 0; a < 3; ++a) {
-        if (model == 1 || show_nominal)
-          md->AddRow({name, kAxes[a], MeanRange(dists[a], 1e3), MeanRange(dists[3 + a], 1e3),
-                      MeanRange(dists[6 + a], 1e3), MeanRange(dists[9 + a], 1e3)});
-        AddValidationCsvRows(s, model == 1, a, csv);
-      }
+      for (int a = 0; a < 3; ++a)
+        md->AddRow({name, kAxes[a], MeanRange(dists[a], 1e3), MeanRange(dists[3 + a], 1e3),
+                    MeanRange(dists[6 + a], 1e3), MeanRange(dists[9 + a], 1e3)});
     }
+  }
+}
+
+// validation.csv's rows: per cell, the nominal and identified model's metrics per axis, then
+// its coverage.
+void ValidationCsvRows(const std::vector<CellSummary>& cells, Table* csv) {
+  for (const auto& s : cells) {
+    for (int model = 0; model < 2; ++model)
+      for (int a = 0; a < 3; ++a) AddValidationCsvRows(s, model == 1, a, csv);
     AddCoverageCsvRows(s, csv);
   }
 }
@@ -638,8 +645,24 @@ TextDocument PaperLayoutSection(const std::vector<CellSummary>& cells) {
   return doc;
 }
 
-// Parameter errors per cell: a Markdown table each, and the tidy CSV and LaTeX of all.
-TextDocument ParameterSections(const std::vector<CellSummary>& cells, Table* csv, Table* tex) {
+// Every cell's parameter errors as rows of parameters.csv and parameters.tex.
+void AddParameterRows(const std::vector<CellSummary>& cells, Table* csv, Table* tex) {
+  for (const auto& s : cells)
+    for (const auto& p : s.parameters) {
+      const std::string unit = UnitOf(p.name);
+      const double f = DisplayUnitOf(p.name).factor;
+      csv->AddRow({s.cell.id, s.cell.label, p.name, unit, Fixed(p.bias * f, 6),
+                   Fixed(p.bias_se * f, 6), Fixed(p.std * f, 6), Fixed(p.predicted_std * f, 6),
+                   Fixed(p.ratio, 6), CsvValue(p.std_se * f), CsvValue(p.ratio_se),
+                   std::to_string(s.ok), CsvValue(p.predicted_std_truth * f),
+                   CsvValue(p.ratio_truth), CsvValue(p.ratio_truth_se)});
+      tex->AddRow({s.cell.label, p.name, unit, Fixed(p.bias * f), Fixed(p.bias_se * f),
+                   Fixed(p.std * f), Fixed(p.predicted_std * f), Fixed(p.ratio, 3)});
+    }
+}
+
+// Parameter errors per cell: a Markdown table each.
+TextDocument ParameterSections(const std::vector<CellSummary>& cells) {
   TextDocument doc;
   doc.AddHeading("Parameter errors (estimate − truth)");
   doc.AddParagraph(
@@ -661,13 +684,6 @@ TextDocument ParameterSections(const std::vector<CellSummary>& cells, Table* csv
                 std::isnan(p.ratio_truth)
                     ? std::string("—")
                     : Fixed(p.ratio_truth, 3) + " ± " + Fixed(p.ratio_truth_se, 3)});
-      csv->AddRow({s.cell.id, s.cell.label, p.name, unit, Fixed(p.bias * f, 6),
-                   Fixed(p.bias_se * f, 6), Fixed(p.std * f, 6), Fixed(p.predicted_std * f, 6),
-                   Fixed(p.ratio, 6), CsvValue(p.std_se * f), CsvValue(p.ratio_se),
-                   std::to_string(s.ok), CsvValue(p.predicted_std_truth * f),
-                   CsvValue(p.ratio_truth), CsvValue(p.ratio_truth_se)});
-      tex->AddRow({s.cell.label, p.name, unit, Fixed(p.bias * f), Fixed(p.bias_se * f),
-                   Fixed(p.std * f), Fixed(p.predicted_std * f), Fixed(p.ratio, 3)});
     }
     if (!s.cell.fixed_for_rank.empty()) {
       std::string f;
@@ -774,9 +790,7 @@ void AppendCellSections(const std::vector<CellSummary>& cells,
   doc->Append(AggregateSection(cells));
   Table val(
       {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
-  Table unused_val(ValidationCsvColumns()), unused_par = ParametersCsvTable(),
-                                            unused_tex = ParametersTexTable();
-  ValidationTables(shown, &val, &unused_val);
+  ValidationTable(shown, &val);
   doc->AddHeading("Validation errors");
   doc->AddParagraph(
       "Over the validation configurations, per base axis: mean ± its "
@@ -791,7 +805,7 @@ void AppendCellSections(const std::vector<CellSummary>& cells,
   doc->AddHeading("Cells");
   doc->AddTable(CellsTable(shown, rule));
   doc->Append(PaperLayoutSection(shown));
-  doc->Append(ParameterSections(shown, &unused_par, &unused_tex));
+  doc->Append(ParameterSections(shown));
   if (place.num_rows() == 0) return;
   doc->AddHeading("The paper's published numbers in lrcal's distributions");
   doc->AddParagraph(
@@ -1143,9 +1157,10 @@ StudyTablesResult WriteStudyTables(const TrialStore& store, const Json& study,
   Table val(
       {"model", "axis", kMetricTitles[0], kMetricTitles[1], kMetricTitles[2], kMetricTitles[3]});
   Table val_csv(ValidationCsvColumns());
-  ValidationTables(result.cells, &val, &val_csv);
+  ValidationTable(result.cells, &val);
+  ValidationCsvRows(result.cells, &val_csv);
   Table par_csv = ParametersCsvTable(), par_tex = ParametersTexTable();
-  ParameterSections(result.cells, &par_csv, &par_tex);
+  AddParameterRows(result.cells, &par_csv, &par_tex);
 
   // The headline first: the sensitivity indices of a sensitivity plan, an aggregate over the
   // cells of a large study, then the validation errors.

@@ -2,7 +2,6 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <mutex>
 #include <sstream>
 
 #include "lrcal/core/error.h"
@@ -644,8 +643,8 @@ struct UnitDrawsKey {
 // w (k × draws) come from the validation set's prediction stream, Z first, so every call on a
 // cell uses the same normals (common random numbers). The data part is scale × the metrics of
 // the unit covariance's draws (RMS and max are homogeneous of degree 1), so cells that differ in
-// σ alone share them (UnitDrawsMemo). Without held columns the held part is zero and the total
-// the data part.
+// σ alone share them (a memo of the unit draws). Without held columns the held part is zero and the
+// total the data part.
 FirstOrderDraws LinearisedPartDraws(const CellContext& c, int draws, const ScaledCovariance& C,
                                     const Eigen::MatrixXd& held) {
   FirstOrderDraws out;

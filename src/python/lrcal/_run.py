@@ -162,6 +162,7 @@ class Run:
             stores = [os.path.join(path, "trials.sqlite")] + \
                 sorted(glob.glob(os.path.join(path, "trials.rank*.sqlite")))
         self._connections = {}
+        self._columns = None  # the trial table's store columns, read once (_trial_columns)
         self._stores = [p for p in stores if os.path.isfile(p)]
         self._cells = self._read_cells()
         varied = varied_keys(self.manifest.get("study", {}))
@@ -217,7 +218,7 @@ class Run:
         validation metrics of the identified (val_*) and nominal (nom_*) models, seconds, and
         missed_configurations where the store records it (stores written before lrcal kept a trial
         whose beam missed at some configurations do not)."""
-        if getattr(self, "_columns", None) is not None:
+        if self._columns is not None:
             return self._columns
         present = []
         if self._stores:  # no store yet: no trials, no metric columns
@@ -234,13 +235,10 @@ class Run:
     def trials(self):
         """Every recorded trial (read on first use, then kept): see the class's docstring. For a
         large run, trials_of(cell) or iter_trials() read a cell or a chunk at a time."""
-        if self._trials is None:
-            rows = []
-            for cell in self._cells:
-                rows.extend(self._cell_rows(cell[0], 0, None, False))
-            known = {c[0] for c in self._cells}
-            rows.extend(r for r in self._rows_where("cell_id NOT IN (SELECT cell_id FROM cells)",
-                                                    (), False) if r[0] not in known)
+        if self._trials is None:  # in study order; a trial of a cell no store lists comes last
+            order = {c[0]: c[1] for c in self._cells}
+            rows = sorted(self._rows_where("1", (), False),
+                          key=lambda r: (order.get(r[0], 1 << 30), r[0], r[1]))
             self._trials = self._trial_table(rows)
         return self._trials
 
@@ -330,7 +328,8 @@ class Run:
         """Parameter errors (estimate - truth, SI) of one cell's successful trials: a table with
         the column `trial` and one column per parameter (cells' parameter_names). `cell` is a
         cell_id or a label."""
-        cell_id, names = self._cell(cell)[0], self._cell(cell)[4]
+        match = self._cell(cell)
+        cell_id, names = match[0], match[4]
         rows = []
         for r in self._cell_rows(cell_id, 0, None, True):
             if r[-1] is None:

@@ -126,7 +126,8 @@ class Run:
         """What a figure showing `shown` cells says about the others ("" when it shows all)."""
         if len(shown) >= len(self.cells):
             return ""
-        if len(self.chosen_cells()) < len(self.cells) and len(shown) == len(self.chosen_cells()):
+        chosen = len(self.chosen_cells())
+        if chosen < len(self.cells) and len(shown) == chosen:
             return (f" {len(shown)} of the {len(self.cells)} cells are drawn: the paper's and "
                     "those at the minimum, quartiles and maximum of the mean RMS position error "
                     "(the summary's per-cell tables show the same; tables/*.csv have every "
