@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "lrcal/core/error.h"
+#include "lrcal/measurement/environment_measurement.h"
 
 namespace lrcal {
 
@@ -40,6 +41,7 @@ std::string IdentifiabilityReport::ToString() const {
     out << "\n";
   }
   for (const auto& d : dependencies) out << "dependence: " << d.ToString() << "\n";
+  for (const auto& x : explanations) out << "lost: " << x << "\n";
   if (!suggested_fixed.empty()) {
     out << "suggested to fix:";
     for (const auto& n : suggested_fixed) out << " " << n;
@@ -223,8 +225,23 @@ IdentifiabilityReport AnalyzeIdentifiability(const MeasurementKind& kind,
                                              const TargetedConfigurations& configs, const double* e,
                                              const IdentifiabilityOptions& options) {
   options.Validate();
-  return AnalyzeJacobian(MeasurementJacobian(kind, kind.LinearisationConfigurations(configs), e),
-                         kind.parameter_names(), configs.size(), options);
+  IdentifiabilityReport report =
+      AnalyzeJacobian(MeasurementJacobian(kind, kind.LinearisationConfigurations(configs), e),
+                      kind.parameter_names(), configs.size(), options);
+  if (const auto* environment = dynamic_cast<const EnvironmentMeasurement*>(&kind)) {
+    // Every non-geometric term the analysis could not estimate, explained in words.
+    std::vector<std::string> lost = report.unidentifiable;
+    for (const Dependency& d : report.dependencies)
+      for (const auto& term : d.terms) lost.push_back(term.first);
+    std::vector<std::string> unique;
+    for (const std::string& name : lost)
+      if ((ComplianceTermJoint(name) >= 0 || name == kThermalLinksTerm ||
+           name == kThermalRangerTerm) &&
+          std::find(unique.begin(), unique.end(), name) == unique.end())
+        unique.push_back(name);
+    report.explanations = environment->ExplainLostTerms(configs, unique);
+  }
+  return report;
 }
 
 }  // namespace lrcal

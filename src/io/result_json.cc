@@ -44,6 +44,7 @@ ResultJson IdentifiabilityJson(const IdentifiabilityReport& r) {
   }
   j["dependencies"] = deps;
   j["suggested_fixed"] = r.suggested_fixed;
+  if (!r.explanations.empty()) j["lost_in_words"] = r.explanations;
   return j;
 }
 

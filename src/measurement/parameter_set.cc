@@ -126,6 +126,12 @@ DisplayUnit DisplayUnitOf(const std::string& name) {
   // The ranger's scale and a coupling's gain (chain_measurement.h) are dimensionless.
   if (term == "ranger_scale" || (term.size() > 5 && term.compare(term.size() - 5, 5, "_gain") == 0))
     return {"ppm", 1e6};
+  // A joint's compliance (environment_measurement.h: c3, rad/(N·m)) and the thermal coefficients
+  // (1/K).
+  if (term.size() > 1 && term[0] == 'c' && term[1] >= '1' && term[1] <= '9' &&
+      term.find_first_not_of("0123456789", 1) == std::string::npos)
+    return {"urad/(N m)", 1e6};
+  if (term == "thermal_links" || term == "thermal_ranger") return {"ppm/K", 1e6};
   return IsAngularName(name) ? DisplayUnit{"mrad", 1e3} : DisplayUnit{"mm", 1e3};
 }
 

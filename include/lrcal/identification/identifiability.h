@@ -60,6 +60,9 @@ struct IdentifiabilityReport {
   std::vector<std::string> unidentifiable;   ///< parameters with a zero column
   std::vector<Dependency> dependencies;      ///< one per dependent parameter
   std::vector<std::string> suggested_fixed;  ///< fix these to obtain a full-rank set
+  /// In words, why a non-geometric term (environment_measurement.h) in `unidentifiable` or a
+  /// dependence is lost: "c1: joint 1 carries no gravity torque in these measurements ...".
+  std::vector<std::string> explanations{};
   int num_params() const { return static_cast<int>(names.size()); }
   bool full_rank() const { return rank == num_params(); }
   std::string ToString() const;

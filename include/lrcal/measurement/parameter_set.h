@@ -137,7 +137,8 @@ std::string UnlabelledName(const std::string& name);
 bool IsAngularName(const std::string& name);
 
 /// How a quantity is shown to users: "mrad" (×1e3 from rad), "mm" (×1e3 from m) or, for the
-/// ranger's scale error, "ppm" (×1e6).
+/// ranger's scale error, "ppm" (×1e6); a joint's compliance c3 in "urad/(N m)" (×1e6 from
+/// rad/(N·m)) and a thermal coefficient in "ppm/K" (×1e6 from 1/K).
 struct DisplayUnit {
   const char* unit;
   double factor;

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "lrcal/kinematics/configuration_set.h"
+#include "lrcal/measurement/environment.h"
 
 namespace lrcal {
 
@@ -11,7 +12,8 @@ namespace lrcal {
 /// the 0-based index of the target its measurement is of: the plane a ranger's beam is aimed
 /// at (plane.h, PlaneSet), the reflector a tracker sees (point_measurement.h). The tag is 0
 /// with one target. A measurement is the pair (configuration, target): subsets and copies keep
-/// the tag, and a kind refuses a tag it has no target for (MeasurementKind::Bind).
+/// the tag (and the environment it was measured in, when given), and a kind refuses a tag it has no
+/// target for (MeasurementKind::Bind).
 ///
 /// Kinematics uses it as a ConfigurationSet (joint values only). Invariant: one tag per
 /// configuration. It holds as long as the set is changed through this class; adding to it
@@ -34,6 +36,7 @@ class TargetedConfigurations : public ConfigurationSet {
   void Clear() {
     ConfigurationSet::Clear();
     target_.clear();
+    environment_.clear();
   }
   void Reserve(int n);
 
@@ -43,11 +46,22 @@ class TargetedConfigurations : public ConfigurationSet {
   const std::vector<int>& targets() const { return target_; }
   /// 1 + the largest tag (0 for an empty set): the targets the set refers to.
   int num_targets_referenced() const;
-  /// A new set with configurations `indices` (in that order), tags kept.
+  /// A new set with configurations `indices` (in that order), tags and environments kept.
   TargetedConfigurations Subset(const std::vector<int>& indices) const;
+
+  /// The environment configuration i was measured in (environment.h): fields not given are NaN
+  /// (a file without environment columns), so that a kind takes its robot's defaults.
+  const Environment& environment(int i) const { return environment_[static_cast<std::size_t>(i)]; }
+  /// Sets configuration i's environment.
+  void SetEnvironment(int i, const Environment& e) {
+    environment_[static_cast<std::size_t>(i)] = e;
+  }
+  /// True when some configuration has a field of its environment given.
+  bool HasEnvironments() const;
 
  private:
   std::vector<int> target_;
+  std::vector<Environment> environment_;  // one per configuration
 };
 
 }  // namespace lrcal
