@@ -212,6 +212,22 @@ void ReadSettingOptions(const po::variables_map& vm,
   }
 }
 
+// The non-geometric model (commands_environment.cc): --estimate-compliance and --estimate-thermal
+// for identify and identifiability; --gravity and --temperature-c for simulate.
+void AddNonGeometricOptions(po::options_description& o);
+bool AsksNonGeometric(const po::variables_map& vm);
+int NonGeometricIdentify(const po::variables_map& vm, const std::string& data_file,
+                         const IdentificationOptions& options);
+int NonGeometricIdentifiability(const po::variables_map& vm, const std::string& configs_file,
+                                const IdentifiabilityOptions& options);
+void AddEnvironmentOptions(po::options_description& o);
+/// True when simulate must read the arm in its environment: --gravity or --temperature-c, the
+/// configurations' environment columns, or a robot file whose true arm bends or grows.
+bool SimulatesEnvironment(const po::variables_map& vm, const RobotFile& rig,
+                          const TargetedConfigurations& configs);
+int NonGeometricSimulate(const po::variables_map& vm, const RobotFile& rig, const PlaneSet& planes,
+                         TargetedConfigurations configs, const NoiseModel& noise);
+
 int KinematicsCommand(const std::vector<std::string>& args);
 int SampleCommand(const std::vector<std::string>& args);
 int SimulateCommand(const std::vector<std::string>& args);

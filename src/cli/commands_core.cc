@@ -347,6 +347,7 @@ int SimulateCommand(const std::vector<std::string>& args) {
   AddSensorOptions(o);
   AddSettingOptions(o, NoiseModel::Settings());
   AddOrientationNoiseOption(o);
+  AddEnvironmentOptions(o);
   o.add_options()("socket", po::value<std::vector<std::string>>()->composing(),
                   "--sensor socket: a socket's true position as x,y,z (m, base frame), one per "
                   "socket id of the configurations, in ascending order of id");
@@ -366,7 +367,14 @@ int SimulateCommand(const std::vector<std::string>& args) {
   if (vm.count("socket"))
     throw InputError("--socket",
                      "is the socket sensor's; --sensor " + sensor + " does not take it");
-  if (sensor != "ranger") return TrackerSimulate(vm, sensor);
+  if (sensor != "ranger") {
+    for (const char* option : {"gravity", "temperature-c"})
+      if (vm.count(option))
+        throw InputError(std::string("--") + option,
+                         "an environment is simulated for the ranger; --sensor " + sensor +
+                             " reads the geometric arm");
+    return TrackerSimulate(vm, sensor);
+  }
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
@@ -382,6 +390,8 @@ int SimulateCommand(const std::vector<std::string>& args) {
                                           std::to_string(noise.repetitions) +
                                           " readings; at most " + std::to_string(kMaxCsvRows) +
                                           " lines per file (what lrcal reads back)");
+  if (SimulatesEnvironment(vm, rig, configs))
+    return NonGeometricSimulate(vm, rig, planes, configs, noise);
   MeasurementSet data;
   std::vector<BeamMiss> misses;
   std::vector<double> raw;
@@ -1228,6 +1238,18 @@ int TreeIdentifiability(const po::variables_map& vm) {
 
 // identify with a tree's chains, several kinds or one kind other than the ranger; nothing for
 // the ranger's own calibration, which IdentifyCommand does.
+// --estimate-compliance and --estimate-thermal are the ranger's for now (one arm, one kind).
+void RefuseNonGeometricForOtherSensors(const po::variables_map& vm) {
+  if (!AsksNonGeometric(vm)) return;
+  const std::string sensor = IsTreeRun(vm) ? "tree" : ResolveSensor(vm);
+  if (sensor != "ranger")
+    throw InputError(vm["estimate-compliance"].as<std::string>() != "none" ? "--estimate-compliance"
+                                                                           : "--estimate-thermal",
+                     "is available for --sensor ranger on one arm; the " + sensor +
+                         " path fits the geometric model (the library's EnvironmentMeasurement "
+                         "wraps any kind)");
+}
+
 std::optional<int> IdentifyOtherThanOneRanger(const po::variables_map& vm) {
   if (IsTreeRun(vm)) return TreeIdentify(vm);
   const std::string sensor = ResolveSensor(vm);
@@ -1249,10 +1271,14 @@ int IdentifyCommand(const std::vector<std::string>& args) {
                     {"loss_scale_mm", "loss_scale_sigma", "sigma_mm"});
   AddSensorOptions(o);
   AddOrientationNoiseOption(o);
+  AddNonGeometricOptions(o);
   po::variables_map vm;
   if (!Parse("identify", "--data M.csv [options]", o, args, &vm)) return 0;
+  RefuseNonGeometricForOtherSensors(vm);
   if (const std::optional<int> done = IdentifyOtherThanOneRanger(vm)) return *done;
   CheckIdentifyOutputs(vm);
+  if (AsksNonGeometric(vm))
+    return NonGeometricIdentify(vm, DataFile(vm), ResolveIdentificationOptions(vm, LoadRobot(vm)));
   const Setup setup = ResolveSetup(vm);
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
@@ -1450,8 +1476,10 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   AddEstimatePresetOption(o);
   AddSettingOptions(o, NoiseModel::Settings(), {"sigma_mm", "repetitions"});
   AddSettingOptions(o, IdentifiabilityOptions::Settings(), {"rank_tolerance"});
+  AddNonGeometricOptions(o);
   po::variables_map vm;
   if (!Parse("identifiability", "--configs C.csv [options]", o, args, &vm)) return 0;
+  RefuseNonGeometricForOtherSensors(vm);
   if (IsTreeRun(vm)) return TreeIdentifiability(vm);
   const std::string sensor = ResolveSensor(vm);
   if (sensor == "mixed") return MixedIdentifiability(vm);
@@ -1463,11 +1491,13 @@ int IdentifiabilityCommand(const std::vector<std::string>& args) {
   const RobotFile& rig = setup.rig;
   const RobotModel& robot = rig.robot;
   const PlaneSet& planes = setup.planes;
+  IdentifiabilityOptions options;
+  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
+  if (AsksNonGeometric(vm))
+    return NonGeometricIdentifiability(vm, SingleFile(vm, "configs"), options);
   const TargetedConfigurations configs =
       ReadRobotConfigurations(SingleFile(vm, "configs"), robot, &planes);
   MeasurementModel model(robot, planes, ResolveParameterSet(robot, vm, planes.size()));
-  IdentifiabilityOptions options;
-  ReadSettingOptions(vm, IdentifiabilityOptions::Settings(), &options);
   const IdentifiabilityReport r = AnalyzeIdentifiability(model, configs, nullptr, options);
   RemedyOptions remedy_options;
   remedy_options.ranger = rig.ranger;

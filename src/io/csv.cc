@@ -319,6 +319,39 @@ TargetedConfigurations ReadConfigurations(const std::string& path, int num_joint
   return Configurations(ReadCsv(path), num_joints, planes);
 }
 
+namespace {
+
+// The optional environment columns of a table (environment.h): gravity_x, gravity_y, gravity_z
+// (m/s², base frame; all three or none) and temperature_c (°C), into each row's configuration of
+// `q` (row r is configuration r).
+void ReadEnvironmentColumns(const CsvTable& t, TargetedConfigurations* q) {
+  const int gx = t.Column("gravity_x"), gy = t.Column("gravity_y"), gz = t.Column("gravity_z");
+  const int tc = t.Column("temperature_c");
+  const int given = (gx >= 0) + (gy >= 0) + (gz >= 0);
+  if (given != 0 && given != 3) {
+    const char* missing = gx < 0 ? "gravity_x" : gy < 0 ? "gravity_y" : "gravity_z";
+    throw InputError(Location(t.path, 1) + " column '" + missing + "'",
+                     "missing: expected gravity_x, gravity_y and gravity_z together (the gravity "
+                     "vector in the base frame, m/s²), or none of them");
+  }
+  if (given == 0 && tc < 0) return;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    Environment e;
+    if (given == 3) e.gravity = Eigen::Vector3d(t.Number(r, gx), t.Number(r, gy), t.Number(r, gz));
+    if (given == 3 && e.gravity.norm() > 100)
+      throw InputError(Location(t.path, t.lines[r]) + " column 'gravity_x'",
+                       "a gravity of " + FormatExact(e.gravity.norm()) +
+                           " m/s²: expected m/s² (9.81 on the ground, 0 on orbit)");
+    if (tc >= 0) e.temperature_c = t.Number(r, tc);
+    if (tc >= 0 && e.temperature_c < -273.15)
+      throw InputError(Location(t.path, t.lines[r]) + " column 'temperature_c'",
+                       FormatExact(e.temperature_c) + " is below absolute zero: expected °C");
+    q->SetEnvironment(static_cast<int>(r), e);
+  }
+}
+
+}  // namespace
+
 TargetedConfigurations Configurations(const CsvTable& t, int num_joints, const PlaneSet* planes) {
   const std::string& path = t.path;
   std::vector<int> cols = JointColumns(t, num_joints);
@@ -326,6 +359,7 @@ TargetedConfigurations Configurations(const CsvTable& t, int num_joints, const P
   const std::vector<int> plane = PlaneColumn(t, planes);
   TargetedConfigurations out(num_joints);
   for (std::size_t r = 0; r < t.rows.size(); ++r) out.Add(JointValues(t, r, cols), plane[r]);
+  ReadEnvironmentColumns(t, &out);
   return out;
 }
 
@@ -373,6 +407,7 @@ MeasurementSet Measurements(const CsvTable& t, int num_joints, const RangerSpec*
       labels.push_back(t.rows[r][cc]);
     }
   }
+  ReadEnvironmentColumns(t, &q);
   return GroupReadings(
       q, h, ranger,
       [&](int r) { return r < 0 ? path : Location(path, t.lines[r]) + " column 'h'"; },
@@ -425,10 +460,17 @@ void WriteReadings(const std::string& path, const TargetedConfigurations& config
   std::ostringstream out;
   for (int j = 0; j < configs.num_joints(); ++j) out << "q" << j + 1 << ",";
   const bool planes = configs.num_targets_referenced() > 1;
+  const bool environments = configs.HasEnvironments();
+  if (environments) out << "gravity_x,gravity_y,gravity_z,temperature_c,";
   out << (planes ? "plane,h,repetition\n" : "h,repetition\n");
   for (int i = 0, k = 0; i < configs.size(); ++i)
     for (int r = 0; r < repetitions; ++r, ++k) {
       for (int j = 0; j < configs.num_joints(); ++j) out << FormatExact(configs.q(i)[j]) << ",";
+      if (environments) {
+        const Environment& e = configs.environment(i);
+        for (int c = 0; c < 3; ++c) out << FormatExact(e.gravity[c]) << ",";
+        out << FormatExact(e.temperature_c) << ",";
+      }
       if (planes) out << configs.target(i) + 1 << ",";
       out << FormatExact(readings[k]) << "," << r + 1 << "\n";
     }

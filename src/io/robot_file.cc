@@ -206,6 +206,136 @@ RigidTransform ParseFixedTransform(const YAML::Node& root, const std::string& pa
   return RigidTransform::FromXyzRpy(xyz, rpy);
 }
 
+// masses: [{link: 2 | tool, mass: kg, com: [x, y, z] m}, ...]
+MassModel ParseMasses(const YAML::Node& root, const std::string& path, int num_links) {
+  using namespace yaml;
+  MassModel out;
+  const YAML::Node list = root["masses"];
+  if (!list) return out;
+  if (!list.IsSequence())
+    throw InputError(Where(path, list, "masses"),
+                     "expected a list of {link, mass, com} (kg, m in the link's frame)");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node m = list[i];
+    const std::string ctx = "masses[" + std::to_string(i) + "]";
+    RequireMap(m, path, ctx);
+    CheckKeys(m, {"link", "mass", "com"}, path, ctx);
+    for (const char* key : {"link", "mass"})
+      if (!m[key])
+        throw InputError(Where(path, m, ctx + "." + key), "missing: expected link (1 to " +
+                                                              std::to_string(num_links) +
+                                                              ", or tool), mass (kg) and com (m)");
+    PointMass pm;
+    if (m["link"].IsScalar() && m["link"].Scalar() == "tool") {
+      pm.link = num_links + 1;
+    } else {
+      pm.link = Integer(m["link"], path, ctx + ".link");
+      if (pm.link < 1 || pm.link > num_links)
+        throw InputError(
+            Where(path, m["link"], ctx + ".link"),
+            "expected a link from 1 to " + std::to_string(num_links) + ", or tool for a payload");
+    }
+    pm.mass = Number(m["mass"], path, ctx + ".mass");
+    if (!(pm.mass > 0))
+      throw InputError(Where(path, m["mass"], ctx + ".mass"), "expected a positive mass in kg");
+    if (m["com"]) {
+      const std::vector<double> c = NumberList(m["com"], path, ctx + ".com");
+      if (c.size() != 3)
+        throw InputError(Where(path, m["com"], ctx + ".com"),
+                         "expected 3 numbers (m, in the link's frame)");
+      pm.com = Eigen::Vector3d(c[0], c[1], c[2]);
+    }
+    out.masses.push_back(pm);
+  }
+  return out;
+}
+
+// compliance: {unit: urad/Nm | rad/Nm, nominal: [N values], true: [N values]}
+Eigen::VectorXd ParseCompliance(const YAML::Node& c, const std::string& path, const char* which,
+                                int num_links, double unit) {
+  using namespace yaml;
+  if (!c || !c[which]) return {};
+  const std::string key = std::string("compliance.") + which;
+  const std::vector<double> v = NumberList(c[which], path, key);
+  if (static_cast<int>(v.size()) != num_links)
+    throw InputError(Where(path, c[which], key), "expected one compliance per joint (" +
+                                                     std::to_string(num_links) + " numbers), got " +
+                                                     std::to_string(v.size()));
+  Eigen::VectorXd out(num_links);
+  for (int j = 0; j < num_links; ++j) {
+    if (v[static_cast<std::size_t>(j)] < 0)
+      throw InputError(Where(path, c[which], key),
+                       "joint " + std::to_string(j + 1) + "'s compliance is negative");
+    out[j] = v[static_cast<std::size_t>(j)] * unit;
+  }
+  return out;
+}
+
+// thermal: {reference_c, links_ppm_per_k, ranger_ppm_per_k, true_links_ppm_per_k,
+// true_ranger_ppm_per_k}; environment: {gravity: [x, y, z], temperature_c}.
+void ParseNonGeometric(const YAML::Node& root, const std::string& path, RobotFile* file) {
+  using namespace yaml;
+  const int n = file->robot.num_links();
+  NonGeometricModel& model = file->non_geometric;
+  model.masses = ParseMasses(root, path, n);
+  const YAML::Node c = root["compliance"];
+  double unit = 1e-6;
+  if (c) {
+    RequireMap(c, path, "compliance");
+    CheckKeys(c, {"unit", "nominal", "true"}, path, "compliance");
+    const std::string u = c["unit"] ? String(c["unit"], path, "compliance.unit") : "urad/Nm";
+    if (u != "urad/Nm" && u != "rad/Nm")
+      throw InputError(
+          Where(path, c["unit"], "compliance.unit"),
+          "expected urad/Nm or rad/Nm (m/N and um/N for a prismatic joint), got '" + u + "'");
+    unit = u == "rad/Nm" ? 1.0 : 1e-6;
+  }
+  model.compliance = ParseCompliance(c, path, "nominal", n, unit);
+  const YAML::Node t = root["thermal"];
+  ThermalCoefficients truth;
+  if (t) {
+    RequireMap(t, path, "thermal");
+    CheckKeys(t,
+              {"reference_c", "links_ppm_per_k", "ranger_ppm_per_k", "true_links_ppm_per_k",
+               "true_ranger_ppm_per_k"},
+              path, "thermal");
+    if (t["reference_c"])
+      model.thermal.reference_c = Number(t["reference_c"], path, "thermal.reference_c");
+    if (t["links_ppm_per_k"])
+      model.thermal.links = Number(t["links_ppm_per_k"], path, "thermal.links_ppm_per_k") * 1e-6;
+    if (t["ranger_ppm_per_k"])
+      model.thermal.ranger = Number(t["ranger_ppm_per_k"], path, "thermal.ranger_ppm_per_k") * 1e-6;
+  }
+  truth = model.thermal;
+  if (t && t["true_links_ppm_per_k"])
+    truth.links = Number(t["true_links_ppm_per_k"], path, "thermal.true_links_ppm_per_k") * 1e-6;
+  if (t && t["true_ranger_ppm_per_k"])
+    truth.ranger = Number(t["true_ranger_ppm_per_k"], path, "thermal.true_ranger_ppm_per_k") * 1e-6;
+  const YAML::Node e = root["environment"];
+  if (e) {
+    RequireMap(e, path, "environment");
+    CheckKeys(e, {"gravity", "temperature_c"}, path, "environment");
+    if (e["gravity"]) {
+      const std::vector<double> g = NumberList(e["gravity"], path, "environment.gravity");
+      if (g.size() != 3)
+        throw InputError(Where(path, e["gravity"], "environment.gravity"),
+                         "expected 3 numbers (m/s², base frame: [0, 0, -9.81] upright)");
+      model.defaults.gravity = Eigen::Vector3d(g[0], g[1], g[2]);
+    }
+    if (e["temperature_c"])
+      model.defaults.temperature_c = Number(e["temperature_c"], path, "environment.temperature_c");
+  }
+  file->true_non_geometric = model;
+  file->true_non_geometric.thermal = truth;
+  file->true_non_geometric.compliance = ParseCompliance(c, path, "true", n, unit);
+  if (file->true_non_geometric.compliance.size() == 0)
+    file->true_non_geometric.compliance = model.compliance;
+  if ((c && c["true"] && model.masses.empty()))
+    throw InputError(Where(path, c, "compliance"),
+                     "a joint compliance bends the arm under gravity's load: give the arm's "
+                     "masses: as well");
+}
+
 RangerSpec ParseRanger(const YAML::Node& root, const std::string& path) {
   using namespace yaml;
   RangerSpec ranger;
@@ -541,10 +671,11 @@ std::vector<FileCoupling> ParseCouplings(const YAML::Node& root, const std::stri
 
 RobotFile ReadRobotYaml(const std::string& path, bool allow_couplings) {
   YAML::Node root = yaml::LoadFile(path);
-  yaml::CheckKeys(root,
-                  {"name", "description", "links", "base", "tool", "true_errors", "tolerances",
-                   "plane", "planes", "ranger", "calibration"},
-                  path, "");
+  yaml::CheckKeys(
+      root,
+      {"name", "description", "links", "base", "tool", "true_errors", "tolerances", "plane",
+       "planes", "ranger", "calibration", "masses", "compliance", "thermal", "environment"},
+      path, "");
   if (root["calibration"] && !root["calibration"].IsMap())
     throw InputError(yaml::Where(path, root["calibration"], "calibration"),
                      "expected a mapping (the record lrcal identify --write-robot writes)");
@@ -567,6 +698,7 @@ RobotFile ReadRobotYaml(const std::string& path, bool allow_couplings) {
   file.path = path;
   file.robot.source = path;
   ParseRangerErrors(root, path, &file);
+  ParseNonGeometric(root, path, &file);
   file.tolerances = ParseTolerances(root, path, links, file.planes ? file.planes->size() : 0);
   if (root["calibration"]) file.calibration = ParseCalibration(root["calibration"], path);
   return file;

@@ -1,5 +1,6 @@
 #include "lrcal/measurement/measurement_set.h"
 
+#include <cmath>
 #include <map>
 
 #include "lrcal/core/error.h"
@@ -37,6 +38,7 @@ void LabelledJointValues(const TargetedConfigurations& q, const std::vector<int>
     }
     for (int j = 0; j < n; ++j) mean[j] = sum[static_cast<std::size_t>(g) * n + j] / count[g];
     data->configs.Add(mean.data(), q.target(first[g]));
+    data->configs.SetEnvironment(g, q.environment(first[g]));
   }
 }
 
@@ -70,6 +72,7 @@ MeasurementSet GroupReadings(const TargetedConfigurations& q, const std::vector<
   const int n = q.num_joints();
   if (labels && labels->size() != h.size())
     throw InputError(where(-1), "expected one configuration label per reading");
+  const bool environments = q.HasEnvironments();
   std::map<std::vector<double>, int> index;
   std::map<std::string, int> label_index;
   std::vector<int> first;  // the reading that opened each configuration
@@ -93,8 +96,20 @@ MeasurementSet GroupReadings(const TargetedConfigurations& q, const std::vector<
     } else {
       std::vector<double> key(q.q(r), q.q(r) + n);
       key.push_back(q.target(r));  // one pose read on two planes would be two configurations
+      if (environments) {          // one pose read warm and cold would be two configurations
+        const Environment& e = q.environment(r);
+        // A field not given (NaN) keys as −∞, which no read value is: NaN has no order.
+        const auto ordered = [](double x) { return x == x ? x : -HUGE_VAL; };
+        key.insert(key.end(), {ordered(e.gravity[0]), ordered(e.gravity[1]), ordered(e.gravity[2]),
+                               ordered(e.temperature_c)});
+      }
       id = index.emplace(std::move(key), next).first->second;
     }
+    if (id != next && labels && !(q.environment(r) == q.environment(first[id])))
+      throw InputError(where(r), "this reading's environment (" + q.environment(r).ToString() +
+                                     ") is not that of earlier readings of its configuration (" +
+                                     q.environment(first[id]).ToString() +
+                                     "); one configuration is read in one environment");
     if (id != next && q.target(r) != q.target(first[id]))
       throw InputError(where(r), "this reading is on plane " + std::to_string(q.target(r) + 1) +
                                      " but earlier readings of its configuration are on plane " +

@@ -13,6 +13,7 @@
 
 #include "lrcal/identification/prior.h"
 #include "lrcal/kinematics/robot_model.h"
+#include "lrcal/measurement/environment_measurement.h"
 #include "lrcal/measurement/plane.h"
 #include "lrcal/measurement/truth.h"
 
@@ -69,6 +70,13 @@ struct RobotFile {
   std::optional<CalibrationRecord> calibration;
   /// A robot YAML file's coupled links (LoadCoupledRobotFile only: LoadRobotFile refuses them).
   std::vector<FileCoupling> couplings{};
+  /// What the arm is beyond its geometry, as a calibration knows it (environment_measurement.h):
+  /// the file's `masses:`, `compliance.nominal` (stiff without it), `thermal:`'s coefficients and
+  /// `environment:` (the defaults of data without environment columns).
+  NonGeometricModel non_geometric{};
+  /// The same for the simulated arm: `compliance.true` and `thermal:`'s true_* coefficients in
+  /// place of the nominal ones (the nominal ones where the file gives no true value).
+  NonGeometricModel true_non_geometric{};
 };
 
 /// The priors a calibration uses: `rig`'s tolerances when `use_tolerances` (an InputError at
