@@ -24,17 +24,18 @@ PoseErrors ComparePoses(const RobotModel& robot, const Eigen::VectorXd& true_val
   return ComparePoses(robot, ToolPoses(robot, true_values, configs), model_values, configs);
 }
 
-PoseErrors ComparePoses(const RobotModel& robot, const std::vector<Pose<double>>& true_poses,
-                        const Eigen::VectorXd& model_values, const ConfigurationSet& configs) {
-  ChainPoint model;
-  PrepareChainPoint(robot, model_values.data(), &model);
-  const int m = configs.size();
+namespace {
+
+// The errors of `model` at configuration i into column i, then the statistics.
+template <typename ModelPose>
+PoseErrors ComparePoseSets(const std::vector<Pose<double>>& true_poses, int m,
+                           const ModelPose& model_pose) {
   PoseErrors out;
   out.position.resize(3, m);
   out.orientation.resize(3, m);
   for (int i = 0; i < m; ++i) {
-    const Pose<double>& pt = true_poses[i];
-    const Pose<double> pm = ToolPose(model, configs, i);
+    const Pose<double>& pt = true_poses[static_cast<std::size_t>(i)];
+    const Pose<double> pm = model_pose(i);
     out.position.col(i) = pt.p_BT - pm.p_BT;
     out.orientation.col(i) = RotationVector(pt.R_BT * pm.R_BT.transpose());
   }
@@ -45,6 +46,22 @@ PoseErrors ComparePoses(const RobotModel& robot, const std::vector<Pose<double>>
     out.stats.max_orientation = out.orientation.cwiseAbs().rowwise().maxCoeff();
   }
   return out;
+}
+
+}  // namespace
+
+PoseErrors ComparePoses(const RobotModel& robot, const std::vector<Pose<double>>& true_poses,
+                        const Eigen::VectorXd& model_values, const ConfigurationSet& configs) {
+  ChainPoint model;
+  PrepareChainPoint(robot, model_values.data(), &model);
+  return ComparePoseSets(true_poses, configs.size(),
+                         [&](int i) { return ToolPose(model, configs, i); });
+}
+
+PoseErrors ComparePoses(const std::vector<Pose<double>>& true_poses,
+                        const std::vector<Pose<double>>& model_poses) {
+  return ComparePoseSets(true_poses, static_cast<int>(model_poses.size()),
+                         [&](int i) { return model_poses[static_cast<std::size_t>(i)]; });
 }
 
 }  // namespace lrcal

@@ -234,10 +234,13 @@ std::string KeyList(const Json& map) {
 // identification.loss_scale_mm: the loss scale in mm, in place of loss_scale_sigma.
 bool IsOptionalKey(const std::string& section, const std::string& key) {
   if (section.empty())
-    return key == "plane" || key == "robot_file_fnv1a" || key == "tool_link" || key == "base_link";
+    return key == "plane" || key == "robot_file_fnv1a" || key == "tool_link" ||
+           key == "base_link" || key == "environment";
   if (section == "pool" || section == "validation")
     return key == "file" || key == "file_fnv1a" || (section == "validation" && key == "tool_link");
-  return section == "identification" && key == "loss_scale_mm";
+  // environment: and identification.estimate (issue 28): optional, so that the cells of studies
+  // without them keep their names.
+  return section == "identification" && (key == "loss_scale_mm" || key == "estimate");
 }
 
 // Every key of `given` must be a setting; a section (a mapping in the defaults) must be given as
@@ -840,6 +843,96 @@ void CheckToolLinks(const KeyLocator& where, const CellSettings& c) {
                          (c.tool_link.empty() ? std::string("none given") : c.tool_link) + ")");
 }
 
+// environment.calibration / environment.validation: {gravity: [x, y, z], temperature_c: T or
+// [T1, T2, ...]}.
+CellSettings::EnvironmentPhase ParseEnvironmentPhase(const Json& s, const std::string& key,
+                                                     const KeyLocator& where) {
+  CellSettings::EnvironmentPhase phase;
+  const Json& j = At(s, key);
+  if (j.is_null()) return phase;
+  if (!j.is_object())
+    throw InputError(where(key), "expected a mapping with keys gravity, temperature_c");
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.key() != "gravity" && it.key() != "temperature_c")
+      throw InputError(where(key + "." + it.key()),
+                       "unknown key; expected one of: gravity, temperature_c");
+  if (j.contains("gravity")) {
+    const Json& g = j["gravity"];
+    if (!g.is_array() || g.size() != 3 || !g[0].is_number() || !g[1].is_number() ||
+        !g[2].is_number())
+      throw InputError(where(key + ".gravity"),
+                       "expected [x, y, z] in m/s² in the base frame ([0, 0, -9.81] upright on "
+                       "the ground, [0, 0, 0] on orbit)");
+    phase.gravity = Eigen::Vector3d(g[0].get<double>(), g[1].get<double>(), g[2].get<double>());
+    if (!phase.gravity.allFinite() || phase.gravity.norm() > 100)
+      throw InputError(where(key + ".gravity"), "expected finite m/s² (|g| at most 100)");
+  }
+  if (j.contains("temperature_c")) {
+    const Json& t = j["temperature_c"];
+    const Json list = t.is_array() ? t : Json::array({t});
+    if (list.empty())
+      throw InputError(where(key + ".temperature_c"), "expected a temperature or a list (°C)");
+    for (const Json& v : list) {
+      if (!v.is_number() || !(v.get<double>() >= -273.15) || !std::isfinite(v.get<double>()))
+        throw InputError(where(key + ".temperature_c"),
+                         "expected temperatures in °C (above absolute zero), got " + t.dump());
+      phase.temperatures_c.push_back(v.get<double>());
+    }
+  }
+  return phase;
+}
+
+// identification.estimate: geometric, compliance, thermal, as a list or "geometric,thermal".
+void ParseEstimate(const Json& s, const KeyLocator& where, CellSettings* c) {
+  const Json& j = At(s, "identification.estimate");
+  c->in_environment = !j.is_null() || !At(s, "environment").is_null();
+  if (!At(s, "environment").is_null()) {
+    const Json& e = At(s, "environment");
+    if (!e.is_object())
+      throw InputError(where("environment"),
+                       "expected a mapping with keys calibration, validation");
+    for (auto it = e.begin(); it != e.end(); ++it)
+      if (it.key() != "calibration" && it.key() != "validation")
+        throw InputError(where("environment." + it.key()),
+                         "unknown key; expected one of: calibration, validation");
+    c->calibration_environment = ParseEnvironmentPhase(s, "environment.calibration", where);
+    c->validation_environment = ParseEnvironmentPhase(s, "environment.validation", where);
+  }
+  if (j.is_null()) return;
+  std::vector<std::string> items;
+  if (j.is_string()) {
+    items = SplitList(j.get<std::string>());
+  } else if (j.is_array()) {
+    for (const Json& v : j) {
+      if (!v.is_string())
+        throw InputError(where("identification.estimate"),
+                         "expected a list of geometric, compliance, thermal");
+      items.push_back(v.get<std::string>());
+    }
+  } else {
+    throw InputError(where("identification.estimate"),
+                     "expected a list of geometric, compliance, thermal (or one string of them "
+                     "separated by commas), got " +
+                         j.dump());
+  }
+  c->estimate_geometric = c->estimate_compliance = c->estimate_thermal = false;
+  for (const std::string& item : items) {
+    if (item == "geometric") {
+      c->estimate_geometric = true;
+    } else if (item == "compliance") {
+      c->estimate_compliance = true;
+    } else if (item == "thermal") {
+      c->estimate_thermal = true;
+    } else {
+      throw InputError(where("identification.estimate"),
+                       "'" + item + "': expected geometric, compliance or thermal");
+    }
+  }
+  if (items.empty())
+    throw InputError(where("identification.estimate"),
+                     "expected at least one of geometric, compliance, thermal");
+}
+
 CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   CellSettings c;
   c.robot = Str(s, "robot", where);
@@ -859,6 +952,12 @@ CellSettings ParseCell(const Json& s, const KeyLocator& where) {
   c.paper_case = Int(s, "paper_case", where, 0);
   if (c.paper_case > 2) throw InputError(where("paper_case"), "expected 0 (none), 1 or 2");
   ParseSensor(s, where, &c);
+  ParseEstimate(s, where, &c);
+  if (c.in_environment && (!c.sensor.IsRanger() || c.IsTree()))
+    throw InputError(
+        where(At(s, "environment").is_null() ? "identification.estimate" : "environment"),
+        "compliance, thermal growth and environments are modelled in studies of the "
+        "ranger on one arm (sensor.kind: ranger)");
   CheckToolLinks(where, c);
   return c;
 }
@@ -1048,7 +1147,9 @@ Axis ParseAxis(const Json& ax, const std::string& ap, const KeyLocator& where) {
   axis.key = Str(ax, "key", KeyLocator{where.file, where.lines, where.context, ap});
   // The URDF links are settings without a default (CheckUnknownKeys): sweepable all the same.
   const bool link_key =
-      axis.key == "tool_link" || axis.key == "base_link" || axis.key == "validation.tool_link";
+      axis.key == "tool_link" || axis.key == "base_link" || axis.key == "validation.tool_link" ||
+      axis.key == "identification.estimate" || axis.key == "environment" ||
+      axis.key == "environment.calibration" || axis.key == "environment.validation";
   if (!link_key && !KeyExists(StudyDefaults(), axis.key))
     throw InputError(where(ap + ".key"), "'" + axis.key +
                                              "' is not a study setting (e.g. "

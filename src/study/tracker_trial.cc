@@ -10,6 +10,7 @@
 // values cached for a fixed truth), or each contact or ball is seated on the true arm with the
 // trial's play; lrcal's LM fits the values on the kind's evaluator; the identified arm is judged
 // on the validation poses as the ranger's is.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -22,6 +23,7 @@
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/measurement/contact_measurement.h"
 #include "lrcal/measurement/pose_measurement.h"
+#include "lrcal/measurement/ranger_measurement.h"
 #include "lrcal/measurement/scanner_measurement.h"
 #include "lrcal/measurement/socket_measurement.h"
 #include "study/trial_pipeline.h"
@@ -42,12 +44,44 @@ std::shared_ptr<const RobotModel> ArmWithValues(const RobotModel& robot,
   return arm;
 }
 
+// A ranger cell in an environment: the full ranger on `arm` inside the non-geometric model. The
+// calibration's (`truth` false) estimates identification.estimate's terms (every joint's
+// compliance, the links' thermal coefficient) and holds identification.fix, the ranger terms not
+// in identification.estimate_ranger and, without geometric, every link value; the simulated
+// arm's (`truth`) has the robot file's true compliance and coefficients and estimates nothing.
+std::unique_ptr<MeasurementKind> RangerInEnvironment(const CellSettings& s, const CellContext& c,
+                                                     const RobotModel& arm, bool truth) {
+  const auto inner = std::make_shared<RangerMeasurement>(
+      MeasurementModel(arm, c.planes,
+                       MakeParameterSet(arm, CellPlaneTerms(s, c.planes.size()), {},
+                                        "identification.fix", RangerTerms{true, true})),
+      c.ranger);
+  if (truth)
+    return std::make_unique<EnvironmentMeasurement>(inner, *c.robot, c.true_non_geometric,
+                                                    NonGeometricTerms{}, std::vector<std::string>{},
+                                                    "identification.estimate");
+  std::vector<std::string> held = s.fixed;
+  if (!s.ranger_terms.offset) held.push_back("ranger_offset");
+  if (!s.ranger_terms.scale) held.push_back("ranger_scale");
+  if (!s.estimate_geometric)
+    for (int v : arm.parameter_indices()) held.push_back(arm.ValueName(v));
+  std::sort(held.begin(), held.end());
+  held.erase(std::unique(held.begin(), held.end()), held.end());
+  NonGeometricTerms terms;
+  if (s.estimate_compliance)
+    for (int j = 0; j < arm.num_links(); ++j) terms.compliance_joints.push_back(j);
+  terms.thermal_links = s.estimate_thermal;
+  return std::make_unique<EnvironmentMeasurement>(inner, *c.robot, c.model_non_geometric, terms,
+                                                  held, "identification.estimate");
+}
+
 // The cell's sensor on `arm` with every term but identification.fix: on the nominal arm the
-// truth's template, on a trial's true arm the sensor that simulates its values.
+// truth's template, on a trial's true arm (`truth`) the sensor that simulates its values.
 std::unique_ptr<MeasurementKind> SensorKindOn(const CellSettings& s, const CellContext& c,
-                                              const RobotModel& arm) {
+                                              const RobotModel& arm, bool truth = false) {
   const std::string source = "identification.fix";
   const StudySensor& sensor = s.sensor;
+  if (c.environment) return RangerInEnvironment(s, c, arm, truth);
   if (sensor.kind == "contact") {
     ContactSetup setup;
     setup.planes = c.planes;
@@ -99,6 +133,19 @@ void MapLinkValues(CellContext* c) {
     c->kind_link_values.push_back(c->robot->FindValue(name));
 }
 
+// A study's environment phase into the configurations that do not say theirs (a file's columns
+// win): its gravity, and its temperatures in turn (configuration i the (i mod n)-th).
+void TakeEnvironment(const CellSettings::EnvironmentPhase& phase, TargetedConfigurations* configs) {
+  for (int i = 0; i < configs->size(); ++i) {
+    Environment e = configs->environment(i);
+    if (!e.gravity.allFinite()) e.gravity = phase.gravity;
+    if (!(e.temperature_c == e.temperature_c) && !phase.temperatures_c.empty())
+      e.temperature_c =
+          phase.temperatures_c[static_cast<std::size_t>(i) % phase.temperatures_c.size()];
+    configs->SetEnvironment(i, e);
+  }
+}
+
 // The pool: configurations over the workspace (only σ_min of the arm's Jacobian is asked), or
 // a pool file's; and the validation poses, drawn from the same stream as a ranger cell's of the
 // same robot and validation settings (common poses across sensors).
@@ -146,6 +193,10 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
     c->pool = SampleScannerConfigurations(dynamic_cast<const ScannerMeasurement&>(*c->sensor_kind),
                                           PerPlaneCounts(s, c->planes, s.pool_size), c->seed,
                                           c->pool_stream, o, &c->pool_report);
+  } else if (kind == "ranger") {  // a ranger in an environment: aimed at its planes
+    c->pool = SampleConfigurations(*c->robot, c->planes, PerPlaneCounts(s, c->planes, s.pool_size),
+                                   RandomStream(c->seed, c->pool_stream, 0, RandomPurpose::kPool),
+                                   aimed, &c->pool_report);
   } else if (kind == "socket") {
     c->pool = SampleSocketConfigurations(dynamic_cast<const SocketMeasurement&>(*c->sensor_kind),
                                          s.pool_size, c->seed, c->pool_stream, o, &c->pool_report);
@@ -157,22 +208,62 @@ void DrawTrackerConfigurations(const Study& study, const CellSettings& s, CellCo
   if (!s.validation_file.empty()) {
     c->validation =
         ReadStudyConfigurations(study, s.validation_file, "validation.file", *c->robot, nullptr);
-    return;
+  } else {
+    // The ranger cell's call (the planes' shares, no beam to hit): the same poses.
+    c->validation = SampleConfigurations(
+        *c->robot, c->planes, PerPlaneCounts(s, c->planes, s.validation_size),
+        RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), o);
   }
-  // The ranger cell's call (the planes' shares, no beam to hit): the same poses.
-  c->validation = SampleConfigurations(
-      *c->robot, c->planes, PerPlaneCounts(s, c->planes, s.validation_size),
-      RandomStream(study.seed, c->validation_stream, 0, RandomPurpose::kValidation), o);
+  if (c->environment) {
+    TakeEnvironment(s.calibration_environment, &c->pool);
+    TakeEnvironment(s.validation_environment, &c->validation);
+  }
+}
+
+}  // namespace
+
+std::vector<Pose<double>> TruePoses(const CellContext& c, const Eigen::VectorXd& true_values,
+                                    const TargetedConfigurations& configs) {
+  return c.environment ? EnvironmentToolPoses(*c.robot, true_values, c.true_non_geometric, configs)
+                       : ToolPoses(*c.robot, true_values, configs);
+}
+
+namespace {
+
+// The poses of the identified model (link values `identified`, estimate e over the cell's terms)
+// at `configs` in their environments: its compliance and thermal coefficient those estimated
+// (the nominal coefficient where thermal is in the model but was held), none where the model has
+// none.
+std::vector<Pose<double>> IdentifiedPoses(const CellContext& c, const Eigen::VectorXd& identified,
+                                          const Eigen::VectorXd& e,
+                                          const TargetedConfigurations& configs) {
+  NonGeometricModel model = c.model_non_geometric;
+  model.compliance = Eigen::VectorXd::Zero(c.robot->num_links());
+  for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
+    const int j = ComplianceTermJoint(c.parameter_names[k]);
+    if (j >= 0) model.compliance[j] += e[static_cast<Eigen::Index>(k)];
+    if (c.parameter_names[k] == kThermalLinksTerm)
+      model.thermal.links += e[static_cast<Eigen::Index>(k)];
+  }
+  return EnvironmentToolPoses(*c.robot, identified, model, configs);
+}
+
+// The identified model against the truth at `configs`: in their environments for a cell in one.
+PoseErrors CompareIdentified(const CellContext& c, const std::vector<Pose<double>>& true_poses,
+                             const Eigen::VectorXd& identified, const Eigen::VectorXd& e,
+                             const TargetedConfigurations& configs) {
+  if (!c.environment) return ComparePoses(*c.robot, true_poses, identified, configs);
+  return ComparePoses(true_poses, IdentifiedPoses(c, identified, e, configs));
 }
 
 void CacheTrackerTruth(const CellSettings& s, CellContext* c) {
   if (s.truth.random) return;
   c->true_robot = ArmWithValues(*c->robot, c->fixed_truth.values);
-  c->validation_true_poses = ToolPoses(*c->robot, c->fixed_truth.values, c->validation);
+  c->validation_true_poses = TruePoses(*c, c->fixed_truth.values, c->validation);
   c->nominal_validation =
-      ComparePoses(*c->robot, c->fixed_truth.values, c->robot->nominal_values(), c->validation)
+      ComparePoses(*c->robot, c->validation_true_poses, c->robot->nominal_values(), c->validation)
           .stats;
-  c->true_kind = SensorKindOn(s, *c, *c->true_robot);
+  c->true_kind = SensorKindOn(s, *c, *c->true_robot, true);
   if (c->seated) return;  // seated anew in every trial
   const std::vector<double> zero(static_cast<std::size_t>(c->true_kind->num_parameters()), 0.0);
   c->design_true_values.resize(
@@ -218,7 +309,7 @@ void SimulateTrackerValues(const CellContext& c, long long trial, const TrialTru
     return;
   }
   const std::shared_ptr<const RobotModel> arm = ArmWithValues(*c.robot, truth.values);
-  const std::unique_ptr<MeasurementKind> sensor = SensorKindOn(s, c, *arm);
+  const std::unique_ptr<MeasurementKind> sensor = SensorKindOn(s, c, *arm, true);
   if (c.seated)
     SeatOnTruth(*sensor, c.design.configs, noise, stream, values);
   else
@@ -413,9 +504,9 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
     const int v = c.kind_link_values[static_cast<std::size_t>(k)];
     if (v >= 0) identified[v] += ws->e[k];
   }
-  const PoseErrors validation =
-      s.truth.random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
-                     : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation);
+  const PoseErrors validation = CompareIdentified(
+      c, s.truth.random ? TruePoses(c, truth.values, c.validation) : c.validation_true_poses,
+      identified, ws->e, c.validation);
   rec->validation = Flatten(validation.stats);
   if (details) {  // a tracker has no distance errors: the poses only
     const Eigen::VectorXd& nominal = c.robot->nominal_values();
@@ -426,9 +517,12 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
         c.tree ? c.tree->chains[static_cast<std::size_t>(c.tree->judged)]->ChainConfigurations(
                      values.configs)
                : values.configs;
-    details->measurement_nominal = ComparePoses(*c.robot, truth.values, nominal, measured);
-    details->measurement_identified = ComparePoses(*c.robot, truth.values, identified, measured);
-    details->validation_nominal = ComparePoses(*c.robot, truth.values, nominal, c.validation);
+    const std::vector<Pose<double>> measured_true = TruePoses(c, truth.values, measured);
+    details->measurement_nominal = ComparePoses(*c.robot, measured_true, nominal, measured);
+    details->measurement_identified =
+        CompareIdentified(c, measured_true, identified, ws->e, measured);
+    details->validation_nominal =
+        ComparePoses(*c.robot, TruePoses(c, truth.values, c.validation), nominal, c.validation);
     details->validation_identified = validation;
   }
   return TrialStatus::kOk;

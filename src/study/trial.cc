@@ -73,6 +73,14 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
     for (std::size_t k = 0; k < c.kind_link_values.size(); ++k)
       if (c.kind_link_values[k] >= 0)
         truth.delta[static_cast<Eigen::Index>(k)] = truth.errors[c.kind_link_values[k]];
+    if (c.environment)  // compliance and thermal growth: the simulated arm's less the model's
+      for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
+        const int j = ComplianceTermJoint(c.parameter_names[k]);
+        if (j >= 0) truth.delta[static_cast<Eigen::Index>(k)] = c.true_non_geometric.Compliance(j);
+        if (c.parameter_names[k] == kThermalLinksTerm)
+          truth.delta[static_cast<Eigen::Index>(k)] =
+              c.true_non_geometric.thermal.links - c.model_non_geometric.thermal.links;
+      }
     return truth;
   }
   const ParameterSet& ps = c.model->parameters();
@@ -275,6 +283,23 @@ void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
   const RobotFile& file = *rig.file;
   c->robot = rig.robot;
   c->ranger = file.ranger;
+  if (s.in_environment) {
+    c->environment = true;
+    c->model_non_geometric = file.non_geometric;
+    c->model_non_geometric.compliance.resize(0);  // a calibration starts stiff
+    if (!s.estimate_thermal) c->model_non_geometric.thermal = ThermalCoefficients{};
+    c->true_non_geometric = file.true_non_geometric;
+    if (c->ranger_offset != 0 || c->ranger_scale != 0)
+      throw InputError("truth.ranger_offset_mm",
+                       "a ranger in an environment is simulated without offset or scale errors "
+                       "(they and thermal growth share the reading's scale): set "
+                       "truth.ranger_offset_mm and truth.ranger_scale_ppm to 0");
+    if (s.estimate_compliance && file.non_geometric.masses.empty())
+      throw InputError(
+          "identification.estimate",
+          "compliance is seen through gravity's torque on the joints: the robot file " + file.path +
+              " has no masses:");
+  }
   const double scale = s.truth.random ? 1.0 : s.truth.scale;
   c->file_true_errors = file.truth.LinkErrors(*c->robot);
   c->ranger_offset =
@@ -929,7 +954,7 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
       return c;
     }
     LoadRig(study, s, c.get());
-    if (!s.sensor.IsRanger()) {
+    if (!s.sensor.IsRanger() || s.in_environment) {
       PrepareTrackerCell(study, s, c.get());
       return c;
     }
@@ -961,10 +986,11 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
     return rec;
   };
   const TrialTruth truth = s.truth.random ? DrawTruth(c, trial) : c.fixed_truth;
-  rec.nominal = Flatten(
-      s.truth.random
-          ? ComparePoses(*c.robot, truth.values, c.robot->nominal_values(), c.validation).stats
-          : c.nominal_validation);
+  rec.nominal =
+      Flatten(s.truth.random ? ComparePoses(*c.robot, TruePoses(c, truth.values, c.validation),
+                                            c.robot->nominal_values(), c.validation)
+                                   .stats
+                             : c.nominal_validation);
   if (c.rank_deficient) return finish(TrialStatus::kRankDeficient);
   if (c.kind) return finish(RunTrackerTrial(c, trial, truth, &rec, details, ws));
 

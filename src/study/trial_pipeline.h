@@ -159,6 +159,12 @@ struct CellContext {
   bool seated = false;
   /// A fixed truth: the true arm and the sensor on it.
   std::shared_ptr<const RobotModel> true_robot;
+  /// A ranger cell in an environment (CellSettings::in_environment): the calibration's
+  /// non-geometric model (the robot file's masses, defaults and, when estimated, its thermal
+  /// coefficients; stiff) and the simulated arm's (the robot file's true compliance and thermal
+  /// coefficients). The sensor kinds are EnvironmentMeasurements around the full ranger.
+  bool environment = false;
+  NonGeometricModel model_non_geometric{}, true_non_geometric{};
   std::unique_ptr<MeasurementKind> true_kind;
   /// The fixed truth's exact values at the design and why none misses ("ok"): each trial adds
   /// its noise (AddMeasurementNoise).
@@ -222,6 +228,10 @@ void AcceptPoolFile(const CellSettings& s, TargetedConfigurations pool, CellCont
 void CheckValuesForTerms(const CellSettings& s, const CellContext& c);
 /// A tracker cell's trial after the truth and the nominal validation are in `rec`.
 struct TrialWorkspace;
+/// The true tool poses at `configs` of the arm with link values `true_values`: in their
+/// environments (compliance, thermal growth) for a cell in one.
+std::vector<Pose<double>> TruePoses(const CellContext& c, const Eigen::VectorXd& true_values,
+                                    const TargetedConfigurations& configs);
 TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
                             TrialRecord* rec, TrialDetails* details, TrialWorkspace* ws);
 /// The validation poses' Jacobian ∂(pose)/∂e at the nominal model in the cell's estimate layout

@@ -38,6 +38,11 @@ std::vector<Pose<double>> ToolPoses(const RobotModel& robot, const Eigen::Vector
 PoseErrors ComparePoses(const RobotModel& robot, const std::vector<Pose<double>>& true_poses,
                         const Eigen::VectorXd& model_values, const ConfigurationSet& configs);
 
+/// The same with both sets of poses given (as many true poses as model poses): a model whose poses
+/// are not its link values' (compliance, thermal growth: environment_measurement.h).
+PoseErrors ComparePoses(const std::vector<Pose<double>>& true_poses,
+                        const std::vector<Pose<double>>& model_poses);
+
 /// Rotation vector (axis·angle, rad) of a rotation matrix; exact near 0 and π.
 Eigen::Vector3d RotationVector(const Eigen::Matrix3d& R);
 

@@ -125,6 +125,20 @@ struct CellSettings {
   IdentificationOptions identification;
   /// sensor: the ranger (the default) or a tracker's point or pose.
   StudySensor sensor;
+  /// environment: where the calibration's readings and the validation poses are taken
+  /// (measurement/environment.h): a gravity vector (m/s², base frame) and a list of temperatures
+  /// (°C) the configurations take in turn. Not given: the robot file's defaults for both.
+  struct EnvironmentPhase {
+    Eigen::Vector3d gravity = Eigen::Vector3d::Constant(std::nan(""));
+    std::vector<double> temperatures_c;  ///< empty: the robot file's
+  };
+  EnvironmentPhase calibration_environment, validation_environment;
+  /// identification.estimate: what the calibrated model has (geometric, compliance, thermal; any
+  /// combination). Only the ranger takes compliance and thermal (environment_measurement.h).
+  bool estimate_geometric = true, estimate_compliance = false, estimate_thermal = false;
+  /// True for a ranger cell with environment: or identification.estimate given: its trials run
+  /// on the non-geometric model (the kind pipeline, src/study/tracker_trial.cc).
+  bool in_environment = false;
   /// Which of the paper's cases this cell reproduces (1, 2; 0 = none): its report places the
   /// published numbers in our distributions.
   int paper_case = 0;
