@@ -85,6 +85,22 @@ void RefuseRangerOnlyOutputs(const po::variables_map& vm) {
                      "is not available with --estimate-compliance or --estimate-thermal");
 }
 
+// A fit refused as rank deficient: what to fix or leave out, and why each term was lost.
+int ReportRankDeficient(const IdentificationSummary& s) {
+  std::string fix;
+  for (const auto& f : s.identifiability.suggested_fixed)
+    if (ComplianceTermJoint(f) < 0 && f != kThermalLinksTerm && f != kThermalRangerTerm)
+      fix += (fix.empty() ? "" : ",") + f;
+  std::cerr << "lrcal identify: the terms are not identifiable from these measurements; pass "
+               "--auto-fix, or "
+            << (fix.empty() ? "" : "fix " + fix + " (--fix) and ")
+            << "leave the lost compliance or thermal terms out of --estimate-compliance and "
+               "--estimate-thermal\n";
+  for (const std::string& x : s.identifiability.explanations)
+    std::cerr << "lrcal identify: lost: " << x << "\n";
+  return 3;
+}
+
 }  // namespace
 
 int NonGeometricIdentify(const po::variables_map& vm, const std::string& data_file,
@@ -109,20 +125,7 @@ int NonGeometricIdentify(const po::variables_map& vm, const std::string& data_fi
     std::cout << s.FullReport();
     for (const std::string& x : held) std::cout << "held at nominal: " << x << "\n";
   }
-  if (s.termination == Termination::kRankDeficient) {
-    std::string fix, estimate;
-    for (const auto& f : s.identifiability.suggested_fixed)
-      if (ComplianceTermJoint(f) < 0 && f != kThermalLinksTerm && f != kThermalRangerTerm)
-        fix += (fix.empty() ? "" : ",") + f;
-    std::cerr << "lrcal identify: the terms are not identifiable from these measurements; pass "
-                 "--auto-fix, or "
-              << (fix.empty() ? "" : "fix " + fix + " (--fix) and ")
-              << "leave the lost compliance or thermal terms out of --estimate-compliance and "
-                 "--estimate-thermal\n";
-    for (const std::string& x : s.identifiability.explanations)
-      std::cerr << "lrcal identify: lost: " << x << "\n";
-    return 3;
-  }
+  if (s.termination == Termination::kRankDeficient) return ReportRankDeficient(s);
   if (s.IsSolutionUsable() && !s.fit.consistent) {
     std::cerr << "lrcal identify: the fit is inconsistent with --sigma-mm (p = " << s.fit.p_value
               << " < 0.001); see the fit line above\n";

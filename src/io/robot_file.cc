@@ -271,28 +271,32 @@ Eigen::VectorXd ParseCompliance(const YAML::Node& c, const std::string& path, co
   return out;
 }
 
-// thermal: {reference_c, links_ppm_per_k, ranger_ppm_per_k, true_links_ppm_per_k,
-// true_ranger_ppm_per_k}; environment: {gravity: [x, y, z], temperature_c}.
-void ParseNonGeometric(const YAML::Node& root, const std::string& path, RobotFile* file) {
+// compliance.unit: rad/(N·m) per unit of the file's numbers.
+double ComplianceUnit(const YAML::Node& c, const std::string& path) {
   using namespace yaml;
-  const int n = file->robot.num_links();
-  NonGeometricModel& model = file->non_geometric;
-  model.masses = ParseMasses(root, path, n);
-  const YAML::Node c = root["compliance"];
-  double unit = 1e-6;
-  if (c) {
-    RequireMap(c, path, "compliance");
-    CheckKeys(c, {"unit", "nominal", "true"}, path, "compliance");
-    const std::string u = c["unit"] ? String(c["unit"], path, "compliance.unit") : "urad/Nm";
-    if (u != "urad/Nm" && u != "rad/Nm")
-      throw InputError(
-          Where(path, c["unit"], "compliance.unit"),
-          "expected urad/Nm or rad/Nm (m/N and um/N for a prismatic joint), got '" + u + "'");
-    unit = u == "rad/Nm" ? 1.0 : 1e-6;
-  }
-  model.compliance = ParseCompliance(c, path, "nominal", n, unit);
+  if (!c) return 1e-6;
+  RequireMap(c, path, "compliance");
+  CheckKeys(c, {"unit", "nominal", "true"}, path, "compliance");
+  const std::string u = c["unit"] ? String(c["unit"], path, "compliance.unit") : "urad/Nm";
+  if (u != "urad/Nm" && u != "rad/Nm")
+    throw InputError(
+        Where(path, c["unit"], "compliance.unit"),
+        "expected urad/Nm or rad/Nm (m/N and um/N for a prismatic joint), got '" + u + "'");
+  return u == "rad/Nm" ? 1.0 : 1e-6;
+}
+
+// One thermal coefficient in ppm/K (1/K out), `fallback` when the key is absent.
+double Coefficient(const YAML::Node& t, const char* key, const std::string& path, double fallback) {
+  if (!t || !t[key]) return fallback;
+  return yaml::Number(t[key], path, std::string("thermal.") + key) * 1e-6;
+}
+
+// thermal: {reference_c, links_ppm_per_k, ranger_ppm_per_k, true_links_ppm_per_k,
+// true_ranger_ppm_per_k}: the model's coefficients and the simulated arm's.
+void ParseThermal(const YAML::Node& root, const std::string& path, ThermalCoefficients* model,
+                  ThermalCoefficients* truth) {
+  using namespace yaml;
   const YAML::Node t = root["thermal"];
-  ThermalCoefficients truth;
   if (t) {
     RequireMap(t, path, "thermal");
     CheckKeys(t,
@@ -300,38 +304,51 @@ void ParseNonGeometric(const YAML::Node& root, const std::string& path, RobotFil
                "true_ranger_ppm_per_k"},
               path, "thermal");
     if (t["reference_c"])
-      model.thermal.reference_c = Number(t["reference_c"], path, "thermal.reference_c");
-    if (t["links_ppm_per_k"])
-      model.thermal.links = Number(t["links_ppm_per_k"], path, "thermal.links_ppm_per_k") * 1e-6;
-    if (t["ranger_ppm_per_k"])
-      model.thermal.ranger = Number(t["ranger_ppm_per_k"], path, "thermal.ranger_ppm_per_k") * 1e-6;
+      model->reference_c = Number(t["reference_c"], path, "thermal.reference_c");
   }
-  truth = model.thermal;
-  if (t && t["true_links_ppm_per_k"])
-    truth.links = Number(t["true_links_ppm_per_k"], path, "thermal.true_links_ppm_per_k") * 1e-6;
-  if (t && t["true_ranger_ppm_per_k"])
-    truth.ranger = Number(t["true_ranger_ppm_per_k"], path, "thermal.true_ranger_ppm_per_k") * 1e-6;
+  model->links = Coefficient(t, "links_ppm_per_k", path, 0);
+  model->ranger = Coefficient(t, "ranger_ppm_per_k", path, 0);
+  *truth = *model;
+  truth->links = Coefficient(t, "true_links_ppm_per_k", path, model->links);
+  truth->ranger = Coefficient(t, "true_ranger_ppm_per_k", path, model->ranger);
+}
+
+// environment: {gravity: [x, y, z], temperature_c}: the defaults of data without the columns.
+void ParseEnvironmentDefaults(const YAML::Node& root, const std::string& path,
+                              Environment* defaults) {
+  using namespace yaml;
   const YAML::Node e = root["environment"];
-  if (e) {
-    RequireMap(e, path, "environment");
-    CheckKeys(e, {"gravity", "temperature_c"}, path, "environment");
-    if (e["gravity"]) {
-      const std::vector<double> g = NumberList(e["gravity"], path, "environment.gravity");
-      if (g.size() != 3)
-        throw InputError(Where(path, e["gravity"], "environment.gravity"),
-                         "expected 3 numbers (m/s², base frame: [0, 0, -9.81] upright)");
-      model.defaults.gravity = Eigen::Vector3d(g[0], g[1], g[2]);
-    }
-    if (e["temperature_c"])
-      model.defaults.temperature_c = Number(e["temperature_c"], path, "environment.temperature_c");
+  if (!e) return;
+  RequireMap(e, path, "environment");
+  CheckKeys(e, {"gravity", "temperature_c"}, path, "environment");
+  if (e["gravity"]) {
+    const std::vector<double> g = NumberList(e["gravity"], path, "environment.gravity");
+    if (g.size() != 3)
+      throw InputError(Where(path, e["gravity"], "environment.gravity"),
+                       "expected 3 numbers (m/s², base frame: [0, 0, -9.81] upright)");
+    defaults->gravity = Eigen::Vector3d(g[0], g[1], g[2]);
   }
+  if (e["temperature_c"])
+    defaults->temperature_c = Number(e["temperature_c"], path, "environment.temperature_c");
+}
+
+void ParseNonGeometric(const YAML::Node& root, const std::string& path, RobotFile* file) {
+  const int n = file->robot.num_links();
+  NonGeometricModel& model = file->non_geometric;
+  model.masses = ParseMasses(root, path, n);
+  const YAML::Node c = root["compliance"];
+  const double unit = ComplianceUnit(c, path);
+  model.compliance = ParseCompliance(c, path, "nominal", n, unit);
+  ThermalCoefficients truth;
+  ParseThermal(root, path, &model.thermal, &truth);
+  ParseEnvironmentDefaults(root, path, &model.defaults);
   file->true_non_geometric = model;
   file->true_non_geometric.thermal = truth;
   file->true_non_geometric.compliance = ParseCompliance(c, path, "true", n, unit);
   if (file->true_non_geometric.compliance.size() == 0)
     file->true_non_geometric.compliance = model.compliance;
-  if ((c && c["true"] && model.masses.empty()))
-    throw InputError(Where(path, c, "compliance"),
+  if (c && (c["true"] || c["nominal"]) && model.masses.empty())
+    throw InputError(yaml::Where(path, c, "compliance"),
                      "a joint compliance bends the arm under gravity's load: give the arm's "
                      "masses: as well");
 }

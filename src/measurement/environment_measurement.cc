@@ -101,20 +101,26 @@ EnvironmentMeasurement::EnvironmentMeasurement(std::shared_ptr<const Measurement
       estimate_(std::move(estimate)),
       held_(std::move(held)),
       source_(source) {
-  const std::vector<std::string>& inner_names = inner_->parameter_names();
-  // The lengths' own nominal values: a truth's inner kind sits on the true arm.
-  const Eigen::VectorXd inner_nominal = inner_->NominalValues();
   const int n = robot.num_links();
   if (model_.compliance.size() != 0 && model_.compliance.size() != n)
     throw InputError(source + ".compliance", "expected one compliance per joint (" +
                                                  std::to_string(n) + "), got " +
                                                  std::to_string(model_.compliance.size()));
   for (const std::string& h : held_)
-    if (!Contains(inner_names, h))
+    if (!Contains(inner_->parameter_names(), h))
       throw InputError(source,
                        "cannot hold '" + h + "': the " + inner_->name() + " kind has no such term");
+  LayOutInnerTerms();
+  LayOutNonGeometricTerms();
+  if (!model_.masses.empty()) model_.masses.Validate(n, source + ".masses");
+}
+
+void EnvironmentMeasurement::LayOutInnerTerms() {
+  const std::vector<std::string>& inner_names = inner_->parameter_names();
+  // The lengths' own nominal values: a truth's inner kind sits on the true arm.
+  const Eigen::VectorXd inner_nominal = inner_->NominalValues();
   for (int k = 0; k < static_cast<int>(inner_names.size()); ++k) {
-    const int v = robot.FindValue(inner_names[static_cast<std::size_t>(k)]);
+    const int v = robot_->FindValue(inner_names[static_cast<std::size_t>(k)]);
     const bool length = v >= 0 && (v % kValuesPerLink == kA || v % kValuesPerLink == kD);
     if (length) {
       layout_.length_columns.push_back(k);
@@ -125,34 +131,38 @@ EnvironmentMeasurement::EnvironmentMeasurement(std::shared_ptr<const Measurement
     layout_.exposed_length.push_back(length ? v : -1);
     names_.push_back(inner_names[static_cast<std::size_t>(k)]);
   }
-  const bool thermal = estimate_.thermal_links || model_.thermal.links != 0;
-  if (thermal) {
-    for (int v : robot.parameter_indices())
+  if (estimate_.thermal_links || model_.thermal.links != 0)
+    for (int v : robot_->parameter_indices())
       if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) &&
-          !Contains(inner_names, robot.ValueName(v)))
-        throw InputError(source, "thermal growth moves " + robot.ValueName(v) + ", which the " +
-                                     inner_->name() + " kind does not have among its terms");
-  }
+          !Contains(inner_names, robot_->ValueName(v)))
+        throw InputError(source_, "thermal growth moves " + robot_->ValueName(v) +
+                                      ", which the " + inner_->name() +
+                                      " kind does not have among its terms");
+}
+
+void EnvironmentMeasurement::LayOutNonGeometricTerms() {
+  const std::vector<std::string>& inner_names = inner_->parameter_names();
   for (int j : estimate_.compliance_joints) {
-    if (j < 0 || j >= n) throw InputError(source, "no joint " + std::to_string(j + 1));
-    const bool revolute = robot.links()[static_cast<std::size_t>(j)].joint == JointType::kRevolute;
+    if (j < 0 || j >= robot_->num_links())
+      throw InputError(source_, "no joint " + std::to_string(j + 1));
+    const bool revolute =
+        robot_->links()[static_cast<std::size_t>(j)].joint == JointType::kRevolute;
     const std::string joint_term = LinkValueFullName(j * kValuesPerLink + (revolute ? kTheta : kD));
     const int column = FindName(inner_names, joint_term);
     if (column < 0)
-      throw InputError(source, "the compliance of joint " + std::to_string(j + 1) + " needs " +
-                                   joint_term + " among the " + inner_->name() +
-                                   " kind's terms (a geometric parameter of the robot)");
+      throw InputError(source_, "the compliance of joint " + std::to_string(j + 1) + " needs " +
+                                    joint_term + " among the " + inner_->name() +
+                                    " kind's terms (a geometric parameter of the robot)");
     layout_.joint_columns.push_back(column);
     names_.push_back(ComplianceTermName(j));
   }
   layout_.ranger_scale_column = FindName(inner_names, "ranger_scale");
   if ((estimate_.thermal_ranger || model_.thermal.ranger != 0) && layout_.ranger_scale_column < 0)
-    throw InputError(source, std::string("the ranger's thermal coefficient needs a ranger kind "
-                                         "with ranger_scale among its terms; the ") +
-                                 inner_->name() + " kind has none");
+    throw InputError(source_, std::string("the ranger's thermal coefficient needs a ranger kind "
+                                          "with ranger_scale among its terms; the ") +
+                                  inner_->name() + " kind has none");
   if (estimate_.thermal_links) names_.push_back(kThermalLinksTerm);
   if (estimate_.thermal_ranger) names_.push_back(kThermalRangerTerm);
-  if (!model_.masses.empty()) model_.masses.Validate(n, source + ".masses");
 }
 
 Eigen::VectorXd EnvironmentMeasurement::NominalValues() const {
@@ -300,50 +310,64 @@ class EnvironmentEvaluator : public MeasurementEvaluator {
 
   // Group g's values into y and its Jacobian, chained to the outer terms, into J.
   void Scatter(const TemperatureGroup& g, const double* e, double* y, double* J) const {
-    const EnvironmentMeasurement::Layout& L = kind_.layout();
     const int k = rows_per_;
     const auto gm = static_cast<int>(g.members.size());
-    const int grows = gm * k;
     for (int r = 0; r < gm; ++r)
       for (int c = 0; c < k; ++c) y[g.members[r] * k + c] = g.y[r * k + c];
     if (!J) return;
+    int o = ChainInnerTerms(g, e, J);
+    if (kind_.estimate().thermal_links) ChainThermalLinks(g, e, o++, J);
+    if (kind_.estimate().thermal_ranger) {
+      const int column = kind_.layout().ranger_scale_column;
+      ForEachRow(g, o, J, [&](int row) { return Inner(g, column, row) * g.delta_t; });
+    }
+  }
+
+  // Inner Jacobian entry (column, group row).
+  double Inner(const TemperatureGroup& g, int column, int row) const {
+    return g.J[static_cast<std::size_t>(column) * g.y.size() + static_cast<std::size_t>(row)];
+  }
+
+  // Column `o` of J over group g's rows: value(group row).
+  template <typename Value>
+  void ForEachRow(const TemperatureGroup& g, int o, double* J, const Value& value) const {
+    const int k = rows_per_;
+    for (std::size_t r = 0; r < g.members.size(); ++r)
+      for (int c = 0; c < k; ++c)
+        J[static_cast<std::ptrdiff_t>(o) * num_rows_ + g.members[r] * k + c] =
+            value(static_cast<int>(r) * k + c);
+  }
+
+  // The exposed inner terms (a length's column times its growth 1 + α ΔT) and each compliance's
+  // (its joint's column times the joint's gravity torque); returns the next column.
+  int ChainInnerTerms(const TemperatureGroup& g, const double* e, double* J) const {
+    const EnvironmentMeasurement::Layout& L = kind_.layout();
     const double growth = ThermalLinks(e) * g.delta_t;
-    const auto inner_col = [&](int col, int row) { return g.J[col * grows + row]; };
-    const auto out = [&](int col, int r, int c) -> double& {
-      return J[static_cast<std::ptrdiff_t>(col) * num_rows_ + g.members[r] * k + c];
-    };
     int o = 0;
     for (std::size_t x = 0; x < L.exposed.size(); ++x, ++o) {
       const double chain = L.exposed_length[x] >= 0 ? 1 + growth : 1.0;
-      for (int r = 0; r < gm; ++r)
-        for (int c = 0; c < k; ++c) out(o, r, c) = inner_col(L.exposed[x], r * k + c) * chain;
+      ForEachRow(g, o, J, [&](int row) { return Inner(g, L.exposed[x], row) * chain; });
     }
     for (std::size_t x = 0; x < L.joint_columns.size(); ++x, ++o) {
       const int j = kind_.estimate().compliance_joints[x];
-      for (int r = 0; r < gm; ++r)
-        for (int c = 0; c < k; ++c)
-          out(o, r, c) = inner_col(L.joint_columns[x], r * k + c) * torque_(j, g.members[r]);
+      ForEachRow(g, o, J, [&](int row) {
+        return Inner(g, L.joint_columns[x], row) * torque_(j, g.members[row / rows_per_]);
+      });
     }
-    if (kind_.estimate().thermal_links) {
-      for (int r = 0; r < gm; ++r)
-        for (int c = 0; c < k; ++c) {
-          double sum = 0;
-          for (std::size_t x = 0; x < L.length_columns.size(); ++x) {
-            const int col = L.length_columns[x];
-            // d ℓ'/d α = (ℓ0 + e_ℓ)·ΔT, and ∂y/∂ℓ' is the inner column.
-            const double own = ExposedValue(col, e);
-            sum += inner_col(col, r * k + c) * (L.length_nominal[x] + own) * g.delta_t;
-          }
-          out(o, r, c) = sum;
-        }
-      ++o;
-    }
-    if (kind_.estimate().thermal_ranger) {
-      for (int r = 0; r < gm; ++r)
-        for (int c = 0; c < k; ++c)
-          out(o, r, c) = inner_col(L.ranger_scale_column, r * k + c) * g.delta_t;
-      ++o;
-    }
+    return o;
+  }
+
+  // ∂y/∂α = Σ over the lengths ℓ of ∂y/∂ℓ'·(ℓ0 + e_ℓ)·ΔT.
+  void ChainThermalLinks(const TemperatureGroup& g, const double* e, int o, double* J) const {
+    const EnvironmentMeasurement::Layout& L = kind_.layout();
+    ForEachRow(g, o, J, [&](int row) {
+      double sum = 0;
+      for (std::size_t x = 0; x < L.length_columns.size(); ++x) {
+        const int col = L.length_columns[x];
+        sum += Inner(g, col, row) * (L.length_nominal[x] + ExposedValue(col, e)) * g.delta_t;
+      }
+      return sum;
+    });
   }
 
   // The estimate of inner column `col` in e (0 when it is held).

@@ -63,6 +63,41 @@ void CombineRobustly(const std::vector<double>& h, const std::vector<int>& group
 
 }  // namespace
 
+namespace {
+
+// What makes reading r's configuration: its joint values, its plane (one pose read on two planes
+// is two configurations) and, when given, its environment (one pose read warm and cold is two).
+std::vector<double> ReadingKey(const TargetedConfigurations& q, int r, bool environments) {
+  std::vector<double> key(q.q(r), q.q(r) + q.num_joints());
+  key.push_back(q.target(r));
+  if (environments) {
+    const Environment& e = q.environment(r);
+    // A field not given (NaN) keys as −∞, which no read value is: NaN has no order.
+    const auto ordered = [](double x) { return x == x ? x : -HUGE_VAL; };
+    key.insert(key.end(), {ordered(e.gravity[0]), ordered(e.gravity[1]), ordered(e.gravity[2]),
+                           ordered(e.temperature_c)});
+  }
+  return key;
+}
+
+// Reading r joins the configuration opened by reading `first`, grouped by label: the same plane
+// and the same environment.
+void CheckSameConfiguration(const TargetedConfigurations& q, int r, int first,
+                            const std::function<std::string(int)>& where) {
+  if (!(q.environment(r) == q.environment(first)))
+    throw InputError(where(r), "this reading's environment (" + q.environment(r).ToString() +
+                                   ") is not that of earlier readings of its configuration (" +
+                                   q.environment(first).ToString() +
+                                   "); one configuration is read in one environment");
+  if (q.target(r) != q.target(first))
+    throw InputError(where(r), "this reading is on plane " + std::to_string(q.target(r) + 1) +
+                                   " but earlier readings of its configuration are on plane " +
+                                   std::to_string(q.target(first) + 1) +
+                                   "; one configuration's readings are on one plane");
+}
+
+}  // namespace
+
 MeasurementSet GroupReadings(const TargetedConfigurations& q, const std::vector<double>& h,
                              const RangerSpec* ranger, const std::function<std::string(int)>& where,
                              const std::vector<std::string>* labels, const Averaging& average) {
@@ -94,27 +129,9 @@ MeasurementSet GroupReadings(const TargetedConfigurations& q, const std::vector<
     if (labels) {
       id = label_index.emplace((*labels)[r], next).first->second;
     } else {
-      std::vector<double> key(q.q(r), q.q(r) + n);
-      key.push_back(q.target(r));  // one pose read on two planes would be two configurations
-      if (environments) {          // one pose read warm and cold would be two configurations
-        const Environment& e = q.environment(r);
-        // A field not given (NaN) keys as −∞, which no read value is: NaN has no order.
-        const auto ordered = [](double x) { return x == x ? x : -HUGE_VAL; };
-        key.insert(key.end(), {ordered(e.gravity[0]), ordered(e.gravity[1]), ordered(e.gravity[2]),
-                               ordered(e.temperature_c)});
-      }
-      id = index.emplace(std::move(key), next).first->second;
+      id = index.emplace(ReadingKey(q, r, environments), next).first->second;
     }
-    if (id != next && labels && !(q.environment(r) == q.environment(first[id])))
-      throw InputError(where(r), "this reading's environment (" + q.environment(r).ToString() +
-                                     ") is not that of earlier readings of its configuration (" +
-                                     q.environment(first[id]).ToString() +
-                                     "); one configuration is read in one environment");
-    if (id != next && q.target(r) != q.target(first[id]))
-      throw InputError(where(r), "this reading is on plane " + std::to_string(q.target(r) + 1) +
-                                     " but earlier readings of its configuration are on plane " +
-                                     std::to_string(q.target(first[id]) + 1) +
-                                     "; one configuration's readings are on one plane");
+    if (id != next) CheckSameConfiguration(q, r, first[id], where);
     if (id == next) {
       first.push_back(r);
       sums.push_back(0);

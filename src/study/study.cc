@@ -882,22 +882,27 @@ CellSettings::EnvironmentPhase ParseEnvironmentPhase(const Json& s, const std::s
   return phase;
 }
 
+// environment: {calibration: ..., validation: ...}.
+void ParseEnvironment(const Json& s, const KeyLocator& where, CellSettings* c) {
+  const Json& e = At(s, "environment");
+  if (e.is_null()) return;
+  if (!e.is_object())
+    throw InputError(where("environment"), "expected a mapping with keys calibration, validation");
+  for (auto it = e.begin(); it != e.end(); ++it)
+    if (it.key() != "calibration" && it.key() != "validation")
+      throw InputError(where("environment." + it.key()),
+                       "unknown key; expected one of: calibration, validation");
+  c->calibration_environment = ParseEnvironmentPhase(s, "environment.calibration", where);
+  c->validation_environment = ParseEnvironmentPhase(s, "environment.validation", where);
+}
+
+void SetEstimate(const std::vector<std::string>& items, const KeyLocator& where, CellSettings* c);
+
 // identification.estimate: geometric, compliance, thermal, as a list or "geometric,thermal".
 void ParseEstimate(const Json& s, const KeyLocator& where, CellSettings* c) {
   const Json& j = At(s, "identification.estimate");
   c->in_environment = !j.is_null() || !At(s, "environment").is_null();
-  if (!At(s, "environment").is_null()) {
-    const Json& e = At(s, "environment");
-    if (!e.is_object())
-      throw InputError(where("environment"),
-                       "expected a mapping with keys calibration, validation");
-    for (auto it = e.begin(); it != e.end(); ++it)
-      if (it.key() != "calibration" && it.key() != "validation")
-        throw InputError(where("environment." + it.key()),
-                         "unknown key; expected one of: calibration, validation");
-    c->calibration_environment = ParseEnvironmentPhase(s, "environment.calibration", where);
-    c->validation_environment = ParseEnvironmentPhase(s, "environment.validation", where);
-  }
+  ParseEnvironment(s, where, c);
   if (j.is_null()) return;
   std::vector<std::string> items;
   if (j.is_string()) {
@@ -915,6 +920,11 @@ void ParseEstimate(const Json& s, const KeyLocator& where, CellSettings* c) {
                      "separated by commas), got " +
                          j.dump());
   }
+  SetEstimate(items, where, c);
+}
+
+// identification.estimate's items into the cell's flags.
+void SetEstimate(const std::vector<std::string>& items, const KeyLocator& where, CellSettings* c) {
   c->estimate_geometric = c->estimate_compliance = c->estimate_thermal = false;
   for (const std::string& item : items) {
     if (item == "geometric") {

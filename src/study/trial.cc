@@ -51,6 +51,22 @@ std::uint64_t ValidationStreamId(const Json& settings) {
 }
 
 // The truth of a trial: the robot file's errors × scale, or errors drawn per trial.
+namespace {
+
+// A cell in an environment: the true compliance and thermal coefficient as deviations from the
+// calibration's nominal model, at their terms in `delta`.
+void AddNonGeometricTruth(const CellContext& c, Eigen::VectorXd* delta) {
+  for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
+    const int j = ComplianceTermJoint(c.parameter_names[k]);
+    if (j >= 0) (*delta)[static_cast<Eigen::Index>(k)] = c.true_non_geometric.Compliance(j);
+    if (c.parameter_names[k] == kThermalLinksTerm)
+      (*delta)[static_cast<Eigen::Index>(k)] =
+          c.true_non_geometric.thermal.links - c.model_non_geometric.thermal.links;
+  }
+}
+
+}  // namespace
+
 TrialTruth DrawTruth(const CellContext& c, long long trial) {
   if (c.tree) return DrawTreeTruth(c, trial);
   const CellSettings& s = c.cell->typed;
@@ -73,14 +89,7 @@ TrialTruth DrawTruth(const CellContext& c, long long trial) {
     for (std::size_t k = 0; k < c.kind_link_values.size(); ++k)
       if (c.kind_link_values[k] >= 0)
         truth.delta[static_cast<Eigen::Index>(k)] = truth.errors[c.kind_link_values[k]];
-    if (c.environment)  // compliance and thermal growth: the simulated arm's less the model's
-      for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
-        const int j = ComplianceTermJoint(c.parameter_names[k]);
-        if (j >= 0) truth.delta[static_cast<Eigen::Index>(k)] = c.true_non_geometric.Compliance(j);
-        if (c.parameter_names[k] == kThermalLinksTerm)
-          truth.delta[static_cast<Eigen::Index>(k)] =
-              c.true_non_geometric.thermal.links - c.model_non_geometric.thermal.links;
-      }
+    if (c.environment) AddNonGeometricTruth(c, &truth.delta);
     return truth;
   }
   const ParameterSet& ps = c.model->parameters();

@@ -124,6 +124,9 @@ class EnvironmentMeasurement : public MeasurementKind {
   const Layout& layout() const { return layout_; }
 
  private:
+  void LayOutInnerTerms();
+  void LayOutNonGeometricTerms();
+
   std::shared_ptr<const MeasurementKind> inner_;
   const RobotModel* robot_;
   NonGeometricModel model_;
