@@ -135,9 +135,8 @@ void EnvironmentMeasurement::LayOutInnerTerms() {
     for (int v : robot_->parameter_indices())
       if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) &&
           !Contains(inner_names, robot_->ValueName(v)))
-        throw InputError(source_, "thermal growth moves " + robot_->ValueName(v) +
-                                      ", which the " + inner_->name() +
-                                      " kind does not have among its terms");
+        throw InputError(source_, "thermal growth moves " + robot_->ValueName(v) + ", which the " +
+                                      inner_->name() + " kind does not have among its terms");
 }
 
 void EnvironmentMeasurement::LayOutNonGeometricTerms() {
