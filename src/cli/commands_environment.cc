@@ -36,17 +36,6 @@ bool AsksNonGeometric(const po::variables_map& vm) {
 
 namespace {
 
-// The ranger with every link value of the arm, its offset and scale and the planes' and frames'
-// terms the options ask for: what the non-geometric model moves (it grows lengths, turns joints).
-std::shared_ptr<const MeasurementKind> FullRanger(const RobotModel& arm, const PlaneSet& planes,
-                                                  const ParameterSet& asked,
-                                                  const RangerSpec& ranger) {
-  std::vector<PlaneTerms> plane_terms = asked.plane_terms;
-  const ParameterSet full = MakeParameterSet(arm, plane_terms, {}, "fix", RangerTerms{true, true},
-                                             asked.frames[0], asked.frames[1]);
-  return std::make_shared<RangerMeasurement>(MeasurementModel(arm, planes, full), ranger);
-}
-
 // The kind identify and identifiability fit: the options' parameter set (--fix, --estimate-*)
 // with the non-geometric terms asked for around it.
 std::unique_ptr<EnvironmentMeasurement> NonGeometricKind(const po::variables_map& vm,
@@ -63,12 +52,8 @@ std::unique_ptr<EnvironmentMeasurement> NonGeometricKind(const po::variables_map
         "--estimate-compliance",
         "a joint's compliance is seen through gravity's torque on it: the robot file " + rig.path +
             " has no masses: (docs/FILE_FORMATS.md)");
-  std::shared_ptr<const MeasurementKind> inner = FullRanger(robot, planes, asked, rig.ranger);
-  std::vector<std::string> held;
-  for (const std::string& name : inner->parameter_names())
-    if (asked.Find(name) < 0) held.push_back(name);
-  return std::make_unique<EnvironmentMeasurement>(inner, robot, rig.non_geometric, terms, held,
-                                                  "--estimate-compliance/--estimate-thermal");
+  return RangerInEnvironment(robot, robot, planes, asked, rig.ranger, rig.non_geometric, terms,
+                             "--estimate-compliance/--estimate-thermal");
 }
 
 // What identify does with the ranger's model that this path does not do yet.
@@ -213,10 +198,12 @@ int NonGeometricSimulate(const po::variables_map& vm, const RobotFile& rig, cons
     configs.SetEnvironment(i, configs.environment(i).Or(rig.true_non_geometric.defaults));
   const RobotModel& robot = rig.robot;
   const RobotModel true_arm = rig.truth.TrueRobot(robot);
-  const std::shared_ptr<const MeasurementKind> inner =
-      FullRanger(true_arm, planes,
-                 MakeParameterSet(robot, std::vector<PlaneTerms>(planes.size()), {}), rig.ranger);
-  const EnvironmentMeasurement truth(inner, robot, rig.true_non_geometric, NonGeometricTerms{});
+  const std::unique_ptr<EnvironmentMeasurement> kind =
+      RangerInEnvironment(true_arm, robot, planes,
+                          MakeParameterSet(robot, std::vector<PlaneTerms>(planes.size()), {}, "fix",
+                                           RangerTerms{true, true}),
+                          rig.ranger, rig.true_non_geometric, NonGeometricTerms{}, "robot file");
+  const EnvironmentMeasurement& truth = *kind;
   // The true ranger's offset and scale as the terms of the truth's ranger (e = 0 elsewhere).
   std::vector<double> e(static_cast<std::size_t>(truth.num_parameters()), 0.0);
   const std::vector<std::string>& names = truth.parameter_names();

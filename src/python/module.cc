@@ -1636,6 +1636,7 @@ and the parameters to fix for a full-rank set (suggested_fixed). str() gives the
       .def_readonly("unidentifiable", &IdentifiabilityReport::unidentifiable)
       .def_readonly("dependencies", &IdentifiabilityReport::dependencies)
       .def_readonly("suggested_fixed", &IdentifiabilityReport::suggested_fixed)
+      .def_readonly("explanations", &IdentifiabilityReport::explanations)
       .def_property_readonly("full_rank", &IdentifiabilityReport::full_rank)
       .def("__str__", &IdentifiabilityReport::ToString);
 
@@ -1921,6 +1922,110 @@ file's record (else the record names and hashes the arrays).
 Joint values outside the robot's joint ranges are refused (degrees for rad?), as the command
 line refuses them in a CSV.
 Returns an lrcal.Identification; raises lrcal.InputError for bad input.)doc";
+
+// identify_in_environment / identifiability_in_environment (issue 28): each configuration's
+// environment from the arrays gravity (m × 3, m/s²) and temperature_c (m, °C), None for the
+// robot file's defaults; the ranger inside the non-geometric model.
+void SetEnvironments(const py::object& gravity, const py::object& temperature_c,
+                     TargetedConfigurations* configs) {
+  const int m = configs->size();
+  if (!gravity.is_none()) {
+    const Array g = gravity.cast<Array>();
+    if (g.ndim() != 2 || g.shape(0) != m || g.shape(1) != 3)
+      throw InputError("gravity=", "expected an array of " + std::to_string(m) +
+                                       " rows of 3 (m/s², base frame), one per row of q");
+    for (int i = 0; i < m; ++i) {
+      Environment e = configs->environment(i);
+      e.gravity = Eigen::Vector3d(g.at(i, 0), g.at(i, 1), g.at(i, 2));
+      if (!e.gravity.allFinite()) throw InputError("gravity=", "expected finite numbers");
+      configs->SetEnvironment(i, e);
+    }
+  }
+  if (!temperature_c.is_none()) {
+    const std::vector<double> t = ToVector(temperature_c.cast<Array>(), "temperature_c");
+    if (static_cast<int>(t.size()) != m)
+      throw InputError("temperature_c=", "expected one temperature (°C) per row of q");
+    for (int i = 0; i < m; ++i) {
+      if (!(t[static_cast<std::size_t>(i)] >= -273.15))
+        throw InputError("temperature_c=", "expected °C above absolute zero");
+      Environment e = configs->environment(i);
+      e.temperature_c = t[static_cast<std::size_t>(i)];
+      configs->SetEnvironment(i, e);
+    }
+  }
+}
+
+NonGeometricTerms ResolveNonGeometricTerms(const RobotFile& rig, const std::string& compliance,
+                                           const std::string& thermal) {
+  NonGeometricTerms terms;
+  terms.compliance_joints =
+      NonGeometricTerms::ParseCompliance(compliance, rig.robot.num_links(), "estimate_compliance=");
+  terms.ParseThermal(thermal, "estimate_thermal=");
+  if (!terms.compliance_joints.empty() && rig.non_geometric.masses.empty())
+    throw InputError("estimate_compliance=",
+                     "a joint's compliance is seen through gravity's torque: the robot file " +
+                         rig.path + " has no masses:");
+  return terms;
+}
+
+void DefineEnvironment(py::module_& m) {
+  m.def(
+      "identify_in_environment",
+      [](const RobotFile& rig, const Array& q, const Array& h, const py::object& gravity,
+         const py::object& temperature_c, const std::string& estimate_compliance,
+         const std::string& estimate_thermal, const py::object& plane,
+         const std::string& estimate_ranger, const py::object& fix, bool auto_fix,
+         double sigma_mm) {
+        ConfigsAndModel set =
+            ResolveConfigsAndModel(rig, q, plane, py::none(), "none", {estimate_ranger}, fix);
+        SetEnvironments(gravity, temperature_c, &set.configs);
+        const std::vector<double> readings = ToVector(h, "h");
+        const MeasurementSet data = GroupReadings(set.configs, readings, &rig.ranger, [](int r) {
+          return r < 0 ? std::string("q, h") : "h[" + std::to_string(r) + "]";
+        });
+        const std::unique_ptr<EnvironmentMeasurement> kind = RangerInEnvironment(
+            rig.robot, rig.robot, set.model->nominal_planes(), set.model->parameters(), rig.ranger,
+            rig.non_geometric, ResolveNonGeometricTerms(rig, estimate_compliance, estimate_thermal),
+            "estimate_compliance=/estimate_thermal=");
+        IdentificationOptions options;
+        if (!(sigma_mm >= 0)) throw InputError("sigma_mm=", "expected sigma >= 0 (mm)");
+        options.sigma = sigma_mm * 1e-3;
+        options.fix_dependent_parameters = auto_fix;
+        py::gil_scoped_release release;
+        return Identify(*kind, ToMeasuredValues(data), options);
+      },
+      py::arg("robot"), py::arg("q"), py::arg("h"), py::arg("gravity") = py::none(),
+      py::arg("temperature_c") = py::none(), py::arg("estimate_compliance") = "none",
+      py::arg("estimate_thermal") = "none", py::arg("plane") = py::none(),
+      py::arg("estimate_ranger") = "none", py::arg("fix") = py::none(), py::arg("auto_fix") = false,
+      py::arg("sigma_mm") = 0.0,
+      R"doc(Calibrate the ranger's readings h (m) at q with joint compliance and thermal growth,
+as `lrcal identify --estimate-compliance ... --estimate-thermal ...`: gravity (m x 3, m/s^2,
+base frame) and temperature_c (m, deg C) per reading, None for the robot file's environment:.
+Terms c1..cN (rad/(N m)), thermal_links, thermal_ranger (1/K) join the geometric ones.)doc");
+  m.def(
+      "identifiability_in_environment",
+      [](const RobotFile& rig, const Array& q, const py::object& gravity,
+         const py::object& temperature_c, const std::string& estimate_compliance,
+         const std::string& estimate_thermal, const py::object& plane,
+         const std::string& estimate_ranger, const py::object& fix) {
+        ConfigsAndModel set =
+            ResolveConfigsAndModel(rig, q, plane, py::none(), "none", {estimate_ranger}, fix);
+        SetEnvironments(gravity, temperature_c, &set.configs);
+        const std::unique_ptr<EnvironmentMeasurement> kind = RangerInEnvironment(
+            rig.robot, rig.robot, set.model->nominal_planes(), set.model->parameters(), rig.ranger,
+            rig.non_geometric, ResolveNonGeometricTerms(rig, estimate_compliance, estimate_thermal),
+            "estimate_compliance=/estimate_thermal=");
+        return AnalyzeIdentifiability(*kind, set.configs);
+      },
+      py::arg("robot"), py::arg("q"), py::arg("gravity") = py::none(),
+      py::arg("temperature_c") = py::none(), py::arg("estimate_compliance") = "none",
+      py::arg("estimate_thermal") = "none", py::arg("plane") = py::none(),
+      py::arg("estimate_ranger") = "none", py::arg("fix") = py::none(),
+      R"doc(What configurations q in their environments can identify of the geometry, the joint
+compliances and the thermal coefficients, as `lrcal identifiability --estimate-compliance ...`;
+.explanations says in words why a compliance or thermal term is lost.)doc");
+}
 
 void DefineIdentify(py::module_& m) {
   // The numeric settings' names and defaults are the schema's (IdentificationOptions::Settings()).
@@ -2882,6 +2987,7 @@ void DefineCalibration(py::module_& m) {
   DefineTree(m);
   DefineCompensate(m);
   DefineIdentify(m);
+  DefineEnvironment(m);
   DefineDesign(m);
   m.def("prior_information", &PriorInformationPy, py::arg("robot"), py::arg("q"),
         py::arg("prior_sigma") = "", py::arg("prior") = false,

@@ -28,6 +28,8 @@
 #include "lrcal/kinematics/gravity_torque.h"
 #include "lrcal/measurement/environment.h"
 #include "lrcal/measurement/measurement_kind.h"
+#include "lrcal/measurement/parameter_set.h"
+#include "lrcal/measurement/plane.h"
 
 namespace lrcal {
 
@@ -136,6 +138,17 @@ class EnvironmentMeasurement : public MeasurementKind {
   Layout layout_;
   std::string source_;
 };
+
+/// The laser ranger inside the non-geometric model: the ranger on `arm` with every link value, its
+/// offset and scale and `asked`'s plane and frame terms (what the model moves), the terms `asked`
+/// does not estimate held; `robot` (the nominal arm, which must outlive the kind, as must `arm`)
+/// carries the gravity torques. What identify --estimate-compliance, Python's
+/// identify_in_environment and simulate use (simulation: `arm` the true arm, `asked` all terms,
+/// nothing estimated).
+std::unique_ptr<EnvironmentMeasurement> RangerInEnvironment(
+    const RobotModel& arm, const RobotModel& robot, const PlaneSet& planes,
+    const ParameterSet& asked, const RangerSpec& ranger, const NonGeometricModel& model,
+    const NonGeometricTerms& terms, const std::string& source);
 
 /// The tool poses of an arm with link values `link_values` (5N, SI) and the non-geometric model
 /// `model` at each configuration of `configs` in its environment (model.defaults for what it

@@ -31,7 +31,8 @@ try:
                          simulate_sockets, identify_sockets, socket_consistency,
                          simulate_contacts, identify_contacts, simulate_scanner,
                          identify_scanner, identify_mixed, compensate,
-                         Tree, identify_tree)
+                         Tree, identify_tree, identify_in_environment,
+                         identifiability_in_environment)
     from ._lrcal import set_data_directory as _set_data_directory
 except ModuleNotFoundError as _missing:
     # Only the Python files are installed (a build without pybind11, e.g. a sanitizer build):
@@ -71,4 +72,5 @@ __all__ = ["Design", "Dependency", "Error", "Identifiability", "Identification",
            "sample_configurations", "simulate", "simulate_tracker", "identify_tracker", "status",
            "simulate_sockets", "identify_sockets", "socket_consistency",
            "simulate_contacts", "identify_contacts", "simulate_scanner", "identify_scanner",
-           "identify_mixed", "compensate", "Tree", "identify_tree"]
+           "identify_mixed", "compensate", "Tree", "identify_tree", "identify_in_environment",
+           "identifiability_in_environment"]
