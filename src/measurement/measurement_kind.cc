@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "lrcal/core/error.h"
+#include "lrcal/measurement/environment_measurement.h"
 
 namespace lrcal {
 
@@ -27,7 +28,10 @@ namespace {
 // The rig disturbances NoiseModel describes for the ranger: refused, not ignored, elsewhere.
 void CheckNoiseFitsKind(const MeasurementKind& kind, const NoiseModel& noise) {
   noise.Validate();
-  if (std::string(kind.name()) == "ranger") return;
+  // The ranger's own disturbances are simulated on its geometric path (simulation.h); inside the
+  // non-geometric model it takes sigma and repetitions like the other kinds.
+  if (std::string(kind.name()) == "ranger" && !dynamic_cast<const EnvironmentMeasurement*>(&kind))
+    return;
   const char* term = noise.encoder_sigma > 0                                 ? "encoder noise"
                      : noise.form_sigma > 0                                  ? "plane form error"
                      : noise.outlier_fraction > 0                            ? "outliers"
