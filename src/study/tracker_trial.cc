@@ -528,6 +528,11 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
   return TrialStatus::kOk;
 }
 
+namespace {
+void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm,
+                                Eigen::MatrixXd* J);
+}  // namespace
+
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
   const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
   const Eigen::MatrixXd arm = PoseJacobian(*c.model, zero.data(), c.validation);
@@ -539,7 +544,48 @@ Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
     for (int j = 0; j < ps.num_robot(); ++j)
       if (ps.robot_values[static_cast<std::size_t>(j)] == c.kind_link_values[k])
         J.col(static_cast<Eigen::Index>(k)) = arm.col(j);
+  if (c.environment) AddNonGeometricPoseColumns(c, arm, &J);
   return J;
 }
+
+namespace {
+
+// A cell in an environment: how each validation pose moves with the non-geometric terms, in the
+// validation environment (first order at the nominal model): c_j moves joint j by τ_j(q, g),
+// thermal_links every length ℓ by ℓ·ΔT.
+void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm,
+                                Eigen::MatrixXd* J) {
+  const ParameterSet& ps = c.model->parameters();
+  const RobotModel& robot = *c.robot;
+  const auto column_of = [&](int value) {
+    for (int j = 0; j < ps.num_robot(); ++j)
+      if (ps.robot_values[static_cast<std::size_t>(j)] == value) return j;
+    return -1;
+  };
+  for (int i = 0; i < c.validation.size(); ++i) {
+    const Environment env = c.validation.environment(i).Or(c.model_non_geometric.defaults);
+    const Eigen::VectorXd tau =
+        GravityTorques(robot, robot.nominal_values().data(), c.model_non_geometric.masses,
+                       c.validation.q(i), env.gravity);
+    const double dt = env.temperature_c - c.model_non_geometric.thermal.reference_c;
+    for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
+      const int joint = ComplianceTermJoint(c.parameter_names[k]);
+      auto out = J->block<6, 1>(6 * i, static_cast<Eigen::Index>(k));
+      if (joint >= 0) {
+        const bool revolute =
+            robot.links()[static_cast<std::size_t>(joint)].joint == JointType::kRevolute;
+        const int col = column_of(joint * kValuesPerLink + (revolute ? kTheta : kD));
+        if (col >= 0) out = arm.block<6, 1>(6 * i, col) * tau[joint];
+      }
+      if (c.parameter_names[k] != kThermalLinksTerm) continue;
+      out.setZero();
+      for (int v : robot.parameter_indices())
+        if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) && column_of(v) >= 0)
+          out += arm.block<6, 1>(6 * i, column_of(v)) * robot.nominal_values()[v] * dt;
+    }
+  }
+}
+
+}  // namespace
 
 }  // namespace lrcal
