@@ -249,6 +249,38 @@ TEST(EnvironmentMeasurement, IdentifiabilitySaysWhatGravityAndTemperatureCannotE
   EXPECT_THAT(free.unidentifiable, ::testing::Not(::testing::Contains(kThermalLinksTerm)));
 }
 
+// The equivalence an independent computation found: on one plane a uniform growth of the arm
+// reads as the ranger's gain and a shift of the plane, so with the plane's offset and the ranger's
+// scale estimated the links' and the ranger's thermal coefficients are not separable, even at
+// two temperatures; the analysis finds the dependence and says it in words.
+TEST(EnvironmentMeasurement, OnePlaneCannotSeparateTheArmsGrowthFromTheRangersGain) {
+  const RobotModel& robot = testing::PaperRobot();
+  const TargetedConfigurations configs = Spread(80, {0, 40}, {Eigen::Vector3d(0, 0, -9.81)});
+  const auto ranger = std::make_shared<RangerMeasurement>(
+      MeasurementModel(
+          robot, testing::PaperPlane(),
+          MakeParameterSet(robot, PlaneTerms{false, true}, {}, "fix", RangerTerms{true, true})),
+      testing::PaperRig().ranger);
+  NonGeometricTerms thermal;
+  thermal.thermal_links = thermal.thermal_ranger = true;
+  const EnvironmentMeasurement kind(ranger, robot, NominalModel(), thermal);
+  const IdentifiabilityReport rep = AnalyzeIdentifiability(kind, configs);
+  EXPECT_FALSE(rep.full_rank());
+  bool thermal_in_dependence = false;
+  for (const Dependency& d : rep.dependencies)
+    for (const auto& term : d.terms) thermal_in_dependence |= term.first == kThermalLinksTerm;
+  EXPECT_TRUE(thermal_in_dependence) << rep.ToString();
+  EXPECT_THAT(rep.explanations,
+              ::testing::Contains(HasSubstr("a uniform growth of the arm reads, on these planes, "
+                                            "as the ranger's gain and a shift of the planes")));
+  // Holding the ranger's coefficient leaves the links' identifiable.
+  thermal.thermal_ranger = false;
+  const EnvironmentMeasurement links_only(ranger, robot, NominalModel(), thermal);
+  const IdentifiabilityReport held = AnalyzeIdentifiability(links_only, configs);
+  EXPECT_THAT(held.names, ::testing::Contains(kThermalLinksTerm));
+  EXPECT_THAT(held.suggested_fixed, ::testing::Not(::testing::Contains(kThermalLinksTerm)));
+}
+
 TEST(EnvironmentMeasurement, AGeometricFitOfACompliantOrWarmArmFailsTheFitCheck) {
   const RobotModel& robot = testing::PaperRobot();
   const TargetedConfigurations configs = Spread(120, {-20, 20, 60}, {Eigen::Vector3d(0, 0, -9.81)});
