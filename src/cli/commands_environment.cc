@@ -58,16 +58,13 @@ std::unique_ptr<EnvironmentMeasurement> NonGeometricKind(const po::variables_map
 
 // What identify does with the ranger's model that this path does not do yet.
 void RefuseRangerOnlyOutputs(const po::variables_map& vm) {
-  for (const char* option : {"write-robot", "report", "predict-at", "holdout", "only-significant",
-                             "measured", "prior-sigma"})
+  for (const char* option :
+       {"write-robot", "report", "predict-at", "holdout", "only-significant", "measured"})
     if (vm.count(option) && !vm[option].defaulted())
       throw InputError(std::string("--") + option,
                        "is not available with --estimate-compliance or --estimate-thermal: the "
                        "calibrated robot file, the report and the accuracy statements are the "
                        "geometric model's (docs/FILE_FORMATS.md, Non-geometric terms)");
-  if (vm.count("prior") && vm["prior"].as<bool>())
-    throw InputError("--prior",
-                     "is not available with --estimate-compliance or --estimate-thermal");
 }
 
 // A fit refused as rank deficient: what to fix or leave out, and why each term was lost.

@@ -53,20 +53,27 @@ constexpr const char* kClasses[] = {"theta",
                                     "tool_z",
                                     "tool_roll",
                                     "tool_pitch",
-                                    "tool_yaw"};
+                                    "tool_yaw",
+                                    "c",
+                                    "thermal_links",
+                                    "thermal_ranger"};
 
 struct Unit {
   const char* name;
   double to_si;
-  char dimension;  // 'a' angle, 'l' length, 's' scale
+  // 'a' angle, 'l' length, 's' scale, 'c' a joint's compliance, 't' a thermal coefficient
+  char dimension;
 };
 constexpr Unit kUnits[] = {{"rad", 1, 'a'},          {"mrad", 1e-3, 'a'}, {"urad", 1e-6, 'a'},
                            {"deg", M_PI / 180, 'a'}, {"m", 1, 'l'},       {"mm", 1e-3, 'l'},
-                           {"um", 1e-6, 'l'},        {"ppm", 1e-6, 's'}};
+                           {"um", 1e-6, 'l'},        {"ppm", 1e-6, 's'},  {"rad/Nm", 1, 'c'},
+                           {"urad/Nm", 1e-6, 'c'},   {"ppm/K", 1e-6, 't'}};
 
 // The dimension of a class's terms.
 char DimensionOf(const std::string& cls) {
   if (cls == "ranger_scale") return 's';
+  if (cls == "c") return 'c';  // environment_measurement.h
+  if (cls == "thermal_links" || cls == "thermal_ranger") return 't';
   // A class is angular when its first member is ("theta" → "theta1", "plane_u" → "plane_u1").
   const std::string member = cls == "plane_u" ? "plane_u1" : cls;
   return IsAngularName(member) ? 'a' : 'l';
@@ -75,6 +82,8 @@ char DimensionOf(const std::string& cls) {
 const char* DimensionName(char dimension) {
   return dimension == 'a'   ? "an angle (rad, mrad, urad or deg)"
          : dimension == 'l' ? "a length (m, mm or um)"
+         : dimension == 'c' ? "a joint's compliance (urad/Nm or rad/Nm)"
+         : dimension == 't' ? "a thermal coefficient (ppm/K)"
                             : "a scale (ppm)";
 }
 
@@ -97,12 +106,12 @@ PriorSigmas PriorSigmas::Parse(const std::string& text, const std::string& sourc
     const std::string key = item.substr(0, eq);
     const std::string cls = TermClass(key);
     if (std::find(std::begin(kClasses), std::end(kClasses), cls) == std::end(kClasses))
-      throw InputError(source,
-                       where + ": '" + key +
-                           "' is neither a term nor a class of terms (theta, alpha, a, "
-                           "d, beta, plane_u, plane_f, ranger_offset, ranger_scale, "
-                           "instrument_*, target_*, socket_*, base_*, tool_*, or one of their "
-                           "names: d6)");
+      throw InputError(source, where + ": '" + key +
+                                   "' is neither a term nor a class of terms (theta, alpha, a, "
+                                   "d, beta, plane_u, plane_f, ranger_offset, ranger_scale, "
+                                   "instrument_*, target_*, socket_*, base_*, tool_*, c (a joint's "
+                                   "compliance), thermal_links, thermal_ranger, or one of their "
+                                   "names: d6)");
     for (const Entry& e : priors.entries)
       if (e.key == key) throw InputError(source, where + ": '" + key + "' is given twice");
     std::string value = item.substr(eq + 1);
@@ -159,9 +168,12 @@ std::string PriorSigmas::ToString() const {
   std::ostringstream out;
   for (std::size_t k = 0; k < entries.size(); ++k) {
     const std::string cls = TermClass(entries[k].key);
-    const DisplayUnit unit = DisplayUnitOf(DimensionOf(cls) == 'a'   ? "theta1"
-                                           : DimensionOf(cls) == 's' ? "ranger_scale"
-                                                                     : "a1");
+    const char dimension = DimensionOf(cls);
+    const DisplayUnit unit = DisplayUnitOf(dimension == 'a'   ? "theta1"
+                                           : dimension == 's' ? "ranger_scale"
+                                           : dimension == 'c' ? "c1"
+                                           : dimension == 't' ? "thermal_links"
+                                                              : "a1");
     out << (k ? ", " : "") << entries[k].key << "=" << entries[k].sigma * unit.factor << " "
         << unit.unit;
   }

@@ -78,6 +78,43 @@ TEST(EnvironmentCli, SimulatedCompliantWarmArmIsCalibratedBack) {
   EXPECT_TRUE(j.at("fit").at("consistent").get<bool>());
 }
 
+// A prior on a compliance the data cannot see (joint 1 under vertical gravity) sets it instead of
+// stopping the fit; a prior's unit is checked.
+TEST(EnvironmentCli, APriorSetsACompliance) {
+  const std::string dir = testing::TempDir("environment_cli_prior");
+  const std::string robot = testing::SourcePath("studies/robots/paper_space.yaml");
+  int code = 0;
+  std::string out =
+      Lrcal(dir, "sample --robot " + robot + " --count 70 --seed 8 --out c.csv", &code);
+  ASSERT_EQ(code, 0) << out;
+  out = Lrcal(
+      dir, "simulate --robot " + robot + " --configs c.csv --sigma-mm 0.005 --seed 3 --out m.csv",
+      &code);
+  ASSERT_EQ(code, 0) << out;
+  out = Lrcal(dir,
+              "identify --robot " + robot +
+                  " --data m.csv --sigma-mm 0.005 --estimate-compliance all "
+                  "--prior-sigma c1=20urad/Nm --format json",
+              &code);
+  ASSERT_EQ(code, 0) << out;
+  const nlohmann::json j = nlohmann::json::parse(out.substr(out.find('{')));
+  // Nothing informs c1: the prior's mean and its σ (posterior/prior 1).
+  for (const auto& p : j.at("parameters"))
+    if (p.at("name") == "c1") {
+      EXPECT_NEAR(p.at("delta").get<double>(), 0.0, 1e-12);
+      EXPECT_NEAR(p.at("std_given_sigma").get<double>(), 20e-6, 1e-9);
+      EXPECT_NEAR(p.at("posterior_to_prior").get<double>(), 1.0, 1e-6);
+    }
+  const auto [c3, c3_std] = Estimate(j, "c3");
+  EXPECT_NEAR(c3, 10e-6, 4 * c3_std);
+  out = Lrcal(dir,
+              "identify --robot " + robot +
+                  " --data m.csv --estimate-compliance all --prior-sigma c1=20mrad",
+              &code);
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_THAT(out, HasSubstr("a joint's compliance (urad/Nm or rad/Nm)"));
+}
+
 TEST(EnvironmentCli, IdentifiabilityNamesWhatGravityAndOneTemperatureCannotSee) {
   const std::string dir = testing::TempDir("environment_cli_rank");
   const std::string robot = testing::SourcePath("studies/robots/paper_space.yaml");

@@ -13,7 +13,8 @@
 // Priors are given by term name ("d6") or by class — the name without its digits: "theta" for
 // every θ_i, "plane_u" for every plane's u1 and u2, "target_x" for every target's x — a name's
 // own entry winning over its class's. Values carry their unit: rad, mrad, urad or deg for
-// angles; m, mm or um for lengths; ppm for the ranger's scale.
+// angles; m, mm or um for lengths; ppm for the ranger's scale; urad/Nm or rad/Nm for a joint's
+// compliance (c3, class c) and ppm/K for a thermal coefficient (environment_measurement.h).
 #pragma once
 
 #include <Eigen/Core>
