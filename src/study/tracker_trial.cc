@@ -553,15 +553,41 @@ namespace {
 // A cell in an environment: how each validation pose moves with the non-geometric terms, in the
 // validation environment (first order at the nominal model): c_j moves joint j by τ_j(q, g),
 // thermal_links every length ℓ by ℓ·ΔT.
+// The column of link value `value` among the arm's pose Jacobian's (c.model's robot terms), −1.
+int ArmColumn(const CellContext& c, int value) {
+  const ParameterSet& ps = c.model->parameters();
+  for (int j = 0; j < ps.num_robot(); ++j)
+    if (ps.robot_values[static_cast<std::size_t>(j)] == value) return j;
+  return -1;
+}
+
+// Validation pose i's rows (6 × 1) of the non-geometric term `name`: joint j's column times τ_j
+// for c_j, every length's column times ℓ·ΔT for thermal_links; zero otherwise.
+Eigen::Matrix<double, 6, 1> NonGeometricPoseColumn(const CellContext& c, const Eigen::MatrixXd& arm,
+                                                   int i, const std::string& name,
+                                                   const Eigen::VectorXd& tau, double dt) {
+  const RobotModel& robot = *c.robot;
+  Eigen::Matrix<double, 6, 1> out = Eigen::Matrix<double, 6, 1>::Zero();
+  const int joint = ComplianceTermJoint(name);
+  if (joint >= 0) {
+    const bool revolute =
+        robot.links()[static_cast<std::size_t>(joint)].joint == JointType::kRevolute;
+    const int col = ArmColumn(c, joint * kValuesPerLink + (revolute ? kTheta : kD));
+    if (col >= 0) out = arm.block<6, 1>(6 * i, col) * tau[joint];
+    return out;
+  }
+  if (name != kThermalLinksTerm) return out;
+  for (int v : robot.parameter_indices()) {
+    const int col = ArmColumn(c, v);
+    if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) && col >= 0)
+      out += arm.block<6, 1>(6 * i, col) * robot.nominal_values()[v] * dt;
+  }
+  return out;
+}
+
 void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm,
                                 Eigen::MatrixXd* J) {
-  const ParameterSet& ps = c.model->parameters();
   const RobotModel& robot = *c.robot;
-  const auto column_of = [&](int value) {
-    for (int j = 0; j < ps.num_robot(); ++j)
-      if (ps.robot_values[static_cast<std::size_t>(j)] == value) return j;
-    return -1;
-  };
   for (int i = 0; i < c.validation.size(); ++i) {
     const Environment env = c.validation.environment(i).Or(c.model_non_geometric.defaults);
     const Eigen::VectorXd tau =
@@ -569,19 +595,10 @@ void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm
                        c.validation.q(i), env.gravity);
     const double dt = env.temperature_c - c.model_non_geometric.thermal.reference_c;
     for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
-      const int joint = ComplianceTermJoint(c.parameter_names[k]);
-      auto out = J->block<6, 1>(6 * i, static_cast<Eigen::Index>(k));
-      if (joint >= 0) {
-        const bool revolute =
-            robot.links()[static_cast<std::size_t>(joint)].joint == JointType::kRevolute;
-        const int col = column_of(joint * kValuesPerLink + (revolute ? kTheta : kD));
-        if (col >= 0) out = arm.block<6, 1>(6 * i, col) * tau[joint];
-      }
-      if (c.parameter_names[k] != kThermalLinksTerm) continue;
-      out.setZero();
-      for (int v : robot.parameter_indices())
-        if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) && column_of(v) >= 0)
-          out += arm.block<6, 1>(6 * i, column_of(v)) * robot.nominal_values()[v] * dt;
+      const std::string& name = c.parameter_names[k];
+      if (ComplianceTermJoint(name) >= 0 || name == kThermalLinksTerm)
+        J->block<6, 1>(6 * i, static_cast<Eigen::Index>(k)) =
+            NonGeometricPoseColumn(c, arm, i, name, tau, dt);
     }
   }
 }
