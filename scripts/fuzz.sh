@@ -18,7 +18,8 @@ flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
 sources=(core/strings core/json core/hash core/data_dir core/random core/settings kinematics/robot_model
          kinematics/rigid_transform kinematics/dh_conversion kinematics/configuration_set
          measurement/plane measurement/parameter_set measurement/measurement_set
-         measurement/targeted_configurations
+         measurement/targeted_configurations measurement/environment_measurement
+         kinematics/gravity_torque
          measurement/noise_model measurement/measurement_kind measurement/averaging core/text_table
          identification/identification_options identification/prior design/design_options io/csv
          io/robot_file io/urdf io/yaml_util study/study study/stop_when study/sensitivity

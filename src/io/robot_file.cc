@@ -291,10 +291,30 @@ double Coefficient(const YAML::Node& t, const char* key, const std::string& path
   return yaml::Number(t[key], path, std::string("thermal.") + key) * 1e-6;
 }
 
+// The links' coefficient at `key`: one number (one material) into `links`, or a list of one per
+// link (a material per link) into `per_link` with `links` 0. Unchanged when the key is absent.
+void LinkCoefficients(const YAML::Node& t, const char* key, const std::string& path, int n,
+                      ThermalCoefficients* out) {
+  if (!t || !t[key]) return;
+  const std::string name = std::string("thermal.") + key;
+  if (!t[key].IsSequence()) {
+    out->links = yaml::Number(t[key], path, name) * 1e-6;
+    out->per_link.resize(0);
+    return;
+  }
+  const std::vector<double> v = yaml::NumberList(t[key], path, name);
+  if (static_cast<int>(v.size()) != n)
+    throw InputError(yaml::Where(path, t[key], name),
+                     "expected one number (ppm/K) for every link, or a list of " +
+                         std::to_string(n) + " (one per link), got " + std::to_string(v.size()));
+  out->links = 0;
+  out->per_link = Eigen::Map<const Eigen::VectorXd>(v.data(), n) * 1e-6;
+}
+
 // thermal: {reference_c, links_ppm_per_k, ranger_ppm_per_k, true_links_ppm_per_k,
 // true_ranger_ppm_per_k}: the model's coefficients and the simulated arm's.
-void ParseThermal(const YAML::Node& root, const std::string& path, ThermalCoefficients* model,
-                  ThermalCoefficients* truth) {
+void ParseThermal(const YAML::Node& root, const std::string& path, int n,
+                  ThermalCoefficients* model, ThermalCoefficients* truth) {
   using namespace yaml;
   const YAML::Node t = root["thermal"];
   if (t) {
@@ -306,10 +326,10 @@ void ParseThermal(const YAML::Node& root, const std::string& path, ThermalCoeffi
     if (t["reference_c"])
       model->reference_c = Number(t["reference_c"], path, "thermal.reference_c");
   }
-  model->links = Coefficient(t, "links_ppm_per_k", path, 0);
+  LinkCoefficients(t, "links_ppm_per_k", path, n, model);
   model->ranger = Coefficient(t, "ranger_ppm_per_k", path, 0);
   *truth = *model;
-  truth->links = Coefficient(t, "true_links_ppm_per_k", path, model->links);
+  LinkCoefficients(t, "true_links_ppm_per_k", path, n, truth);
   truth->ranger = Coefficient(t, "true_ranger_ppm_per_k", path, model->ranger);
 }
 
@@ -340,7 +360,7 @@ void ParseNonGeometric(const YAML::Node& root, const std::string& path, RobotFil
   const double unit = ComplianceUnit(c, path);
   model.compliance = ParseCompliance(c, path, "nominal", n, unit);
   ThermalCoefficients truth;
-  ParseThermal(root, path, &model.thermal, &truth);
+  ParseThermal(root, path, n, &model.thermal, &truth);
   ParseEnvironmentDefaults(root, path, &model.defaults);
   file->true_non_geometric = model;
   file->true_non_geometric.thermal = truth;

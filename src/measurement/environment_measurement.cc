@@ -6,7 +6,6 @@
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/strings.h"
-#include "lrcal/measurement/ranger_measurement.h"
 
 namespace lrcal {
 
@@ -26,7 +25,7 @@ std::string Environment::ToString() const {
 
 bool NonGeometricModel::IsGeometric() const {
   const bool stiff = masses.empty() || compliance.size() == 0 || compliance.isZero(0.0);
-  return stiff && thermal.links == 0 && thermal.ranger == 0;
+  return stiff && thermal.LinksStill() && thermal.ranger == 0;
 }
 
 std::string ComplianceTermName(int joint) { return "c" + std::to_string(joint + 1); }
@@ -107,6 +106,10 @@ EnvironmentMeasurement::EnvironmentMeasurement(std::shared_ptr<const Measurement
     throw InputError(source + ".compliance", "expected one compliance per joint (" +
                                                  std::to_string(n) + "), got " +
                                                  std::to_string(model_.compliance.size()));
+  if (model_.thermal.per_link.size() != 0 && model_.thermal.per_link.size() != n)
+    throw InputError(source + ".thermal", "expected one coefficient per link (" +
+                                              std::to_string(n) + "), got " +
+                                              std::to_string(model_.thermal.per_link.size()));
   for (const std::string& h : held_)
     if (!Contains(inner_->parameter_names(), h))
       throw InputError(source,
@@ -123,16 +126,19 @@ void EnvironmentMeasurement::LayOutInnerTerms() {
   for (int k = 0; k < static_cast<int>(inner_names.size()); ++k) {
     const int v = robot_->FindValue(inner_names[static_cast<std::size_t>(k)]);
     const bool length = v >= 0 && (v % kValuesPerLink == kA || v % kValuesPerLink == kD);
+    const double base = length ? model_.thermal.Link(v / kValuesPerLink) - model_.thermal.links : 0;
     if (length) {
       layout_.length_columns.push_back(k);
       layout_.length_nominal.push_back(inner_nominal[k]);
+      layout_.length_base.push_back(base);
     }
     if (Contains(held_, inner_names[static_cast<std::size_t>(k)])) continue;
     layout_.exposed.push_back(k);
     layout_.exposed_length.push_back(length ? v : -1);
+    layout_.exposed_base.push_back(base);
     names_.push_back(inner_names[static_cast<std::size_t>(k)]);
   }
-  if (estimate_.thermal_links || model_.thermal.links != 0)
+  if (estimate_.thermal_links || !model_.thermal.LinksStill())
     for (int v : robot_->parameter_indices())
       if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) &&
           !Contains(inner_names, robot_->ValueName(v)))
@@ -299,9 +305,10 @@ class EnvironmentEvaluator : public MeasurementEvaluator {
     const EnvironmentMeasurement::Layout& L = kind_.layout();
     std::fill(inner, inner + kind_.inner().num_parameters(), 0.0);
     for (std::size_t o = 0; o < L.exposed.size(); ++o) inner[L.exposed[o]] = e[o];
-    const double growth = ThermalLinks(e) * dt;
-    if (growth != 0)
+    const double common = ThermalLinks(e);
+    if (dt != 0)
       for (std::size_t k = 0; k < L.length_columns.size(); ++k) {
+        const double growth = (common + L.length_base[k]) * dt;
         double& v = inner[L.length_columns[k]];
         v = (L.length_nominal[k] + v) * (1 + growth) - L.length_nominal[k];
       }
@@ -342,10 +349,11 @@ class EnvironmentEvaluator : public MeasurementEvaluator {
   // (its joint's column times the joint's gravity torque); returns the next column.
   int ChainInnerTerms(const TemperatureGroup& g, const double* e, double* J) const {
     const EnvironmentMeasurement::Layout& L = kind_.layout();
-    const double growth = ThermalLinks(e) * g.delta_t;
+    const double common = ThermalLinks(e);
     int o = 0;
     for (std::size_t x = 0; x < L.exposed.size(); ++x, ++o) {
-      const double chain = L.exposed_length[x] >= 0 ? 1 + growth : 1.0;
+      const double chain =
+          L.exposed_length[x] >= 0 ? 1 + (common + L.exposed_base[x]) * g.delta_t : 1.0;
       ForEachRow(g, o, J, [&](int row) { return Inner(g, L.exposed[x], row) * chain; });
     }
     for (std::size_t x = 0; x < L.joint_columns.size(); ++x, ++o) {
@@ -463,20 +471,6 @@ std::vector<std::string> EnvironmentMeasurement::ExplainLostTerms(
   return out;
 }
 
-std::unique_ptr<EnvironmentMeasurement> RangerInEnvironment(
-    const RobotModel& arm, const RobotModel& robot, const PlaneSet& planes,
-    const ParameterSet& asked, const RangerSpec& ranger, const NonGeometricModel& model,
-    const NonGeometricTerms& terms, const std::string& source) {
-  const ParameterSet full = MakeParameterSet(
-      arm, asked.plane_terms, {}, "fix", RangerTerms{true, true}, asked.frames[0], asked.frames[1]);
-  auto inner = std::make_shared<RangerMeasurement>(MeasurementModel(arm, planes, full), ranger);
-  std::vector<std::string> held;
-  for (const std::string& name : inner->parameter_names())
-    if (asked.Find(name) < 0) held.push_back(name);
-  return std::make_unique<EnvironmentMeasurement>(std::move(inner), robot, model, terms, held,
-                                                  source);
-}
-
 std::vector<Pose<double>> EnvironmentToolPoses(const RobotModel& robot,
                                                const Eigen::VectorXd& link_values,
                                                const NonGeometricModel& model,
@@ -488,10 +482,11 @@ std::vector<Pose<double>> EnvironmentToolPoses(const RobotModel& robot,
   Eigen::VectorXd grown = link_values;
   for (int i = 0; i < configs.size(); ++i) {
     const Environment env = configs.environment(i).Or(model.defaults);
-    const double growth = model.thermal.links * (env.temperature_c - model.thermal.reference_c);
+    const double dt = env.temperature_c - model.thermal.reference_c;
     grown = link_values;
     for (int v : robot.parameter_indices())
-      if (v % kValuesPerLink == kA || v % kValuesPerLink == kD) grown[v] *= 1 + growth;
+      if (v % kValuesPerLink == kA || v % kValuesPerLink == kD)
+        grown[v] *= 1 + model.thermal.Link(v / kValuesPerLink) * dt;
     const Eigen::VectorXd tau = GravityTorques(robot, robot.nominal_values().data(), model.masses,
                                                configs.q(i), env.gravity);
     for (int j = 0; j < n; ++j)

@@ -83,4 +83,18 @@ MeasuredValues ToMeasuredValues(const MeasurementSet& data) {
   return values;
 }
 
+std::unique_ptr<EnvironmentMeasurement> RangerInEnvironment(
+    const RobotModel& arm, const RobotModel& robot, const PlaneSet& planes,
+    const ParameterSet& asked, const RangerSpec& ranger, const NonGeometricModel& model,
+    const NonGeometricTerms& terms, const std::string& source) {
+  const ParameterSet full = MakeParameterSet(
+      arm, asked.plane_terms, {}, "fix", RangerTerms{true, true}, asked.frames[0], asked.frames[1]);
+  auto inner = std::make_shared<RangerMeasurement>(MeasurementModel(arm, planes, full), ranger);
+  std::vector<std::string> held;
+  for (const std::string& name : inner->parameter_names())
+    if (asked.Find(name) < 0) held.push_back(name);
+  return std::make_unique<EnvironmentMeasurement>(std::move(inner), robot, model, terms, held,
+                                                  source);
+}
+
 }  // namespace lrcal

@@ -59,6 +59,7 @@ void AddNonGeometricTruth(const CellContext& c, Eigen::VectorXd* delta) {
   for (std::size_t k = 0; k < c.parameter_names.size(); ++k) {
     const int j = ComplianceTermJoint(c.parameter_names[k]);
     if (j >= 0) (*delta)[static_cast<Eigen::Index>(k)] = c.true_non_geometric.Compliance(j);
+    // The common correction: exact when the truth's per-link coefficients are the model's.
     if (c.parameter_names[k] == kThermalLinksTerm)
       (*delta)[static_cast<Eigen::Index>(k)] =
           c.true_non_geometric.thermal.links - c.model_non_geometric.thermal.links;

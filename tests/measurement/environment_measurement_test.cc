@@ -82,7 +82,7 @@ T ReferenceReading(const EnvironmentMeasurement& kind, const RobotModel& robot,
   const std::vector<std::string>& names = kind.parameter_names();
   std::vector<T> values(static_cast<std::size_t>(robot.num_values()));
   for (int v = 0; v < robot.num_values(); ++v) values[v] = T(robot.nominal_values()[v]);
-  T offset(0), scale(0), alpha(m.thermal.links), alpha_r(m.thermal.ranger);
+  T offset(0), scale(0), dalpha(0), alpha_r(m.thermal.ranger);
   std::vector<T> c(6);
   for (int j = 0; j < 6; ++j) c[j] = T(m.Compliance(j));
   for (std::size_t k = 0; k < names.size(); ++k) {
@@ -91,13 +91,14 @@ T ReferenceReading(const EnvironmentMeasurement& kind, const RobotModel& robot,
     if (names[k] == "ranger_offset") offset += e[k];
     if (names[k] == "ranger_scale") scale += e[k];
     if (ComplianceTermJoint(names[k]) >= 0) c[ComplianceTermJoint(names[k])] += e[k];
-    if (names[k] == kThermalLinksTerm) alpha += e[k];
+    if (names[k] == kThermalLinksTerm) dalpha += e[k];
     if (names[k] == kThermalRangerTerm) alpha_r += e[k];
   }
   const Environment env = kind.EnvironmentOf(configs, i);
   const double dt = env.temperature_c - m.thermal.reference_c;
   for (int v : robot.parameter_indices())
-    if (v % kValuesPerLink == kA || v % kValuesPerLink == kD) values[v] *= T(1.0) + alpha * dt;
+    if (v % kValuesPerLink == kA || v % kValuesPerLink == kD)
+      values[v] *= T(1.0) + (T(m.thermal.Link(v / kValuesPerLink)) + dalpha) * dt;
   const Eigen::VectorXd tau =
       GravityTorques(robot, robot.nominal_values().data(), m.masses, configs.q(i), env.gravity);
   for (int j = 0; j < 6; ++j) values[j * kValuesPerLink + kTheta] += c[j] * tau[j];
@@ -119,6 +120,10 @@ TEST(EnvironmentMeasurement, JacobianIsAutodiffsAndCentralDifferences) {
   const RobotModel& robot = testing::PaperRobot();
   NonGeometricModel model = NominalModel();
   model.compliance = Eigen::VectorXd::Constant(6, 2e-5);
+  // A material per link: aluminium links 1-3, carbon fibre 4-6, on a common part.
+  model.thermal.links = 1e-6;
+  model.thermal.per_link.resize(6);
+  model.thermal.per_link << 22e-6, 22e-6, 22e-6, 0.5e-6, 0.5e-6, 0.5e-6;
   const EnvironmentMeasurement kind(FullRanger(robot), robot, model, AllTerms(), {"d6"});
   ASSERT_LE(kind.num_parameters(), kMaxTerms);
   EXPECT_THAT(kind.parameter_names(), ::testing::Contains("c3"));
@@ -224,6 +229,50 @@ TEST(EnvironmentMeasurement, RecoversGeometryComplianceAndThermalGrowthFromExact
     EXPECT_NEAR(s.delta[k], expected, tolerance::kRoundTrip) << name;
   }
   EXPECT_LT(s.residual_rms, 1e-12);
+}
+
+// A material per link: the links' coefficients differ (aluminium and carbon fibre), the truth's
+// common part is off by 1.5 ppm/K; exact readings recover it and the geometry to 1e-9.
+TEST(EnvironmentMeasurement, RecoversACommonCorrectionOfPerLinkCoefficients) {
+  const RobotModel& robot = testing::PaperRobot();
+  const TargetedConfigurations configs = Spread(120, {-20, 20, 60}, {Eigen::Vector3d(0, 0, -9.81)});
+  NonGeometricModel nominal = NominalModel();
+  nominal.thermal.links = 0;
+  nominal.thermal.per_link.resize(6);
+  nominal.thermal.per_link << 23e-6, 23e-6, 23e-6, 1e-6, 1e-6, 1e-6;
+  NonGeometricModel truth = nominal;
+  truth.thermal.links = 1.5e-6;
+  const MeasuredValues data = TrueReadings(robot, truth, configs);
+  NonGeometricTerms terms;
+  terms.thermal_links = true;
+  const EnvironmentMeasurement kind(FullRanger(robot), robot, nominal, terms,
+                                    {"ranger_offset", "ranger_scale"});
+  const IdentificationSummary s = Identify(kind, data);
+  ASSERT_TRUE(s.IsSolutionUsable()) << s.FullReport();
+  for (int k = 0; k < kind.num_parameters(); ++k) {
+    const std::string& name = s.names[static_cast<std::size_t>(k)];
+    const int v = robot.FindValue(name);
+    const double expected = name == kThermalLinksTerm ? 1.5e-6
+                            : v >= 0                  ? testing::PaperTrueErrors()[v]
+                                                      : 0.0;
+    EXPECT_NEAR(s.delta[k], expected, tolerance::kRoundTrip) << name;
+  }
+  // The poses follow each link's own material: the true arm's poses at 60 °C against its
+  // link values grown link by link.
+  const RobotModel true_arm = Truth{testing::PaperTrueErrors()}.TrueRobot(robot);
+  TargetedConfigurations warm = configs.Subset({0});
+  Environment hot;
+  hot.temperature_c = 60;
+  hot.gravity = Eigen::Vector3d::Zero();
+  warm.SetEnvironment(0, hot);
+  const Pose<double> pose =
+      EnvironmentToolPoses(robot, true_arm.nominal_values(), truth, warm).front();
+  Eigen::VectorXd grown = true_arm.nominal_values();
+  for (int v : robot.parameter_indices())
+    if (v % kValuesPerLink == kA || v % kValuesPerLink == kD)
+      grown[v] *= 1 + truth.thermal.Link(v / kValuesPerLink) * 40;
+  const Pose<double> expected = ForwardKinematics<double>(robot, grown.data(), warm.q(0));
+  EXPECT_THAT(pose.p_BT, EigenNear(expected.p_BT, 1e-15));
 }
 
 TEST(EnvironmentMeasurement, IdentifiabilitySaysWhatGravityAndTemperatureCannotExcite) {

@@ -28,16 +28,24 @@
 #include "lrcal/kinematics/gravity_torque.h"
 #include "lrcal/measurement/environment.h"
 #include "lrcal/measurement/measurement_kind.h"
-#include "lrcal/measurement/parameter_set.h"
-#include "lrcal/measurement/plane.h"
 
 namespace lrcal {
 
 /// Thermal coefficients (a robot file's `thermal:`).
 struct ThermalCoefficients {
   double reference_c = 20;  ///< °C: where the link values hold
-  double links = 0;         ///< 1/K: every link length's coefficient (one material)
-  double ranger = 0;        ///< 1/K: the ranger's scale per kelvin
+  double links = 0;         ///< 1/K: every link length's coefficient (one material), or the
+                            ///< common part added to `per_link`'s
+  /// 1/K per link (a material per link); empty: `links` for every link. Link i's lengths grow by
+  /// 1 + (links + per_link[i])·ΔT, so an estimated thermal_links is a correction common to all.
+  Eigen::VectorXd per_link{};
+  double ranger = 0;  ///< 1/K: the ranger's scale per kelvin
+  /// Link i's coefficient (0-based), 1/K.
+  double Link(int i) const {
+    return links + (per_link.size() == 0 ? 0.0 : per_link[static_cast<Eigen::Index>(i)]);
+  }
+  /// True when no link grows.
+  bool LinksStill() const { return links == 0 && (per_link.size() == 0 || per_link.isZero(0.0)); }
 };
 
 /// What the arm is beyond its geometry: masses, joint compliances, thermal coefficients, and the
@@ -118,8 +126,10 @@ class EnvironmentMeasurement : public MeasurementKind {
   struct Layout {
     std::vector<int> exposed;         ///< inner column of each exposed inner term
     std::vector<int> exposed_length;  ///< per exposed term: its robot value index if a length, −1
-    std::vector<int> length_columns;  ///< inner columns of the lengths thermal growth scales
+    std::vector<double> exposed_base;  ///< per exposed length: its link's coefficient less `links`
+    std::vector<int> length_columns;   ///< inner columns of the lengths thermal growth scales
     std::vector<double> length_nominal;  ///< their nominal values (m)
+    std::vector<double> length_base;     ///< their link's coefficient less `links` (1/K)
     std::vector<int> joint_columns;      ///< per estimated compliance joint: its θ_j (d_j) column
     int ranger_scale_column = -1;        ///< inner column of ranger_scale, −1
   };
@@ -138,17 +148,6 @@ class EnvironmentMeasurement : public MeasurementKind {
   Layout layout_;
   std::string source_;
 };
-
-/// The laser ranger inside the non-geometric model: the ranger on `arm` with every link value, its
-/// offset and scale and `asked`'s plane and frame terms (what the model moves), the terms `asked`
-/// does not estimate held; `robot` (the nominal arm, which must outlive the kind, as must `arm`)
-/// carries the gravity torques. What identify --estimate-compliance, Python's
-/// identify_in_environment and simulate use (simulation: `arm` the true arm, `asked` all terms,
-/// nothing estimated).
-std::unique_ptr<EnvironmentMeasurement> RangerInEnvironment(
-    const RobotModel& arm, const RobotModel& robot, const PlaneSet& planes,
-    const ParameterSet& asked, const RangerSpec& ranger, const NonGeometricModel& model,
-    const NonGeometricTerms& terms, const std::string& source);
 
 /// The tool poses of an arm with link values `link_values` (5N, SI) and the non-geometric model
 /// `model` at each configuration of `configs` in its environment (model.defaults for what it

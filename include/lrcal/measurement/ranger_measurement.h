@@ -9,6 +9,7 @@
 
 #include <memory>
 
+#include "lrcal/measurement/environment_measurement.h"
 #include "lrcal/measurement/measurement_kind.h"
 #include "lrcal/measurement/measurement_model.h"
 #include "lrcal/measurement/measurement_set.h"
@@ -67,6 +68,17 @@ class RangerMeasurement : public MeasurementKind {
   MeasurementModel model_;
   RangerSpec ranger_;
 };
+
+/// The laser ranger inside the non-geometric model: the ranger on `arm` with every link value, its
+/// offset and scale and `asked`'s plane and frame terms (what the model moves), the terms `asked`
+/// does not estimate held; `robot` (the nominal arm, which must outlive the kind, as must `arm`)
+/// carries the gravity torques. What identify --estimate-compliance, Python's
+/// identify_in_environment and simulate use (simulation: `arm` the true arm, `asked` all terms,
+/// nothing estimated).
+std::unique_ptr<EnvironmentMeasurement> RangerInEnvironment(
+    const RobotModel& arm, const RobotModel& robot, const PlaneSet& planes,
+    const ParameterSet& asked, const RangerSpec& ranger, const NonGeometricModel& model,
+    const NonGeometricTerms& terms, const std::string& source);
 
 /// A ranger's MeasurementSet as the kind-neutral MeasuredValues (one value per configuration).
 MeasuredValues ToMeasuredValues(const MeasurementSet& data);
