@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <vector>
 
 #include "core/dense_kernel_variants.h"
 
@@ -56,35 +58,158 @@ void CholeskySubstitute(const RowMajorMatrixXd& L_in, const Eigen::VectorXd& b,
 
 namespace {
 
-[[gnu::always_inline]] inline void NormalMatrixBody(const double* __restrict J, int m, int n,
-                                                    double* __restrict A) {
-  constexpr int kLanes = 8;
-  const int full = m - m % kLanes;
-  for (int a = 0; a < n; ++a) {
-    const double* __restrict ca = J + static_cast<std::size_t>(a) * m;
-    for (int b = 0; b <= a; ++b) {
-      const double* __restrict cb = J + static_cast<std::size_t>(b) * m;
-      double acc[kLanes] = {0, 0, 0, 0, 0, 0, 0, 0};
-      for (int i = 0; i < full; i += kLanes)
-        for (int l = 0; l < kLanes; ++l) acc[l] += ca[i + l] * cb[i + l];
-      double tail = 0;
-      for (int i = full; i < m; ++i) tail += ca[i] * cb[i];
-      const double sum =
-          ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail;
-      A[a + static_cast<std::size_t>(b) * n] = sum;
-      A[b + static_cast<std::size_t>(a) * n] = sum;
+// Eight doubles as one value: GCC lowers its elementwise operations to whatever vector width the
+// variant has (four SSE2 registers, two AVX2 ones, one AVX-512 one), lane by lane in the same
+// order, so every variant computes the same bits.
+using Lanes8 = double __attribute__((vector_size(64)));
+
+// The fixed order in which an entry's eight partial sums and its tail (the last m mod 8 rows,
+// summed in order) are added.
+[[gnu::always_inline]] inline double SumLanes(const Lanes8& acc, double tail) {
+  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail;
+}
+
+[[gnu::always_inline]] inline double Tail(const double* ca, const double* cb, int full, int m) {
+  double tail = 0;
+  for (int i = full; i < m; ++i) tail += ca[i] * cb[i];
+  return tail;
+}
+
+// Entries (a, b) … (a, b + kWidth − 1) together: column a is loaded once for all of them, and
+// their partial sums are kWidth independent chains.
+template <int kWidth>
+[[gnu::always_inline]] inline void NormalMatrixEntries(const double* __restrict J, int m, int n,
+                                                       int a, int b, int full,
+                                                       double* __restrict A) {
+  const double* ca = J + static_cast<std::size_t>(a) * m;
+  const double* cb[kWidth];
+  Lanes8 acc[kWidth];
+  for (int w = 0; w < kWidth; ++w) {
+    cb[w] = J + static_cast<std::size_t>(b + w) * m;
+    acc[w] = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
+  }
+  for (int i = 0; i < full; i += 8) {
+    Lanes8 x, y;  // unaligned loads
+    std::memcpy(&x, ca + i, sizeof x);
+    for (int w = 0; w < kWidth; ++w) {
+      std::memcpy(&y, cb[w] + i, sizeof y);
+      acc[w] += x * y;
     }
+  }
+  for (int w = 0; w < kWidth; ++w) {
+    const double sum = SumLanes(acc[w], Tail(ca, cb[w], full, m));
+    A[a + static_cast<std::size_t>(b + w) * n] = sum;
+    A[b + w + static_cast<std::size_t>(a) * n] = sum;
   }
 }
 
-void NormalMatrixDefault(const double* J, int m, int n, double* A) { NormalMatrixBody(J, m, n, A); }
+using Index8 = long long __attribute__((vector_size(64)));
+
+// Entries (a + r, b … b + 7) for r < kRows at once, their partial sums reduced side by side:
+// the eight accumulators of a row are transposed pairwise, so each level of SumLanes' tree is one
+// vector addition (lane k of the result is entry b + k, its sums added in SumLanes' order), and
+// the tails come from `tail_rows` (the last m mod 8 rows of J, row-major: tail_rows[i·n + c] =
+// J(full + i, c)).
+template <int kRows>
+[[gnu::always_inline]] inline void NormalMatrixEntries8(const double* __restrict J, int m, int n,
+                                                        int a, int b, int full,
+                                                        const double* __restrict tail_rows,
+                                                        double* __restrict A) {
+  Lanes8 acc[kRows][8];
+  for (auto& row : acc)
+    for (auto& v : row) v = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < full; i += 8) {
+    Lanes8 x[kRows], y;  // unaligned loads
+    for (int r = 0; r < kRows; ++r)
+      std::memcpy(&x[r], J + static_cast<std::size_t>(a + r) * m + i, sizeof(Lanes8));
+    for (int w = 0; w < 8; ++w) {
+      std::memcpy(&y, J + static_cast<std::size_t>(b + w) * m + i, sizeof y);
+      for (int r = 0; r < kRows; ++r) acc[r][w] += x[r] * y;
+    }
+  }
+  for (int r = 0; r < kRows; ++r) {
+    // Level 1: lanes (2j, 2j+1) of entries w and w+1 → (acc[2j] + acc[2j+1]) of each.
+    Lanes8 p[4];
+    for (int k = 0; k < 4; ++k) {
+      const Lanes8 lo =
+          __builtin_shuffle(acc[r][2 * k], acc[r][2 * k + 1], Index8{0, 8, 2, 10, 4, 12, 6, 14});
+      const Lanes8 hi =
+          __builtin_shuffle(acc[r][2 * k], acc[r][2 * k + 1], Index8{1, 9, 3, 11, 5, 13, 7, 15});
+      p[k] = lo + hi;  // [e0 s01, e1 s01, e0 s23, e1 s23, e0 s45, e1 s45, e0 s67, e1 s67]
+    }
+    // Level 2: (s01 + s23) and (s45 + s67) of four entries.
+    Lanes8 q[2];
+    for (int k = 0; k < 2; ++k) {
+      const Lanes8 lo = __builtin_shuffle(p[2 * k], p[2 * k + 1], Index8{0, 1, 8, 9, 4, 5, 12, 13});
+      const Lanes8 hi =
+          __builtin_shuffle(p[2 * k], p[2 * k + 1], Index8{2, 3, 10, 11, 6, 7, 14, 15});
+      q[k] = lo + hi;  // [e0..e3 (s01 + s23), e0..e3 (s45 + s67)]
+    }
+    // Level 3: the two halves of each entry's sum.
+    const Lanes8 lo = __builtin_shuffle(q[0], q[1], Index8{0, 1, 2, 3, 8, 9, 10, 11});
+    const Lanes8 hi = __builtin_shuffle(q[0], q[1], Index8{4, 5, 6, 7, 12, 13, 14, 15});
+    Lanes8 tail = Lanes8{0, 0, 0, 0, 0, 0, 0, 0}, y;
+    for (int i = 0; i < m - full; ++i) {
+      std::memcpy(&y, tail_rows + static_cast<std::size_t>(i) * n + b, sizeof y);
+      tail += tail_rows[static_cast<std::size_t>(i) * n + a + r] * y;
+    }
+    const Lanes8 sum = (lo + hi) + tail;
+    std::memcpy(A + static_cast<std::size_t>(a + r) * n + b, &sum, sizeof sum);
+    for (int w = 0; w < 8; ++w) A[a + r + static_cast<std::size_t>(b + w) * n] = sum[w];
+  }
+}
+
+// Entry (a, b) = Σ_i J(i,a)·J(i,b), summed in 8 partial sums (row index mod 8) over the first
+// m − m mod 8 rows, then SumLanes: the same sequence of operations in every variant. kWide
+// (AVX-512, whose 32 registers hold eight entries' sums) takes entries eight at a time, also past
+// the diagonal (entry (a, b) and entry (b, a) have the same bits: each product commutes).
+template <bool kWide>
+[[gnu::always_inline]] inline void NormalMatrixBody(const double* __restrict J, int m, int n,
+                                                    double* __restrict A) {
+  constexpr int kLanes = 8, kWidth = 4;
+  const int full = m - m % kLanes;
+  thread_local std::vector<double> tail_rows;
+  if constexpr (kWide) {
+    tail_rows.resize(static_cast<std::size_t>(m - full) * n);
+    for (int r = 0; r < m - full; ++r)
+      for (int c = 0; c < n; ++c)
+        tail_rows[static_cast<std::size_t>(r) * n + c] =
+            J[static_cast<std::size_t>(c) * m + full + r];
+  }
+  // Entries (a, b …  a) of row a, from b on, in blocks of kWidth and then one by one.
+  const auto rest_of_row = [&](int a, int b) {
+    for (; b + kWidth <= a + 1; b += kWidth) NormalMatrixEntries<kWidth>(J, m, n, a, b, full, A);
+    for (; b <= a; ++b) NormalMatrixEntries<1>(J, m, n, a, b, full, A);
+  };
+  int a = 0;
+  if constexpr (kWide) {
+    for (; a + 1 < n; a += 2) {  // rows a and a + 1 share the loads of their blocks
+      int b = 0;
+      for (; b <= a + 1 && b + 8 <= n; b += 8)
+        NormalMatrixEntries8<2>(J, m, n, a, b, full, tail_rows.data(), A);
+      rest_of_row(a, b);
+      rest_of_row(a + 1, b);
+    }
+  }
+  for (; a < n; ++a) {
+    int b = 0;
+    if constexpr (kWide)
+      for (; b <= a && b + 8 <= n; b += 8)
+        NormalMatrixEntries8<1>(J, m, n, a, b, full, tail_rows.data(), A);
+    rest_of_row(a, b);
+  }
+}
+
+void NormalMatrixDefault(const double* J, int m, int n, double* A) {
+  NormalMatrixBody<false>(J, m, n, A);
+}
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) void NormalMatrixAvx2(const double* J, int m, int n, double* A) {
-  NormalMatrixBody(J, m, n, A);
+  NormalMatrixBody<false>(J, m, n, A);
 }
 __attribute__((target("avx512f"))) void NormalMatrixAvx512(const double* J, int m, int n,
                                                            double* A) {
-  NormalMatrixBody(J, m, n, A);
+  NormalMatrixBody<true>(J, m, n, A);
 }
 #endif
 

@@ -6,6 +6,8 @@
 
 #include <cstring>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "core/dense_kernel_variants.h"
 #include "lrcal/identification/identification.h"
@@ -32,16 +34,33 @@ TEST(CpuDispatch, ListsTheDefaultVariantAndUsesASupportedOne) {
 TEST(CpuDispatch, NormalMatrixHasTheSameBitsInEveryVariant) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (int m : {25, 100, 103}) {
-    Eigen::MatrixXd J(m, 27);
+  // Sizes that reach every path of the AVX-512 variant: rows fewer than 8 (tail only), a
+  // multiple of 8 (no tail), blocks of eight columns with and without a partner row, and the
+  // columns left over.
+  for (const auto& [m, n] : std::vector<std::pair<int, int>>{
+           {25, 27}, {100, 27}, {103, 27}, {5, 9}, {96, 8}, {100, 25}, {17, 1}, {600, 30}}) {
+    Eigen::MatrixXd J(m, n);
     for (int k = 0; k < J.size(); ++k) J.data()[k] = u(rng);
     Eigen::MatrixXd reference;
     NormalMatrix(J, &reference, Isa::kDefault);
     EXPECT_LT((reference - J.transpose() * J).norm(), 1e-12 * reference.norm());
+    // The order of the sums is the documented one (entry by entry, in every variant).
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) {
+        double lanes[8] = {0, 0, 0, 0, 0, 0, 0, 0}, tail = 0;
+        const int full = m - m % 8;
+        for (int i = 0; i < full; ++i) lanes[i % 8] += J(i, a) * J(i, b);
+        for (int i = full; i < m; ++i) tail += J(i, a) * J(i, b);
+        const double expected = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
+                                ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7])) + tail;
+        ASSERT_TRUE(SameBits(&reference(a, b), &expected, 1)) << a << "," << b << " m=" << m;
+      }
+    }
     for (Isa isa : SupportedIsas()) {
       Eigen::MatrixXd A;
       NormalMatrix(J, &A, isa);
-      EXPECT_TRUE(SameBits(A.data(), reference.data(), A.size())) << IsaName(isa) << " m=" << m;
+      EXPECT_TRUE(SameBits(A.data(), reference.data(), A.size()))
+          << IsaName(isa) << " m=" << m << " n=" << n;
     }
   }
 }
