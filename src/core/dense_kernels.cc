@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/dense_kernel_variants.h"
+#include "core/lanes.h"
 
 namespace lrcal {
 
@@ -58,10 +59,9 @@ void CholeskySubstitute(const RowMajorMatrixXd& L_in, const Eigen::VectorXd& b,
 
 namespace {
 
-// Eight doubles as one value: GCC lowers its elementwise operations to whatever vector width the
-// variant has (four SSE2 registers, two AVX2 ones, one AVX-512 one), lane by lane in the same
-// order, so every variant computes the same bits.
-using Lanes8 = double __attribute__((vector_size(64)));
+// Eight doubles as one value (core/lanes.h): four SSE2 registers, two AVX2 ones or one AVX-512
+// one, the same bits in each.
+using Lanes8 = lanes::VectorOf<8>::type;
 
 // The fixed order in which an entry's eight partial sums and its tail (the last m mod 8 rows,
 // summed in order) are added.
@@ -89,12 +89,8 @@ template <int kWidth>
     acc[w] = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
   }
   for (int i = 0; i < full; i += 8) {
-    Lanes8 x, y;  // unaligned loads
-    std::memcpy(&x, ca + i, sizeof x);
-    for (int w = 0; w < kWidth; ++w) {
-      std::memcpy(&y, cb[w] + i, sizeof y);
-      acc[w] += x * y;
-    }
+    const Lanes8 x = lanes::Load<Lanes8>(ca + i);
+    for (int w = 0; w < kWidth; ++w) acc[w] += x * lanes::Load<Lanes8>(cb[w] + i);
   }
   for (int w = 0; w < kWidth; ++w) {
     const double sum = SumLanes(acc[w], Tail(ca, cb[w], full, m));
@@ -119,11 +115,11 @@ template <int kRows>
   for (auto& row : acc)
     for (auto& v : row) v = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
   for (int i = 0; i < full; i += 8) {
-    Lanes8 x[kRows], y;  // unaligned loads
+    Lanes8 x[kRows];
     for (int r = 0; r < kRows; ++r)
-      std::memcpy(&x[r], J + static_cast<std::size_t>(a + r) * m + i, sizeof(Lanes8));
+      x[r] = lanes::Load<Lanes8>(J + static_cast<std::size_t>(a + r) * m + i);
     for (int w = 0; w < 8; ++w) {
-      std::memcpy(&y, J + static_cast<std::size_t>(b + w) * m + i, sizeof y);
+      const Lanes8 y = lanes::Load<Lanes8>(J + static_cast<std::size_t>(b + w) * m + i);
       for (int r = 0; r < kRows; ++r) acc[r][w] += x[r] * y;
     }
   }
@@ -148,13 +144,12 @@ template <int kRows>
     // Level 3: the two halves of each entry's sum.
     const Lanes8 lo = __builtin_shuffle(q[0], q[1], Index8{0, 1, 2, 3, 8, 9, 10, 11});
     const Lanes8 hi = __builtin_shuffle(q[0], q[1], Index8{4, 5, 6, 7, 12, 13, 14, 15});
-    Lanes8 tail = Lanes8{0, 0, 0, 0, 0, 0, 0, 0}, y;
-    for (int i = 0; i < m - full; ++i) {
-      std::memcpy(&y, tail_rows + static_cast<std::size_t>(i) * n + b, sizeof y);
-      tail += tail_rows[static_cast<std::size_t>(i) * n + a + r] * y;
-    }
+    Lanes8 tail = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
+    for (int i = 0; i < m - full; ++i)
+      tail += tail_rows[static_cast<std::size_t>(i) * n + a + r] *
+              lanes::Load<Lanes8>(tail_rows + static_cast<std::size_t>(i) * n + b);
     const Lanes8 sum = (lo + hi) + tail;
-    std::memcpy(A + static_cast<std::size_t>(a + r) * n + b, &sum, sizeof sum);
+    lanes::Store(A + static_cast<std::size_t>(a + r) * n + b, sum);
     for (int w = 0; w < 8; ++w) A[a + r + static_cast<std::size_t>(b + w) * n] = sum[w];
   }
 }

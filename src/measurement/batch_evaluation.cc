@@ -2,308 +2,309 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 #include "core/cpu_dispatch.h"
-#include "measurement/batch_chain.h"
+#include "core/lanes.h"
 
 namespace lrcal {
-
-using batch::kFrameArrays;
-using batch::kO;
-using batch::kOPrev;
-using batch::kXCommon;
-using batch::kYTwist;
-using batch::kZPrev;
 
 void BatchEvaluator::SetConfigurations(const TargetedConfigurations& configs) {
   m_ = configs.size();
   joints_ = configs.num_joints();
-  joint_arrays_.Set(configs);
+  // Padded to whole blocks of kMaxLanes; the padding repeats the last configuration (finite
+  // values whose results are never stored).
+  stride_ = (m_ + kMaxLanes - 1) / kMaxLanes * kMaxLanes;
+  const std::size_t size = static_cast<std::size_t>(joints_) * stride_;
+  q_.resize(size);
+  cq_.resize(size);
+  sq_.resize(size);
+  for (int i = 0; i < stride_; ++i) {
+    const int from = std::min(i, m_ - 1);
+    for (int j = 0; j < joints_; ++j) {
+      const std::size_t at = static_cast<std::size_t>(j) * stride_ + i;
+      q_[at] = from < 0 ? 0.0 : configs.q(from)[j];
+      cq_[at] = from < 0 ? 1.0 : configs.cos_q(from)[j];
+      sq_[at] = from < 0 ? 0.0 : configs.sin_q(from)[j];
+    }
+  }
   plane_.clear();
   num_targets_referenced_ = configs.num_targets_referenced();
   if (num_targets_referenced_ > 1) {
-    plane_.resize(m_);
-    for (int i = 0; i < m_; ++i) plane_[i] = configs.target(i);
+    plane_.resize(stride_);
+    for (int i = 0; i < stride_; ++i) plane_[i] = configs.target(std::min(i, m_ - 1));
   }
-  state_.resize(12 * static_cast<std::size_t>(m_));
-  frames_.resize(static_cast<std::size_t>(kFrameArrays) * joints_ * m_);
-  scratch_.resize(12 * static_cast<std::size_t>(m_));
 }
 
 namespace {
 
+// The kernel runs on blocks of W configurations at once, each quantity a vector of W doubles
+// (GCC's vector extension: elementwise IEEE arithmetic, lowered to the variant's registers), and
+// follows one block through the whole chain, the readings and the Jacobian before the next: the
+// chain's running frame stays in registers and the link frames the Jacobian needs stay in a few
+// kilobytes of first-level cache. Each configuration's arithmetic is MeasurementModel's fast path
+// operation for operation (the same expressions in the same order, and -ffp-contract=off forbids
+// fused multiply-adds), so every variant and every block width gives the same bits.
+
+using lanes::All;
+using lanes::Load;
+using lanes::Store;
+
 struct KernelArgs {
-  int m;
+  int m;       // configurations (J's leading dimension)
+  int stride;  // of the joint arrays (m rounded up to whole blocks)
   const ModelPoint* point;
   const ParameterSet* parameters;
   const double* q;
   const double* cq;
   const double* sq;
   const int* plane;  // per configuration; null when all are aimed at plane 0
-  double* state;
-  double* frames;
-  double* scratch;
   double* h;
   double* J;
 };
 
-// The vectorised kernel: structure-of-arrays loops over all configurations, in force-inlined
-// steps that the compiler inlines into one function per instruction set (cpu_dispatch.h); every
-// variant gives the same bits (each configuration's arithmetic is the same sequence of
-// operations, and -ffp-contract=off forbids fused multiply-adds). The chain's steps are
-// batch_chain.h's.
-using batch::FrameArrays;
-using batch::FrameArraysOf;
-
-// What the readings leave for the Jacobian (args.scratch, 9 arrays of m): −1/(n·b), the hit
-// point, n·b, and (several planes) each configuration's plane normal and offset.
-struct ReadingArrays {
-  double* __restrict inv;
-  double* __restrict ph0;
-  double* __restrict ph1;
-  double* __restrict ph2;
-  double* __restrict nbs;
-  double* __restrict pn0;
-  double* __restrict pn1;
-  double* __restrict pn2;
-  double* __restrict pf;
+template <typename V>
+struct Vec3 {
+  V c0, c1, c2;
 };
 
-[[gnu::always_inline]] inline ReadingArrays ReadingArraysOf(double* scratch, int m) {
-  return {scratch,         scratch + m,     scratch + 2 * m, scratch + 3 * m, scratch + 4 * m,
-          scratch + 5 * m, scratch + 6 * m, scratch + 7 * m, scratch + 8 * m};
+// A link's frames kept for the Jacobian (ChainFrames' o_prev, z_prev, x_common, y_twist, o).
+template <typename V>
+struct LinkFramesOf {
+  Vec3<V> z_prev, o_prev, x_common, y_twist, o;
+};
+
+// The running frame: axes x, y, z and origin o.
+template <typename V>
+struct Frame {
+  Vec3<V> x, y, z, o;
+};
+
+template <typename V>
+[[gnu::always_inline]] inline Frame<V> BaseFrame(const ModelPoint& point) {
+  const Eigen::Matrix3d& rb = point.base.rotation;
+  const Eigen::Vector3d& pb = point.base.translation;
+  const auto all = [](double x) { return All<V>(x); };
+  return {{all(rb(0, 0)), all(rb(1, 0)), all(rb(2, 0))},
+          {all(rb(0, 1)), all(rb(1, 1)), all(rb(2, 1))},
+          {all(rb(0, 2)), all(rb(1, 2)), all(rb(2, 2))},
+          {all(pb(0)), all(pb(1)), all(pb(2))}};
 }
 
-// The plane normal n and offset f at configuration i: the one plane's (scalars), or
-// configuration i's plane's (gathered into arrays).
-template <bool kSeveralPlanes>
-struct PlaneAt {
-  const ReadingArrays& r;
-  double s0, s1, s2, sf;
-  [[gnu::always_inline]] double n0(int i) const { return kSeveralPlanes ? r.pn0[i] : s0; }
-  [[gnu::always_inline]] double n1(int i) const { return kSeveralPlanes ? r.pn1[i] : s1; }
-  [[gnu::always_inline]] double n2(int i) const { return kSeveralPlanes ? r.pn2[i] : s2; }
-  [[gnu::always_inline]] double f(int i) const { return kSeveralPlanes ? r.pf[i] : sf; }
+// Through link l (D-H + β): batch::PropagateLink's arithmetic.
+template <typename V, bool kJacobian>
+[[gnu::always_inline]] inline void Propagate(const ChainPoint::LinkTrig& t, const V& q, const V& cq,
+                                             const V& sq, Frame<V>* s, LinkFramesOf<V>* f) {
+  const double ct0 = t.cos_theta0, st0 = t.sin_theta0, ca = t.cos_alpha, sa = t.sin_alpha,
+               cb = t.cos_beta, sb = t.sin_beta, a = t.a, d0 = t.d;
+  const double revolute = t.prismatic ? 0.0 : 1.0;
+  const V ct = revolute * (ct0 * cq - st0 * sq) + (1 - revolute) * ct0;
+  const V st = revolute * (st0 * cq + ct0 * sq) + (1 - revolute) * st0;
+  const V d = d0 + (1 - revolute) * q;
+  Vec3<V>& x = s->x;
+  Vec3<V>& y = s->y;
+  Vec3<V>& z = s->z;
+  Vec3<V>& o = s->o;
+  const Vec3<V> xc{ct * x.c0 + st * y.c0, ct * x.c1 + st * y.c1, ct * x.c2 + st * y.c2};
+  const Vec3<V> yr{ct * y.c0 - st * x.c0, ct * y.c1 - st * x.c1, ct * y.c2 - st * x.c2};
+  const Vec3<V> yt{ca * yr.c0 + sa * z.c0, ca * yr.c1 + sa * z.c1, ca * yr.c2 + sa * z.c2};
+  const Vec3<V> za{ca * z.c0 - sa * yr.c0, ca * z.c1 - sa * yr.c1, ca * z.c2 - sa * yr.c2};
+  if constexpr (kJacobian) {
+    f->z_prev = z;
+    f->o_prev = o;
+    f->x_common = xc;
+    f->y_twist = yt;
+  }
+  o.c0 += a * xc.c0 + d * z.c0;
+  o.c1 += a * xc.c1 + d * z.c1;
+  o.c2 += a * xc.c2 + d * z.c2;
+  if constexpr (kJacobian) f->o = o;
+  x = {cb * xc.c0 - sb * za.c0, cb * xc.c1 - sb * za.c1, cb * xc.c2 - sb * za.c2};
+  z = {sb * xc.c0 + cb * za.c0, sb * xc.c1 + cb * za.c1, sb * xc.c2 + cb * za.c2};
+  y = yt;
+}
+
+// The tool frame: p ← p + R·t, R ← R·R_tool (batch::ApplyTool's arithmetic).
+template <typename V>
+[[gnu::always_inline]] inline void ApplyTool(const ChainPoint& point, Frame<V>* s) {
+  const Eigen::Matrix3d& rt = point.tool.rotation;
+  const Eigen::Vector3d& pt = point.tool.translation;
+  const Frame<V> r = *s;
+  const auto row = [&](const V& xr, const V& yr, const V& zr, V* o, V* x, V* y, V* z) {
+    *o += xr * pt(0) + yr * pt(1) + zr * pt(2);
+    *x = xr * rt(0, 0) + yr * rt(1, 0) + zr * rt(2, 0);
+    *y = xr * rt(0, 1) + yr * rt(1, 1) + zr * rt(2, 1);
+    *z = xr * rt(0, 2) + yr * rt(1, 2) + zr * rt(2, 2);
+  };
+  row(r.x.c0, r.y.c0, r.z.c0, &s->o.c0, &s->x.c0, &s->y.c0, &s->z.c0);
+  row(r.x.c1, r.y.c1, r.z.c1, &s->o.c1, &s->x.c1, &s->y.c1, &s->z.c1);
+  row(r.x.c2, r.y.c2, r.z.c2, &s->o.c2, &s->x.c2, &s->y.c2, &s->z.c2);
+}
+
+// The reading and what the Jacobian needs of it: the plane's normal n and offset f, −1/(n·b),
+// the hit point.
+template <typename V>
+struct Reading {
+  Vec3<V> n;
+  V f, h, inv, nb;
+  Vec3<V> ph;
 };
 
-template <bool kSeveralPlanes>
-[[gnu::always_inline]] inline PlaneAt<kSeveralPlanes> GatherPlanes(const KernelArgs& args,
-                                                                   const ReadingArrays& r) {
+// (r × n)·axis / (−n·b) with r = ph − c: a rotation about an axis through c.
+template <typename V>
+[[gnu::always_inline]] inline V TurnColumn(const Reading<V>& r, const Vec3<V>& c,
+                                           const Vec3<V>& axis) {
+  const V r0 = r.ph.c0 - c.c0, r1 = r.ph.c1 - c.c1, r2 = r.ph.c2 - c.c2;
+  const Vec3<V>& n = r.n;
+  const V g = (r1 * n.c2 - r2 * n.c1) * axis.c0 + (r2 * n.c0 - r0 * n.c2) * axis.c1 +
+              (r0 * n.c1 - r1 * n.c0) * axis.c2;
+  return g * r.inv;
+}
+
+// n·axis / (−n·b): a shift along an axis.
+template <typename V>
+[[gnu::always_inline]] inline V ShiftColumn(const Reading<V>& r, const Vec3<V>& axis) {
+  return (r.n.c0 * axis.c0 + r.n.c1 * axis.c1 + r.n.c2 * axis.c2) * r.inv;
+}
+
+// The column of link value `index`: d and a move the origin along an axis; θ, α and β turn
+// about an axis through a point (θ: z_prev through o_prev; α: x_common through o; β: y_twist
+// through o).
+template <typename V>
+[[gnu::always_inline]] inline V LinkColumn(const LinkFramesOf<V>* frames, int index,
+                                           const Reading<V>& r) {
+  const LinkFramesOf<V>& f = frames[index / kValuesPerLink];
+  switch (index % kValuesPerLink) {
+    case kD:
+      return ShiftColumn(r, f.z_prev);
+    case kA:
+      return ShiftColumn(r, f.x_common);
+    case kTheta:
+      return TurnColumn(r, f.o_prev, f.z_prev);
+    case kAlpha:
+      return TurnColumn(r, f.o, f.x_common);
+    default:
+      return TurnColumn(r, f.o, f.y_twist);
+  }
+}
+
+// One estimated base or tool term's column: a shift moves the hit point along v, a rotation
+// turns it about v through a point; the base's v and point are fixed in B, the tool's v turns
+// with the tool (R_BT·v) and its point is the beam's origin.
+template <typename V, bool kTool, bool kShift>
+[[gnu::always_inline]] inline V FrameColumn(const ModelPoint& point, const Frame<V>& s,
+                                            const Reading<V>& r, const Eigen::Vector3d& v) {
+  Vec3<V> w{All<V>(v[0]), All<V>(v[1]), All<V>(v[2])};
+  if constexpr (kTool) {
+    w = {s.x.c0 * v[0] + s.y.c0 * v[1] + s.z.c0 * v[2],
+         s.x.c1 * v[0] + s.y.c1 * v[1] + s.z.c1 * v[2],
+         s.x.c2 * v[0] + s.y.c2 * v[1] + s.z.c2 * v[2]};
+  }
+  if constexpr (kShift) {
+    return ShiftColumn(r, w);
+  } else {
+    const Eigen::Vector3d& pb = point.base.translation;
+    const Vec3<V> c = kTool ? s.o : Vec3<V>{All<V>(pb[0]), All<V>(pb[1]), All<V>(pb[2])};
+    return TurnColumn(r, c, w);
+  }
+}
+
+// Configurations i0 … i0 + valid − 1 (valid ≤ W): their readings into h and, with kJacobian,
+// their rows of J. Returns how many beams run along their plane.
+template <typename V, bool kJacobian>
+[[gnu::always_inline]] inline int Block(const KernelArgs& args, int i0, int valid) {
   const ModelPoint& point = *args.point;
-  const Plane& plane0 = point.planes[0];
-  if constexpr (kSeveralPlanes) {
-    for (int i = 0; i < args.m; ++i) {
-      const Plane& p = point.planes[args.plane[i]];
-      r.pn0[i] = p.normal.x();
-      r.pn1[i] = p.normal.y();
-      r.pn2[i] = p.normal.z();
-      r.pf[i] = p.offset;
+  Frame<V> s = BaseFrame<V>(point);
+  LinkFramesOf<V> frames[kJacobian ? kMaxLinks : 1];
+  for (int l = 0; l < point.num_links; ++l) {
+    const std::size_t at = static_cast<std::size_t>(l) * args.stride + i0;
+    Propagate<V, kJacobian>(point.links[l], Load<V>(args.q + at), Load<V>(args.cq + at),
+                            Load<V>(args.sq + at), &s, &frames[kJacobian ? l : 0]);
+  }
+  if (point.has_tool) ApplyTool(point, &s);
+  constexpr int kW = lanes::kWidth<V>;
+  Reading<V> r;
+  if (args.plane) {
+    for (int k = 0; k < kW; ++k) {
+      const Plane& p = point.planes[args.plane[i0 + k]];
+      r.n.c0[k] = p.normal.x();
+      r.n.c1[k] = p.normal.y();
+      r.n.c2[k] = p.normal.z();
+      r.f[k] = p.offset;
+    }
+  } else {
+    const Plane& p = point.planes[0];
+    r.n = {All<V>(p.normal.x()), All<V>(p.normal.y()), All<V>(p.normal.z())};
+    r.f = All<V>(p.offset);
+  }
+  const Vec3<V>& n = r.n;
+  r.nb = n.c0 * s.z.c0 + n.c1 * s.z.c1 + n.c2 * s.z.c2;
+  r.h = -(n.c0 * s.o.c0 + n.c1 * s.o.c1 + n.c2 * s.o.c2 + r.f) / r.nb;
+  r.inv = -1.0 / r.nb;
+  r.ph = {s.o.c0 + r.h * s.z.c0, s.o.c1 + r.h * s.z.c1, s.o.c2 + r.h * s.z.c2};
+  Store(args.h + i0, r.h, valid);
+  int parallel = 0;
+  for (int k = 0; k < valid; ++k) parallel += std::fabs(r.nb[k]) <= kParallelBeamThreshold;
+  if constexpr (kJacobian) {
+    const ParameterSet& ps = *args.parameters;
+    const auto column = [&](int c) { return args.J + static_cast<std::size_t>(c) * args.m + i0; };
+    for (int k = 0; k < ps.num_robot(); ++k)
+      Store(column(k), LinkColumn(frames, ps.robot_values[k], r), valid);
+    // Plane p's chart u (two) and offset f: nonzero on the configurations aimed at plane p.
+    for (int p = 0; p < ps.num_planes(); ++p) {
+      const PlaneColumns& pc = ps.plane_columns[p];
+      V own = All<V>(p == 0 ? 1.0 : 0.0);
+      if (args.plane)
+        for (int k = 0; k < kW; ++k) own[k] = args.plane[i0 + k] == p ? 1.0 : 0.0;
+      for (int c = 0; c < 2; ++c) {
+        if (pc.u[c] < 0) continue;
+        const Eigen::Matrix<double, 3, 2>& dn_du = point.dn_du[p];
+        const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
+        Store(column(pc.u[c]), own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv), valid);
+      }
+      if (pc.f >= 0) Store(column(pc.f), own * r.inv, valid);
+    }
+    if (ps.EstimatesFrames()) {
+      for (int k = 0; k < 3; ++k) {
+        const int* base = ps.frame_columns[0];
+        const int* tool = ps.frame_columns[1];
+        if (base[k] >= 0)
+          Store(column(base[k]), FrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)),
+                valid);
+        if (base[3 + k] >= 0)
+          Store(column(base[3 + k]),
+                FrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)), valid);
+        if (tool[k] >= 0)
+          Store(column(tool[k]),
+                FrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)), valid);
+        if (tool[3 + k] >= 0)
+          Store(column(tool[3 + k]),
+                FrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)), valid);
+      }
     }
   }
-  return {r, plane0.normal.x(), plane0.normal.y(), plane0.normal.z(), plane0.offset};
-}
-
-// Readings h = −(n·p + f)/(n·b); keeps −1/(n·b) and the hit point for the Jacobian. Returns the
-// number of beams along the plane (|n·b| ≤ kParallelBeamThreshold: no reading).
-template <bool kSeveralPlanes>
-[[gnu::always_inline]] inline int Readings(const KernelArgs& args, const FrameArrays& s,
-                                           const ReadingArrays& r,
-                                           const PlaneAt<kSeveralPlanes>& n) {
-  const int m = args.m;
-  double* __restrict h = args.h;
-  const double* __restrict z0 = s.z0;
-  const double* __restrict z1 = s.z1;
-  const double* __restrict z2 = s.z2;
-  const double* __restrict o0 = s.o0;
-  const double* __restrict o1 = s.o1;
-  const double* __restrict o2 = s.o2;
-  double* __restrict inv = r.inv;
-  double* __restrict ph0 = r.ph0;
-  double* __restrict ph1 = r.ph1;
-  double* __restrict ph2 = r.ph2;
-  double* __restrict nbs = r.nbs;
-#pragma GCC ivdep
-  for (int i = 0; i < m; ++i) {
-    const double nb = n.n0(i) * z0[i] + n.n1(i) * z1[i] + n.n2(i) * z2[i];
-    const double hi = -(n.n0(i) * o0[i] + n.n1(i) * o1[i] + n.n2(i) * o2[i] + n.f(i)) / nb;
-    nbs[i] = nb;
-    h[i] = hi;
-    inv[i] = -1.0 / nb;
-    ph0[i] = o0[i] + hi * z0[i];
-    ph1[i] = o1[i] + hi * z1[i];
-    ph2[i] = o2[i] + hi * z2[i];
-  }
-  int parallel = 0;
-  for (int i = 0; i < m; ++i) parallel += std::fabs(nbs[i]) <= kParallelBeamThreshold;
   return parallel;
 }
 
-// The Jacobian column of the link value at `index`: d and a move the origin along an axis
-// (n·axis/(−n·b)); θ, α and β turn about an axis through a point ((r × n)·axis/(−n·b), r from
-// that point to the hit point).
-template <bool kSeveralPlanes>
-[[gnu::always_inline]] inline void LinkColumn(const KernelArgs& args, int index,
-                                              const ReadingArrays& r,
-                                              const PlaneAt<kSeveralPlanes>& n,
-                                              double* __restrict col) {
-  const int m = args.m;
-  const int l = index / kValuesPerLink;
-  const double* f = args.frames + static_cast<std::size_t>(l) * kFrameArrays * m;
-  const double* __restrict inv = r.inv;
-  const int v = index % kValuesPerLink;
-  if (v == kD || v == kA) {
-    const double* __restrict a0 = f + (v == kD ? kZPrev : kXCommon) * m;
-    const double* __restrict a1 = a0 + m;
-    const double* __restrict a2 = a1 + m;
-#pragma GCC ivdep
-    for (int i = 0; i < m; ++i)
-      col[i] = (n.n0(i) * a0[i] + n.n1(i) * a1[i] + n.n2(i) * a2[i]) * inv[i];
-    return;
-  }
-  // θ: axis z_prev through o_prev; α: x_common through o; β: y_twist through o.
-  const double* __restrict c0 = f + (v == kTheta ? kOPrev : kO) * m;
-  const double* __restrict c1 = c0 + m;
-  const double* __restrict c2 = c1 + m;
-  const double* __restrict a0 = f + (v == kTheta ? kZPrev : v == kAlpha ? kXCommon : kYTwist) * m;
-  const double* __restrict a1 = a0 + m;
-  const double* __restrict a2 = a1 + m;
-  const double* __restrict ph0 = r.ph0;
-  const double* __restrict ph1 = r.ph1;
-  const double* __restrict ph2 = r.ph2;
-#pragma GCC ivdep
-  for (int i = 0; i < m; ++i) {
-    const double r0 = ph0[i] - c0[i], r1 = ph1[i] - c1[i], r2 = ph2[i] - c2[i];
-    // (r × n)·axis
-    const double g = (r1 * n.n2(i) - r2 * n.n1(i)) * a0[i] + (r2 * n.n0(i) - r0 * n.n2(i)) * a1[i] +
-                     (r0 * n.n1(i) - r1 * n.n0(i)) * a2[i];
-    col[i] = g * inv[i];
-  }
-}
-
-// The Jacobian columns of plane p's chart u (two) and offset f: nonzero only on the
-// configurations aimed at plane p (all are aimed at plane 0 in the single-plane kernel).
-template <bool kSeveralPlanes>
-[[gnu::always_inline]] inline void PlaneColumnsOf(const KernelArgs& args, int p,
-                                                  const ReadingArrays& r) {
-  const int m = args.m;
-  const PlaneColumns& pc = args.parameters->plane_columns[p];
-  const double* __restrict inv = r.inv;
-  const double* __restrict ph0 = r.ph0;
-  const double* __restrict ph1 = r.ph1;
-  const double* __restrict ph2 = r.ph2;
-  const double all_own = p == 0 ? 1.0 : 0.0;
-  const auto own = [&](int i) {
-    return kSeveralPlanes ? (args.plane[i] == p ? 1.0 : 0.0) : all_own;
-  };
-  for (int c = 0; c < 2; ++c) {
-    if (pc.u[c] < 0) continue;
-    double* __restrict col = args.J + static_cast<std::size_t>(pc.u[c]) * m;
-    const Eigen::Matrix<double, 3, 2>& dn_du = args.point->dn_du[p];
-    const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
-#pragma GCC ivdep
-    for (int i = 0; i < m; ++i)
-      col[i] = own(i) * ((ph0[i] * d0 + ph1[i] * d1 + ph2[i] * d2) * inv[i]);
-  }
-  if (pc.f >= 0) {
-    double* __restrict col = args.J + static_cast<std::size_t>(pc.f) * m;
-#pragma GCC ivdep
-    for (int i = 0; i < m; ++i) col[i] = own(i) * inv[i];
-  }
-}
-
-// One Jacobian column of an estimated base or tool term (measurement_model.h): a shift moves the
-// hit point along a direction v (n·v/(−n·b)), a rotation turns it about an axis v through a point
-// ((r × n)·v/(−n·b)). The base's v and point are fixed in B; the tool's v turns with the tool
-// (R_BT·v, from the state's axes) and its point is the beam's origin.
-template <bool kSeveralPlanes, bool kTool, bool kShift>
-[[gnu::always_inline]] inline void FrameColumn(const KernelArgs& args, const FrameArrays& s,
-                                               const ReadingArrays& r,
-                                               const PlaneAt<kSeveralPlanes>& n,
-                                               const Eigen::Vector3d& v, double* __restrict col) {
-  const Eigen::Vector3d& pb = args.point->base.translation;
-  for (int i = 0; i < args.m; ++i) {
-    double w0 = v[0], w1 = v[1], w2 = v[2];
-    if constexpr (kTool) {
-      w0 = s.x0[i] * v[0] + s.y0[i] * v[1] + s.z0[i] * v[2];
-      w1 = s.x1[i] * v[0] + s.y1[i] * v[1] + s.z1[i] * v[2];
-      w2 = s.x2[i] * v[0] + s.y2[i] * v[1] + s.z2[i] * v[2];
-    }
-    double g;
-    if constexpr (kShift) {
-      g = n.n0(i) * w0 + n.n1(i) * w1 + n.n2(i) * w2;
-    } else {
-      const double r0 = r.ph0[i] - (kTool ? s.o0[i] : pb[0]);
-      const double r1 = r.ph1[i] - (kTool ? s.o1[i] : pb[1]);
-      const double r2 = r.ph2[i] - (kTool ? s.o2[i] : pb[2]);
-      g = (r1 * n.n2(i) - r2 * n.n1(i)) * w0 + (r2 * n.n0(i) - r0 * n.n2(i)) * w1 +
-          (r0 * n.n1(i) - r1 * n.n0(i)) * w2;
-    }
-    col[i] = g * r.inv[i];
-  }
-}
-
-// Every estimated base and tool term's column.
-template <bool kSeveralPlanes>
-[[gnu::always_inline]] inline void FrameColumnsOf(const KernelArgs& args, const FrameArrays& s,
-                                                  const ReadingArrays& r,
-                                                  const PlaneAt<kSeveralPlanes>& n) {
-  const ModelPoint& point = *args.point;
-  const auto column = [&](int f, int k) {
-    const int c = args.parameters->frame_columns[f][k];
-    return c < 0 ? nullptr : args.J + static_cast<std::size_t>(c) * args.m;
-  };
-  for (int k = 0; k < 3; ++k) {
-    if (double* col = column(0, k))
-      FrameColumn<kSeveralPlanes, false, true>(args, s, r, n, Eigen::Vector3d::Unit(k), col);
-    if (double* col = column(0, 3 + k))
-      FrameColumn<kSeveralPlanes, false, false>(args, s, r, n, point.base_axes.col(k), col);
-    if (double* col = column(1, k))
-      FrameColumn<kSeveralPlanes, true, true>(args, s, r, n, point.tool_shifts_T.col(k), col);
-    if (double* col = column(1, 3 + k))
-      FrameColumn<kSeveralPlanes, true, false>(args, s, r, n, point.tool_axes_T.col(k), col);
-  }
-}
-
-// The kernel: frames through the chain, the readings and (kJacobian) the Jacobian's columns.
-template <bool kJacobian, bool kSeveralPlanes>
+template <int W>
 [[gnu::always_inline]] inline bool KernelBody(const KernelArgs& args) {
-  const int m = args.m;
-  const ModelPoint& point = *args.point;
-  const FrameArrays s = FrameArraysOf(args.state, m);
-  batch::StartAtBase(point, m, s);
-  const batch::ChainArrays chain{m, &point, args.q, args.cq, args.sq, args.frames};
-  for (int l = 0; l < point.num_links; ++l) batch::PropagateLink<kJacobian>(chain, l, s);
-  if (point.has_tool) batch::ApplyTool(point, m, s);
-  const ReadingArrays r = ReadingArraysOf(args.scratch, m);
-  const PlaneAt<kSeveralPlanes> n = GatherPlanes<kSeveralPlanes>(args, r);
-  const int parallel = Readings<kSeveralPlanes>(args, s, r, n);
-  if constexpr (!kJacobian) return parallel == 0;
-  const ParameterSet& ps = *args.parameters;
-  for (int k = 0; k < ps.num_robot(); ++k)
-    LinkColumn<kSeveralPlanes>(args, ps.robot_values[k], r, n,
-                               args.J + static_cast<std::size_t>(k) * m);
-  for (int p = 0; p < ps.num_planes(); ++p) PlaneColumnsOf<kSeveralPlanes>(args, p, r);
-  if (ps.EstimatesFrames()) FrameColumnsOf<kSeveralPlanes>(args, s, r, n);
+  using V = typename lanes::VectorOf<W>::type;
+  int parallel = 0;
+  for (int i0 = 0; i0 < args.m; i0 += W) {
+    const int valid = std::min(W, args.m - i0);
+    parallel += args.J ? Block<V, true>(args, i0, valid) : Block<V, false>(args, i0, valid);
+  }
   return parallel == 0;
 }
 
-template <bool kJacobian>
-[[gnu::always_inline]] inline bool KernelPlanes(const KernelArgs& a) {
-  return a.plane ? KernelBody<kJacobian, true>(a) : KernelBody<kJacobian, false>(a);
-}
-
-bool KernelDefault(const KernelArgs& a) {
-  return a.J ? KernelPlanes<true>(a) : KernelPlanes<false>(a);
-}
+bool KernelDefault(const KernelArgs& a) { return KernelBody<2>(a); }
 #if defined(__x86_64__)
-__attribute__((target("avx2"))) bool KernelAvx2(const KernelArgs& a) {
-  return a.J ? KernelPlanes<true>(a) : KernelPlanes<false>(a);
-}
+__attribute__((target("avx2"))) bool KernelAvx2(const KernelArgs& a) { return KernelBody<4>(a); }
 __attribute__((target("avx512f"))) bool KernelAvx512(const KernelArgs& a) {
-  return a.J ? KernelPlanes<true>(a) : KernelPlanes<false>(a);
+  return KernelBody<8>(a);
 }
 #endif
 
@@ -320,18 +321,9 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
     throw std::invalid_argument("BatchEvaluator: a configuration is aimed at plane " +
                                 std::to_string(num_targets_referenced_) + " of " +
                                 std::to_string(model.num_planes()));
-  const KernelArgs args{m_,
-                        &point,
-                        &model.parameters(),
-                        joint_arrays_.q.data(),
-                        joint_arrays_.cq.data(),
-                        joint_arrays_.sq.data(),
-                        plane_.empty() ? nullptr : plane_.data(),
-                        state_.data(),
-                        frames_.data(),
-                        scratch_.data(),
-                        h,
-                        J};
+  const KernelArgs args{m_,        stride_,    &point,     &model.parameters(),
+                        q_.data(), cq_.data(), sq_.data(), plane_.empty() ? nullptr : plane_.data(),
+                        h,         J};
   bool ok;
   switch (isa) {
 #if defined(__x86_64__)

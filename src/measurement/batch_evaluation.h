@@ -1,18 +1,18 @@
 // Laser readings and the identification Jacobian for a whole set of configurations at once.
 //
-// The same mathematics as MeasurementModel::Evaluate (measurement_model.h), laid out as
-// structure-of-arrays: every quantity of the chain (rotation columns, origins, the axes the
-// Jacobian needs) is an array over the configurations, and each step of the chain is a loop over
-// contiguous arrays that the compiler vectorises. The Jacobian is written column-major (m×n),
-// ready for the normal equations' rank-k update. batch_evaluation_test.cc checks it against the
-// per-configuration path. The Monte-Carlo hot path (LevenbergMarquardt) uses it.
+// The same mathematics as MeasurementModel::Evaluate (measurement_model.h), vectorised over the
+// configurations: the kernel takes them a block at a time (2, 4 or 8, the variant's vector
+// width), follows the block through the chain with the running frame in registers, and writes
+// its readings and its rows of the Jacobian (column-major m×n, ready for the normal equations)
+// before the next block. batch_evaluation_test.cc checks it against the per-configuration path
+// and cpu_dispatch_test.cc checks that every variant gives the same bits. The Monte-Carlo hot
+// path (LevenbergMarquardt) uses it.
 #pragma once
 
 #include <vector>
 
 #include "core/cpu_dispatch.h"
 #include "lrcal/measurement/measurement_model.h"
-#include "measurement/batch_chain.h"
 
 namespace lrcal {
 
@@ -31,13 +31,15 @@ class BatchEvaluator {
                 Isa isa);
 
  private:
-  int m_ = 0, joints_ = 0, num_targets_referenced_ = 0;
-  batch::JointArrays joint_arrays_;
+  // The widest block the kernel takes (AVX-512: eight doubles).
+  static constexpr int kMaxLanes = 8;
+  int m_ = 0, joints_ = 0, num_targets_referenced_ = 0, stride_ = 0;
+  // The configurations' joint values and their cos/sin, one array per joint
+  // ([joint·stride + i], padded to whole blocks by repeating the last configuration).
+  std::vector<double> q_, cq_, sq_;
   // Each configuration's plane; empty when every configuration is aimed at plane 0 (the
   // single-plane kernel, which keeps the plane's normal in registers).
   std::vector<int> plane_;
-  // Chain state and per-link frames: [(link·kFrameArrays + k)·m + i].
-  std::vector<double> state_, frames_, scratch_;
 };
 
 }  // namespace lrcal

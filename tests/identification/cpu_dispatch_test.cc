@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <utility>
 #include <vector>
 
 #include "core/dense_kernel_variants.h"
+#include "lrcal/core/dense_kernels.h"
 #include "lrcal/identification/identification.h"
 #include "measurement/batch_evaluation.h"
 #include "test_util.h"
@@ -63,6 +65,67 @@ TEST(CpuDispatch, NormalMatrixHasTheSameBitsInEveryVariant) {
           << IsaName(isa) << " m=" << m << " n=" << n;
     }
   }
+}
+
+// The Cholesky solve against the left-looking formula written out here (the order in which
+// every entry loses its products): L and x bit for bit (the solver's steps, hence every study
+// table, depend on them); a pivot below the threshold is refused.
+TEST(CpuDispatch, CholeskySolveHasTheBitsOfTheLeftLookingFormula) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int n : {1, 2, 5, 8, 9, 25, 30, 33}) {
+    Eigen::MatrixXd G(n + 3, n);
+    for (int k = 0; k < G.size(); ++k) G.data()[k] = u(rng);
+    const Eigen::MatrixXd A = G.transpose() * G + 0.1 * Eigen::MatrixXd::Identity(n, n);
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) b[i] = u(rng);
+    Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+    for (int j = 0; j < n; ++j) {
+      double d = A(j, j);
+      for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+      L(j, j) = std::sqrt(d);
+      const double inv = 1.0 / L(j, j);
+      for (int i = j + 1; i < n; ++i) {
+        double s = A(i, j);
+        for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
+        L(i, j) = s * inv;
+      }
+    }
+    Eigen::VectorXd x(n);
+    for (int i = 0; i < n; ++i) {
+      double s = b[i];
+      for (int k = 0; k < i; ++k) s -= L(i, k) * x[k];
+      x[i] = s / L(i, i);
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      double s = x[i];
+      for (int k = i + 1; k < n; ++k) s -= L(k, i) * x[k];
+      x[i] = s / L(i, i);
+    }
+    EXPECT_LT((A * x - b).norm(), 1e-10 * b.norm());
+    RowMajorMatrixXd factor;
+    Eigen::VectorXd solution;
+    ASSERT_TRUE(CholeskySolve(A, b, &factor, &solution)) << " n=" << n;
+    for (int j = 0; j < n; ++j)
+      for (int i = j; i < n; ++i)
+        ASSERT_TRUE(SameBits(&factor(i, j), &L(i, j), 1))
+            << " n=" << n << " L(" << i << "," << j << ")";
+    EXPECT_TRUE(SameBits(solution.data(), x.data(), n)) << " n=" << n;
+    // The cached factor's substitution gives the same solution.
+    Eigen::VectorXd again;
+    CholeskySubstitute(factor, b, &again);
+    EXPECT_TRUE(SameBits(again.data(), x.data(), n)) << " n=" << n;
+  }
+  // A singular matrix, and a pivot under the caller's threshold, are refused.
+  Eigen::MatrixXd singular = Eigen::MatrixXd::Identity(4, 4);
+  singular(3, 3) = 0;
+  Eigen::MatrixXd tiny = Eigen::MatrixXd::Identity(4, 4);
+  tiny(2, 2) = 1e-15;
+  RowMajorMatrixXd factor;
+  Eigen::VectorXd solution;
+  EXPECT_FALSE(CholeskySolve(singular, Eigen::VectorXd::Ones(4), &factor, &solution, 0));
+  EXPECT_TRUE(CholeskySolve(tiny, Eigen::VectorXd::Ones(4), &factor, &solution, 0));
+  EXPECT_FALSE(CholeskySolve(tiny, Eigen::VectorXd::Ones(4), &factor, &solution, 1e-13));
 }
 
 TEST(CpuDispatch, BatchKernelHasTheSameBitsInEveryVariant) {

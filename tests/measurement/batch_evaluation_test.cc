@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "test_util.h"
@@ -142,6 +144,72 @@ TEST(BatchEvaluator, MatchesWithEstimatedBaseAndToolTermsOnEveryVariant) {
   for (Isa isa : SupportedIsas()) {
     ExpectSame(one, testing::ConfigurationsFacing(robot, planes[0], 30, 3), isa);
     ExpectSame(three, mixed, isa);
+  }
+}
+
+// The bits themselves: a fingerprint (FNV-1a over the bytes) of the readings and the Jacobian
+// of three models, taken from the structure-of-arrays kernel this one replaced (lrcal 3d70741).
+// Study tables are reproducible across versions only while these hold; a change of the
+// kernel's arithmetic, even by an ulp, changes them (and then the golden tables).
+std::uint64_t Fingerprint(const MeasurementModel& model, const TargetedConfigurations& configs,
+                          Isa isa) {
+  const int n = model.num_parameters(), m = configs.size();
+  std::vector<double> e(n);
+  for (int k = 0; k < n; ++k) e[k] = 1e-3 * std::sin(1.0 + k);
+  ModelPoint point;
+  model.Prepare(e.data(), &point);
+  BatchEvaluator batch;
+  batch.SetConfigurations(configs);
+  std::vector<double> values(m + static_cast<std::size_t>(m) * n);
+  batch.Evaluate(model, point, values.data(), values.data() + m, isa);
+  std::uint64_t hash = 1469598103934665603ull;
+  const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
+  for (std::size_t i = 0; i < values.size() * sizeof(double); ++i)
+    hash = (hash ^ bytes[i]) * 1099511628211ull;
+  return hash;
+}
+
+TEST(BatchEvaluator, KeepsTheBitsOfEarlierVersions) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PlaneSet planes(
+      {Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8), Plane::FromCoefficients(1, 0.1, 0, 0.9),
+       Plane::FromCoefficients(0, 1, 0.2, 0.9)},
+      {});
+  TargetedConfigurations mixed(robot.num_links());
+  for (int p = 0; p < planes.size(); ++p) {
+    const TargetedConfigurations facing =
+        testing::ConfigurationsFacing(robot, planes[p], 13, 3 + p);
+    for (int i = 0; i < facing.size(); ++i) mixed.Add(facing.q(i), p);
+  }
+  const FrameTerms all = FrameTerms::Parse("all", "base"), some = FrameTerms::Parse("x,z,rpy", "t");
+  const MeasurementModel three(
+      robot, planes,
+      MakeParameterSet(robot, std::vector<PlaneTerms>(3, PlaneTerms{true, true}), {}, "--fix",
+                       RangerTerms{true, true}, some, all));
+  const MeasurementModel paper(testing::PaperRobot(), testing::PaperPlane(),
+                               MakeParameterSet(testing::PaperRobot(), PlaneTerms{true, true}));
+  std::vector<Link> links(3);
+  links[0].nominal = {0.1, -1.2, 0.3, 0.5, 0.0};
+  links[1].joint = JointType::kPrismatic;
+  links[1].nominal = {0.4, 0.7, 0.2, 0.1, 0.05};
+  links[1].q_min = 0;
+  links[1].q_max = 1;
+  links[2].nominal = {-0.3, 0.0, 0.4, 0.2, 0.02};
+  for (auto& l : links) l.is_parameter = {true, true, true, true, true};
+  const RobotModel prismatic_robot("three", links);
+  const MeasurementModel prismatic(prismatic_robot, Plane::FromCoefficients(0.1, 0.2, 1.0, 2.0),
+                                   MakeParameterSet(prismatic_robot, PlaneTerms{true, true}));
+  TargetedConfigurations prismatic_configs(3);
+  for (int i = 0; i < 21; ++i)
+    prismatic_configs.Add(
+        std::vector<double>{std::sin(0.3 * i), 0.5 + 0.4 * std::cos(0.7 * i), std::sin(1.1 * i)});
+  for (Isa isa : SupportedIsas()) {
+    EXPECT_EQ(Fingerprint(three, mixed, isa), 17478510445932503751ull) << IsaName(isa);
+    EXPECT_EQ(Fingerprint(paper, testing::PaperHittingConfigurations(101), isa),
+              18378035986957087008ull)
+        << IsaName(isa);
+    EXPECT_EQ(Fingerprint(prismatic, prismatic_configs, isa), 17918719079727539558ull)
+        << IsaName(isa);
   }
 }
 
