@@ -99,8 +99,6 @@ template <int kWidth>
   }
 }
 
-using Index8 = long long __attribute__((vector_size(64)));
-
 // Entries (a + r, b … b + 7) for r < kRows at once, their partial sums reduced side by side:
 // the eight accumulators of a row are transposed pairwise, so each level of SumLanes' tree is one
 // vector addition (lane k of the result is entry b + k, its sums added in SumLanes' order), and
@@ -128,22 +126,21 @@ template <int kRows>
     Lanes8 p[4];
     for (int k = 0; k < 4; ++k) {
       const Lanes8 lo =
-          __builtin_shuffle(acc[r][2 * k], acc[r][2 * k + 1], Index8{0, 8, 2, 10, 4, 12, 6, 14});
+          __builtin_shufflevector(acc[r][2 * k], acc[r][2 * k + 1], 0, 8, 2, 10, 4, 12, 6, 14);
       const Lanes8 hi =
-          __builtin_shuffle(acc[r][2 * k], acc[r][2 * k + 1], Index8{1, 9, 3, 11, 5, 13, 7, 15});
+          __builtin_shufflevector(acc[r][2 * k], acc[r][2 * k + 1], 1, 9, 3, 11, 5, 13, 7, 15);
       p[k] = lo + hi;  // [e0 s01, e1 s01, e0 s23, e1 s23, e0 s45, e1 s45, e0 s67, e1 s67]
     }
     // Level 2: (s01 + s23) and (s45 + s67) of four entries.
     Lanes8 q[2];
     for (int k = 0; k < 2; ++k) {
-      const Lanes8 lo = __builtin_shuffle(p[2 * k], p[2 * k + 1], Index8{0, 1, 8, 9, 4, 5, 12, 13});
-      const Lanes8 hi =
-          __builtin_shuffle(p[2 * k], p[2 * k + 1], Index8{2, 3, 10, 11, 6, 7, 14, 15});
+      const Lanes8 lo = __builtin_shufflevector(p[2 * k], p[2 * k + 1], 0, 1, 8, 9, 4, 5, 12, 13);
+      const Lanes8 hi = __builtin_shufflevector(p[2 * k], p[2 * k + 1], 2, 3, 10, 11, 6, 7, 14, 15);
       q[k] = lo + hi;  // [e0..e3 (s01 + s23), e0..e3 (s45 + s67)]
     }
     // Level 3: the two halves of each entry's sum.
-    const Lanes8 lo = __builtin_shuffle(q[0], q[1], Index8{0, 1, 2, 3, 8, 9, 10, 11});
-    const Lanes8 hi = __builtin_shuffle(q[0], q[1], Index8{4, 5, 6, 7, 12, 13, 14, 15});
+    const Lanes8 lo = __builtin_shufflevector(q[0], q[1], 0, 1, 2, 3, 8, 9, 10, 11);
+    const Lanes8 hi = __builtin_shufflevector(q[0], q[1], 4, 5, 6, 7, 12, 13, 14, 15);
     Lanes8 tail = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
     for (int i = 0; i < m - full; ++i)
       tail += tail_rows[static_cast<std::size_t>(i) * n + a + r] *

@@ -212,23 +212,15 @@ template <typename V, bool kTool, bool kShift>
   }
 }
 
-// Configurations i0 … i0 + valid − 1 (valid ≤ W): their readings into h and, with kJacobian,
-// their rows of J. Returns how many beams run along their plane.
-template <typename V, bool kJacobian>
-[[gnu::always_inline]] inline int Block(const KernelArgs& args, int i0, int valid) {
+// The reading of configurations i0 … from the block's final frame s: h = −(n·o + f)/(n·b), and
+// what the Jacobian needs of it.
+template <typename V>
+[[gnu::always_inline]] inline Reading<V> ReadingOf(const KernelArgs& args, int i0,
+                                                   const Frame<V>& s) {
   const ModelPoint& point = *args.point;
-  Frame<V> s = BaseFrame<V>(point);
-  LinkFramesOf<V> frames[kJacobian ? kMaxLinks : 1];
-  for (int l = 0; l < point.num_links; ++l) {
-    const std::size_t at = static_cast<std::size_t>(l) * args.stride + i0;
-    Propagate<V, kJacobian>(point.links[l], Load<V>(args.q + at), Load<V>(args.cq + at),
-                            Load<V>(args.sq + at), &s, &frames[kJacobian ? l : 0]);
-  }
-  if (point.has_tool) ApplyTool(point, &s);
-  constexpr int kW = lanes::kWidth<V>;
   Reading<V> r;
   if (args.plane) {
-    for (int k = 0; k < kW; ++k) {
+    for (int k = 0; k < lanes::kWidth<V>; ++k) {
       const Plane& p = point.planes[args.plane[i0 + k]];
       r.n.c0[k] = p.normal.x();
       r.n.c1[k] = p.normal.y();
@@ -245,46 +237,81 @@ template <typename V, bool kJacobian>
   r.h = -(n.c0 * s.o.c0 + n.c1 * s.o.c1 + n.c2 * s.o.c2 + r.f) / r.nb;
   r.inv = -1.0 / r.nb;
   r.ph = {s.o.c0 + r.h * s.z.c0, s.o.c1 + r.h * s.z.c1, s.o.c2 + r.h * s.z.c2};
+  return r;
+}
+
+// J's rows i0 … i0 + valid − 1 in column c.
+[[gnu::always_inline]] inline double* Column(const KernelArgs& args, int c, int i0) {
+  return args.J + static_cast<std::size_t>(c) * args.m + i0;
+}
+
+// Plane p's chart u (two) and offset f: nonzero on the configurations aimed at plane p.
+template <typename V>
+[[gnu::always_inline]] inline void PlaneColumns(const KernelArgs& args, int i0, int valid,
+                                                const Reading<V>& r) {
+  const ParameterSet& ps = *args.parameters;
+  for (int p = 0; p < ps.num_planes(); ++p) {
+    const lrcal::PlaneColumns& pc = ps.plane_columns[p];
+    V own = All<V>(p == 0 ? 1.0 : 0.0);
+    if (args.plane)
+      for (int k = 0; k < lanes::kWidth<V>; ++k) own[k] = args.plane[i0 + k] == p ? 1.0 : 0.0;
+    for (int c = 0; c < 2; ++c) {
+      if (pc.u[c] < 0) continue;
+      const Eigen::Matrix<double, 3, 2>& dn_du = args.point->dn_du[p];
+      const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
+      Store(Column(args, pc.u[c], i0), own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv),
+            valid);
+    }
+    if (pc.f >= 0) Store(Column(args, pc.f, i0), own * r.inv, valid);
+  }
+}
+
+// Every estimated base and tool term's column.
+template <typename V>
+[[gnu::always_inline]] inline void FrameColumns(const KernelArgs& args, int i0, int valid,
+                                                const Frame<V>& s, const Reading<V>& r) {
+  const ModelPoint& point = *args.point;
+  const int* base = args.parameters->frame_columns[0];
+  const int* tool = args.parameters->frame_columns[1];
+  for (int k = 0; k < 3; ++k) {
+    if (base[k] >= 0)
+      Store(Column(args, base[k], i0),
+            FrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)), valid);
+    if (base[3 + k] >= 0)
+      Store(Column(args, base[3 + k], i0),
+            FrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)), valid);
+    if (tool[k] >= 0)
+      Store(Column(args, tool[k], i0),
+            FrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)), valid);
+    if (tool[3 + k] >= 0)
+      Store(Column(args, tool[3 + k], i0),
+            FrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)), valid);
+  }
+}
+
+// Configurations i0 … i0 + valid − 1 (valid ≤ W): their readings into h and, with kJacobian,
+// their rows of J. Returns how many beams run along their plane.
+template <typename V, bool kJacobian>
+[[gnu::always_inline]] inline int Block(const KernelArgs& args, int i0, int valid) {
+  const ModelPoint& point = *args.point;
+  Frame<V> s = BaseFrame<V>(point);
+  LinkFramesOf<V> frames[kJacobian ? kMaxLinks : 1];
+  for (int l = 0; l < point.num_links; ++l) {
+    const std::size_t at = static_cast<std::size_t>(l) * args.stride + i0;
+    Propagate<V, kJacobian>(point.links[l], Load<V>(args.q + at), Load<V>(args.cq + at),
+                            Load<V>(args.sq + at), &s, &frames[kJacobian ? l : 0]);
+  }
+  if (point.has_tool) ApplyTool(point, &s);
+  const Reading<V> r = ReadingOf(args, i0, s);
   Store(args.h + i0, r.h, valid);
   int parallel = 0;
   for (int k = 0; k < valid; ++k) parallel += std::fabs(r.nb[k]) <= kParallelBeamThreshold;
   if constexpr (kJacobian) {
     const ParameterSet& ps = *args.parameters;
-    const auto column = [&](int c) { return args.J + static_cast<std::size_t>(c) * args.m + i0; };
     for (int k = 0; k < ps.num_robot(); ++k)
-      Store(column(k), LinkColumn(frames, ps.robot_values[k], r), valid);
-    // Plane p's chart u (two) and offset f: nonzero on the configurations aimed at plane p.
-    for (int p = 0; p < ps.num_planes(); ++p) {
-      const PlaneColumns& pc = ps.plane_columns[p];
-      V own = All<V>(p == 0 ? 1.0 : 0.0);
-      if (args.plane)
-        for (int k = 0; k < kW; ++k) own[k] = args.plane[i0 + k] == p ? 1.0 : 0.0;
-      for (int c = 0; c < 2; ++c) {
-        if (pc.u[c] < 0) continue;
-        const Eigen::Matrix<double, 3, 2>& dn_du = point.dn_du[p];
-        const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
-        Store(column(pc.u[c]), own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv), valid);
-      }
-      if (pc.f >= 0) Store(column(pc.f), own * r.inv, valid);
-    }
-    if (ps.EstimatesFrames()) {
-      for (int k = 0; k < 3; ++k) {
-        const int* base = ps.frame_columns[0];
-        const int* tool = ps.frame_columns[1];
-        if (base[k] >= 0)
-          Store(column(base[k]), FrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)),
-                valid);
-        if (base[3 + k] >= 0)
-          Store(column(base[3 + k]),
-                FrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)), valid);
-        if (tool[k] >= 0)
-          Store(column(tool[k]),
-                FrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)), valid);
-        if (tool[3 + k] >= 0)
-          Store(column(tool[3 + k]),
-                FrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)), valid);
-      }
-    }
+      Store(Column(args, k, i0), LinkColumn(frames, ps.robot_values[k], r), valid);
+    PlaneColumns(args, i0, valid, r);
+    if (ps.EstimatesFrames()) FrameColumns(args, i0, valid, s, r);
   }
   return parallel;
 }
