@@ -67,24 +67,24 @@ struct KernelArgs {
 };
 
 template <typename V>
-struct Vec3 {
+struct BlockVec3 {
   V c0, c1, c2;
 };
 
 // A link's frames kept for the Jacobian (ChainFrames' o_prev, z_prev, x_common, y_twist, o).
 template <typename V>
-struct LinkFramesOf {
-  Vec3<V> z_prev, o_prev, x_common, y_twist, o;
+struct BlockLinkFrames {
+  BlockVec3<V> z_prev, o_prev, x_common, y_twist, o;
 };
 
 // The running frame: axes x, y, z and origin o.
 template <typename V>
-struct Frame {
-  Vec3<V> x, y, z, o;
+struct BlockFrame {
+  BlockVec3<V> x, y, z, o;
 };
 
 template <typename V>
-[[gnu::always_inline]] inline Frame<V> BaseFrame(const ModelPoint& point) {
+[[gnu::always_inline]] inline BlockFrame<V> BlockAtBase(const ModelPoint& point) {
   const Eigen::Matrix3d& rb = point.base.rotation;
   const Eigen::Vector3d& pb = point.base.translation;
   const auto all = [](double x) { return All<V>(x); };
@@ -96,22 +96,23 @@ template <typename V>
 
 // Through link l (D-H + β): batch::PropagateLink's arithmetic.
 template <typename V, bool kJacobian>
-[[gnu::always_inline]] inline void Propagate(const ChainPoint::LinkTrig& t, const V& q, const V& cq,
-                                             const V& sq, Frame<V>* s, LinkFramesOf<V>* f) {
+[[gnu::always_inline]] inline void PropagateBlock(const ChainPoint::LinkTrig& t, const V& q,
+                                                  const V& cq, const V& sq, BlockFrame<V>* s,
+                                                  BlockLinkFrames<V>* f) {
   const double ct0 = t.cos_theta0, st0 = t.sin_theta0, ca = t.cos_alpha, sa = t.sin_alpha,
                cb = t.cos_beta, sb = t.sin_beta, a = t.a, d0 = t.d;
   const double revolute = t.prismatic ? 0.0 : 1.0;
   const V ct = revolute * (ct0 * cq - st0 * sq) + (1 - revolute) * ct0;
   const V st = revolute * (st0 * cq + ct0 * sq) + (1 - revolute) * st0;
   const V d = d0 + (1 - revolute) * q;
-  Vec3<V>& x = s->x;
-  Vec3<V>& y = s->y;
-  Vec3<V>& z = s->z;
-  Vec3<V>& o = s->o;
-  const Vec3<V> xc{ct * x.c0 + st * y.c0, ct * x.c1 + st * y.c1, ct * x.c2 + st * y.c2};
-  const Vec3<V> yr{ct * y.c0 - st * x.c0, ct * y.c1 - st * x.c1, ct * y.c2 - st * x.c2};
-  const Vec3<V> yt{ca * yr.c0 + sa * z.c0, ca * yr.c1 + sa * z.c1, ca * yr.c2 + sa * z.c2};
-  const Vec3<V> za{ca * z.c0 - sa * yr.c0, ca * z.c1 - sa * yr.c1, ca * z.c2 - sa * yr.c2};
+  BlockVec3<V>& x = s->x;
+  BlockVec3<V>& y = s->y;
+  BlockVec3<V>& z = s->z;
+  BlockVec3<V>& o = s->o;
+  const BlockVec3<V> xc{ct * x.c0 + st * y.c0, ct * x.c1 + st * y.c1, ct * x.c2 + st * y.c2};
+  const BlockVec3<V> yr{ct * y.c0 - st * x.c0, ct * y.c1 - st * x.c1, ct * y.c2 - st * x.c2};
+  const BlockVec3<V> yt{ca * yr.c0 + sa * z.c0, ca * yr.c1 + sa * z.c1, ca * yr.c2 + sa * z.c2};
+  const BlockVec3<V> za{ca * z.c0 - sa * yr.c0, ca * z.c1 - sa * yr.c1, ca * z.c2 - sa * yr.c2};
   if constexpr (kJacobian) {
     f->z_prev = z;
     f->o_prev = o;
@@ -129,10 +130,10 @@ template <typename V, bool kJacobian>
 
 // The tool frame: p ← p + R·t, R ← R·R_tool (batch::ApplyTool's arithmetic).
 template <typename V>
-[[gnu::always_inline]] inline void ApplyTool(const ChainPoint& point, Frame<V>* s) {
+[[gnu::always_inline]] inline void ApplyToolToBlock(const ChainPoint& point, BlockFrame<V>* s) {
   const Eigen::Matrix3d& rt = point.tool.rotation;
   const Eigen::Vector3d& pt = point.tool.translation;
-  const Frame<V> r = *s;
+  const BlockFrame<V> r = *s;
   const auto row = [&](const V& xr, const V& yr, const V& zr, V* o, V* x, V* y, V* z) {
     *o += xr * pt(0) + yr * pt(1) + zr * pt(2);
     *x = xr * rt(0, 0) + yr * rt(1, 0) + zr * rt(2, 0);
@@ -147,18 +148,18 @@ template <typename V>
 // The reading and what the Jacobian needs of it: the plane's normal n and offset f, −1/(n·b),
 // the hit point.
 template <typename V>
-struct Reading {
-  Vec3<V> n;
+struct BlockReading {
+  BlockVec3<V> n;
   V f, h, inv, nb;
-  Vec3<V> ph;
+  BlockVec3<V> ph;
 };
 
 // (r × n)·axis / (−n·b) with r = ph − c: a rotation about an axis through c.
 template <typename V>
-[[gnu::always_inline]] inline V TurnColumn(const Reading<V>& r, const Vec3<V>& c,
-                                           const Vec3<V>& axis) {
+[[gnu::always_inline]] inline V BlockTurnColumn(const BlockReading<V>& r, const BlockVec3<V>& c,
+                                                const BlockVec3<V>& axis) {
   const V r0 = r.ph.c0 - c.c0, r1 = r.ph.c1 - c.c1, r2 = r.ph.c2 - c.c2;
-  const Vec3<V>& n = r.n;
+  const BlockVec3<V>& n = r.n;
   const V g = (r1 * n.c2 - r2 * n.c1) * axis.c0 + (r2 * n.c0 - r0 * n.c2) * axis.c1 +
               (r0 * n.c1 - r1 * n.c0) * axis.c2;
   return g * r.inv;
@@ -166,7 +167,8 @@ template <typename V>
 
 // n·axis / (−n·b): a shift along an axis.
 template <typename V>
-[[gnu::always_inline]] inline V ShiftColumn(const Reading<V>& r, const Vec3<V>& axis) {
+[[gnu::always_inline]] inline V BlockShiftColumn(const BlockReading<V>& r,
+                                                 const BlockVec3<V>& axis) {
   return (r.n.c0 * axis.c0 + r.n.c1 * axis.c1 + r.n.c2 * axis.c2) * r.inv;
 }
 
@@ -174,20 +176,20 @@ template <typename V>
 // about an axis through a point (θ: z_prev through o_prev; α: x_common through o; β: y_twist
 // through o).
 template <typename V>
-[[gnu::always_inline]] inline V LinkColumn(const LinkFramesOf<V>* frames, int index,
-                                           const Reading<V>& r) {
-  const LinkFramesOf<V>& f = frames[index / kValuesPerLink];
+[[gnu::always_inline]] inline V BlockLinkColumn(const BlockLinkFrames<V>* frames, int index,
+                                                const BlockReading<V>& r) {
+  const BlockLinkFrames<V>& f = frames[index / kValuesPerLink];
   switch (index % kValuesPerLink) {
     case kD:
-      return ShiftColumn(r, f.z_prev);
+      return BlockShiftColumn(r, f.z_prev);
     case kA:
-      return ShiftColumn(r, f.x_common);
+      return BlockShiftColumn(r, f.x_common);
     case kTheta:
-      return TurnColumn(r, f.o_prev, f.z_prev);
+      return BlockTurnColumn(r, f.o_prev, f.z_prev);
     case kAlpha:
-      return TurnColumn(r, f.o, f.x_common);
+      return BlockTurnColumn(r, f.o, f.x_common);
     default:
-      return TurnColumn(r, f.o, f.y_twist);
+      return BlockTurnColumn(r, f.o, f.y_twist);
   }
 }
 
@@ -195,30 +197,31 @@ template <typename V>
 // turns it about v through a point; the base's v and point are fixed in B, the tool's v turns
 // with the tool (R_BT·v) and its point is the beam's origin.
 template <typename V, bool kTool, bool kShift>
-[[gnu::always_inline]] inline V FrameColumn(const ModelPoint& point, const Frame<V>& s,
-                                            const Reading<V>& r, const Eigen::Vector3d& v) {
-  Vec3<V> w{All<V>(v[0]), All<V>(v[1]), All<V>(v[2])};
+[[gnu::always_inline]] inline V BlockFrameColumn(const ModelPoint& point, const BlockFrame<V>& s,
+                                                 const BlockReading<V>& r,
+                                                 const Eigen::Vector3d& v) {
+  BlockVec3<V> w{All<V>(v[0]), All<V>(v[1]), All<V>(v[2])};
   if constexpr (kTool) {
     w = {s.x.c0 * v[0] + s.y.c0 * v[1] + s.z.c0 * v[2],
          s.x.c1 * v[0] + s.y.c1 * v[1] + s.z.c1 * v[2],
          s.x.c2 * v[0] + s.y.c2 * v[1] + s.z.c2 * v[2]};
   }
   if constexpr (kShift) {
-    return ShiftColumn(r, w);
+    return BlockShiftColumn(r, w);
   } else {
     const Eigen::Vector3d& pb = point.base.translation;
-    const Vec3<V> c = kTool ? s.o : Vec3<V>{All<V>(pb[0]), All<V>(pb[1]), All<V>(pb[2])};
-    return TurnColumn(r, c, w);
+    const BlockVec3<V> c = kTool ? s.o : BlockVec3<V>{All<V>(pb[0]), All<V>(pb[1]), All<V>(pb[2])};
+    return BlockTurnColumn(r, c, w);
   }
 }
 
 // The reading of configurations i0 … from the block's final frame s: h = −(n·o + f)/(n·b), and
 // what the Jacobian needs of it.
 template <typename V>
-[[gnu::always_inline]] inline Reading<V> ReadingOf(const KernelArgs& args, int i0,
-                                                   const Frame<V>& s) {
+[[gnu::always_inline]] inline BlockReading<V> BlockReadingOf(const KernelArgs& args, int i0,
+                                                             const BlockFrame<V>& s) {
   const ModelPoint& point = *args.point;
-  Reading<V> r;
+  BlockReading<V> r;
   if (args.plane) {
     for (int k = 0; k < lanes::kWidth<V>; ++k) {
       const Plane& p = point.planes[args.plane[i0 + k]];
@@ -232,7 +235,7 @@ template <typename V>
     r.n = {All<V>(p.normal.x()), All<V>(p.normal.y()), All<V>(p.normal.z())};
     r.f = All<V>(p.offset);
   }
-  const Vec3<V>& n = r.n;
+  const BlockVec3<V>& n = r.n;
   r.nb = n.c0 * s.z.c0 + n.c1 * s.z.c1 + n.c2 * s.z.c2;
   r.h = -(n.c0 * s.o.c0 + n.c1 * s.o.c1 + n.c2 * s.o.c2 + r.f) / r.nb;
   r.inv = -1.0 / r.nb;
@@ -241,17 +244,17 @@ template <typename V>
 }
 
 // J's rows i0 … i0 + valid − 1 in column c.
-[[gnu::always_inline]] inline double* Column(const KernelArgs& args, int c, int i0) {
+[[gnu::always_inline]] inline double* BlockColumn(const KernelArgs& args, int c, int i0) {
   return args.J + static_cast<std::size_t>(c) * args.m + i0;
 }
 
 // Plane p's chart u (two) and offset f: nonzero on the configurations aimed at plane p.
 template <typename V>
-[[gnu::always_inline]] inline void PlaneColumns(const KernelArgs& args, int i0, int valid,
-                                                const Reading<V>& r) {
+[[gnu::always_inline]] inline void BlockPlaneColumns(const KernelArgs& args, int i0, int valid,
+                                                     const BlockReading<V>& r) {
   const ParameterSet& ps = *args.parameters;
   for (int p = 0; p < ps.num_planes(); ++p) {
-    const lrcal::PlaneColumns& pc = ps.plane_columns[p];
+    const PlaneColumns& pc = ps.plane_columns[p];
     V own = All<V>(p == 0 ? 1.0 : 0.0);
     if (args.plane)
       for (int k = 0; k < lanes::kWidth<V>; ++k) own[k] = args.plane[i0 + k] == p ? 1.0 : 0.0;
@@ -259,33 +262,34 @@ template <typename V>
       if (pc.u[c] < 0) continue;
       const Eigen::Matrix<double, 3, 2>& dn_du = args.point->dn_du[p];
       const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
-      Store(Column(args, pc.u[c], i0), own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv),
-            valid);
+      Store(BlockColumn(args, pc.u[c], i0),
+            own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv), valid);
     }
-    if (pc.f >= 0) Store(Column(args, pc.f, i0), own * r.inv, valid);
+    if (pc.f >= 0) Store(BlockColumn(args, pc.f, i0), own * r.inv, valid);
   }
 }
 
 // Every estimated base and tool term's column.
 template <typename V>
-[[gnu::always_inline]] inline void FrameColumns(const KernelArgs& args, int i0, int valid,
-                                                const Frame<V>& s, const Reading<V>& r) {
+[[gnu::always_inline]] inline void BlockFrameColumns(const KernelArgs& args, int i0, int valid,
+                                                     const BlockFrame<V>& s,
+                                                     const BlockReading<V>& r) {
   const ModelPoint& point = *args.point;
   const int* base = args.parameters->frame_columns[0];
   const int* tool = args.parameters->frame_columns[1];
   for (int k = 0; k < 3; ++k) {
     if (base[k] >= 0)
-      Store(Column(args, base[k], i0),
-            FrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)), valid);
+      Store(BlockColumn(args, base[k], i0),
+            BlockFrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)), valid);
     if (base[3 + k] >= 0)
-      Store(Column(args, base[3 + k], i0),
-            FrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)), valid);
+      Store(BlockColumn(args, base[3 + k], i0),
+            BlockFrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)), valid);
     if (tool[k] >= 0)
-      Store(Column(args, tool[k], i0),
-            FrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)), valid);
+      Store(BlockColumn(args, tool[k], i0),
+            BlockFrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)), valid);
     if (tool[3 + k] >= 0)
-      Store(Column(args, tool[3 + k], i0),
-            FrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)), valid);
+      Store(BlockColumn(args, tool[3 + k], i0),
+            BlockFrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)), valid);
   }
 }
 
@@ -294,24 +298,24 @@ template <typename V>
 template <typename V, bool kJacobian>
 [[gnu::always_inline]] inline int Block(const KernelArgs& args, int i0, int valid) {
   const ModelPoint& point = *args.point;
-  Frame<V> s = BaseFrame<V>(point);
-  LinkFramesOf<V> frames[kJacobian ? kMaxLinks : 1];
+  BlockFrame<V> s = BlockAtBase<V>(point);
+  BlockLinkFrames<V> frames[kJacobian ? kMaxLinks : 1];
   for (int l = 0; l < point.num_links; ++l) {
     const std::size_t at = static_cast<std::size_t>(l) * args.stride + i0;
-    Propagate<V, kJacobian>(point.links[l], Load<V>(args.q + at), Load<V>(args.cq + at),
-                            Load<V>(args.sq + at), &s, &frames[kJacobian ? l : 0]);
+    PropagateBlock<V, kJacobian>(point.links[l], Load<V>(args.q + at), Load<V>(args.cq + at),
+                                 Load<V>(args.sq + at), &s, &frames[kJacobian ? l : 0]);
   }
-  if (point.has_tool) ApplyTool(point, &s);
-  const Reading<V> r = ReadingOf(args, i0, s);
+  if (point.has_tool) ApplyToolToBlock(point, &s);
+  const BlockReading<V> r = BlockReadingOf(args, i0, s);
   Store(args.h + i0, r.h, valid);
   int parallel = 0;
   for (int k = 0; k < valid; ++k) parallel += std::fabs(r.nb[k]) <= kParallelBeamThreshold;
   if constexpr (kJacobian) {
     const ParameterSet& ps = *args.parameters;
     for (int k = 0; k < ps.num_robot(); ++k)
-      Store(Column(args, k, i0), LinkColumn(frames, ps.robot_values[k], r), valid);
-    PlaneColumns(args, i0, valid, r);
-    if (ps.EstimatesFrames()) FrameColumns(args, i0, valid, s, r);
+      Store(BlockColumn(args, k, i0), BlockLinkColumn(frames, ps.robot_values[k], r), valid);
+    BlockPlaneColumns(args, i0, valid, r);
+    if (ps.EstimatesFrames()) BlockFrameColumns(args, i0, valid, s, r);
   }
   return parallel;
 }
