@@ -38,7 +38,7 @@ inline constexpr int kWidth = static_cast<int>(sizeof(V) / sizeof(double));
 /// W doubles from p (unaligned).
 template <typename V>
 [[gnu::always_inline]] inline V Load(const double* p) {
-  V v;
+  V v = {};
   std::memcpy(&v, p, sizeof v);
   return v;
 }
@@ -55,7 +55,7 @@ template <typename V>
 /// Every lane x (a negative zero stays one, as the scalar it stands for).
 template <typename V>
 [[gnu::always_inline]] inline V All(double x) {
-  V v;
+  V v = {};
   for (int k = 0; k < kWidth<V>; ++k) v[k] = x;
   return v;
 }

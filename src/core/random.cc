@@ -35,24 +35,27 @@ double RandomStream::Normal(std::uint64_t index) const {
   return index % 2 == 0 ? z.x : z.y;
 }
 
-void RandomStream::Normals(std::uint64_t first, int count, double* out) const {
-  int k = 0;
-  while (k < count) {
-    const std::uint64_t index = first + k;
-    if (index % 4 != 0 || count - k < 4) {
-      out[k++] = Normal(index);
-      continue;
+double NormalDraws::operator()(std::uint64_t index) {
+  const std::uint64_t pair = index / 2;
+  if (!have_pair_ || pair != pair_) {
+    if (!have_block_ || index / 4 != block_) {
+      stream_.Block(index / 4, words_);
+      block_ = index / 4;
+      have_block_ = true;
     }
-    std::uint64_t w[4];
-    Block(index / 4, w);
-    r123::double2 a = r123::boxmuller(w[0], w[1]);
-    r123::double2 b = r123::boxmuller(w[2], w[3]);
-    out[k] = a.x;
-    out[k + 1] = a.y;
-    out[k + 2] = b.x;
-    out[k + 3] = b.y;
-    k += 4;
+    const int k = static_cast<int>(index % 4) / 2;
+    const r123::double2 z = r123::boxmuller(words_[2 * k], words_[2 * k + 1]);
+    z_[0] = z.x;
+    z_[1] = z.y;
+    pair_ = pair;
+    have_pair_ = true;
   }
+  return z_[index % 2];
+}
+
+void RandomStream::Normals(std::uint64_t first, int count, double* out) const {
+  NormalDraws draws(*this);
+  for (int k = 0; k < count; ++k) out[k] = draws(first + static_cast<std::uint64_t>(k));
 }
 
 }  // namespace lrcal

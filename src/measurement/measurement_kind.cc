@@ -95,6 +95,7 @@ int AddMeasurementNoise(const MeasurementKind& truth, const std::vector<double>&
   int missed = 0;
   std::vector<double> z(static_cast<std::size_t>(R) * k);
   std::vector<double> readings(static_cast<std::size_t>(R));  // one component's R readings
+  NormalDraws normal(stream);  // neighbouring configurations share counter blocks
   for (int i = 0; i < configs.size(); ++i) {
     if (reasons[i] != "ok" || !std::isfinite(exact[static_cast<std::size_t>(i) * k])) {
       ++missed;
@@ -104,7 +105,7 @@ int AddMeasurementNoise(const MeasurementKind& truth, const std::vector<double>&
     data->repetitions.push_back(R);
     if (weighted) data->weights.insert(data->weights.end(), weight.begin(), weight.end());
     if (noise.DrawsMean()) {
-      stream.Normals(static_cast<std::uint64_t>(i) * k, k, z.data());
+      for (int c = 0; c < k; ++c) z[c] = normal(static_cast<std::uint64_t>(i) * k + c);
       for (int c = 0; c < k; ++c)
         data->y.push_back(exact[static_cast<std::size_t>(i) * k + c] +
                           sigma[static_cast<std::size_t>(c)] / std::sqrt(static_cast<double>(R)) *

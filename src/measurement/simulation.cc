@@ -152,6 +152,7 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
   if (raw) raw->clear();
   const bool outliers = noise.outlier_fraction > 0;
   const RandomStream outlier_stream = stream.WithPurpose(RandomPurpose::kOutlier);
+  NormalDraws normal(stream);  // neighbouring slots share their counter block and pair
   int missed = 0;
   for (int i = 0; i < configs.size(); ++i) {
     const std::uint64_t slot = noise_slots ? (*noise_slots)[i] : i;
@@ -161,8 +162,7 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
     }
     double mean;
     if (noise.DrawsMean()) {
-      mean =
-          (1 + noise.ranger_scale) * h[i] + noise.ranger_offset + sigma_mean * stream.Normal(slot);
+      mean = (1 + noise.ranger_scale) * h[i] + noise.ranger_offset + sigma_mean * normal(slot);
       if (outliers) mean += OutlierError(noise, outlier_stream, slot, 0);
     } else {
       mean = MeanOfReadings(noise, stream, outlier_stream, slot,

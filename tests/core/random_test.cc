@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 namespace lrcal {
 namespace {
@@ -60,6 +62,23 @@ TEST(RandomStream, BulkNormalsEqualAddressedNormals) {
   std::vector<double> bulk(37);
   s.Normals(5, 37, bulk.data());
   for (int i = 0; i < 37; ++i) EXPECT_EQ(bulk[i], s.Normal(5 + i));
+}
+
+// NormalDraws keeps the last counter block and Box–Muller pair: whatever the order of the
+// indices (increasing runs with gaps, as a design's slots; decreasing; repeated; scattered),
+// every value is the addressed normal's, bit for bit.
+TEST(RandomStream, NormalDrawsEqualAddressedNormalsInAnyOrder) {
+  const RandomStream s(7, 2, 11, RandomPurpose::kNoise);
+  std::vector<std::uint64_t> order;
+  for (std::uint64_t i = 0; i < 40; ++i) order.push_back(i);                  // a run
+  for (std::uint64_t i : {41, 43, 44, 47, 52, 53, 54}) order.push_back(i);    // gaps
+  for (std::uint64_t i = 60; i-- > 45;) order.push_back(i);                   // decreasing
+  for (std::uint64_t i : {5, 5, 4, 1000003, 6, 2, 2, 3}) order.push_back(i);  // scattered
+  NormalDraws draws(s);
+  for (std::uint64_t i : order) {
+    const double expected = s.Normal(i), got = draws(i);
+    EXPECT_EQ(std::memcmp(&expected, &got, sizeof got), 0) << "index " << i;
+  }
 }
 
 TEST(RandomStream, StreamsDifferByEveryAddressPart) {

@@ -60,6 +60,23 @@ class RandomStream {
   std::uint64_t seed_, stream_, trial_, purpose_;
 };
 
+/// RandomStream::Normal for a run of indices drawn one by one, mostly in increasing order (a
+/// trial's noise at its design's slots): neighbouring indices share a counter block (four
+/// words) and a Box–Muller pair (two normals), which are kept from the last draw instead of
+/// being computed again. Returns exactly Normal(index), whatever the order.
+class NormalDraws {
+ public:
+  explicit NormalDraws(const RandomStream& stream) : stream_(stream) {}
+  double operator()(std::uint64_t index);
+
+ private:
+  RandomStream stream_;
+  bool have_block_ = false, have_pair_ = false;
+  std::uint64_t block_ = 0, pair_ = 0;  // index / 4 and index / 2 of what is kept
+  std::uint64_t words_[4] = {0, 0, 0, 0};
+  double z_[2] = {0, 0};
+};
+
 /// Philox4x64-10 of (counter, key), exposed for the known-answer test.
 void Philox4x64(const std::uint64_t counter[4], const std::uint64_t key[2], std::uint64_t out[4]);
 
