@@ -10,5 +10,9 @@ namespace lrcal {
 
 /// NormalMatrix(J, A) run by the given variant (one this CPU supports: SupportedIsas()).
 void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa);
+/// ScaleRows and ScaleSymmetric run by the given variant.
+void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J, Isa isa);
+void ScaleSymmetric(const Eigen::VectorXd& s, const Eigen::MatrixXd& A, double lambda,
+                    Eigen::MatrixXd* As, Isa isa);
 
 }  // namespace lrcal

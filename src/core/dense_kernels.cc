@@ -227,4 +227,89 @@ void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa) {
 
 void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A) { NormalMatrix(J, A, ActiveIsa()); }
 
+namespace {
+
+// J(i, k) *= s[i] for a column-major m×n J: one multiplication per entry, any width.
+[[gnu::always_inline]] inline void ScaleRowsBody(const double* __restrict s, int m, int n,
+                                                 double* __restrict J) {
+  for (int k = 0; k < n; ++k) {
+    double* __restrict col = J + static_cast<std::size_t>(k) * m;
+    for (int i = 0; i < m; ++i) col[i] *= s[i];
+  }
+}
+
+// As(i, j) = (s[i]·A(i, j))·s[j], then λ added on the diagonal: Eigen's
+// s.asDiagonal() * A * s.asDiagonal() and diagonal() += λ, entry by entry.
+[[gnu::always_inline]] inline void ScaleSymmetricBody(const double* __restrict s,
+                                                      const double* __restrict A, int n,
+                                                      double lambda, double* __restrict As) {
+  for (int j = 0; j < n; ++j) {
+    const double* __restrict a = A + static_cast<std::size_t>(j) * n;
+    double* __restrict out = As + static_cast<std::size_t>(j) * n;
+    const double sj = s[j];
+    for (int i = 0; i < n; ++i) out[i] = (s[i] * a[i]) * sj;
+    out[j] += lambda;
+  }
+}
+
+void ScaleRowsDefault(const double* s, int m, int n, double* J) { ScaleRowsBody(s, m, n, J); }
+void ScaleSymmetricDefault(const double* s, const double* A, int n, double lambda, double* As) {
+  ScaleSymmetricBody(s, A, n, lambda, As);
+}
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void ScaleRowsAvx2(const double* s, int m, int n, double* J) {
+  ScaleRowsBody(s, m, n, J);
+}
+__attribute__((target("avx512f"))) void ScaleRowsAvx512(const double* s, int m, int n, double* J) {
+  ScaleRowsBody(s, m, n, J);
+}
+__attribute__((target("avx2"))) void ScaleSymmetricAvx2(const double* s, const double* A, int n,
+                                                        double lambda, double* As) {
+  ScaleSymmetricBody(s, A, n, lambda, As);
+}
+__attribute__((target("avx512f"))) void ScaleSymmetricAvx512(const double* s, const double* A,
+                                                             int n, double lambda, double* As) {
+  ScaleSymmetricBody(s, A, n, lambda, As);
+}
+#endif
+
+}  // namespace
+
+void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J, Isa isa) {
+  const int m = static_cast<int>(J->rows()), n = static_cast<int>(J->cols());
+  switch (isa) {
+#if defined(__x86_64__)
+    case Isa::kAvx512:
+      return ScaleRowsAvx512(s.data(), m, n, J->data());
+    case Isa::kAvx2:
+      return ScaleRowsAvx2(s.data(), m, n, J->data());
+#endif
+    default:
+      return ScaleRowsDefault(s.data(), m, n, J->data());
+  }
+}
+
+void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J) { ScaleRows(s, J, ActiveIsa()); }
+
+void ScaleSymmetric(const Eigen::VectorXd& s, const Eigen::MatrixXd& A, double lambda,
+                    Eigen::MatrixXd* As, Isa isa) {
+  const int n = static_cast<int>(A.rows());
+  As->resize(n, n);
+  switch (isa) {
+#if defined(__x86_64__)
+    case Isa::kAvx512:
+      return ScaleSymmetricAvx512(s.data(), A.data(), n, lambda, As->data());
+    case Isa::kAvx2:
+      return ScaleSymmetricAvx2(s.data(), A.data(), n, lambda, As->data());
+#endif
+    default:
+      return ScaleSymmetricDefault(s.data(), A.data(), n, lambda, As->data());
+  }
+}
+
+void ScaleSymmetric(const Eigen::VectorXd& s, const Eigen::MatrixXd& A, double lambda,
+                    Eigen::MatrixXd* As) {
+  ScaleSymmetric(s, A, lambda, As, ActiveIsa());
+}
+
 }  // namespace lrcal

@@ -26,7 +26,7 @@ double LevenbergMarquardt::Linearize(MeasurementEvaluator& model, const double* 
   h_.resize(m);
   if (!model.Predict(e.data(), h_.data(), J->data()))
     return std::numeric_limits<double>::quiet_NaN();
-  J->array().colwise() *= sqrt_w_.array();
+  ScaleRows(sqrt_w_, J);
   *r = sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) - h_);
   return 0.5 * r->squaredNorm();
 }
@@ -49,7 +49,7 @@ bool LevenbergMarquardt::StartLeastSquares(MeasurementEvaluator& model, const do
   sqrt_w_ = Eigen::Map<const Eigen::VectorXd>(weights, m).cwiseSqrt();
   if (nominal) {
     J_ = nominal->G;
-    J_.array().colwise() *= sqrt_w_.array();
+    ScaleRows(sqrt_w_, &J_);
     r_ = sqrt_w_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(mean_h, m) -
                               Eigen::Map<const Eigen::VectorXd>(nominal->h.data(), m));
     *cost = 0.5 * r_.squaredNorm();
@@ -100,8 +100,7 @@ bool LevenbergMarquardt::LeastSquaresStep(int iteration, double lambda, const No
   if (iteration == 1 && first_factor_cached_) {
     CholeskySubstitute(nominal->L0, rhs_, &step_);
   } else {
-    As_.noalias() = scale_.asDiagonal() * A_ * scale_.asDiagonal();
-    As_.diagonal().array() += lambda;
+    ScaleSymmetric(scale_, A_, lambda, &As_);
     if (!CholeskySolve(As_, rhs_, &L_, &step_, lambda == 0 ? kMinScaledPivot : 0)) {
       *termination = lambda == 0 && iteration == 1 ? Termination::kRankDeficient
                                                    : Termination::kNumericalFailure;
@@ -270,9 +269,7 @@ void LevenbergMarquardt::RobustStep(double lambda, bool newton_failed, bool* use
   // singular (too few inliers) or its last step at this damping was rejected.
   for (int attempt = newton_failed ? 1 : 0; attempt < 2 && !solved; ++attempt) {
     *used_newton = attempt == 0;
-    As_.noalias() =
-        scale_.asDiagonal() * (attempt == 0 ? A_ : ReweightedMatrix()) * scale_.asDiagonal();
-    As_.diagonal().array() += lambda;
+    ScaleSymmetric(scale_, attempt == 0 ? A_ : ReweightedMatrix(), lambda, &As_);
     solved = CholeskySolve(As_, rhs_, &L_, &step_, 1e-13);
   }
   step_ = scale_.cwiseProduct(step_);

@@ -105,11 +105,10 @@ int AddMeasurementNoise(const MeasurementKind& truth, const std::vector<double>&
     data->repetitions.push_back(R);
     if (weighted) data->weights.insert(data->weights.end(), weight.begin(), weight.end());
     if (noise.DrawsMean()) {
-      for (int c = 0; c < k; ++c) z[c] = normal(static_cast<std::uint64_t>(i) * k + c);
       for (int c = 0; c < k; ++c)
         data->y.push_back(exact[static_cast<std::size_t>(i) * k + c] +
                           sigma[static_cast<std::size_t>(c)] / std::sqrt(static_cast<double>(R)) *
-                              z[c]);
+                              normal(static_cast<std::uint64_t>(i) * k + c));
       continue;
     }
     stream.Normals(static_cast<std::uint64_t>(i) * R * k, R * k, z.data());

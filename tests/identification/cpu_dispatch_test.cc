@@ -128,6 +128,33 @@ TEST(CpuDispatch, CholeskySolveHasTheBitsOfTheLeftLookingFormula) {
   EXPECT_FALSE(CholeskySolve(tiny, Eigen::VectorXd::Ones(4), &factor, &solution, 1e-13));
 }
 
+// The solver's row weighting and Marquardt scaling: Eigen's expressions' bits in every variant.
+TEST(CpuDispatch, ScalingsHaveTheBitsOfEigensExpressionsInEveryVariant) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (const auto& [m, n] : std::vector<std::pair<int, int>>{{100, 25}, {7, 3}, {301, 27}}) {
+    Eigen::MatrixXd J(m, n), A(n, n);
+    Eigen::VectorXd w(m), s(n);
+    for (int k = 0; k < J.size(); ++k) J.data()[k] = u(rng);
+    for (int k = 0; k < A.size(); ++k) A.data()[k] = u(rng);
+    for (int i = 0; i < m; ++i) w[i] = std::exp(u(rng));
+    for (int i = 0; i < n; ++i) s[i] = std::exp(u(rng));
+    Eigen::MatrixXd rows = J;
+    rows.array().colwise() *= w.array();
+    Eigen::MatrixXd scaled;
+    scaled.noalias() = s.asDiagonal() * A * s.asDiagonal();
+    scaled.diagonal().array() += 0.37;
+    for (Isa isa : SupportedIsas()) {
+      Eigen::MatrixXd got = J, got_scaled;
+      ScaleRows(w, &got, isa);
+      EXPECT_TRUE(SameBits(got.data(), rows.data(), got.size())) << IsaName(isa) << " m=" << m;
+      ScaleSymmetric(s, A, 0.37, &got_scaled, isa);
+      EXPECT_TRUE(SameBits(got_scaled.data(), scaled.data(), scaled.size()))
+          << IsaName(isa) << " n=" << n;
+    }
+  }
+}
+
 TEST(CpuDispatch, BatchKernelHasTheSameBitsInEveryVariant) {
   const RobotModel& robot = testing::PaperRobot();
   MeasurementModel model(robot, testing::PaperPlane(),

@@ -18,6 +18,16 @@ using RowMajorMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, E
 /// vectorises without -ffast-math.
 void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A);
 
+/// J(i, k) ← J(i, k)·s[i] for every entry (the solver's row weights √w on its Jacobian), run by
+/// the widest variant the CPU has; the same bits as Eigen's `J.array().colwise() *= s.array()`.
+void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J);
+
+/// As = diag(s)·A·diag(s) + λ·I for a square A, each entry (s[i]·A(i, j))·s[j] (+ λ on the
+/// diagonal): the Marquardt-scaled, damped normal matrix, with the bits of Eigen's
+/// `s.asDiagonal() * A * s.asDiagonal()` and `diagonal().array() += λ`, in every variant.
+void ScaleSymmetric(const Eigen::VectorXd& s, const Eigen::MatrixXd& A, double lambda,
+                    Eigen::MatrixXd* As);
+
 /// Solves the symmetric positive definite system A·x = b by a plain Cholesky factorisation,
 /// leaving the factor in L. Returns false if a pivot is not positive, or below `min_pivot` × the
 /// largest diagonal entry of A (the caller's test of numerical rank).
