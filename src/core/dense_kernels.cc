@@ -59,50 +59,32 @@ void CholeskySubstitute(const RowMajorMatrixXd& L_in, const Eigen::VectorXd& b,
 
 namespace {
 
-// Eight doubles as one value (core/lanes.h): four SSE2 registers, two AVX2 ones or one AVX-512
-// one, the same bits in each.
+// Eight doubles as one value (core/lanes.h): one AVX-512 register.
 using Lanes8 = lanes::VectorOf<8>::type;
 
-// The fixed order in which an entry's eight partial sums and its tail (the last m mod 8 rows,
-// summed in order) are added.
-[[gnu::always_inline]] inline double SumLanes(const Lanes8& acc, double tail) {
-  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail;
-}
-
-[[gnu::always_inline]] inline double Tail(const double* ca, const double* cb, int full, int m) {
+// Entry (a, b) alone: eight partial sums (row index mod 8) over the first `full` rows, the tail
+// (the last m mod 8 rows) in order, added in the fixed order below; plain loops that the compiler
+// vectorises at each variant's width.
+[[gnu::always_inline]] inline void NormalMatrixEntry(const double* __restrict J, int m, int n,
+                                                     int a, int b, int full, double* __restrict A) {
+  constexpr int kLanes = 8;
+  const double* __restrict ca = J + static_cast<std::size_t>(a) * m;
+  const double* __restrict cb = J + static_cast<std::size_t>(b) * m;
+  double acc[kLanes] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < full; i += kLanes)
+    for (int l = 0; l < kLanes; ++l) acc[l] += ca[i + l] * cb[i + l];
   double tail = 0;
   for (int i = full; i < m; ++i) tail += ca[i] * cb[i];
-  return tail;
-}
-
-// Entries (a, b) … (a, b + kWidth − 1) together: column a is loaded once for all of them, and
-// their partial sums are kWidth independent chains.
-template <int kWidth>
-[[gnu::always_inline]] inline void NormalMatrixEntries(const double* __restrict J, int m, int n,
-                                                       int a, int b, int full,
-                                                       double* __restrict A) {
-  const double* ca = J + static_cast<std::size_t>(a) * m;
-  const double* cb[kWidth];
-  Lanes8 acc[kWidth];
-  for (int w = 0; w < kWidth; ++w) {
-    cb[w] = J + static_cast<std::size_t>(b + w) * m;
-    acc[w] = Lanes8{0, 0, 0, 0, 0, 0, 0, 0};
-  }
-  for (int i = 0; i < full; i += 8) {
-    const Lanes8 x = lanes::Load<Lanes8>(ca + i);
-    for (int w = 0; w < kWidth; ++w) acc[w] += x * lanes::Load<Lanes8>(cb[w] + i);
-  }
-  for (int w = 0; w < kWidth; ++w) {
-    const double sum = SumLanes(acc[w], Tail(ca, cb[w], full, m));
-    A[a + static_cast<std::size_t>(b + w) * n] = sum;
-    A[b + w + static_cast<std::size_t>(a) * n] = sum;
-  }
+  const double sum =
+      ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail;
+  A[a + static_cast<std::size_t>(b) * n] = sum;
+  A[b + static_cast<std::size_t>(a) * n] = sum;
 }
 
 // Entries (a + r, b … b + 7) for r < kRows at once, their partial sums reduced side by side:
-// the eight accumulators of a row are transposed pairwise, so each level of SumLanes' tree is one
-// vector addition (lane k of the result is entry b + k, its sums added in SumLanes' order), and
-// the tails come from `tail_rows` (the last m mod 8 rows of J, row-major: tail_rows[i·n + c] =
+// the eight accumulators of a row are transposed pairwise, so each level of NormalMatrixEntry's
+// tree is one vector addition (lane k of the result is entry b + k, its sums added in that order),
+// and the tails come from `tail_rows` (the last m mod 8 rows of J, row-major: tail_rows[i·n + c] =
 // J(full + i, c)).
 template <int kRows>
 [[gnu::always_inline]] inline void NormalMatrixEntries8(const double* __restrict J, int m, int n,
@@ -151,30 +133,30 @@ template <int kRows>
   }
 }
 
-// Entry (a, b) = Σ_i J(i,a)·J(i,b), summed in 8 partial sums (row index mod 8) over the first
-// m − m mod 8 rows, then SumLanes: the same sequence of operations in every variant. kWide
-// (AVX-512, whose 32 registers hold eight entries' sums) takes entries eight at a time, also past
-// the diagonal (entry (a, b) and entry (b, a) have the same bits: each product commutes).
+// Entry (a, b) = Σ_i J(i,a)·J(i,b) as NormalMatrixEntry sums it, in every variant. kWide
+// (AVX-512, whose 32 registers hold sixteen entries' sums) takes two rows by eight columns of
+// entries at a time, also past the diagonal (entry (a, b) and entry (b, a) have the same bits:
+// each product commutes), and the rest one by one; the other variants take every entry alone
+// (GCC's lowering of eight-lane vectors to narrower registers is slower than its own
+// vectorisation of NormalMatrixEntry).
 template <bool kWide>
 [[gnu::always_inline]] inline void NormalMatrixBody(const double* __restrict J, int m, int n,
                                                     double* __restrict A) {
-  constexpr int kLanes = 8, kWidth = 4;
+  constexpr int kLanes = 8;
   const int full = m - m % kLanes;
-  thread_local std::vector<double> tail_rows;
-  if constexpr (kWide) {
+  const auto rest_of_row = [&](int a, int b) {  // entries (a, b …  a)
+    for (; b <= a; ++b) NormalMatrixEntry(J, m, n, a, b, full, A);
+  };
+  if constexpr (!kWide) {
+    for (int a = 0; a < n; ++a) rest_of_row(a, 0);
+  } else {
+    thread_local std::vector<double> tail_rows;
     tail_rows.resize(static_cast<std::size_t>(m - full) * n);
     for (int r = 0; r < m - full; ++r)
       for (int c = 0; c < n; ++c)
         tail_rows[static_cast<std::size_t>(r) * n + c] =
             J[static_cast<std::size_t>(c) * m + full + r];
-  }
-  // Entries (a, b …  a) of row a, from b on, in blocks of kWidth and then one by one.
-  const auto rest_of_row = [&](int a, int b) {
-    for (; b + kWidth <= a + 1; b += kWidth) NormalMatrixEntries<kWidth>(J, m, n, a, b, full, A);
-    for (; b <= a; ++b) NormalMatrixEntries<1>(J, m, n, a, b, full, A);
-  };
-  int a = 0;
-  if constexpr (kWide) {
+    int a = 0;
     for (; a + 1 < n; a += 2) {  // rows a and a + 1 share the loads of their blocks
       int b = 0;
       for (; b <= a + 1 && b + 8 <= n; b += 8)
@@ -182,13 +164,12 @@ template <bool kWide>
       rest_of_row(a, b);
       rest_of_row(a + 1, b);
     }
-  }
-  for (; a < n; ++a) {
-    int b = 0;
-    if constexpr (kWide)
+    for (; a < n; ++a) {
+      int b = 0;
       for (; b <= a && b + 8 <= n; b += 8)
         NormalMatrixEntries8<1>(J, m, n, a, b, full, tail_rows.data(), A);
-    rest_of_row(a, b);
+      rest_of_row(a, b);
+    }
   }
 }
 
