@@ -119,20 +119,30 @@ TEST(BatchEvaluator, MatchesWithBaseAndToolTransforms) {
   ExpectSame(model, testing::ConfigurationsFacing(robot, plane, 40, 4));
 }
 
-// The base's and the tool's terms estimated (parameter_set.h FrameTerms): the kernel computes
-// their columns from its own arrays, on one plane and on three, on every instruction set.
-TEST(BatchEvaluator, MatchesWithEstimatedBaseAndToolTermsOnEveryVariant) {
-  const RobotModel& robot = testing::PaperRobotWithFrames();
-  const PlaneSet planes(
+// Three planes around the paper's arm, and 13 configurations facing each (tagged with its plane).
+PlaneSet ThreePlanes() {
+  return PlaneSet(
       {Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8), Plane::FromCoefficients(1, 0.1, 0, 0.9),
        Plane::FromCoefficients(0, 1, 0.2, 0.9)},
       {});
+}
+
+TargetedConfigurations FacingEachPlane(const RobotModel& robot, const PlaneSet& planes) {
   TargetedConfigurations mixed(robot.num_links());
   for (int p = 0; p < planes.size(); ++p) {
     const TargetedConfigurations facing =
         testing::ConfigurationsFacing(robot, planes[p], 13, 3 + p);
     for (int i = 0; i < facing.size(); ++i) mixed.Add(facing.q(i), p);
   }
+  return mixed;
+}
+
+// The base's and the tool's terms estimated (parameter_set.h FrameTerms): the kernel computes
+// their columns from its own arrays, on one plane and on three, on every instruction set.
+TEST(BatchEvaluator, MatchesWithEstimatedBaseAndToolTermsOnEveryVariant) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PlaneSet planes = ThreePlanes();
+  const TargetedConfigurations mixed = FacingEachPlane(robot, planes);
   const FrameTerms all = FrameTerms::Parse("all", "base"), some = FrameTerms::Parse("x,z,rpy", "t");
   const MeasurementModel one(robot, PlaneSet({planes[0]}, {}),
                              MakeParameterSet(robot, PlaneTerms{true, true}, {}, "--fix",
@@ -171,16 +181,8 @@ std::uint64_t Fingerprint(const MeasurementModel& model, const TargetedConfigura
 
 TEST(BatchEvaluator, KeepsTheBitsOfEarlierVersions) {
   const RobotModel& robot = testing::PaperRobotWithFrames();
-  const PlaneSet planes(
-      {Plane::FromCoefficients(0.2, -0.3, 1.0, 0.8), Plane::FromCoefficients(1, 0.1, 0, 0.9),
-       Plane::FromCoefficients(0, 1, 0.2, 0.9)},
-      {});
-  TargetedConfigurations mixed(robot.num_links());
-  for (int p = 0; p < planes.size(); ++p) {
-    const TargetedConfigurations facing =
-        testing::ConfigurationsFacing(robot, planes[p], 13, 3 + p);
-    for (int i = 0; i < facing.size(); ++i) mixed.Add(facing.q(i), p);
-  }
+  const PlaneSet planes = ThreePlanes();
+  const TargetedConfigurations mixed = FacingEachPlane(robot, planes);
   const FrameTerms all = FrameTerms::Parse("all", "base"), some = FrameTerms::Parse("x,z,rpy", "t");
   const MeasurementModel three(
       robot, planes,
