@@ -1,9 +1,10 @@
 // The chain's forward kinematics over many configurations at once, as structure-of-arrays:
-// the steps the batch kernels of the ranger (batch_evaluation.h) and of the point kind
-// (batch_point.h) share. Every step is a loop over contiguous arrays of the m configurations
-// that the compiler vectorises, force-inlined into each kernel's per-instruction-set variant
-// (cpu_dispatch.h). The arithmetic per configuration is ToolPose's (chain.h), operation for
-// operation, so with -ffp-contract=off every variant gives the same bits.
+// the steps of the point kind's batch kernel (batch_point.h; the ranger's, batch_evaluation.h,
+// walks blocks of configurations through the same arithmetic with its frame in registers). Every
+// step is a loop over contiguous arrays of the m configurations that the compiler vectorises,
+// force-inlined into each kernel's per-instruction-set variant (cpu_dispatch.h). The arithmetic per
+// configuration is ToolPose's (chain.h), operation for operation, so with -ffp-contract=off every
+// variant gives the same bits.
 #pragma once
 
 #include <algorithm>
