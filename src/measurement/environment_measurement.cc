@@ -125,7 +125,7 @@ void EnvironmentMeasurement::LayOutInnerTerms() {
   const Eigen::VectorXd inner_nominal = inner_->NominalValues();
   for (int k = 0; k < static_cast<int>(inner_names.size()); ++k) {
     const int v = robot_->FindValue(inner_names[static_cast<std::size_t>(k)]);
-    const bool length = v >= 0 && (v % kValuesPerLink == kA || v % kValuesPerLink == kD);
+    const bool length = v >= 0 && !IsAngle(v % kValuesPerLink);
     const double base = length ? model_.thermal.Link(v / kValuesPerLink) - model_.thermal.links : 0;
     if (length) {
       layout_.length_columns.push_back(k);
@@ -140,8 +140,7 @@ void EnvironmentMeasurement::LayOutInnerTerms() {
   }
   if (estimate_.thermal_links || !model_.thermal.LinksStill())
     for (int v : robot_->parameter_indices())
-      if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) &&
-          !Contains(inner_names, robot_->ValueName(v)))
+      if (!IsAngle(v % kValuesPerLink) && !Contains(inner_names, robot_->ValueName(v)))
         throw InputError(source_, "thermal growth moves " + robot_->ValueName(v) + ", which the " +
                                       inner_->name() + " kind does not have among its terms");
 }
@@ -485,8 +484,7 @@ std::vector<Pose<double>> EnvironmentToolPoses(const RobotModel& robot,
     const double dt = env.temperature_c - model.thermal.reference_c;
     grown = link_values;
     for (int v : robot.parameter_indices())
-      if (v % kValuesPerLink == kA || v % kValuesPerLink == kD)
-        grown[v] *= 1 + model.thermal.Link(v / kValuesPerLink) * dt;
+      if (!IsAngle(v % kValuesPerLink)) grown[v] *= 1 + model.thermal.Link(v / kValuesPerLink) * dt;
     const Eigen::VectorXd tau = GravityTorques(robot, robot.nominal_values().data(), model.masses,
                                                configs.q(i), env.gravity);
     for (int j = 0; j < n; ++j)

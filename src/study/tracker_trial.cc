@@ -529,30 +529,7 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
 }
 
 namespace {
-void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm,
-                                Eigen::MatrixXd* J);
-}  // namespace
 
-Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
-  const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
-  const Eigen::MatrixXd arm = PoseJacobian(*c.model, zero.data(), c.validation);
-  if (!c.kind) return arm;
-  // The tracker's link terms are columns of the arm's; its instrument and target move no pose.
-  const ParameterSet& ps = c.model->parameters();
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(arm.rows(), c.kind->num_parameters());
-  for (std::size_t k = 0; k < c.kind_link_values.size(); ++k)
-    for (int j = 0; j < ps.num_robot(); ++j)
-      if (ps.robot_values[static_cast<std::size_t>(j)] == c.kind_link_values[k])
-        J.col(static_cast<Eigen::Index>(k)) = arm.col(j);
-  if (c.environment) AddNonGeometricPoseColumns(c, arm, &J);
-  return J;
-}
-
-namespace {
-
-// A cell in an environment: how each validation pose moves with the non-geometric terms, in the
-// validation environment (first order at the nominal model): c_j moves joint j by τ_j(q, g),
-// thermal_links every length ℓ by ℓ·ΔT.
 // The column of link value `value` among the arm's pose Jacobian's (c.model's robot terms), −1.
 int ArmColumn(const CellContext& c, int value) {
   const ParameterSet& ps = c.model->parameters();
@@ -579,12 +556,15 @@ Eigen::Matrix<double, 6, 1> NonGeometricPoseColumn(const CellContext& c, const E
   if (name != kThermalLinksTerm) return out;
   for (int v : robot.parameter_indices()) {
     const int col = ArmColumn(c, v);
-    if ((v % kValuesPerLink == kA || v % kValuesPerLink == kD) && col >= 0)
+    if (!IsAngle(v % kValuesPerLink) && col >= 0)
       out += arm.block<6, 1>(6 * i, col) * robot.nominal_values()[v] * dt;
   }
   return out;
 }
 
+// A cell in an environment: how each validation pose moves with the non-geometric terms, in the
+// validation environment (first order at the nominal model): c_j moves joint j by τ_j(q, g),
+// thermal_links every length ℓ by ℓ·ΔT.
 void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm,
                                 Eigen::MatrixXd* J) {
   const RobotModel& robot = *c.robot;
@@ -604,5 +584,18 @@ void AddNonGeometricPoseColumns(const CellContext& c, const Eigen::MatrixXd& arm
 }
 
 }  // namespace
+
+Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c) {
+  const std::vector<double> zero(static_cast<std::size_t>(c.model->num_parameters()), 0.0);
+  const Eigen::MatrixXd arm = PoseJacobian(*c.model, zero.data(), c.validation);
+  if (!c.kind) return arm;
+  // The tracker's link terms are columns of the arm's; its instrument and target move no pose.
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(arm.rows(), c.kind->num_parameters());
+  for (std::size_t k = 0; k < c.kind_link_values.size(); ++k)
+    if (const int j = ArmColumn(c, c.kind_link_values[k]); j >= 0)
+      J.col(static_cast<Eigen::Index>(k)) = arm.col(j);
+  if (c.environment) AddNonGeometricPoseColumns(c, arm, &J);
+  return J;
+}
 
 }  // namespace lrcal
