@@ -59,8 +59,9 @@ void CholeskySubstitute(const RowMajorMatrixXd& L_in, const Eigen::VectorXd& b,
 
 namespace {
 
-// Eight doubles as one value (core/lanes.h): one AVX-512 register.
+// Eight doubles as one value (core/lanes.h): one AVX-512 register; four: one AVX2 register.
 using Lanes8 = lanes::VectorOf<8>::type;
+using Lanes4 = lanes::VectorOf<4>::type;
 
 // Entry (a, b) alone: eight partial sums (row index mod 8) over the first `full` rows, the tail
 // (the last m mod 8 rows) in order, added in the fixed order below; plain loops that the compiler
@@ -133,13 +134,68 @@ template <int kRows>
   }
 }
 
-// Entry (a, b) = Σ_i J(i,a)·J(i,b) as NormalMatrixEntry sums it, in every variant. kWide
-// (AVX-512, whose 32 registers hold sixteen entries' sums) takes two rows by eight columns of
-// entries at a time, also past the diagonal (entry (a, b) and entry (b, a) have the same bits:
-// each product commutes), and the rest one by one; the other variants take every entry alone
-// (GCC's lowering of eight-lane vectors to narrower registers is slower than its own
-// vectorisation of NormalMatrixEntry).
-template <bool kWide>
+// Entries (a, b … b + 3) at once with four-double vectors (AVX2's registers): each entry's
+// eight partial sums are two vectors (row index mod 8 = 0…3 and 4…7), and the four entries'
+// sums are reduced side by side in NormalMatrixEntry's tree (lane w of the result is entry
+// b + w). The tails come from `tail_rows` as in NormalMatrixEntries8.
+[[gnu::always_inline]] inline void NormalMatrixEntries4(const double* __restrict J, int m, int n,
+                                                        int a, int b, int full,
+                                                        const double* __restrict tail_rows,
+                                                        double* __restrict A) {
+  Lanes4 lo[4], hi[4];  // entry b + w: partial sums 0…3, 4…7
+  for (int w = 0; w < 4; ++w) lo[w] = hi[w] = Lanes4{0, 0, 0, 0};
+  const double* __restrict ca = J + static_cast<std::size_t>(a) * m;
+  for (int i = 0; i < full; i += 8) {
+    const Lanes4 xl = lanes::Load<Lanes4>(ca + i), xh = lanes::Load<Lanes4>(ca + i + 4);
+    for (int w = 0; w < 4; ++w) {
+      const double* cb = J + static_cast<std::size_t>(b + w) * m + i;
+      lo[w] += xl * lanes::Load<Lanes4>(cb);
+      hi[w] += xh * lanes::Load<Lanes4>(cb + 4);
+    }
+  }
+  // Level 1: [e0 s01, e1 s01, e0 s23, e1 s23] of entries (0, 1) and (2, 3), likewise s45, s67.
+  Lanes4 pl[2], ph[2];
+  for (int k = 0; k < 2; ++k) {
+    pl[k] = __builtin_shufflevector(lo[2 * k], lo[2 * k + 1], 0, 4, 2, 6) +
+            __builtin_shufflevector(lo[2 * k], lo[2 * k + 1], 1, 5, 3, 7);
+    ph[k] = __builtin_shufflevector(hi[2 * k], hi[2 * k + 1], 0, 4, 2, 6) +
+            __builtin_shufflevector(hi[2 * k], hi[2 * k + 1], 1, 5, 3, 7);
+  }
+  // Level 2: s01 + s23 and s45 + s67 of the four entries.
+  const Lanes4 ql = __builtin_shufflevector(pl[0], pl[1], 0, 1, 4, 5) +
+                    __builtin_shufflevector(pl[0], pl[1], 2, 3, 6, 7);
+  const Lanes4 qh = __builtin_shufflevector(ph[0], ph[1], 0, 1, 4, 5) +
+                    __builtin_shufflevector(ph[0], ph[1], 2, 3, 6, 7);
+  Lanes4 tail = Lanes4{0, 0, 0, 0};
+  for (int i = 0; i < m - full; ++i)
+    tail += tail_rows[static_cast<std::size_t>(i) * n + a] *
+            lanes::Load<Lanes4>(tail_rows + static_cast<std::size_t>(i) * n + b);
+  const Lanes4 sum = (ql + qh) + tail;
+  lanes::Store(A + static_cast<std::size_t>(a) * n + b, sum);
+  for (int w = 0; w < 4; ++w) A[a + static_cast<std::size_t>(b + w) * n] = sum[w];
+}
+
+// J's last m − full rows, row-major (tail_rows[i·n + c] = J(full + i, c)), for the blocked
+// entries' tails.
+[[gnu::always_inline]] inline const double* TailRows(const double* __restrict J, int m, int n,
+                                                     int full) {
+  thread_local std::vector<double> tail_rows;
+  tail_rows.resize(static_cast<std::size_t>(m - full) * n);
+  for (int r = 0; r < m - full; ++r)
+    for (int c = 0; c < n; ++c)
+      tail_rows[static_cast<std::size_t>(r) * n + c] =
+          J[static_cast<std::size_t>(c) * m + full + r];
+  return tail_rows.data();
+}
+
+// Entry (a, b) = Σ_i J(i,a)·J(i,b) as NormalMatrixEntry sums it, in every variant. The blocks
+// also reach past the diagonal (entry (a, b) and entry (b, a) have the same bits: each product
+// commutes); the entries no block covers are taken one by one. kBlock 8 (AVX-512, whose 32
+// registers hold sixteen entries' sums) takes two rows by eight columns of entries at a time;
+// kBlock 4 (AVX2: sixteen registers) one row by four columns; kBlock 1 (SSE2) every entry alone
+// (there GCC's own vectorisation of NormalMatrixEntry is faster than any lowering of wider
+// vectors to its two-double registers).
+template <int kBlock>
 [[gnu::always_inline]] inline void NormalMatrixBody(const double* __restrict J, int m, int n,
                                                     double* __restrict A) {
   constexpr int kLanes = 8;
@@ -147,42 +203,44 @@ template <bool kWide>
   const auto rest_of_row = [&](int a, int b) {  // entries (a, b …  a)
     for (; b <= a; ++b) NormalMatrixEntry(J, m, n, a, b, full, A);
   };
-  if constexpr (!kWide) {
+  if constexpr (kBlock == 1) {
     for (int a = 0; a < n; ++a) rest_of_row(a, 0);
+  } else if constexpr (kBlock == 4) {
+    const double* tail_rows = TailRows(J, m, n, full);
+    for (int a = 0; a < n; ++a) {
+      int b = 0;
+      for (; b <= a && b + 4 <= n; b += 4) NormalMatrixEntries4(J, m, n, a, b, full, tail_rows, A);
+      rest_of_row(a, b);
+    }
   } else {
-    thread_local std::vector<double> tail_rows;
-    tail_rows.resize(static_cast<std::size_t>(m - full) * n);
-    for (int r = 0; r < m - full; ++r)
-      for (int c = 0; c < n; ++c)
-        tail_rows[static_cast<std::size_t>(r) * n + c] =
-            J[static_cast<std::size_t>(c) * m + full + r];
+    const double* tail_rows = TailRows(J, m, n, full);
     int a = 0;
     for (; a + 1 < n; a += 2) {  // rows a and a + 1 share the loads of their blocks
       int b = 0;
       for (; b <= a + 1 && b + 8 <= n; b += 8)
-        NormalMatrixEntries8<2>(J, m, n, a, b, full, tail_rows.data(), A);
+        NormalMatrixEntries8<2>(J, m, n, a, b, full, tail_rows, A);
       rest_of_row(a, b);
       rest_of_row(a + 1, b);
     }
     for (; a < n; ++a) {
       int b = 0;
       for (; b <= a && b + 8 <= n; b += 8)
-        NormalMatrixEntries8<1>(J, m, n, a, b, full, tail_rows.data(), A);
+        NormalMatrixEntries8<1>(J, m, n, a, b, full, tail_rows, A);
       rest_of_row(a, b);
     }
   }
 }
 
 void NormalMatrixDefault(const double* J, int m, int n, double* A) {
-  NormalMatrixBody<false>(J, m, n, A);
+  NormalMatrixBody<1>(J, m, n, A);
 }
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) void NormalMatrixAvx2(const double* J, int m, int n, double* A) {
-  NormalMatrixBody<false>(J, m, n, A);
+  NormalMatrixBody<4>(J, m, n, A);
 }
 __attribute__((target("avx512f"))) void NormalMatrixAvx512(const double* J, int m, int n,
                                                            double* A) {
-  NormalMatrixBody<true>(J, m, n, A);
+  NormalMatrixBody<8>(J, m, n, A);
 }
 #endif
 
