@@ -13,6 +13,14 @@
 namespace lrcal {
 
 void BatchEvaluator::SetConfigurations(const TargetedConfigurations& configs) {
+  const std::size_t values = static_cast<std::size_t>(configs.size()) * configs.num_joints();
+  const double* q = configs.size() > 0 ? configs.q(0) : nullptr;
+  if (configs.size() == m_ && configs.num_joints() == joints_ && taken_q_.size() == values &&
+      (values == 0 || std::memcmp(taken_q_.data(), q, values * sizeof(double)) == 0) &&
+      configs.targets() == taken_targets_)
+    return;
+  taken_q_.assign(q, q + values);
+  taken_targets_ = configs.targets();
   m_ = configs.size();
   joints_ = configs.num_joints();
   // Padded to whole blocks of kMaxLanes; the padding repeats the last configuration (finite

@@ -19,6 +19,9 @@ namespace lrcal {
 class BatchEvaluator {
  public:
   /// Takes the configurations' joint values and their cos/sin (transposed to arrays per joint).
+  /// The configurations already taken (the same joint values, bit for bit, and the same
+  /// targets: a Monte-Carlo trial on its cell's design) are kept as they are: cos and sin are
+  /// functions of q (ConfigurationSet::Add), so the arrays would not change.
   void SetConfigurations(const TargetedConfigurations& configs);
   int size() const { return m_; }
 
@@ -40,6 +43,9 @@ class BatchEvaluator {
   // Each configuration's plane; empty when every configuration is aimed at plane 0 (the
   // single-plane kernel, which keeps the plane's normal in registers).
   std::vector<int> plane_;
+  // The configurations taken, as given (row-major q and the targets), to recognise them.
+  std::vector<double> taken_q_;
+  std::vector<int> taken_targets_;
 };
 
 }  // namespace lrcal

@@ -1,5 +1,6 @@
 #include "lrcal/measurement/simulation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -136,11 +137,18 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
              const TargetedConfigurations& configs, const NoiseModel& noise,
              const RandomStream& stream, MeasurementSet* data, std::vector<double>* raw,
              const std::vector<int>* noise_slots, const std::vector<double>* per_reading) {
-  // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial).
-  if (data->configs.num_joints() != configs.num_joints())
-    data->configs = TargetedConfigurations(configs.num_joints());
-  data->configs.Clear();
-  data->configs.Reserve(configs.size());
+  // Reuse the buffers of `data` (the Monte-Carlo workspace calls this once per trial); when no
+  // beam misses, the configurations are copied whole.
+  const bool every_beam_hits = std::all_of(misses.begin(), misses.begin() + configs.size(),
+                                           [](BeamMiss miss) { return miss == BeamMiss::kNone; });
+  if (every_beam_hits) {
+    data->configs = configs;
+  } else {
+    if (data->configs.num_joints() != configs.num_joints())
+      data->configs = TargetedConfigurations(configs.num_joints());
+    data->configs.Clear();
+    data->configs.Reserve(configs.size());
+  }
   data->mean_h.clear();
   data->repetitions.clear();
   data->variance_factor.clear();
@@ -168,7 +176,7 @@ int AddNoise(const std::vector<double>& h, const std::vector<BeamMiss>& misses,
       mean = MeanOfReadings(noise, stream, outlier_stream, slot,
                             per_reading ? &(*per_reading)[i * R] : nullptr, h[i], &z, raw);
     }
-    data->configs.AddFrom(configs, i);
+    if (!every_beam_hits) data->configs.AddFrom(configs, i);
     data->mean_h.push_back(mean);
     data->repetitions.push_back(R);
     if (!noise.average.IsMean()) data->variance_factor.push_back(factor);
