@@ -475,8 +475,8 @@ TrackerFit FitTrackerTrial(const CellContext& c, TrialWorkspace* ws) {
 }  // namespace
 
 TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
-                            TrialRecord* rec, TrialDetails* details, TrialWorkspace* ws) {
-  const CellSettings& s = c.cell->typed;
+                            const std::vector<Pose<double>>& validation_true, TrialRecord* rec,
+                            TrialDetails* details, TrialWorkspace* ws) {
   MeasuredValues& values = ws->values;
   SimulateTrackerValues(c, trial, truth, &values);
   rec->missed_configurations = c.design.configs.size() - values.size();
@@ -504,9 +504,8 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
     const int v = c.kind_link_values[static_cast<std::size_t>(k)];
     if (v >= 0) identified[v] += ws->e[k];
   }
-  const PoseErrors validation = CompareIdentified(
-      c, s.truth.random ? TruePoses(c, truth.values, c.validation) : c.validation_true_poses,
-      identified, ws->e, c.validation);
+  const PoseErrors validation =
+      CompareIdentified(c, validation_true, identified, ws->e, c.validation);
   rec->validation = Flatten(validation.stats);
   if (details) {  // a tracker has no distance errors: the poses only
     const Eigen::VectorXd& nominal = c.robot->nominal_values();
@@ -521,8 +520,7 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
     details->measurement_nominal = ComparePoses(*c.robot, measured_true, nominal, measured);
     details->measurement_identified =
         CompareIdentified(c, measured_true, identified, ws->e, measured);
-    details->validation_nominal =
-        ComparePoses(*c.robot, TruePoses(c, truth.values, c.validation), nominal, c.validation);
+    details->validation_nominal = ComparePoses(*c.robot, validation_true, nominal, c.validation);
     details->validation_identified = validation;
   }
   return TrialStatus::kOk;

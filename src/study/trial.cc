@@ -950,6 +950,18 @@ void FillDetails(const CellContext& c, const TrialTruth& truth, const Eigen::Vec
   details->validation_identified = ComparePoses(*c.robot, truth.values, identified, c.validation);
 }
 
+// A ranger cell's preparation after its rig is loaded.
+void PrepareRangerCell(const Study& study, const CellSettings& s, CellContext* c) {
+  BuildParameterSet(s, c);
+  DrawCellConfigurations(study, s, c);
+  CheckIdentifiability(s, c);
+  c->parameter_names = c->model->parameters().names;
+  SelectCellDesign(s, c);
+  CacheTruth(s, c);
+  PredictValidation(c);
+  StateCoverageRadii(s, c);
+}
+
 }  // namespace
 
 std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
@@ -961,24 +973,18 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
     if (s.IsTree() ||
         RobotChainIsCoupled(ResolveRobotPath(s.robot, study.folder()), s.tool_link, s.base_link)) {
       PrepareTreeCell(study, s, c.get());
-      return c;
+    } else {
+      LoadRig(study, s, c.get());
+      if (!s.sensor.IsRanger() || s.in_environment)
+        PrepareTrackerCell(study, s, c.get());
+      else
+        PrepareRangerCell(study, s, c.get());
     }
-    LoadRig(study, s, c.get());
-    if (!s.sensor.IsRanger() || s.in_environment) {
-      PrepareTrackerCell(study, s, c.get());
-      return c;
-    }
-    BuildParameterSet(s, c.get());
-    DrawCellConfigurations(study, s, c.get());
-    CheckIdentifiability(s, c.get());
-    c->parameter_names = c->model->parameters().names;
-    SelectCellDesign(s, c.get());
-    CacheTruth(s, c.get());
-    PredictValidation(c.get());
-    StateCoverageRadii(s, c.get());
   } catch (const InputError& e) {
     throw InputError(study.path + " cell '" + cell.label + "' (" + cell.id + ")", e.what());
   }
+  if (s.truth.random)
+    c->validation_nominal_poses = ToolPoses(*c->robot, c->robot->nominal_values(), c->validation);
   return c;
 }
 
@@ -996,13 +1002,17 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
     return rec;
   };
   const TrialTruth truth = s.truth.random ? DrawTruth(c, trial) : c.fixed_truth;
+  // The true validation poses, computed once a trial (the nominal's errors and the identified
+  // arm's are both taken against them).
+  std::vector<Pose<double>> drawn_true_poses;
+  if (s.truth.random) drawn_true_poses = TruePoses(c, truth.values, c.validation);
+  const std::vector<Pose<double>>& validation_true =
+      s.truth.random ? drawn_true_poses : c.validation_true_poses;
   rec.nominal =
-      Flatten(s.truth.random ? ComparePoses(*c.robot, TruePoses(c, truth.values, c.validation),
-                                            c.robot->nominal_values(), c.validation)
-                                   .stats
+      Flatten(s.truth.random ? ComparePoses(validation_true, c.validation_nominal_poses).stats
                              : c.nominal_validation);
   if (c.rank_deficient) return finish(TrialStatus::kRankDeficient);
-  if (c.kind) return finish(RunTrackerTrial(c, trial, truth, &rec, details, ws));
+  if (c.kind) return finish(RunTrackerTrial(c, trial, truth, validation_true, &rec, details, ws));
 
   TrialDesign redrawn;
   const TrialDesign* design = nullptr;
@@ -1029,9 +1039,7 @@ TrialRecord RunTrial(const CellContext& c, long long trial, TrialWorkspace* ws,
   rec.errors.resize(n);
   for (int k = 0; k < n; ++k) rec.errors[k] = ws->e[k] - truth.delta[k];
   const Eigen::VectorXd identified = c.model->LinkValues(ws->e.data());
-  const PoseErrors validation =
-      s.truth.random ? ComparePoses(*c.robot, truth.values, identified, c.validation)
-                     : ComparePoses(*c.robot, c.validation_true_poses, identified, c.validation);
+  const PoseErrors validation = ComparePoses(*c.robot, validation_true, identified, c.validation);
   rec.validation = Flatten(validation.stats);
   RecordCoverage(c, validation, &rec);
   if (details) FillDetails(c, truth, identified, *ws, details);

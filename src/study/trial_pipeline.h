@@ -119,7 +119,9 @@ struct CellContext {
   std::vector<double> design_true_h;  ///< exact true readings on the design (fixed truth)
   std::vector<BeamMiss> design_true_miss;
   std::vector<Pose<double>> validation_true_poses;  ///< true tool poses (fixed truth)
-  TargetedConfigurations validation;                ///< shared by every trial of the cell
+  /// The nominal arm's tool poses at `validation` (a drawn truth: every trial compares them).
+  std::vector<Pose<double>> validation_nominal_poses;
+  TargetedConfigurations validation;  ///< shared by every trial of the cell
   Eigen::VectorXd predicted_std;  ///< √diag σ²(GᵀWG)⁻¹ at nominal (SI), W = repetitions
   /// The same with G at the true parameters: the Cramér–Rao bound of the simulated experiment
   /// (fixed truth and design; empty otherwise).
@@ -232,8 +234,10 @@ struct TrialWorkspace;
 /// environments (compliance, thermal growth) for a cell in one.
 std::vector<Pose<double>> TruePoses(const CellContext& c, const Eigen::VectorXd& true_values,
                                     const TargetedConfigurations& configs);
+/// `validation_true`: the true tool poses at c.validation (TruePoses at the trial's truth).
 TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTruth& truth,
-                            TrialRecord* rec, TrialDetails* details, TrialWorkspace* ws);
+                            const std::vector<Pose<double>>& validation_true, TrialRecord* rec,
+                            TrialDetails* details, TrialWorkspace* ws);
 /// The validation poses' Jacobian ∂(pose)/∂e at the nominal model in the cell's estimate layout
 /// (6 rows per pose: position, then orientation).
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
