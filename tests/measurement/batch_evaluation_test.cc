@@ -220,5 +220,47 @@ TEST(BatchEvaluator, KeepsTheBitsOfEarlierVersions) {
   }
 }
 
+// Rebinding keeps the arrays only for the configurations already taken: another set of the
+// same size, one joint of one configuration changed (to 0, to −0, by one ulp) or one target
+// alone, evaluates as a fresh evaluator bound to it does (dropping either comparison of
+// SetConfigurations fails this test).
+TEST(BatchEvaluator, RebindingTakesEveryChangeOfTheConfigurations) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PlaneSet planes = ThreePlanes();
+  const MeasurementModel three = ThreePlaneModel(robot, planes);
+  const TargetedConfigurations mixed = FacingEachPlane(robot, planes);
+  const auto with = [&](int changed, double q_value, int target) {
+    TargetedConfigurations out(robot.num_links());
+    for (int i = 0; i < mixed.size(); ++i) {
+      std::vector<double> q(mixed.q(i), mixed.q(i) + robot.num_links());
+      if (i == changed && q_value == q_value) q[2] = q_value;
+      out.Add(q, i == changed && target >= 0 ? target : mixed.target(i));
+    }
+    return out;
+  };
+  const std::vector<TargetedConfigurations> sets = {mixed,
+                                                    with(5, 0.0, -1),
+                                                    with(5, -0.0, -1),  // the sign of zero alone
+                                                    with(5, -0.0, 2),   // the target alone
+                                                    with(5, std::nextafter(0.0, 1), 2),  // one ulp
+                                                    mixed};
+  std::vector<double> e(three.num_parameters(), 1e-3);
+  ModelPoint point;
+  three.Prepare(e.data(), &point);
+  const int m = mixed.size(), n = three.num_parameters();
+  BatchEvaluator reused;
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    BatchEvaluator fresh;
+    fresh.SetConfigurations(sets[k]);
+    reused.SetConfigurations(sets[k]);
+    std::vector<double> a(m + static_cast<std::size_t>(m) * n), b(a.size());
+    fresh.Evaluate(three, point, a.data(), a.data() + m);
+    reused.Evaluate(three, point, b.data(), b.data() + m);
+    EXPECT_EQ(Fnv1a(std::string(reinterpret_cast<const char*>(a.data()), a.size() * 8)),
+              Fnv1a(std::string(reinterpret_cast<const char*>(b.data()), b.size() * 8)))
+        << "set " << k;
+  }
+}
+
 }  // namespace
 }  // namespace lrcal
