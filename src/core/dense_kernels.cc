@@ -27,10 +27,28 @@ bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, RowMajorM
     const double ljj = std::sqrt(d);
     L[j * n + j] = ljj;
     const double inv = 1.0 / ljj;
-    for (int i = j + 1; i < n; ++i) {
+    // Entries (i … i + 3, j) side by side: four independent chains of subtractions, each in
+    // the order of the one-entry loop below (contiguous in both rows).
+    int i = j + 1;
+    for (; i + 3 < n; i += 4) {
+      const double *l0 = L + i * n, *l1 = l0 + n, *l2 = l1 + n, *l3 = l2 + n;
+      double s0 = A(i, j), s1 = A(i + 1, j), s2 = A(i + 2, j), s3 = A(i + 3, j);
+      for (int k = 0; k < j; ++k) {
+        const double x = lj[k];
+        s0 -= l0[k] * x;
+        s1 -= l1[k] * x;
+        s2 -= l2[k] * x;
+        s3 -= l3[k] * x;
+      }
+      L[i * n + j] = s0 * inv;
+      L[(i + 1) * n + j] = s1 * inv;
+      L[(i + 2) * n + j] = s2 * inv;
+      L[(i + 3) * n + j] = s3 * inv;
+    }
+    for (; i < n; ++i) {
       const double* li = L + i * n;
       double s = A(i, j);
-      for (int k = 0; k < j; ++k) s -= li[k] * lj[k];  // contiguous in both rows
+      for (int k = 0; k < j; ++k) s -= li[k] * lj[k];
       L[i * n + j] = s * inv;
     }
   }
@@ -44,7 +62,31 @@ void CholeskySubstitute(const RowMajorMatrixXd& L_in, const Eigen::VectorXd& b,
   const double* L = L_in.data();
   x->resize(n);
   double* y = x->data();
-  for (int i = 0; i < n; ++i) {  // L·y = b
+  // L·y = b. Rows i … i + 3 side by side over the y already known, then in turn: each row's
+  // subtractions in the order of the one-row loop below.
+  int i = 0;
+  for (; i + 3 < n; i += 4) {
+    const double *l0 = L + i * n, *l1 = l0 + n, *l2 = l1 + n, *l3 = l2 + n;
+    double s0 = b[i], s1 = b[i + 1], s2 = b[i + 2], s3 = b[i + 3];
+    for (int k = 0; k < i; ++k) {
+      const double yk = y[k];
+      s0 -= l0[k] * yk;
+      s1 -= l1[k] * yk;
+      s2 -= l2[k] * yk;
+      s3 -= l3[k] * yk;
+    }
+    y[i] = s0 / l0[i];
+    s1 -= l1[i] * y[i];
+    y[i + 1] = s1 / l1[i + 1];
+    s2 -= l2[i] * y[i];
+    s2 -= l2[i + 1] * y[i + 1];
+    y[i + 2] = s2 / l2[i + 2];
+    s3 -= l3[i] * y[i];
+    s3 -= l3[i + 1] * y[i + 1];
+    s3 -= l3[i + 2] * y[i + 2];
+    y[i + 3] = s3 / l3[i + 3];
+  }
+  for (; i < n; ++i) {
     const double* li = L + i * n;
     double s = b[i];
     for (int k = 0; k < i; ++k) s -= li[k] * y[k];
