@@ -184,8 +184,7 @@ template <int kRows>
                                                         int a, int b, int full,
                                                         const double* __restrict tail_rows,
                                                         double* __restrict A) {
-  Lanes4 lo[4], hi[4];  // entry b + w: partial sums 0…3, 4…7
-  for (int w = 0; w < 4; ++w) lo[w] = hi[w] = Lanes4{0, 0, 0, 0};
+  Lanes4 lo[4] = {}, hi[4] = {};  // entry b + w: partial sums 0…3, 4…7, from zero
   const double* __restrict ca = J + static_cast<std::size_t>(a) * m;
   for (int i = 0; i < full; i += 8) {
     const Lanes4 xl = lanes::Load<Lanes4>(ca + i), xh = lanes::Load<Lanes4>(ca + i + 4);

@@ -160,8 +160,9 @@ LevenbergMarquardt::Next LevenbergMarquardt::LeastSquaresIteration(MeasurementEv
   return Next::kIterate;
 }
 
-// The Monte-Carlo hot path (~28 µs per case-2 trial on the AMD EPYC, docs/PERFORMANCE.md): its
-// bit-for-bit results are pinned by the golden tables and the Ceres agreement tests.
+// The Monte-Carlo hot path (27 µs per case-2 trial on the AVX-512 AMD EPYC, 52–62 µs on the
+// AVX2 one: docs/PERFORMANCE.md): its bit-for-bit results are pinned by the golden tables and
+// the Ceres agreement tests.
 LevenbergMarquardt::Result LevenbergMarquardt::SolveLeastSquares(
     MeasurementEvaluator& model, const double* mean_h, const double* weights,
     const IdentificationOptions& options, Eigen::VectorXd* e, const Nominal* nominal) {
