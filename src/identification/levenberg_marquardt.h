@@ -178,6 +178,8 @@ class LevenbergMarquardt {
   RobustWeights robust_w_, robust_w_trial_;
   Eigen::MatrixXd A_reweighted_, J_weighted_;
   bool reweighted_formed_ = false;
+  // The evaluator weights J's rows by sqrt_w_ itself (MeasurementEvaluator::WeightJacobianRows).
+  bool rows_weighted_ = false;
 };
 
 }  // namespace lrcal

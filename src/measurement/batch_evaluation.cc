@@ -72,6 +72,7 @@ struct KernelArgs {
   const int* plane;  // per configuration; null when all are aimed at plane 0
   double* h;
   double* J;
+  const double* row_scale;  // J's row weights (m values); null: none
 };
 
 template <typename V>
@@ -259,7 +260,7 @@ template <typename V>
 // Plane p's chart u (two) and offset f: nonzero on the configurations aimed at plane p.
 template <typename V>
 [[gnu::always_inline]] inline void BlockPlaneColumns(const KernelArgs& args, int i0, int valid,
-                                                     const BlockReading<V>& r) {
+                                                     const BlockReading<V>& r, const V& w) {
   const ParameterSet& ps = *args.parameters;
   for (int p = 0; p < ps.num_planes(); ++p) {
     const PlaneColumns& pc = ps.plane_columns[p];
@@ -271,9 +272,9 @@ template <typename V>
       const Eigen::Matrix<double, 3, 2>& dn_du = args.point->dn_du[p];
       const double d0 = dn_du(0, c), d1 = dn_du(1, c), d2 = dn_du(2, c);
       Store(BlockColumn(args, pc.u[c], i0),
-            own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv), valid);
+            own * ((r.ph.c0 * d0 + r.ph.c1 * d1 + r.ph.c2 * d2) * r.inv) * w, valid);
     }
-    if (pc.f >= 0) Store(BlockColumn(args, pc.f, i0), own * r.inv, valid);
+    if (pc.f >= 0) Store(BlockColumn(args, pc.f, i0), own * r.inv * w, valid);
   }
 }
 
@@ -281,23 +282,23 @@ template <typename V>
 template <typename V>
 [[gnu::always_inline]] inline void BlockFrameColumns(const KernelArgs& args, int i0, int valid,
                                                      const BlockFrame<V>& s,
-                                                     const BlockReading<V>& r) {
+                                                     const BlockReading<V>& r, const V& w) {
   const ModelPoint& point = *args.point;
   const int* base = args.parameters->frame_columns[0];
   const int* tool = args.parameters->frame_columns[1];
   for (int k = 0; k < 3; ++k) {
     if (base[k] >= 0)
       Store(BlockColumn(args, base[k], i0),
-            BlockFrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)), valid);
+            BlockFrameColumn<V, false, true>(point, s, r, Eigen::Vector3d::Unit(k)) * w, valid);
     if (base[3 + k] >= 0)
       Store(BlockColumn(args, base[3 + k], i0),
-            BlockFrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)), valid);
+            BlockFrameColumn<V, false, false>(point, s, r, point.base_axes.col(k)) * w, valid);
     if (tool[k] >= 0)
       Store(BlockColumn(args, tool[k], i0),
-            BlockFrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)), valid);
+            BlockFrameColumn<V, true, true>(point, s, r, point.tool_shifts_T.col(k)) * w, valid);
     if (tool[3 + k] >= 0)
       Store(BlockColumn(args, tool[3 + k], i0),
-            BlockFrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)), valid);
+            BlockFrameColumn<V, true, false>(point, s, r, point.tool_axes_T.col(k)) * w, valid);
   }
 }
 
@@ -319,11 +320,19 @@ template <typename V, bool kJacobian>
   int parallel = 0;
   for (int k = 0; k < valid; ++k) parallel += std::fabs(r.nb[k]) <= kParallelBeamThreshold;
   if constexpr (kJacobian) {
+    // The rows' weights (1 without: x · 1 = x exactly), the last multiplication of each entry.
+    V w = All<V>(1.0);
+    if (args.row_scale) {
+      if (valid == lanes::kWidth<V>)
+        w = Load<V>(args.row_scale + i0);
+      else
+        for (int k = 0; k < valid; ++k) w[k] = args.row_scale[i0 + k];
+    }
     const ParameterSet& ps = *args.parameters;
     for (int k = 0; k < ps.num_robot(); ++k)
-      Store(BlockColumn(args, k, i0), BlockLinkColumn(frames, ps.robot_values[k], r), valid);
-    BlockPlaneColumns(args, i0, valid, r);
-    if (ps.EstimatesFrames()) BlockFrameColumns(args, i0, valid, s, r);
+      Store(BlockColumn(args, k, i0), BlockLinkColumn(frames, ps.robot_values[k], r) * w, valid);
+    BlockPlaneColumns(args, i0, valid, r, w);
+    if (ps.EstimatesFrames()) BlockFrameColumns(args, i0, valid, s, r, w);
   }
   return parallel;
 }
@@ -350,19 +359,32 @@ __attribute__((target("avx512f"))) bool KernelAvx512(const KernelArgs& a) {
 }  // namespace
 
 bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
-                              double* J) {
-  return Evaluate(model, point, h, J, ActiveIsa());
+                              double* J, const double* row_scale) {
+  return Evaluate(model, point, h, J, ActiveIsa(), row_scale);
 }
 
 bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h,
-                              double* J, Isa isa) {
+                              double* J, Isa isa, const double* row_scale) {
   if (num_targets_referenced_ > model.num_planes())
     throw std::invalid_argument("BatchEvaluator: a configuration is aimed at plane " +
                                 std::to_string(num_targets_referenced_) + " of " +
                                 std::to_string(model.num_planes()));
-  const KernelArgs args{m_,        stride_,    &point,     &model.parameters(),
-                        q_.data(), cq_.data(), sq_.data(), plane_.empty() ? nullptr : plane_.data(),
-                        h,         J};
+  // The ranger's terms change J after the kernel (MeasurementModel::ApplyRanger): the rows are
+  // weighted after them, in a pass of their own.
+  const ParameterSet& ps = model.parameters();
+  const bool ranger_changes_J =
+      ps.ranger_offset_index >= 0 || ps.ranger_scale_index >= 0 || point.ranger_scale != 0;
+  const KernelArgs args{m_,
+                        stride_,
+                        &point,
+                        &ps,
+                        q_.data(),
+                        cq_.data(),
+                        sq_.data(),
+                        plane_.empty() ? nullptr : plane_.data(),
+                        h,
+                        J,
+                        ranger_changes_J ? nullptr : row_scale};
   bool ok;
   switch (isa) {
 #if defined(__x86_64__)
@@ -377,6 +399,11 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
       ok = KernelDefault(args);
   }
   model.ApplyRanger(point, m_, h, J);
+  if (J && row_scale && ranger_changes_J)
+    for (int k = 0; k < model.num_parameters(); ++k) {
+      double* col = J + static_cast<std::size_t>(k) * m_;
+      for (int i = 0; i < m_; ++i) col[i] *= row_scale[i];
+    }
   return ok;
 }
 

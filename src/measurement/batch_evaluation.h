@@ -28,10 +28,14 @@ class BatchEvaluator {
   /// Readings h[0..m) at `point`; if `J` is not null also ∂h/∂e into the column-major m×n
   /// matrix J (leading dimension m). Returns false if some beam runs parallel to the plane
   /// (|n·b| ≤ 1e-12), whose h is then not finite.
-  bool Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h, double* J);
+  /// With `row_scale` (m values), J's rows come weighted: J(i, k) · row_scale[i], as the one
+  /// multiplication of a separate pass (the kernel multiplies as it stores, or, when the ranger's
+  /// terms change J after it, a pass at the end).
+  bool Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h, double* J,
+                const double* row_scale = nullptr);
   /// The same with a chosen instruction-set variant (cpu_dispatch.h): identical bits.
   bool Evaluate(const MeasurementModel& model, const ModelPoint& point, double* h, double* J,
-                Isa isa);
+                Isa isa, const double* row_scale = nullptr);
 
  private:
   // The widest block the kernel takes (AVX-512: eight doubles).

@@ -18,7 +18,7 @@ int RangerEvaluator::num_rows() const { return batch_->size(); }
 
 bool RangerEvaluator::Predict(const double* e, double* y, double* J) {
   model_->Prepare(e, &point_);
-  return batch_->Evaluate(*model_, point_, y, J);
+  return batch_->Evaluate(*model_, point_, y, J, row_scale_);
 }
 
 RangerMeasurement::RangerMeasurement(MeasurementModel model, RangerSpec ranger)

@@ -714,6 +714,15 @@ TEST(MeasurementKindIdentification, RangerThroughTheInterfaceIsTheRangerPath) {
   evaluator.Bind(model, data.configs);
   through.Solve(evaluator, data.mean_h.data(), weights.data(), options, &b);
   EXPECT_EQ(a, b);
+  // The solver had the evaluator weight J's rows while it ran, and gives it back unweighted.
+  RangerEvaluator fresh;
+  fresh.Bind(model, data.configs);
+  const auto m = static_cast<std::size_t>(evaluator.num_rows());
+  std::vector<double> h_after(m), J_after(m * evaluator.num_parameters()), h_fresh(m),
+      J_fresh(J_after.size());
+  evaluator.Predict(b.data(), h_after.data(), J_after.data());
+  fresh.Predict(b.data(), h_fresh.data(), J_fresh.data());
+  EXPECT_EQ(J_after, J_fresh);
 
   const RangerMeasurement kind(model, testing::PaperRig().ranger);
   const MeasuredValues values = ToMeasuredValues(data);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <string>
 
@@ -259,6 +260,49 @@ TEST(BatchEvaluator, RebindingTakesEveryChangeOfTheConfigurations) {
     EXPECT_EQ(Fnv1a(std::string(reinterpret_cast<const char*>(a.data()), a.size() * 8)),
               Fnv1a(std::string(reinterpret_cast<const char*>(b.data()), b.size() * 8)))
         << "set " << k;
+  }
+}
+
+// Weighted rows (the solver's √w): J(i, k) · w[i] bit for bit as a separate pass gives it, for a
+// model whose J the kernel finishes (weighted as it stores) and for one whose ranger terms
+// change J after the kernel (weighted in a pass of its own), on every variant, with a number of
+// configurations that leaves a partial block.
+TEST(BatchEvaluator, WeightsRowsAsASeparatePassWould) {
+  const RobotModel& robot = testing::PaperRobotWithFrames();
+  const PlaneSet planes = ThreePlanes();
+  const TargetedConfigurations mixed = FacingEachPlane(robot, planes);  // 39: 8·4 + 7
+  const MeasurementModel with_ranger = ThreePlaneModel(robot, planes);
+  const MeasurementModel without_ranger(
+      robot, planes,
+      MakeParameterSet(robot, std::vector<PlaneTerms>(3, PlaneTerms{true, true}), {}, "--fix",
+                       RangerTerms{}, FrameTerms::Parse("x,z,rpy", "t"),
+                       FrameTerms::Parse("all", "base")));
+  ASSERT_GE(with_ranger.parameters().ranger_scale_index, 0);
+  ASSERT_LT(without_ranger.parameters().ranger_offset_index, 0);
+  ASSERT_LT(without_ranger.parameters().ranger_scale_index, 0);
+  const int m = mixed.size();
+  std::vector<double> w(m);
+  for (int i = 0; i < m; ++i) w[i] = std::sqrt(1.0 + 0.37 * i);
+  for (const MeasurementModel* model : {&with_ranger, &without_ranger}) {
+    const int n = model->num_parameters();
+    std::vector<double> e(n);
+    for (int k = 0; k < n; ++k) e[k] = 1e-3 * std::cos(2.0 + k);
+    ModelPoint point;
+    model->Prepare(e.data(), &point);
+    BatchEvaluator batch;
+    batch.SetConfigurations(mixed);
+    for (Isa isa : SupportedIsas()) {
+      std::vector<double> h(m), J(static_cast<std::size_t>(m) * n), hw(m), Jw(J.size());
+      batch.Evaluate(*model, point, h.data(), J.data(), isa);
+      batch.Evaluate(*model, point, hw.data(), Jw.data(), isa, w.data());
+      for (int k = 0; k < n; ++k)
+        for (int i = 0; i < m; ++i) J[static_cast<std::size_t>(k) * m + i] *= w[i];
+      EXPECT_EQ(std::memcmp(h.data(), hw.data(), m * sizeof(double)), 0) << IsaName(isa);
+      for (std::size_t at = 0; at < J.size(); ++at)
+        ASSERT_EQ(std::memcmp(&J[at], &Jw[at], sizeof(double)), 0)
+            << model->parameters().names[at / m] << " at configuration " << at % m << ", "
+            << IsaName(isa) << ": " << J[at] << " against " << Jw[at];
+    }
   }
 }
 

@@ -44,6 +44,15 @@ class MeasurementEvaluator {
   /// matrix J (leading dimension num_rows()). Returns false when some prediction is undefined at
   /// e (a ranger's beam parallel to its plane): y is then not finite there.
   virtual bool Predict(const double* e, double* y, double* J) = 0;
+  /// Asks the following Predict calls for J with its rows weighted: J(i, k) · row_scale[i]
+  /// (num_rows() values, kept by the caller until the next call; null: unweighted), the one
+  /// multiplication a separate pass over J would make, so the same bits. Returns false when this
+  /// evaluator does not weight rows (the caller then does); the ranger's batch kernel does, as
+  /// it stores J.
+  virtual bool WeightJacobianRows(const double* row_scale) {
+    (void)row_scale;
+    return false;
+  }
 };
 
 /// One kind of measurement, built on a robot and the kind's nominal geometry (the sensor's

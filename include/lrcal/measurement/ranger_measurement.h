@@ -34,11 +34,16 @@ class RangerEvaluator : public MeasurementEvaluator {
   /// The readings (1 + s)·h + o at e and their Jacobian (measurement_model.h); false when a beam
   /// runs parallel to its plane at e.
   bool Predict(const double* e, double* y, double* J) override;
+  bool WeightJacobianRows(const double* row_scale) override {
+    row_scale_ = row_scale;
+    return true;
+  }
 
  private:
   const MeasurementModel* model_ = nullptr;
   std::unique_ptr<BatchEvaluator> batch_;
   ModelPoint point_;
+  const double* row_scale_ = nullptr;
 };
 
 /// The ranger as a measurement kind: one reading per configuration, a configuration's plane is
