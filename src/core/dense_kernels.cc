@@ -11,6 +11,32 @@
 
 namespace lrcal {
 
+namespace {
+
+// s[r] −= Σ_{k < count} L(row0 + r, k)·x[k] for the four rows r = 0 … 3 of a row-major matrix
+// of leading dimension n (`rows` points at row row0): each row's subtractions in the order of k,
+// the four rows' chains independent of each other (the factorisation and the substitution are
+// latency-bound, one chain at a time).
+[[gnu::always_inline]] inline void SubtractFourRowProducts(const double* rows, int n,
+                                                           const double* x, int count,
+                                                           double s[4]) {
+  const double *l0 = rows, *l1 = l0 + n, *l2 = l1 + n, *l3 = l2 + n;
+  double s0 = s[0], s1 = s[1], s2 = s[2], s3 = s[3];
+  for (int k = 0; k < count; ++k) {
+    const double xk = x[k];
+    s0 -= l0[k] * xk;
+    s1 -= l1[k] * xk;
+    s2 -= l2[k] * xk;
+    s3 -= l3[k] * xk;
+  }
+  s[0] = s0;
+  s[1] = s1;
+  s[2] = s2;
+  s[3] = s3;
+}
+
+}  // namespace
+
 bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, RowMajorMatrixXd* L_out,
                    Eigen::VectorXd* x, double min_pivot) {
   const int n = static_cast<int>(A.rows());
@@ -27,23 +53,12 @@ bool CholeskySolve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, RowMajorM
     const double ljj = std::sqrt(d);
     L[j * n + j] = ljj;
     const double inv = 1.0 / ljj;
-    // Entries (i … i + 3, j) side by side: four independent chains of subtractions, each in
-    // the order of the one-entry loop below (contiguous in both rows).
+    // Entries (i … i + 3, j) side by side, each in the order of the one-entry loop below.
     int i = j + 1;
     for (; i + 3 < n; i += 4) {
-      const double *l0 = L + i * n, *l1 = l0 + n, *l2 = l1 + n, *l3 = l2 + n;
-      double s0 = A(i, j), s1 = A(i + 1, j), s2 = A(i + 2, j), s3 = A(i + 3, j);
-      for (int k = 0; k < j; ++k) {
-        const double x = lj[k];
-        s0 -= l0[k] * x;
-        s1 -= l1[k] * x;
-        s2 -= l2[k] * x;
-        s3 -= l3[k] * x;
-      }
-      L[i * n + j] = s0 * inv;
-      L[(i + 1) * n + j] = s1 * inv;
-      L[(i + 2) * n + j] = s2 * inv;
-      L[(i + 3) * n + j] = s3 * inv;
+      double s[4] = {A(i, j), A(i + 1, j), A(i + 2, j), A(i + 3, j)};
+      SubtractFourRowProducts(L + i * n, n, lj, j, s);
+      for (int r = 0; r < 4; ++r) L[(i + r) * n + j] = s[r] * inv;
     }
     for (; i < n; ++i) {
       const double* li = L + i * n;
@@ -66,25 +81,20 @@ void CholeskySubstitute(const RowMajorMatrixXd& L_in, const Eigen::VectorXd& b,
   // subtractions in the order of the one-row loop below.
   int i = 0;
   for (; i + 3 < n; i += 4) {
+    double s[4] = {b[i], b[i + 1], b[i + 2], b[i + 3]};
+    SubtractFourRowProducts(L + i * n, n, y, i, s);
+    // Then each row's last terms, y[i] … y[i + r − 1], in order.
     const double *l0 = L + i * n, *l1 = l0 + n, *l2 = l1 + n, *l3 = l2 + n;
-    double s0 = b[i], s1 = b[i + 1], s2 = b[i + 2], s3 = b[i + 3];
-    for (int k = 0; k < i; ++k) {
-      const double yk = y[k];
-      s0 -= l0[k] * yk;
-      s1 -= l1[k] * yk;
-      s2 -= l2[k] * yk;
-      s3 -= l3[k] * yk;
-    }
-    y[i] = s0 / l0[i];
-    s1 -= l1[i] * y[i];
-    y[i + 1] = s1 / l1[i + 1];
-    s2 -= l2[i] * y[i];
-    s2 -= l2[i + 1] * y[i + 1];
-    y[i + 2] = s2 / l2[i + 2];
-    s3 -= l3[i] * y[i];
-    s3 -= l3[i + 1] * y[i + 1];
-    s3 -= l3[i + 2] * y[i + 2];
-    y[i + 3] = s3 / l3[i + 3];
+    y[i] = s[0] / l0[i];
+    s[1] -= l1[i] * y[i];
+    y[i + 1] = s[1] / l1[i + 1];
+    s[2] -= l2[i] * y[i];
+    s[2] -= l2[i + 1] * y[i + 1];
+    y[i + 2] = s[2] / l2[i + 2];
+    s[3] -= l3[i] * y[i];
+    s[3] -= l3[i + 1] * y[i + 1];
+    s[3] -= l3[i + 2] * y[i + 2];
+    y[i + 3] = s[3] / l3[i + 3];
   }
   for (; i < n; ++i) {
     const double* li = L + i * n;
