@@ -23,6 +23,8 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"(lrcal/)?([a-z_]+)/([^"]+)"')
 PRIVATE_ALLOWED = {
     ("measurement", "core/cpu_dispatch.h"): "the batch kernel's run-time ISA dispatch",
     ("measurement", "core/lanes.h"): "the batch kernel's vectors, shared with the normal matrix",
+    ("measurement", "core/dense_kernel_variants.h"):
+        "the batch kernel weights J's rows with the variant it was handed (ScaleRows)",
     ("study", "identification/levenberg_marquardt.h"):
         "the trial pipeline holds the solver's workspace (issue 25 item 4: a public trial API)",
     ("study", "io/yaml_util.h"): "the study reader uses the robot files' YAML helpers",

@@ -365,18 +365,21 @@ __attribute__((target("avx512f"))) void ScaleSymmetricAvx512(const double* s, co
 
 }  // namespace
 
-void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J, Isa isa) {
-  const int m = static_cast<int>(J->rows()), n = static_cast<int>(J->cols());
+void ScaleRows(const double* s, int m, int n, double* J, Isa isa) {
   switch (isa) {
 #if defined(__x86_64__)
     case Isa::kAvx512:
-      return ScaleRowsAvx512(s.data(), m, n, J->data());
+      return ScaleRowsAvx512(s, m, n, J);
     case Isa::kAvx2:
-      return ScaleRowsAvx2(s.data(), m, n, J->data());
+      return ScaleRowsAvx2(s, m, n, J);
 #endif
     default:
-      return ScaleRowsDefault(s.data(), m, n, J->data());
+      return ScaleRowsDefault(s, m, n, J);
   }
+}
+
+void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J, Isa isa) {
+  ScaleRows(s.data(), static_cast<int>(J->rows()), static_cast<int>(J->cols()), J->data(), isa);
 }
 
 void ScaleRows(const Eigen::VectorXd& s, Eigen::MatrixXd* J) { ScaleRows(s, J, ActiveIsa()); }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/cpu_dispatch.h"
+#include "core/dense_kernel_variants.h"
 #include "core/lanes.h"
 
 namespace lrcal {
@@ -372,8 +373,7 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
   // The ranger's terms change J after the kernel (MeasurementModel::ApplyRanger): the rows are
   // weighted after them, in a pass of their own.
   const ParameterSet& ps = model.parameters();
-  const bool ranger_changes_J =
-      ps.ranger_offset_index >= 0 || ps.ranger_scale_index >= 0 || point.ranger_scale != 0;
+  const bool ranger_changes_J = model.RangerChangesJacobian(point);
   const KernelArgs args{m_,
                         stride_,
                         &point,
@@ -399,11 +399,7 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
       ok = KernelDefault(args);
   }
   model.ApplyRanger(point, m_, h, J);
-  if (J && row_scale && ranger_changes_J)
-    for (int k = 0; k < model.num_parameters(); ++k) {
-      double* col = J + static_cast<std::size_t>(k) * m_;
-      for (int i = 0; i < m_; ++i) col[i] *= row_scale[i];
-    }
+  if (J && row_scale && ranger_changes_J) ScaleRows(row_scale, m_, model.num_parameters(), J, isa);
   return ok;
 }
 

@@ -128,8 +128,9 @@ void MeasurementModel::FrameColumns(const ModelPoint& point, const Pose<double>&
 void MeasurementModel::ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const {
   const int io = parameters_.ranger_offset_index, is = parameters_.ranger_scale_index;
   const double o = point.ranger_offset, s = point.ranger_scale;
-  if (io < 0 && is < 0 && o == 0 && s == 0) return;
-  if (J) {
+  const bool changes_J = RangerChangesJacobian(point);
+  if (!changes_J && o == 0) return;
+  if (J && changes_J) {
     for (int k = 0; k < num_parameters(); ++k) {
       double* col = J + static_cast<std::size_t>(k) * m;
       if (k == io) {

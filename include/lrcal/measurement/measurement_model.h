@@ -127,6 +127,13 @@ class MeasurementModel {
   /// to their Jacobian (column-major, leading dimension m): see Evaluate. A no-op for a
   /// perfect ranger that is not estimated (the paper's model keeps its bits).
   void ApplyRanger(const ModelPoint& point, int m, double* h, double* J) const;
+  /// Whether ApplyRanger changes J at `point`: a ranger term is estimated (its column is set)
+  /// or the ranger's scale is not zero (every column is multiplied by 1 + scale). An offset
+  /// alone moves the readings only.
+  bool RangerChangesJacobian(const ModelPoint& point) const {
+    return parameters_.ranger_offset_index >= 0 || parameters_.ranger_scale_index >= 0 ||
+           point.ranger_scale != 0;
+  }
 
  private:
   // Frame f's six terms (x, y, z, roll, pitch, yaw) at estimate e: 0 where not estimated.
