@@ -11,7 +11,7 @@ bash scripts/install_packages.sh clang libclang-rt-14-dev libyaml-cpp-dev libeig
   nlohmann-json3-dev librandom123-dev libboost-dev
 out=build-fuzz
 mkdir -p "$out/obj" "$out/findings"
-flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
+flags=(-std=c++17 -O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefined
        -fno-sanitize-recover=undefined -Iinclude -Isrc -I/usr/include/eigen3
        "-DLRCAL_SOURCE_DIR=\"$PWD\"")
 # The readers and what they need (no Ceres, no SQLite: the fuzzers build in about a minute).

@@ -4,10 +4,10 @@
 #   bash scripts/setup.sh run    # build and run the main job
 #   bash scripts/setup.sh test   # build and run every test (what .ci/run does first)
 #   bash scripts/setup.sh build  # build only
-# LRCAL_WERROR=ON (CI) turns warnings into errors; LRCAL_UNITY=ON (CI) compiles the library and
-# the test binaries as unity builds (faster from scratch, slower to rebuild after an edit; the
-# results have the same bits: no fused multiply-adds, CMakeLists.txt), LRCAL_UNITY_TESTS=ON the
-# test binaries only.
+# LRCAL_WERROR=ON (CI) turns warnings into errors; LRCAL_UNITY=ON (CI) compiles the library, the
+# CLI and the test binaries as unity builds (faster from scratch, slower to rebuild after an edit;
+# the results have the same bits: no fused multiply-adds, CMakeLists.txt), LRCAL_UNITY_TESTS=ON
+# the test binaries only.
 set -euo pipefail
 action="${1:-run}"
 case "$action" in run|test|build) ;; *) echo "usage: bash scripts/setup.sh run|test|build" >&2; exit 2;; esac
