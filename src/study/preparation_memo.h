@@ -1,7 +1,8 @@
 // Process-wide memos of the steps of a cell's preparation that the cells of a sweep or a
-// sensitivity plan share (the robot file, the pool and validation draws, the design's selection,
-// its certificate, the first-order draws): the cells of a noise sweep differ in σ alone, yet each
-// would otherwise draw, select and propagate the same configurations again.
+// sensitivity plan share (the robot file and whether its chain is coupled, the pool and
+// validation draws, the pool's identifiability, the design's selection, its certificate, the
+// first-order draws): the cells of a noise sweep differ in σ alone, yet each would otherwise
+// parse, draw, analyse, select and propagate the same configurations again.
 //
 // An entry is matched on exact equality of every input the step reads (no hash is trusted), so a
 // hit returns the bits of computing the step again: the memo changes time, never a result.

@@ -15,9 +15,11 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <system_error>
 #include <thread>
+#include <utility>
 
 #include "lrcal/core/error.h"
 #include "lrcal/core/text_table.h"
@@ -249,7 +251,10 @@ class StudyRunner {
 
   RunResult Run() {
     start_ = Clock::now();
-    if (!AlreadyComplete()) PrepareCells();
+    contexts_.resize(study_.cells.size());
+    for (std::size_t i = 0; i < study_.cells.size(); ++i)
+      cell_index_.emplace(study_.cells[i].id, static_cast<int>(i));
+    PrepareCells(CellsToPrepare(), true);
     if (stop_->stop_requested()) {  // a signal while the cells were prepared: nothing written
       result_.interrupted = true;
       result_.seconds = Seconds(start_, Clock::now());
@@ -257,8 +262,7 @@ class StudyRunner {
     }
     OpenRunDirectory();
     FindMissingTrials();
-    // Insurance: should the store show work after all, the cells are prepared now.
-    if (contexts_.empty() && result_.done_before < result_.total) PrepareCells();
+    PrepareLateCells();
     try {
       RunTrials();
     } catch (const StorageError& e) {
@@ -297,29 +301,64 @@ class StudyRunner {
            "command again: the run resumes where it stopped and gives the same tables.";
   }
 
-  // A rerun of a finished run has nothing to compute and so nothing to prepare: every trial of
-  // this process's share is recorded in a run directory of this very study (the count
-  // FindMissingTrials makes again under the lock). The store already
-  // holds every cell's row, the session is still recorded and the tables still written, so the
-  // rerun gives what it gave before, without minutes of preparing cells. Only for one process
-  // and fixed trial counts: a stop_when run decides in the loop, which needs its cells. Anything
-  // unusual (no manifest, another study, a damaged store) takes the ordinary path, whose checks
-  // say what is wrong.
-  bool AlreadyComplete() const {
+  // The cells this process prepares (indices, in order) and what for: those with trials of its
+  // share still to compute, or with no row in the main store, as the run directory stands before
+  // the lock. A resume then prepares only its unfinished cells, for their trials alone when the
+  // store holds their row (written by the session that prepared them in full), and a rerun of a
+  // finished run prepares none. Every cell in full for a new directory, an MPI job (every rank
+  // runs trials of any cell and writes every row to its own store), a stop_when run (it decides
+  // in the loop, over every cell) or anything unusual (no manifest, another study, a damaged
+  // store), whose checks under the lock then say what is wrong. PrepareLateCells covers a store
+  // that changed between this reading and the lock.
+  std::vector<std::pair<int, CellPreparation>> CellsToPrepare() const {
+    const int num_cells = static_cast<int>(study_.cells.size());
+    std::vector<std::pair<int, CellPreparation>> all;
+    for (int i = 0; i < num_cells; ++i) all.emplace_back(i, CellPreparation::kFull);
     if (ranks_ > 1 || (study_.stop_when.enabled() && options_.shard_count == 1) ||
         !dir_.HasManifest())
-      return false;
+      return all;
     try {
       const Json manifest = dir_.ReadManifest();
       RunDirectory::CheckCompatible(manifest, study_.ToJson(), study_.path, options_.shard_index,
                                     options_.shard_count);
-      // More trials per cell than recorded extend the run: there is work, so cells are needed.
-      if (manifest["study"].value("trials", 0LL) != study_.trials) return false;
-      for (const auto& cell : dir_.ReadDone(study_))
-        if (MissingInShare(cell) > 0) return false;
-      return true;
+      const std::vector<std::string> ids = TrialStore(dir_.MainStorePath()).CellIds();
+      const std::set<std::string> stored(ids.begin(), ids.end());
+      const DoneSet done = dir_.ReadDone(study_);
+      std::vector<std::pair<int, CellPreparation>> needed;
+      for (int i = 0; i < num_cells; ++i) {
+        const auto u = static_cast<std::size_t>(i);
+        if (stored.count(study_.cells[u].id) == 0)
+          needed.emplace_back(i, CellPreparation::kFull);
+        else if (MissingInShare(done[u]) > 0)
+          needed.emplace_back(i, CellPreparation::kForTrials);
+      }
+      return needed;
     } catch (const std::exception&) {
-      return false;
+      return all;
+    }
+  }
+
+  // Insurance, under the lock: a cell that FindMissingTrials finds with trials to compute and
+  // CellsToPrepare did not prepare, or whose row the main store lacks and that was not prepared
+  // in full (the store changed in between), is prepared now (its row written), before any trial.
+  void PrepareLateCells() {
+    std::set<std::string> stored;
+    if (ranks_ == 1)
+      for (std::string& id : store_->CellIds()) stored.insert(std::move(id));
+    std::vector<std::pair<int, CellPreparation>> late;
+    for (std::size_t c = 0; c < contexts_.size(); ++c) {
+      const bool no_row = ranks_ == 1 && stored.count(study_.cells[c].id) == 0;
+      const CellContext* context = contexts_[c].get();
+      if (no_row && (!context || context->for_trials_only))
+        late.emplace_back(static_cast<int>(c), CellPreparation::kFull);
+      else if (!context && MissingInShare(done_[c]) > 0)
+        late.emplace_back(static_cast<int>(c), CellPreparation::kForTrials);
+    }
+    if (late.empty()) return;
+    PrepareCells(late, false);
+    for (const auto& [c, what] : late) {  // a stop between cells leaves some unprepared
+      const auto& context = contexts_[static_cast<std::size_t>(c)];
+      if (context && what == CellPreparation::kFull) store_->PutCell(ToStoredCell(*context));
     }
   }
 
@@ -338,30 +377,41 @@ class StudyRunner {
     return missing;
   }
 
-  // Every rank prepares every cell (the same deterministic result), on all its threads: cells
-  // are independent and PrepareCell is a pure function of the study and the cell, so the
-  // contexts (and everything computed from them) do not depend on the thread count. Workers
-  // claim cells in order; after a failure no new cell is claimed, and the error of the first
-  // failing cell in order is thrown — every earlier cell was claimed and prepared, so it is the
-  // error a single thread would have met.
-  void PrepareCells() {
+  // Prepares the cells `which` ((index, what for), in index order) on all threads. Every rank
+  // prepares every cell it needs (the same deterministic result): cells are independent and
+  // PrepareCell is a pure function of the study and the cell (memos return the bits they would
+  // compute), so the contexts (and everything computed from them) depend neither on the thread
+  // count nor on which other cells are prepared. Workers claim cells in order; after a failure no
+  // new cell is claimed, and the error of the first failing cell in order is thrown — every earlier
+  // cell was claimed and prepared, so it is the error a single thread would have met.
+  // `before_writing`: nothing is written yet, so a signal ends the process at once; otherwise
+  // (PrepareLateCells) the stop token is checked between cells and the trials then stop.
+  void PrepareCells(const std::vector<std::pair<int, CellPreparation>>& which,
+                    bool before_writing) {
     // Signals end the process at once while nothing is written (see OnStopSignal); a library
     // caller's own stop token is checked between cells.
     struct Preparing {
-      Preparing() { g_preparing.store(true); }
-      ~Preparing() { g_preparing.store(false); }
-    } preparing;
-    const int num_cells = static_cast<int>(study_.cells.size());
-    std::vector<std::unique_ptr<CellContext>> prepared(static_cast<std::size_t>(num_cells));
-    std::vector<std::exception_ptr> errors(prepared.size());
+      explicit Preparing(bool on) : on_(on) {
+        if (on_) g_preparing.store(true);
+      }
+      ~Preparing() {
+        if (on_) g_preparing.store(false);
+      }
+      bool on_;
+    } preparing(before_writing);
+    const auto start = Clock::now();
+    const int count = static_cast<int>(which.size());
+    std::vector<std::unique_ptr<CellContext>> prepared(which.size());
+    std::vector<std::exception_ptr> errors(which.size());
     std::atomic<int> next{0};
     std::atomic<bool> failed{false};
-    PreparationProgress progress(options_.progress && root(), start_, num_cells);
+    PreparationProgress progress(options_.progress && root(), start_, count);
     const auto work = [&] {
-      for (int i = next++; i < num_cells && !failed && !stop_->stop_requested(); i = next++) {
+      for (int i = next++; i < count && !failed && !stop_->stop_requested(); i = next++) {
         const auto u = static_cast<std::size_t>(i);
         try {
-          prepared[u] = PrepareCell(study_, study_.cells[u]);
+          prepared[u] = PrepareCell(study_, study_.cells[static_cast<std::size_t>(which[u].first)],
+                                    which[u].second);
         } catch (...) {
           errors[u] = std::current_exception();
           failed = true;
@@ -370,18 +420,18 @@ class StudyRunner {
       }
     };
     std::vector<std::thread> workers;
-    for (int t = 1; t < std::min(threads_, num_cells); ++t) workers.emplace_back(work);
+    for (int t = 1; t < std::min(threads_, count); ++t) workers.emplace_back(work);
     work();
     for (std::thread& w : workers) w.join();
     for (const std::exception_ptr& e : errors)
       if (e) std::rethrow_exception(e);
     for (std::size_t i = 0; i < prepared.size() && prepared[i]; ++i) {
-      cell_index_.emplace(study_.cells[i].id, static_cast<int>(i));
-      contexts_.push_back(std::move(prepared[i]));
+      contexts_[static_cast<std::size_t>(which[i].first)] = std::move(prepared[i]);
+      ++result_.cells_prepared;
     }
     progress.Finish();
     ClearPreparationMemos();  // the cells hold what they share
-    result_.prepare_seconds = Seconds(start_, Clock::now());
+    result_.prepare_seconds += Seconds(before_writing ? start_ : start, Clock::now());
   }
 
   // Rank 0 owns the directory: lock, manifest (and its refusals), main store. Every rank
@@ -410,7 +460,8 @@ class StudyRunner {
                                       : ""));
         TrialStore main_store(dir_.MainStorePath());
         main_store.SetMeta("study", study_.ToJson().dump());
-        for (const auto& context : contexts_) main_store.PutCell(ToStoredCell(*context));
+        for (const auto& context : contexts_)
+          if (context && !context->for_trials_only) main_store.PutCell(ToStoredCell(*context));
       } catch (const std::exception& e) {
         if (ranks_ == 1) throw;
         refusal = e.what();
@@ -422,7 +473,8 @@ class StudyRunner {
     store_path_ = ranks_ == 1 ? dir_.MainStorePath() : dir_.RankStorePath(rank_);
     store_ = std::make_unique<TrialStore>(store_path_);
     if (ranks_ > 1)
-      for (const auto& context : contexts_) store_->PutCell(ToStoredCell(*context));
+      for (const auto& context : contexts_)
+        if (context) store_->PutCell(ToStoredCell(*context));
     collective_->Barrier();  // every store exists with its tables
   }
 
@@ -465,8 +517,12 @@ class StudyRunner {
       while (!stop_->stop_requested()) {
         work_->Claim(kClaim, &chunk);
         if (chunk.empty()) break;
-        for (const auto& [cell, trial] : chunk)
-          local.push_back(RunTrial(*contexts_[cell], trial, &ws));
+        for (const auto& [cell, trial] : chunk) {
+          const CellContext* context = contexts_[static_cast<std::size_t>(cell)].get();
+          if (!context)  // every cell with a missing trial was prepared (PrepareLateCells)
+            throw std::logic_error("trial of cell " + study_.cells[cell].id + " not prepared");
+          local.push_back(RunTrial(*context, trial, &ws));
+        }
         queue->Push(&local);
       }
     } catch (...) {
@@ -517,7 +573,7 @@ class StudyRunner {
   // rules and tells every rank what it decided. Stops with the run (signal, --max-trials) or
   // when every cell is decided.
   void RunRounds(ProgressReporter* progress) {
-    const int num_cells = static_cast<int>(contexts_.size());
+    const int num_cells = static_cast<int>(study_.cells.size());
     if (root()) stopping_.assign(num_cells, CellStopping(study_.stop_when, study_.trials));
     std::vector<TrialRange> ranges(num_cells, TrialRange{0, study_.stop_when.block});
     while (true) {
@@ -563,9 +619,9 @@ class StudyRunner {
       for (std::size_t c = 0; c < stopping_.size(); ++c) {
         CellStopping& state = stopping_[c];
         if (!state.decided() &&
-            !FeedStopping(stores, contexts_[c]->cell->id, state.next_boundary(), &state))
+            !FeedStopping(stores, study_.cells[c].id, state.next_boundary(), &state))
           throw std::logic_error("stop_when: a round ended with trials of cell " +
-                                 contexts_[c]->cell->id + " unrecorded");
+                                 study_.cells[c].id + " unrecorded");
         if (state.decided()) {
           ranges.push_back({0, 0});
           ++decided;
@@ -659,6 +715,19 @@ class StudyRunner {
   }
 
   // Rank 0 folds the rank stores into the main store and closes the session in the manifest.
+  // The trials of this shard recorded now, on rank 0 after the merge. One process: those
+  // recorded before (the union over every store, read under the lock) and those it committed,
+  // none of them recorded before (MissingTrials). Ranks: what the merged store holds.
+  long long RecordedInShare(const TrialStore& main_store) const {
+    if (ranks_ == 1) return result_.done_before + result_.computed;
+    long long recorded = 0;
+    for (const Cell& cell : study_.cells)
+      for (long long t : main_store.DoneTrials(cell.id))
+        if (t >= 0 && t < study_.trials && t % options_.shard_count == options_.shard_index)
+          ++recorded;
+    return recorded;
+  }
+
   void FinishSession() {
     result_.ranks_computed = collective_->SumAll(result_.computed);
     store_.reset();          // close this process's store before rank 0 merges it
@@ -666,11 +735,7 @@ class StudyRunner {
     if (root()) {
       TrialStore main_store(dir_.MainStorePath());
       dir_.MergeRankStores(&main_store);
-      long long done_now = 0;
-      for (const Cell& cell : study_.cells)
-        for (long long t : main_store.DoneTrials(cell.id))
-          if (t >= 0 && t < study_.trials && t % options_.shard_count == options_.shard_index)
-            ++done_now;
+      const long long done_now = RecordedInShare(main_store);
       result_.complete = adaptive_ ? all_decided_ : done_now >= result_.total;
       result_.interrupted = stop_->stop_requested() || !result_.complete;
       result_.reached_max_trials = ReachedMaxTrials();
@@ -685,6 +750,7 @@ class StudyRunner {
                             {"sum_of_trial_times", result_.trial_seconds}};
       result_.peak_rss_kb = PeakRssKb();
       session["peak_rss_kb"] = {{"after_trials", result_.peak_rss_kb_trials}};
+      session["cells_prepared"] = result_.cells_prepared;
       dir_.WriteManifest(manifest_);
       dir_.AppendLog(
           "session " + std::to_string(session_ + 1) + " ended (" +
@@ -713,13 +779,13 @@ class StudyRunner {
   RunDirectory dir_;
   Clock::time_point start_;
   RunResult result_;
-  std::vector<std::unique_ptr<CellContext>> contexts_;
+  std::vector<std::unique_ptr<CellContext>> contexts_;  // by cell index; null: not prepared
   Json manifest_;
   std::size_t session_ = 0;
   std::string store_path_;
   std::unique_ptr<TrialStore> store_;
   DoneSet done_;
-  std::map<std::string, int> cell_index_;  // cell id → index in contexts_
+  std::map<std::string, int> cell_index_;  // cell id → index in study_.cells and contexts_
   std::unique_ptr<RemainingTimeEstimate> eta_;
   std::unique_ptr<ProgressReporter> progress_;
   bool dynamic_ = false;
@@ -827,7 +893,8 @@ std::string RunSummaryText(const RunResult& r, const RunOptions& options, int ra
           ? "runner overhead " + Fixed(100 * (r.run_seconds * threads / r.trial_seconds - 1), 1) +
                 " % over the trials' own time"
           : "too short to measure the runner's overhead";
-  out << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s, trials "
+  out << "lrcal run: wall time: prepare " << Fixed(r.prepare_seconds, 3) << " s ("
+      << r.cells_prepared << (r.cells_prepared == 1 ? " cell" : " cells") << "), trials "
       << Fixed(r.run_seconds, 3) << " s (" << threads << " threads"
       << (ranks > 1 ? " on rank 0 of " + std::to_string(ranks) : std::string()) << "; " << overhead
       << "), tables " << Fixed(r.tables_seconds, 3) << " s; peak memory "

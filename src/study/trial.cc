@@ -8,6 +8,7 @@
 #include "lrcal/core/hash.h"
 #include "lrcal/design/design_certificate.h"
 #include "lrcal/design/task_criterion.h"
+#include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/pose_accuracy.h"
 #include "lrcal/identification/prior.h"
 #include "lrcal/identification/total_accuracy.h"
@@ -274,14 +275,27 @@ struct RigKey {
   }
 };
 
-// LoadRobotFile, matched on the file's path, links and bytes (a file edited between two cells'
-// preparations is read again).
-LoadedRig LoadRigFile(const std::string& path, const CellSettings& s) {
-  static PreparationMemo<RigKey, LoadedRig, 8> memo;
+// The key of a robot file as it is now: its path, the cell's links and its bytes (a file edited
+// between two cells' preparations is read again).
+RigKey RigKeyOf(const std::string& path, const CellSettings& s) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream bytes;
   bytes << in.rdbuf();
-  return memo.Get(RigKey{path, s.tool_link, s.base_link, bytes.str()}, [&] {
+  return RigKey{path, s.tool_link, s.base_link, bytes.str()};
+}
+
+// RobotChainIsCoupled (a coupled chain is prepared as a tree), matched as LoadRigFile is: the
+// cells of a plan on one robot file parse it once.
+bool RigIsCoupled(const std::string& path, const CellSettings& s) {
+  static PreparationMemo<RigKey, bool, 8> memo;
+  return memo.Get(RigKeyOf(path, s),
+                  [&] { return RobotChainIsCoupled(path, s.tool_link, s.base_link); });
+}
+
+// LoadRobotFile, matched on RigKeyOf.
+LoadedRig LoadRigFile(const std::string& path, const CellSettings& s) {
+  static PreparationMemo<RigKey, LoadedRig, 8> memo;
+  return memo.Get(RigKeyOf(path, s), [&] {
     auto file = std::make_shared<RobotFile>(LoadRobotFile(path, s.tool_link, s.base_link));
     auto robot = std::make_shared<const RobotModel>(file->robot);
     return LoadedRig{std::move(file), std::move(robot)};
@@ -457,8 +471,27 @@ PriorInformation PosteriorOn(const CellSettings& s, const CellContext& c,
 }
 
 // Identifiability of the parameter set on the whole pool (the design is checked later).
+// Every input of AnalyzeJacobian with its default options: G, the terms' names and the count.
+struct IdentifiabilityKey {
+  Eigen::MatrixXd G;
+  std::vector<std::string> names;
+  int num_configurations;
+  bool operator==(const IdentifiabilityKey& o) const {
+    return num_configurations == o.num_configurations && names == o.names && SameMatrix(G, o.G);
+  }
+};
+
+// AnalyzeIdentifiability on the cell's pool; the SVD of G through a memo (the cells of a plan
+// over noise settings share their pool, hence G).
+IdentifiabilityReport AnalyzePool(const CellContext& c) {
+  static PreparationMemo<IdentifiabilityKey, IdentifiabilityReport> memo;
+  IdentifiabilityKey key{IdentificationJacobian(*c.model, c.pool), c.model->parameters().names,
+                         c.pool.size()};
+  return memo.Get(key, [&] { return AnalyzeJacobian(key.G, key.names, key.num_configurations); });
+}
+
 void CheckIdentifiability(const CellSettings& s, CellContext* c) {
-  const IdentifiabilityReport rep = AnalyzeIdentifiability(*c->model, c->pool);
+  const IdentifiabilityReport rep = AnalyzePool(*c);
   if (rep.full_rank()) return;
   // Priors that set every direction the readings cannot see: nothing to fix.
   if (!s.identification.priors.empty() &&
@@ -509,7 +542,7 @@ void SelectCellDesign(const CellSettings& s, CellContext* c) {
   if (s.selection_redraw) c->pool_design_G = G;
   c->design = SelectDesign(*c, 0, c->pool, G);
   c->design_efficiency = std::nan("");
-  if (!s.selection_redraw && !s.pool_redraw) {
+  if (!s.selection_redraw && !s.pool_redraw && !c->for_trials_only) {
     // 300 relaxation steps (~20 ms a cell, against ~100 ms for `lrcal design`'s 1500): the bound
     // is looser, so the efficiency stated is a lower bound that 1500 steps raise by up to 0.3 %
     // (tests/study/trial_test.cc).
@@ -771,6 +804,10 @@ void SetPredictedCovariance(CellContext* c, Eigen::MatrixXd unit, double scale) 
 }
 
 void PredictValidation(CellContext* c) {
+  if (c->for_trials_only) {  // the stored row holds it
+    c->predicted_validation.fill(std::nan(""));
+    return;
+  }
   constexpr int kDraws = 4000;
   const Eigen::MatrixXd draws = LinearisedDraws(*c, kDraws);
   std::array<double, 12> sum{};
@@ -964,14 +1001,15 @@ void PrepareRangerCell(const Study& study, const CellSettings& s, CellContext* c
 
 }  // namespace
 
-std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell) {
+std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell,
+                                         CellPreparation what) {
   auto c = std::make_unique<CellContext>();
   c->cell = &cell;
+  c->for_trials_only = what == CellPreparation::kForTrials;
   c->seed = study.seed;
   const CellSettings& s = cell.typed;
   try {
-    if (s.IsTree() ||
-        RobotChainIsCoupled(ResolveRobotPath(s.robot, study.folder()), s.tool_link, s.base_link)) {
+    if (s.IsTree() || RigIsCoupled(ResolveRobotPath(s.robot, study.folder()), s)) {
       PrepareTreeCell(study, s, c.get());
     } else {
       LoadRig(study, s, c.get());

@@ -92,6 +92,10 @@ struct TrialDesign {
 /// Per-cell prepared data, read-only and shared by all threads.
 struct CellContext {
   const Cell* cell = nullptr;
+  /// Prepared for its trials alone (CellPreparation::kForTrials): what only the cell's stored
+  /// row holds (design_efficiency, predicted_validation) is not computed (NaN), and
+  /// ToStoredCell refuses the context.
+  bool for_trials_only = false;
   std::uint64_t seed = 0;
   /// The seed of the selection's random draws: the study's, or 0 when the pool comes from a
   /// file (the design then does not change with the seed).
@@ -242,9 +246,16 @@ TrialStatus RunTrackerTrial(const CellContext& c, long long trial, const TrialTr
 /// (6 rows per pose: position, then orientation).
 Eigen::MatrixXd ValidationPoseJacobian(const CellContext& c);
 
+/// What a cell is prepared for. kFull: everything, its stored row included. kForTrials: what its
+/// trials read, bit for bit as kFull prepares it, without the parts that only its row holds
+/// (the design's certificate, the first-order prediction of the validation metrics: about half
+/// of a ranger cell's preparation), for a resume whose store already holds the row.
+enum class CellPreparation { kFull, kForTrials };
+
 /// Builds the context of a cell. Throws InputError (naming the study and the cell) when the cell
 /// cannot run at all: no pool can be sampled, fewer configurations than parameters, ...
-std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell);
+std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell,
+                                         CellPreparation what = CellPreparation::kFull);
 
 /// Per-thread scratch space: reused by every trial the thread runs.
 struct TrialWorkspace {
@@ -264,7 +275,8 @@ struct TrialWorkspace {
 TrialRecord RunTrial(const CellContext& context, long long trial, TrialWorkspace* workspace,
                      TrialDetails* details = nullptr);
 
-/// What the trial store records of a prepared cell (trial_store.h).
+/// What the trial store records of a prepared cell (trial_store.h); std::logic_error for a
+/// context prepared for its trials alone.
 StoredCell ToStoredCell(const CellContext& context);
 
 }  // namespace lrcal

@@ -179,6 +179,9 @@ void TrialStore::Exec(const std::string& sql) const {
 }
 
 StoredCell ToStoredCell(const CellContext& c) {
+  if (c.for_trials_only)
+    throw std::logic_error("ToStoredCell: cell " + c.cell->id +
+                           " was prepared for its trials alone");
   StoredCell s;
   s.id = c.cell->id;
   s.label = c.cell->label;
@@ -229,6 +232,13 @@ void TrialStore::PutCell(const StoredCell& cell) {
   else
     sqlite3_bind_double(st.get(), 13, cell.design_efficiency);
   st.Step();
+}
+
+std::vector<std::string> TrialStore::CellIds() const {
+  Statement st(db_, "SELECT cell_id FROM cells ORDER BY ord, cell_id");
+  std::vector<std::string> out;
+  while (st.Step()) out.push_back(st.ColumnText(0));
+  return out;
 }
 
 std::vector<StoredCell> TrialStore::Cells() const {

@@ -6,11 +6,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sqlite3.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -183,6 +185,77 @@ TEST(MonteCarlo, ResumedInSlicesEqualsUninterrupted) {
   EXPECT_EQ(Tables(dir + "/whole"), Tables(dir + "/sliced"));
 }
 
+// How many of the run's cells hold all `trials` trials in its main store.
+int CompleteCells(const std::string& run_dir, long long trials) {
+  TrialStore store((fs::path(run_dir) / "trials.sqlite").string());
+  int complete = 0;
+  for (const auto& c : store.Cells()) complete += store.CountTrials(c.id) == trials;
+  return complete;
+}
+
+// A resume prepares only the cells with trials left to compute (cells are prepared one by one in
+// a new run, so a fresh run of four cells prepares four), a rerun of a finished run none, and
+// the tables are those of an uninterrupted run.
+TEST(MonteCarlo, AResumePreparesOnlyTheCellsWithTrialsToCompute) {
+  const std::string dir = testing::TempDir("mc_lazy");
+  const std::string study = SmallStudy(dir, 30);  // four cells of 30 trials, run cell by cell
+  EXPECT_EQ(RunSmall(study, dir + "/whole", 2).cells_prepared, 4);
+  RunResult a = RunSmall(study, dir + "/sliced", 2, 0, 1, 75);
+  EXPECT_EQ(a.cells_prepared, 4);
+  const int complete = CompleteCells(dir + "/sliced", 30);
+  EXPECT_EQ(complete, 2);  // 75 trials: two whole cells and half of the third
+  RunResult b = RunSmall(study, dir + "/sliced", 1);
+  EXPECT_EQ(b.done_before, 75);
+  EXPECT_EQ(b.computed, 45);
+  EXPECT_EQ(b.cells_prepared, 4 - complete);
+  EXPECT_EQ(Tables(dir + "/whole"), Tables(dir + "/sliced"));
+  // The resumed cells were prepared for their trials alone: their rows stay as the first session
+  // wrote them, the certificate and the first-order prediction included.
+  const std::vector<StoredCell> whole_rows = TrialStore(dir + "/whole/trials.sqlite").Cells();
+  const std::vector<StoredCell> sliced_rows = TrialStore(dir + "/sliced/trials.sqlite").Cells();
+  ASSERT_EQ(whole_rows.size(), sliced_rows.size());
+  for (std::size_t i = 0; i < whole_rows.size(); ++i) {
+    EXPECT_EQ(sliced_rows[i].id, whole_rows[i].id);
+    EXPECT_EQ(sliced_rows[i].predicted_validation.size(), 12u);
+    EXPECT_EQ(sliced_rows[i].predicted_validation, whole_rows[i].predicted_validation);
+    EXPECT_FALSE(std::isnan(sliced_rows[i].design_efficiency));
+    EXPECT_EQ(sliced_rows[i].design_efficiency, whole_rows[i].design_efficiency);
+  }
+  EXPECT_EQ(RunSmall(study, dir + "/sliced", 2).cells_prepared, 0);
+  EXPECT_EQ(Tables(dir + "/whole"), Tables(dir + "/sliced"));
+
+  // A finished cell whose row the store lacks is prepared again and its row written back.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir + "/sliced/trials.sqlite").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "DELETE FROM cells WHERE ord = 0", nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  RunResult c = RunSmall(study, dir + "/sliced", 2);
+  EXPECT_EQ(c.cells_prepared, 1);
+  EXPECT_EQ(c.computed, 0);
+  EXPECT_EQ(CompleteCells(dir + "/sliced", 30), 4);
+
+  // An unfinished cell whose row the store lacks is prepared in full, and its row written back
+  // as the first session wrote it.
+  RunSmall(study, dir + "/sliced2", 2, 0, 1, 75);
+  ASSERT_EQ(sqlite3_open((dir + "/sliced2/trials.sqlite").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "DELETE FROM cells WHERE ord = 2", nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  EXPECT_EQ(RunSmall(study, dir + "/sliced2", 2).cells_prepared, 2);
+  const std::vector<StoredCell> rows2 = TrialStore(dir + "/sliced2/trials.sqlite").Cells();
+  ASSERT_EQ(rows2.size(), whole_rows.size());
+  for (std::size_t i = 0; i < rows2.size(); ++i) {
+    EXPECT_EQ(rows2[i].predicted_validation, whole_rows[i].predicted_validation);
+    EXPECT_EQ(rows2[i].design_efficiency, whole_rows[i].design_efficiency);
+  }
+  EXPECT_EQ(Tables(dir + "/whole"), Tables(dir + "/sliced2"));
+
+  // A shard's rerun prepares nothing either: its share of every cell is recorded.
+  RunSmall(study, dir + "/shard", 2, 1, 2);
+  EXPECT_EQ(RunSmall(study, dir + "/shard", 2, 1, 2).cells_prepared, 0);
+}
+
 // Starts `lrcal run` in the background; returns its pid.
 pid_t Spawn(const std::vector<std::string>& args) {
   pid_t pid = fork();
@@ -348,6 +421,7 @@ TEST(MonteCarlo, AddingASweepValueKeepsExistingCells) {
   RunResult b = RunSmall(SmallStudy(dir, 10, "", "[0.1, 0.2, 0.4]"), run, 2);
   EXPECT_EQ(b.done_before, 40);
   EXPECT_EQ(b.computed, 20);  // only the two new cells
+  EXPECT_EQ(b.cells_prepared, 2);
   const Study after = LoadStudy(SmallStudy(dir, 10, "", "[0.1, 0.2, 0.4]"));
   for (const Cell& c : before.cells) {
     bool found = false;

@@ -87,6 +87,15 @@ TEST(TrackerStudy, ATrackerCellRecoversATruthItCanSeeToWithinItsNoise) {
   }
 }
 
+TEST(TrackerStudy, ACellPreparedForItsTrialsAloneRunsTheSameTrials) {
+  const std::string dir = testing::TempDir("tracker_robot_for_trials");
+  const std::string robot = RobotSeenByATracker(dir);
+  const Study study = LoadStudy(WriteTrackerStudy(
+      "for_trials", robot,
+      std::string("selection: {count: 30}\nsensor: {kind: pose, ") + kTracker + "}\n"));
+  testing::ExpectForTrialsPreparesTheSameTrials(study, study.cells.at(0), 3);
+}
+
 TEST(TrackerStudy, ThePredictedCovarianceHoldsOverTheTrials) {
   // truth.scale 0: the true arm is the nominal one, so the terms held at nominal are true and the
   // estimate's error is the noise's alone: its Mahalanobis distance δᵀΣ⁻¹δ averages n over the

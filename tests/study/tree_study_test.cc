@@ -86,6 +86,11 @@ std::string TreeStudyError(const std::string& name, const TreeSections& t) {
   return "no error";
 }
 
+TEST(TreeStudy, ACellPreparedForItsTrialsAloneRunsTheSameTrials) {
+  const Study study = LoadStudy(WriteTreeStudy("for_trials", TreeSections{}));
+  testing::ExpectForTrialsPreparesTheSameTrials(study, study.cells.at(0), 2);
+}
+
 TEST(TreeStudy, ANoiseFreeTreeCellRecoversEveryChainsTruth) {
   // Noise of 1e-9 mm and 1e-9 mrad: the estimate is the truth to 1e-9 of a term's size, the
   // shared torso's terms and each arm's own alike, and so is the judged arm's pose.

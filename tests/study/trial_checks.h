@@ -5,7 +5,11 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 
+#include "lrcal/study/study.h"
 #include "study/trial_pipeline.h"
 
 namespace lrcal::testing {
@@ -43,6 +47,38 @@ inline void ExpectTrialsRecoverTheTruth(const CellContext& c, int trials, double
     }
     for (int a = 0; a < 12; ++a) EXPECT_NEAR(r.validation[a], 0, validation) << a;
     EXPECT_GT(r.nominal[0], 1e-4);  // the nominal arm is off by millimetres
+  }
+}
+
+/// A cell prepared for its trials alone (CellPreparation::kForTrials, as a resume prepares a cell
+/// whose row is stored) runs trials 0 … trials − 1 to the bits of the cell prepared in full, with
+/// the stored row's parts left out (NaN) and ToStoredCell refusing it.
+inline void ExpectForTrialsPreparesTheSameTrials(const Study& study, const Cell& cell, int trials) {
+  const auto full = PrepareCell(study, cell);
+  const auto lean = PrepareCell(study, cell, CellPreparation::kForTrials);
+  EXPECT_FALSE(full->for_trials_only);
+  EXPECT_TRUE(lean->for_trials_only);
+  EXPECT_TRUE(std::isnan(lean->design_efficiency));
+  for (double v : lean->predicted_validation) EXPECT_TRUE(std::isnan(v));
+  EXPECT_FALSE(std::isnan(full->predicted_validation[0]));  // what the lean cell leaves out
+  EXPECT_THROW(ToStoredCell(*lean), std::logic_error);
+  EXPECT_EQ(ToStoredCell(*full).id, cell.id);
+  TrialWorkspace ws_full, ws_lean;
+  for (int t = 0; t < trials; ++t) {
+    const TrialRecord a = RunTrial(*full, t, &ws_full), b = RunTrial(*lean, t, &ws_lean);
+    EXPECT_EQ(a.status, b.status) << "trial " << t;
+    EXPECT_EQ(a.iterations, b.iterations) << "trial " << t;
+    EXPECT_EQ(a.residual_rms, b.residual_rms) << "trial " << t;
+    EXPECT_EQ(a.sigma_hat, b.sigma_hat) << "trial " << t;
+    EXPECT_EQ(a.sigma_min, b.sigma_min) << "trial " << t;
+    EXPECT_EQ(a.errors, b.errors) << "trial " << t;
+    EXPECT_EQ(a.validation, b.validation) << "trial " << t;
+    EXPECT_EQ(a.nominal, b.nominal) << "trial " << t;
+    EXPECT_EQ(a.missed_configurations, b.missed_configurations) << "trial " << t;
+    // NaN unless the cell asks for coverage: compare the bits' meaning, NaN equal to NaN.
+    EXPECT_TRUE(a.coverage == b.coverage || (std::isnan(a.coverage) && std::isnan(b.coverage)));
+    EXPECT_TRUE(a.coverage_total == b.coverage_total ||
+                (std::isnan(a.coverage_total) && std::isnan(b.coverage_total)));
   }
 }
 

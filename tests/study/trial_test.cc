@@ -9,6 +9,7 @@
 #include "lrcal/study/study.h"
 #include "study/trial_pipeline.h"
 #include "test_util.h"
+#include "trial_checks.h"
 
 namespace lrcal {
 namespace {
@@ -53,6 +54,24 @@ TEST(CellPreparation, SharedCertificatesAreEachCellsOwn) {
     const DesignCertificate own = CertifyDesign(G, c->design.slots, DesignCriterion::kE, 300);
     ASSERT_TRUE(own.available);
     EXPECT_EQ(c->design_efficiency, own.efficiency) << cell.label;
+  }
+}
+
+// A resume prepares a cell whose row is stored for its trials alone (runner.cc): the same trials,
+// bit for bit, for a cell with a fixed truth, a drawn one, and coverage stated per trial.
+TEST(CellPreparation, ACellPreparedForItsTrialsAloneRunsTheSameTrials) {
+  const std::string dir = testing::TempDir("cell_for_trials");
+  std::ofstream(dir + "/s.yaml") << "name: c\nseed: 3\ntrials: 1\nrobot: "
+                                 << testing::SourcePath("studies/robots/paper.yaml")
+                                 << "\npool: {size: 101}\nselection: {count: 30}\n"
+                                    "validation: {size: 8, coverage: true}\n"
+                                    "sweep:\n  axes:\n    - key: truth.mode\n"
+                                    "      values: [robot_file, random]\n";
+  const Study study = LoadStudy(dir + "/s.yaml");
+  ASSERT_EQ(study.cells.size(), 2u);
+  for (const Cell& cell : study.cells) {
+    SCOPED_TRACE(cell.label);
+    testing::ExpectForTrialsPreparesTheSameTrials(study, cell, 3);
   }
 }
 

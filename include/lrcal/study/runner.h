@@ -3,11 +3,17 @@
 // count, shard split, MPI rank count or restart history.
 //
 // A run is a sequence of named steps (StudyRunner::Run, after Ceres' TrustRegionMinimizer):
-//   PrepareCells      every cell's pool, design and predicted covariance; a study that cannot
+//   CellsToPrepare    every cell of a new run; on a resume (one process, fixed trial counts)
+//                     only the cells with trials still to compute in this process's share, for
+//                     their trials alone when the store holds their row (no certificate, no
+//                     first-order prediction: the row has them)
+//   PrepareCells      those cells' pools, designs and predicted covariance; a study that cannot
 //                     run fails here, before anything is written
 //   OpenRunDirectory  rank 0 locks the directory, refuses an incompatible one, starts a session
-//                     in the manifest and records the cells in the store
+//                     in the manifest and records the prepared cells in the store
 //   FindMissingTrials the union of every store's records; the rest is this run's work
+//   PrepareLateCells  any cell with work that was not prepared (the store changed before the
+//                     lock), before any trial
 //   RunTrials         workers claim trials from a WorkSource (static or dynamic schedule) and
 //                     hand records to the writer (this thread), which commits them in batches
 //                     and reports progress
@@ -93,9 +99,12 @@ struct RunResult {
   /// A rerun with nothing new found the tables already written for these very records by this
   /// lrcal (TablesAreCurrent) and left them as they were; tables_written is set too.
   bool tables_current = false;
-  double seconds = 0;            ///< wall time of the whole call
-  double trial_seconds = 0;      ///< sum of the computed trials' own wall time
-  double prepare_seconds = 0;    ///< wall time preparing the cells (pools, designs, covariance)
+  double seconds = 0;          ///< wall time of the whole call
+  double trial_seconds = 0;    ///< sum of the computed trials' own wall time
+  double prepare_seconds = 0;  ///< wall time preparing the cells (pools, designs, covariance)
+  /// Cells this process prepared: every cell in a new run, only those with trials of its share
+  /// still to compute (or no row in the store) on a resume, none on a rerun of a finished run.
+  int cells_prepared = 0;
   double run_seconds = 0;        ///< wall time from the first trial to the last record written
   double tables_seconds = 0;     ///< wall time aggregating and writing the tables (the caller's)
   long peak_rss_kb_trials = 0;   ///< peak resident memory when the trials were done (kB)

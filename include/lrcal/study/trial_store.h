@@ -68,6 +68,8 @@ class TrialStore {
 
   void PutCell(const StoredCell& cell);
   std::vector<StoredCell> Cells() const;  ///< by ord
+  /// The ids of the stored cells, by ord: Cells() without reading their rows' JSON.
+  std::vector<std::string> CellIds() const;
   /// Inserts records in one transaction; already present (cell_id, trial) are left as they are.
   void Insert(const std::vector<TrialRecord>& records);
   /// Trial indices stored for a cell, ascending.
