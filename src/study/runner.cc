@@ -714,7 +714,6 @@ class StudyRunner {
            result_.computed >= options_.max_new_trials;
   }
 
-  // Rank 0 folds the rank stores into the main store and closes the session in the manifest.
   // The trials of this shard recorded now, on rank 0 after the merge. One process: those
   // recorded before (the union over every store, read under the lock) and those it committed,
   // none of them recorded before (MissingTrials). Ranks: what the merged store holds.
@@ -728,6 +727,7 @@ class StudyRunner {
     return recorded;
   }
 
+  // Rank 0 folds the rank stores into the main store and closes the session in the manifest.
   void FinishSession() {
     result_.ranks_computed = collective_->SumAll(result_.computed);
     store_.reset();          // close this process's store before rank 0 merges it

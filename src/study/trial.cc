@@ -284,26 +284,26 @@ RigKey RigKeyOf(const std::string& path, const CellSettings& s) {
   return RigKey{path, s.tool_link, s.base_link, bytes.str()};
 }
 
-// RobotChainIsCoupled (a coupled chain is prepared as a tree), matched as LoadRigFile is: the
+// RobotChainIsCoupled (a coupled chain is prepared as a tree), matched on the file's key: the
 // cells of a plan on one robot file parse it once.
-bool RigIsCoupled(const std::string& path, const CellSettings& s) {
+bool RigIsCoupled(const RigKey& key) {
   static PreparationMemo<RigKey, bool, 8> memo;
-  return memo.Get(RigKeyOf(path, s),
-                  [&] { return RobotChainIsCoupled(path, s.tool_link, s.base_link); });
+  return memo.Get(key, [&] { return RobotChainIsCoupled(key.path, key.tool_link, key.base_link); });
 }
 
-// LoadRobotFile, matched on RigKeyOf.
-LoadedRig LoadRigFile(const std::string& path, const CellSettings& s) {
+// LoadRobotFile, matched on the file's key.
+LoadedRig LoadRigFile(const RigKey& key) {
   static PreparationMemo<RigKey, LoadedRig, 8> memo;
-  return memo.Get(RigKeyOf(path, s), [&] {
-    auto file = std::make_shared<RobotFile>(LoadRobotFile(path, s.tool_link, s.base_link));
+  return memo.Get(key, [&] {
+    auto file = std::make_shared<RobotFile>(LoadRobotFile(key.path, key.tool_link, key.base_link));
     auto robot = std::make_shared<const RobotModel>(file->robot);
     return LoadedRig{std::move(file), std::move(robot)};
   });
 }
 
-void LoadRig(const Study& study, const CellSettings& s, CellContext* c) {
-  const LoadedRig rig = LoadRigFile(ResolveRobotPath(s.robot, study.folder()), s);
+// The cell's arm from its robot file (`key`: RigKeyOf the resolved path).
+void LoadRig(const RigKey& key, const CellSettings& s, CellContext* c) {
+  const LoadedRig rig = LoadRigFile(key);
   const RobotFile& file = *rig.file;
   c->robot = rig.robot;
   c->ranger = file.ranger;
@@ -470,7 +470,6 @@ PriorInformation PosteriorOn(const CellSettings& s, const CellContext& c,
                                c.model->parameters().names);
 }
 
-// Identifiability of the parameter set on the whole pool (the design is checked later).
 // Every input of AnalyzeJacobian with its default options: G, the terms' names and the count.
 struct IdentifiabilityKey {
   Eigen::MatrixXd G;
@@ -481,8 +480,8 @@ struct IdentifiabilityKey {
   }
 };
 
-// AnalyzeIdentifiability on the cell's pool; the SVD of G through a memo (the cells of a plan
-// over noise settings share their pool, hence G).
+// AnalyzeIdentifiability(*c.model, c.pool) (which is AnalyzeJacobian of the pool's G), with the
+// SVD of G through a memo: the cells of a plan over noise settings share their pool, hence G.
 IdentifiabilityReport AnalyzePool(const CellContext& c) {
   static PreparationMemo<IdentifiabilityKey, IdentifiabilityReport> memo;
   IdentifiabilityKey key{IdentificationJacobian(*c.model, c.pool), c.model->parameters().names,
@@ -490,6 +489,7 @@ IdentifiabilityReport AnalyzePool(const CellContext& c) {
   return memo.Get(key, [&] { return AnalyzeJacobian(key.G, key.names, key.num_configurations); });
 }
 
+// Identifiability of the parameter set on the whole pool (the design is checked later).
 void CheckIdentifiability(const CellSettings& s, CellContext* c) {
   const IdentifiabilityReport rep = AnalyzePool(*c);
   if (rep.full_rank()) return;
@@ -1009,10 +1009,13 @@ std::unique_ptr<CellContext> PrepareCell(const Study& study, const Cell& cell,
   c->seed = study.seed;
   const CellSettings& s = cell.typed;
   try {
-    if (s.IsTree() || RigIsCoupled(ResolveRobotPath(s.robot, study.folder()), s)) {
+    // The robot file read once: whether its chain is coupled and, if not, its arm.
+    const RigKey rig =
+        s.IsTree() ? RigKey{} : RigKeyOf(ResolveRobotPath(s.robot, study.folder()), s);
+    if (s.IsTree() || RigIsCoupled(rig)) {
       PrepareTreeCell(study, s, c.get());
     } else {
-      LoadRig(study, s, c.get());
+      LoadRig(rig, s, c.get());
       if (!s.sensor.IsRanger() || s.in_environment)
         PrepareTrackerCell(study, s, c.get());
       else
