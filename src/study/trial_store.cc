@@ -2,11 +2,13 @@
 
 #include <sqlite3.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <thread>
 
 #include "lrcal/kinematics/validation_metric.h"
 #include "study/trial_pipeline.h"
@@ -14,6 +16,9 @@
 namespace lrcal {
 
 namespace {
+
+// How long an operation waits for another connection's lock before it fails.
+constexpr int kBusyTimeoutMs = 10000;
 
 // SQLite's result codes that mean the storage failed (not the query): a StorageError, which the
 // runner turns into a clean stop that keeps every committed trial.
@@ -108,13 +113,33 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
     db_ = nullptr;
     throw StorageError("cannot open trial store " + path + ": " + msg);
   }
-  sqlite3_busy_timeout(db_, 10000);
-  Exec("PRAGMA journal_mode=WAL");
-  Exec("PRAGMA synchronous=NORMAL");
-  // Fault injection for tests: a store that holds at most this many pages fails with SQLITE_FULL
-  // exactly as a full disk does.
-  if (const char* pages = std::getenv("LRCAL_TEST_STORE_MAX_PAGES"))
-    Exec("PRAGMA max_page_count=" + std::to_string(std::atol(pages)));
+  // Whatever fails below, the connection is closed (which rolls back an open transaction).
+  try {
+    sqlite3_busy_timeout(db_, kBusyTimeoutMs);
+    // Switching to WAL takes the file's exclusive lock. While another process opens the same new
+    // store (a run starting as `lrcal status` or a test polls it), SQLite answers SQLITE_BUSY
+    // here without calling the busy handler, so wait for it as the handler would.
+    ExecWhileBusy("PRAGMA journal_mode=WAL");
+    Exec("PRAGMA synchronous=NORMAL");
+    // Fault injection for tests: a store that holds at most this many pages fails with
+    // SQLITE_FULL exactly as a full disk does.
+    if (const char* pages = std::getenv("LRCAL_TEST_STORE_MAX_PAGES"))
+      Exec("PRAGMA max_page_count=" + std::to_string(std::atol(pages)));
+    // The schema in one write transaction taken up front: two processes opening an old store
+    // must not both find a column missing and both add it, and a read transaction that turns
+    // into a write one gets SQLITE_BUSY at once, without waiting, when another connection wrote
+    // first.
+    ExecWhileBusy("BEGIN IMMEDIATE");
+    CreateSchema();
+    Exec("COMMIT");
+  } catch (...) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw;
+  }
+}
+
+void TrialStore::CreateSchema() {
   Exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
   Exec(
       "CREATE TABLE IF NOT EXISTS cells(cell_id TEXT PRIMARY KEY, ord INTEGER, label TEXT, "
@@ -167,6 +192,22 @@ TrialStore::TrialStore(const std::string& path) : path_(path) {
 }
 
 TrialStore::~TrialStore() { sqlite3_close(db_); }
+
+void TrialStore::ExecWhileBusy(const std::string& sql) const {
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(kBusyTimeoutMs);
+  for (;;) {
+    char* err = nullptr;
+    const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
+    if (rc == SQLITE_OK) return;
+    std::string msg = err ? err : "unknown error";
+    sqlite3_free(err);
+    const bool busy = (rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED;
+    if (!busy || std::chrono::steady_clock::now() >= deadline)
+      ThrowSqlite(rc, "sqlite (" + path_ + "): " + msg + " in: " + sql);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
 
 void TrialStore::Exec(const std::string& sql) const {
   char* err = nullptr;

@@ -96,6 +96,11 @@ class TrialStore {
 
  private:
   void Exec(const std::string& sql) const;
+  /// Exec, retried for up to the busy timeout while another connection holds a lock SQLite does
+  /// not wait for by itself (the switch to WAL, BEGIN IMMEDIATE on a store being created).
+  void ExecWhileBusy(const std::string& sql) const;
+  /// Creates the tables and adds the columns older stores lack; inside a write transaction.
+  void CreateSchema();
   sqlite3* db_ = nullptr;
   std::string path_;
 };
