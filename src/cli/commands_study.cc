@@ -61,8 +61,9 @@ int RunCommand(const std::vector<std::string>& args) {
       "out", po::value<std::string>(), "run directory (default: output/<study name>)")(
       "shard", po::value<std::string>(), "run only shard i/N of the trials (batch schedulers)")(
       "schedule", po::value<std::string>()->default_value("static"),
-      "MPI only: static (every P-th trial per rank) or dynamic (chunks from rank 0)")(
-      "quiet", po::bool_switch(), "no progress output");
+      "MPI only: static (blocks of trials dealt to the ranks in turn; each rank prepares "
+      "only its blocks' cells) or dynamic (chunks from rank 0)")("quiet", po::bool_switch(),
+                                                                 "no progress output");
   AddSettingOptions(o, RunOptions::Settings(), {"threads", "max_trials"});
   po::positional_options_description pos;
   pos.add("study", 1);

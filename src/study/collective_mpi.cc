@@ -31,6 +31,17 @@ class MpiCollective : public Collective {
     if (length > 0) MPI_Bcast(buffer.data(), static_cast<int>(length), MPI_CHAR, 0, MPI_COMM_WORLD);
     return std::string(buffer.begin(), buffer.end());
   }
+  std::string FirstNonEmpty(const std::string& text) override {
+    int mine = text.empty() ? size_ : rank_, first = size_;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first == size_) return "";
+    long long length = static_cast<long long>(text.size());
+    MPI_Bcast(&length, 1, MPI_LONG_LONG, first, MPI_COMM_WORLD);
+    std::vector<char> buffer(text.begin(), text.end());
+    buffer.resize(static_cast<std::size_t>(length));
+    MPI_Bcast(buffer.data(), static_cast<int>(length), MPI_CHAR, first, MPI_COMM_WORLD);
+    return std::string(buffer.begin(), buffer.end());
+  }
   void Send(int to, int tag, long long value) override {
     MPI_Send(&value, 1, MPI_LONG_LONG, to, tag, MPI_COMM_WORLD);
   }

@@ -254,7 +254,7 @@ class StudyRunner {
     contexts_.resize(study_.cells.size());
     for (std::size_t i = 0; i < study_.cells.size(); ++i)
       cell_index_.emplace(study_.cells[i].id, static_cast<int>(i));
-    PrepareCells(CellsToPrepare(), true);
+    PrepareCellsOnEveryRank(CellsToPrepare(), true);
     if (stop_->stop_requested()) {  // a signal while the cells were prepared: nothing written
       result_.interrupted = true;
       result_.seconds = Seconds(start_, Clock::now());
@@ -266,7 +266,7 @@ class StudyRunner {
     try {
       RunTrials();
     } catch (const StorageError& e) {
-      CloseSessionAfterStorageError();
+      CloseSession("stopped: results could not be written");
       throw StorageError(std::string(e.what()) + "\n" + SafeTrialsNote());
     }
     FinishSession();
@@ -279,14 +279,13 @@ class StudyRunner {
 
   // Best effort: the manifest says how the session ended; if even that cannot be written, the
   // old manifest stays as it was (atomic writes never leave a partial file).
-  void CloseSessionAfterStorageError() {
+  void CloseSession(const std::string& ended) {
     if (!root()) return;
     try {
       Json& session = manifest_["sessions"][session_];
       session["end"] = UtcNow();
-      session["ended"] = "stopped: results could not be written";
-      dir_.AppendLog("session " + std::to_string(session_ + 1) +
-                     " stopped: results could not be written");
+      session["ended"] = ended;
+      dir_.AppendLog("session " + std::to_string(session_ + 1) + " " + ended);
       dir_.WriteManifest(manifest_);
     } catch (const std::exception&) {
     }
@@ -301,19 +300,29 @@ class StudyRunner {
            "command again: the run resumes where it stopped and gives the same tables.";
   }
 
+  // An MPI job under the static schedule: each rank knows from the recorded trials which cells
+  // its share touches, and prepares only those (RankCells). The dynamic schedule hands out trials
+  // of any cell and stop_when decides over every cell: there every rank prepares every cell.
+  bool RanksShareCells() const {
+    return ranks_ > 1 && !options_.dynamic_schedule &&
+           !(study_.stop_when.enabled() && options_.shard_count == 1);
+  }
+
   // The cells this process prepares (indices, in order) and what for: those with trials of its
   // share still to compute, or with no row in the main store, as the run directory stands before
   // the lock. A resume then prepares only its unfinished cells, for their trials alone when the
   // store holds their row (written by the session that prepared them in full), and a rerun of a
-  // finished run prepares none. Every cell in full for a new directory, an MPI job (every rank
-  // runs trials of any cell and writes every row to its own store), a stop_when run (it decides
-  // in the loop, over every cell) or anything unusual (no manifest, another study, a damaged
-  // store), whose checks under the lock then say what is wrong. PrepareLateCells covers a store
-  // that changed between this reading and the lock.
+  // finished run prepares none. An MPI job under the static schedule: this rank's cells
+  // (RankCellsBeforeLock). Every cell in full for a new directory, an MPI job under the dynamic
+  // schedule (every rank runs trials of any cell and writes every row to its own store), a
+  // stop_when run (it decides in the loop, over every cell) or anything unusual (no manifest,
+  // another study, a damaged store), whose checks under the lock then say what is wrong.
+  // PrepareLateCells covers a store that changed between this reading and the lock.
   std::vector<std::pair<int, CellPreparation>> CellsToPrepare() const {
     const int num_cells = static_cast<int>(study_.cells.size());
     std::vector<std::pair<int, CellPreparation>> all;
     for (int i = 0; i < num_cells; ++i) all.emplace_back(i, CellPreparation::kFull);
+    if (RanksShareCells()) return RankCellsBeforeLock();
     if (ranks_ > 1 || (study_.stop_when.enabled() && options_.shard_count == 1) ||
         !dir_.HasManifest())
       return all;
@@ -338,10 +347,87 @@ class StudyRunner {
     }
   }
 
+  // An MPI job under the static schedule: the cells (in full) whose trials the schedule deals
+  // to this rank, given the recorded trials `done` (about 1/P of the cells), and on rank 0 also
+  // those no rank runs trials of whose row the main store (`rows`) lacks, so that every cell has
+  // its row after the merge, as in one process.
+  std::vector<std::pair<int, CellPreparation>> RankCells(const DoneSet& done,
+                                                         const std::set<std::string>& rows) const {
+    const StaticScheduleCells cells = CellsOfStaticSchedule(
+        MissingTrials(&done, study_.trials, options_.shard_index, options_.shard_count),
+        study_.cells.size(), rank_, ranks_, options_.max_new_trials);
+    std::vector<std::pair<int, CellPreparation>> which;
+    for (std::size_t c = 0; c < study_.cells.size(); ++c)
+      if (cells.mine[c] || (root() && !cells.anyone[c] && rows.count(study_.cells[c].id) == 0))
+        which.emplace_back(static_cast<int>(c), CellPreparation::kFull);
+    return which;
+  }
+
+  // RankCells as the run directory stands before the lock (every rank reads it; a new or
+  // unusual directory counts as holding nothing). PrepareLateCells checks under the lock.
+  std::vector<std::pair<int, CellPreparation>> RankCellsBeforeLock() const {
+    DoneSet done(study_.cells.size(), std::vector<bool>(static_cast<std::size_t>(study_.trials)));
+    std::set<std::string> rows;
+    try {
+      if (dir_.HasManifest()) {
+        RunDirectory::CheckCompatible(dir_.ReadManifest(), study_.ToJson(), study_.path,
+                                      options_.shard_index, options_.shard_count);
+        done = dir_.ReadDone(study_);
+        if (root())
+          for (std::string& id : TrialStore(dir_.MainStorePath()).CellIds())
+            rows.insert(std::move(id));
+      }
+    } catch (const std::exception&) {
+      done.assign(study_.cells.size(), std::vector<bool>(static_cast<std::size_t>(study_.trials)));
+      rows.clear();
+    }
+    return RankCells(done, rows);
+  }
+
+  // PrepareCells, every rank learning whether any failed: in an MPI job under the static schedule
+  // a cell fails on the rank that prepares it alone. Every rank then throws the error of the
+  // lowest failing rank (rank 0 prints it; an input error gives exit 2 from every rank), so that
+  // no rank goes on to wait for the others and nothing is written before the lock.
+  void PrepareCellsOnEveryRank(const std::vector<std::pair<int, CellPreparation>>& which,
+                               bool before_writing) {
+    if (ranks_ == 1) {
+      PrepareCells(which, before_writing);
+      return;
+    }
+    std::exception_ptr failure;
+    std::string error;  // "I" (the study's fault) or "E", then the message
+    try {
+      PrepareCells(which, before_writing);
+    } catch (const InputError& e) {
+      failure = std::current_exception();
+      error = std::string("I") + e.what();
+    } catch (const std::exception& e) {
+      failure = std::current_exception();
+      error = std::string("E") + e.what();
+    }
+    const std::string first = collective_->FirstNonEmpty(error);
+    if (first.empty()) return;
+    if (!before_writing) CloseSession("stopped: a cell could not be prepared");
+    if (failure && first == error) std::rethrow_exception(failure);
+    if (first[0] == 'I') throw InputError("", first.substr(1));
+    throw std::runtime_error(first.substr(1));
+  }
+
   // Insurance, under the lock: a cell that FindMissingTrials finds with trials to compute and
   // CellsToPrepare did not prepare, or whose row the main store lacks and that was not prepared
   // in full (the store changed in between), is prepared now (its row written), before any trial.
   void PrepareLateCells() {
+    if (RanksShareCells()) {  // every rank, with the rows of what it prepares now
+      std::vector<std::pair<int, CellPreparation>> late;
+      for (const auto& cell : RankCells(done_, main_rows_))
+        if (!contexts_[static_cast<std::size_t>(cell.first)]) late.push_back(cell);
+      PrepareCellsOnEveryRank(late, false);
+      for (const auto& [c, what] : late) {
+        const auto& context = contexts_[static_cast<std::size_t>(c)];
+        if (context) store_->PutCell(ToStoredCell(*context));
+      }
+      return;
+    }
     std::set<std::string> stored;
     if (ranks_ == 1)
       for (std::string& id : store_->CellIds()) stored.insert(std::move(id));
@@ -460,6 +546,8 @@ class StudyRunner {
                                       : ""));
         TrialStore main_store(dir_.MainStorePath());
         main_store.SetMeta("study", study_.ToJson().dump());
+        if (RanksShareCells())
+          for (std::string& id : main_store.CellIds()) main_rows_.insert(std::move(id));
         for (const auto& context : contexts_)
           if (context && !context->for_trials_only) main_store.PutCell(ToStoredCell(*context));
       } catch (const std::exception& e) {
@@ -730,6 +818,7 @@ class StudyRunner {
   // Rank 0 folds the rank stores into the main store and closes the session in the manifest.
   void FinishSession() {
     result_.ranks_computed = collective_->SumAll(result_.computed);
+    const long long cells_prepared = collective_->SumAll(result_.cells_prepared);
     store_.reset();          // close this process's store before rank 0 merges it
     collective_->Barrier();  // every rank's records are committed
     if (root()) {
@@ -750,7 +839,7 @@ class StudyRunner {
                             {"sum_of_trial_times", result_.trial_seconds}};
       result_.peak_rss_kb = PeakRssKb();
       session["peak_rss_kb"] = {{"after_trials", result_.peak_rss_kb_trials}};
-      session["cells_prepared"] = result_.cells_prepared;
+      session["cells_prepared"] = cells_prepared;  // by every rank
       dir_.WriteManifest(manifest_);
       dir_.AppendLog(
           "session " + std::to_string(session_ + 1) + " ended (" +
@@ -784,6 +873,7 @@ class StudyRunner {
   std::size_t session_ = 0;
   std::string store_path_;
   std::unique_ptr<TrialStore> store_;
+  std::set<std::string> main_rows_;  // rank 0, MPI static schedule: the main store's cell rows
   DoneSet done_;
   std::map<std::string, int> cell_index_;  // cell id → index in study_.cells and contexts_
   std::unique_ptr<RemainingTimeEstimate> eta_;

@@ -64,13 +64,31 @@ class CountingWorkSource : public WorkSource {
   long long share_ = 0, claimed_ = 0;  // claimed_ under mutex_; share_ fixed after construction
 };
 
-// Every P-th missing trial to rank r; max_new_trials limits this process.
+// The static schedule's dealing: the missing trials, in canonical order, in blocks of `block`,
+// the blocks to the ranks in turn.
+struct Dealing {
+  long long block;
+  int ranks;
+  Dealing(long long count, int num_ranks)
+      : block(std::max<long long>(1, (count + kStaticBlocksPerRank * num_ranks - 1) /
+                                         (kStaticBlocksPerRank * num_ranks))),
+        ranks(num_ranks) {}
+  // The rank of the s-th missing trial (from 0).
+  int RankOf(long long s) const { return static_cast<int>((s / block) % ranks); }
+  // How many of `count` missing trials go to `rank`.
+  long long Share(long long count, int rank) const {
+    const long long cycle = block * ranks;
+    const long long rest = count % cycle - rank * block;
+    return count / cycle * block + std::clamp<long long>(rest, 0, block);
+  }
+};
+
+// The missing trials dealt to the ranks in blocks (Dealing); max_new_trials limits this process.
 class StaticSchedule : public CountingWorkSource {
  public:
   StaticSchedule(MissingTrials missing, int rank, int ranks, long long max_new)
-      : missing_(std::move(missing)), rank_(rank), ranks_(ranks) {
-    const long long count = missing_.Count();
-    share_ = count / ranks + (rank < count % ranks ? 1 : 0);
+      : missing_(std::move(missing)), rank_(rank), dealing_(missing_.Count(), ranks) {
+    share_ = dealing_.Share(missing_.Count(), rank);
     if (max_new > 0) share_ = std::min(share_, max_new);
   }
   void Claim(int max, std::vector<TrialId>* out) override {
@@ -80,7 +98,7 @@ class StaticSchedule : public CountingWorkSource {
     while (static_cast<int>(out->size()) < max && claimed_ < share_) {
       bool found = false;
       while (missing_.Next(&id))
-        if ((missing_.seen() - 1) % ranks_ == rank_) {
+        if (dealing_.RankOf(missing_.seen() - 1) == rank_) {
           found = true;
           break;
         }
@@ -93,7 +111,8 @@ class StaticSchedule : public CountingWorkSource {
 
  private:
   MissingTrials missing_;
-  int rank_, ranks_;
+  int rank_;
+  Dealing dealing_;
 };
 
 // Rank 0 hands out chunks of kChunk missing trials, numbered in canonical order; each rank's
@@ -200,6 +219,24 @@ class DynamicSchedule : public CountingWorkSource {
 };
 
 }  // namespace
+
+StaticScheduleCells CellsOfStaticSchedule(MissingTrials missing, std::size_t num_cells, int rank,
+                                          int ranks, long long max_new_trials) {
+  StaticScheduleCells cells{std::vector<bool>(num_cells), std::vector<bool>(num_cells)};
+  const Dealing dealing(missing.Count(), ranks);
+  std::vector<long long> dealt(static_cast<std::size_t>(ranks));
+  TrialId id;
+  while (missing.Next(&id)) {
+    const int r = dealing.RankOf(missing.seen() - 1);
+    long long& n = dealt[static_cast<std::size_t>(r)];
+    if (max_new_trials > 0 && n >= max_new_trials) continue;
+    ++n;
+    const auto c = static_cast<std::size_t>(id.first);
+    cells.anyone[c] = true;
+    if (r == rank) cells.mine[c] = true;
+  }
+  return cells;
+}
 
 std::unique_ptr<WorkSource> MakeStaticSchedule(MissingTrials missing, int rank, int ranks,
                                                long long max_new_trials) {

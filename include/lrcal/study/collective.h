@@ -19,6 +19,8 @@ class Collective {
   virtual std::string Broadcast(const std::string& text) = 0;
   /// The sum over ranks of `value`, on every rank.
   virtual long long SumAll(long long value) = 0;
+  /// The `text` of the lowest rank whose text is not empty, on every rank ("" when all are).
+  virtual std::string FirstNonEmpty(const std::string& text) = 0;
   /// Point-to-point messages of one number (the dynamic work queue).
   virtual void Send(int to, int tag, long long value) = 0;
   /// A waiting message from any rank, if there is one (does not block).

@@ -68,8 +68,10 @@ struct RunOptions {
   /// Stop (as if interrupted) after this many new trials; 0 = no limit. For tests and for
   /// running a study in slices.
   long long max_new_trials = 0;
-  /// MPI only: rank 0 hands out chunks of missing trials on request, instead of dealing every
-  /// P-th trial to each rank. For sweeps whose cells differ a lot in cost. Same results.
+  /// MPI only: rank 0 hands out chunks of missing trials on request, instead of dealing blocks
+  /// of them to the ranks in turn (kStaticBlocksPerRank each; every rank then prepares only its
+  /// blocks' cells). For sweeps whose cells differ a lot in cost; every rank then prepares every
+  /// cell. Same results.
   bool dynamic_schedule = false;
   /// Called on the thread that called RunStudy about every 0.1 s while the trials run, and once
   /// when they end (rank 0 only). It must not throw; to stop the run it sets the run's
@@ -103,7 +105,9 @@ struct RunResult {
   double trial_seconds = 0;    ///< sum of the computed trials' own wall time
   double prepare_seconds = 0;  ///< wall time preparing the cells (pools, designs, covariance)
   /// Cells this process prepared: every cell in a new run, only those with trials of its share
-  /// still to compute (or no row in the store) on a resume, none on a rerun of a finished run.
+  /// still to compute (or no row in the store) on a resume, none on a rerun of a finished run;
+  /// an MPI rank under the static schedule, the cells of its blocks. (The manifest's session
+  /// counts every rank's.)
   int cells_prepared = 0;
   double run_seconds = 0;        ///< wall time from the first trial to the last record written
   double tables_seconds = 0;     ///< wall time aggregating and writing the tables (the caller's)

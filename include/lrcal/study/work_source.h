@@ -1,7 +1,10 @@
 // Where a run's workers get their trials: the missing (cell, trial) pairs of this process, in
 // canonical order. Two schedules (Dakota's split of one concern per class):
-//  - StaticSchedule: the missing trials are dealt to the ranks in turn (every P-th to rank r);
-//    no messages while trials run. The only schedule of a single process.
+//  - StaticSchedule: the missing trials are dealt to the ranks in blocks, in turn (about
+//    kStaticBlocksPerRank blocks each, spread over the study so that cheap and dear cells are
+//    shared); no messages while trials run. A rank's trials then fall in a fraction of the
+//    cells, and it prepares only those (CellsOfStaticSchedule). The only schedule of a single
+//    process.
 //  - DynamicSchedule (MPI): rank 0 hands out chunks of missing trials on request, for sweeps
 //    whose cells differ a lot in cost.
 // Claim() is called by worker threads; Pump() by the runner's main thread only (it alone talks
@@ -64,6 +67,19 @@ class WorkSource {
   /// Trials this process expects to run (for progress and the static-schedule check).
   virtual long long share() const = 0;
 };
+
+/// How many blocks of missing trials the static schedule deals to each rank: more balance the
+/// ranks' work better when cells differ in cost, fewer leave each rank fewer cells to prepare
+/// (about cells / P + this many).
+inline constexpr long long kStaticBlocksPerRank = 8;
+
+/// Which cells (one flag per cell) have trials the static schedule deals to `rank`, and to any
+/// rank, each rank stopping after max_new_trials (when positive) as its schedule does.
+struct StaticScheduleCells {
+  std::vector<bool> mine, anyone;
+};
+StaticScheduleCells CellsOfStaticSchedule(MissingTrials missing, std::size_t num_cells, int rank,
+                                          int ranks, long long max_new_trials);
 
 std::unique_ptr<WorkSource> MakeStaticSchedule(MissingTrials missing, int rank, int ranks,
                                                long long max_new_trials);
