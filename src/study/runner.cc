@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -318,7 +319,7 @@ class StudyRunner {
   // stop_when run (it decides in the loop, over every cell) or anything unusual (no manifest,
   // another study, a damaged store), whose checks under the lock then say what is wrong.
   // PrepareLateCells covers a store that changed between this reading and the lock.
-  std::vector<std::pair<int, CellPreparation>> CellsToPrepare() const {
+  std::vector<std::pair<int, CellPreparation>> CellsToPrepare() {
     const int num_cells = static_cast<int>(study_.cells.size());
     std::vector<std::pair<int, CellPreparation>> all;
     for (int i = 0; i < num_cells; ++i) all.emplace_back(i, CellPreparation::kFull);
@@ -347,25 +348,31 @@ class StudyRunner {
     }
   }
 
-  // An MPI job under the static schedule: the cells (in full) whose trials the schedule deals
-  // to this rank, given the recorded trials `done` (about 1/P of the cells), and on rank 0 also
-  // those no rank runs trials of whose row the main store (`rows`) lacks, so that every cell has
-  // its row after the merge, as in one process.
+  // An MPI job under the static schedule: the cells whose trials the schedule deals to this
+  // rank, given the recorded trials `done` (about 1/P of the cells), for their trials alone when
+  // the main store holds their row (`rows`); and on rank 0, in full, those no rank runs trials of
+  // whose row the main store lacks, so that every cell has its row after the merge, as in one
+  // process.
   std::vector<std::pair<int, CellPreparation>> RankCells(const DoneSet& done,
                                                          const std::set<std::string>& rows) const {
     const StaticScheduleCells cells = CellsOfStaticSchedule(
         MissingTrials(&done, study_.trials, options_.shard_index, options_.shard_count),
         study_.cells.size(), rank_, ranks_, options_.max_new_trials);
     std::vector<std::pair<int, CellPreparation>> which;
-    for (std::size_t c = 0; c < study_.cells.size(); ++c)
-      if (cells.mine[c] || (root() && !cells.anyone[c] && rows.count(study_.cells[c].id) == 0))
+    for (std::size_t c = 0; c < study_.cells.size(); ++c) {
+      const bool row = rows.count(study_.cells[c].id) > 0;
+      if (cells.mine[c])
+        which.emplace_back(static_cast<int>(c),
+                           row ? CellPreparation::kForTrials : CellPreparation::kFull);
+      else if (root() && !cells.anyone[c] && !row)
         which.emplace_back(static_cast<int>(c), CellPreparation::kFull);
+    }
     return which;
   }
 
   // RankCells as the run directory stands before the lock (every rank reads it; a new or
   // unusual directory counts as holding nothing). PrepareLateCells checks under the lock.
-  std::vector<std::pair<int, CellPreparation>> RankCellsBeforeLock() const {
+  std::vector<std::pair<int, CellPreparation>> RankCellsBeforeLock() {
     DoneSet done(study_.cells.size(), std::vector<bool>(static_cast<std::size_t>(study_.trials)));
     std::set<std::string> rows;
     try {
@@ -373,15 +380,16 @@ class StudyRunner {
         RunDirectory::CheckCompatible(dir_.ReadManifest(), study_.ToJson(), study_.path,
                                       options_.shard_index, options_.shard_count);
         done = dir_.ReadDone(study_);
-        if (root())
-          for (std::string& id : TrialStore(dir_.MainStorePath()).CellIds())
-            rows.insert(std::move(id));
+        for (std::string& id : TrialStore(dir_.MainStorePath()).CellIds())
+          rows.insert(std::move(id));
       }
     } catch (const std::exception&) {
       done.assign(study_.cells.size(), std::vector<bool>(static_cast<std::size_t>(study_.trials)));
       rows.clear();
     }
-    return RankCells(done, rows);
+    std::vector<std::pair<int, CellPreparation>> which = RankCells(done, rows);
+    rows_before_lock_ = std::move(rows);
+    return which;
   }
 
   // PrepareCells, every rank learning whether any failed: in an MPI job under the static schedule
@@ -413,19 +421,34 @@ class StudyRunner {
     throw std::runtime_error(first.substr(1));
   }
 
+  // PrepareLateCells of an MPI job under the static schedule: every rank, with the rows of what it
+  // prepares now in full.
+  void PrepareLateRankCells() {
+    std::vector<std::pair<int, CellPreparation>> late;
+    for (std::size_t c = 0; c < contexts_.size(); ++c) {
+      // Rank 0 alone sees the main store under the lock: a cell prepared for its trials alone
+      // whose row is gone is prepared again, in full, for its row.
+      const CellContext* context = contexts_[c].get();
+      if (root() && context && context->for_trials_only &&
+          main_rows_.count(study_.cells[c].id) == 0)
+        late.emplace_back(static_cast<int>(c), CellPreparation::kFull);
+    }
+    for (const auto& cell : RankCells(done_, root() ? main_rows_ : rows_before_lock_))
+      if (!contexts_[static_cast<std::size_t>(cell.first)]) late.push_back(cell);
+    std::sort(late.begin(), late.end());
+    PrepareCellsOnEveryRank(late, false);
+    for (const auto& [c, what] : late) {
+      const auto& context = contexts_[static_cast<std::size_t>(c)];
+      if (context && !context->for_trials_only) store_->PutCell(ToStoredCell(*context));
+    }
+  }
+
   // Insurance, under the lock: a cell that FindMissingTrials finds with trials to compute and
   // CellsToPrepare did not prepare, or whose row the main store lacks and that was not prepared
   // in full (the store changed in between), is prepared now (its row written), before any trial.
   void PrepareLateCells() {
-    if (RanksShareCells()) {  // every rank, with the rows of what it prepares now
-      std::vector<std::pair<int, CellPreparation>> late;
-      for (const auto& cell : RankCells(done_, main_rows_))
-        if (!contexts_[static_cast<std::size_t>(cell.first)]) late.push_back(cell);
-      PrepareCellsOnEveryRank(late, false);
-      for (const auto& [c, what] : late) {
-        const auto& context = contexts_[static_cast<std::size_t>(c)];
-        if (context) store_->PutCell(ToStoredCell(*context));
-      }
+    if (RanksShareCells()) {
+      PrepareLateRankCells();
       return;
     }
     std::set<std::string> stored;
@@ -520,36 +543,42 @@ class StudyRunner {
     result_.prepare_seconds += Seconds(before_writing ? start_ : start, Clock::now());
   }
 
+  // Rank 0: lock the directory, check and extend the manifest, log the session and write the
+  // rows of the cells prepared in full to the main store.
+  void StartSession() {
+    dir_.CreateAndLock();
+    Json manifest;
+    if (dir_.HasManifest()) {
+      manifest = dir_.ReadManifest();
+      RunDirectory::CheckCompatible(manifest, study_.ToJson(), study_.path, options_.shard_index,
+                                    options_.shard_count);
+    }
+    manifest_ = RunDirectory::StartSession(manifest, study_, options_.shard_index,
+                                           options_.shard_count, threads_, ranks_, &session_);
+    dir_.WriteManifest(manifest_);
+    dir_.AppendLog("session " + std::to_string(session_ + 1) + " started: study '" + study_.name +
+                   "', " + std::to_string(study_.cells.size()) + " cells x " +
+                   std::to_string(study_.trials) + " trials, " + std::to_string(threads_) +
+                   " threads" + (ranks_ > 1 ? ", " + std::to_string(ranks_) + " MPI ranks" : "") +
+                   (options_.shard_count > 1
+                        ? ", shard " + std::to_string(options_.shard_index + 1) + "/" +
+                              std::to_string(options_.shard_count)
+                        : ""));
+    TrialStore main_store(dir_.MainStorePath());
+    main_store.SetMeta("study", study_.ToJson().dump());
+    if (RanksShareCells())
+      for (std::string& id : main_store.CellIds()) main_rows_.insert(std::move(id));
+    for (const auto& context : contexts_)
+      if (context && !context->for_trials_only) main_store.PutCell(ToStoredCell(*context));
+  }
+
   // Rank 0 owns the directory: lock, manifest (and its refusals), main store. Every rank
   // learns whether that worked; then each opens its own store.
   void OpenRunDirectory() {
     std::string refusal;
     if (root()) {
       try {
-        dir_.CreateAndLock();
-        Json manifest;
-        if (dir_.HasManifest()) {
-          manifest = dir_.ReadManifest();
-          RunDirectory::CheckCompatible(manifest, study_.ToJson(), study_.path,
-                                        options_.shard_index, options_.shard_count);
-        }
-        manifest_ = RunDirectory::StartSession(manifest, study_, options_.shard_index,
-                                               options_.shard_count, threads_, ranks_, &session_);
-        dir_.WriteManifest(manifest_);
-        dir_.AppendLog(
-            "session " + std::to_string(session_ + 1) + " started: study '" + study_.name + "', " +
-            std::to_string(study_.cells.size()) + " cells x " + std::to_string(study_.trials) +
-            " trials, " + std::to_string(threads_) + " threads" +
-            (ranks_ > 1 ? ", " + std::to_string(ranks_) + " MPI ranks" : "") +
-            (options_.shard_count > 1 ? ", shard " + std::to_string(options_.shard_index + 1) +
-                                            "/" + std::to_string(options_.shard_count)
-                                      : ""));
-        TrialStore main_store(dir_.MainStorePath());
-        main_store.SetMeta("study", study_.ToJson().dump());
-        if (RanksShareCells())
-          for (std::string& id : main_store.CellIds()) main_rows_.insert(std::move(id));
-        for (const auto& context : contexts_)
-          if (context && !context->for_trials_only) main_store.PutCell(ToStoredCell(*context));
+        StartSession();
       } catch (const std::exception& e) {
         if (ranks_ == 1) throw;
         refusal = e.what();
@@ -562,7 +591,7 @@ class StudyRunner {
     store_ = std::make_unique<TrialStore>(store_path_);
     if (ranks_ > 1)
       for (const auto& context : contexts_)
-        if (context) store_->PutCell(ToStoredCell(*context));
+        if (context && !context->for_trials_only) store_->PutCell(ToStoredCell(*context));
     collective_->Barrier();  // every store exists with its tables
   }
 
@@ -874,6 +903,7 @@ class StudyRunner {
   std::string store_path_;
   std::unique_ptr<TrialStore> store_;
   std::set<std::string> main_rows_;  // rank 0, MPI static schedule: the main store's cell rows
+  std::set<std::string> rows_before_lock_;  // MPI static schedule: the same, before the lock
   DoneSet done_;
   std::map<std::string, int> cell_index_;  // cell id → index in study_.cells and contexts_
   std::unique_ptr<RemainingTimeEstimate> eta_;
