@@ -421,23 +421,26 @@ class StudyRunner {
     throw std::runtime_error(first.substr(1));
   }
 
-  // PrepareLateCells of an MPI job under the static schedule: every rank, with the rows of what it
-  // prepares now in full.
+  // PrepareLateCells of an MPI job under the static schedule: every rank prepares what RankCells
+  // gives under the lock and it lacks, and writes the rows of what it prepares in full. Rank 0
+  // alone sees the main store under the lock: a row that was there before the lock and is gone
+  // belongs to a cell the other ranks prepared for its trials alone, so rank 0 prepares it in
+  // full and writes the row.
   void PrepareLateRankCells() {
-    std::vector<std::pair<int, CellPreparation>> late;
-    for (std::size_t c = 0; c < contexts_.size(); ++c) {
-      // Rank 0 alone sees the main store under the lock: a cell prepared for its trials alone
-      // whose row is gone is prepared again, in full, for its row.
-      const CellContext* context = contexts_[c].get();
-      if (root() && context && context->for_trials_only &&
-          main_rows_.count(study_.cells[c].id) == 0)
-        late.emplace_back(static_cast<int>(c), CellPreparation::kFull);
-    }
-    for (const auto& cell : RankCells(done_, root() ? main_rows_ : rows_before_lock_))
-      if (!contexts_[static_cast<std::size_t>(cell.first)]) late.push_back(cell);
-    std::sort(late.begin(), late.end());
-    PrepareCellsOnEveryRank(late, false);
-    for (const auto& [c, what] : late) {
+    std::map<int, CellPreparation> late;
+    for (const auto& [c, what] : RankCells(done_, rows_before_lock_))
+      if (!contexts_[static_cast<std::size_t>(c)]) late[c] = what;
+    if (root())
+      for (std::size_t c = 0; c < contexts_.size(); ++c) {
+        const std::string& id = study_.cells[c].id;
+        const CellContext* context = contexts_[c].get();
+        const bool full = context && !context->for_trials_only;
+        if (!full && rows_before_lock_.count(id) > 0 && main_rows_.count(id) == 0)
+          late[static_cast<int>(c)] = CellPreparation::kFull;
+      }
+    const std::vector<std::pair<int, CellPreparation>> which(late.begin(), late.end());
+    PrepareCellsOnEveryRank(which, false);
+    for (const auto& [c, what] : which) {
       const auto& context = contexts_[static_cast<std::size_t>(c)];
       if (context && !context->for_trials_only) store_->PutCell(ToStoredCell(*context));
     }
