@@ -23,24 +23,11 @@ class MpiCollective : public Collective {
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   void Barrier() override { MPI_Barrier(MPI_COMM_WORLD); }
-  std::string Broadcast(const std::string& text) override {
-    long long length = static_cast<long long>(text.size());
-    MPI_Bcast(&length, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
-    std::vector<char> buffer(text.begin(), text.end());
-    buffer.resize(static_cast<std::size_t>(length));
-    if (length > 0) MPI_Bcast(buffer.data(), static_cast<int>(length), MPI_CHAR, 0, MPI_COMM_WORLD);
-    return std::string(buffer.begin(), buffer.end());
-  }
+  std::string Broadcast(const std::string& text) override { return BroadcastFrom(0, text); }
   std::string FirstNonEmpty(const std::string& text) override {
     int mine = text.empty() ? size_ : rank_, first = size_;
     MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    if (first == size_) return "";
-    long long length = static_cast<long long>(text.size());
-    MPI_Bcast(&length, 1, MPI_LONG_LONG, first, MPI_COMM_WORLD);
-    std::vector<char> buffer(text.begin(), text.end());
-    buffer.resize(static_cast<std::size_t>(length));
-    MPI_Bcast(buffer.data(), static_cast<int>(length), MPI_CHAR, first, MPI_COMM_WORLD);
-    return std::string(buffer.begin(), buffer.end());
+    return first == size_ ? "" : BroadcastFrom(first, text);
   }
   void Send(int to, int tag, long long value) override {
     MPI_Send(&value, 1, MPI_LONG_LONG, to, tag, MPI_COMM_WORLD);
@@ -68,6 +55,17 @@ class MpiCollective : public Collective {
   }
 
  private:
+  // `root`'s text on every rank: its length, then its bytes.
+  std::string BroadcastFrom(int root, const std::string& text) {
+    long long length = static_cast<long long>(text.size());
+    MPI_Bcast(&length, 1, MPI_LONG_LONG, root, MPI_COMM_WORLD);
+    std::vector<char> buffer(text.begin(), text.end());
+    buffer.resize(static_cast<std::size_t>(length));
+    if (length > 0)
+      MPI_Bcast(buffer.data(), static_cast<int>(length), MPI_CHAR, root, MPI_COMM_WORLD);
+    return std::string(buffer.begin(), buffer.end());
+  }
+
   int rank_ = 0, size_ = 1;
 };
 

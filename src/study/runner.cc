@@ -320,31 +320,41 @@ class StudyRunner {
   // another study, a damaged store), whose checks under the lock then say what is wrong.
   // PrepareLateCells covers a store that changed between this reading and the lock.
   std::vector<std::pair<int, CellPreparation>> CellsToPrepare() {
+    if (RanksShareCells()) return RankCellsBeforeLock();
     const int num_cells = static_cast<int>(study_.cells.size());
     std::vector<std::pair<int, CellPreparation>> all;
     for (int i = 0; i < num_cells; ++i) all.emplace_back(i, CellPreparation::kFull);
-    if (RanksShareCells()) return RankCellsBeforeLock();
+    DoneSet done;
+    std::set<std::string> stored;
     if (ranks_ > 1 || (study_.stop_when.enabled() && options_.shard_count == 1) ||
-        !dir_.HasManifest())
+        !ReadBeforeLock(&done, &stored))
       return all;
+    std::vector<std::pair<int, CellPreparation>> needed;
+    for (int i = 0; i < num_cells; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      if (stored.count(study_.cells[u].id) == 0)
+        needed.emplace_back(i, CellPreparation::kFull);
+      else if (MissingInShare(done[u]) > 0)
+        needed.emplace_back(i, CellPreparation::kForTrials);
+    }
+    return needed;
+  }
+
+  // The run directory as it stands before the lock: the trials recorded in any of its stores and
+  // the main store's cell rows. False, with nothing read, for a new directory or anything unusual
+  // (another study, a damaged store), whose checks under the lock then say what is wrong.
+  bool ReadBeforeLock(DoneSet* done, std::set<std::string>* rows) const {
+    if (!dir_.HasManifest()) return false;
     try {
-      const Json manifest = dir_.ReadManifest();
-      RunDirectory::CheckCompatible(manifest, study_.ToJson(), study_.path, options_.shard_index,
-                                    options_.shard_count);
-      const std::vector<std::string> ids = TrialStore(dir_.MainStorePath()).CellIds();
-      const std::set<std::string> stored(ids.begin(), ids.end());
-      const DoneSet done = dir_.ReadDone(study_);
-      std::vector<std::pair<int, CellPreparation>> needed;
-      for (int i = 0; i < num_cells; ++i) {
-        const auto u = static_cast<std::size_t>(i);
-        if (stored.count(study_.cells[u].id) == 0)
-          needed.emplace_back(i, CellPreparation::kFull);
-        else if (MissingInShare(done[u]) > 0)
-          needed.emplace_back(i, CellPreparation::kForTrials);
-      }
-      return needed;
+      RunDirectory::CheckCompatible(dir_.ReadManifest(), study_.ToJson(), study_.path,
+                                    options_.shard_index, options_.shard_count);
+      for (std::string& id : TrialStore(dir_.MainStorePath()).CellIds())
+        rows->insert(std::move(id));
+      *done = dir_.ReadDone(study_);
+      return true;
     } catch (const std::exception&) {
-      return all;
+      rows->clear();
+      return false;
     }
   }
 
@@ -373,20 +383,10 @@ class StudyRunner {
   // RankCells as the run directory stands before the lock (every rank reads it; a new or
   // unusual directory counts as holding nothing). PrepareLateCells checks under the lock.
   std::vector<std::pair<int, CellPreparation>> RankCellsBeforeLock() {
-    DoneSet done(study_.cells.size(), std::vector<bool>(static_cast<std::size_t>(study_.trials)));
+    DoneSet done;
     std::set<std::string> rows;
-    try {
-      if (dir_.HasManifest()) {
-        RunDirectory::CheckCompatible(dir_.ReadManifest(), study_.ToJson(), study_.path,
-                                      options_.shard_index, options_.shard_count);
-        done = dir_.ReadDone(study_);
-        for (std::string& id : TrialStore(dir_.MainStorePath()).CellIds())
-          rows.insert(std::move(id));
-      }
-    } catch (const std::exception&) {
+    if (!ReadBeforeLock(&done, &rows))
       done.assign(study_.cells.size(), std::vector<bool>(static_cast<std::size_t>(study_.trials)));
-      rows.clear();
-    }
     std::vector<std::pair<int, CellPreparation>> which = RankCells(done, rows);
     rows_before_lock_ = std::move(rows);
     return which;

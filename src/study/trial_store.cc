@@ -41,6 +41,15 @@ bool IsStorageFailure(int rc) {
   throw std::runtime_error(message);
 }
 
+// Runs `sql` once: SQLite's result code, and its message in `message` when it is not SQLITE_OK.
+int ExecOnce(sqlite3* db, const std::string& sql, std::string* message) {
+  char* err = nullptr;
+  const int rc = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &err);
+  if (rc != SQLITE_OK) *message = err ? err : "unknown error";
+  sqlite3_free(err);
+  return rc;
+}
+
 class Statement {
  public:
   Statement(sqlite3* db, const std::string& sql) : db_(db) {
@@ -197,11 +206,9 @@ void TrialStore::ExecWhileBusy(const std::string& sql) const {
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::milliseconds(kBusyTimeoutMs);
   for (;;) {
-    char* err = nullptr;
-    const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
+    std::string msg;
+    const int rc = ExecOnce(db_, sql, &msg);
     if (rc == SQLITE_OK) return;
-    std::string msg = err ? err : "unknown error";
-    sqlite3_free(err);
     const bool busy = (rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED;
     if (!busy || std::chrono::steady_clock::now() >= deadline)
       ThrowSqlite(rc, "sqlite (" + path_ + "): " + msg + " in: " + sql);
@@ -210,13 +217,9 @@ void TrialStore::ExecWhileBusy(const std::string& sql) const {
 }
 
 void TrialStore::Exec(const std::string& sql) const {
-  char* err = nullptr;
-  const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
-  if (rc != SQLITE_OK) {
-    std::string msg = err ? err : "unknown error";
-    sqlite3_free(err);
-    ThrowSqlite(rc, "sqlite (" + path_ + "): " + msg + " in: " + sql);
-  }
+  std::string msg;
+  const int rc = ExecOnce(db_, sql, &msg);
+  if (rc != SQLITE_OK) ThrowSqlite(rc, "sqlite (" + path_ + "): " + msg + " in: " + sql);
 }
 
 StoredCell ToStoredCell(const CellContext& c) {

@@ -67,16 +67,18 @@ class CountingWorkSource : public WorkSource {
 // The static schedule's dealing: the missing trials, in canonical order, in blocks of `block`,
 // the blocks to the ranks in turn.
 struct Dealing {
+  long long count;  // missing trials
   long long block;
   int ranks;
-  Dealing(long long count, int num_ranks)
-      : block(std::max<long long>(1, (count + kStaticBlocksPerRank * num_ranks - 1) /
+  Dealing(long long num_missing, int num_ranks)
+      : count(num_missing),
+        block(std::max<long long>(1, (count + kStaticBlocksPerRank * num_ranks - 1) /
                                          (kStaticBlocksPerRank * num_ranks))),
         ranks(num_ranks) {}
   // The rank of the s-th missing trial (from 0).
   int RankOf(long long s) const { return static_cast<int>((s / block) % ranks); }
-  // How many of `count` missing trials go to `rank`.
-  long long Share(long long count, int rank) const {
+  // How many of the missing trials go to `rank`.
+  long long Share(int rank) const {
     const long long cycle = block * ranks;
     const long long rest = count % cycle - rank * block;
     return count / cycle * block + std::clamp<long long>(rest, 0, block);
@@ -88,7 +90,7 @@ class StaticSchedule : public CountingWorkSource {
  public:
   StaticSchedule(MissingTrials missing, int rank, int ranks, long long max_new)
       : missing_(std::move(missing)), rank_(rank), dealing_(missing_.Count(), ranks) {
-    share_ = dealing_.Share(missing_.Count(), rank);
+    share_ = dealing_.Share(rank);
     if (max_new > 0) share_ = std::min(share_, max_new);
   }
   void Claim(int max, std::vector<TrialId>* out) override {
