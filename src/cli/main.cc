@@ -7,6 +7,7 @@
 
 #include "cli_common.h"
 #include "lrcal/build_info.h"
+#include "lrcal/core/dense_kernels.h"
 
 namespace lrcal::cli {
 
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
   }
   if (!std::strcmp(argv[1], "--version")) {
     std::cout << "lrcal " << LRCAL_VERSION << " (" << LRCAL_GIT_COMMIT << ", " << LRCAL_COMPILER
-              << ")\n";
+              << "; kernels: " << lrcal::KernelVariant() << ")\n";
     return 0;
   }
   const std::string name = argv[1];

@@ -1,5 +1,6 @@
 #include "core/cpu_dispatch.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 
@@ -13,6 +14,8 @@ const char* IsaName(Isa isa) {
       return "avx2";
     case Isa::kAvx512:
       return "avx512";
+    case Isa::kAvx512OnAvx2:
+      return "avx512-on-avx2";
   }
   return "?";
 }
@@ -21,7 +24,10 @@ std::vector<Isa> SupportedIsas() {
   std::vector<Isa> out = {Isa::kDefault};
 #if defined(__x86_64__)
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2")) out.push_back(Isa::kAvx2);
+  if (__builtin_cpu_supports("avx2")) {
+    out.push_back(Isa::kAvx2);
+    out.push_back(Isa::kAvx512OnAvx2);
+  }
   if (__builtin_cpu_supports("avx512f")) out.push_back(Isa::kAvx512);
 #endif
   return out;
@@ -30,12 +36,14 @@ std::vector<Isa> SupportedIsas() {
 Isa ActiveIsa() {
   static const Isa isa = [] {
     const std::vector<Isa> supported = SupportedIsas();
-    Isa best = supported.back();
     if (const char* forced = std::getenv("LRCAL_ISA")) {
       for (Isa i : supported)
         if (std::string(forced) == IsaName(i)) return i;
     }
-    return best;
+    const auto has = [&](Isa i) {
+      return std::find(supported.begin(), supported.end(), i) != supported.end();
+    };
+    return has(Isa::kAvx512) ? Isa::kAvx512 : has(Isa::kAvx2) ? Isa::kAvx2 : Isa::kDefault;
   }();
   return isa;
 }

@@ -293,6 +293,11 @@ __attribute__((target("avx512f"))) void NormalMatrixAvx512(const double* J, int 
                                                            double* A) {
   NormalMatrixBody<8>(J, m, n, A);
 }
+// The AVX-512 variant's code on an AVX2 machine (cpu_dispatch.h, Isa::kAvx512OnAvx2).
+__attribute__((target("avx2"))) void NormalMatrixAvx512OnAvx2(const double* J, int m, int n,
+                                                              double* A) {
+  NormalMatrixBody<8>(J, m, n, A);
+}
 #endif
 
 }  // namespace
@@ -305,6 +310,9 @@ void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa) {
     case Isa::kAvx512:
       NormalMatrixAvx512(J.data(), m, n, A->data());
       return;
+    case Isa::kAvx512OnAvx2:
+      NormalMatrixAvx512OnAvx2(J.data(), m, n, A->data());
+      return;
     case Isa::kAvx2:
       NormalMatrixAvx2(J.data(), m, n, A->data());
       return;
@@ -316,6 +324,8 @@ void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa) {
 }
 
 void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A) { NormalMatrix(J, A, ActiveIsa()); }
+
+const char* KernelVariant() { return IsaName(ActiveIsa()); }
 
 namespace {
 
@@ -371,6 +381,7 @@ void ScaleRows(const double* s, int m, int n, double* J, Isa isa) {
     case Isa::kAvx512:
       return ScaleRowsAvx512(s, m, n, J);
     case Isa::kAvx2:
+    case Isa::kAvx512OnAvx2:  // no lanes of its own: the AVX-512 variant is this loop
       return ScaleRowsAvx2(s, m, n, J);
 #endif
     default:
@@ -393,6 +404,7 @@ void ScaleSymmetric(const Eigen::VectorXd& s, const Eigen::MatrixXd& A, double l
     case Isa::kAvx512:
       return ScaleSymmetricAvx512(s.data(), A.data(), n, lambda, As->data());
     case Isa::kAvx2:
+    case Isa::kAvx512OnAvx2:  // no lanes of its own: the AVX-512 variant is this loop
       return ScaleSymmetricAvx2(s.data(), A.data(), n, lambda, As->data());
 #endif
     default:

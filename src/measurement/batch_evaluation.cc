@@ -355,6 +355,10 @@ __attribute__((target("avx2"))) bool KernelAvx2(const KernelArgs& a) { return Ke
 __attribute__((target("avx512f"))) bool KernelAvx512(const KernelArgs& a) {
   return KernelBody<8>(a);
 }
+// The AVX-512 variant's blocks of eight on an AVX2 machine (cpu_dispatch.h, Isa::kAvx512OnAvx2).
+__attribute__((target("avx2"))) bool KernelAvx512OnAvx2(const KernelArgs& a) {
+  return KernelBody<8>(a);
+}
 #endif
 
 }  // namespace
@@ -390,6 +394,9 @@ bool BatchEvaluator::Evaluate(const MeasurementModel& model, const ModelPoint& p
 #if defined(__x86_64__)
     case Isa::kAvx512:
       ok = KernelAvx512(args);
+      break;
+    case Isa::kAvx512OnAvx2:
+      ok = KernelAvx512OnAvx2(args);
       break;
     case Isa::kAvx2:
       ok = KernelAvx2(args);

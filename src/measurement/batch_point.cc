@@ -426,6 +426,7 @@ void BatchPointEvaluator::Evaluate(const PointMeasurement& kind,
       PointKernelAvx512(args);
       break;
     case Isa::kAvx2:
+    case Isa::kAvx512OnAvx2:  // no lanes of its own: the AVX-512 variant is this code
       PointKernelAvx2(args);
       break;
 #endif

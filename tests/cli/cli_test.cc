@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/cpu_dispatch.h"
 #include "lrcal/core/strings.h"
 #include "lrcal/identification/identifiability.h"
 #include "lrcal/identification/pose_accuracy.h"
@@ -41,6 +42,23 @@ class CliTest : public ::testing::Test {
   }
   std::string dir_;
 };
+
+TEST_F(CliTest, VersionNamesTheKernelsThatRunAndAForcedVariant) {
+  std::string out;
+  ASSERT_EQ(RunCommand("LRCAL_ISA= " + LrcalBinary() + " --version", &out), 0) << out;
+  EXPECT_THAT(out, ::testing::MatchesRegex("lrcal [0-9.]+ \\(.*; kernels: "
+                                           "(default|avx2|avx512)\\)\n"));
+  // A forced variant the CPU has is the one named; one it lacks (or a misspelt one) is not.
+  for (Isa isa : SupportedIsas()) {
+    ASSERT_EQ(
+        RunCommand(std::string("LRCAL_ISA=") + IsaName(isa) + " " + LrcalBinary() + " --version",
+                   &out),
+        0);
+    EXPECT_THAT(out, ::testing::HasSubstr(std::string("kernels: ") + IsaName(isa) + ")"));
+  }
+  ASSERT_EQ(RunCommand("LRCAL_ISA=avx1024 " + LrcalBinary() + " --version", &out), 0);
+  EXPECT_THAT(out, ::testing::Not(::testing::HasSubstr("avx1024")));
+}
 
 TEST_F(CliTest, KinematicsJsonHasThePoseBeamAndDistance) {
   // q = 0: tool at (0, 2.2, 0.62), beam +y0: the paper's plane is behind (h < 0 → no reading).

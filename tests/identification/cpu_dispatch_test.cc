@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <utility>
@@ -31,6 +33,23 @@ TEST(CpuDispatch, ListsTheDefaultVariantAndUsesASupportedOne) {
   std::cout << "supported:";
   for (Isa i : isas) std::cout << " " << IsaName(i);
   std::cout << "; active: " << IsaName(ActiveIsa()) << "\n";
+}
+
+TEST(CpuDispatch, TheAvx512VariantsLanesRunWhereverAvx2DoesButOnlyWhenForced) {
+  const auto isas = SupportedIsas();
+  const auto has = [&](Isa i) { return std::find(isas.begin(), isas.end(), i) != isas.end(); };
+  // The eight-lane code compiled for AVX2 is what lets an AVX2-only machine (CI's) test the
+  // AVX-512 variant's code: every test that loops over SupportedIsas() runs it.
+  EXPECT_EQ(has(Isa::kAvx512OnAvx2), has(Isa::kAvx2));
+  EXPECT_STREQ(IsaName(Isa::kAvx512OnAvx2), "avx512-on-avx2");
+  if (std::getenv("LRCAL_ISA") == nullptr) {
+    // Unforced, the best real variant runs, never the test variant.
+    const Isa best = has(Isa::kAvx512) ? Isa::kAvx512
+                     : has(Isa::kAvx2) ? Isa::kAvx2
+                                       : Isa::kDefault;
+    EXPECT_EQ(ActiveIsa(), best);
+    EXPECT_STREQ(KernelVariant(), IsaName(best));
+  }
 }
 
 TEST(CpuDispatch, NormalMatrixHasTheSameBitsInEveryVariant) {
