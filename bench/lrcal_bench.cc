@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "lrcal/core/machine.h"
 #include "lrcal/design/configuration_sampling.h"
 #include "lrcal/design/experiment_design.h"
 #include "lrcal/identification/identifiability.h"
@@ -425,4 +426,14 @@ BENCHMARK(BM_Aggregate1e5)->Unit(benchmark::kMillisecond)->Iterations(3);
 }  // namespace
 }  // namespace lrcal
 
-BENCHMARK_MAIN();
+// Google Benchmark's main, with the CPU's model and the kernels' variant in the context it prints
+// first: a figure is quoted with the CPU it came from (docs/PERFORMANCE.md).
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::AddCustomContext("cpu_model", lrcal::CpuModelName());
+  benchmark::AddCustomContext("lrcal_kernels", lrcal::KernelVariant());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

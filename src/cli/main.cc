@@ -7,7 +7,7 @@
 
 #include "cli_common.h"
 #include "lrcal/build_info.h"
-#include "lrcal/core/dense_kernels.h"
+#include "lrcal/core/machine.h"
 
 namespace lrcal::cli {
 

@@ -325,8 +325,6 @@ void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A, Isa isa) {
 
 void NormalMatrix(const Eigen::MatrixXd& J, Eigen::MatrixXd* A) { NormalMatrix(J, A, ActiveIsa()); }
 
-const char* KernelVariant() { return IsaName(ActiveIsa()); }
-
 namespace {
 
 // J(i, k) *= s[i] for a column-major m×n J: one multiplication per entry, any width.

@@ -14,14 +14,13 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
 
 #include "lrcal/build_info.h"
-#include "lrcal/core/dense_kernels.h"
 #include "lrcal/core/error.h"
+#include "lrcal/core/machine.h"
 #include "lrcal/core/text_table.h"
 #include "lrcal/study/runner.h"
 #include "lrcal/study/stopping.h"
@@ -40,21 +39,6 @@ Json Dependencies() {
       {"ceres", CERES_VERSION_STRING},
       {"sqlite", sqlite3_libversion()},
       {"random123", "Philox4x64-10, Random123 boxmuller"}};
-}
-
-// The CPU's model name as Linux reports it (/proc/cpuinfo), "unknown" elsewhere: a session's
-// timings mean little without it.
-std::string CpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) != 0) continue;
-    const auto colon = line.find(':');
-    if (colon == std::string::npos) break;
-    const auto first = line.find_first_not_of(" \t", colon + 1);
-    return first == std::string::npos ? "unknown" : line.substr(first);
-  }
-  return "unknown";
 }
 
 constexpr const char* kRandomNumbers =
@@ -259,7 +243,7 @@ Json RunDirectory::StartSession(Json manifest, const Study& study, int shard_ind
   manifest["sessions"].push_back({{"start", UtcNow()},
                                   {"threads", threads},
                                   {"ranks", ranks},
-                                  {"cpu", CpuModel()},
+                                  {"cpu", CpuModelName()},
                                   {"kernels", KernelVariant()},
                                   {"ended", "running"}});
   *session = manifest["sessions"].size() - 1;

@@ -14,6 +14,7 @@
 
 #include "core/dense_kernel_variants.h"
 #include "lrcal/core/dense_kernels.h"
+#include "lrcal/core/machine.h"
 #include "lrcal/identification/identification.h"
 #include "measurement/batch_evaluation.h"
 #include "test_util.h"

@@ -8,13 +8,6 @@
 
 namespace lrcal {
 
-/// The instruction-set variant these kernels and the batch evaluators run in this process:
-/// "default" (baseline x86-64), "avx2" or "avx512", the best the CPU has, unless LRCAL_ISA in the
-/// environment forced another it has (also "avx512-on-avx2", the AVX-512 code compiled for AVX2,
-/// for tests). Every variant gives the same bits; the name is provenance (`lrcal --version`, the
-/// run manifest's sessions).
-const char* KernelVariant();
-
 /// A Cholesky factor stored row-major, so that the factorisation's inner products run over
 /// contiguous memory.
 using RowMajorMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
